@@ -1,0 +1,16 @@
+/* A tracked allocator: the model owns all its memory and counts it, so it
+ * can report its bytes per ball and per contact. Callers pass the sizes
+ * they know (array capacities), so no header is hidden in each block. */
+#pragma once
+
+#include <stddef.h>
+
+typedef struct sx_alloc {
+    size_t bytes;  /* currently allocated */
+    size_t peak;   /* high-water mark */
+} sx_alloc;
+
+/* Resizes p from old_n to new_n elements of `size` bytes; new elements are
+ * zeroed. Returns NULL (p untouched) on failure or overflow. */
+void *sx_alloc_resize(sx_alloc *a, void *p, size_t old_n, size_t new_n, size_t size);
+void sx_alloc_free(sx_alloc *a, void *p, size_t n, size_t size);

@@ -1,0 +1,498 @@
+/* Ball store: a structure of arrays indexed densely, with stable ids mapped
+ * to dense indices. Removal swaps the last ball into the hole and patches
+ * the candidate pairs that referred to either index, so contact history
+ * survives deletions. */
+#include "model_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Grows s->field from s->cap to cap elements of `per` components. */
+#define RESIZE(s, field, per)                                                              \
+    do {                                                                                   \
+        void *q = sx_alloc_resize(&m->alloc, (s)->field, (size_t)((s)->cap * (per)),       \
+                                  (size_t)(cap * (per)), sizeof *(s)->field);              \
+        if (!q) return SX_ENOMEM;                                                          \
+        (s)->field = q;                                                                    \
+    } while (0)
+
+sx_status sx__balls_reserve(sx_model *m, int64_t cap)
+{
+    sx_balls *b = &m->balls;
+    if (cap <= b->cap) return SX_OK;
+    if (cap < 2 * b->cap) cap = 2 * b->cap;
+    if (cap < 64) cap = 64;
+    if (cap > INT32_MAX / 4) return SX_ENOMEM;
+    const int d = m->dim, r = m->rdim;
+    RESIZE(b, x, d);
+    RESIZE(b, v, d);
+    RESIZE(b, w, r);
+    RESIZE(b, f, d);
+    RESIZE(b, t, r);
+    RESIZE(b, x_build, d);
+    RESIZE(b, rad, 1);
+    RESIZE(b, inv_mass, 1);
+    RESIZE(b, inv_inertia, 1);
+    RESIZE(b, alpha, 1);
+    RESIZE(b, id, 1);
+    RESIZE(b, mat, 1);
+    RESIZE(b, fix, 1);
+    if (b->fapp) {
+        RESIZE(b, fapp, d);
+        RESIZE(b, tapp, r);
+    }
+    b->cap = cap;
+    return SX_OK;
+}
+
+static void free_field(sx_model *m, void *p, int64_t n, size_t size)
+{
+    sx_alloc_free(&m->alloc, p, (size_t)n, size);
+}
+
+void sx__balls_free(sx_model *m)
+{
+    sx_balls *b = &m->balls;
+    const int64_t c = b->cap, d = m->dim, r = m->rdim;
+    free_field(m, b->x, c * d, sizeof(double));
+    free_field(m, b->v, c * d, sizeof(double));
+    free_field(m, b->w, c * r, sizeof(double));
+    free_field(m, b->f, c * d, sizeof(double));
+    free_field(m, b->t, c * r, sizeof(double));
+    free_field(m, b->x_build, c * d, sizeof(double));
+    free_field(m, b->rad, c, sizeof(double));
+    free_field(m, b->inv_mass, c, sizeof(double));
+    free_field(m, b->inv_inertia, c, sizeof(double));
+    free_field(m, b->alpha, c, sizeof(double));
+    free_field(m, b->id, c, sizeof(int32_t));
+    free_field(m, b->mat, c, sizeof(uint16_t));
+    free_field(m, b->fix, c, sizeof(uint8_t));
+    free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
+    free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
+    free_field(m, b->index_of, b->index_cap, sizeof(int32_t));
+    memset(b, 0, sizeof *b);
+}
+
+/* 4-43 and its 2D analogue: sphere I = 2/5 m R^2, disk of unit thickness I = 1/2 m R^2. */
+void sx__ball_update_mass(sx_model *m, int64_t i)
+{
+    sx_balls *b = &m->balls;
+    const double r = b->rad[i], rho = m->mats[b->mat[i]].def.density;
+    double mass, inertia;
+    if (m->dim == 3) {
+        mass = 4.0 / 3.0 * SX_PI * r * r * r * rho;
+        inertia = 0.4 * mass * r * r;
+    } else {
+        mass = SX_PI * r * r * rho;
+        inertia = 0.5 * mass * r * r;
+    }
+    b->inv_mass[i] = 1.0 / mass;
+    b->inv_inertia[i] = 1.0 / inertia;
+}
+
+int64_t sx__ball_index(const sx_model *m, int64_t id)
+{
+    const sx_balls *b = &m->balls;
+    if (id < 1 || id >= b->next_id) return -1;
+    return b->index_of[id];
+}
+
+static sx_status grow_index(sx_model *m, int64_t need)
+{
+    sx_balls *b = &m->balls;
+    if (need <= b->index_cap) return SX_OK;
+    int64_t cap = b->index_cap * 2 > need ? b->index_cap * 2 : need + 64;
+    if (cap > INT32_MAX) return SX_ENOMEM;
+    int32_t *q = sx_alloc_resize(&m->alloc, b->index_of, (size_t)b->index_cap, (size_t)cap, sizeof *q);
+    if (!q) return SX_ENOMEM;
+    b->index_of = q;
+    b->index_cap = cap;
+    return SX_OK;
+}
+
+static bool finite_vec(const double *v, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!isfinite(v[k])) return false;
+    return true;
+}
+
+sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_add: the model is stepping; add balls between cycles");
+    if (!(def->radius > 0) || !isfinite(def->radius))
+        return sx__fail(m, SX_EINVAL, "ball_add: radius must be a positive finite number (got %g)", def->radius);
+    if (def->material < 0 || def->material >= m->nmat)
+        return sx__fail(m, SX_ENOTFOUND, "ball_add: no material with index %d (define one with material first)",
+                        def->material);
+    const int d = m->dim, r = m->rdim;
+    if (!finite_vec(def->pos, d) || !finite_vec(def->vel, d) || !finite_vec(def->spin, r))
+        return sx__fail(m, SX_EINVAL, "ball_add: position, velocity and spin must be finite");
+    sx_balls *b = &m->balls;
+    if (b->next_id < 1) b->next_id = 1;
+    if (b->next_id >= INT32_MAX) return sx__fail(m, SX_ENOMEM, "ball_add: ball ids exhausted");
+    if (sx__balls_reserve(m, b->n + 1) || grow_index(m, b->next_id + 1))
+        return sx__fail(m, SX_ENOMEM, "ball_add: out of memory at %lld balls", (long long)b->n);
+    const int64_t i = b->n++;
+    const int64_t id = b->next_id++;
+    for (int k = 0; k < d; k++) {
+        b->x[i * d + k] = def->pos[k];
+        b->v[i * d + k] = def->vel[k];
+        b->f[i * d + k] = 0;
+        b->x_build[i * d + k] = def->pos[k];
+    }
+    /* 2D: the scalar spin is about z; accept it in spin[0] (documented) */
+    for (int k = 0; k < r; k++) {
+        b->w[i * r + k] = def->spin[k];
+        b->t[i * r + k] = 0;
+    }
+    if (b->fapp) {
+        for (int k = 0; k < d; k++) b->fapp[i * d + k] = 0;
+        for (int k = 0; k < r; k++) b->tapp[i * r + k] = 0;
+    }
+    b->rad[i] = def->radius;
+    b->mat[i] = (uint16_t)def->material;
+    b->alpha[i] = m->mats[def->material].def.damping;
+    b->fix[i] = 0;
+    b->id[i] = (int32_t)id;
+    b->index_of[id] = (int32_t)i;
+    sx__ball_update_mass(m, i);
+    m->build_needed = true;
+    m->dt_stale = true;
+    if (out_id) *out_id = id;
+    return SX_OK;
+}
+
+/* Moves ball `from` into slot `to` (all per-ball fields). */
+static void move_ball(sx_model *m, int64_t to, int64_t from)
+{
+    sx_balls *b = &m->balls;
+    const int d = m->dim, r = m->rdim;
+    memcpy(b->x + to * d, b->x + from * d, d * sizeof(double));
+    memcpy(b->v + to * d, b->v + from * d, d * sizeof(double));
+    memcpy(b->f + to * d, b->f + from * d, d * sizeof(double));
+    memcpy(b->x_build + to * d, b->x_build + from * d, d * sizeof(double));
+    memcpy(b->w + to * r, b->w + from * r, r * sizeof(double));
+    memcpy(b->t + to * r, b->t + from * r, r * sizeof(double));
+    if (b->fapp) {
+        memcpy(b->fapp + to * d, b->fapp + from * d, d * sizeof(double));
+        memcpy(b->tapp + to * r, b->tapp + from * r, r * sizeof(double));
+    }
+    b->rad[to] = b->rad[from];
+    b->inv_mass[to] = b->inv_mass[from];
+    b->inv_inertia[to] = b->inv_inertia[from];
+    b->alpha[to] = b->alpha[from];
+    b->id[to] = b->id[from];
+    b->mat[to] = b->mat[from];
+    b->fix[to] = b->fix[from];
+    b->index_of[b->id[to]] = (int32_t)to;
+}
+
+/* Drops the pairs of ball `gone` and renames `last` to `gone` in the rest.
+ * Ball-ball pairs keep a < b by swapping the ends (and flipping the
+ * history's sign, which is expressed relative to a -> b). */
+static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
+{
+    const int d = m->dim;
+    sx_pairs *p = &m->bb;
+    int64_t k = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        int32_t a = p->a[c], bb = p->b[c];
+        if (a == gone || bb == gone) continue;
+        if (a == last) a = gone;
+        if (bb == last) bb = gone;
+        p->a[k] = a;
+        p->b[k] = bb;
+        for (int j = 0; j < d; j++) {
+            p->fs[k * d + j] = p->fs[c * d + j];
+            p->nold[k * d + j] = p->nold[c * d + j];
+        }
+        p->touching[k] = p->touching[c];
+        if (a > bb) {
+            p->a[k] = bb;
+            p->b[k] = a;
+            for (int j = 0; j < d; j++) {
+                p->fs[k * d + j] = -p->fs[k * d + j];
+                p->nold[k * d + j] = -p->nold[k * d + j];
+            }
+        }
+        k++;
+    }
+    p->n = k;
+    p = &m->bw;
+    k = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        if (p->a[c] == gone) continue;
+        p->a[k] = p->a[c] == last ? gone : p->a[c];
+        p->b[k] = p->b[c];
+        for (int j = 0; j < d; j++) {
+            p->fs[k * d + j] = p->fs[c * d + j];
+            p->nold[k * d + j] = p->nold[c * d + j];
+        }
+        p->touching[k] = p->touching[c];
+        k++;
+    }
+    p->n = k;
+}
+
+sx_status sx_ball_remove(sx_model *m, int64_t id)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_remove: the model is stepping");
+    const int64_t i = sx__ball_index(m, id);
+    if (i < 0) return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)id);
+    sx_balls *b = &m->balls;
+    const int64_t last = b->n - 1;
+    patch_pairs_after_remove(m, (int32_t)i, (int32_t)last);
+    if (i != last) move_ball(m, i, last);
+    b->index_of[id] = -1;
+    b->n--;
+    m->build_needed = true;
+    m->dt_stale = true;
+    return SX_OK;
+}
+
+void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
+{
+    sx_balls *b = &m->balls;
+    const int64_t n = b->n;
+    const int d = m->dim, r = m->rdim;
+#define GATHER(field, per, type)                                                   \
+    do {                                                                           \
+        type *tmp = (type *)scratch;                                               \
+        for (int64_t i = 0; i < n; i++)                                            \
+            for (int k = 0; k < (per); k++) tmp[i * (per) + k] = b->field[(int64_t)order[i] * (per) + k]; \
+        memcpy(b->field, tmp, (size_t)(n * (per)) * sizeof(type));                 \
+    } while (0)
+    GATHER(x, d, double);
+    GATHER(v, d, double);
+    GATHER(f, d, double);
+    GATHER(x_build, d, double);
+    GATHER(w, r, double);
+    GATHER(t, r, double);
+    if (b->fapp) {
+        GATHER(fapp, d, double);
+        GATHER(tapp, r, double);
+    }
+    GATHER(rad, 1, double);
+    GATHER(inv_mass, 1, double);
+    GATHER(inv_inertia, 1, double);
+    GATHER(alpha, 1, double);
+    GATHER(id, 1, int32_t);
+    GATHER(mat, 1, uint16_t);
+    GATHER(fix, 1, uint8_t);
+#undef GATHER
+    for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
+}
+
+sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
+{
+    if (cap <= p->cap) return SX_OK;
+    if (cap < p->cap + p->cap / 2) cap = p->cap + p->cap / 2;
+    if (cap < 256) cap = 256;
+    if (cap > INT32_MAX) return SX_ENOMEM;
+    const int d = m->dim;
+    RESIZE(p, a, 1);
+    RESIZE(p, b, 1);
+    RESIZE(p, fs, d);
+    RESIZE(p, nold, d);
+    RESIZE(p, touching, 1);
+    p->cap = cap;
+    return SX_OK;
+}
+
+void sx__pairs_free(sx_model *m, sx_pairs *p)
+{
+    const int64_t c = p->cap, d = m->dim;
+    free_field(m, p->a, c, sizeof(int32_t));
+    free_field(m, p->b, c, sizeof(int32_t));
+    free_field(m, p->fs, c * d, sizeof(double));
+    free_field(m, p->nold, c * d, sizeof(double));
+    free_field(m, p->touching, c, sizeof(uint8_t));
+    memset(p, 0, sizeof *p);
+}
+
+/* ------------------------------------------------------------ accessors */
+
+int64_t sx_ball_count(const sx_model *m) { return m->balls.n; }
+
+int64_t sx_ball_id_at(const sx_model *m, int64_t i)
+{
+    return i >= 0 && i < m->balls.n ? m->balls.id[i] : -1;
+}
+
+bool sx_ball_exists(const sx_model *m, int64_t id) { return sx__ball_index(m, id) >= 0; }
+
+/* Resolves an id or fails with a message naming the caller. */
+static int64_t lookup(const sx_model *m, int64_t id, const char *fn)
+{
+    const int64_t i = sx__ball_index(m, id);
+    if (i < 0) sx__fail((sx_model *)m, SX_ENOTFOUND, "%s: no ball with id %lld", fn, (long long)id);
+    return i;
+}
+
+static sx_status ensure_applied(sx_model *m)
+{
+    sx_balls *b = &m->balls;
+    if (b->fapp) return SX_OK;
+    const int64_t c = b->cap;
+    b->fapp = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(c * m->dim), sizeof(double));
+    b->tapp = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(c * m->rdim), sizeof(double));
+    if (!b->fapp || !b->tapp) return SX_ENOMEM;
+    return SX_OK;
+}
+
+/* Where a vector field lives and how many components it has. */
+static double *vec_field(const sx_model *m, sx_ball_vec which, int *n)
+{
+    const sx_balls *b = &m->balls;
+    *n = m->dim;
+    switch (which) {
+    case SX_BALL_POS: return b->x;
+    case SX_BALL_VEL: return b->v;
+    case SX_BALL_FORCE: return b->f;
+    case SX_BALL_APPLIED_FORCE: return b->fapp;
+    default: break;
+    }
+    *n = m->rdim;
+    switch (which) {
+    case SX_BALL_SPIN: return b->w;
+    case SX_BALL_MOMENT: return b->t;
+    case SX_BALL_APPLIED_MOMENT: return b->tapp;
+    default: return NULL;
+    }
+}
+
+sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec which, double out[3])
+{
+    const int64_t i = lookup(m, id, "ball_get_vec");
+    if (i < 0) return SX_ENOTFOUND;
+    if (which < SX_BALL_POS || which > SX_BALL_APPLIED_MOMENT)
+        return sx__fail((sx_model *)m, SX_EINVAL, "ball_get_vec: unknown field %d", (int)which);
+    int n;
+    const double *src = vec_field(m, which, &n);
+    out[0] = out[1] = out[2] = 0;
+    if (src)
+        for (int k = 0; k < n; k++) out[k] = src[i * n + k];
+    return SX_OK;
+}
+
+sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double val[3])
+{
+    const int64_t i = lookup(m, id, "ball_set_vec");
+    if (i < 0) return SX_ENOTFOUND;
+    if (which == SX_BALL_FORCE || which == SX_BALL_MOMENT)
+        return sx__fail(m, SX_EINVAL, "ball_set_vec: force and moment are results of the step; set the applied force instead");
+    if (which < SX_BALL_POS || which > SX_BALL_APPLIED_MOMENT)
+        return sx__fail(m, SX_EINVAL, "ball_set_vec: unknown field %d", (int)which);
+    if ((which == SX_BALL_APPLIED_FORCE || which == SX_BALL_APPLIED_MOMENT) && ensure_applied(m))
+        return sx__fail(m, SX_ENOMEM, "ball_set_vec: out of memory");
+    int n;
+    double *dst = vec_field(m, which, &n);
+    for (int k = 0; k < n; k++)
+        if (!isfinite(val[k])) return sx__fail(m, SX_EINVAL, "ball_set_vec: components must be finite");
+    for (int k = 0; k < n; k++) dst[i * n + k] = val[k];
+    if (which == SX_BALL_POS) m->build_needed = true; /* a jump may skip the skin test */
+    return SX_OK;
+}
+
+sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which, double *out)
+{
+    const int64_t i = lookup(m, id, "ball_get");
+    if (i < 0) return SX_ENOTFOUND;
+    const sx_balls *b = &m->balls;
+    switch (which) {
+    case SX_BALL_RADIUS: *out = b->rad[i]; return SX_OK;
+    case SX_BALL_MASS: *out = 1.0 / b->inv_mass[i]; return SX_OK;
+    case SX_BALL_INERTIA: *out = 1.0 / b->inv_inertia[i]; return SX_OK;
+    case SX_BALL_DAMPING: *out = b->alpha[i]; return SX_OK;
+    }
+    return sx__fail((sx_model *)m, SX_EINVAL, "ball_get: unknown field %d", (int)which);
+}
+
+sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double value)
+{
+    const int64_t i = lookup(m, id, "ball_set");
+    if (i < 0) return SX_ENOTFOUND;
+    sx_balls *b = &m->balls;
+    switch (which) {
+    case SX_BALL_RADIUS:
+        if (!(value > 0) || !isfinite(value))
+            return sx__fail(m, SX_EINVAL, "ball_set: radius must be a positive finite number (got %g)", value);
+        b->rad[i] = value;
+        sx__ball_update_mass(m, i);
+        m->build_needed = true;
+        m->dt_stale = true;
+        return SX_OK;
+    case SX_BALL_DAMPING:
+        if (!(value >= 0 && value < 1))
+            return sx__fail(m, SX_EINVAL, "ball_set: local damping must be in [0, 1) (got %g)", value);
+        b->alpha[i] = value;
+        return SX_OK;
+    case SX_BALL_MASS:
+    case SX_BALL_INERTIA:
+        return sx__fail(m, SX_EINVAL, "ball_set: mass and inertia follow from radius and density");
+    }
+    return sx__fail(m, SX_EINVAL, "ball_set: unknown field %d", (int)which);
+}
+
+sx_status sx_ball_material(const sx_model *m, int64_t id, int *material)
+{
+    const int64_t i = lookup(m, id, "ball_material");
+    if (i < 0) return SX_ENOTFOUND;
+    *material = m->balls.mat[i];
+    return SX_OK;
+}
+
+sx_status sx_ball_set_material(sx_model *m, int64_t id, int material)
+{
+    const int64_t i = lookup(m, id, "ball_set_material");
+    if (i < 0) return SX_ENOTFOUND;
+    if (material < 0 || material >= m->nmat)
+        return sx__fail(m, SX_ENOTFOUND, "ball_set_material: no material with index %d", material);
+    m->balls.mat[i] = (uint16_t)material;
+    m->balls.alpha[i] = m->mats[material].def.damping;
+    sx__ball_update_mass(m, i);
+    m->dt_stale = true;
+    return SX_OK;
+}
+
+/* The store keeps the 2D scalar spin's fixity in the first rotational bit. */
+static unsigned to_store_mask(const sx_model *m, unsigned mask)
+{
+    if (m->dim == 3) return mask & (SX_FIX_VEL | SX_FIX_SPIN);
+    return (mask & (SX_FIX_VX | SX_FIX_VY)) | ((mask & SX_FIX_WZ) ? SX_FIX_WX : 0);
+}
+
+static unsigned from_store_mask(const sx_model *m, unsigned mask)
+{
+    if (m->dim == 3) return mask;
+    return (mask & (SX_FIX_VX | SX_FIX_VY)) | ((mask & SX_FIX_WX) ? SX_FIX_WZ : 0);
+}
+
+sx_status sx_ball_fixity(const sx_model *m, int64_t id, unsigned *mask)
+{
+    const int64_t i = lookup(m, id, "ball_fixity");
+    if (i < 0) return SX_ENOTFOUND;
+    *mask = from_store_mask(m, m->balls.fix[i]);
+    return SX_OK;
+}
+
+sx_status sx_ball_set_fixity(sx_model *m, int64_t id, unsigned mask)
+{
+    const int64_t i = lookup(m, id, "ball_set_fixity");
+    if (i < 0) return SX_ENOTFOUND;
+    const unsigned valid = m->dim == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ);
+    if (mask & ~valid)
+        return sx__fail(m, SX_EINVAL, "ball_set_fixity: mask 0x%x has components a %dD ball does not have", mask,
+                        m->dim);
+    m->balls.fix[i] = (uint8_t)to_store_mask(m, mask);
+    return SX_OK;
+}
+
+sx_ball_def sx_ball_default_def(void)
+{
+    sx_ball_def d;
+    memset(&d, 0, sizeof d);
+    d.radius = 1.0;
+    return d;
+}

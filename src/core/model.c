@@ -1,0 +1,450 @@
+/* The model: owner of all storage, the material table and the step
+ * pipeline. The pipeline is
+ *     broad phase (when needed) -> timestep (auto) -> contact forces
+ *     -> law of motion -> walls -> time, guard
+ * with the dimension-specific stages in kernels.c. */
+#include "model_internal.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* How often the automatic timestep is re-estimated between builds, and how
+ * often the energy guard looks at an unforced system. */
+enum { DT_REFRESH_STEPS = 32, GUARD_STEPS = 64 };
+/* An unforced system whose mechanical energy grows past this many times its
+ * initial scale is numerically unstable. */
+#define GUARD_ENERGY_FACTOR 100.0
+
+sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(m->err, sizeof m->err, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
+static const sx_kernels *kernels(const sx_model *m) { return m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d; }
+
+sx_model_def sx_model_default_def(void)
+{
+    sx_model_def d;
+    memset(&d, 0, sizeof d);
+    d.dim = 3;
+    d.timestep_safety = 0.8;
+    return d;
+}
+
+sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
+{
+    const char *why = NULL;
+    if (def->dim != 2 && def->dim != 3) why = "dim must be 2 or 3";
+    else if (!(def->timestep >= 0) || !isfinite(def->timestep)) why = "timestep must be >= 0 (0 = automatic)";
+    else if (!(def->timestep_safety > 0 && def->timestep_safety <= 1)) why = "timestep_safety must be in (0, 1]";
+    else if (!(def->skin >= 0) || !isfinite(def->skin)) why = "skin must be >= 0 (0 = automatic)";
+    for (int k = 0; k < 3 && !why; k++)
+        if (!isfinite(def->gravity[k])) why = "gravity must be finite";
+    if (!why && def->dim == 2 && def->gravity[2] != 0) why = "a 2D model has no z gravity component";
+    if (why) {
+        if (err) snprintf(err, errlen, "model_create: %s", why);
+        return NULL;
+    }
+    sx_model *m = calloc(1, sizeof *m);
+    if (!m) {
+        if (err) snprintf(err, errlen, "model_create: out of memory");
+        return NULL;
+    }
+    m->dim = def->dim;
+    m->rdim = def->dim == 3 ? 3 : 1;
+    memcpy(m->gravity, def->gravity, sizeof m->gravity);
+    m->dt_user = def->timestep;
+    m->dt_safety = def->timestep_safety;
+    m->skin_user = def->skin;
+    m->dt_stale = true;
+    m->build_needed = true;
+    return m;
+}
+
+void sx_model_destroy(sx_model *m)
+{
+    if (!m) return;
+    sx__balls_free(m);
+    sx__pairs_free(m, &m->bb);
+    sx__pairs_free(m, &m->bw);
+    sx__walls_free(m);
+    sx_alloc_free(&m->alloc, m->grid.start, (size_t)m->grid.cap_cells, sizeof(int32_t));
+    sx_alloc_free(&m->alloc, m->grid.cell_of, (size_t)m->grid.cap_balls, sizeof(int32_t));
+    sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
+    sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof(double));
+    sx_alloc_free(&m->alloc, m->mats, (size_t)m->cap_mat, sizeof *m->mats);
+    free(m);
+}
+
+const char *sx_model_error(const sx_model *m) { return m->err; }
+int sx_model_dim(const sx_model *m) { return m->dim; }
+double sx_model_time(const sx_model *m) { return m->time; }
+int64_t sx_model_step_count(const sx_model *m) { return m->step; }
+size_t sx_model_bytes(const sx_model *m) { return m->alloc.bytes; }
+void sx_model_interrupt(sx_model *m) { m->interrupt = 1; }
+
+void sx_model_gravity(const sx_model *m, double out[3]) { memcpy(out, m->gravity, sizeof m->gravity); }
+
+sx_status sx_model_set_gravity(sx_model *m, const double g[3])
+{
+    for (int k = 0; k < m->dim; k++)
+        if (!isfinite(g[k])) return sx__fail(m, SX_EINVAL, "set_gravity: components must be finite");
+    for (int k = 0; k < m->dim; k++) m->gravity[k] = g[k];
+    return SX_OK;
+}
+
+double *sx__scratch(sx_model *m, int64_t n)
+{
+    if (n > m->scratch_cap) {
+        double *q = sx_alloc_resize(&m->alloc, m->scratch, (size_t)m->scratch_cap, (size_t)n, sizeof *q);
+        if (!q) return NULL;
+        m->scratch = q;
+        m->scratch_cap = n;
+    }
+    return m->scratch;
+}
+
+/* ------------------------------------------------------------ materials */
+
+sx_material_def sx_material_default_def(void)
+{
+    sx_material_def d;
+    memset(&d, 0, sizeof d);
+    d.density = 2650;
+    d.kn = 1e8;
+    d.ks = 1e8;
+    d.friction = 0.5;
+    return d;
+}
+
+int sx_material_find(const sx_model *m, const char *name)
+{
+    for (int i = 0; i < m->nmat; i++)
+        if (strcmp(m->mats[i].name, name) == 0) return i;
+    return -1;
+}
+
+int sx_material_count(const sx_model *m) { return m->nmat; }
+
+const char *sx_material_name(const sx_model *m, int index)
+{
+    return index >= 0 && index < m->nmat ? m->mats[index].name : NULL;
+}
+
+sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out)
+{
+    if (index < 0 || index >= m->nmat)
+        return sx__fail((sx_model *)m, SX_ENOTFOUND, "material_get: no material with index %d", index);
+    *out = m->mats[index].def;
+    return SX_OK;
+}
+
+sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *d, int *out)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "material: the model is stepping");
+    if (!name || !*name || strlen(name) >= sizeof m->mats[0].name)
+        return sx__fail(m, SX_EINVAL, "material: the name must have 1 to %zu characters", sizeof m->mats[0].name - 1);
+#define CHECK(cond, what, val) \
+    if (!(cond) || !isfinite(val)) return sx__fail(m, SX_EINVAL, "material '%s': %s (got %g)", name, what, val)
+    CHECK(d->density > 0, "density must be > 0 kg/m^3", d->density);
+    CHECK(d->kn > 0, "kn must be > 0 N/m", d->kn);
+    CHECK(d->ks >= 0, "ks must be >= 0 N/m", d->ks);
+    CHECK(d->friction >= 0, "friction must be >= 0", d->friction);
+    CHECK(d->damping >= 0 && d->damping < 1, "local damping must be in [0, 1)", d->damping);
+    CHECK(d->viscous_normal >= 0, "viscous_normal must be >= 0", d->viscous_normal);
+    CHECK(d->viscous_shear >= 0, "viscous_shear must be >= 0", d->viscous_shear);
+#undef CHECK
+    int i = sx_material_find(m, name);
+    if (i < 0) {
+        if (m->nmat >= UINT16_MAX) return sx__fail(m, SX_EINVAL, "material: too many materials");
+        if (m->nmat == m->cap_mat) {
+            const int cap = m->cap_mat ? 2 * m->cap_mat : 8;
+            sx_material *q = sx_alloc_resize(&m->alloc, m->mats, (size_t)m->cap_mat, (size_t)cap, sizeof *q);
+            if (!q) return sx__fail(m, SX_ENOMEM, "material: out of memory");
+            m->mats = q;
+            m->cap_mat = cap;
+        }
+        i = m->nmat++;
+        snprintf(m->mats[i].name, sizeof m->mats[i].name, "%s", name);
+    }
+    const bool density_changed = m->mats[i].def.density != d->density;
+    const bool damping_changed = m->mats[i].def.damping != d->damping;
+    m->mats[i].def = *d;
+    for (int64_t b = 0; b < m->balls.n; b++) {
+        if (m->balls.mat[b] != i) continue;
+        if (density_changed) sx__ball_update_mass(m, b);
+        if (damping_changed) m->balls.alpha[b] = d->damping;
+    }
+    m->dt_stale = true;
+    if (out) *out = i;
+    return SX_OK;
+}
+
+/* 4-22, 4-23 (springs in series), 4-30 (the smaller friction). */
+static sx_pair_law combine(const sx_material_def *a, double kn, double ks, double mu, double bn, double bs)
+{
+    sx_pair_law l;
+    l.kn = a->kn * kn / (a->kn + kn);
+    l.ks = a->ks + ks > 0 ? a->ks * ks / (a->ks + ks) : 0;
+    l.mu = a->friction < mu ? a->friction : mu;
+    l.beta_n = bn;
+    l.beta_s = bs;
+    return l;
+}
+
+sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
+{
+    const sx_material_def *a = &m->mats[mat].def;
+    return combine(a, w->def.kn, w->def.ks, w->def.friction, a->viscous_normal, a->viscous_shear);
+}
+
+static sx_status refresh_laws(sx_model *m)
+{
+    const int n = m->nmat;
+    if (n != m->law_n) {
+        sx_pair_law *q = sx_alloc_resize(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), (size_t)(n * n), sizeof *q);
+        if (n && !q) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+        m->law = q;
+        m->law_n = n;
+    }
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            const sx_material_def *a = &m->mats[i].def, *b = &m->mats[j].def;
+            m->law[i * n + j] = combine(a, b->kn, b->ks, b->friction, 0.5 * (a->viscous_normal + b->viscous_normal),
+                                        0.5 * (a->viscous_shear + b->viscous_shear));
+        }
+    return SX_OK;
+}
+
+/* ------------------------------------------------------------- timestep */
+
+static double mean_radius(const sx_model *m)
+{
+    double s = 0;
+    for (int64_t i = 0; i < m->balls.n; i++) s += m->balls.rad[i];
+    return m->balls.n ? s / (double)m->balls.n : 0;
+}
+
+/* Broad phase and laws up to date, so timestep queries see current contacts. */
+static sx_status prepare(sx_model *m)
+{
+    sx_status st = refresh_laws(m);
+    if (st) return st;
+    if (m->build_needed) {
+        m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
+        if (!kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
+        m->dt_stale = true;
+    }
+    return SX_OK;
+}
+
+static sx_status update_timestep(sx_model *m)
+{
+    if (m->dt_user > 0) {
+        m->dt = m->dt_user;
+    } else if (m->dt_stale || m->step % DT_REFRESH_STEPS == 0 || !(m->dt > 0)) {
+        const double crit = kernels(m)->critical_dt(m);
+        if (!isfinite(crit))
+            return sx__fail(m, SX_EINVAL,
+                            "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
+        m->dt = m->dt_safety * crit;
+    }
+    m->dt_stale = false;
+    return SX_OK;
+}
+
+double sx_model_critical_timestep(sx_model *m)
+{
+    if (prepare(m)) return NAN;
+    return kernels(m)->critical_dt(m);
+}
+
+double sx_model_timestep(sx_model *m)
+{
+    if (m->dt_user > 0) return m->dt_user;
+    if (prepare(m) || update_timestep(m)) return NAN;
+    return m->dt;
+}
+
+sx_status sx_model_set_timestep(sx_model *m, double dt)
+{
+    if (!(dt >= 0) || !isfinite(dt))
+        return sx__fail(m, SX_EINVAL, "set_timestep: the timestep must be > 0 s, or 0 for automatic (got %g)", dt);
+    m->dt_user = dt;
+    m->dt_stale = true;
+    return SX_OK;
+}
+
+/* ---------------------------------------------------------------- guard */
+
+/* An unforced system (no moving wall, no applied load, no fixed velocity
+ * that could inject energy) cannot gain mechanical energy: if it does by
+ * orders of magnitude, the integration is unstable. */
+static bool unforced(const sx_model *m)
+{
+    for (int64_t w = 0; w < m->nwall; w++)
+        for (int k = 0; k < m->dim; k++)
+            if (m->walls[w].def.vel[k] != 0) return false;
+    if (m->balls.fapp) return false;
+    for (int64_t i = 0; i < m->balls.n; i++)
+        if (m->balls.fix[i]) return false;
+    return true;
+}
+
+static double mechanical_energy(const sx_model *m)
+{
+    sx_energy e;
+    kernels(m)->energy(m, &e);
+    return e.kinetic + e.gravitational + e.strain;
+}
+
+static void guard_start(sx_model *m)
+{
+    m->guard_on = unforced(m);
+    if (!m->guard_on) return;
+    sx_energy e;
+    kernels(m)->energy(m, &e);
+    m->guard_e0 = e.kinetic + e.gravitational + e.strain;
+    /* the scale: the energy in play, with a floor of each ball's weight over its radius */
+    double floor_e = 0, g = 0;
+    for (int k = 0; k < m->dim; k++) g += m->gravity[k] * m->gravity[k];
+    g = sqrt(g);
+    for (int64_t i = 0; i < m->balls.n; i++) floor_e += g * m->balls.rad[i] / m->balls.inv_mass[i];
+    m->guard_scale = e.kinetic + e.strain + floor_e;
+}
+
+static sx_status guard_check(sx_model *m)
+{
+    if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
+    const double gain = mechanical_energy(m) - m->guard_e0;
+    if (gain > GUARD_ENERGY_FACTOR * m->guard_scale)
+        return sx__fail(m, SX_EUNSTABLE,
+                        "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
+                        "(%.3g times its initial scale %g J); the timestep %g s is too large "
+                        "(critical estimate %g s)",
+                        (long long)m->step, gain, gain / m->guard_scale, m->guard_scale, m->dt,
+                        kernels(m)->critical_dt(m));
+    return SX_OK;
+}
+
+/* ---------------------------------------------------------------- cycle */
+
+static void move_walls(sx_model *m, double *max_wall)
+{
+    *max_wall = 0;
+    for (int64_t i = 0; i < m->nwall; i++) {
+        sx_wall *w = &m->walls[i];
+        double s = 0;
+        for (int k = 0; k < m->dim; k++) {
+            w->def.point[k] += w->def.vel[k] * m->dt;
+            s += w->def.vel[k] * w->def.vel[k];
+        }
+        w->moved += sqrt(s) * m->dt;
+        if (w->moved > *max_wall) *max_wall = w->moved;
+    }
+}
+
+sx_status sx_model_cycle(sx_model *m, int64_t n)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
+    if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
+    m->err[0] = 0;
+    m->interrupt = 0;
+    sx_status st = prepare(m);
+    if (st) return st;
+    if ((st = update_timestep(m))) return st;
+    const sx_kernels *k = kernels(m);
+    m->locked = true;
+    guard_start(m);
+    for (int64_t s = 0; s < n; s++) {
+        if (m->interrupt) {
+            st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
+            break;
+        }
+        if (m->build_needed) {
+            m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
+            if (!k->build(m)) {
+                st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
+                break;
+            }
+        }
+        if ((st = update_timestep(m))) break;
+        if ((st = k->contacts(m))) break;
+        double max_disp, max_wall;
+        if ((st = k->integrate(m, &max_disp))) break;
+        move_walls(m, &max_wall);
+        m->time += m->dt;
+        m->step++;
+        /* Verlet criterion: two balls may close the gap by twice the largest
+         * displacement, a ball and a wall by both of their displacements. */
+        if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
+        if (m->step % GUARD_STEPS == 0 && (st = guard_check(m))) break;
+    }
+    m->locked = false;
+    return st;
+}
+
+/* ---------------------------------------------------------------- state */
+
+static uint64_t fnv(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+uint64_t sx_model_state_hash(const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const size_t n = (size_t)b->n, d = (size_t)m->dim, r = (size_t)m->rdim;
+    uint64_t h = 0xcbf29ce484222325ULL;
+    h = fnv(h, &m->time, sizeof m->time);
+    h = fnv(h, &m->step, sizeof m->step);
+    h = fnv(h, b->id, n * sizeof *b->id);
+    h = fnv(h, b->x, n * d * sizeof(double));
+    h = fnv(h, b->v, n * d * sizeof(double));
+    h = fnv(h, b->w, n * r * sizeof(double));
+    h = fnv(h, b->f, n * d * sizeof(double));
+    h = fnv(h, b->t, n * r * sizeof(double));
+    h = fnv(h, b->rad, n * sizeof(double));
+    const sx_pairs *ps[2] = {&m->bb, &m->bw};
+    for (int s = 0; s < 2; s++) {
+        const sx_pairs *p = ps[s];
+        for (int64_t c = 0; c < p->n; c++) {
+            if (!p->touching[c]) continue;
+            const int32_t ends[2] = {b->id[p->a[c]], s == 0 ? b->id[p->b[c]] : p->b[c]};
+            h = fnv(h, ends, sizeof ends);
+            h = fnv(h, p->fs + c * (int64_t)d, d * sizeof(double));
+        }
+    }
+    for (int64_t w = 0; w < m->nwall; w++) {
+        h = fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
+        h = fnv(h, m->walls[w].force, sizeof m->walls[w].force);
+    }
+    return h;
+}
+
+sx_energy sx_model_energy(const sx_model *m)
+{
+    sx_energy e;
+    memset(&e, 0, sizeof e);
+    /* materials may have changed since the last cycle */
+    if (refresh_laws((sx_model *)m)) return e;
+    kernels(m)->energy(m, &e);
+    return e;
+}
+
+int64_t sx_contact_count(const sx_model *m) { return kernels(m)->count_contacts(m); }
+
+bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
+{
+    if (refresh_laws((sx_model *)m)) return false;
+    return kernels(m)->each_contact(m, fn, ud);
+}

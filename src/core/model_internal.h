@@ -1,0 +1,151 @@
+/* The model's private layout, shared by the dimension-independent layer
+ * (model.c, balls.c, walls.c, ...) and the kernels compiled once per
+ * dimension (kernels.c with SEIXO_DIM = 2 and 3).
+ *
+ * Storage is a structure of arrays. A vector field holds `dim` components
+ * per ball, a rotational field `rdim` (1 in 2D, 3 in 3D), so a 2D scene
+ * never stores a third component. Ids are stable; dense indices change when
+ * the broad phase re-sorts balls spatially.
+ */
+#pragma once
+
+#include "alloc.h"
+#include "seixo.h"
+
+#include <signal.h>
+
+#define SX_ERRLEN 512
+
+/* pi to double precision (M_PI is not C11) */
+#define SX_PI 3.14159265358979323846
+
+typedef struct sx_material {
+    char name[64];
+    sx_material_def def;
+} sx_material;
+
+/* Balls: hot arrays first. */
+typedef struct sx_balls {
+    int64_t n, cap;
+    double *x, *v, *w;     /* position (dim), velocity (dim), spin (rdim) */
+    double *f, *t;         /* force (dim), moment (rdim) of the last step */
+    double *x_build;       /* position at the last broad-phase build (dim) */
+    double *rad, *inv_mass, *inv_inertia, *alpha; /* radius, 1/m, 1/I, local damping */
+    int32_t *id;           /* stable id of each dense index */
+    uint16_t *mat;         /* material index */
+    uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
+    /* cold: applied loads, allocated on first use */
+    double *fapp, *tapp;
+    /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
+    int32_t *index_of;
+    int64_t index_cap, next_id;
+} sx_balls;
+
+typedef struct sx_wall {
+    int64_t id;
+    sx_wall_def def;       /* def.point moves with the wall */
+    double u[3], v[3];     /* rect: unit edge directions; length in len_u, len_v */
+    double len_u, len_v;
+    double seg_len;        /* segment length */
+    double force[3], moment[3];
+    double moved;          /* distance moved since the last broad-phase build */
+} sx_wall;
+
+/* Candidate pairs of the broad phase with their history, in one flat
+ * structure of arrays. Ball-ball pairs: a < b as dense indices, grouped by a
+ * (CSR) in cell order. Ball-wall pairs: a the ball, b the wall's index.
+ * History: the shear force on b (dim) and the contact normal of the last
+ * step (dim), used by the rotation 4-7/4-14. touching = 0 means no history. */
+typedef struct sx_pairs {
+    int64_t n, cap;
+    int32_t *a, *b;
+    double *fs;            /* shear force (dim) */
+    double *nold;          /* previous normal (dim) */
+    uint8_t *touching;
+} sx_pairs;
+
+typedef struct sx_grid {
+    double lo[3], cell;
+    int64_t nc[3], ncells, cap_cells;
+    int32_t *head;         /* first ball of each cell (after sorting: start index) */
+    int32_t *start;        /* cells' start in sorted order (ncells + 1) */
+    int32_t *cell_of;      /* cell of each ball */
+    int64_t cap_balls;
+} sx_grid;
+
+/* Contact parameters of a pair of materials (4-22, 4-23, 4-30). */
+typedef struct sx_pair_law {
+    double kn, ks, mu;      /* springs in series, smaller friction */
+    double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
+} sx_pair_law;
+
+struct sx_model {
+    int dim, rdim;
+    double gravity[3];
+    double dt_user;          /* 0 = automatic */
+    double dt;               /* the timestep in use */
+    double dt_safety;
+    double skin, skin_user;
+    double time;
+    int64_t step;
+    bool dt_stale;           /* recompute the automatic timestep before the next step */
+    bool build_needed;       /* broad phase must be rebuilt before the next step */
+    bool locked;             /* stepping */
+    volatile sig_atomic_t interrupt;
+
+    sx_alloc alloc;
+    char err[SX_ERRLEN];
+
+    sx_material *mats;
+    int nmat, cap_mat;
+
+    sx_balls balls;
+
+    sx_wall *walls;
+    int64_t nwall, cap_wall, next_wall_id;
+
+    sx_pairs bb, bw;        /* ball-ball and ball-wall candidate pairs */
+    sx_pair_law *law;       /* nmat x nmat contact parameters, refreshed each cycle */
+    int law_n;
+    double *scratch;        /* per-build scratch (sorting, timestep sums) */
+    int64_t scratch_cap;
+    sx_grid grid;
+    int64_t builds;         /* number of broad-phase builds so far */
+
+    /* stability guard: mechanical energy at the start of the current cycle */
+    double guard_e0, guard_scale;
+    bool guard_on;
+};
+
+/* error helper: formats into m->err and returns status */
+sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Dimension kernels (kernels.c, one instance per dimension). */
+typedef struct sx_kernels {
+    bool (*build)(sx_model *m);                  /* broad phase + history transfer; false: out of memory */
+    sx_status (*contacts)(sx_model *m);          /* forces of all contacts */
+    sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
+    double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
+    void (*energy)(const sx_model *m, sx_energy *e);
+    bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
+    int64_t (*count_contacts)(const sx_model *m);
+} sx_kernels;
+
+extern const sx_kernels sx_kernels_2d, sx_kernels_3d;
+
+/* storage helpers (balls.c, walls.c) */
+sx_status sx__balls_reserve(sx_model *m, int64_t cap);
+void sx__balls_free(sx_model *m);
+/* new index i <- old index order[i]; scratch holds n * dim doubles */
+void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
+void sx__ball_update_mass(sx_model *m, int64_t i);
+sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
+void sx__pairs_free(sx_model *m, sx_pairs *p);
+void sx__walls_free(sx_model *m);
+void sx__wall_prepare(sx_model *m, sx_wall *w);
+int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
+int64_t sx__wall_index(const sx_model *m, int64_t id);
+double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */
+/* Law of a ball of material `mat` against a wall (wall stiffness in series). */
+sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);

@@ -1,0 +1,233 @@
+/* seixo — the public C API of the core library (libseixo).
+ *
+ * The core knows nothing of Lua or HDF5. Everything a user can get wrong is
+ * reported through an sx_status and a message readable with
+ * sx_model_error(); programming errors (NULL model) are asserts.
+ *
+ * Units are SI throughout. Vectors are double[3]; in a 2D model only the
+ * first two components are read or written, and a spin or moment is the
+ * scalar in component 0.
+ */
+#pragma once
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(__GNUC__)
+#define SX_API __attribute__((visibility("default")))
+#else
+#define SX_API
+#endif
+
+#define SX_VERSION "0.1.0"
+
+typedef struct sx_model sx_model;
+
+typedef enum sx_status {
+    SX_OK = 0,
+    SX_EINVAL,      ///< an argument is out of range or inconsistent
+    SX_ENOMEM,      ///< an allocation failed
+    SX_ENOTFOUND,   ///< no ball, wall or material with that id/name
+    SX_EUNSTABLE,   ///< the stability guard stopped the run
+    SX_EINTERRUPT,  ///< the run was interrupted (sx_model_interrupt)
+    SX_ELOCKED,     ///< the model is stepping; the change is not allowed now
+} sx_status;
+
+/* ---------------------------------------------------------------- model */
+
+typedef struct sx_model_def {
+    int dim;                 ///< 2 (disks of unit thickness) or 3 (spheres)
+    double gravity[3];       ///< m/s^2
+    double timestep;         ///< s; 0 selects the automatic critical timestep
+    double timestep_safety;  ///< fraction of the critical timestep (auto mode), default 0.8
+    double skin;             ///< m; Verlet skin of the broad phase; 0 = 0.2 x the mean radius
+} sx_model_def;
+
+/// Defaults: dim 3, no gravity, automatic timestep with safety 0.8, automatic skin.
+SX_API sx_model_def sx_model_default_def(void);
+
+/// Creates a model. On failure returns NULL and writes a message into err.
+SX_API sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen);
+SX_API void sx_model_destroy(sx_model *m);
+
+/// The message of the last failed call on this model ("" if none).
+SX_API const char *sx_model_error(const sx_model *m);
+
+SX_API int sx_model_dim(const sx_model *m);
+SX_API double sx_model_time(const sx_model *m);        ///< s
+SX_API int64_t sx_model_step_count(const sx_model *m); ///< steps taken
+
+/// The timestep the next step will use (s): the user's value, or the
+/// automatic one computed from the current contacts.
+SX_API double sx_model_timestep(sx_model *m);
+/// The critical timestep estimate sqrt(m/k) over balls, without safety factor (s).
+SX_API double sx_model_critical_timestep(sx_model *m);
+/// Sets a fixed timestep (s > 0), or 0 to return to the automatic one.
+SX_API sx_status sx_model_set_timestep(sx_model *m, double dt);
+
+SX_API void sx_model_gravity(const sx_model *m, double out[3]);
+SX_API sx_status sx_model_set_gravity(sx_model *m, const double g[3]);
+
+/// Advances the model n steps. Stops early with SX_EUNSTABLE (stability
+/// guard) or SX_EINTERRUPT; the model stays consistent and inspectable.
+SX_API sx_status sx_model_cycle(sx_model *m, int64_t n);
+
+/// Asks a running cycle to stop at the next step boundary (async-signal-safe).
+SX_API void sx_model_interrupt(sx_model *m);
+
+/// A 64-bit hash of the full dynamic state (positions, velocities, spins,
+/// forces, contact histories, walls, time); equal hashes mean bit-identical states.
+SX_API uint64_t sx_model_state_hash(const sx_model *m);
+
+/// Bytes currently allocated by the model.
+SX_API size_t sx_model_bytes(const sx_model *m);
+
+/* ------------------------------------------------------------ materials */
+
+typedef struct sx_material_def {
+    double density;         ///< kg/m^3 (> 0)
+    double kn;              ///< N/m, normal stiffness of the ball (springs in series, 4-22)
+    double ks;              ///< N/m, shear stiffness of the ball (4-23)
+    double friction;        ///< Coulomb coefficient (>= 0); a contact uses the smaller (4-30)
+    double damping;         ///< local (non-viscous) damping coefficient alpha in [0, 1)
+    double viscous_normal;  ///< normal critical-damping ratio of the contact dashpot, >= 0
+    double viscous_shear;   ///< shear critical-damping ratio of the contact dashpot, >= 0
+} sx_material_def;
+
+/// density 2650, kn = ks = 1e8, friction 0.5, no damping.
+SX_API sx_material_def sx_material_default_def(void);
+
+/// Adds a material, or redefines it if the name exists (balls using it get
+/// their mass and inertia recomputed). Writes its index (>= 0) to *out if out is not NULL.
+SX_API sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *def, int *out);
+/// Index of the named material, or -1.
+SX_API int sx_material_find(const sx_model *m, const char *name);
+SX_API int sx_material_count(const sx_model *m);
+SX_API const char *sx_material_name(const sx_model *m, int index);
+SX_API sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out);
+
+/* ---------------------------------------------------------------- balls */
+
+typedef struct sx_ball_def {
+    double pos[3];    ///< m
+    double vel[3];    ///< m/s
+    double spin[3];   ///< rad/s (2D: spin[0])
+    double radius;    ///< m (> 0)
+    int material;     ///< material index
+} sx_ball_def;
+
+SX_API sx_ball_def sx_ball_default_def(void);
+
+/// Adds a ball; its stable id (>= 1) is written to *id.
+SX_API sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *id);
+SX_API sx_status sx_ball_remove(sx_model *m, int64_t id);
+SX_API int64_t sx_ball_count(const sx_model *m);
+/// Id of the ball at dense index i (0 <= i < count); the order changes when
+/// the broad phase re-sorts balls, ids never do.
+SX_API int64_t sx_ball_id_at(const sx_model *m, int64_t i);
+SX_API bool sx_ball_exists(const sx_model *m, int64_t id);
+
+typedef enum sx_ball_vec {
+    SX_BALL_POS,     ///< m
+    SX_BALL_VEL,     ///< m/s
+    SX_BALL_SPIN,    ///< rad/s
+    SX_BALL_FORCE,   ///< N: contact forces plus applied force of the last step
+    SX_BALL_MOMENT,  ///< N m: contact moments plus applied moment of the last step
+    SX_BALL_APPLIED_FORCE,   ///< N, constant external force added every step
+    SX_BALL_APPLIED_MOMENT,  ///< N m
+} sx_ball_vec;
+
+SX_API sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec which, double out[3]);
+/// Sets pos, vel, spin or an applied force/moment (force and moment of the
+/// last step are results, not settable).
+SX_API sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double v[3]);
+
+typedef enum sx_ball_scalar {
+    SX_BALL_RADIUS,   ///< m (settable; mass and inertia follow from the density)
+    SX_BALL_MASS,     ///< kg
+    SX_BALL_INERTIA,  ///< kg m^2
+    SX_BALL_DAMPING,  ///< local damping alpha (settable)
+} sx_ball_scalar;
+
+SX_API sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which, double *out);
+SX_API sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double value);
+SX_API sx_status sx_ball_material(const sx_model *m, int64_t id, int *material);
+SX_API sx_status sx_ball_set_material(sx_model *m, int64_t id, int material);
+
+/// Fixity bits: a fixed component keeps its velocity (or spin) whatever the force.
+enum {
+    SX_FIX_VX = 1 << 0, SX_FIX_VY = 1 << 1, SX_FIX_VZ = 1 << 2,
+    SX_FIX_WX = 1 << 3, SX_FIX_WY = 1 << 4, SX_FIX_WZ = 1 << 5,
+    SX_FIX_VEL = SX_FIX_VX | SX_FIX_VY | SX_FIX_VZ,
+    SX_FIX_SPIN = SX_FIX_WX | SX_FIX_WY | SX_FIX_WZ,
+};
+/// In 2D only SX_FIX_VX, SX_FIX_VY and SX_FIX_WZ (the scalar spin, about z) apply.
+SX_API sx_status sx_ball_fixity(const sx_model *m, int64_t id, unsigned *mask);
+SX_API sx_status sx_ball_set_fixity(sx_model *m, int64_t id, unsigned mask);
+
+/* ---------------------------------------------------------------- walls */
+
+typedef enum sx_wall_kind {
+    SX_WALL_PLANE,    ///< 3D infinite plane: point + normal; balls live on the normal's side
+    SX_WALL_LINE,     ///< 2D infinite line: point + normal; balls live on the normal's side
+    SX_WALL_RECT,     ///< 3D finite rectangle: corner + two edge vectors; two-sided
+    SX_WALL_SEGMENT,  ///< 2D finite segment: two end points; two-sided
+} sx_wall_kind;
+
+typedef struct sx_wall_def {
+    sx_wall_kind kind;
+    double point[3];   ///< plane/line: a point on it; rect: a corner; segment: first end
+    double normal[3];  ///< plane/line: normal towards the balls (normalised on input)
+    double edge1[3];   ///< rect: first edge from the corner; segment: second end minus first
+    double edge2[3];   ///< rect: second edge from the corner (orthogonal to edge1)
+    double vel[3];     ///< m/s, imposed translational velocity
+    double kn, ks;     ///< N/m, wall stiffnesses (in series with the ball's, 4-22)
+    double friction;   ///< Coulomb coefficient; the contact uses the smaller of ball and wall
+} sx_wall_def;
+
+/// A plane at the origin with normal +z (2D: a line with normal +y), kn = ks = 1e8, friction 0.5.
+SX_API sx_wall_def sx_wall_default_def(int dim);
+
+SX_API sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id);
+SX_API sx_status sx_wall_remove(sx_model *m, int64_t id);
+SX_API int64_t sx_wall_count(const sx_model *m);
+SX_API int64_t sx_wall_id_at(const sx_model *m, int64_t i);
+SX_API bool sx_wall_exists(const sx_model *m, int64_t id);
+/// The definition as it is now (point moved by the wall's motion).
+SX_API sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out);
+SX_API sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3]);
+/// Resultant force (N) of the balls on the wall in the last step, and its
+/// moment (N m) about the wall's reference point (def.point; rect: its centre).
+SX_API sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], double moment[3]);
+
+/* ------------------------------------------------------------- contacts */
+
+/// Number of ball-ball and ball-wall contacts currently touching (overlap > 0).
+SX_API int64_t sx_contact_count(const sx_model *m);
+
+typedef struct sx_contact_info {
+    int64_t a, b;        ///< ball ids (b is a wall id when is_wall)
+    bool is_wall;
+    double normal[3];    ///< unit normal from a to b (ball-wall: from the wall to the ball)
+    double point[3];     ///< contact point, m (4-4)
+    double overlap;      ///< m (4-3)
+    double fn;           ///< N, normal force magnitude (compression positive)
+    double shear[3];     ///< N, shear force on b
+    double kn, ks;       ///< N/m, contact stiffnesses
+} sx_contact_info;
+
+/// Calls fn for every touching contact, in the store's deterministic order.
+/// Stops and returns false when fn returns false.
+SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
+
+/* ------------------------------------------------------------- energies */
+
+typedef struct sx_energy {
+    double kinetic;        ///< J, translational + rotational
+    double gravitational;  ///< J, -sum m g.x (zero at the origin)
+    double strain;         ///< J, stored in contact springs
+} sx_energy;
+
+/// Energies of the current state (computed on demand, O(N + contacts)).
+SX_API sx_energy sx_model_energy(const sx_model *m);

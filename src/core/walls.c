@@ -1,0 +1,204 @@
+/* Wall store: planes/lines (one-sided: balls live on the normal's side),
+ * rectangles and segments (two-sided, distance to the closest point).
+ * Walls move only by their imposed velocity; the step records the
+ * resultant force and moment of the balls on each. */
+#include "model_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+sx_wall_def sx_wall_default_def(int dim)
+{
+    sx_wall_def d;
+    memset(&d, 0, sizeof d);
+    d.kind = dim == 2 ? SX_WALL_LINE : SX_WALL_PLANE;
+    d.normal[dim == 2 ? 1 : 2] = 1.0;
+    d.kn = 1e8;
+    d.ks = 1e8;
+    d.friction = 0.5;
+    return d;
+}
+
+static double norm(const double *v, int d)
+{
+    double s = 0;
+    for (int k = 0; k < d; k++) s += v[k] * v[k];
+    return sqrt(s);
+}
+
+int64_t sx__wall_index(const sx_model *m, int64_t id)
+{
+    for (int64_t i = 0; i < m->nwall; i++)
+        if (m->walls[i].id == id) return i;
+    return -1;
+}
+
+/* Derived geometry: unit normal, rectangle frame, segment length. */
+void sx__wall_prepare(sx_model *m, sx_wall *w)
+{
+    const int d = m->dim;
+    sx_wall_def *def = &w->def;
+    if (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_LINE) {
+        const double n = norm(def->normal, d);
+        for (int k = 0; k < d; k++) def->normal[k] /= n;
+    } else if (def->kind == SX_WALL_RECT) {
+        w->len_u = norm(def->edge1, 3);
+        w->len_v = norm(def->edge2, 3);
+        for (int k = 0; k < 3; k++) {
+            w->u[k] = def->edge1[k] / w->len_u;
+            w->v[k] = def->edge2[k] / w->len_v;
+        }
+        /* the normal of a rectangle is edge1 x edge2, for reporting only */
+        def->normal[0] = w->u[1] * w->v[2] - w->u[2] * w->v[1];
+        def->normal[1] = w->u[2] * w->v[0] - w->u[0] * w->v[2];
+        def->normal[2] = w->u[0] * w->v[1] - w->u[1] * w->v[0];
+    } else {
+        w->seg_len = norm(def->edge1, 2);
+        def->normal[0] = -def->edge1[1] / w->seg_len;
+        def->normal[1] = def->edge1[0] / w->seg_len;
+    }
+}
+
+static bool finite3(const double *v, int d)
+{
+    for (int k = 0; k < d; k++)
+        if (!isfinite(v[k])) return false;
+    return true;
+}
+
+static sx_status validate(sx_model *m, const sx_wall_def *def)
+{
+    const int d = m->dim;
+    const bool ok_kind = d == 3 ? (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_RECT)
+                                : (def->kind == SX_WALL_LINE || def->kind == SX_WALL_SEGMENT);
+    if (!ok_kind)
+        return sx__fail(m, SX_EINVAL, "wall_add: kind %d is not a %dD wall (3D: plane, rect; 2D: line, segment)",
+                        (int)def->kind, d);
+    if (!finite3(def->point, d) || !finite3(def->vel, d) || !finite3(def->normal, d) ||
+        !finite3(def->edge1, d) || !finite3(def->edge2, d))
+        return sx__fail(m, SX_EINVAL, "wall_add: point, normal, edges and velocity must be finite");
+    if (!(def->kn > 0) || !(def->ks >= 0) || !isfinite(def->kn) || !isfinite(def->ks))
+        return sx__fail(m, SX_EINVAL, "wall_add: kn must be > 0 and ks >= 0 (got kn=%g, ks=%g)", def->kn, def->ks);
+    if (!(def->friction >= 0) || !isfinite(def->friction))
+        return sx__fail(m, SX_EINVAL, "wall_add: friction must be >= 0 (got %g)", def->friction);
+    switch (def->kind) {
+    case SX_WALL_PLANE:
+    case SX_WALL_LINE:
+        if (!(norm(def->normal, d) > 0)) return sx__fail(m, SX_EINVAL, "wall_add: the normal must not be zero");
+        break;
+    case SX_WALL_RECT: {
+        const double a = norm(def->edge1, 3), b = norm(def->edge2, 3);
+        if (!(a > 0) || !(b > 0)) return sx__fail(m, SX_EINVAL, "wall_add: rect edges must not be zero");
+        const double dot = def->edge1[0] * def->edge2[0] + def->edge1[1] * def->edge2[1] + def->edge1[2] * def->edge2[2];
+        if (fabs(dot) > 1e-9 * a * b)
+            return sx__fail(m, SX_EINVAL, "wall_add: rect edges must be orthogonal (edge1.edge2 = %g)", dot);
+        break;
+    }
+    case SX_WALL_SEGMENT:
+        if (!(norm(def->edge1, 2) > 0)) return sx__fail(m, SX_EINVAL, "wall_add: the segment has zero length");
+        break;
+    }
+    return SX_OK;
+}
+
+sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "wall_add: the model is stepping");
+    sx_status st = validate(m, def);
+    if (st) return st;
+    if (m->nwall == m->cap_wall) {
+        const int64_t cap = m->cap_wall ? 2 * m->cap_wall : 8;
+        sx_wall *q = sx_alloc_resize(&m->alloc, m->walls, (size_t)m->cap_wall, (size_t)cap, sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "wall_add: out of memory");
+        m->walls = q;
+        m->cap_wall = cap;
+    }
+    sx_wall *w = &m->walls[m->nwall++];
+    memset(w, 0, sizeof *w);
+    w->def = *def;
+    for (int k = m->dim; k < 3; k++) /* a 2D wall has no third component */
+        w->def.point[k] = w->def.normal[k] = w->def.edge1[k] = w->def.edge2[k] = w->def.vel[k] = 0;
+    w->id = ++m->next_wall_id;
+    sx__wall_prepare(m, w);
+    m->build_needed = true;
+    m->dt_stale = true;
+    if (id) *id = w->id;
+    return SX_OK;
+}
+
+sx_status sx_wall_remove(sx_model *m, int64_t id)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "wall_remove: the model is stepping");
+    const int64_t i = sx__wall_index(m, id);
+    if (i < 0) return sx__fail(m, SX_ENOTFOUND, "wall_remove: no wall with id %lld", (long long)id);
+    const int64_t last = m->nwall - 1;
+    const int d = m->dim;
+    sx_pairs *p = &m->bw;
+    int64_t k = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        if (p->b[c] == i) continue;
+        p->a[k] = p->a[c];
+        p->b[k] = p->b[c] == last ? (int32_t)i : p->b[c];
+        memmove(p->fs + k * d, p->fs + c * d, d * sizeof(double));
+        memmove(p->nold + k * d, p->nold + c * d, d * sizeof(double));
+        p->touching[k] = p->touching[c];
+        k++;
+    }
+    p->n = k;
+    m->walls[i] = m->walls[last];
+    m->nwall--;
+    m->build_needed = true;
+    m->dt_stale = true;
+    return SX_OK;
+}
+
+int64_t sx_wall_count(const sx_model *m) { return m->nwall; }
+
+int64_t sx_wall_id_at(const sx_model *m, int64_t i) { return i >= 0 && i < m->nwall ? m->walls[i].id : -1; }
+
+bool sx_wall_exists(const sx_model *m, int64_t id) { return sx__wall_index(m, id) >= 0; }
+
+static const sx_wall *lookup(const sx_model *m, int64_t id, const char *fn)
+{
+    const int64_t i = sx__wall_index(m, id);
+    if (i < 0) {
+        sx__fail((sx_model *)m, SX_ENOTFOUND, "%s: no wall with id %lld", fn, (long long)id);
+        return NULL;
+    }
+    return &m->walls[i];
+}
+
+sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out)
+{
+    const sx_wall *w = lookup(m, id, "wall_get");
+    if (!w) return SX_ENOTFOUND;
+    *out = w->def;
+    return SX_OK;
+}
+
+sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
+{
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_vel");
+    if (!w) return SX_ENOTFOUND;
+    if (!finite3(vel, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_vel: velocity must be finite");
+    for (int k = 0; k < m->dim; k++) w->def.vel[k] = vel[k];
+    return SX_OK;
+}
+
+sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], double moment[3])
+{
+    const sx_wall *w = lookup(m, id, "wall_force");
+    if (!w) return SX_ENOTFOUND;
+    for (int k = 0; k < 3; k++) {
+        if (force) force[k] = w->force[k];
+        if (moment) moment[k] = w->moment[k];
+    }
+    return SX_OK;
+}
+
+void sx__walls_free(sx_model *m)
+{
+    sx_alloc_free(&m->alloc, m->walls, (size_t)m->cap_wall, sizeof *m->walls);
+    m->walls = NULL;
+    m->nwall = m->cap_wall = 0;
+}
