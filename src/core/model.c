@@ -320,6 +320,21 @@ static void guard_start(sx_model *m)
     m->guard_scale = e.kinetic + e.strain + floor_e;
 }
 
+/* The ball with the largest translational kinetic energy: the one to name. */
+static int64_t most_energetic_ball(const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    int64_t best = -1;
+    double top = -1;
+    for (int64_t i = 0; i < b->n; i++) {
+        double v2 = 0;
+        for (int k = 0; k < m->dim; k++) v2 += b->v[i * m->dim + k] * b->v[i * m->dim + k];
+        const double ke = 0.5 * v2 / b->inv_mass[i];
+        if (ke > top) top = ke, best = b->id[i];
+    }
+    return best;
+}
+
 static sx_status guard_check(sx_model *m)
 {
     if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
@@ -327,10 +342,10 @@ static sx_status guard_check(sx_model *m)
     if (gain > GUARD_ENERGY_FACTOR * m->guard_scale)
         return sx__fail(m, SX_EUNSTABLE,
                         "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
-                        "(%.3g times its initial scale %g J); the timestep %g s is too large "
+                        "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is too large "
                         "(critical estimate %g s)",
-                        (long long)m->step, gain, gain / m->guard_scale, m->guard_scale, m->dt,
-                        kernels(m)->critical_dt(m));
+                        (long long)m->step, gain, gain / m->guard_scale, m->guard_scale,
+                        (long long)most_energetic_ball(m), m->dt, kernels(m)->critical_dt(m));
     return SX_OK;
 }
 
