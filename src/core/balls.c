@@ -198,7 +198,11 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
     int64_t k = 0;
     for (int64_t c = 0; c < p->n; c++) {
         int32_t a = p->a[c], bb = p->b[c];
-        if (a == gone || bb == gone) continue;
+        if (a == gone || bb == gone) {
+            if (p->bond && p->bond[c]) sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL);
+            continue;
+        }
+        if (p->bond) p->bond[k] = p->bond[c];
         if (a == last) a = gone;
         if (bb == last) bb = gone;
         p->a[k] = a;
@@ -215,6 +219,7 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
                 p->fs[k * d + j] = -p->fs[k * d + j];
                 p->nold[k * d + j] = -p->nold[k * d + j];
             }
+            if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
         }
         k++;
     }
@@ -296,6 +301,7 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, fs, d);
     RESIZE(p, nold, d);
     RESIZE(p, touching, 1);
+    if (p->bond) RESIZE(p, bond, 1);
     p->cap = cap;
     return SX_OK;
 }
@@ -308,6 +314,7 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->fs, c * d, sizeof(double));
     free_field(m, p->nold, c * d, sizeof(double));
     free_field(m, p->touching, c, sizeof(uint8_t));
+    free_field(m, p->bond, p->bond ? c : 0, sizeof(int32_t));
     memset(p, 0, sizeof *p);
 }
 

@@ -66,6 +66,8 @@ typedef struct history {
     int64_t *src;    /* index into the saved arrays */
     int64_t cap;
     double *fs, *nold;
+    int32_t *bond;   /* bond slot + 1 of each saved pair (0: none) */
+    uint8_t *seen;   /* per bond slot: found again by the grid */
     int64_t n;
 } history;
 
@@ -87,8 +89,9 @@ static inline uint64_t bw_key(int64_t id, int64_t wall)
     return (1ULL << 63) | ((uint64_t)id << 32) | (uint64_t)wall;
 }
 
-static void history_put(history *h, uint64_t key, const double *fs, const double *nold)
+static void history_put(history *h, uint64_t key, const double *fs, const double *nold, int32_t bond)
 {
+    h->bond[h->n] = bond;
     int64_t s = (int64_t)(hash_key(key) & (uint64_t)(h->cap - 1));
     while (h->key[s]) s = (s + 1) & (h->cap - 1);
     h->key[s] = key;
@@ -123,7 +126,9 @@ static bool history_save(sx_model *m, history *h)
     h->src = malloc((size_t)h->cap * sizeof *h->src);
     h->fs = malloc((size_t)(live * D) * sizeof(double));
     h->nold = malloc((size_t)(live * D) * sizeof(double));
-    if (!h->key || !h->src || !h->fs || !h->nold) return false;
+    h->bond = malloc((size_t)live * sizeof(int32_t));
+    h->seen = calloc((size_t)(m->bonds.n + 1), 1);
+    if (!h->key || !h->src || !h->fs || !h->nold || !h->bond || !h->seen) return false;
     const int32_t *id = m->balls.id;
     for (int64_t c = 0; c < m->bb.n; c++) {
         if (!m->bb.touching[c]) continue;
@@ -135,23 +140,28 @@ static bool history_save(sx_model *m, history *h)
             fs[k] = sgn * m->bb.fs[c * D + k];
             nold[k] = sgn * m->bb.nold[c * D + k];
         }
-        history_put(h, bb_key(ia, ib), fs, nold);
+        const int32_t bond = m->bb.bond ? m->bb.bond[c] : 0;
+        if (bond && sgn < 0) sx__bond_flip(m, bond - 1);
+        history_put(h, bb_key(ia, ib), fs, nold, bond);
     }
     for (int64_t c = 0; c < m->bw.n; c++)
         if (m->bw.touching[c])
-            history_put(h, bw_key(id[m->bw.a[c]], m->bw.b[c]), m->bw.fs + c * D, m->bw.nold + c * D);
+            history_put(h, bw_key(id[m->bw.a[c]], m->bw.b[c]), m->bw.fs + c * D, m->bw.nold + c * D, 0);
     return true;
 }
 
 static void history_free(history *h)
 {
+    free(h->bond);
+    free(h->seen);
     free(h->key);
     free(h->src);
     free(h->fs);
     free(h->nold);
 }
 
-/* Appends candidate pair (a, b) and restores its history if it had one. */
+/* Appends candidate pair (a, b) and restores its history if it had one;
+ * sgn is -1 when a has the higher id (history is kept lower id -> higher). */
 static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const history *h, uint64_t key, double sgn)
 {
     if (p->n == p->cap && sx__pairs_reserve(m, p, p->n + 1)) return false;
@@ -159,15 +169,40 @@ static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const hist
     p->a[c] = a;
     p->b[c] = b;
     const int64_t s = history_get(h, key);
+    if (p->bond) p->bond[c] = 0;
     if (s >= 0) {
         for (int k = 0; k < D; k++) {
             p->fs[c * D + k] = sgn * h->fs[s * D + k];
             p->nold[c * D + k] = sgn * h->nold[s * D + k];
         }
         p->touching[c] = 1;
+        const int32_t bond = h->bond[s];
+        if (bond && p->bond) {
+            p->bond[c] = bond;
+            h->seen[bond - 1] = 1;
+            if (sgn < 0) sx__bond_flip(m, bond - 1);
+        }
     } else {
         for (int k = 0; k < D; k++) p->fs[c * D + k] = p->nold[c * D + k] = 0;
         p->touching[c] = 0;
+    }
+    return true;
+}
+
+/* Bonded pairs stay in the store whatever their gap: those the grid did
+ * not find again are appended (after the grid's pairs, in slot order). */
+static bool keep_bonded_pairs(sx_model *m, const history *h)
+{
+    const sx_bonds *bs = &m->bonds;
+    for (int64_t s = 0; s < bs->n; s++) {
+        if (!bs->kind[s] || h->seen[s]) continue;
+        int32_t a = m->balls.index_of[bs->ida[s]], b = m->balls.index_of[bs->idb[s]];
+        if (a > b) {
+            const int32_t t = a;
+            a = b, b = t;
+        }
+        const int64_t ia = m->balls.id[a], ib = m->balls.id[b];
+        if (!pair_push(m, &m->bb, a, b, h, bb_key(ia, ib), ia < ib ? 1.0 : -1.0)) return false;
     }
     return true;
 }
@@ -372,7 +407,7 @@ static bool KERNEL(build)(sx_model *m)
 {
     history h;
     bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h) &&
-              build_wall_pairs(m, &h);
+              keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h);
     history_free(&h);
     if (!ok) return false;
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
@@ -384,45 +419,108 @@ static bool KERNEL(build)(sx_model *m)
 
 /* ------------------------------------------------------- contact forces */
 
-/* The incremental shear force of one contact, 4-7 ... 4-20, and the slip
- * limit 4-30/4-31. n is the current normal (from a to b), vc the velocity of
- * b's contact point relative to a's, wbar_n the mean spin of the two
- * entities projected on n (4-9). Returns true when the contact slips. */
-static inline bool shear_update(double *fs, const double *nold, const double *n, const double *wn, double dt,
-                                const double *vs, double ks, double fmax)
+/* The rotation carried by a contact from one step to the next: into the new
+ * contact plane (4-13/4-14, c = n_old x n) and about the normal by the mean
+ * spin of the two entities (4-8/4-9/4-15). Applied to the shear force and to
+ * the parallel bond's shear force and bending moment. */
+typedef struct carry {
+    double c[D == 3 ? 3 : 1];
+    double wdt[D == 3 ? 3 : 1];
+} carry;
+
+static inline void carry_make(carry *r, const double *nold, const double *n, const double *wa, const double *wb,
+                              double dt)
 {
-    /* 4-13/4-14: rotate the old shear force into the new contact plane, F += (n_old x n) x F */
 #if D == 3
-    double c[3];
-    c[0] = nold[1] * n[2] - nold[2] * n[1];
-    c[1] = nold[2] * n[0] - nold[0] * n[2];
-    c[2] = nold[0] * n[1] - nold[1] * n[0];
-    double r[3];
-    spin_cross(c, fs, r);
-    for (int k = 0; k < 3; k++) fs[k] += r[k];
-    /* 4-8/4-15: rotate about the normal by the mean spin, F += (w_bar dt) x F */
-    const double wdt[3] = {wn[0] * dt, wn[1] * dt, wn[2] * dt};
-    spin_cross(wdt, fs, r);
-    for (int k = 0; k < 3; k++) fs[k] += r[k];
+    r->c[0] = nold[1] * n[2] - nold[2] * n[1];
+    r->c[1] = nold[2] * n[0] - nold[0] * n[2];
+    r->c[2] = nold[0] * n[1] - nold[1] * n[0];
+    /* 4-9: the mean spin projected on the normal (a wall does not spin) */
+    const double wbar = 0.5 * ((wa ? dot(wa, n) : 0) + dot(wb, n));
+    for (int k = 0; k < 3; k++) r->wdt[k] = wbar * n[k] * dt;
 #else
-    /* in 2D c is along z and the spins are normal to n, so 4-15 is the identity */
-    (void)wn;
-    (void)dt;
-    const double c = nold[0] * n[1] - nold[1] * n[0];
-    const double f0 = fs[0];
-    fs[0] -= c * fs[1];
-    fs[1] += c * f0;
+    /* in 2D c is along z, and the spins are normal to n, so 4-15 is the identity */
+    (void)wa, (void)wb, (void)dt;
+    r->c[0] = nold[0] * n[1] - nold[1] * n[0];
+    r->wdt[0] = 0;
 #endif
-    /* 4-18/4-19/4-20: increment from the shear velocity */
-    for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt;
-    /* 4-30/4-31: Coulomb slip */
-    const double f2 = dot(fs, fs);
-    if (f2 > fmax * fmax) {
-        const double s = fmax / sqrt(f2);
-        for (int k = 0; k < D; k++) fs[k] *= s;
-        return true;
+}
+
+static inline void carry_apply(const carry *r, double *v)
+{
+#if D == 3
+    double t[3];
+    spin_cross(r->c, v, t); /* 4-14: F + c x F */
+    for (int k = 0; k < 3; k++) v[k] += t[k];
+    spin_cross(r->wdt, v, t); /* 4-15: F + (w dt) x F */
+    for (int k = 0; k < 3; k++) v[k] += t[k];
+#else
+    const double v0 = v[0];
+    v[0] -= r->c[0] * v[1];
+    v[1] += r->c[0] * v0;
+#endif
+}
+
+/* Normal and shear stiffness of a contact (4-22/4-23, 4-25/4-26, 4-49/4-50).
+ * rbar is 4-27's 2RARB/(RA+RB) (ball-wall: R, 4-28). Returns the normal force. */
+static inline double stiffness(const sx_pair_law *l, double ra, double rb, double rbar, double un, double *kn,
+                               double *ks)
+{
+    if (l->hertz) {
+        const double u = un > 0 ? un : 0;
+        *kn = 2 * l->g * sqrt(2 * rbar) / (3 * (1 - l->nu)) * sqrt(u);                  /* 4-25 */
+        const double fn = *kn * u;
+        *ks = 2 * cbrt(l->g * l->g * 3 * (1 - l->nu) * rbar) / (2 - l->nu) * cbrt(fn); /* 4-26 */
+        return fn;
     }
-    return false;
+    if (l->per_radius) {
+        const double kna = l->ec_a > 0 ? (D == 3 ? 4 * ra * l->ec_a : 2 * l->ec_a) : l->kn_a; /* 4-49 */
+        const double ksa = l->ec_a > 0 ? kna / l->ratio_a : l->ks_a;                          /* 4-50 */
+        const double knb = l->ec_b > 0 ? (D == 3 ? 4 * rb * l->ec_b : 2 * l->ec_b) : l->kn_b;
+        const double ksb = l->ec_b > 0 ? knb / l->ratio_b : l->ks_b;
+        *kn = kna * knb / (kna + knb);
+        *ks = ksa + ksb > 0 ? ksa * ksb / (ksa + ksb) : 0;
+    } else {
+        *kn = l->kn;
+        *ks = l->ks;
+    }
+    return *kn * un; /* 4-6 */
+}
+
+/* Strain energy of a contact spring: linear 1/2 Fn Un, Hertz 2/5 Fn Un, plus
+ * the shear spring's 1/2 |Fs|^2 / ks. */
+static inline double contact_strain(bool hertz, double fn, double un, const double *fs, double ks)
+{
+    const double normal = (hertz ? 0.4 : 0.5) * fn * un;
+    return normal + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+}
+
+/* Section of a parallel bond: area, moment of inertia, polar moment (4-35;
+ * 2D: a beam of unit thickness, A = 2R, I = 2/3 R^3, no twist). */
+static inline void pb_section(double r, double *area, double *inertia, double *polar)
+{
+#if D == 3
+    *area = SX_PI * r * r;
+    *inertia = 0.25 * SX_PI * r * r * r * r;
+    *polar = 0.5 * SX_PI * r * r * r * r;
+#else
+    *area = 2 * r;
+    *inertia = 2.0 / 3.0 * r * r * r;
+    *polar = 0;
+#endif
+}
+
+static double pb_strain(const sx_bonds *b, int64_t s)
+{
+    double area, inertia, polar;
+    pb_section(b->rbar[s], &area, &inertia, &polar);
+    const double *fs = b->fs + s * D, *ms = b->ms + s * RD;
+    double e = 0.5 * b->fn[s] * b->fn[s] / (b->kn[s] * area) + 0.5 * dot(fs, fs) / (b->ks[s] * area);
+    double m2 = 0;
+    for (int k = 0; k < RD; k++) m2 += ms[k] * ms[k];
+    e += 0.5 * m2 / (b->kn[s] * inertia);
+    if (D == 3) e += 0.5 * b->mn[s] * b->mn[s] / (b->ks[s] * polar);
+    return e;
 }
 
 static double KERNEL(critical_dt)(sx_model *m);
@@ -437,8 +535,71 @@ static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64
                     KERNEL(critical_dt)(m));
 }
 
-/* Ball-ball contacts: 4-1 ... 4-21 with the linear law 4-22/4-23 and the
- * contact dashpots. The total force F acts on b and -F on a. */
+static void log_crack(sx_model *m, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int64_t i, int64_t j,
+                      double fn, double fs, double mn, double ms)
+{
+    sx_crack c;
+    memset(&c, 0, sizeof c);
+    c.time = m->time;
+    c.step = m->step;
+    for (int k = 0; k < D; k++) c.pos[k] = xc[k];
+    c.mode = mode;
+    c.kind = kind;
+    c.a = m->balls.id[i];
+    c.b = m->balls.id[j];
+    c.fn = fn, c.fs = fs, c.mn = mn, c.ms = ms;
+    sx__crack_log(m, &c);
+}
+
+/* The parallel bond of pair (i, j), 4-32 ... 4-39: carried with the contact,
+ * incremented from the relative motion, checked against its strengths.
+ * Adds its force to F (on j) and its moment to mb (on j). Returns false
+ * when it broke. */
+static bool parallel_bond(sx_model *m, int32_t s, const carry *rot, const double *n, double vn, const double *vs,
+                          const double *dtheta, const double *xc, int64_t i, int64_t j, double *F, double *mb)
+{
+    sx_bonds *b = &m->bonds;
+    const double dt = m->dt, rbar = b->rbar[s];
+    double area, inertia, polar;
+    pb_section(rbar, &area, &inertia, &polar);
+    double *fs = b->fs + s * D, *ms = b->ms + s * RD;
+    carry_apply(rot, fs);
+#if D == 3
+    carry_apply(rot, ms);
+#endif
+    b->fn[s] += b->kn[s] * area * (-vn * dt); /* 4-33, compression positive */
+    for (int k = 0; k < D; k++) fs[k] -= b->ks[s] * area * vs[k] * dt; /* 4-33 with dUs (seed typo corrected) */
+#if D == 3
+    const double twist = dot(dtheta, n);
+    b->mn[s] -= b->ks[s] * polar * twist; /* 4-34 */
+    for (int k = 0; k < 3; k++) ms[k] -= b->kn[s] * inertia * (dtheta[k] - twist * n[k]);
+#else
+    (void)polar;
+    ms[0] -= b->kn[s] * inertia * dtheta[0];
+#endif
+    double ms2 = 0;
+    for (int k = 0; k < RD; k++) ms2 += ms[k] * ms[k];
+    const double msn = sqrt(ms2), fsn = sqrt(dot(fs, fs)), mnn = fabs(b->mn[s]);
+    /* 4-38 as corrected: magnitudes, the twist only in 3D */
+    const double sigma = -b->fn[s] / area + msn * rbar / inertia;
+    const double tau = fsn / area + (D == 3 ? mnn * rbar / polar : 0);
+    if (sigma >= b->sigma_c[s] || tau >= b->tau_c[s]) {
+        const bool tension = sigma / b->sigma_c[s] >= tau / b->tau_c[s];
+        log_crack(m, xc, tension ? SX_CRACK_TENSION : SX_CRACK_SHEAR, SX_BOND_PARALLEL, i, j, b->fn[s], fsn, mnn, msn);
+        if (m->track_energy) m->acc.bond_released += pb_strain(b, s);
+        return false;
+    }
+    for (int k = 0; k < D; k++) F[k] += b->fn[s] * n[k] + fs[k]; /* 4-32 */
+#if D == 3
+    for (int k = 0; k < 3; k++) mb[k] += b->mn[s] * n[k] + ms[k];
+#else
+    mb[0] += ms[0];
+#endif
+    return true;
+}
+
+/* Ball-ball contacts: 4-1 ... 4-21 with the contact models of 4.3.3 - 4.3.5.
+ * The total force F acts on b and -F on a. */
 static sx_status ball_contacts(sx_model *m)
 {
     sx_balls *B = &m->balls;
@@ -447,12 +608,21 @@ static sx_status ball_contacts(sx_model *m)
     double *f = B->f, *t = B->t;
     const double dt = m->dt;
     const int nlaw = m->law_n;
+    const bool track = m->track_energy;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c], j = p->b[c];
+        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
         double n[D];
         for (int k = 0; k < D; k++) n[k] = x[j * D + k] - x[i * D + k];
         const double d2 = dot(n, n), rsum = rad[i] + rad[j];
-        if (d2 >= rsum * rsum) {
+        const sx_pair_law *law = &m->law[B->mat[i] * nlaw + B->mat[j]];
+        double *fs = p->fs + c * D;
+        if (__builtin_expect(d2 >= rsum * rsum && slot < 0, 1)) {
+            if (p->touching[c] && track) { /* the shear spring's energy is released as the contact opens */
+                double kn, ks;
+                stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, 0, &kn, &ks);
+                if (!law->hertz && ks > 0) m->acc.slip += 0.5 * dot(fs, fs) / ks;
+            }
             p->touching[c] = 0;
             continue;
         }
@@ -463,10 +633,11 @@ static sx_status ball_contacts(sx_model *m)
         const double rmin = rad[i] < rad[j] ? rad[i] : rad[j];
         if (un > rmin) return overlap_error(m, "balls", B->id[i], B->id[j], un, rmin);
         const double la = rad[i] - 0.5 * un, lb = rad[j] - 0.5 * un;
-        double ra[D], rb[D];
+        double ra[D], rb[D], xc[D];
         for (int k = 0; k < D; k++) {
             ra[k] = la * n[k];
             rb[k] = -lb * n[k];
+            xc[k] = x[i * D + k] + ra[k];
         }
         /* 4-16: contact-point velocity of b relative to a */
         double va[D], vb[D], vc[D];
@@ -477,46 +648,92 @@ static sx_status ball_contacts(sx_model *m)
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k]; /* 4-17 */
 
-        const sx_pair_law *law = &m->law[B->mat[i] * nlaw + B->mat[j]];
-        const double fn = law->kn * un; /* 4-6 */
-        double *fs = p->fs + c * D;
-        double wn[D];
-#if D == 3
-        /* 4-9: mean spin of the two balls along the normal */
-        const double wbar = 0.5 * (dot(w + i * RD, n) + dot(w + j * RD, n));
-        for (int k = 0; k < D; k++) wn[k] = wbar * n[k];
-#endif
-        if (!p->touching[c]) {
-            for (int k = 0; k < D; k++) fs[k] = 0;
-            for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
-        }
-        const bool slip = shear_update(fs, p->nold + c * D, n, wn, dt, vs, law->ks, law->mu * fn);
-        for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
-        p->touching[c] = 1;
+        if (!p->touching[c])
+            for (int k = 0; k < D; k++) fs[k] = 0, p->nold[c * D + k] = n[k];
+        carry rot;
+        carry_make(&rot, p->nold + c * D, n, w + i * RD, w + j * RD, dt);
+        unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+        const unsigned bonds_before = bonds;
 
-        double ftot_n = fn, F[D];
-        double dsh[D] = {0};
-        if (law->beta_n > 0 || law->beta_s > 0) {
-            /* viscous dashpots at the critical-damping ratios, on the reduced mass */
-            const double mstar = 1.0 / (im[i] + im[j]);
-            ftot_n -= 2 * law->beta_n * sqrt(mstar * law->kn) * vn;
-            if (!slip) {
-                const double cs = 2 * law->beta_s * sqrt(mstar * law->ks);
-                for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
+        double kn, ks, fn = 0, F[D], mb[RD];
+        for (int k = 0; k < RD; k++) mb[k] = 0;
+        const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
+        bool slip = false;
+        if (active) {
+            fn = stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, un, &kn, &ks);
+            carry_apply(&rot, fs);
+            for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt; /* 4-18 ... 4-20 */
+            if (bonds & SX_BOND_CONTACT) {
+                const double fsn = sqrt(dot(fs, fs));
+                if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
+                    log_crack(m, xc, SX_CRACK_TENSION, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    if (track) m->acc.bond_released += 0.5 * fn * un + (ks > 0 ? 0.5 * fsn * fsn / ks : 0);
+                    bonds &= ~(unsigned)SX_BOND_CONTACT;
+                    fn = 0;
+                    for (int k = 0; k < D; k++) fs[k] = 0;
+                } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
+                    log_crack(m, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    bonds &= ~(unsigned)SX_BOND_CONTACT;
+                }
             }
+            if (!(bonds & SX_BOND_CONTACT)) {
+                if (un <= 0) { /* unbonded and open: no contact force */
+                    fn = 0;
+                    for (int k = 0; k < D; k++) fs[k] = 0;
+                }
+                /* 4-30/4-31: Coulomb slip with the smaller friction */
+                const double fmax = law->mu * (fn > 0 ? fn : 0);
+                const double f2 = dot(fs, fs);
+                if (f2 > fmax * fmax) {
+                    const double sc = fmax / sqrt(f2);
+                    if (track && ks > 0) m->acc.slip += 0.5 * f2 * (1 - sc * sc) / ks;
+                    for (int k = 0; k < D; k++) fs[k] *= sc;
+                    slip = true;
+                }
+            }
+            double fd = fn;
+            double dsh[D];
+            for (int k = 0; k < D; k++) dsh[k] = 0;
+            if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
+                /* viscous dashpots at the critical-damping ratios, on the reduced mass */
+                const double mstar = 1.0 / (im[i] + im[j]);
+                const double fdn = -2 * law->beta_n * sqrt(mstar * kn) * vn;
+                fd += fdn;
+                double work = fdn * vn;
+                if (!slip) {
+                    const double cs = 2 * law->beta_s * sqrt(mstar * ks);
+                    for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
+                    work += dot(dsh, vs);
+                }
+                if (track) m->acc.viscous -= work * dt;
+            }
+            for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k]; /* 4-5 */
+        } else {
+            for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
         }
-        for (int k = 0; k < D; k++) F[k] = ftot_n * n[k] + fs[k] + dsh[k]; /* 4-5 */
-        /* 4-21 */
-        double ma[RD], mb[RD];
+        if (bonds & SX_BOND_PARALLEL) {
+            double dtheta[RD];
+            for (int k = 0; k < RD; k++) dtheta[k] = (w[j * RD + k] - w[i * RD + k]) * dt;
+            if (!parallel_bond(m, slot, &rot, n, vn, vs, dtheta, xc, i, j, F, mb))
+                bonds &= ~(unsigned)SX_BOND_PARALLEL;
+        }
+        if (bonds != bonds_before) {
+            sx__bond_break(m, slot, bonds_before & ~bonds);
+            if (!bonds) p->bond[c] = 0;
+        }
+        for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
+        p->touching[c] = active || bonds;
+        /* 4-21 and 4-39 */
+        double ma[RD], mbc[RD];
         moment_of(ra, F, ma);
-        moment_of(rb, F, mb);
+        moment_of(rb, F, mbc);
         for (int k = 0; k < D; k++) {
             f[i * D + k] -= F[k];
             f[j * D + k] += F[k];
         }
         for (int k = 0; k < RD; k++) {
-            t[i * RD + k] -= ma[k];
-            t[j * RD + k] += mb[k];
+            t[i * RD + k] -= ma[k] + mb[k];
+            t[j * RD + k] += mbc[k] + mb[k];
         }
     }
     return SX_OK;
@@ -529,13 +746,21 @@ static sx_status wall_contacts(sx_model *m)
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bw;
     const double dt = m->dt;
+    const bool track = m->track_energy;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c];
         sx_wall *wl = &m->walls[p->b[c]];
         const double *xi = B->x + i * D, r = B->rad[i];
+        double *fs = p->fs + c * D;
         double n[D];
         const double dist = wall_distance(wl, xi, n);
+        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         if (dist >= r) {
+            if (p->touching[c] && track && !law.hertz) {
+                double kn, ks;
+                stiffness(&law, r, 0, r, 0, &kn, &ks);
+                if (ks > 0) m->acc.slip += 0.5 * dot(fs, fs) / ks;
+            }
             p->touching[c] = 0;
             continue;
         }
@@ -553,31 +778,40 @@ static sx_status wall_contacts(sx_model *m)
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
 
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
-        const double fn = law.kn * un;
-        double *fs = p->fs + c * D;
-        double wn[D];
-#if D == 3
-        /* 4-9/4-10 with a wall that does not spin */
-        const double wbar = 0.5 * dot(B->w + i * RD, n);
-        for (int k = 0; k < D; k++) wn[k] = wbar * n[k];
-#endif
+        double kn, ks;
+        const double fn = stiffness(&law, r, 0, r, un, &kn, &ks);
         if (!p->touching[c])
             for (int k = 0; k < D; k++) fs[k] = 0, p->nold[c * D + k] = n[k];
-        const bool slip = shear_update(fs, p->nold + c * D, n, wn, dt, vs, law.ks, law.mu * fn);
+        carry rot;
+        carry_make(&rot, p->nold + c * D, n, NULL, B->w + i * RD, dt);
+        carry_apply(&rot, fs);
+        for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt;
+        const double fmax = law.mu * fn, f2 = dot(fs, fs);
+        bool slip = false;
+        if (f2 > fmax * fmax) {
+            const double sc = fmax / sqrt(f2);
+            if (track && ks > 0) m->acc.slip += 0.5 * f2 * (1 - sc * sc) / ks;
+            for (int k = 0; k < D; k++) fs[k] *= sc;
+            slip = true;
+        }
         for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
         p->touching[c] = 1;
 
-        double ftot_n = fn, dsh[D] = {0}, F[D];
+        double fd = fn, dsh[D], F[D];
+        for (int k = 0; k < D; k++) dsh[k] = 0;
         if (law.beta_n > 0 || law.beta_s > 0) {
             const double mass = 1.0 / B->inv_mass[i];
-            ftot_n -= 2 * law.beta_n * sqrt(mass * law.kn) * vn;
+            const double fdn = -2 * law.beta_n * sqrt(mass * kn) * vn;
+            fd += fdn;
+            double work = fdn * vn;
             if (!slip) {
-                const double cs = 2 * law.beta_s * sqrt(mass * law.ks);
+                const double cs = 2 * law.beta_s * sqrt(mass * ks);
                 for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
+                work += dot(dsh, vs);
             }
+            if (track) m->acc.viscous -= work * dt;
         }
-        for (int k = 0; k < D; k++) F[k] = ftot_n * n[k] + fs[k] + dsh[k];
+        for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k];
         double mb[RD], mw[RD], arm[D];
         moment_of(rb, F, mb);
         for (int k = 0; k < D; k++) {
@@ -615,7 +849,11 @@ static sx_status KERNEL(contacts)(sx_model *m)
     }
     sx_status st = ball_contacts(m);
     if (st) return st;
-    return wall_contacts(m);
+    if ((st = wall_contacts(m))) return st;
+    if (m->track_energy) /* boundary work of the moving walls over this step */
+        for (int64_t w = 0; w < m->nwall; w++)
+            m->acc.boundary_work -= dot(m->walls[w].force, m->walls[w].def.vel) * m->dt;
+    return SX_OK;
 }
 
 /* --------------------------------------------------------- law of motion */
@@ -628,13 +866,16 @@ static inline double damped(double force, double vel, double alpha)
 }
 
 /* 4-46 ... 4-48: central differences, velocities at half steps. Returns the
- * largest displacement since the last build in *max_disp. */
+ * largest displacement since the last build in *max_disp. With energy
+ * tracking, the damping's and applied loads' work use the mean of the old
+ * and new velocities. */
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     sx_balls *B = &m->balls;
     const double dt = m->dt;
     const double *g = m->gravity;
-    double worst = 0;
+    const bool track = m->track_energy;
+    double worst = 0, damp_work = 0, load_work = 0;
     for (int64_t i = 0; i < B->n; i++) {
         const unsigned fix = B->fix[i];
         const double a = B->alpha[i], im = B->inv_mass[i], ii = B->inv_inertia[i];
@@ -644,7 +885,13 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         for (int k = 0; k < D; k++) {
             if (!(fix & (SX_FIX_VX << k))) {
                 const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
-                v[k] += damped(force, v[k], a) * im * dt; /* 4-46 */
+                const double fd = damped(force, v[k], a);
+                const double vold = v[k];
+                v[k] += fd * im * dt; /* 4-46 */
+                if (track) {
+                    damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
+                    if (B->fapp) load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
+                }
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - B->x_build[i * D + k];
@@ -653,7 +900,15 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         double *w = B->w + i * RD;
         const double *t = B->t + i * RD;
         for (int k = 0; k < RD; k++)
-            if (!(fix & (SX_FIX_WX << k))) w[k] += damped(t[k], w[k], a) * ii * dt; /* 4-47 */
+            if (!(fix & (SX_FIX_WX << k))) {
+                const double md = damped(t[k], w[k], a);
+                const double wold = w[k];
+                w[k] += md * ii * dt; /* 4-47 */
+                if (track) {
+                    damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
+                    if (B->tapp) load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
+                }
+            }
         bool ok = true;
         for (int k = 0; k < D; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
         for (int k = 0; k < RD; k++) ok &= isfinite(w[k]);
@@ -664,17 +919,26 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
                             (long long)m->step, (long long)B->id[i], m->dt, KERNEL(critical_dt)(m));
         if (disp2 > worst) worst = disp2;
     }
+    if (track) {
+        m->acc.local_damping -= damp_work;
+        m->acc.boundary_work += load_work;
+    }
     *max_disp = sqrt(worst);
     return SX_OK;
 }
 
 /* -------------------------------------------------------------- timestep */
 
+/* Hertz has no stiffness at zero overlap: a free Hertz ball is rated at the
+ * tangent stiffness of this overlap, a fraction of its radius. */
+#define HERTZ_REFERENCE_OVERLAP 0.01
+
 /* PFC-style estimate: for each ball sqrt(m / k_tran) with k_tran the sum of
- * its contacts' normal and shear stiffnesses, and sqrt(I / k_rot) with
- * k_rot = sum ks l^2 (l the lever arm). A ball without contacts is taken as
- * if touching one entity with its own stiffnesses, so the first impact is
- * already resolved. */
+ * its contacts' (tangent) normal and shear stiffnesses, bonds included, and
+ * sqrt(I / k_rot) with k_rot = sum ks l^2 plus the bonds' rotational
+ * stiffness. A ball is never rated below its own stiffness (as if touching
+ * one entity like itself), so the first impact is already resolved and the
+ * timestep does not jump as contacts form. */
 static double KERNEL(critical_dt)(sx_model *m)
 {
     sx_balls *B = &m->balls;
@@ -687,33 +951,58 @@ static double KERNEL(critical_dt)(sx_model *m)
     const sx_pairs *p = &m->bb;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c], j = p->b[c];
+        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
         double dx[D];
         for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
-        const double rsum = B->rad[i] + B->rad[j];
-        if (dot(dx, dx) >= rsum * rsum) continue;
+        const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
         const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
-        kt[i] += law->kn + law->ks;
-        kt[j] += law->kn + law->ks;
-        kr[i] += law->ks * B->rad[i] * B->rad[i];
-        kr[j] += law->ks * B->rad[j] * B->rad[j];
+        double ktr = 0, krot_i = 0, krot_j = 0;
+        if (un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT))) {
+            double kn, ks;
+            stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
+            if (law->hertz) kn *= 1.5; /* 4-29 */
+            ktr = kn + ks;
+            krot_i = ks * B->rad[i] * B->rad[i];
+            krot_j = ks * B->rad[j] * B->rad[j];
+        }
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) {
+            const sx_bonds *b = &m->bonds;
+            double area, inertia, polar;
+            pb_section(b->rbar[slot], &area, &inertia, &polar);
+            ktr += (b->kn[slot] + b->ks[slot]) * area;
+            const double krb = b->kn[slot] * inertia + b->ks[slot] * polar;
+            krot_i += krb + b->ks[slot] * area * B->rad[i] * B->rad[i];
+            krot_j += krb + b->ks[slot] * area * B->rad[j] * B->rad[j];
+        }
+        kt[i] += ktr;
+        kt[j] += ktr;
+        kr[i] += krot_i;
+        kr[j] += krot_j;
     }
     p = &m->bw;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c];
         double nrm[D];
-        if (wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm) >= B->rad[i]) continue;
+        const double un = B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
+        if (un <= 0) continue;
         const sx_pair_law law = sx__wall_law(m, B->mat[i], &m->walls[p->b[c]]);
-        kt[i] += law.kn + law.ks;
-        kr[i] += law.ks * B->rad[i] * B->rad[i];
+        double kn, ks;
+        stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
+        if (law.hertz) kn *= 1.5;
+        kt[i] += kn + ks;
+        kr[i] += ks * B->rad[i] * B->rad[i];
     }
     double best = INFINITY;
     for (int64_t i = 0; i < n; i++) {
-        double ktr = kt[i], krot = kr[i];
-        if (ktr == 0) {
-            const sx_material_def *md = &m->mats[B->mat[i]].def;
-            ktr = md->kn + md->ks;
-            krot = md->ks * B->rad[i] * B->rad[i];
-        }
+        /* the ball's own rating: a contact with an entity of its own stiffness */
+        const sx_pair_law *self = &m->law[B->mat[i] * m->law_n + B->mat[i]];
+        const double r = B->rad[i];
+        double kn, ks;
+        stiffness(self, r, r, r, HERTZ_REFERENCE_OVERLAP * r, &kn, &ks);
+        if (self->hertz) kn *= 1.5;
+        else kn *= 2, ks *= 2; /* undo the series combination with itself */
+        const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
+        const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
         const double dtt = sqrt(1.0 / (B->inv_mass[i] * ktr));
         if (dtt < best) best = dtt;
         if (krot > 0) {
@@ -736,10 +1025,24 @@ static double pair_geometry(const sx_model *m, int64_t i, int64_t j, double *n)
     return B->rad[i] + B->rad[j] - d;
 }
 
+/* Normal force and stiffnesses of a stored ball-ball pair from its geometry. */
+static double pair_force(const sx_model *m, int64_t c, double un, double *kn, double *ks)
+{
+    const sx_balls *B = &m->balls;
+    const int64_t i = m->bb.a[c], j = m->bb.b[c];
+    const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
+    const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+    const bool active = un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT));
+    const double rsum = B->rad[i] + B->rad[j];
+    const double fn = stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, kn, ks);
+    return active ? fn : 0;
+}
+
 static void KERNEL(energy)(const sx_model *m, sx_energy *e)
 {
     const sx_balls *B = &m->balls;
-    memset(e, 0, sizeof *e);
+    *e = m->acc;
+    e->kinetic = e->gravitational = e->strain = e->bond_strain = 0;
     for (int64_t i = 0; i < B->n; i++) {
         const double *v = B->v + i * D, *w = B->w + i * RD;
         double ww = 0;
@@ -749,33 +1052,31 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
     }
     for (int64_t c = 0; c < m->bb.n; c++) {
         if (!m->bb.touching[c]) continue;
-        double n[D];
+        double n[D], kn, ks;
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
-        const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
-        const double *fs = m->bb.fs + c * D;
-        if (un > 0) e->strain += 0.5 * law->kn * un * un;
-        if (law->ks > 0) e->strain += 0.5 * dot(fs, fs) / law->ks;
+        const double fn = pair_force(m, c, un, &kn, &ks);
+        const bool hertz = m->law[B->mat[i] * m->law_n + B->mat[j]].hertz;
+        e->strain += contact_strain(hertz, fn, un, m->bb.fs + c * D, ks);
+        const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
     }
     for (int64_t c = 0; c < m->bw.n; c++) {
         if (!m->bw.touching[c]) continue;
-        double n[D];
+        double n[D], kn, ks;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
         const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
-        const double *fs = m->bw.fs + c * D;
-        if (un > 0) e->strain += 0.5 * law.kn * un * un;
-        if (law.ks > 0) e->strain += 0.5 * dot(fs, fs) / law.ks;
+        const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
+        if (un > 0) e->strain += contact_strain(law.hertz, fn, un, m->bw.fs + c * D, ks);
     }
 }
 
 static void fill_info(sx_contact_info *ci, const double *n, const double *xc, double un, double fn,
-                      const double *fs, const sx_pair_law *law)
+                      const double *fs, double kn, double ks)
 {
-    memset(ci->normal, 0, sizeof ci->normal);
-    memset(ci->point, 0, sizeof ci->point);
-    memset(ci->shear, 0, sizeof ci->shear);
+    memset(ci, 0, sizeof *ci);
     for (int k = 0; k < D; k++) {
         ci->normal[k] = n[k];
         ci->point[k] = xc[k];
@@ -783,8 +1084,8 @@ static void fill_info(sx_contact_info *ci, const double *n, const double *xc, do
     }
     ci->overlap = un;
     ci->fn = fn;
-    ci->kn = law->kn;
-    ci->ks = law->ks;
+    ci->kn = kn;
+    ci->ks = ks;
 }
 
 static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
@@ -794,25 +1095,40 @@ static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_
     for (int64_t c = 0; c < m->bb.n; c++) {
         if (!m->bb.touching[c]) continue;
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
-        double n[D], xc[D];
+        double n[D], xc[D], kn, ks;
         const double un = pair_geometry(m, i, j, n);
         for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] + (B->rad[i] - 0.5 * un) * n[k];
-        const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
-        fill_info(&ci, n, xc, un, law->kn * un, m->bb.fs + c * D, law);
+        const double f = pair_force(m, c, un, &kn, &ks);
+        fill_info(&ci, n, xc, un, f, m->bb.fs + c * D, kn, ks);
         ci.a = B->id[i];
         ci.b = B->id[j];
-        ci.is_wall = false;
+        const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+        if (slot >= 0) {
+            const sx_bonds *b = &m->bonds;
+            ci.bond = b->kind[slot];
+            if (b->kind[slot] & SX_BOND_PARALLEL) {
+                ci.pb_fn = b->fn[slot];
+                ci.pb_radius = b->rbar[slot];
+                for (int k = 0; k < D; k++) ci.pb_fs[k] = b->fs[slot * D + k];
+#if D == 3
+                for (int k = 0; k < 3; k++) ci.pb_moment[k] = b->mn[slot] * n[k] + b->ms[slot * 3 + k];
+#else
+                ci.pb_moment[0] = b->ms[slot];
+#endif
+            }
+        }
         if (!fn(&ci, ud)) return false;
     }
     for (int64_t c = 0; c < m->bw.n; c++) {
         if (!m->bw.touching[c]) continue;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
-        double n[D], xc[D];
+        double n[D], xc[D], kn = 0, ks = 0;
         const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
         for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] - (B->rad[i] - 0.5 * un) * n[k];
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
-        fill_info(&ci, n, xc, un, law.kn * un, m->bw.fs + c * D, &law);
+        const double f = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
+        fill_info(&ci, n, xc, un, f, m->bw.fs + c * D, kn, ks);
         ci.a = B->id[i];
         ci.b = wl->id;
         ci.is_wall = true;

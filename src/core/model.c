@@ -75,6 +75,7 @@ void sx_model_destroy(sx_model *m)
     sx__pairs_free(m, &m->bb);
     sx__pairs_free(m, &m->bw);
     sx__walls_free(m);
+    sx__bonds_free(m);
     sx_alloc_free(&m->alloc, m->grid.start, (size_t)m->grid.cap_cells, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->grid.cell_of, (size_t)m->grid.cap_balls, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
@@ -117,10 +118,14 @@ sx_material_def sx_material_default_def(void)
 {
     sx_material_def d;
     memset(&d, 0, sizeof d);
+    d.model = SX_MODEL_LINEAR;
     d.density = 2650;
     d.kn = 1e8;
     d.ks = 1e8;
     d.friction = 0.5;
+    d.stiffness_ratio = 1;
+    d.shear_modulus = 29e9;
+    d.poisson = 0.15;
     return d;
 }
 
@@ -160,6 +165,14 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     CHECK(d->damping >= 0 && d->damping < 1, "local damping must be in [0, 1)", d->damping);
     CHECK(d->viscous_normal >= 0, "viscous_normal must be >= 0", d->viscous_normal);
     CHECK(d->viscous_shear >= 0, "viscous_shear must be >= 0", d->viscous_shear);
+    CHECK(d->modulus >= 0, "modulus must be >= 0 Pa (0: use kn, ks)", d->modulus);
+    CHECK(d->stiffness_ratio > 0, "stiffness_ratio (kn/ks) must be > 0", d->stiffness_ratio);
+    if (d->model != SX_MODEL_LINEAR && d->model != SX_MODEL_HERTZ)
+        return sx__fail(m, SX_EINVAL, "material '%s': model must be linear or hertz", name);
+    if (d->model == SX_MODEL_HERTZ) {
+        CHECK(d->shear_modulus > 0, "the Hertz shear modulus must be > 0 Pa", d->shear_modulus);
+        CHECK(d->poisson >= 0 && d->poisson < 0.5, "the Hertz Poisson's ratio must be in [0, 0.5)", d->poisson);
+    }
 #undef CHECK
     int i = sx_material_find(m, name);
     if (i < 0) {
@@ -187,22 +200,36 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     return SX_OK;
 }
 
-/* 4-22, 4-23 (springs in series), 4-30 (the smaller friction). */
-static sx_pair_law combine(const sx_material_def *a, double kn, double ks, double mu, double bn, double bs)
+static double series(double a, double b) { return a + b > 0 ? a * b / (a + b) : 0; }
+
+/* 4-22, 4-23 (springs in series), 4-30 (the smaller friction); a is a
+ * material, the other side given by its stiffnesses (a material's or a wall's). */
+static sx_pair_law combine(const sx_material_def *a, double kn, double ks, double ec, double ratio, double mu,
+                           double bn, double bs)
 {
     sx_pair_law l;
-    l.kn = a->kn * kn / (a->kn + kn);
-    l.ks = a->ks + ks > 0 ? a->ks * ks / (a->ks + ks) : 0;
+    memset(&l, 0, sizeof l);
+    l.kn = series(a->kn, kn);
+    l.ks = series(a->ks, ks);
     l.mu = a->friction < mu ? a->friction : mu;
     l.beta_n = bn;
     l.beta_s = bs;
+    l.per_radius = a->modulus > 0 || ec > 0;
+    l.kn_a = a->kn, l.ks_a = a->ks, l.ec_a = a->modulus, l.ratio_a = a->stiffness_ratio;
+    l.kn_b = kn, l.ks_b = ks, l.ec_b = ec, l.ratio_b = ratio;
     return l;
 }
 
+/* A ball against a wall: the wall's springs in series; Hertz uses the
+ * ball's own G and nu (4-28). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
 {
     const sx_material_def *a = &m->mats[mat].def;
-    return combine(a, w->def.kn, w->def.ks, w->def.friction, a->viscous_normal, a->viscous_shear);
+    sx_pair_law l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
+    l.hertz = a->model == SX_MODEL_HERTZ;
+    l.g = a->shear_modulus;
+    l.nu = a->poisson;
+    return l;
 }
 
 static sx_status refresh_laws(sx_model *m)
@@ -217,9 +244,33 @@ static sx_status refresh_laws(sx_model *m)
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
             const sx_material_def *a = &m->mats[i].def, *b = &m->mats[j].def;
-            m->law[i * n + j] = combine(a, b->kn, b->ks, b->friction, 0.5 * (a->viscous_normal + b->viscous_normal),
-                                        0.5 * (a->viscous_shear + b->viscous_shear));
+            sx_pair_law *l = &m->law[i * n + j];
+            *l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
+                         0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
+            /* 4-27: a Hertz pair uses the means of G and nu */
+            l->hertz = a->model == SX_MODEL_HERTZ && b->model == SX_MODEL_HERTZ;
+            l->g = 0.5 * (a->shear_modulus + b->shear_modulus);
+            l->nu = 0.5 * (a->poisson + b->poisson);
         }
+    return SX_OK;
+}
+
+/* Pairs mixing a Hertz material with a linear one are refused where balls
+ * of both exist (the model of such a contact would be ambiguous). */
+static sx_status check_models(sx_model *m)
+{
+    bool used_hertz = false, used_linear = false;
+    int hertz = -1, linear = -1;
+    for (int64_t i = 0; i < m->balls.n; i++) {
+        const int k = m->balls.mat[i];
+        if (m->mats[k].def.model == SX_MODEL_HERTZ) used_hertz = true, hertz = k;
+        else used_linear = true, linear = k;
+    }
+    if (used_hertz && used_linear)
+        return sx__fail(m, SX_EINVAL,
+                        "contact model: balls of material '%s' (hertz) and '%s' (linear) may touch; "
+                        "a contact between Hertz and linear materials is not defined: use one model for both",
+                        m->mats[hertz].name, m->mats[linear].name);
     return SX_OK;
 }
 
@@ -233,9 +284,10 @@ static double mean_radius(const sx_model *m)
 }
 
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
-static sx_status prepare(sx_model *m)
+sx_status sx__prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
+    if (!st) st = check_models(m);
     if (st) return st;
     if (m->build_needed) {
         m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
@@ -262,14 +314,14 @@ static sx_status update_timestep(sx_model *m)
 
 double sx_model_critical_timestep(sx_model *m)
 {
-    if (prepare(m)) return NAN;
+    if (sx__prepare(m)) return NAN;
     return kernels(m)->critical_dt(m);
 }
 
 double sx_model_timestep(sx_model *m)
 {
     if (m->dt_user > 0) return m->dt_user;
-    if (prepare(m) || update_timestep(m)) return NAN;
+    if (sx__prepare(m) || update_timestep(m)) return NAN;
     return m->dt;
 }
 
@@ -372,7 +424,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
     if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
     m->err[0] = 0;
     m->interrupt = 0;
-    sx_status st = prepare(m);
+    sx_status st = sx__prepare(m);
     if (st) return st;
     if ((st = update_timestep(m))) return st;
     const sx_kernels *k = kernels(m);
@@ -454,6 +506,12 @@ sx_energy sx_model_energy(const sx_model *m)
     if (refresh_laws((sx_model *)m)) return e;
     kernels(m)->energy(m, &e);
     return e;
+}
+
+void sx_model_track_energy(sx_model *m, bool on)
+{
+    m->track_energy = on;
+    memset(&m->acc, 0, sizeof m->acc);
 }
 
 int64_t sx_contact_count(const sx_model *m) { return kernels(m)->count_contacts(m); }

@@ -22,7 +22,30 @@
 typedef struct sx_material {
     char name[64];
     sx_material_def def;
+    sx_bpm_def bpm;
 } sx_material;
+
+/* Bonds live apart from pairs, so an unbonded scene stores none. A pair
+ * refers to its bond by slot (pairs.bond, allocated with the first bond);
+ * slots are never reused. Vectors are expressed for the pair's a -> b
+ * orientation, like the pair's shear force. */
+typedef struct sx_bonds {
+    int64_t n, cap, intact;
+    uint8_t *kind;          /* SX_BOND_* bits still intact */
+    int32_t *ida, *idb;     /* the balls, by id (the pair may be re-sorted) */
+    double *cb_n, *cb_s;    /* contact-bond strengths, N */
+    double *rbar, *kn, *ks; /* parallel bond: radius (4-53), stiffnesses per area (4-51/4-52) */
+    double *sigma_c, *tau_c;/* parallel-bond strengths, Pa */
+    double *fn;             /* normal force, compression positive */
+    double *fs;             /* shear force (dim) */
+    double *mn;             /* twisting moment about n (3D only; scalar) */
+    double *ms;             /* bending moment (3D: vector, 2D: scalar) */
+} sx_bonds;
+
+typedef struct sx_cracks {
+    int64_t n, cap;
+    sx_crack *ev;
+} sx_cracks;
 
 /* Balls: hot arrays first. */
 typedef struct sx_balls {
@@ -61,7 +84,8 @@ typedef struct sx_pairs {
     int32_t *a, *b;
     double *fs;            /* shear force (dim) */
     double *nold;          /* previous normal (dim) */
-    uint8_t *touching;
+    uint8_t *touching;     /* history is live (touching, or bonded) */
+    int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
 } sx_pairs;
 
 typedef struct sx_grid {
@@ -73,10 +97,18 @@ typedef struct sx_grid {
     int64_t cap_balls;
 } sx_grid;
 
-/* Contact parameters of a pair of materials (4-22, 4-23, 4-30). */
+/* Contact parameters of a pair of materials, or of a material and a wall
+ * (4-22, 4-23, 4-27/4-28, 4-30, 4-49/4-50). */
 typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
+    bool hertz;             /* Hertz-Mindlin with g, nu (the means, 4-27) */
+    double g, nu;
+    /* BPM modulus mode (4-49/4-50): a side with ec > 0 has kn = 4 R ec (3D)
+     * or 2 ec (2D) and ks = kn / ratio, put in series per contact; a side
+     * with ec = 0 keeps its kn, ks. */
+    bool per_radius;
+    double kn_a, ks_a, ec_a, ratio_a, kn_b, ks_b, ec_b, ratio_b;
 } sx_pair_law;
 
 struct sx_model {
@@ -111,6 +143,11 @@ struct sx_model {
     int64_t scratch_cap;
     sx_grid grid;
     int64_t builds;         /* number of broad-phase builds so far */
+
+    sx_bonds bonds;
+    sx_cracks cracks;
+    bool track_energy;
+    sx_energy acc;          /* accumulated energy terms (slip, damping, work, ...) */
 
     /* stability guard: mechanical energy at the start of the current cycle */
     double guard_e0, guard_scale;
@@ -147,5 +184,15 @@ void sx__wall_prepare(sx_model *m, sx_wall *w);
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);
 double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */
+/* Records a broken bond; false when out of memory (the event is dropped). */
+bool sx__crack_log(sx_model *m, const sx_crack *c);
+/* Drops kind bits from a bond; the bond's slot stays, and intact counts follow. */
+void sx__bond_break(sx_model *m, int32_t slot, unsigned kind);
+sx_status sx__bonds_reserve_pairs(sx_model *m); /* allocates pairs.bond when bonds appear */
+/* Re-expresses a bond's vectors for the reversed pair orientation (b -> a). */
+void sx__bond_flip(sx_model *m, int32_t slot);
+void sx__bonds_free(sx_model *m);
+/* Laws refreshed and broad phase built if needed (before queries and cycles). */
+sx_status sx__prepare(sx_model *m);
 /* Law of a ball of material `mat` against a wall (wall stiffness in series). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);

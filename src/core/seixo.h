@@ -85,17 +85,30 @@ SX_API size_t sx_model_bytes(const sx_model *m);
 
 /* ------------------------------------------------------------ materials */
 
+typedef enum sx_contact_model {
+    SX_MODEL_LINEAR = 0,  ///< linear springs kn, ks in series (4-22/4-23)
+    SX_MODEL_HERTZ = 1,   ///< Hertz-Mindlin from shear_modulus and poisson (4-25 ... 4-29)
+} sx_contact_model;
+
 typedef struct sx_material_def {
+    sx_contact_model model; ///< a ball-ball pair uses Hertz only if both materials are Hertz;
+                            ///< mixing Hertz with linear is refused when cycling
     double density;         ///< kg/m^3 (> 0)
     double kn;              ///< N/m, normal stiffness of the ball (springs in series, 4-22)
     double ks;              ///< N/m, shear stiffness of the ball (4-23)
+    double modulus;         ///< Pa, BPM contact modulus Ec (4-49): if > 0, kn = 2 Ec (2D) or
+                            ///< 4 R Ec (3D) per ball and ks = kn / stiffness_ratio; kn, ks ignored
+    double stiffness_ratio; ///< kn/ks for the BPM modulus (4-50), > 0
+    double shear_modulus;   ///< Pa, Hertz G (> 0 for Hertz)
+    double poisson;         ///< Hertz Poisson's ratio in [0, 0.5)
     double friction;        ///< Coulomb coefficient (>= 0); a contact uses the smaller (4-30)
     double damping;         ///< local (non-viscous) damping coefficient alpha in [0, 1)
     double viscous_normal;  ///< normal critical-damping ratio of the contact dashpot, >= 0
     double viscous_shear;   ///< shear critical-damping ratio of the contact dashpot, >= 0
 } sx_material_def;
 
-/// density 2650, kn = ks = 1e8, friction 0.5, no damping.
+/// Linear, density 2650, kn = ks = 1e8, friction 0.5, no damping, stiffness_ratio 1,
+/// Hertz G = 29 GPa, nu = 0.15 (used only when model is Hertz).
 SX_API sx_material_def sx_material_default_def(void);
 
 /// Adds a material, or redefines it if the name exists (balls using it get
@@ -214,12 +227,80 @@ typedef struct sx_contact_info {
     double overlap;      ///< m (4-3)
     double fn;           ///< N, normal force magnitude (compression positive)
     double shear[3];     ///< N, shear force on b
-    double kn, ks;       ///< N/m, contact stiffnesses
+    double kn, ks;       ///< N/m, contact stiffnesses (Hertz: secant normal, current shear)
+    unsigned bond;       ///< SX_BOND_* bits intact on this contact (0: unbonded)
+    double pb_fn;        ///< N, parallel-bond normal force (compression positive)
+    double pb_fs[3];     ///< N, parallel-bond shear force on b
+    double pb_moment[3]; ///< N m, parallel-bond moment on b (twist + bending; 2D: [0])
+    double pb_radius;    ///< m, parallel-bond radius (4-53)
 } sx_contact_info;
 
-/// Calls fn for every touching contact, in the store's deterministic order.
+/// Calls fn for every touching or bonded contact, in the store's deterministic order.
 /// Stops and returns false when fn returns false.
 SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
+
+/* ---------------------------------------------------------------- bonds */
+
+typedef enum sx_bond_kind {
+    SX_BOND_CONTACT = 1,   ///< contact bond: normal and shear strengths as forces (4.3.5)
+    SX_BOND_PARALLEL = 2,  ///< parallel bond: a cement disk/beam (4-32 ... 4-39)
+} sx_bond_kind;
+
+/// Bond installation, like PFC's: every ball-ball pair closer than `gap`
+/// (of the given materials) gets a bond. A parameter left at 0 takes the
+/// mean of the two materials' bond micro-parameters.
+typedef struct sx_bond_def {
+    sx_bond_kind kind;
+    double gap;                 ///< m, install where d - RA - RB < gap (>= 0)
+    uint64_t seed;              ///< seed of the per-bond strength draws
+    int material_a, material_b; ///< restrict to pairs of these materials (-1: any)
+    /* contact bond */
+    double normal_strength, normal_strength_sd; ///< N, tensile force to break (mean, std)
+    double shear_strength, shear_strength_sd;   ///< N, shear force to break (mean, std)
+    /* parallel bond */
+    double radius_multiplier;   ///< lambda-bar (4-53), > 0
+    double modulus;             ///< Pa, Ec-bar: kn-bar = Ec-bar / (RA + RB) (4-51)
+    double stiffness_ratio;     ///< kn-bar / ks-bar (4-52)
+    double tensile_strength, tensile_strength_sd; ///< Pa, sigma-bar_c (mean, std)
+    double cohesion, cohesion_sd;                 ///< Pa, tau-bar_c (mean, std)
+} sx_bond_def;
+
+/// Zero everywhere (take the materials' values), kind parallel, gap 0, seed 1, any materials.
+SX_API sx_bond_def sx_bond_default_def(void);
+/// Installs bonds; writes the number installed to *count (may be NULL).
+/// Refused for Hertz pairs (the seed: Hertz is not to be used with bonds).
+SX_API sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count);
+/// Number of intact bonds (a pair with both kinds counts once).
+SX_API int64_t sx_bond_count(const sx_model *m);
+
+/// The bonded-particle micro-parameters of a material (4.4), used by
+/// sx_bond_install where its def leaves a value at 0.
+typedef struct sx_bpm_def {
+    double radius_multiplier, modulus, stiffness_ratio;
+    double tensile_strength, tensile_strength_sd, cohesion, cohesion_sd;
+    double normal_strength, normal_strength_sd, shear_strength, shear_strength_sd;
+} sx_bpm_def;
+SX_API sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def);
+SX_API sx_status sx_material_get_bpm(const sx_model *m, int material, sx_bpm_def *out);
+
+typedef enum sx_crack_mode { SX_CRACK_TENSION = 1, SX_CRACK_SHEAR = 2 } sx_crack_mode;
+
+/// A broken bond.
+typedef struct sx_crack {
+    double time;          ///< s
+    int64_t step;
+    double pos[3];        ///< m, contact point (4-4)
+    sx_crack_mode mode;
+    sx_bond_kind kind;    ///< which bond broke
+    int64_t a, b;         ///< ball ids
+    double fn;            ///< N, normal force at failure (compression positive)
+    double fs;            ///< N, shear force magnitude at failure
+    double mn;            ///< N m, twisting moment magnitude at failure (parallel bond, 3D)
+    double ms;            ///< N m, bending moment magnitude at failure (parallel bond)
+} sx_crack;
+
+SX_API int64_t sx_crack_count(const sx_model *m);
+SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
 
 /* ------------------------------------------------------------- energies */
 
@@ -227,7 +308,17 @@ typedef struct sx_energy {
     double kinetic;        ///< J, translational + rotational
     double gravitational;  ///< J, -sum m g.x (zero at the origin)
     double strain;         ///< J, stored in contact springs
+    double bond_strain;    ///< J, stored in parallel bonds
+    /* accumulated since tracking was switched on (zero when off) */
+    double slip;           ///< J, dissipated by Coulomb slip (and shear springs released when contacts open)
+    double local_damping;  ///< J, dissipated by local damping
+    double viscous;        ///< J, dissipated by contact dashpots
+    double boundary_work;  ///< J, work done on the balls by moving walls and applied loads
+    double bond_released;  ///< J, strain energy released by bonds when they broke
 } sx_energy;
 
-/// Energies of the current state (computed on demand, O(N + contacts)).
+/// Energies of the current state (computed on demand, O(N + contacts)) and
+/// the accumulated terms.
 SX_API sx_energy sx_model_energy(const sx_model *m);
+/// Switches tracking of the accumulated terms on (reset to zero) or off.
+SX_API void sx_model_track_energy(sx_model *m, bool on);

@@ -1,0 +1,298 @@
+/* Bonds (contact and parallel, seed 4.3.5 and 4-32 ... 4-39), their
+ * installation from the bonded-particle micro-parameters (4.4), and the
+ * crack log of broken bonds. The bond forces themselves are computed with
+ * the contact in kernels.c. */
+#include "model_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+sx_bond_def sx_bond_default_def(void)
+{
+    sx_bond_def d;
+    memset(&d, 0, sizeof d);
+    d.kind = SX_BOND_PARALLEL;
+    d.seed = 1;
+    d.material_a = d.material_b = -1;
+    return d;
+}
+
+/* ------------------------------------------------------------- storage */
+
+#define GROW(field, per)                                                                     \
+    do {                                                                                     \
+        void *q = sx_alloc_resize(&m->alloc, b->field, (size_t)(b->cap * (per)),             \
+                                  (size_t)(cap * (per)), sizeof *b->field);                  \
+        if (!q) return SX_ENOMEM;                                                            \
+        b->field = q;                                                                        \
+    } while (0)
+
+static sx_status bonds_reserve(sx_model *m, int64_t cap)
+{
+    sx_bonds *b = &m->bonds;
+    if (cap <= b->cap) return SX_OK;
+    if (cap < 2 * b->cap) cap = 2 * b->cap;
+    if (cap < 256) cap = 256;
+    if (cap > INT32_MAX - 1) return SX_ENOMEM;
+    const int d = m->dim, r = m->rdim;
+    GROW(kind, 1);
+    GROW(ida, 1);
+    GROW(idb, 1);
+    GROW(cb_n, 1);
+    GROW(cb_s, 1);
+    GROW(rbar, 1);
+    GROW(kn, 1);
+    GROW(ks, 1);
+    GROW(sigma_c, 1);
+    GROW(tau_c, 1);
+    GROW(fn, 1);
+    GROW(fs, d);
+    GROW(mn, 1);
+    GROW(ms, r);
+    b->cap = cap;
+    return SX_OK;
+}
+#undef GROW
+
+void sx__bonds_free(sx_model *m)
+{
+    sx_bonds *b = &m->bonds;
+    const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
+    sx_alloc *a = &m->alloc;
+    sx_alloc_free(a, b->kind, c, 1);
+    sx_alloc_free(a, b->ida, c, sizeof(int32_t));
+    sx_alloc_free(a, b->idb, c, sizeof(int32_t));
+    double *scalars[] = {b->cb_n, b->cb_s, b->rbar, b->kn, b->ks, b->sigma_c, b->tau_c, b->fn, b->mn};
+    for (size_t k = 0; k < sizeof scalars / sizeof *scalars; k++) sx_alloc_free(a, scalars[k], c, sizeof(double));
+    sx_alloc_free(a, b->fs, c * d, sizeof(double));
+    sx_alloc_free(a, b->ms, c * r, sizeof(double));
+    memset(b, 0, sizeof *b);
+    sx_alloc_free(a, m->cracks.ev, (size_t)m->cracks.cap, sizeof *m->cracks.ev);
+    memset(&m->cracks, 0, sizeof m->cracks);
+}
+
+/* Only ball-ball pairs carry bonds. */
+sx_status sx__bonds_reserve_pairs(sx_model *m)
+{
+    sx_pairs *p = &m->bb;
+    if (p->bond || p->cap == 0) return SX_OK;
+    p->bond = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)p->cap, sizeof *p->bond);
+    return p->bond ? SX_OK : SX_ENOMEM;
+}
+
+void sx__bond_break(sx_model *m, int32_t slot, unsigned kind)
+{
+    sx_bonds *b = &m->bonds;
+    const unsigned before = b->kind[slot];
+    b->kind[slot] = (uint8_t)(before & ~kind);
+    if (before && !b->kind[slot]) b->intact--;
+}
+
+/* The twist (a scalar about n) and the normal force keep their sign when
+ * a and b swap; the shear force and bending moment on b become those on a. */
+void sx__bond_flip(sx_model *m, int32_t slot)
+{
+    sx_bonds *b = &m->bonds;
+    for (int k = 0; k < m->dim; k++) b->fs[slot * m->dim + k] = -b->fs[slot * m->dim + k];
+    for (int k = 0; k < m->rdim; k++) b->ms[slot * m->rdim + k] = -b->ms[slot * m->rdim + k];
+}
+
+bool sx__crack_log(sx_model *m, const sx_crack *c)
+{
+    sx_cracks *k = &m->cracks;
+    if (k->n == k->cap) {
+        const int64_t cap = k->cap ? 2 * k->cap : 256;
+        sx_crack *q = sx_alloc_resize(&m->alloc, k->ev, (size_t)k->cap, (size_t)cap, sizeof *q);
+        if (!q) return false;
+        k->ev = q;
+        k->cap = cap;
+    }
+    k->ev[k->n++] = *c;
+    return true;
+}
+
+int64_t sx_bond_count(const sx_model *m) { return m->bonds.intact; }
+int64_t sx_crack_count(const sx_model *m) { return m->cracks.n; }
+
+sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out)
+{
+    if (i < 0 || i >= m->cracks.n)
+        return sx__fail((sx_model *)m, SX_ENOTFOUND, "crack_get: no crack %lld (there are %lld)", (long long)i,
+                        (long long)m->cracks.n);
+    *out = m->cracks.ev[i];
+    return SX_OK;
+}
+
+/* ------------------------------------------------------- micro-parameters */
+
+static sx_status check_bpm(sx_model *m, const char *who, const double *v, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!(v[k] >= 0) || !isfinite(v[k]))
+            return sx__fail(m, SX_EINVAL, "%s: %s must be >= 0 (got %g)", who, names[k], v[k]);
+    return SX_OK;
+}
+
+static const char *const bpm_names[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
+                                        "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
+                                        "normal_strength_sd", "shear_strength", "shear_strength_sd"};
+
+sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def)
+{
+    if (material < 0 || material >= m->nmat)
+        return sx__fail(m, SX_ENOTFOUND, "material_set_bpm: no material with index %d", material);
+    const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
+                        def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
+                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd};
+    sx_status st = check_bpm(m, "material_set_bpm", v, bpm_names, (int)(sizeof v / sizeof *v));
+    if (st) return st;
+    m->mats[material].bpm = *def;
+    return SX_OK;
+}
+
+sx_status sx_material_get_bpm(const sx_model *m, int material, sx_bpm_def *out)
+{
+    if (material < 0 || material >= m->nmat)
+        return sx__fail((sx_model *)m, SX_ENOTFOUND, "material_get_bpm: no material with index %d", material);
+    *out = m->mats[material].bpm;
+    return SX_OK;
+}
+
+/* ------------------------------------------------------------ installing */
+
+/* splitmix64: a small, well-mixed generator, so draws depend only on the seed. */
+static uint64_t next_u64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static double uniform01(uint64_t *s) { return ((double)(next_u64(s) >> 11) + 0.5) * 0x1.0p-53; }
+
+/* A strength from a normal distribution (Box-Muller), redrawn while negative. */
+static double draw_strength(uint64_t *s, double mean, double sd)
+{
+    if (sd <= 0) return mean;
+    for (int tries = 0; tries < 64; tries++) {
+        const double u1 = uniform01(s), u2 = uniform01(s);
+        const double z = sqrt(-2.0 * log(u1)) * cos(2.0 * SX_PI * u2);
+        const double v = mean + sd * z;
+        if (v >= 0) return v;
+    }
+    return mean;
+}
+
+/* The value given in the def, or the mean of the two materials' values. */
+static double param(double given, double a, double b) { return given > 0 ? given : 0.5 * (a + b); }
+
+/* Whether the def's material filter admits a pair of materials (a, b). */
+static bool pair_selected(const sx_bond_def *def, int a, int b)
+{
+    const int fa = def->material_a, fb = def->material_b;
+    if (fa >= 0 && fb >= 0) return (a == fa && b == fb) || (a == fb && b == fa);
+    const int f = fa >= 0 ? fa : fb;
+    return f < 0 || a == f || b == f;
+}
+
+sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "bond: the model is stepping");
+    if (def->kind != SX_BOND_CONTACT && def->kind != SX_BOND_PARALLEL)
+        return sx__fail(m, SX_EINVAL, "bond: kind must be contact or parallel");
+    if (!(def->gap >= 0) || !isfinite(def->gap))
+        return sx__fail(m, SX_EINVAL, "bond: gap must be >= 0 m (got %g)", def->gap);
+    const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
+                        def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
+                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd};
+    sx_status st = check_bpm(m, "bond", v, bpm_names, (int)(sizeof v / sizeof *v));
+    if (st) return st;
+    if (def->material_a >= m->nmat || def->material_b >= m->nmat)
+        return sx__fail(m, SX_ENOTFOUND, "bond: no material with index %d",
+                        def->material_a >= m->nmat ? def->material_a : def->material_b);
+
+    /* candidates within the gap: rebuild the broad phase with a skin at least that wide */
+    const double skin_user = m->skin_user;
+    if (m->skin_user < def->gap && def->gap > 0) m->skin_user = def->gap;
+    m->build_needed = true;
+    st = sx__prepare(m);
+    m->skin_user = skin_user;
+    m->build_needed = true; /* back to the normal skin; bonded pairs are kept */
+    if (st) return st;
+    if ((st = sx__bonds_reserve_pairs(m))) return sx__fail(m, st, "bond: out of memory");
+
+    const int d = m->dim;
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    uint64_t rng = def->seed;
+    int64_t installed = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int64_t i = p->a[c], j = p->b[c];
+        const int ma = B->mat[i], mb = B->mat[j];
+        if (!pair_selected(def, ma, mb)) continue;
+        double n[3] = {0, 0, 0}, dist = 0;
+        for (int k = 0; k < d; k++) {
+            n[k] = B->x[j * d + k] - B->x[i * d + k];
+            dist += n[k] * n[k];
+        }
+        dist = sqrt(dist);
+        if (dist - B->rad[i] - B->rad[j] >= def->gap) continue;
+        if (m->law[ma * m->law_n + mb].hertz)
+            return sx__fail(m, SX_EINVAL,
+                            "bond: materials '%s' and '%s' use the Hertz-Mindlin model, which is not to be combined "
+                            "with bonds (seed 4.3.3); use the linear model for bonded materials",
+                            m->mats[ma].name, m->mats[mb].name);
+        int32_t slot = p->bond[c] - 1;
+        if (slot < 0) {
+            if (bonds_reserve(m, m->bonds.n + 1)) return sx__fail(m, SX_ENOMEM, "bond: out of memory");
+            slot = (int32_t)m->bonds.n++;
+            sx_bonds *b = &m->bonds;
+            b->kind[slot] = 0;
+            b->ida[slot] = B->id[i];
+            b->idb[slot] = B->id[j];
+            b->fn[slot] = b->mn[slot] = 0;
+            for (int k = 0; k < d; k++) b->fs[slot * d + k] = 0;
+            for (int k = 0; k < m->rdim; k++) b->ms[slot * m->rdim + k] = 0;
+            p->bond[c] = slot + 1;
+        }
+        sx_bonds *b = &m->bonds;
+        if (b->kind[slot] & def->kind) continue; /* already bonded this way */
+        const sx_bpm_def *pa = &m->mats[ma].bpm, *pb = &m->mats[mb].bpm;
+        if (def->kind == SX_BOND_CONTACT) {
+            b->cb_n[slot] = draw_strength(&rng, param(def->normal_strength, pa->normal_strength, pb->normal_strength),
+                                          param(def->normal_strength_sd, pa->normal_strength_sd, pb->normal_strength_sd));
+            b->cb_s[slot] = draw_strength(&rng, param(def->shear_strength, pa->shear_strength, pb->shear_strength),
+                                          param(def->shear_strength_sd, pa->shear_strength_sd, pb->shear_strength_sd));
+        } else {
+            const double lambda = param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier);
+            const double ec = param(def->modulus, pa->modulus, pb->modulus);
+            const double ratio = param(def->stiffness_ratio, pa->stiffness_ratio, pb->stiffness_ratio);
+            if (!(lambda > 0) || !(ec > 0) || !(ratio > 0))
+                return sx__fail(m, SX_EINVAL,
+                                "bond: a parallel bond needs radius_multiplier, modulus and stiffness_ratio > 0 "
+                                "(from the call or the materials' bond parameters)");
+            const double ri = B->rad[i], rj = B->rad[j];
+            b->rbar[slot] = lambda * (ri < rj ? ri : rj);             /* 4-53 */
+            b->kn[slot] = ec / (ri + rj);                             /* 4-51 */
+            b->ks[slot] = b->kn[slot] / ratio;                        /* 4-52 */
+            b->sigma_c[slot] = draw_strength(&rng, param(def->tensile_strength, pa->tensile_strength, pb->tensile_strength),
+                                             param(def->tensile_strength_sd, pa->tensile_strength_sd, pb->tensile_strength_sd));
+            b->tau_c[slot] = draw_strength(&rng, param(def->cohesion, pa->cohesion, pb->cohesion),
+                                           param(def->cohesion_sd, pa->cohesion_sd, pb->cohesion_sd));
+        }
+        if (!b->kind[slot]) b->intact++;
+        b->kind[slot] |= (uint8_t)def->kind;
+        if (!p->touching[c]) { /* the bond starts from the current geometry */
+            for (int k = 0; k < d; k++) {
+                p->nold[c * d + k] = n[k] / dist;
+                p->fs[c * d + k] = 0;
+            }
+            p->touching[c] = 1;
+        }
+        installed++;
+    }
+    m->dt_stale = true;
+    if (count) *count = installed;
+    return SX_OK;
+}
