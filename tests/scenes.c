@@ -35,3 +35,26 @@ int64_t scene_ball(sx_model *m, const double *pos, const double *vel, double rad
     ck_assert_msg(sx_ball_add(m, &b, &id) == SX_OK, "%s", sx_model_error(m));
     return id;
 }
+
+int64_t scene_ball_of(sx_model *m, int material, const double *pos, const double *vel, double radius)
+{
+    sx_ball_def b = sx_ball_default_def();
+    for (int i = 0; i < sx_model_dim(m); i++) {
+        b.pos[i] = pos[i];
+        b.vel[i] = vel ? vel[i] : 0;
+    }
+    b.radius = radius;
+    b.material = material;
+    int64_t id = 0;
+    ck_assert_msg(sx_ball_add(m, &b, &id) == SX_OK, "%s", sx_model_error(m));
+    return id;
+}
+
+void scene_impose(sx_model *m, int64_t id, const double *vel, const double *spin)
+{
+    const double zero[3] = {0, 0, 0};
+    ck_assert_msg(sx_ball_set_vec(m, id, SX_BALL_VEL, vel ? vel : zero) == SX_OK, "%s", sx_model_error(m));
+    ck_assert_msg(sx_ball_set_vec(m, id, SX_BALL_SPIN, spin ? spin : zero) == SX_OK, "%s", sx_model_error(m));
+    const unsigned all = sx_model_dim(m) == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ);
+    ck_assert_msg(sx_ball_set_fixity(m, id, all) == SX_OK, "%s", sx_model_error(m));
+}

@@ -662,6 +662,8 @@ static sx_status ball_contacts(sx_model *m)
         if (active) {
             fn = stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, un, &kn, &ks);
             carry_apply(&rot, fs);
+            double f0[D]; /* the shear force before this step's increment, for the slip energy */
+            for (int k = 0; k < D; k++) f0[k] = fs[k];
             for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt; /* 4-18 ... 4-20 */
             if (bonds & SX_BOND_CONTACT) {
                 const double fsn = sqrt(dot(fs, fs));
@@ -678,6 +680,8 @@ static sx_status ball_contacts(sx_model *m)
             }
             if (!(bonds & SX_BOND_CONTACT)) {
                 if (un <= 0) { /* unbonded and open: no contact force */
+                    /* a contact bond that failed in shear while in tension releases both springs */
+                    if (track) m->acc.bond_released += 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                 }
@@ -686,7 +690,13 @@ static sx_status ball_contacts(sx_model *m)
                 const double f2 = dot(fs, fs);
                 if (f2 > fmax * fmax) {
                     const double sc = fmax / sqrt(f2);
-                    if (track && ks > 0) m->acc.slip += 0.5 * f2 * (1 - sc * sc) / ks;
+                    /* slip work: the mean of the shear force before and after the step along the
+                     * slip displacement (trial - final force) / ks */
+                    if (track && ks > 0) {
+                        double e = 0;
+                        for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
+                        m->acc.slip += 0.5 * e / ks;
+                    }
                     for (int k = 0; k < D; k++) fs[k] *= sc;
                     slip = true;
                 }
@@ -709,6 +719,11 @@ static sx_status ball_contacts(sx_model *m)
             }
             for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k]; /* 4-5 */
         } else {
+            if (track && p->touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
+                double kn0, ks0;
+                stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, 0, &kn0, &ks0);
+                if (!law->hertz && ks0 > 0) m->acc.slip += 0.5 * dot(fs, fs) / ks0;
+            }
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
         }
         if (bonds & SX_BOND_PARALLEL) {
@@ -785,12 +800,18 @@ static sx_status wall_contacts(sx_model *m)
         carry rot;
         carry_make(&rot, p->nold + c * D, n, NULL, B->w + i * RD, dt);
         carry_apply(&rot, fs);
+        double f0[D];
+        for (int k = 0; k < D; k++) f0[k] = fs[k];
         for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt;
         const double fmax = law.mu * fn, f2 = dot(fs, fs);
         bool slip = false;
         if (f2 > fmax * fmax) {
             const double sc = fmax / sqrt(f2);
-            if (track && ks > 0) m->acc.slip += 0.5 * f2 * (1 - sc * sc) / ks;
+            if (track && ks > 0) { /* as for ball-ball contacts */
+                double e = 0;
+                for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
+                m->acc.slip += 0.5 * e / ks;
+            }
             for (int k = 0; k < D; k++) fs[k] *= sc;
             slip = true;
         }
@@ -944,10 +965,10 @@ static double KERNEL(critical_dt)(sx_model *m)
     sx_balls *B = &m->balls;
     const int64_t n = B->n;
     if (n == 0) return INFINITY;
-    double *kt = sx__scratch(m, 2 * n);
+    double *kt = sx__scratch(m, 4 * n);
     if (!kt) return INFINITY;
-    double *kr = kt + n;
-    memset(kt, 0, (size_t)(2 * n) * sizeof(double));
+    double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
+    memset(kt, 0, (size_t)(4 * n) * sizeof(double));
     const sx_pairs *p = &m->bb;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c], j = p->b[c];
@@ -960,6 +981,12 @@ static double KERNEL(critical_dt)(sx_model *m)
         if (un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT))) {
             double kn, ks;
             stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
+            if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
+                const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
+                const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
+                ct[i] += cn + cs, ct[j] += cn + cs;
+                cr[i] += cs * B->rad[i] * B->rad[i], cr[j] += cs * B->rad[j] * B->rad[j];
+            }
             if (law->hertz) kn *= 1.5; /* 4-29 */
             ktr = kn + ks;
             krot_i = ks * B->rad[i] * B->rad[i];
@@ -988,6 +1015,12 @@ static double KERNEL(critical_dt)(sx_model *m)
         const sx_pair_law law = sx__wall_law(m, B->mat[i], &m->walls[p->b[c]]);
         double kn, ks;
         stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
+        if (law.beta_n > 0 || law.beta_s > 0) {
+            const double mass = 1.0 / B->inv_mass[i];
+            const double cs = 2 * law.beta_s * sqrt(mass * ks);
+            ct[i] += 2 * law.beta_n * sqrt(mass * kn) + cs;
+            cr[i] += cs * B->rad[i] * B->rad[i];
+        }
         if (law.hertz) kn *= 1.5;
         kt[i] += kn + ks;
         kr[i] += ks * B->rad[i] * B->rad[i];
@@ -1003,10 +1036,17 @@ static double KERNEL(critical_dt)(sx_model *m)
         else kn *= 2, ks *= 2; /* undo the series combination with itself */
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
-        const double dtt = sqrt(1.0 / (B->inv_mass[i] * ktr));
+        /* Contact dashpots lower the stable timestep of the central differences: for
+         * m x'' + c x' + k x = 0 with x' taken at the half step, stability needs
+         * (w dt)^2 + 4 z (w dt) < 4, i.e. dt < (2/w)(sqrt(1 + z^2) - z), z = c / (2 sqrt(k m));
+         * local damping scales a decelerating force by up to (1 + alpha), so z is scaled too. */
+        const double amp = 1 + B->alpha[i];
+        const double zt = amp * ct[i] / (2 * sqrt(ktr / B->inv_mass[i]));
+        const double dtt = sqrt(1.0 / (B->inv_mass[i] * ktr)) * (sqrt(1 + zt * zt) - zt);
         if (dtt < best) best = dtt;
         if (krot > 0) {
-            const double dtr = sqrt(1.0 / (B->inv_inertia[i] * krot));
+            const double zr = amp * cr[i] / (2 * sqrt(krot / B->inv_inertia[i]));
+            const double dtr = sqrt(1.0 / (B->inv_inertia[i] * krot)) * (sqrt(1 + zr * zr) - zr);
             if (dtr < best) best = dtr;
         }
     }
