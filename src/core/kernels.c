@@ -370,6 +370,20 @@ static bool build_wall_pairs(sx_model *m, const history *h)
 
 static bool KERNEL(build)(sx_model *m)
 {
+    if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
+        m->bb.n = m->bw.n = 0;
+        m->builds++;
+        m->build_needed = false;
+        return true;
+    }
+    /* the automatic skin: a fifth of the mean radius */
+    if (m->skin_user > 0) {
+        m->skin = m->skin_user;
+    } else {
+        double sum = 0;
+        for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
+        m->skin = 0.2 * sum / (double)m->balls.n;
+    }
     history h;
     bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h) &&
               build_wall_pairs(m, &h);
@@ -747,18 +761,18 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
         e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
     }
+    /* every overlap stores normal strain, even one no step has seen yet;
+     * the shear spring only once the contact has history */
     for (int64_t c = 0; c < m->bb.n; c++) {
-        if (!m->bb.touching[c]) continue;
         double n[D];
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
         const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
         const double *fs = m->bb.fs + c * D;
         if (un > 0) e->strain += 0.5 * law->kn * un * un;
-        if (law->ks > 0) e->strain += 0.5 * dot(fs, fs) / law->ks;
+        if (m->bb.touching[c] && law->ks > 0) e->strain += 0.5 * dot(fs, fs) / law->ks;
     }
     for (int64_t c = 0; c < m->bw.n; c++) {
-        if (!m->bw.touching[c]) continue;
         double n[D];
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
@@ -766,7 +780,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         const double *fs = m->bw.fs + c * D;
         if (un > 0) e->strain += 0.5 * law.kn * un * un;
-        if (law.ks > 0) e->strain += 0.5 * dot(fs, fs) / law.ks;
+        if (m->bw.touching[c] && law.ks > 0) e->strain += 0.5 * dot(fs, fs) / law.ks;
     }
 }
 

@@ -225,20 +225,12 @@ static sx_status refresh_laws(sx_model *m)
 
 /* ------------------------------------------------------------- timestep */
 
-static double mean_radius(const sx_model *m)
-{
-    double s = 0;
-    for (int64_t i = 0; i < m->balls.n; i++) s += m->balls.rad[i];
-    return m->balls.n ? s / (double)m->balls.n : 0;
-}
-
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
 static sx_status prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (st) return st;
     if (m->build_needed) {
-        m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
         if (!kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
         m->dt_stale = true;
     }
@@ -384,7 +376,6 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
             break;
         }
         if (m->build_needed) {
-            m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
             if (!k->build(m)) {
                 st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
                 break;
