@@ -37,6 +37,7 @@ sx_status sx__balls_reserve(sx_model *m, int64_t cap)
     RESIZE(b, id, 1);
     RESIZE(b, mat, 1);
     RESIZE(b, fix, 1);
+    RESIZE(b, group, 1);
     if (b->fapp) {
         RESIZE(b, fapp, d);
         RESIZE(b, tapp, r);
@@ -67,6 +68,7 @@ void sx__balls_free(sx_model *m)
     free_field(m, b->id, c, sizeof(int32_t));
     free_field(m, b->mat, c, sizeof(uint16_t));
     free_field(m, b->fix, c, sizeof(uint8_t));
+    free_field(m, b->group, c, sizeof(int32_t));
     free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
     free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
     free_field(m, b->index_of, b->index_cap, sizeof(int32_t));
@@ -154,6 +156,7 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     b->mat[i] = (uint16_t)def->material;
     b->alpha[i] = m->mats[def->material].def.damping;
     b->fix[i] = 0;
+    b->group[i] = 0;
     b->id[i] = (int32_t)id;
     b->index_of[id] = (int32_t)i;
     sx__ball_update_mass(m, i);
@@ -185,6 +188,7 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
     b->id[to] = b->id[from];
     b->mat[to] = b->mat[from];
     b->fix[to] = b->fix[from];
+    b->group[to] = b->group[from];
     b->index_of[b->id[to]] = (int32_t)to;
 }
 
@@ -280,6 +284,7 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     GATHER(id, 1, int32_t);
     GATHER(mat, 1, uint16_t);
     GATHER(fix, 1, uint8_t);
+    GATHER(group, 1, int32_t);
 #undef GATHER
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
@@ -495,4 +500,20 @@ sx_ball_def sx_ball_default_def(void)
     memset(&d, 0, sizeof d);
     d.radius = 1.0;
     return d;
+}
+
+sx_status sx_ball_group(const sx_model *m, int64_t id, int32_t *group)
+{
+    const int64_t i = lookup(m, id, "ball_group");
+    if (i < 0) return SX_ENOTFOUND;
+    *group = m->balls.group[i];
+    return SX_OK;
+}
+
+sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group)
+{
+    const int64_t i = lookup(m, id, "ball_set_group");
+    if (i < 0) return SX_ENOTFOUND;
+    m->balls.group[i] = group;
+    return SX_OK;
 }

@@ -454,3 +454,34 @@ bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void
     if (refresh_laws((sx_model *)m)) return false;
     return kernels(m)->each_contact(m, fn, ud);
 }
+
+static bool add_contact_force(const sx_contact_info *ci, void *ud)
+{
+    double *acc = ud;
+    double s2 = ci->fn * ci->fn;
+    for (int k = 0; k < 3; k++) s2 += ci->shear[k] * ci->shear[k];
+    acc[0] += sqrt(s2);
+    acc[1] += 1;
+    return true;
+}
+
+double sx_model_unbalanced_ratio(const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const int d = m->dim;
+    double unbalanced = 0;
+    for (int64_t i = 0; i < b->n; i++) {
+        double s2 = 0;
+        for (int k = 0; k < d; k++) {
+            if (b->fix[i] & (SX_FIX_VX << k)) continue; /* a fixed component is balanced by its fixity */
+            const double f = b->f[i * d + k] + m->gravity[k] / b->inv_mass[i];
+            s2 += f * f;
+        }
+        unbalanced += sqrt(s2);
+    }
+    double acc[2] = {0, 0};
+    sx_contact_each(m, add_contact_force, acc);
+    if (b->n == 0) return 0;
+    if (acc[1] == 0 || acc[0] == 0) return unbalanced > 0 ? INFINITY : 0;
+    return (unbalanced / (double)b->n) / (acc[0] / acc[1]);
+}

@@ -34,6 +34,7 @@ typedef struct sx_balls {
     int32_t *id;           /* stable id of each dense index */
     uint16_t *mat;         /* material index */
     uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
+    int32_t *group;        /* user group number (0: none) */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */

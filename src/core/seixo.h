@@ -76,6 +76,11 @@ SX_API sx_status sx_model_cycle(sx_model *m, int64_t n);
 /// Asks a running cycle to stop at the next step boundary (async-signal-safe).
 SX_API void sx_model_interrupt(sx_model *m);
 
+/// PFC's mean unbalanced-force ratio: the mean over balls of |F + m g| (free
+/// components) over the mean contact force magnitude; 0 when at rest with no
+/// contacts, infinity when forces act but no contact carries any.
+SX_API double sx_model_unbalanced_ratio(const sx_model *m);
+
 /// A 64-bit hash of the full dynamic state (positions, velocities, spins,
 /// forces, contact histories, walls, time); equal hashes mean bit-identical states.
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
@@ -154,6 +159,10 @@ SX_API sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which
 SX_API sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double value);
 SX_API sx_status sx_ball_material(const sx_model *m, int64_t id, int *material);
 SX_API sx_status sx_ball_set_material(sx_model *m, int64_t id, int material);
+
+/// A user group number per ball (0 = no group); the Lua layer maps names to numbers.
+SX_API sx_status sx_ball_group(const sx_model *m, int64_t id, int32_t *group);
+SX_API sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group);
 
 /// Fixity bits: a fixed component keeps its velocity (or spin) whatever the force.
 enum {
