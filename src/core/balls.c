@@ -121,6 +121,7 @@ static bool finite_vec(const double *v, int n)
 
 sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_add: the model is stepping; add balls between cycles");
     if (!(def->radius > 0) || !isfinite(def->radius))
         return sx__fail(m, SX_EINVAL, "ball_add: radius must be a positive finite number (got %g)", def->radius);
@@ -197,29 +198,15 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
  * history's sign, which is expressed relative to a -> b). */
 static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
 {
-    const int d = m->dim;
     sx_pairs *p = &m->bb;
     int64_t k = 0;
     for (int64_t c = 0; c < p->n; c++) {
         int32_t a = p->a[c], bb = p->b[c];
         if (a == gone || bb == gone) continue;
-        if (a == last) a = gone;
-        if (bb == last) bb = gone;
-        p->a[k] = a;
-        p->b[k] = bb;
-        for (int j = 0; j < d; j++) {
-            p->fs[k * d + j] = p->fs[c * d + j];
-            p->nold[k * d + j] = p->nold[c * d + j];
-        }
-        p->touching[k] = p->touching[c];
-        if (a > bb) {
-            p->a[k] = bb;
-            p->b[k] = a;
-            for (int j = 0; j < d; j++) {
-                p->fs[k * d + j] = -p->fs[k * d + j];
-                p->nold[k * d + j] = -p->nold[k * d + j];
-            }
-        }
+        sx__pair_move(m, p, k, c);
+        p->a[k] = a == last ? gone : a;
+        p->b[k] = bb == last ? gone : bb;
+        if (p->a[k] > p->b[k]) sx__pair_flip(m, p, k);
         k++;
     }
     p->n = k;
@@ -227,13 +214,8 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
     k = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->a[c] == gone) continue;
-        p->a[k] = p->a[c] == last ? gone : p->a[c];
-        p->b[k] = p->b[c];
-        for (int j = 0; j < d; j++) {
-            p->fs[k * d + j] = p->fs[c * d + j];
-            p->nold[k * d + j] = p->nold[c * d + j];
-        }
-        p->touching[k] = p->touching[c];
+        sx__pair_move(m, p, k, c);
+        if (p->a[k] == last) p->a[k] = gone;
         k++;
     }
     p->n = k;
@@ -241,6 +223,7 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
 
 sx_status sx_ball_remove(sx_model *m, int64_t id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_remove: the model is stepping");
     const int64_t i = sx__ball_index(m, id);
     if (i < 0) return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)id);
@@ -301,8 +284,34 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, fs, d);
     RESIZE(p, nold, d);
     RESIZE(p, touching, 1);
+    RESIZE(p, un, 1);
+    RESIZE(p, fn, 1);
     p->cap = cap;
     return SX_OK;
+}
+
+void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
+{
+    const int d = m->dim;
+    p->a[to] = p->a[from];
+    p->b[to] = p->b[from];
+    memmove(p->fs + to * d, p->fs + from * d, (size_t)d * sizeof(double));
+    memmove(p->nold + to * d, p->nold + from * d, (size_t)d * sizeof(double));
+    p->touching[to] = p->touching[from];
+    p->un[to] = p->un[from];
+    p->fn[to] = p->fn[from];
+}
+
+void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k)
+{
+    const int d = m->dim;
+    const int32_t a = p->a[k];
+    p->a[k] = p->b[k];
+    p->b[k] = a;
+    for (int j = 0; j < d; j++) {
+        p->fs[k * d + j] = -p->fs[k * d + j];
+        p->nold[k * d + j] = -p->nold[k * d + j];
+    }
 }
 
 void sx__pairs_free(sx_model *m, sx_pairs *p)
@@ -313,6 +322,8 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->fs, c * d, sizeof(double));
     free_field(m, p->nold, c * d, sizeof(double));
     free_field(m, p->touching, c, sizeof(uint8_t));
+    free_field(m, p->un, c, sizeof(double));
+    free_field(m, p->fn, c, sizeof(double));
     memset(p, 0, sizeof *p);
 }
 
@@ -383,6 +394,7 @@ sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec which, doub
 
 sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double val[3])
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_vec");
     if (i < 0) return SX_ENOTFOUND;
     if (which == SX_BALL_FORCE || which == SX_BALL_MOMENT)
@@ -416,6 +428,7 @@ sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which, doubl
 
 sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double value)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set");
     if (i < 0) return SX_ENOTFOUND;
     sx_balls *b = &m->balls;
@@ -450,6 +463,7 @@ sx_status sx_ball_material(const sx_model *m, int64_t id, int *material)
 
 sx_status sx_ball_set_material(sx_model *m, int64_t id, int material)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_material");
     if (i < 0) return SX_ENOTFOUND;
     if (material < 0 || material >= m->nmat)
@@ -484,6 +498,7 @@ sx_status sx_ball_fixity(const sx_model *m, int64_t id, unsigned *mask)
 
 sx_status sx_ball_set_fixity(sx_model *m, int64_t id, unsigned mask)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_fixity");
     if (i < 0) return SX_ENOTFOUND;
     const unsigned valid = m->dim == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ);

@@ -61,11 +61,15 @@ static inline void moment_of(const double *r, const double *f, double *out)
 
 /* ---------------------------------------------------------- broad phase */
 
+/* A pair's history as saved across a build: shear force (D), previous
+ * normal (D), overlap and normal force of the last evaluation. */
+#define REC (2 * D + 2)
+
 typedef struct history {
     uint64_t *key;   /* 0 = empty slot */
-    int64_t *src;    /* index into the saved arrays */
+    int64_t *src;    /* record index of each slot */
     int64_t cap;
-    double *fs, *nold;
+    double *rec;     /* REC doubles per saved pair */
     int64_t n;
 } history;
 
@@ -87,14 +91,20 @@ static inline uint64_t bw_key(int64_t id, int64_t wall)
     return (1ULL << 63) | ((uint64_t)id << 32) | (uint64_t)wall;
 }
 
-static void history_put(history *h, uint64_t key, const double *fs, const double *nold)
+/* Saves pair c of p; sgn re-expresses the vectors for the key's orientation. */
+static void history_put(history *h, uint64_t key, const sx_pairs *p, int64_t c, double sgn)
 {
     int64_t s = (int64_t)(hash_key(key) & (uint64_t)(h->cap - 1));
     while (h->key[s]) s = (s + 1) & (h->cap - 1);
     h->key[s] = key;
     h->src[s] = h->n;
-    memcpy(h->fs + h->n * D, fs, D * sizeof(double));
-    memcpy(h->nold + h->n * D, nold, D * sizeof(double));
+    double *r = h->rec + h->n * REC;
+    for (int k = 0; k < D; k++) {
+        r[k] = sgn * p->fs[c * D + k];
+        r[D + k] = sgn * p->nold[c * D + k];
+    }
+    r[2 * D] = p->un[c];
+    r[2 * D + 1] = p->fn[c];
     h->n++;
 }
 
@@ -109,7 +119,8 @@ static int64_t history_get(const history *h, uint64_t key)
     return -1;
 }
 
-/* Saves every touching pair's history keyed by stable ids. */
+/* Saves every touching pair's history keyed by stable ids (ball-ball
+ * vectors relative to lower id -> higher id). */
 static bool history_save(sx_model *m, history *h)
 {
     memset(h, 0, sizeof *h);
@@ -121,25 +132,16 @@ static bool history_save(sx_model *m, history *h)
     while (h->cap < 2 * live) h->cap *= 2;
     h->key = calloc((size_t)h->cap, sizeof *h->key);
     h->src = malloc((size_t)h->cap * sizeof *h->src);
-    h->fs = malloc((size_t)(live * D) * sizeof(double));
-    h->nold = malloc((size_t)(live * D) * sizeof(double));
-    if (!h->key || !h->src || !h->fs || !h->nold) return false;
+    h->rec = malloc((size_t)(live * REC) * sizeof(double));
+    if (!h->key || !h->src || !h->rec) return false;
     const int32_t *id = m->balls.id;
     for (int64_t c = 0; c < m->bb.n; c++) {
         if (!m->bb.touching[c]) continue;
         const int64_t ia = id[m->bb.a[c]], ib = id[m->bb.b[c]];
-        double fs[D], nold[D];
-        /* stored relative to the pair's a -> b; keep it relative to lower id -> higher id */
-        const double sgn = ia < ib ? 1.0 : -1.0;
-        for (int k = 0; k < D; k++) {
-            fs[k] = sgn * m->bb.fs[c * D + k];
-            nold[k] = sgn * m->bb.nold[c * D + k];
-        }
-        history_put(h, bb_key(ia, ib), fs, nold);
+        history_put(h, bb_key(ia, ib), &m->bb, c, ia < ib ? 1.0 : -1.0);
     }
     for (int64_t c = 0; c < m->bw.n; c++)
-        if (m->bw.touching[c])
-            history_put(h, bw_key(id[m->bw.a[c]], m->bw.b[c]), m->bw.fs + c * D, m->bw.nold + c * D);
+        if (m->bw.touching[c]) history_put(h, bw_key(id[m->bw.a[c]], m->bw.b[c]), &m->bw, c, 1.0);
     return true;
 }
 
@@ -147,11 +149,11 @@ static void history_free(history *h)
 {
     free(h->key);
     free(h->src);
-    free(h->fs);
-    free(h->nold);
+    free(h->rec);
 }
 
-/* Appends candidate pair (a, b) and restores its history if it had one. */
+/* Appends candidate pair (a, b) and restores its history if it had one;
+ * sgn is -1 when a has the higher id. */
 static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const history *h, uint64_t key, double sgn)
 {
     if (p->n == p->cap && sx__pairs_reserve(m, p, p->n + 1)) return false;
@@ -159,16 +161,14 @@ static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const hist
     p->a[c] = a;
     p->b[c] = b;
     const int64_t s = history_get(h, key);
-    if (s >= 0) {
-        for (int k = 0; k < D; k++) {
-            p->fs[c * D + k] = sgn * h->fs[s * D + k];
-            p->nold[c * D + k] = sgn * h->nold[s * D + k];
-        }
-        p->touching[c] = 1;
-    } else {
-        for (int k = 0; k < D; k++) p->fs[c * D + k] = p->nold[c * D + k] = 0;
-        p->touching[c] = 0;
+    const double *r = s >= 0 ? h->rec + s * REC : NULL;
+    for (int k = 0; k < D; k++) {
+        p->fs[c * D + k] = r ? sgn * r[k] : 0;
+        p->nold[c * D + k] = r ? sgn * r[D + k] : 0;
     }
+    p->un[c] = r ? r[2 * D] : 0;
+    p->fn[c] = r ? r[2 * D + 1] : 0;
+    p->touching[c] = r != NULL;
     return true;
 }
 
@@ -374,6 +374,7 @@ static bool KERNEL(build)(sx_model *m)
         m->bb.n = m->bw.n = 0;
         m->builds++;
         m->build_needed = false;
+        m->dt_stale = true;
         return true;
     }
     /* the automatic skin: a fifth of the mean radius */
@@ -393,6 +394,7 @@ static bool KERNEL(build)(sx_model *m)
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;
     m->build_needed = false;
+    m->dt_stale = true; /* new contacts: a new automatic timestep, wherever the build happens */
     return true;
 }
 
@@ -459,7 +461,8 @@ static sx_status ball_contacts(sx_model *m)
     sx_pairs *p = &m->bb;
     const double *x = B->x, *v = B->v, *w = B->w, *rad = B->rad, *im = B->inv_mass;
     double *f = B->f, *t = B->t;
-    const double dt = m->dt;
+    /* 4-16 ... 4-20: v_{n-1/2} moved the balls from x_{n-1} to x_n during the previous step */
+    const double dt = m->dt_prev > 0 ? m->dt_prev : m->dt;
     const int nlaw = m->law_n;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c], j = p->b[c];
@@ -520,6 +523,8 @@ static sx_status ball_contacts(sx_model *m)
             }
         }
         for (int k = 0; k < D; k++) F[k] = ftot_n * n[k] + fs[k] + dsh[k]; /* 4-5 */
+        p->un[c] = un;
+        p->fn[c] = ftot_n;
         /* 4-21 */
         double ma[RD], mb[RD];
         moment_of(ra, F, ma);
@@ -542,7 +547,7 @@ static sx_status wall_contacts(sx_model *m)
 {
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bw;
-    const double dt = m->dt;
+    const double dt = m->dt_prev > 0 ? m->dt_prev : m->dt; /* as in ball_contacts */
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c];
         sx_wall *wl = &m->walls[p->b[c]];
@@ -592,6 +597,8 @@ static sx_status wall_contacts(sx_model *m)
             }
         }
         for (int k = 0; k < D; k++) F[k] = ftot_n * n[k] + fs[k] + dsh[k];
+        p->un[c] = un;
+        p->fn[c] = ftot_n;
         double mb[RD], mw[RD], arm[D];
         moment_of(rb, F, mb);
         for (int k = 0; k < D; k++) {
@@ -647,6 +654,8 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     sx_balls *B = &m->balls;
     const double dt = m->dt;
+    /* the kick spans the time between the half-step velocities, t_{n+1/2} - t_{n-1/2} */
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
     const double *g = m->gravity;
     double worst = 0;
     for (int64_t i = 0; i < B->n; i++) {
@@ -658,7 +667,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         for (int k = 0; k < D; k++) {
             if (!(fix & (SX_FIX_VX << k))) {
                 const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
-                v[k] += damped(force, v[k], a) * im * dt; /* 4-46 */
+                v[k] += damped(force, v[k], a) * im * dtv; /* 4-46 */
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - B->x_build[i * D + k];
@@ -667,7 +676,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         double *w = B->w + i * RD;
         const double *t = B->t + i * RD;
         for (int k = 0; k < RD; k++)
-            if (!(fix & (SX_FIX_WX << k))) w[k] += damped(t[k], w[k], a) * ii * dt; /* 4-47 */
+            if (!(fix & (SX_FIX_WX << k))) w[k] += damped(t[k], w[k], a) * ii * dtv; /* 4-47 */
         bool ok = true;
         for (int k = 0; k < D; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
         for (int k = 0; k < RD; k++) ok &= isfinite(w[k]);
@@ -784,54 +793,42 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
     }
 }
 
-static void fill_info(sx_contact_info *ci, const double *n, const double *xc, double un, double fn,
-                      const double *fs, const sx_pair_law *law)
+/* Contacts are reported as the last force evaluation left them (the forces
+ * the balls felt): normal, overlap, normal force (with its dashpot) and the
+ * elastic shear force; the point is placed from ball a's current centre. */
+static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall,
+                   bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    memset(ci->normal, 0, sizeof ci->normal);
-    memset(ci->point, 0, sizeof ci->point);
-    memset(ci->shear, 0, sizeof ci->shear);
+    const sx_balls *B = &m->balls;
+    const int64_t i = p->a[c];
+    const double *n = p->nold + c * D, un = p->un[c];
+    sx_contact_info ci;
+    memset(&ci, 0, sizeof ci);
+    const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])
+                                    : m->law[B->mat[i] * m->law_n + B->mat[p->b[c]]];
+    /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
+    const double arm = is_wall ? -(B->rad[i] - 0.5 * un) : B->rad[i] - 0.5 * un;
     for (int k = 0; k < D; k++) {
-        ci->normal[k] = n[k];
-        ci->point[k] = xc[k];
-        ci->shear[k] = fs[k];
+        ci.normal[k] = n[k];
+        ci.point[k] = B->x[i * D + k] + arm * n[k];
+        ci.shear[k] = p->fs[c * D + k];
     }
-    ci->overlap = un;
-    ci->fn = fn;
-    ci->kn = law->kn;
-    ci->ks = law->ks;
+    ci.overlap = un;
+    ci.fn = p->fn[c];
+    ci.kn = law.kn;
+    ci.ks = law.ks;
+    ci.a = B->id[i];
+    ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
+    ci.is_wall = is_wall;
+    return fn(&ci, ud);
 }
 
 static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    const sx_balls *B = &m->balls;
-    sx_contact_info ci;
-    for (int64_t c = 0; c < m->bb.n; c++) {
-        if (!m->bb.touching[c]) continue;
-        const int64_t i = m->bb.a[c], j = m->bb.b[c];
-        double n[D], xc[D];
-        const double un = pair_geometry(m, i, j, n);
-        for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] + (B->rad[i] - 0.5 * un) * n[k];
-        const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
-        fill_info(&ci, n, xc, un, law->kn * un, m->bb.fs + c * D, law);
-        ci.a = B->id[i];
-        ci.b = B->id[j];
-        ci.is_wall = false;
-        if (!fn(&ci, ud)) return false;
-    }
-    for (int64_t c = 0; c < m->bw.n; c++) {
-        if (!m->bw.touching[c]) continue;
-        const int64_t i = m->bw.a[c];
-        const sx_wall *wl = &m->walls[m->bw.b[c]];
-        double n[D], xc[D];
-        const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
-        for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] - (B->rad[i] - 0.5 * un) * n[k];
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
-        fill_info(&ci, n, xc, un, law.kn * un, m->bw.fs + c * D, &law);
-        ci.a = B->id[i];
-        ci.b = wl->id;
-        ci.is_wall = true;
-        if (!fn(&ci, ud)) return false;
-    }
+    for (int64_t c = 0; c < m->bb.n; c++)
+        if (m->bb.touching[c] && !report(m, &m->bb, c, false, fn, ud)) return false;
+    for (int64_t c = 0; c < m->bw.n; c++)
+        if (m->bw.touching[c] && !report(m, &m->bw, c, true, fn, ud)) return false;
     return true;
 }
 

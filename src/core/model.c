@@ -65,6 +65,7 @@ sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
     m->skin_user = def->skin;
     m->dt_stale = true;
     m->build_needed = true;
+    m->guard_dirty = true;
     return m;
 }
 
@@ -97,6 +98,7 @@ sx_status sx_model_set_gravity(sx_model *m, const double g[3])
     for (int k = 0; k < m->dim; k++)
         if (!isfinite(g[k])) return sx__fail(m, SX_EINVAL, "set_gravity: components must be finite");
     for (int k = 0; k < m->dim; k++) m->gravity[k] = g[k];
+    m->guard_dirty = true;
     return SX_OK;
 }
 
@@ -183,6 +185,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
         if (damping_changed) m->balls.alpha[b] = d->damping;
     }
     m->dt_stale = true;
+    m->guard_dirty = true;
     if (out) *out = i;
     return SX_OK;
 }
@@ -230,10 +233,7 @@ static sx_status prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (st) return st;
-    if (m->build_needed) {
-        if (!kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
-        m->dt_stale = true;
-    }
+    if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;
 }
 
@@ -369,7 +369,12 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
     if ((st = update_timestep(m))) return st;
     const sx_kernels *k = kernels(m);
     m->locked = true;
-    guard_start(m);
+    /* the energy baseline is taken when the user has changed the system, not
+     * at every call: a script cycling one step at a time is guarded too */
+    if (m->guard_dirty) {
+        guard_start(m);
+        m->guard_dirty = false;
+    }
     for (int64_t s = 0; s < n; s++) {
         if (m->interrupt) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
@@ -387,6 +392,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
         if ((st = k->integrate(m, &max_disp))) break;
         move_walls(m, &max_wall);
         m->time += m->dt;
+        m->dt_prev = m->dt;
         m->step++;
         /* Verlet criterion: two balls may close the gap by twice the largest
          * displacement, a ball and a wall by both of their displacements. */
@@ -413,6 +419,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
     uint64_t h = 0xcbf29ce484222325ULL;
     h = fnv(h, &m->time, sizeof m->time);
     h = fnv(h, &m->step, sizeof m->step);
+    h = fnv(h, &m->dt_prev, sizeof m->dt_prev);
     h = fnv(h, b->id, n * sizeof *b->id);
     h = fnv(h, b->x, n * d * sizeof(double));
     h = fnv(h, b->v, n * d * sizeof(double));

@@ -212,7 +212,7 @@ SX_API sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], d
 
 /* ------------------------------------------------------------- contacts */
 
-/// Number of ball-ball and ball-wall contacts currently touching (overlap > 0).
+/// Number of ball-ball and ball-wall contacts of the last step's force evaluation.
 SX_API int64_t sx_contact_count(const sx_model *m);
 
 typedef struct sx_contact_info {
@@ -221,12 +221,13 @@ typedef struct sx_contact_info {
     double normal[3];    ///< unit normal from a to b (ball-wall: from the wall to the ball)
     double point[3];     ///< contact point, m (4-4)
     double overlap;      ///< m (4-3)
-    double fn;           ///< N, normal force magnitude (compression positive)
-    double shear[3];     ///< N, shear force on b
+    double fn;           ///< N, normal force incl. its dashpot (compression positive)
+    double shear[3];     ///< N, elastic shear force on b (the shear dashpot is not included)
     double kn, ks;       ///< N/m, contact stiffnesses
 } sx_contact_info;
 
-/// Calls fn for every touching contact, in the store's deterministic order.
+/// Calls fn for every contact of the last step's force evaluation, in the
+/// store's deterministic order: the forces the balls felt in that step.
 /// Stops and returns false when fn returns false.
 SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
 
