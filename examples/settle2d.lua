@@ -1,12 +1,12 @@
 -- Settling disks in a box under gravity (2D, disks of unit thickness).
 --   scripts/run examples/settle2d.lua [count] [steps]
 local count = tonumber(arg and arg[1]) or 1000
-local steps = tonumber(arg and arg[2]) or 20000
+local steps = tonumber(arg and arg[2]) or 40000
 
 local m = seixo.model{dim = 2, gravity = {0, -9.81}}
-m:material("glass", {density = 2500, kn = 1e5, ks = 1e5, friction = 0.5, damping = 0.7})
+m:material("glass", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.7})
 
-local rmax = 1.2e-3
+local rmax = 6e-3
 local side = math.ceil(math.sqrt(count / 2))        -- lattice columns
 local pitch = 2.05 * rmax
 local width = side * pitch

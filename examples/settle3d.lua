@@ -1,14 +1,14 @@
 -- Settling spheres in a box under gravity (3D).
 --   scripts/run examples/settle3d.lua [count] [steps]
--- Balls start on a jittered lattice with radii uniform in [0.8, 1.2] mm and
+-- Balls start on a jittered lattice with radii uniform in [4, 6] mm and
 -- fall into a box of six planes; local damping settles them.
 local count = tonumber(arg and arg[1]) or 2000
-local steps = tonumber(arg and arg[2]) or 20000
+local steps = tonumber(arg and arg[2]) or 40000
 
 local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
-m:material("glass", {density = 2500, kn = 1e5, ks = 1e5, friction = 0.5, damping = 0.7})
+m:material("glass", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.7})
 
-local rmax = 1.2e-3
+local rmax = 6e-3
 local side = math.ceil((count / 2) ^ (1 / 3))        -- lattice columns per side
 local pitch = 2.05 * rmax
 local width = side * pitch

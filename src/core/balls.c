@@ -37,6 +37,7 @@ sx_status sx__balls_reserve(sx_model *m, int64_t cap)
     RESIZE(b, id, 1);
     RESIZE(b, mat, 1);
     RESIZE(b, fix, 1);
+    RESIZE(b, group, 1);
     if (b->fapp) {
         RESIZE(b, fapp, d);
         RESIZE(b, tapp, r);
@@ -67,6 +68,7 @@ void sx__balls_free(sx_model *m)
     free_field(m, b->id, c, sizeof(int32_t));
     free_field(m, b->mat, c, sizeof(uint16_t));
     free_field(m, b->fix, c, sizeof(uint8_t));
+    free_field(m, b->group, c, sizeof(int32_t));
     free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
     free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
     free_field(m, b->index_of, b->index_cap, sizeof(int32_t));
@@ -119,6 +121,7 @@ static bool finite_vec(const double *v, int n)
 
 sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_add: the model is stepping; add balls between cycles");
     if (!(def->radius > 0) || !isfinite(def->radius))
         return sx__fail(m, SX_EINVAL, "ball_add: radius must be a positive finite number (got %g)", def->radius);
@@ -154,6 +157,7 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     b->mat[i] = (uint16_t)def->material;
     b->alpha[i] = m->mats[def->material].def.damping;
     b->fix[i] = 0;
+    b->group[i] = 0;
     b->id[i] = (int32_t)id;
     b->index_of[id] = (int32_t)i;
     sx__ball_update_mass(m, i);
@@ -185,6 +189,7 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
     b->id[to] = b->id[from];
     b->mat[to] = b->mat[from];
     b->fix[to] = b->fix[from];
+    b->group[to] = b->group[from];
     b->index_of[b->id[to]] = (int32_t)to;
 }
 
@@ -193,7 +198,6 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
  * history's sign, which is expressed relative to a -> b). */
 static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
 {
-    const int d = m->dim;
     sx_pairs *p = &m->bb;
     int64_t k = 0;
     for (int64_t c = 0; c < p->n; c++) {
@@ -202,25 +206,10 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
             if (p->bond && p->bond[c]) sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL);
             continue;
         }
-        if (p->bond) p->bond[k] = p->bond[c];
-        if (a == last) a = gone;
-        if (bb == last) bb = gone;
-        p->a[k] = a;
-        p->b[k] = bb;
-        for (int j = 0; j < d; j++) {
-            p->fs[k * d + j] = p->fs[c * d + j];
-            p->nold[k * d + j] = p->nold[c * d + j];
-        }
-        p->touching[k] = p->touching[c];
-        if (a > bb) {
-            p->a[k] = bb;
-            p->b[k] = a;
-            for (int j = 0; j < d; j++) {
-                p->fs[k * d + j] = -p->fs[k * d + j];
-                p->nold[k * d + j] = -p->nold[k * d + j];
-            }
-            if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
-        }
+        sx__pair_move(m, p, k, c);
+        p->a[k] = a == last ? gone : a;
+        p->b[k] = bb == last ? gone : bb;
+        if (p->a[k] > p->b[k]) sx__pair_flip(m, p, k);
         k++;
     }
     p->n = k;
@@ -228,13 +217,8 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
     k = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->a[c] == gone) continue;
-        p->a[k] = p->a[c] == last ? gone : p->a[c];
-        p->b[k] = p->b[c];
-        for (int j = 0; j < d; j++) {
-            p->fs[k * d + j] = p->fs[c * d + j];
-            p->nold[k * d + j] = p->nold[c * d + j];
-        }
-        p->touching[k] = p->touching[c];
+        sx__pair_move(m, p, k, c);
+        if (p->a[k] == last) p->a[k] = gone;
         k++;
     }
     p->n = k;
@@ -242,6 +226,7 @@ static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
 
 sx_status sx_ball_remove(sx_model *m, int64_t id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_remove: the model is stepping");
     const int64_t i = sx__ball_index(m, id);
     if (i < 0) return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)id);
@@ -285,6 +270,7 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     GATHER(id, 1, int32_t);
     GATHER(mat, 1, uint16_t);
     GATHER(fix, 1, uint8_t);
+    GATHER(group, 1, int32_t);
 #undef GATHER
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
@@ -302,8 +288,36 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, nold, d);
     RESIZE(p, touching, 1);
     if (p->bond) RESIZE(p, bond, 1);
+    RESIZE(p, un, 1);
+    RESIZE(p, fn, 1);
     p->cap = cap;
     return SX_OK;
+}
+
+void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
+{
+    const int d = m->dim;
+    p->a[to] = p->a[from];
+    p->b[to] = p->b[from];
+    memmove(p->fs + to * d, p->fs + from * d, (size_t)d * sizeof(double));
+    memmove(p->nold + to * d, p->nold + from * d, (size_t)d * sizeof(double));
+    p->touching[to] = p->touching[from];
+    p->un[to] = p->un[from];
+    p->fn[to] = p->fn[from];
+    if (p->bond) p->bond[to] = p->bond[from];
+}
+
+void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k)
+{
+    const int d = m->dim;
+    const int32_t a = p->a[k];
+    p->a[k] = p->b[k];
+    p->b[k] = a;
+    for (int j = 0; j < d; j++) {
+        p->fs[k * d + j] = -p->fs[k * d + j];
+        p->nold[k * d + j] = -p->nold[k * d + j];
+    }
+    if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
 }
 
 void sx__pairs_free(sx_model *m, sx_pairs *p)
@@ -315,6 +329,8 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->nold, c * d, sizeof(double));
     free_field(m, p->touching, c, sizeof(uint8_t));
     free_field(m, p->bond, p->bond ? c : 0, sizeof(int32_t));
+    free_field(m, p->un, c, sizeof(double));
+    free_field(m, p->fn, c, sizeof(double));
     memset(p, 0, sizeof *p);
 }
 
@@ -385,6 +401,7 @@ sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec which, doub
 
 sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double val[3])
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_vec");
     if (i < 0) return SX_ENOTFOUND;
     if (which == SX_BALL_FORCE || which == SX_BALL_MOMENT)
@@ -418,6 +435,7 @@ sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which, doubl
 
 sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double value)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set");
     if (i < 0) return SX_ENOTFOUND;
     sx_balls *b = &m->balls;
@@ -452,6 +470,7 @@ sx_status sx_ball_material(const sx_model *m, int64_t id, int *material)
 
 sx_status sx_ball_set_material(sx_model *m, int64_t id, int material)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_material");
     if (i < 0) return SX_ENOTFOUND;
     if (material < 0 || material >= m->nmat)
@@ -486,6 +505,7 @@ sx_status sx_ball_fixity(const sx_model *m, int64_t id, unsigned *mask)
 
 sx_status sx_ball_set_fixity(sx_model *m, int64_t id, unsigned mask)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_fixity");
     if (i < 0) return SX_ENOTFOUND;
     const unsigned valid = m->dim == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ);
@@ -502,4 +522,20 @@ sx_ball_def sx_ball_default_def(void)
     memset(&d, 0, sizeof d);
     d.radius = 1.0;
     return d;
+}
+
+sx_status sx_ball_group(const sx_model *m, int64_t id, int32_t *group)
+{
+    const int64_t i = lookup(m, id, "ball_group");
+    if (i < 0) return SX_ENOTFOUND;
+    *group = m->balls.group[i];
+    return SX_OK;
+}
+
+sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group)
+{
+    const int64_t i = lookup(m, id, "ball_set_group");
+    if (i < 0) return SX_ENOTFOUND;
+    m->balls.group[i] = group;
+    return SX_OK;
 }

@@ -61,11 +61,15 @@ static inline void moment_of(const double *r, const double *f, double *out)
 
 /* ---------------------------------------------------------- broad phase */
 
+/* A pair's history as saved across a build: shear force (D), previous
+ * normal (D), overlap and normal force of the last evaluation. */
+#define REC (2 * D + 2)
+
 typedef struct history {
     uint64_t *key;   /* 0 = empty slot */
-    int64_t *src;    /* index into the saved arrays */
+    int64_t *src;    /* record index of each slot */
     int64_t cap;
-    double *fs, *nold;
+    double *rec;     /* REC doubles per saved pair */
     int32_t *bond;   /* bond slot + 1 of each saved pair (0: none) */
     uint8_t *seen;   /* per bond slot: found again by the grid */
     int64_t n;
@@ -89,15 +93,24 @@ static inline uint64_t bw_key(int64_t id, int64_t wall)
     return (1ULL << 63) | ((uint64_t)id << 32) | (uint64_t)wall;
 }
 
-static void history_put(history *h, uint64_t key, const double *fs, const double *nold, int32_t bond)
+/* Saves pair c of p; sgn re-expresses the vectors (and the bond's) for the
+ * key's orientation, lower id -> higher id. */
+static void history_put(sx_model *m, history *h, uint64_t key, const sx_pairs *p, int64_t c, double sgn)
 {
-    h->bond[h->n] = bond;
     int64_t s = (int64_t)(hash_key(key) & (uint64_t)(h->cap - 1));
     while (h->key[s]) s = (s + 1) & (h->cap - 1);
     h->key[s] = key;
     h->src[s] = h->n;
-    memcpy(h->fs + h->n * D, fs, D * sizeof(double));
-    memcpy(h->nold + h->n * D, nold, D * sizeof(double));
+    double *r = h->rec + h->n * REC;
+    for (int k = 0; k < D; k++) {
+        r[k] = sgn * p->fs[c * D + k];
+        r[D + k] = sgn * p->nold[c * D + k];
+    }
+    r[2 * D] = p->un[c];
+    r[2 * D + 1] = p->fn[c];
+    const int32_t bond = p->bond ? p->bond[c] : 0;
+    if (bond && sgn < 0) sx__bond_flip(m, bond - 1);
+    h->bond[h->n] = bond;
     h->n++;
 }
 
@@ -112,10 +125,12 @@ static int64_t history_get(const history *h, uint64_t key)
     return -1;
 }
 
-/* Saves every touching pair's history keyed by stable ids. */
+/* Saves every touching (or bonded) pair's history keyed by stable ids. */
 static bool history_save(sx_model *m, history *h)
 {
     memset(h, 0, sizeof *h);
+    h->seen = calloc((size_t)(m->bonds.n + 1), 1);
+    if (!h->seen) return false;
     int64_t live = 0;
     for (int64_t c = 0; c < m->bb.n; c++) live += m->bb.touching[c];
     for (int64_t c = 0; c < m->bw.n; c++) live += m->bw.touching[c];
@@ -124,44 +139,31 @@ static bool history_save(sx_model *m, history *h)
     while (h->cap < 2 * live) h->cap *= 2;
     h->key = calloc((size_t)h->cap, sizeof *h->key);
     h->src = malloc((size_t)h->cap * sizeof *h->src);
-    h->fs = malloc((size_t)(live * D) * sizeof(double));
-    h->nold = malloc((size_t)(live * D) * sizeof(double));
+    h->rec = malloc((size_t)(live * REC) * sizeof(double));
     h->bond = malloc((size_t)live * sizeof(int32_t));
-    h->seen = calloc((size_t)(m->bonds.n + 1), 1);
-    if (!h->key || !h->src || !h->fs || !h->nold || !h->bond || !h->seen) return false;
+    if (!h->key || !h->src || !h->rec || !h->bond) return false;
     const int32_t *id = m->balls.id;
     for (int64_t c = 0; c < m->bb.n; c++) {
         if (!m->bb.touching[c]) continue;
         const int64_t ia = id[m->bb.a[c]], ib = id[m->bb.b[c]];
-        double fs[D], nold[D];
-        /* stored relative to the pair's a -> b; keep it relative to lower id -> higher id */
-        const double sgn = ia < ib ? 1.0 : -1.0;
-        for (int k = 0; k < D; k++) {
-            fs[k] = sgn * m->bb.fs[c * D + k];
-            nold[k] = sgn * m->bb.nold[c * D + k];
-        }
-        const int32_t bond = m->bb.bond ? m->bb.bond[c] : 0;
-        if (bond && sgn < 0) sx__bond_flip(m, bond - 1);
-        history_put(h, bb_key(ia, ib), fs, nold, bond);
+        history_put(m, h, bb_key(ia, ib), &m->bb, c, ia < ib ? 1.0 : -1.0);
     }
     for (int64_t c = 0; c < m->bw.n; c++)
-        if (m->bw.touching[c])
-            history_put(h, bw_key(id[m->bw.a[c]], m->bw.b[c]), m->bw.fs + c * D, m->bw.nold + c * D, 0);
+        if (m->bw.touching[c]) history_put(m, h, bw_key(id[m->bw.a[c]], m->bw.b[c]), &m->bw, c, 1.0);
     return true;
 }
 
 static void history_free(history *h)
 {
-    free(h->bond);
-    free(h->seen);
     free(h->key);
     free(h->src);
-    free(h->fs);
-    free(h->nold);
+    free(h->rec);
+    free(h->bond);
+    free(h->seen);
 }
 
 /* Appends candidate pair (a, b) and restores its history if it had one;
- * sgn is -1 when a has the higher id (history is kept lower id -> higher). */
+ * sgn is -1 when a has the higher id. */
 static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const history *h, uint64_t key, double sgn)
 {
     if (p->n == p->cap && sx__pairs_reserve(m, p, p->n + 1)) return false;
@@ -169,22 +171,21 @@ static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const hist
     p->a[c] = a;
     p->b[c] = b;
     const int64_t s = history_get(h, key);
-    if (p->bond) p->bond[c] = 0;
-    if (s >= 0) {
-        for (int k = 0; k < D; k++) {
-            p->fs[c * D + k] = sgn * h->fs[s * D + k];
-            p->nold[c * D + k] = sgn * h->nold[s * D + k];
-        }
-        p->touching[c] = 1;
-        const int32_t bond = h->bond[s];
-        if (bond && p->bond) {
-            p->bond[c] = bond;
+    const double *r = s >= 0 ? h->rec + s * REC : NULL;
+    for (int k = 0; k < D; k++) {
+        p->fs[c * D + k] = r ? sgn * r[k] : 0;
+        p->nold[c * D + k] = r ? sgn * r[D + k] : 0;
+    }
+    p->un[c] = r ? r[2 * D] : 0;
+    p->fn[c] = r ? r[2 * D + 1] : 0;
+    p->touching[c] = r != NULL;
+    if (p->bond) {
+        const int32_t bond = r ? h->bond[s] : 0;
+        p->bond[c] = bond;
+        if (bond) {
             h->seen[bond - 1] = 1;
             if (sgn < 0) sx__bond_flip(m, bond - 1);
         }
-    } else {
-        for (int k = 0; k < D; k++) p->fs[c * D + k] = p->nold[c * D + k] = 0;
-        p->touching[c] = 0;
     }
     return true;
 }
@@ -405,6 +406,21 @@ static bool build_wall_pairs(sx_model *m, const history *h)
 
 static bool KERNEL(build)(sx_model *m)
 {
+    if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
+        m->bb.n = m->bw.n = 0;
+        m->builds++;
+        m->build_needed = false;
+        m->dt_stale = true;
+        return true;
+    }
+    /* the automatic skin: a fifth of the mean radius */
+    if (m->skin_user > 0) {
+        m->skin = m->skin_user;
+    } else {
+        double sum = 0;
+        for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
+        m->skin = 0.2 * sum / (double)m->balls.n;
+    }
     history h;
     bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h) &&
               keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h);
@@ -414,6 +430,7 @@ static bool KERNEL(build)(sx_model *m)
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;
     m->build_needed = false;
+    m->dt_stale = true; /* new contacts: a new automatic timestep, wherever the build happens */
     return true;
 }
 
@@ -525,6 +542,10 @@ static double pb_strain(const sx_bonds *b, int64_t s)
 
 static double KERNEL(critical_dt)(sx_model *m);
 
+/* 4-16 ... 4-20: the velocity v_{n-1/2} moved the entities from x_{n-1} to
+ * x_n during the previous step, so displacement increments use its length. */
+static inline double motion_dt(const sx_model *m) { return m->dt_prev > 0 ? m->dt_prev : m->dt; }
+
 static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64_t idb, double un, double r)
 {
     return sx__fail(m, SX_EUNSTABLE,
@@ -559,7 +580,7 @@ static bool parallel_bond(sx_model *m, int32_t s, const carry *rot, const double
                           const double *dtheta, const double *xc, int64_t i, int64_t j, double *F, double *mb)
 {
     sx_bonds *b = &m->bonds;
-    const double dt = m->dt, rbar = b->rbar[s];
+    const double dt = motion_dt(m), rbar = b->rbar[s];
     double area, inertia, polar;
     pb_section(rbar, &area, &inertia, &polar);
     double *fs = b->fs + s * D, *ms = b->ms + s * RD;
@@ -606,7 +627,7 @@ static sx_status ball_contacts(sx_model *m)
     sx_pairs *p = &m->bb;
     const double *x = B->x, *v = B->v, *w = B->w, *rad = B->rad, *im = B->inv_mass;
     double *f = B->f, *t = B->t;
-    const double dt = m->dt;
+    const double dt = motion_dt(m);
     const int nlaw = m->law_n;
     const bool track = m->track_energy;
     for (int64_t c = 0; c < p->n; c++) {
@@ -718,6 +739,7 @@ static sx_status ball_contacts(sx_model *m)
                 if (track) m->acc.viscous -= work * dt;
             }
             for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k]; /* 4-5 */
+            p->fn[c] = fd;
         } else {
             if (track && p->touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
                 double kn0, ks0;
@@ -725,7 +747,9 @@ static sx_status ball_contacts(sx_model *m)
                 if (!law->hertz && ks0 > 0) m->acc.slip += 0.5 * dot(fs, fs) / ks0;
             }
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
+            p->fn[c] = 0;
         }
+        p->un[c] = un;
         if (bonds & SX_BOND_PARALLEL) {
             double dtheta[RD];
             for (int k = 0; k < RD; k++) dtheta[k] = (w[j * RD + k] - w[i * RD + k]) * dt;
@@ -760,7 +784,7 @@ static sx_status wall_contacts(sx_model *m)
 {
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bw;
-    const double dt = m->dt;
+    const double dt = motion_dt(m);
     const bool track = m->track_energy;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c];
@@ -833,6 +857,8 @@ static sx_status wall_contacts(sx_model *m)
             if (track) m->acc.viscous -= work * dt;
         }
         for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k];
+        p->un[c] = un;
+        p->fn[c] = fd;
         double mb[RD], mw[RD], arm[D];
         moment_of(rb, F, mb);
         for (int k = 0; k < D; k++) {
@@ -894,6 +920,8 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     sx_balls *B = &m->balls;
     const double dt = m->dt;
+    /* the kick spans the time between the half-step velocities, t_{n+1/2} - t_{n-1/2} */
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
     const double *g = m->gravity;
     const bool track = m->track_energy;
     double worst = 0, damp_work = 0, load_work = 0;
@@ -908,7 +936,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
                 const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
                 const double fd = damped(force, v[k], a);
                 const double vold = v[k];
-                v[k] += fd * im * dt; /* 4-46 */
+                v[k] += fd * im * dtv; /* 4-46 */
                 if (track) {
                     damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
                     if (B->fapp) load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
@@ -924,7 +952,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
             if (!(fix & (SX_FIX_WX << k))) {
                 const double md = damped(t[k], w[k], a);
                 const double wold = w[k];
-                w[k] += md * ii * dt; /* 4-47 */
+                w[k] += md * ii * dtv; /* 4-47 */
                 if (track) {
                     damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
                     if (B->tapp) load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
@@ -1090,90 +1118,82 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
         e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
     }
+    /* every overlap stores normal strain, even one no step has seen yet;
+     * the shear spring only once the contact has history */
+    const double zero[D] = {0};
     for (int64_t c = 0; c < m->bb.n; c++) {
-        if (!m->bb.touching[c]) continue;
         double n[D], kn, ks;
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
         const double fn = pair_force(m, c, un, &kn, &ks);
         const bool hertz = m->law[B->mat[i] * m->law_n + B->mat[j]].hertz;
-        e->strain += contact_strain(hertz, fn, un, m->bb.fs + c * D, ks);
+        e->strain += contact_strain(hertz, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
     }
     for (int64_t c = 0; c < m->bw.n; c++) {
-        if (!m->bw.touching[c]) continue;
         double n[D], kn, ks;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
         const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
-        if (un > 0) e->strain += contact_strain(law.hertz, fn, un, m->bw.fs + c * D, ks);
+        if (un > 0) e->strain += contact_strain(law.hertz, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
     }
 }
 
-static void fill_info(sx_contact_info *ci, const double *n, const double *xc, double un, double fn,
-                      const double *fs, double kn, double ks)
+/* Contacts are reported as the last force evaluation left them (the forces
+ * the balls felt): normal, overlap, normal force (with its dashpot), the
+ * elastic shear force and the bonds; the point is placed from ball a's
+ * current centre. */
+static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall,
+                   bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    memset(ci, 0, sizeof *ci);
+    const sx_balls *B = &m->balls;
+    const int64_t i = p->a[c];
+    const double *n = p->nold + c * D, un = p->un[c];
+    sx_contact_info ci;
+    memset(&ci, 0, sizeof ci);
+    const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])
+                                    : m->law[B->mat[i] * m->law_n + B->mat[p->b[c]]];
+    const double rj = is_wall ? B->rad[i] : B->rad[p->b[c]];
+    stiffness(&law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
+    /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
+    const double arm = is_wall ? -(B->rad[i] - 0.5 * un) : B->rad[i] - 0.5 * un;
     for (int k = 0; k < D; k++) {
-        ci->normal[k] = n[k];
-        ci->point[k] = xc[k];
-        ci->shear[k] = fs[k];
+        ci.normal[k] = n[k];
+        ci.point[k] = B->x[i * D + k] + arm * n[k];
+        ci.shear[k] = p->fs[c * D + k];
     }
-    ci->overlap = un;
-    ci->fn = fn;
-    ci->kn = kn;
-    ci->ks = ks;
+    ci.overlap = un;
+    ci.fn = p->fn[c];
+    ci.a = B->id[i];
+    ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
+    ci.is_wall = is_wall;
+    const int32_t slot = !is_wall && p->bond ? p->bond[c] - 1 : -1;
+    if (slot >= 0) {
+        const sx_bonds *b = &m->bonds;
+        ci.bond = b->kind[slot];
+        if (b->kind[slot] & SX_BOND_PARALLEL) {
+            ci.pb_fn = b->fn[slot];
+            ci.pb_radius = b->rbar[slot];
+            for (int k = 0; k < D; k++) ci.pb_fs[k] = b->fs[slot * D + k];
+#if D == 3
+            for (int k = 0; k < 3; k++) ci.pb_moment[k] = b->mn[slot] * n[k] + b->ms[slot * 3 + k];
+#else
+            ci.pb_moment[0] = b->ms[slot];
+#endif
+        }
+    }
+    return fn(&ci, ud);
 }
 
 static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    const sx_balls *B = &m->balls;
-    sx_contact_info ci;
-    for (int64_t c = 0; c < m->bb.n; c++) {
-        if (!m->bb.touching[c]) continue;
-        const int64_t i = m->bb.a[c], j = m->bb.b[c];
-        double n[D], xc[D], kn, ks;
-        const double un = pair_geometry(m, i, j, n);
-        for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] + (B->rad[i] - 0.5 * un) * n[k];
-        const double f = pair_force(m, c, un, &kn, &ks);
-        fill_info(&ci, n, xc, un, f, m->bb.fs + c * D, kn, ks);
-        ci.a = B->id[i];
-        ci.b = B->id[j];
-        const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
-        if (slot >= 0) {
-            const sx_bonds *b = &m->bonds;
-            ci.bond = b->kind[slot];
-            if (b->kind[slot] & SX_BOND_PARALLEL) {
-                ci.pb_fn = b->fn[slot];
-                ci.pb_radius = b->rbar[slot];
-                for (int k = 0; k < D; k++) ci.pb_fs[k] = b->fs[slot * D + k];
-#if D == 3
-                for (int k = 0; k < 3; k++) ci.pb_moment[k] = b->mn[slot] * n[k] + b->ms[slot * 3 + k];
-#else
-                ci.pb_moment[0] = b->ms[slot];
-#endif
-            }
-        }
-        if (!fn(&ci, ud)) return false;
-    }
-    for (int64_t c = 0; c < m->bw.n; c++) {
-        if (!m->bw.touching[c]) continue;
-        const int64_t i = m->bw.a[c];
-        const sx_wall *wl = &m->walls[m->bw.b[c]];
-        double n[D], xc[D], kn = 0, ks = 0;
-        const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
-        for (int k = 0; k < D; k++) xc[k] = B->x[i * D + k] - (B->rad[i] - 0.5 * un) * n[k];
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
-        const double f = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
-        fill_info(&ci, n, xc, un, f, m->bw.fs + c * D, kn, ks);
-        ci.a = B->id[i];
-        ci.b = wl->id;
-        ci.is_wall = true;
-        if (!fn(&ci, ud)) return false;
-    }
+    for (int64_t c = 0; c < m->bb.n; c++)
+        if (m->bb.touching[c] && !report(m, &m->bb, c, false, fn, ud)) return false;
+    for (int64_t c = 0; c < m->bw.n; c++)
+        if (m->bw.touching[c] && !report(m, &m->bw, c, true, fn, ud)) return false;
     return true;
 }
 

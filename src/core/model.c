@@ -65,6 +65,7 @@ sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
     m->skin_user = def->skin;
     m->dt_stale = true;
     m->build_needed = true;
+    m->guard_dirty = true;
     return m;
 }
 
@@ -98,6 +99,7 @@ sx_status sx_model_set_gravity(sx_model *m, const double g[3])
     for (int k = 0; k < m->dim; k++)
         if (!isfinite(g[k])) return sx__fail(m, SX_EINVAL, "set_gravity: components must be finite");
     for (int k = 0; k < m->dim; k++) m->gravity[k] = g[k];
+    m->guard_dirty = true;
     return SX_OK;
 }
 
@@ -196,6 +198,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
         if (damping_changed) m->balls.alpha[b] = d->damping;
     }
     m->dt_stale = true;
+    m->guard_dirty = true;
     if (out) *out = i;
     return SX_OK;
 }
@@ -276,24 +279,13 @@ static sx_status check_models(sx_model *m)
 
 /* ------------------------------------------------------------- timestep */
 
-static double mean_radius(const sx_model *m)
-{
-    double s = 0;
-    for (int64_t i = 0; i < m->balls.n; i++) s += m->balls.rad[i];
-    return m->balls.n ? s / (double)m->balls.n : 0;
-}
-
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
 sx_status sx__prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (!st) st = check_models(m);
     if (st) return st;
-    if (m->build_needed) {
-        m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
-        if (!kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
-        m->dt_stale = true;
-    }
+    if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;
 }
 
@@ -429,14 +421,18 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
     if ((st = update_timestep(m))) return st;
     const sx_kernels *k = kernels(m);
     m->locked = true;
-    guard_start(m);
+    /* the energy baseline is taken when the user has changed the system, not
+     * at every call: a script cycling one step at a time is guarded too */
+    if (m->guard_dirty) {
+        guard_start(m);
+        m->guard_dirty = false;
+    }
     for (int64_t s = 0; s < n; s++) {
         if (m->interrupt) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
         }
         if (m->build_needed) {
-            m->skin = m->skin_user > 0 ? m->skin_user : 0.2 * mean_radius(m);
             if (!k->build(m)) {
                 st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
                 break;
@@ -448,6 +444,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
         if ((st = k->integrate(m, &max_disp))) break;
         move_walls(m, &max_wall);
         m->time += m->dt;
+        m->dt_prev = m->dt;
         m->step++;
         /* Verlet criterion: two balls may close the gap by twice the largest
          * displacement, a ball and a wall by both of their displacements. */
@@ -474,6 +471,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
     uint64_t h = 0xcbf29ce484222325ULL;
     h = fnv(h, &m->time, sizeof m->time);
     h = fnv(h, &m->step, sizeof m->step);
+    h = fnv(h, &m->dt_prev, sizeof m->dt_prev);
     h = fnv(h, b->id, n * sizeof *b->id);
     h = fnv(h, b->x, n * d * sizeof(double));
     h = fnv(h, b->v, n * d * sizeof(double));
@@ -520,4 +518,35 @@ bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void
 {
     if (refresh_laws((sx_model *)m)) return false;
     return kernels(m)->each_contact(m, fn, ud);
+}
+
+static bool add_contact_force(const sx_contact_info *ci, void *ud)
+{
+    double *acc = ud;
+    double s2 = ci->fn * ci->fn;
+    for (int k = 0; k < 3; k++) s2 += ci->shear[k] * ci->shear[k];
+    acc[0] += sqrt(s2);
+    acc[1] += 1;
+    return true;
+}
+
+double sx_model_unbalanced_ratio(const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const int d = m->dim;
+    double unbalanced = 0;
+    for (int64_t i = 0; i < b->n; i++) {
+        double s2 = 0;
+        for (int k = 0; k < d; k++) {
+            if (b->fix[i] & (SX_FIX_VX << k)) continue; /* a fixed component is balanced by its fixity */
+            const double f = b->f[i * d + k] + m->gravity[k] / b->inv_mass[i];
+            s2 += f * f;
+        }
+        unbalanced += sqrt(s2);
+    }
+    double acc[2] = {0, 0};
+    sx_contact_each(m, add_contact_force, acc);
+    if (b->n == 0) return 0;
+    if (acc[1] == 0 || acc[0] == 0) return unbalanced > 0 ? INFINITY : 0;
+    return (unbalanced / (double)b->n) / (acc[0] / acc[1]);
 }

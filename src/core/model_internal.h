@@ -57,6 +57,7 @@ typedef struct sx_balls {
     int32_t *id;           /* stable id of each dense index */
     uint16_t *mat;         /* material index */
     uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
+    int32_t *group;        /* user group number (0: none) */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
@@ -86,6 +87,9 @@ typedef struct sx_pairs {
     double *nold;          /* previous normal (dim) */
     uint8_t *touching;     /* history is live (touching, or bonded) */
     int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
+    /* the last force evaluation, for queries consistent with the balls' forces */
+    double *un;            /* overlap */
+    double *fn;            /* normal force incl. the normal dashpot, compression positive */
 } sx_pairs;
 
 typedef struct sx_grid {
@@ -116,6 +120,7 @@ struct sx_model {
     double gravity[3];
     double dt_user;          /* 0 = automatic */
     double dt;               /* the timestep in use */
+    double dt_prev;          /* the timestep of the last step taken (0 before the first) */
     double dt_safety;
     double skin, skin_user;
     double time;
@@ -152,6 +157,7 @@ struct sx_model {
     /* stability guard: mechanical energy at the start of the current cycle */
     double guard_e0, guard_scale;
     bool guard_on;
+    bool guard_dirty;        /* the system was changed by the user: take a new energy baseline */
 };
 
 /* error helper: formats into m->err and returns status */
@@ -179,6 +185,8 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
+void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
+void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
 void sx__walls_free(sx_model *m);
 void sx__wall_prepare(sx_model *m, sx_wall *w);
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */

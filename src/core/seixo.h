@@ -76,6 +76,11 @@ SX_API sx_status sx_model_cycle(sx_model *m, int64_t n);
 /// Asks a running cycle to stop at the next step boundary (async-signal-safe).
 SX_API void sx_model_interrupt(sx_model *m);
 
+/// PFC's mean unbalanced-force ratio: the mean over balls of |F + m g| (free
+/// components) over the mean contact force magnitude; 0 when at rest with no
+/// contacts, infinity when forces act but no contact carries any.
+SX_API double sx_model_unbalanced_ratio(const sx_model *m);
+
 /// A 64-bit hash of the full dynamic state (positions, velocities, spins,
 /// forces, contact histories, walls, time); equal hashes mean bit-identical states.
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
@@ -168,6 +173,10 @@ SX_API sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, doub
 SX_API sx_status sx_ball_material(const sx_model *m, int64_t id, int *material);
 SX_API sx_status sx_ball_set_material(sx_model *m, int64_t id, int material);
 
+/// A user group number per ball (0 = no group); the Lua layer maps names to numbers.
+SX_API sx_status sx_ball_group(const sx_model *m, int64_t id, int32_t *group);
+SX_API sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group);
+
 /// Fixity bits: a fixed component keeps its velocity (or spin) whatever the force.
 enum {
     SX_FIX_VX = 1 << 0, SX_FIX_VY = 1 << 1, SX_FIX_VZ = 1 << 2,
@@ -216,7 +225,7 @@ SX_API sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], d
 
 /* ------------------------------------------------------------- contacts */
 
-/// Number of ball-ball and ball-wall contacts currently touching (overlap > 0).
+/// Number of ball-ball and ball-wall contacts of the last step's force evaluation.
 SX_API int64_t sx_contact_count(const sx_model *m);
 
 typedef struct sx_contact_info {
@@ -225,8 +234,8 @@ typedef struct sx_contact_info {
     double normal[3];    ///< unit normal from a to b (ball-wall: from the wall to the ball)
     double point[3];     ///< contact point, m (4-4)
     double overlap;      ///< m (4-3)
-    double fn;           ///< N, normal force magnitude (compression positive)
-    double shear[3];     ///< N, shear force on b
+    double fn;           ///< N, normal force incl. its dashpot (compression positive)
+    double shear[3];     ///< N, elastic shear force on b (the shear dashpot is not included)
     double kn, ks;       ///< N/m, contact stiffnesses (Hertz: secant normal, current shear)
     unsigned bond;       ///< SX_BOND_* bits intact on this contact (0: unbonded)
     double pb_fn;        ///< N, parallel-bond normal force (compression positive)
@@ -235,7 +244,9 @@ typedef struct sx_contact_info {
     double pb_radius;    ///< m, parallel-bond radius (4-53)
 } sx_contact_info;
 
-/// Calls fn for every touching or bonded contact, in the store's deterministic order.
+/// Calls fn for every contact of the last step's force evaluation (bonded
+/// pairs included, whatever their gap), in the store's deterministic order:
+/// the forces the balls felt in that step.
 /// Stops and returns false when fn returns false.
 SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
 

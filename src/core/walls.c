@@ -103,6 +103,7 @@ static sx_status validate(sx_model *m, const sx_wall_def *def)
 
 sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "wall_add: the model is stepping");
     sx_status st = validate(m, def);
     if (st) return st;
@@ -128,20 +129,17 @@ sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id)
 
 sx_status sx_wall_remove(sx_model *m, int64_t id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "wall_remove: the model is stepping");
     const int64_t i = sx__wall_index(m, id);
     if (i < 0) return sx__fail(m, SX_ENOTFOUND, "wall_remove: no wall with id %lld", (long long)id);
     const int64_t last = m->nwall - 1;
-    const int d = m->dim;
     sx_pairs *p = &m->bw;
     int64_t k = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->b[c] == i) continue;
-        p->a[k] = p->a[c];
-        p->b[k] = p->b[c] == last ? (int32_t)i : p->b[c];
-        memmove(p->fs + k * d, p->fs + c * d, d * sizeof(double));
-        memmove(p->nold + k * d, p->nold + c * d, d * sizeof(double));
-        p->touching[k] = p->touching[c];
+        sx__pair_move(m, p, k, c);
+        if (p->b[k] == last) p->b[k] = (int32_t)i;
         k++;
     }
     p->n = k;
@@ -178,6 +176,7 @@ sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out)
 
 sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_vel");
     if (!w) return SX_ENOTFOUND;
     if (!finite3(vel, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_vel: velocity must be finite");

@@ -1,0 +1,308 @@
+/* Balls: m:ball{...} adds one, m:ball(id) finds one, m:balls() iterates.
+ * A ball object is a handle (model, id); its fields read and write the
+ * core's state, and every access checks that the ball still exists. */
+#include "bindings.h"
+
+static const sx_lua_kind ball_kind = {"seixo.ball", "ball", sx_ball_exists};
+
+/* The ball of the handle at index 1: live, in an open model. */
+static sx_model *check_ball(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &ball_kind, id); }
+
+/* The index of the named material, or -1 with the message pushed. */
+static int find_material(lua_State *L, const sx_model *m, const char *name)
+{
+    const int i = sx_material_find(m, name);
+    if (i < 0) lua_pushfstring(L, "no material named '%s'", name);
+    return i;
+}
+
+/* ------------------------------------------------------------- fields */
+
+static int vec_len(const sx_model *m, sx_ball_vec which)
+{
+    const bool rotational = which == SX_BALL_SPIN || which == SX_BALL_MOMENT || which == SX_BALL_APPLIED_MOMENT;
+    return rotational ? sx_lua_rdim(sx_model_dim(m)) : sx_model_dim(m);
+}
+
+static int get_vec(lua_State *L, sx_ball_vec which)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    double v[3];
+    sx_lua_check(L, m, sx_ball_get_vec(m, id, which, v));
+    sx_lua_pushvec(L, v, vec_len(m, which));
+    return 1;
+}
+
+static int set_vec(lua_State *L, sx_ball_vec which)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    double v[3] = {0, 0, 0};
+    sx_lua_checkvalue(L, 3, vec_len(m, which), v, lua_tostring(L, 2));
+    sx_lua_check(L, m, sx_ball_set_vec(m, id, which, v));
+    return 0;
+}
+
+static int get_scalar(lua_State *L, sx_ball_scalar which)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    double v;
+    sx_lua_check(L, m, sx_ball_get(m, id, which, &v));
+    lua_pushnumber(L, v);
+    return 1;
+}
+
+static int set_scalar(lua_State *L, sx_ball_scalar which)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    double v;
+    sx_lua_checkvalue(L, 3, 1, &v, lua_tostring(L, 2));
+    sx_lua_check(L, m, sx_ball_set(m, id, which, v));
+    return 0;
+}
+
+static int get_pos(lua_State *L) { return get_vec(L, SX_BALL_POS); }
+static int get_vel(lua_State *L) { return get_vec(L, SX_BALL_VEL); }
+static int get_spin(lua_State *L) { return get_vec(L, SX_BALL_SPIN); }
+static int get_force(lua_State *L) { return get_vec(L, SX_BALL_FORCE); }
+static int get_moment(lua_State *L) { return get_vec(L, SX_BALL_MOMENT); }
+static int get_applied_force(lua_State *L) { return get_vec(L, SX_BALL_APPLIED_FORCE); }
+static int get_applied_moment(lua_State *L) { return get_vec(L, SX_BALL_APPLIED_MOMENT); }
+static int set_pos(lua_State *L) { return set_vec(L, SX_BALL_POS); }
+static int set_vel(lua_State *L) { return set_vec(L, SX_BALL_VEL); }
+static int set_spin(lua_State *L) { return set_vec(L, SX_BALL_SPIN); }
+static int set_applied_force(lua_State *L) { return set_vec(L, SX_BALL_APPLIED_FORCE); }
+static int set_applied_moment(lua_State *L) { return set_vec(L, SX_BALL_APPLIED_MOMENT); }
+static int get_radius(lua_State *L) { return get_scalar(L, SX_BALL_RADIUS); }
+static int get_mass(lua_State *L) { return get_scalar(L, SX_BALL_MASS); }
+static int get_inertia(lua_State *L) { return get_scalar(L, SX_BALL_INERTIA); }
+static int get_damping(lua_State *L) { return get_scalar(L, SX_BALL_DAMPING); }
+static int set_radius(lua_State *L) { return set_scalar(L, SX_BALL_RADIUS); }
+static int set_damping(lua_State *L) { return set_scalar(L, SX_BALL_DAMPING); }
+
+static int get_id(lua_State *L)
+{
+    int64_t id;
+    check_ball(L, &id);
+    lua_pushinteger(L, (lua_Integer)id);
+    return 1;
+}
+
+static int get_material(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    int mat;
+    sx_lua_check(L, m, sx_ball_material(m, id, &mat));
+    lua_pushstring(L, sx_material_name(m, mat));
+    return 1;
+}
+
+static int set_material(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    if (lua_type(L, 3) != LUA_TSTRING)
+        return luaL_error(L, "field 'material': material name expected, got %s", luaL_typename(L, 3));
+    const int mat = find_material(L, m, lua_tostring(L, 3));
+    if (mat < 0) return luaL_error(L, "field 'material': %s", lua_tostring(L, -1));
+    sx_lua_check(L, m, sx_ball_set_material(m, id, mat));
+    return 0;
+}
+
+/* Fixity words: the six components, then the groups; a 2D ball has only
+ * vx, vy and wz (its scalar spin), so a 2D mask of 0 marks a word it lacks. */
+static const char *const fix_names[] = {"vx", "vy", "vz", "wx", "wy", "wz", "vel", "spin", "all", NULL};
+static const unsigned fix_masks[][2] = {
+    /* 3D, 2D */
+    {SX_FIX_VX, SX_FIX_VX},
+    {SX_FIX_VY, SX_FIX_VY},
+    {SX_FIX_VZ, 0},
+    {SX_FIX_WX, 0},
+    {SX_FIX_WY, 0},
+    {SX_FIX_WZ, SX_FIX_WZ},
+    {SX_FIX_VEL, SX_FIX_VX | SX_FIX_VY},
+    {SX_FIX_SPIN, SX_FIX_WZ},
+    {SX_FIX_VEL | SX_FIX_SPIN, SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ},
+};
+enum { FIX_COMPONENTS = 6 };
+_Static_assert(sizeof fix_names / sizeof fix_names[0] == sizeof fix_masks / sizeof fix_masks[0] + 1,
+               "one mask pair per fixity word");
+
+static int fix_word(lua_State *L, int dim, int idx)
+{
+    if (lua_type(L, idx) != LUA_TSTRING)
+        return luaL_error(L, "field 'fix': fixity name expected, got %s", luaL_typename(L, idx));
+    const char *word = lua_tostring(L, idx);
+    const int i = sx_lua_find(word, fix_names);
+    if (i < 0) {
+        sx_lua_pushlist(L, fix_names);
+        return luaL_error(L, "field 'fix': unknown fixity '%s' (valid: %s)", word, lua_tostring(L, -1));
+    }
+    const unsigned mask = fix_masks[i][dim == 3 ? 0 : 1];
+    if (!mask) return luaL_error(L, "field 'fix': a 2D ball has no '%s' (only vx, vy, wz)", word);
+    return (int)mask;
+}
+
+/* nil or {} frees every component; a word or an array of words fixes those. */
+static unsigned fix_value(lua_State *L, int dim, int idx)
+{
+    if (lua_isnil(L, idx)) return 0;
+    if (lua_type(L, idx) == LUA_TSTRING) return (unsigned)fix_word(L, dim, idx);
+    if (!lua_istable(L, idx))
+        luaL_error(L, "field 'fix': string or array of strings expected, got %s", luaL_typename(L, idx));
+    unsigned mask = 0;
+    const lua_Unsigned n = lua_rawlen(L, idx);
+    for (lua_Unsigned k = 1; k <= n; k++) {
+        lua_rawgeti(L, idx, (lua_Integer)k);
+        mask |= (unsigned)fix_word(L, dim, -1);
+        lua_pop(L, 1);
+    }
+    return mask;
+}
+
+static int get_fix(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    unsigned mask;
+    sx_lua_check(L, m, sx_ball_fixity(m, id, &mask));
+    lua_newtable(L);
+    int n = 0;
+    for (int i = 0; i < FIX_COMPONENTS; i++) {
+        if (!(mask & fix_masks[i][0])) continue;
+        lua_pushstring(L, fix_names[i]);
+        lua_rawseti(L, -2, ++n);
+    }
+    return 1;
+}
+
+static int set_fix(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    sx_lua_check(L, m, sx_ball_set_fixity(m, id, fix_value(L, sx_model_dim(m), 3)));
+    return 0;
+}
+
+/* ------------------------------------------------- methods, metamethods */
+
+static int ball_remove(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    sx_lua_check(L, m, sx_ball_remove(m, id));
+    return 0;
+}
+
+static int ball_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &ball_kind); }
+
+/* ------------------------------------------------------- model methods */
+
+/* The material of a new ball when the table names none: the only one. */
+static int sole_material(lua_State *L, const sx_model *m)
+{
+    const int n = sx_material_count(m);
+    if (n == 0) return luaL_argerror(L, 2, "no material defined yet; add one with m:material(name, {...})");
+    if (n > 1) return luaL_argerror(L, 2, "field 'material' is required when the model has several materials");
+    return 0;
+}
+
+static int add_ball(lua_State *L, sx_model *m)
+{
+    static const char *const keys[] = {"pos", "radius", "vel", "spin", "material", NULL};
+    const int dim = sx_model_dim(m);
+    sx_lua_checkkeys(L, 2, keys);
+    sx_ball_def d = sx_ball_default_def();
+    sx_lua_checkvecfield(L, 2, "pos", dim, d.pos);
+    d.radius = sx_lua_checknumfield(L, 2, "radius");
+    sx_lua_optvecfield(L, 2, "vel", dim, d.vel);
+    sx_lua_optvecfield(L, 2, "spin", sx_lua_rdim(dim), d.spin);
+    const char *name = sx_lua_optstrfield(L, 2, "material");
+    d.material = name ? find_material(L, m, name) : sole_material(L, m);
+    if (d.material < 0) return luaL_argerror(L, 2, lua_pushfstring(L, "field 'material': %s", lua_tostring(L, -1)));
+    int64_t id;
+    sx_lua_check(L, m, sx_ball_add(m, &d, &id));
+    sx_lua_pushhandle(L, 1, &ball_kind, id);
+    return 1;
+}
+
+/* m:ball{...} adds a ball; m:ball(id) returns the ball with that id, or nil. */
+static int model_ball(lua_State *L)
+{
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    if (lua_type(L, 2) == LUA_TTABLE) return add_ball(L, m);
+    if (lua_type(L, 2) != LUA_TNUMBER) return luaL_typeerror(L, 2, "table or integer");
+    const int64_t id = (int64_t)luaL_checkinteger(L, 2);
+    if (!sx_ball_exists(m, id)) return 0;
+    sx_lua_pushhandle(L, 1, &ball_kind, id);
+    return 1;
+}
+
+static int next_ball(lua_State *L) { return sx_lua_nexthandle(L, &ball_kind); }
+
+static int model_balls(lua_State *L)
+{
+    sx_lua_pushiterator(L, 1, sx_ball_count, sx_ball_id_at, next_ball);
+    return 1;
+}
+
+static int model_ball_count(lua_State *L)
+{
+    lua_pushinteger(L, (lua_Integer)sx_ball_count(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
+void sx_lua_balls_register(lua_State *L)
+{
+    static const luaL_Reg model_methods[] = {
+        {"ball", model_ball},
+        {"balls", model_balls},
+        {"ball_count", model_ball_count},
+        {NULL, NULL},
+    };
+    static const luaL_Reg meta[] = {
+        {"__tostring", ball_tostring},
+        {"__eq", sx_lua_handle_eq},
+        {NULL, NULL},
+    };
+    static const luaL_Reg ball_methods[] = {
+        {"remove", ball_remove},
+        {NULL, NULL},
+    };
+    static const luaL_Reg getters[] = {
+        {"id", get_id},
+        {"pos", get_pos},
+        {"vel", get_vel},
+        {"spin", get_spin},
+        {"force", get_force},
+        {"moment", get_moment},
+        {"applied_force", get_applied_force},
+        {"applied_moment", get_applied_moment},
+        {"radius", get_radius},
+        {"mass", get_mass},
+        {"inertia", get_inertia},
+        {"material", get_material},
+        {"fix", get_fix},
+        {"damping", get_damping},
+        {NULL, NULL},
+    };
+    static const luaL_Reg setters[] = {
+        {"pos", set_pos},
+        {"vel", set_vel},
+        {"spin", set_spin},
+        {"applied_force", set_applied_force},
+        {"applied_moment", set_applied_moment},
+        {"radius", set_radius},
+        {"material", set_material},
+        {"fix", set_fix},
+        {"damping", set_damping},
+        {NULL, NULL},
+    };
+    luaL_setfuncs(L, model_methods, 0);
+    sx_lua_newclass(L, ball_kind.tname, ball_kind.name, meta, ball_methods, getters, setters);
+    lua_pop(L, 1);
+}

@@ -1,0 +1,342 @@
+/* Helpers shared by the binding files: status and argument checks, vectors,
+ * property tables, classes with field accessors, handles and iterators.
+ *
+ * A handle is a userdata holding an object id, with the model userdata as
+ * its uservalue: it keeps the model alive, never holds a core pointer, and
+ * checks on every use that the model is open and the object still exists.
+ *
+ * Property tables are read raw (no metamethods), like the unknown-key check,
+ * so what is checked is exactly what is used. Field getters and setters are
+ * called directly from __index/__newindex rather than through lua_call, so
+ * their errors carry the script position of the access. */
+#include "bindings.h"
+
+#include <limits.h>
+#include <string.h>
+
+void sx_lua_check(lua_State *L, const sx_model *m, sx_status st)
+{
+    if (st != SX_OK) luaL_error(L, "%s", sx_model_error(m));
+}
+
+int sx_lua_find(const char *s, const char *const list[])
+{
+    for (int i = 0; list[i]; i++)
+        if (strcmp(s, list[i]) == 0) return i;
+    return -1;
+}
+
+static void add_name(luaL_Buffer *b, int i, const char *name)
+{
+    if (i > 0) luaL_addstring(b, ", ");
+    luaL_addstring(b, name);
+}
+
+void sx_lua_pushlist(lua_State *L, const char *const list[])
+{
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    for (int i = 0; list[i]; i++) add_name(&b, i, list[i]);
+    luaL_pushresult(&b);
+}
+
+static void push_names(lua_State *L, const luaL_Reg regs[])
+{
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    for (int i = 0; regs && regs[i].name; i++) add_name(&b, i, regs[i].name);
+    luaL_pushresult(&b);
+}
+
+/* A key as a message shows it: 'name' for strings, the value otherwise. */
+static const char *push_key(lua_State *L, int idx)
+{
+    if (lua_type(L, idx) == LUA_TSTRING) return lua_pushfstring(L, "'%s'", lua_tostring(L, idx));
+    return luaL_tolstring(L, idx, NULL);
+}
+
+void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[])
+{
+    luaL_checktype(L, arg, LUA_TTABLE);
+    lua_pushnil(L);
+    while (lua_next(L, arg)) {
+        lua_pop(L, 1);
+        if (lua_type(L, -1) == LUA_TSTRING && sx_lua_find(lua_tostring(L, -1), keys) >= 0) continue;
+        const char *key = push_key(L, -1);
+        sx_lua_pushlist(L, keys);
+        luaL_argerror(L, arg, lua_pushfstring(L, "unknown key %s (valid keys: %s)", key, lua_tostring(L, -1)));
+    }
+}
+
+/* ------------------------------------------------------------- vectors */
+
+const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
+{
+    idx = lua_absindex(L, idx);
+    if (n == 1) {
+        if (lua_type(L, idx) != LUA_TNUMBER)
+            return lua_pushfstring(L, "number expected, got %s", luaL_typename(L, idx));
+        out[0] = lua_tonumber(L, idx);
+        return NULL;
+    }
+    if (!lua_istable(L, idx))
+        return lua_pushfstring(L, "array of %d numbers expected, got %s", n, luaL_typename(L, idx));
+    const lua_Unsigned len = lua_rawlen(L, idx);
+    if (len != (lua_Unsigned)n)
+        return lua_pushfstring(L, "%d components expected in a %dD model, got %I", n, n, (lua_Integer)len);
+    double v[3];
+    for (int k = 0; k < n; k++) {
+        const int t = lua_rawgeti(L, idx, k + 1);
+        v[k] = lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (t != LUA_TNUMBER)
+            return lua_pushfstring(L, "component %d: number expected, got %s", k + 1, lua_typename(L, t));
+    }
+    memcpy(out, v, (size_t)n * sizeof *v);
+    return NULL;
+}
+
+void sx_lua_pushvec(lua_State *L, const double *v, int n)
+{
+    if (n == 1) {
+        lua_pushnumber(L, v[0]);
+        return;
+    }
+    lua_createtable(L, n, 0);
+    for (int k = 0; k < n; k++) {
+        lua_pushnumber(L, v[k]);
+        lua_rawseti(L, -2, k + 1);
+    }
+}
+
+void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *field)
+{
+    const char *err = sx_lua_tovec(L, idx, n, out);
+    if (err) luaL_error(L, "field '%s': %s", field, err);
+}
+
+/* ----------------------------------------------------- property tables */
+
+static int rawfield(lua_State *L, int arg, const char *key)
+{
+    lua_pushstring(L, key);
+    return lua_rawget(L, arg);
+}
+
+static int field_error(lua_State *L, int arg, const char *key, const char *msg)
+{
+    return luaL_argerror(L, arg, lua_pushfstring(L, "field '%s': %s", key, msg));
+}
+
+static int field_missing(lua_State *L, int arg, const char *key)
+{
+    return luaL_argerror(L, arg, lua_pushfstring(L, "field '%s' is required", key));
+}
+
+bool sx_lua_optvecfield(lua_State *L, int arg, const char *key, int n, double *out)
+{
+    if (rawfield(L, arg, key) == LUA_TNIL) {
+        lua_pop(L, 1);
+        return false;
+    }
+    const char *err = sx_lua_tovec(L, -1, n, out);
+    if (err) field_error(L, arg, key, err);
+    lua_pop(L, 1);
+    return true;
+}
+
+void sx_lua_checkvecfield(lua_State *L, int arg, const char *key, int n, double *out)
+{
+    if (!sx_lua_optvecfield(L, arg, key, n, out)) field_missing(L, arg, key);
+}
+
+bool sx_lua_optnumfield(lua_State *L, int arg, const char *key, double *out)
+{
+    return sx_lua_optvecfield(L, arg, key, 1, out);
+}
+
+double sx_lua_checknumfield(lua_State *L, int arg, const char *key)
+{
+    double v = 0;
+    sx_lua_checkvecfield(L, arg, key, 1, &v);
+    return v;
+}
+
+const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key)
+{
+    const int t = rawfield(L, arg, key);
+    if (t != LUA_TNIL && t != LUA_TSTRING)
+        field_error(L, arg, key, lua_pushfstring(L, "string expected, got %s", lua_typename(L, t)));
+    const char *s = lua_tostring(L, -1);
+    lua_pop(L, 1);
+    return s;
+}
+
+/* ------------------------------------------------------------- classes */
+
+static int no_field(lua_State *L, const char *what)
+{
+    const char *kind = lua_tostring(L, lua_upvalueindex(3));
+    const char *names = lua_tostring(L, lua_upvalueindex(4));
+    const char *key = push_key(L, 2);
+    if (!*names) return luaL_error(L, "%s has no %s %s", kind, what, key);
+    return luaL_error(L, "%s has no %s %s (%ss: %s)", kind, what, key, what, names);
+}
+
+/* upvalues: methods, getters, kind, the readable field names */
+static int object_index(lua_State *L)
+{
+    lua_settop(L, 2);
+    lua_pushvalue(L, 2);
+    if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
+    lua_pushvalue(L, 2);
+    lua_rawget(L, lua_upvalueindex(2));
+    const lua_CFunction get = lua_tocfunction(L, -1);
+    lua_settop(L, 2);
+    return get ? get(L) : no_field(L, "field");
+}
+
+/* upvalues: setters, getters, kind, the writable field names */
+static int object_newindex(lua_State *L)
+{
+    lua_settop(L, 3);
+    lua_pushvalue(L, 2);
+    lua_rawget(L, lua_upvalueindex(1));
+    const lua_CFunction set = lua_tocfunction(L, -1);
+    lua_settop(L, 3);
+    if (set) return set(L);
+    lua_pushvalue(L, 2);
+    if (lua_rawget(L, lua_upvalueindex(2)) != LUA_TNIL)
+        return luaL_error(L, "%s field %s is read-only", lua_tostring(L, lua_upvalueindex(3)), push_key(L, 2));
+    return no_field(L, "writable field");
+}
+
+static void push_regs(lua_State *L, const luaL_Reg regs[])
+{
+    lua_newtable(L);
+    if (regs) luaL_setfuncs(L, regs, 0);
+}
+
+void sx_lua_newclass(lua_State *L, const char *tname, const char *kind, const luaL_Reg meta[],
+                     const luaL_Reg methods[], const luaL_Reg getters[], const luaL_Reg setters[])
+{
+    luaL_newmetatable(L, tname);
+    const int mt = lua_gettop(L);
+    luaL_setfuncs(L, meta, 0);
+    push_regs(L, methods);
+    const int methods_at = lua_gettop(L);
+    push_regs(L, getters);
+    const int getters_at = lua_gettop(L);
+
+    lua_pushvalue(L, methods_at);
+    lua_pushvalue(L, getters_at);
+    lua_pushstring(L, kind);
+    push_names(L, getters);
+    lua_pushcclosure(L, object_index, 4);
+    lua_setfield(L, mt, "__index");
+
+    push_regs(L, setters);
+    lua_pushvalue(L, getters_at);
+    lua_pushstring(L, kind);
+    push_names(L, setters);
+    lua_pushcclosure(L, object_newindex, 4);
+    lua_setfield(L, mt, "__newindex");
+
+    lua_settop(L, methods_at);
+    lua_remove(L, mt);
+}
+
+/* ------------------------------------------------------------- handles */
+
+typedef struct handle {
+    int64_t id;
+} handle;
+
+void sx_lua_pushhandle(lua_State *L, int model, const sx_lua_kind *k, int64_t id)
+{
+    model = lua_absindex(L, model);
+    handle *h = lua_newuserdatauv(L, sizeof *h, 1);
+    h->id = id;
+    luaL_setmetatable(L, k->tname);
+    lua_pushvalue(L, model);
+    lua_setiuservalue(L, -2, 1);
+}
+
+/* The id of the handle at idx and its model, NULL if the model is closed. */
+static sx_model *tohandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id)
+{
+    idx = lua_absindex(L, idx);
+    const handle *h = luaL_checkudata(L, idx, k->tname);
+    *id = h->id;
+    lua_getiuservalue(L, idx, 1);
+    sx_model *m = sx_lua_tomodel(L, -1);
+    lua_pop(L, 1);
+    return m;
+}
+
+sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id)
+{
+    sx_model *m = tohandle(L, idx, k, id);
+    if (!m) luaL_error(L, "the model has been closed");
+    if (!k->exists(m, *id)) luaL_error(L, "%s %I has been removed", k->name, (lua_Integer)*id);
+    return m;
+}
+
+int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k)
+{
+    int64_t id;
+    const sx_model *m = tohandle(L, 1, k, &id);
+    const char *state = !m ? " (model closed)" : k->exists(m, id) ? "" : " (removed)";
+    lua_pushfstring(L, "%s %I%s", k->tname, (lua_Integer)id, state);
+    return 1;
+}
+
+int sx_lua_handle_eq(lua_State *L)
+{
+    bool eq = lua_getmetatable(L, 1) && lua_getmetatable(L, 2) && lua_rawequal(L, -1, -2);
+    lua_settop(L, 2);
+    if (eq) {
+        lua_getiuservalue(L, 1, 1);
+        lua_getiuservalue(L, 2, 1);
+        eq = lua_rawequal(L, -1, -2) &&
+             ((const handle *)lua_touserdata(L, 1))->id == ((const handle *)lua_touserdata(L, 2))->id;
+    }
+    lua_pushboolean(L, eq);
+    return 1;
+}
+
+/* ----------------------------------------------------------- iterators */
+
+/* The closure's upvalues: the model userdata, the table of ids, the
+ * position reached in it. */
+void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_model *),
+                         int64_t (*id_at)(const sx_model *, int64_t), lua_CFunction next)
+{
+    model = lua_absindex(L, model);
+    const sx_model *m = sx_lua_checkmodel(L, model);
+    const int64_t n = count(m);
+    lua_pushvalue(L, model);
+    lua_createtable(L, n < INT_MAX ? (int)n : INT_MAX, 0);
+    for (int64_t i = 0; i < n; i++) {
+        lua_pushinteger(L, (lua_Integer)id_at(m, i));
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_pushinteger(L, 0);
+    lua_pushcclosure(L, next, 3);
+}
+
+int sx_lua_nexthandle(lua_State *L, const sx_lua_kind *k)
+{
+    const sx_model *m = sx_lua_checkmodel(L, lua_upvalueindex(1));
+    lua_Integer i = lua_tointeger(L, lua_upvalueindex(3));
+    while (lua_rawgeti(L, lua_upvalueindex(2), ++i) == LUA_TNUMBER) {
+        const int64_t id = (int64_t)lua_tointeger(L, -1);
+        lua_pop(L, 1);
+        if (!k->exists(m, id)) continue;  // removed since the snapshot
+        lua_pushinteger(L, i);
+        lua_replace(L, lua_upvalueindex(3));
+        sx_lua_pushhandle(L, lua_upvalueindex(1), k, id);
+        return 1;
+    }
+    return 1;  // the nil that ended the snapshot
+}

@@ -1,0 +1,288 @@
+/* Walls: m:wall{kind = ...} adds a plane or rect (3D), a line or segment
+ * (2D), or a box: the planes (lines) of an axis-aligned box, facing inward.
+ * m:walls() iterates. A wall object is a handle (model, id) like a ball:
+ * its geometry is read back from the core, only its velocity is writable. */
+#include "bindings.h"
+
+#include <stddef.h>
+#include <string.h>
+
+static const char *const kind_names[] = {"plane", "line", "rect", "segment", "box", NULL};
+enum { KIND_BOX = 4 };
+_Static_assert(SX_WALL_PLANE == 0 && SX_WALL_LINE == 1 && SX_WALL_RECT == 2 && SX_WALL_SEGMENT == 3,
+               "kind_names is indexed by sx_wall_kind");
+
+static const char *const plane_keys[] = {"kind", "point", "normal", "kn", "ks", "friction", "vel", NULL};
+static const char *const rect_keys[] = {"kind", "corner", "point", "edge1", "edge2", "kn", "ks", "friction", "vel",
+                                        NULL};
+static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", NULL};
+static const char *const box_keys[] = {"kind", "min", "max", "kn", "ks", "friction", NULL};
+
+/* What a wall kind needs: its dimension, its counterpart in the other
+ * dimension (for the error message) and its valid keys. */
+static const struct shape {
+    int dim;
+    const char *other;
+    const char *const *keys;
+} shapes[] = {
+    [SX_WALL_PLANE] = {3, "line", plane_keys},
+    [SX_WALL_LINE] = {2, "plane", plane_keys},
+    [SX_WALL_RECT] = {3, "segment", rect_keys},
+    [SX_WALL_SEGMENT] = {2, "rect", segment_keys},
+};
+
+static const sx_lua_kind wall_kind = {"seixo.wall", "wall", sx_wall_exists};
+
+/* The wall of the handle at index 1: live, in an open model. */
+static sx_model *check_wall(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &wall_kind, id); }
+
+/* ------------------------------------------------------------- fields */
+
+static const sx_model *wall_def(lua_State *L, sx_wall_def *d)
+{
+    int64_t id;
+    const sx_model *m = check_wall(L, &id);
+    sx_lua_check(L, m, sx_wall_get(m, id, d));
+    return m;
+}
+
+/* A vector or number field of the definition, by its offset in sx_wall_def. */
+static int push_def_vec(lua_State *L, size_t offset)
+{
+    sx_wall_def d;
+    const sx_model *m = wall_def(L, &d);
+    sx_lua_pushvec(L, (const double *)((const char *)&d + offset), sx_model_dim(m));
+    return 1;
+}
+
+static int push_def_number(lua_State *L, size_t offset)
+{
+    sx_wall_def d;
+    wall_def(L, &d);
+    lua_pushnumber(L, *(const double *)((const char *)&d + offset));
+    return 1;
+}
+
+static int get_point(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, point)); }
+static int get_normal(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, normal)); }
+static int get_edge1(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge1)); }
+static int get_edge2(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge2)); }
+static int get_vel(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, vel)); }
+static int get_kn(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, kn)); }
+static int get_ks(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, ks)); }
+static int get_friction(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, friction)); }
+
+static int get_kind(lua_State *L)
+{
+    sx_wall_def d;
+    wall_def(L, &d);
+    lua_pushstring(L, kind_names[d.kind]);
+    return 1;
+}
+
+static int get_id(lua_State *L)
+{
+    int64_t id;
+    check_wall(L, &id);
+    lua_pushinteger(L, (lua_Integer)id);
+    return 1;
+}
+
+/* The resultant of the last step: its force (which = 0) or moment (1). */
+static int push_resultant(lua_State *L, int which)
+{
+    int64_t id;
+    const sx_model *m = check_wall(L, &id);
+    double fm[2][3];
+    sx_lua_check(L, m, sx_wall_force(m, id, fm[0], fm[1]));
+    const int dim = sx_model_dim(m);
+    sx_lua_pushvec(L, fm[which], which ? sx_lua_rdim(dim) : dim);
+    return 1;
+}
+
+static int get_force(lua_State *L) { return push_resultant(L, 0); }
+static int get_moment(lua_State *L) { return push_resultant(L, 1); }
+
+static int set_vel(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    double v[3] = {0, 0, 0};
+    sx_lua_checkvalue(L, 3, sx_model_dim(m), v, "vel");
+    sx_lua_check(L, m, sx_wall_set_vel(m, id, v));
+    return 0;
+}
+
+/* ------------------------------------------------- methods, metamethods */
+
+static int wall_remove(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    sx_lua_check(L, m, sx_wall_remove(m, id));
+    return 0;
+}
+
+static int wall_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &wall_kind); }
+
+/* ------------------------------------------------------- model methods */
+
+/* The keys every kind but the box shares (the box has no velocity). */
+static void read_common(lua_State *L, int dim, sx_wall_def *d)
+{
+    sx_lua_optnumfield(L, 2, "kn", &d->kn);
+    sx_lua_optnumfield(L, 2, "ks", &d->ks);
+    sx_lua_optnumfield(L, 2, "friction", &d->friction);
+    sx_lua_optvecfield(L, 2, "vel", dim, d->vel);
+}
+
+/* A rect's corner, given as `corner` or as `point` like the other kinds. */
+static void read_corner(lua_State *L, double *corner)
+{
+    const bool named_corner = sx_lua_optvecfield(L, 2, "corner", 3, corner);
+    const bool named_point = sx_lua_optvecfield(L, 2, "point", 3, corner);
+    if (named_corner && named_point) luaL_argerror(L, 2, "give the rect's 'corner' or 'point', not both");
+    if (!named_corner && !named_point) luaL_argerror(L, 2, "field 'corner' (or 'point') is required");
+}
+
+static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
+{
+    const int dim = sx_model_dim(m);
+    const struct shape *s = &shapes[kind];
+    if (s->dim != dim)
+        return luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': a %s is a %dD wall; use '%s' in a %dD model",
+                                                   kind_names[kind], s->dim, s->other, dim));
+    sx_lua_checkkeys(L, 2, s->keys);
+    sx_wall_def d = sx_wall_default_def(dim);
+    d.kind = kind;
+    read_common(L, dim, &d);
+    switch (kind) {
+    case SX_WALL_PLANE:
+    case SX_WALL_LINE:
+        sx_lua_checkvecfield(L, 2, "point", dim, d.point);
+        sx_lua_checkvecfield(L, 2, "normal", dim, d.normal);
+        break;
+    case SX_WALL_RECT:
+        read_corner(L, d.point);
+        sx_lua_checkvecfield(L, 2, "edge1", dim, d.edge1);
+        sx_lua_checkvecfield(L, 2, "edge2", dim, d.edge2);
+        break;
+    case SX_WALL_SEGMENT: {
+        double p2[3] = {0, 0, 0};
+        sx_lua_checkvecfield(L, 2, "p1", dim, d.point);
+        sx_lua_checkvecfield(L, 2, "p2", dim, p2);
+        for (int c = 0; c < dim; c++) d.edge1[c] = p2[c] - d.point[c];
+        break;
+    }
+    }
+    int64_t id;
+    sx_lua_check(L, m, sx_wall_add(m, &d, &id));
+    sx_lua_pushhandle(L, 1, &wall_kind, id);
+    return 1;
+}
+
+/* A box is added whole or not at all: on a failure, remove the walls
+ * already added, then raise the core's message. */
+static int undo_box(lua_State *L, sx_model *m, const int64_t *ids, int n)
+{
+    lua_pushstring(L, sx_model_error(m));
+    for (int i = 0; i < n; i++) sx_wall_remove(m, ids[i]);
+    return luaL_error(L, "%s", lua_tostring(L, -1));
+}
+
+/* The walls of the box [min, max]: for each axis, the lower then the
+ * upper side, each facing inward. */
+static int add_box(lua_State *L, sx_model *m)
+{
+    const int dim = sx_model_dim(m);
+    sx_lua_checkkeys(L, 2, box_keys);
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    sx_lua_checkvecfield(L, 2, "min", dim, lo);
+    sx_lua_checkvecfield(L, 2, "max", dim, hi);
+    for (int c = 0; c < dim; c++) luaL_argcheck(L, lo[c] < hi[c], 2, "field 'max': each component must exceed min's");
+    sx_wall_def d = sx_wall_default_def(dim);
+    read_common(L, dim, &d);
+    int64_t ids[6];
+    int n = 0;
+    lua_createtable(L, 2 * dim, 0);
+    for (int axis = 0; axis < dim; axis++)
+        for (int side = 0; side < 2; side++) {
+            memcpy(d.point, side ? hi : lo, sizeof d.point);
+            memset(d.normal, 0, sizeof d.normal);
+            d.normal[axis] = side ? -1 : 1;
+            if (sx_wall_add(m, &d, &ids[n]) != SX_OK) return undo_box(L, m, ids, n);
+            sx_lua_pushhandle(L, 1, &wall_kind, ids[n]);
+            lua_rawseti(L, -2, ++n);
+        }
+    return 1;
+}
+
+static int model_wall(lua_State *L)
+{
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    luaL_checktype(L, 2, LUA_TTABLE);
+    const char *name = sx_lua_optstrfield(L, 2, "kind");
+    if (!name) return luaL_argerror(L, 2, "field 'kind' is required");
+    const int kind = sx_lua_find(name, kind_names);
+    if (kind < 0) {
+        sx_lua_pushlist(L, kind_names);
+        return luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': unknown kind '%s' (valid: %s)", name,
+                                                   lua_tostring(L, -1)));
+    }
+    return kind == KIND_BOX ? add_box(L, m) : add_wall(L, m, (sx_wall_kind)kind);
+}
+
+static int next_wall(lua_State *L) { return sx_lua_nexthandle(L, &wall_kind); }
+
+static int model_walls(lua_State *L)
+{
+    sx_lua_pushiterator(L, 1, sx_wall_count, sx_wall_id_at, next_wall);
+    return 1;
+}
+
+static int model_wall_count(lua_State *L)
+{
+    lua_pushinteger(L, (lua_Integer)sx_wall_count(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
+void sx_lua_walls_register(lua_State *L)
+{
+    static const luaL_Reg model_methods[] = {
+        {"wall", model_wall},
+        {"walls", model_walls},
+        {"wall_count", model_wall_count},
+        {NULL, NULL},
+    };
+    static const luaL_Reg meta[] = {
+        {"__tostring", wall_tostring},
+        {"__eq", sx_lua_handle_eq},
+        {NULL, NULL},
+    };
+    static const luaL_Reg wall_methods[] = {
+        {"remove", wall_remove},
+        {NULL, NULL},
+    };
+    static const luaL_Reg getters[] = {
+        {"id", get_id},
+        {"kind", get_kind},
+        {"force", get_force},
+        {"moment", get_moment},
+        {"vel", get_vel},
+        {"point", get_point},
+        {"normal", get_normal},
+        {"edge1", get_edge1},
+        {"edge2", get_edge2},
+        {"kn", get_kn},
+        {"ks", get_ks},
+        {"friction", get_friction},
+        {NULL, NULL},
+    };
+    static const luaL_Reg setters[] = {
+        {"vel", set_vel},
+        {NULL, NULL},
+    };
+    luaL_setfuncs(L, model_methods, 0);
+    sx_lua_newclass(L, wall_kind.tname, wall_kind.name, meta, wall_methods, getters, setters);
+    lua_pop(L, 1);
+}

@@ -1,0 +1,653 @@
+-- Lua-level tests of the `seixo` module API.
+--   build/seixo tests/lua/api.lua
+-- Prints "N passed, M failed" and exits non-zero on any failure.
+
+local passed, failed = 0, 0
+
+local function test(name, fn)
+  local ok, err = pcall(fn)
+  if ok then
+    passed = passed + 1
+  else
+    failed = failed + 1
+    io.stderr:write("FAIL ", name, ": ", tostring(err), "\n")
+  end
+end
+
+local function check(cond, msg)
+  if not cond then error(msg or "check failed", 2) end
+end
+
+local function eq(a, b, context)
+  if a ~= b then
+    error(string.format("expected %s, got %s%s", tostring(b), tostring(a), context and " (" .. context .. ")" or ""), 2)
+  end
+end
+
+-- |a - b| <= rel * |b| (or <= rel when b is 0)
+local function near(a, b, rel)
+  local tol = rel * (b == 0 and 1 or math.abs(b))
+  if not (math.abs(a - b) <= tol) then
+    error(string.format("expected %.17g, got %.17g (tolerance %g)", b, a, tol), 2)
+  end
+end
+
+local function vec_eq(v, w)
+  check(type(v) == "table", "expected a vector, got " .. type(v))
+  eq(#v, #w)
+  for k = 1, #w do eq(v[k], w[k]) end
+end
+
+-- fn must fail with a message containing every given fragment
+local function raises(fn, ...)
+  local ok, err = pcall(fn)
+  if ok then error("expected an error", 2) end
+  err = tostring(err)
+  for _, fragment in ipairs({...}) do
+    if not err:find(fragment, 1, true) then
+      error(string.format("error %q lacks %q", err, fragment), 2)
+    end
+  end
+end
+
+local HERE = "api.lua:"  -- errors must carry the script position
+
+local function model3(opts)
+  local m = seixo.model(opts or {dim = 3})
+  m:material("rock", {density = 2000, kn = 1e6, ks = 5e5, friction = 0.4})
+  return m
+end
+
+local function model2(opts)
+  local m = seixo.model(opts or {dim = 2})
+  m:material("rock", {density = 2000, kn = 1e6, ks = 5e5, friction = 0.4})
+  return m
+end
+
+---------------------------------------------------------------- module
+
+test("module is global, required and preloaded", function()
+  check(type(seixo) == "table")
+  eq(require("seixo"), seixo)
+  eq(type(package.preload.seixo), "function")
+  eq(type(seixo.version), "string")
+  eq(type(seixo.model), "function")
+end)
+
+---------------------------------------------------------------- model
+
+test("model defaults", function()
+  local m = seixo.model()
+  eq(m:dim(), 3)
+  eq(m:time(), 0)
+  eq(m:step(), 0)
+  eq(m:ball_count(), 0)
+  eq(m:wall_count(), 0)
+  eq(m:contact_count(), 0)
+  vec_eq(m:gravity(), {0, 0, 0})
+  check(m:hash():match("^%x+$") and #m:hash() == 16, "hash is 16 hex digits: " .. m:hash())
+  check(math.type(m:bytes()) == "integer" and m:bytes() >= 0)
+  check(tostring(m):find("3D", 1, true))
+  local e = m:energy()
+  eq(e.kinetic, 0)
+  eq(e.gravitational, 0)
+  eq(e.strain, 0)
+end)
+
+test("model constructor options", function()
+  local m = seixo.model{dim = 2, gravity = {1, -9.81}, timestep = 1e-5}
+  eq(m:dim(), 2)
+  vec_eq(m:gravity(), {1, -9.81})
+  eq(m:timestep(), 1e-5)
+  m:set_gravity({0, -1})
+  vec_eq(m:gravity(), {0, -1})
+end)
+
+test("model constructor errors", function()
+  raises(function() seixo.model{dim = 4} end, HERE, "'model'", "2 or 3")
+  raises(function() seixo.model{dimm = 3} end, HERE, "unknown key 'dimm'", "valid keys", "dim", "gravity", "timestep")
+  raises(function() seixo.model{dim = 3, gravity = {0, -9.81}} end, HERE, "gravity", "3 components", "got 2")
+  raises(function() seixo.model{dim = 2, gravity = {0, 0, -9.81}} end, HERE, "gravity", "2 components", "got 3")
+  raises(function() seixo.model{gravity = "down"} end, HERE, "gravity", "got string")
+  raises(function() seixo.model{gravity = {0, "a", 0}} end, HERE, "gravity", "component 2")
+  raises(function() seixo.model{timestep = -1} end, HERE, "timestep")
+  raises(function() seixo.model{dim = "3"} end, HERE, "dim", "number expected")
+  raises(function() seixo.model{[1] = 3} end, HERE, "unknown key 1")
+  raises(function() seixo.model(3) end, HERE, "table expected")
+  raises(function() local m = seixo.model(); m:set_gravity({1, 2}) end, HERE, "set_gravity", "3 components")
+end)
+
+test("unknown model field", function()
+  local m = seixo.model()
+  raises(function() return m.cycel end, HERE, "model has no field 'cycel'")
+  raises(function() m.x = 1 end, HERE, "model has no writable field 'x'")
+end)
+
+test("material", function()
+  local m = seixo.model()
+  eq(m:material("sand", {kn = 1e7, friction = 0.3, damping = 0.7}), "sand")
+  eq(m:material("default"), "default")
+  raises(function() m:material("bad", {fricton = 0.5}) end, HERE, "unknown key 'fricton'", "friction", "viscous_shear")
+  raises(function() m:material("bad", {density = -1}) end, HERE, "density")
+  raises(function() m:material("bad", {kn = "stiff"}) end, HERE, "field 'kn'", "number expected")
+  raises(function() m:material("bad", {damping = 1.5}) end, HERE, "damping")
+  raises(function() m:material(nil, {}) end, HERE, "bad argument #1 to 'material'")
+  raises(function() m:material("", {}) end, HERE, "name")
+end)
+
+---------------------------------------------------------------- balls
+
+test("3D ball fields", function()
+  local m = model3()
+  local b = m:ball{pos = {1, 2, 3}, radius = 0.1, vel = {0.5, 0, 0}, spin = {0, 0, 2}}
+  check(math.type(b.id) == "integer" and b.id >= 1)
+  vec_eq(b.pos, {1, 2, 3})
+  vec_eq(b.vel, {0.5, 0, 0})
+  vec_eq(b.spin, {0, 0, 2})
+  vec_eq(b.force, {0, 0, 0})
+  vec_eq(b.moment, {0, 0, 0})
+  eq(b.radius, 0.1)
+  near(b.mass, 4 / 3 * math.pi * 0.1 ^ 3 * 2000, 1e-14)
+  near(b.inertia, 0.4 * b.mass * 0.1 ^ 2, 1e-14)
+  eq(b.material, "rock")
+  eq(#b.fix, 0)
+  eq(b.damping, 0)
+  check(tostring(b):find("seixo.ball", 1, true))
+  eq(m:ball_count(), 1)
+end)
+
+test("3D ball writes", function()
+  local m = model3()
+  m:material("steel", {density = 7800})
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.1, material = "rock"}
+  b.pos = {4, 5, 6}
+  vec_eq(b.pos, {4, 5, 6})
+  b.vel = {1, 2, 3}
+  vec_eq(b.vel, {1, 2, 3})
+  b.spin = {0.1, 0.2, 0.3}
+  vec_eq(b.spin, {0.1, 0.2, 0.3})
+  b.radius = 0.2
+  eq(b.radius, 0.2)
+  near(b.mass, 4 / 3 * math.pi * 0.2 ^ 3 * 2000, 1e-14)
+  b.material = "steel"
+  eq(b.material, "steel")
+  near(b.mass, 4 / 3 * math.pi * 0.2 ^ 3 * 7800, 1e-14)
+  b.damping = 0.7
+  eq(b.damping, 0.7)
+  b.fix = {"vx", "wz"}
+  vec_eq(b.fix, {"vx", "wz"})
+  b.fix = "vel"
+  vec_eq(b.fix, {"vx", "vy", "vz"})
+  b.fix = "spin"
+  vec_eq(b.fix, {"wx", "wy", "wz"})
+  b.fix = "all"
+  vec_eq(b.fix, {"vx", "vy", "vz", "wx", "wy", "wz"})
+  b.fix = nil
+  eq(#b.fix, 0)
+  b.fix = {"vel", "wx"}
+  vec_eq(b.fix, {"vx", "vy", "vz", "wx"})
+  b.fix = {}
+  eq(#b.fix, 0)
+end)
+
+test("3D ball field errors", function()
+  local m = model3()
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.1}
+  raises(function() b.pos = {1, 2} end, HERE, "field 'pos'", "3 components", "got 2")
+  raises(function() b.vel = 3 end, HERE, "field 'vel'", "got number")
+  raises(function() b.spin = 1 end, HERE, "field 'spin'")
+  raises(function() b.radius = "big" end, HERE, "field 'radius'", "number expected")
+  raises(function() b.radius = -1 end, HERE, "radius")
+  raises(function() b.radius = 0 / 0 end, HERE, "radius")
+  raises(function() b.pos = {0 / 0, 0, 0} end, HERE, "finite")
+  raises(function() b.damping = 1 end, HERE, "damping")
+  raises(function() b.mass = 1 end, HERE, "ball field 'mass' is read-only")
+  raises(function() b.force = {1, 1, 1} end, HERE, "read-only")
+  raises(function() return b.postion end, HERE, "ball has no field 'postion'", "pos", "radius")
+  raises(function() b.colour = 1 end, HERE, "no writable field 'colour'")
+  raises(function() b.fix = "vq" end, HERE, "unknown fixity 'vq'", "vx")
+  raises(function() b.fix = {"vx", 3} end, HERE, "field 'fix'", "got number")
+  raises(function() b.fix = true end, HERE, "field 'fix'")
+  raises(function() b.material = "nosuch" end, HERE, "no material named 'nosuch'")
+  raises(function() b.material = 1 end, HERE, "field 'material'")
+end)
+
+test("ball constructor errors", function()
+  local m = model3()
+  raises(function() m:ball{radius = 0.1} end, HERE, "bad argument #1 to 'ball'", "field 'pos' is required")
+  raises(function() m:ball{pos = {0, 0, 0}} end, HERE, "field 'radius' is required")
+  raises(function() m:ball{pos = {0, 0}, radius = 0.1} end, HERE, "field 'pos'", "3 components")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1, radiu = 1} end, HERE, "unknown key 'radiu'",
+         "pos, radius, vel, spin, material")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = -0.1} end, HERE, "radius")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1, material = "glass"} end, HERE, "no material named 'glass'")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1, material = 1} end, HERE, "field 'material'")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1, spin = 2} end, HERE, "field 'spin'")
+  raises(function() m:ball("one") end, HERE, "table or integer expected")
+  raises(function() m:ball(1.5) end, HERE, "integer")
+  m:material("glass")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1} end, HERE, "field 'material' is required")
+  local empty = seixo.model()
+  raises(function() empty:ball{pos = {0, 0, 0}, radius = 0.1} end, HERE, "no material defined")
+end)
+
+test("ball lookup by id", function()
+  local m = model3()
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.1}
+  local c = m:ball(b.id)
+  check(c == b, "same id, same model: equal handles")
+  check(rawequal(c, b) == false)
+  eq(m:ball(b.id + 1000), nil)
+  eq(m:ball(-1), nil)
+  eq(m:ball(0), nil)
+  local other = model3()
+  local d = other:ball{pos = {0, 0, 0}, radius = 0.1}
+  eq(d.id, b.id)
+  check(d ~= b, "same id in another model: different balls")
+end)
+
+test("2D ball fields", function()
+  local m = model2()
+  local b = m:ball{pos = {1, 2}, radius = 0.1, vel = {3, 4}, spin = 5}
+  vec_eq(b.pos, {1, 2})
+  vec_eq(b.vel, {3, 4})
+  eq(b.spin, 5)
+  eq(b.moment, 0)
+  vec_eq(b.force, {0, 0})
+  near(b.mass, math.pi * 0.1 ^ 2 * 2000, 1e-14)
+  near(b.inertia, 0.5 * b.mass * 0.1 ^ 2, 1e-14)
+  b.spin = -1.5
+  eq(b.spin, -1.5)
+  b.fix = "spin"
+  vec_eq(b.fix, {"wz"})
+  b.fix = "all"
+  vec_eq(b.fix, {"vx", "vy", "wz"})
+  b.fix = "vel"
+  vec_eq(b.fix, {"vx", "vy"})
+  raises(function() b.fix = "vz" end, HERE, "2D ball has no 'vz'")
+  raises(function() b.fix = {"wx"} end, HERE, "2D ball has no 'wx'")
+  raises(function() b.pos = {1, 2, 3} end, HERE, "field 'pos'", "2 components", "got 3")
+  raises(function() b.spin = {0, 0, 1} end, HERE, "field 'spin'", "number expected")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1} end, HERE, "field 'pos'", "2 components", "got 3")
+  raises(function() m:ball{pos = {0, 0}, radius = 0.1, spin = {1, 2}} end, HERE, "field 'spin'")
+end)
+
+test("applied force and moment", function()
+  local m = model3{dim = 3, timestep = 1e-3}
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.1}
+  b.applied_force = {b.mass, 0, 0}  -- 1 m/s^2
+  vec_eq(b.applied_force, {b.mass, 0, 0})
+  m:cycle(10)
+  near(b.vel[1], 10 * 1e-3, 1e-12)
+  local m2 = model2{dim = 2, timestep = 1e-3}
+  local d = m2:ball{pos = {0, 0}, radius = 0.1}
+  d.applied_moment = 2
+  eq(d.applied_moment, 2)
+end)
+
+test("removed balls", function()
+  local m = model3()
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.1}
+  local id = b.id
+  b:remove()
+  eq(m:ball_count(), 0)
+  eq(m:ball(id), nil)
+  raises(function() return b.pos end, HERE, "ball " .. id .. " has been removed")
+  raises(function() return b.id end, HERE, "removed")
+  raises(function() b.vel = {0, 0, 0} end, HERE, "removed")
+  raises(function() b:remove() end, HERE, "removed")
+  check(tostring(b):find("removed", 1, true))
+end)
+
+test("ball iteration is a snapshot", function()
+  local m = model3()
+  for i = 1, 10 do m:ball{pos = {i, 0, 0}, radius = 0.1} end
+  local seen = 0
+  for b in m:balls() do
+    seen = seen + 1
+    check(getmetatable(b).__name == "seixo.ball")
+  end
+  eq(seen, 10)
+  -- removing while iterating is safe, and a removed ball is skipped
+  local visited = 0
+  for b in m:balls() do
+    visited = visited + 1
+    local next_id = b.id + 1
+    b:remove()
+    local other = m:ball(next_id)
+    if other and visited % 2 == 1 then other:remove() end
+  end
+  eq(m:ball_count(), 0)
+  check(visited < 10, "removed balls are not visited")
+  -- balls added during the loop are not visited
+  for i = 1, 3 do m:ball{pos = {i, 0, 0}, radius = 0.1} end
+  local n = 0
+  for _ in m:balls() do
+    n = n + 1
+    m:ball{pos = {0, 5, 0}, radius = 0.1}
+  end
+  eq(n, 3)
+  eq(m:ball_count(), 6)
+end)
+
+---------------------------------------------------------------- walls
+
+test("3D box", function()
+  local m = model3()
+  local box = m:wall{kind = "box", min = {0, 0, 0}, max = {1, 2, 3}, kn = 1e7}
+  eq(#box, 6)
+  eq(m:wall_count(), 6)
+  local normals = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}
+  for i, w in ipairs(box) do
+    eq(w.kind, "plane")
+    vec_eq(w.normal, normals[i])
+    eq(w.kn, 1e7)
+    vec_eq(w.force, {0, 0, 0})
+    vec_eq(w.moment, {0, 0, 0})
+  end
+  vec_eq(box[1].point, {0, 0, 0})
+  vec_eq(box[6].point, {1, 2, 3})
+  local n = 0
+  for w in m:walls() do
+    n = n + 1
+    check(w == box[n], "walls() in creation order")
+  end
+  eq(n, 6)
+end)
+
+test("2D box", function()
+  local m = model2()
+  local box = m:wall{kind = "box", min = {0, 0}, max = {1, 1}}
+  eq(#box, 4)
+  for _, w in ipairs(box) do
+    eq(w.kind, "line")
+    eq(#w.normal, 2)
+    eq(w.moment, 0)
+  end
+  vec_eq(box[3].normal, {0, 1})
+end)
+
+test("wall kinds and fields", function()
+  local m = model3()
+  local p = m:wall{kind = "plane", point = {0, 0, 1}, normal = {0, 0, 2}, friction = 0.2, vel = {0, 0, -1}}
+  eq(p.kind, "plane")
+  vec_eq(p.normal, {0, 0, 1})
+  eq(p.friction, 0.2)
+  vec_eq(p.vel, {0, 0, -1})
+  p.vel = {0, 0, 0.5}
+  vec_eq(p.vel, {0, 0, 0.5})
+  local r = m:wall{kind = "rect", corner = {0, 0, 0}, edge1 = {1, 0, 0}, edge2 = {0, 2, 0}, ks = 1e6}
+  eq(r.kind, "rect")
+  vec_eq(r.edge2, {0, 2, 0})
+  eq(r.ks, 1e6)
+  local r2 = m:wall{kind = "rect", point = {0, 0, 1}, edge1 = {1, 0, 0}, edge2 = {0, 1, 0}}
+  vec_eq(r2.point, {0, 0, 1})
+  local m2 = model2()
+  local s = m2:wall{kind = "segment", p1 = {1, 1}, p2 = {3, 2}}
+  eq(s.kind, "segment")
+  vec_eq(s.point, {1, 1})
+  vec_eq(s.edge1, {2, 1})
+  local l = m2:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
+  eq(l.kind, "line")
+  check(tostring(l):find("seixo.wall", 1, true))
+  l:remove()
+  eq(m2:wall_count(), 1)
+  raises(function() return l.kind end, HERE, "has been removed")
+end)
+
+test("wall errors", function()
+  local m = model3()
+  raises(function() m:wall{point = {0, 0, 0}} end, HERE, "field 'kind' is required")
+  raises(function() m:wall{kind = "disk"} end, HERE, "unknown kind 'disk'", "plane, line, rect, segment, box")
+  raises(function() m:wall{kind = "line", point = {0, 0}, normal = {0, 1}} end, HERE, "3D", "'plane'")
+  raises(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, p1 = {0, 0, 0}} end, HERE,
+         "unknown key 'p1'", "normal")
+  raises(function() m:wall{kind = "plane", point = {0, 0, 0}} end, HERE, "field 'normal' is required")
+  raises(function() m:wall{kind = "plane", point = {0, 0}, normal = {0, 1}} end, HERE, "field 'point'",
+         "3 components")
+  raises(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 0}} end, HERE, "normal")
+  raises(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = -1} end, HERE, "kn")
+  raises(function() m:wall{kind = "rect", edge1 = {1, 0, 0}, edge2 = {0, 1, 0}} end, HERE, "'corner'")
+  raises(function() m:wall{kind = "rect", corner = {0, 0, 0}, point = {0, 0, 0}, edge1 = {1, 0, 0},
+                            edge2 = {0, 1, 0}} end, HERE, "not both")
+  raises(function() m:wall{kind = "rect", corner = {0, 0, 0}, edge1 = {1, 0, 0}, edge2 = {1, 1, 0}} end, HERE,
+         "orthogonal")
+  raises(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 0, 1}} end, HERE, "field 'max'")
+  raises(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 1, 1}, vel = {0, 0, 0}} end, HERE,
+         "unknown key 'vel'")
+  raises(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 1, 1}, kn = -5} end, HERE, "kn")
+  eq(m:wall_count(), 0)  -- a box that fails adds nothing
+  local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  raises(function() w.point = {1, 1, 1} end, HERE, "wall field 'point' is read-only")
+  raises(function() w.vel = {1, 1} end, HERE, "field 'vel'", "3 components")
+  raises(function() return w.colour end, HERE, "wall has no field 'colour'")
+  local m2 = model2()
+  raises(function() m2:wall{kind = "plane", point = {0, 0}, normal = {0, 1}} end, HERE, "'line'")
+  raises(function() m2:wall{kind = "segment", p1 = {0, 0}, p2 = {0, 0}} end, HERE, "zero length")
+end)
+
+---------------------------------------------------------------- motion
+
+-- Leapfrog under gravity from rest: v_n = -g n dt, z_n = z0 - g dt^2 n(n+1)/2.
+local function free_fall(dim)
+  local g, dt, n = 9.81, 1e-4, 250
+  local gravity = dim == 3 and {0, 0, -g} or {0, -g}
+  local m = seixo.model{dim = dim, gravity = gravity, timestep = dt}
+  m:material("rock", {density = 2000})
+  local pos = dim == 3 and {0.3, -0.2, 1} or {0.3, 1}
+  local b = m:ball{pos = pos, radius = 0.01}
+  m:cycle(n)
+  eq(m:step(), n)
+  near(m:time(), n * dt, 1e-12)
+  eq(m:timestep(), dt)
+  local z0 = pos[dim]
+  near(b.pos[dim], z0 - g * dt * dt * n * (n + 1) / 2, 1e-12)
+  near(b.vel[dim], -g * n * dt, 1e-12)
+  eq(b.pos[1], 0.3)
+  eq(b.vel[1], 0)
+  local e = m:energy()
+  near(e.kinetic, 0.5 * b.mass * b.vel[dim] ^ 2, 1e-12)
+  near(e.gravitational, b.mass * g * b.pos[dim], 1e-12)
+  eq(e.strain, 0)
+  return m, b
+end
+
+test("3D free fall", function() free_fall(3) end)
+test("2D free fall", function() free_fall(2) end)
+
+test("cycle in pieces equals one cycle", function()
+  local m1 = free_fall(3)
+  local m2 = seixo.model{dim = 3, gravity = {0, 0, -9.81}, timestep = 1e-4}
+  m2:material("rock", {density = 2000})
+  m2:ball{pos = {0.3, -0.2, 1}, radius = 0.01}
+  local h0 = m2:hash()
+  m2:cycle(100)
+  check(m2:hash() ~= h0, "the hash follows the state")
+  m2:cycle(150)
+  eq(m2:hash(), m1:hash())
+  m2:cycle(0)
+  eq(m2:hash(), m1:hash())
+end)
+
+test("contacts and ball-wall forces", function()
+  local m = model3{dim = 3, gravity = {0, 0, -9.81}}
+  m:material("rock", {density = 2000, kn = 1e6, ks = 5e5, damping = 0.7})
+  local floor = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  local a = m:ball{pos = {0, 0, 0.0101}, radius = 0.01}
+  m:ball{pos = {0, 0, 0.0303}, radius = 0.01}
+  m:cycle(2000)
+  eq(m:contact_count(), 2)
+  check(floor.force[3] < 0, "the balls push the floor down")
+  near(-floor.force[3], 2 * a.mass * 9.81, 1e-2)
+  check(m:energy().strain > 0)
+  check(m:timestep() > 0 and m:timestep() <= m:critical_timestep())
+end)
+
+test("timestep control", function()
+  local m = model3()
+  m:ball{pos = {0, 0, 0}, radius = 0.1}
+  m:set_timestep(1e-3)
+  eq(m:timestep(), 1e-3)
+  m:set_timestep()
+  near(m:timestep(), 0.8 * m:critical_timestep(), 1e-12)
+  m:set_timestep(0)
+  near(m:timestep(), 0.8 * m:critical_timestep(), 1e-12)
+  raises(function() m:set_timestep(-1) end, HERE, "set_timestep")
+  raises(function() m:set_timestep("x") end, HERE, "number expected")
+end)
+
+test("cycle arguments", function()
+  local m = model3{dim = 3, timestep = 1e-4}
+  raises(function() m:cycle(-1) end, HERE, "bad argument #1 to 'cycle'", ">= 0")
+  raises(function() m:cycle(1.5) end, HERE, "integer")
+  raises(function() m:cycle() end, HERE, "number expected")
+  raises(function() m:cycle("ten") end, HERE, "number expected")
+  raises(function() m.cycle(m:ball{pos = {0, 0, 0}, radius = 1}, 1) end, HERE, "seixo.model expected")
+end)
+
+---------------------------------------------------------------- lifetime
+
+test("closed models", function()
+  local b
+  do
+    local m <close> = model3()
+    b = m:ball{pos = {0, 0, 0}, radius = 0.1}
+  end
+  raises(function() return b.pos end, HERE, "closed")
+  check(tostring(b):find("model closed", 1, true))
+  local m = model3()
+  m:close()
+  raises(function() m:time() end, HERE, "closed")
+  raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1} end, HERE, "closed")
+  check(tostring(m):find("closed", 1, true))
+  m:close()  -- closing twice is harmless
+end)
+
+test("handles keep their model alive", function()
+  local b = model3():ball{pos = {1, 2, 3}, radius = 0.1}
+  collectgarbage()
+  collectgarbage()
+  vec_eq(b.pos, {1, 2, 3})
+  local it = model3():balls()
+  collectgarbage()
+  eq(it(), nil)
+end)
+
+test("garbage arguments never crash", function()
+  local values = {false, true, 0, -1, 1, 0.5, 0 / 0, math.huge, -math.huge, math.mininteger, "x", "",
+                  {}, {1}, {1, 2}, {1, 2, 3}, {1, 2, 3, 4}, {"a", "b", "c"}, print, io.stdout}
+  for _, dim in ipairs({2, 3}) do
+    local m = seixo.model{dim = dim, timestep = 1e-6}
+    m:material("rock")
+    local b = m:ball{pos = dim == 3 and {0, 0, 0} or {0, 0}, radius = 0.1}
+    local w = m:wall{kind = "box", min = dim == 3 and {-1, -1, -1} or {-1, -1}, max = dim == 3 and {1, 1, 1} or {1, 1}}
+    local methods = {"material", "ball", "wall", "cycle", "set_timestep", "set_gravity", "balls", "walls",
+                     "energy", "hash", "bytes", "contact_count", "critical_timestep", "gravity"}
+    local fields = {"pos", "vel", "spin", "radius", "material", "damping", "fix", "applied_force",
+                    "applied_moment", "mass", "id", "nope"}
+    for _, v in ipairs(values) do
+      for _, name in ipairs(methods) do
+        if not (name == "cycle" and math.type(v) == "integer" and v > 1) then
+          pcall(m[name], m, v)
+          pcall(m[name], m, v, v)
+          pcall(m[name], v)
+        end
+      end
+      for _, f in ipairs(fields) do pcall(function() b[f] = v end) end
+      pcall(function() w[1].vel = v end)
+      pcall(function() return b[v] end)
+      pcall(function() m:ball{pos = v, radius = v, vel = v, spin = v, material = v} end)
+      pcall(function() m:wall{kind = v} end)
+      pcall(function() m:wall{kind = "box", min = v, max = v} end)
+      pcall(function() m:material("rock", {kn = v, ks = v, density = v}) end)
+    end
+    check(m:ball_count() >= 1)
+  end
+end)
+
+---------------------------------------------------------------- the executable
+
+-- These run a child seixo (under a time limit), so that a crash or a hang
+-- fails one test instead of the whole file.
+local SEIXO = arg[-1]
+
+local function quote(s) return "'" .. s:gsub("'", "'\\''") .. "'" end
+
+-- The exit status and the output (stdout and stderr) of a shell command
+-- line run with the seixo executable as its first word.
+local function run(args, input)
+  local cmd = "timeout 60 " .. quote(SEIXO) .. " " .. args .. " 2>&1"
+  if input then cmd = "printf '%s' " .. quote(input) .. " | " .. cmd end
+  local p = io.popen(cmd)
+  local out = p:read("a")
+  local _, _, status = p:close()
+  return status, out
+end
+
+test("seixo -e, exit status and one-line errors", function()
+  local status, out = run("-e " .. quote("print(seixo.model{dim = 2}:dim())"))
+  eq(status, 0)
+  eq(out, "2\n")
+  status, out = run("-e " .. quote("local m = seixo.model() m:cycle(-1)"))
+  eq(status, 1)
+  check(out:match("^seixo: %(command line%):1: bad argument #1 to 'cycle'"), out)
+  eq(select(2, out:gsub("\n", "")), 1)
+  status, out = run("no/such/script.lua")
+  eq(status, 1)
+  check(out:match("^seixo: cannot open no/such/script.lua"), out)
+  status, out = run("--bogus")
+  eq(status, 1)
+  check(out:match("^seixo: unrecognized option '%-%-bogus'"), out)
+end)
+
+test("seixo --version and --help", function()
+  local status, out = run("--version")
+  eq(status, 0)
+  check(out:find("seixo " .. seixo.version, 1, true) and out:find("Lua 5.4", 1, true), out)
+  status, out = run("--help")
+  eq(status, 0)
+  check(out:find("usage: seixo", 1, true), out)
+end)
+
+test("script arguments", function()
+  local status, out = run("- one two", "print(select('#', ...), table.concat({...}, ','), arg[0], arg[1], arg[2])")
+  eq(status, 0)
+  eq(out, "2\tone,two\t-\tone\ttwo\n")
+end)
+
+test("interactive session", function()
+  local status, out = run("-i", table.concat({
+    "1 + 1",
+    "local t = {1, 2,",
+    "  3} print(#t)",
+    "error('oops')",
+    "m = seixo.model{dim = 2, timestep = 1e-3}",
+    "m:material('a') b = m:ball{pos = {0, 0}, radius = 1}",
+    "b.pos",
+    "m:energy().strain",
+  }, "\n") .. "\n")
+  eq(status, 0)
+  check(out:find("^2\n3\n"), out)
+  check(out:find("seixo: stdin:1: oops\n", 1, true), out)
+  check(out:find("{0.0, 0.0}\n", 1, true), out)
+  check(out:find("\n0.0\n", 1, true), out)
+end)
+
+test("an empty model gives errors, not crashes", function()
+  local status, out = run("-e " .. quote("seixo.model():timestep()"))
+  eq(status, 1)
+  check(out:find("no ball", 1, true), out)
+  status, out = run("-e " .. quote("seixo.model{timestep = 1e-4}:cycle(1)"))
+  eq(status, 0, out)
+  status, out = run("-e " .. quote("seixo.model():critical_timestep()"))
+  eq(status, 0, out)
+  status, out = run("-e " .. quote([[
+    local m = seixo.model{timestep = 1e-4}
+    m:material("a")
+    m:ball{pos = {0, 0, 0}, radius = 1}:remove()
+    m:cycle(1)]]))
+  eq(status, 0, out)
+end)
+
+print(string.format("%d passed, %d failed", passed, failed))
+if failed > 0 then os.exit(1) end
