@@ -38,6 +38,15 @@ sx_model *sx_lua_checkmodel(lua_State *L, int idx);
 void sx_lua_balls_register(lua_State *L);
 void sx_lua_walls_register(lua_State *L);
 
+/* ---------------------------------------------------------- bonds.c */
+
+/// Adds m:bond, m:bond_count, m:cracks, m:crack_count, m:track_energy to the
+/// model methods table on the top of the stack.
+void sx_lua_bonds_register(lua_State *L);
+/// Reads the material keys model, shear_modulus, poisson, modulus,
+/// stiffness_ratio into d and the `bond` sub-table into bpm (*has_bpm).
+void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm);
+
 /* ----------------------------------------------------------- util.c */
 
 /// Raises a Lua error with the model's message unless st is SX_OK.

@@ -13,6 +13,7 @@
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
+#include <string.h>
 
 #define SX_LUA_MODEL "seixo.model"
 
@@ -80,10 +81,15 @@ static int model_tostring(lua_State *L)
 static int model_material(lua_State *L)
 {
     static const char *const keys[] = {"kn",      "ks",             "friction",      "density",
-                                       "damping", "viscous_normal", "viscous_shear", NULL};
+                                       "damping", "viscous_normal", "viscous_shear", "model",
+                                       "shear_modulus", "poisson", "modulus", "stiffness_ratio",
+                                       "bond",    NULL};
     sx_model *m = sx_lua_checkmodel(L, 1);
     const char *name = luaL_checkstring(L, 2);
     sx_material_def d = sx_material_default_def();
+    bool has_bpm = false;
+    sx_bpm_def bpm;
+    memset(&bpm, 0, sizeof bpm);
     if (!lua_isnoneornil(L, 3)) {
         sx_lua_checkkeys(L, 3, keys);
         sx_lua_optnumfield(L, 3, "kn", &d.kn);
@@ -93,8 +99,11 @@ static int model_material(lua_State *L)
         sx_lua_optnumfield(L, 3, "damping", &d.damping);
         sx_lua_optnumfield(L, 3, "viscous_normal", &d.viscous_normal);
         sx_lua_optnumfield(L, 3, "viscous_shear", &d.viscous_shear);
+        sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
     }
-    sx_lua_check(L, m, sx_material_set(m, name, &d, NULL));
+    int index = -1;
+    sx_lua_check(L, m, sx_material_set(m, name, &d, &index));
+    if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm));
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
 }
@@ -225,13 +234,17 @@ static int model_contact_count(lua_State *L)
 static int model_energy(lua_State *L)
 {
     const sx_energy e = sx_model_energy(sx_lua_checkmodel(L, 1));
-    lua_createtable(L, 0, 3);
-    lua_pushnumber(L, e.kinetic);
-    lua_setfield(L, -2, "kinetic");
-    lua_pushnumber(L, e.gravitational);
-    lua_setfield(L, -2, "gravitational");
-    lua_pushnumber(L, e.strain);
-    lua_setfield(L, -2, "strain");
+    const struct {
+        const char *name;
+        double value;
+    } terms[] = {{"kinetic", e.kinetic},     {"gravitational", e.gravitational}, {"strain", e.strain},
+                 {"bond_strain", e.bond_strain}, {"slip", e.slip},           {"local_damping", e.local_damping},
+                 {"viscous", e.viscous},     {"boundary_work", e.boundary_work}, {"bond_released", e.bond_released}};
+    lua_createtable(L, 0, (int)(sizeof terms / sizeof *terms));
+    for (size_t k = 0; k < sizeof terms / sizeof *terms; k++) {
+        lua_pushnumber(L, terms[k].value);
+        lua_setfield(L, -2, terms[k].name);
+    }
     return 1;
 }
 

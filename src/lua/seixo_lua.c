@@ -14,6 +14,7 @@ int luaopen_seixo(lua_State *L)
     sx_lua_model_register(L);
     sx_lua_balls_register(L);
     sx_lua_walls_register(L);
+    sx_lua_bonds_register(L);
     lua_pop(L, 1);
     luaL_newlib(L, functions);
     lua_pushliteral(L, SX_VERSION);

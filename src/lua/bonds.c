@@ -1,0 +1,206 @@
+/* Bonds, cracks and the bonded-particle material parameters:
+ *   m:bond{kind=, gap=, seed=, materials=, ...}   install bonds (PFC-style)
+ *   m:bond_count()                                 intact bonds
+ *   m:cracks()                                     the crack log, a table of events
+ *   m:crack_count([mode])                          broken bonds (all, "tension", "shear")
+ *   m:track_energy(on)                             accumulate dissipation and work
+ * and the material keys model/shear_modulus/poisson/modulus/stiffness_ratio
+ * and the `bond` sub-table read by m:material. */
+#include "bindings.h"
+
+#include <string.h>
+
+static const char *const bpm_keys[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
+                                       "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
+                                       "normal_strength_sd", "shear_strength", "shear_strength_sd", NULL};
+
+/* The bpm fields in bpm_keys order, so one loop reads them all. */
+static double *bpm_field(sx_bpm_def *b, int k)
+{
+    double *const fields[] = {&b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
+                              &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
+                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+    return fields[k];
+}
+
+static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
+{
+    for (int k = 0; bpm_keys[k]; k++) sx_lua_optnumfield(L, arg, bpm_keys[k], bpm_field(b, k));
+}
+
+void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm)
+{
+    static const char *const models[] = {"linear", "hertz", NULL};
+    const char *model = sx_lua_optstrfield(L, arg, "model");
+    if (model) {
+        const int k = sx_lua_find(model, models);
+        if (k < 0) luaL_argerror(L, arg, lua_pushfstring(L, "field 'model': 'linear' or 'hertz' expected, got '%s'", model));
+        d->model = k == 1 ? SX_MODEL_HERTZ : SX_MODEL_LINEAR;
+    }
+    sx_lua_optnumfield(L, arg, "shear_modulus", &d->shear_modulus);
+    sx_lua_optnumfield(L, arg, "poisson", &d->poisson);
+    sx_lua_optnumfield(L, arg, "modulus", &d->modulus);
+    sx_lua_optnumfield(L, arg, "stiffness_ratio", &d->stiffness_ratio);
+    *has_bpm = false;
+    if (lua_getfield(L, arg, "bond") != LUA_TNIL) {
+        if (!lua_istable(L, -1)) luaL_argerror(L, arg, "field 'bond': a table of bond micro-parameters expected");
+        const int t = lua_gettop(L);
+        sx_lua_checkkeys(L, t, bpm_keys);
+        read_bpm(L, t, bpm);
+        *has_bpm = true;
+    }
+    lua_pop(L, 1);
+}
+
+/* A material name or index of the model; a Lua error names the argument. */
+static int material_index(lua_State *L, sx_model *m, int arg, const char *name)
+{
+    const int k = sx_material_find(m, name);
+    if (k < 0) luaL_argerror(L, arg, lua_pushfstring(L, "no material named '%s'", name));
+    return k;
+}
+
+static int model_bond(lua_State *L)
+{
+    static const char *const keys[] = {"kind", "gap", "seed", "materials", "radius_multiplier", "modulus",
+                                       "stiffness_ratio", "tensile_strength", "tensile_strength_sd", "cohesion",
+                                       "cohesion_sd", "normal_strength", "normal_strength_sd", "shear_strength",
+                                       "shear_strength_sd", NULL};
+    static const char *const kinds[] = {"contact", "parallel", NULL};
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    luaL_checktype(L, 2, LUA_TTABLE);
+    sx_lua_checkkeys(L, 2, keys);
+    sx_bond_def d = sx_bond_default_def();
+    const char *kind = sx_lua_optstrfield(L, 2, "kind");
+    if (kind) {
+        const int k = sx_lua_find(kind, kinds);
+        if (k < 0) luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': 'contact' or 'parallel' expected, got '%s'", kind));
+        d.kind = k == 0 ? SX_BOND_CONTACT : SX_BOND_PARALLEL;
+    }
+    sx_lua_optnumfield(L, 2, "gap", &d.gap);
+    double seed = 1;
+    if (sx_lua_optnumfield(L, 2, "seed", &seed))
+        luaL_argcheck(L, seed >= 0 && seed < 9007199254740992.0 && seed == (double)(int64_t)seed, 2,
+                      "field 'seed': a non-negative integer expected");
+    d.seed = (uint64_t)seed;
+    if (lua_getfield(L, 2, "materials") != LUA_TNIL) {
+        /* one name, or a pair {a, b}: bonds only between those materials */
+        if (lua_type(L, -1) == LUA_TSTRING) {
+            d.material_a = material_index(L, m, 2, lua_tostring(L, -1));
+        } else if (lua_istable(L, -1) && lua_rawlen(L, -1) >= 1 && lua_rawlen(L, -1) <= 2) {
+            for (int k = 1; k <= (int)lua_rawlen(L, -1); k++) {
+                lua_rawgeti(L, -1, k);
+                if (lua_type(L, -1) != LUA_TSTRING) luaL_argerror(L, 2, "field 'materials': material names expected");
+                const int idx = material_index(L, m, 2, lua_tostring(L, -1));
+                if (k == 1) d.material_a = idx;
+                else d.material_b = idx;
+                lua_pop(L, 1);
+            }
+        } else {
+            luaL_argerror(L, 2, "field 'materials': a material name or a list of one or two names expected");
+        }
+    }
+    lua_pop(L, 1);
+    sx_bpm_def b;
+    memset(&b, 0, sizeof b);
+    read_bpm(L, 2, &b);
+    d.radius_multiplier = b.radius_multiplier;
+    d.modulus = b.modulus;
+    d.stiffness_ratio = b.stiffness_ratio;
+    d.tensile_strength = b.tensile_strength;
+    d.tensile_strength_sd = b.tensile_strength_sd;
+    d.cohesion = b.cohesion;
+    d.cohesion_sd = b.cohesion_sd;
+    d.normal_strength = b.normal_strength;
+    d.normal_strength_sd = b.normal_strength_sd;
+    d.shear_strength = b.shear_strength;
+    d.shear_strength_sd = b.shear_strength_sd;
+    int64_t count = 0;
+    sx_lua_check(L, m, sx_bond_install(m, &d, &count));
+    lua_pushinteger(L, (lua_Integer)count);
+    return 1;
+}
+
+static int model_bond_count(lua_State *L)
+{
+    lua_pushinteger(L, (lua_Integer)sx_bond_count(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
+static void setnum(lua_State *L, const char *k, double v)
+{
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+}
+
+static int model_cracks(lua_State *L)
+{
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const int64_t n = sx_crack_count(m);
+    lua_createtable(L, n > 0 && n < INT32_MAX ? (int)n : 0, 0);
+    for (int64_t i = 0; i < n; i++) {
+        sx_crack c;
+        sx_lua_check(L, m, sx_crack_get(m, i, &c));
+        lua_createtable(L, 0, 11);
+        setnum(L, "time", c.time);
+        lua_pushinteger(L, (lua_Integer)c.step);
+        lua_setfield(L, -2, "step");
+        sx_lua_pushvec(L, c.pos, sx_model_dim(m));
+        lua_setfield(L, -2, "pos");
+        lua_pushstring(L, c.mode == SX_CRACK_TENSION ? "tension" : "shear");
+        lua_setfield(L, -2, "mode");
+        lua_pushstring(L, c.kind == SX_BOND_CONTACT ? "contact" : "parallel");
+        lua_setfield(L, -2, "kind");
+        lua_pushinteger(L, (lua_Integer)c.a);
+        lua_setfield(L, -2, "a");
+        lua_pushinteger(L, (lua_Integer)c.b);
+        lua_setfield(L, -2, "b");
+        setnum(L, "fn", c.fn);
+        setnum(L, "fs", c.fs);
+        setnum(L, "mn", c.mn);
+        setnum(L, "ms", c.ms);
+        lua_rawseti(L, -2, (lua_Integer)(i + 1));
+    }
+    return 1;
+}
+
+static int model_crack_count(lua_State *L)
+{
+    static const char *const modes[] = {"tension", "shear", NULL};
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const int64_t n = sx_crack_count(m);
+    if (lua_isnoneornil(L, 2)) {
+        lua_pushinteger(L, (lua_Integer)n);
+        return 1;
+    }
+    const sx_crack_mode want = luaL_checkoption(L, 2, NULL, modes) == 0 ? SX_CRACK_TENSION : SX_CRACK_SHEAR;
+    int64_t count = 0;
+    for (int64_t i = 0; i < n; i++) {
+        sx_crack c;
+        sx_lua_check(L, m, sx_crack_get(m, i, &c));
+        count += c.mode == want;
+    }
+    lua_pushinteger(L, (lua_Integer)count);
+    return 1;
+}
+
+static int model_track_energy(lua_State *L)
+{
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    luaL_checktype(L, 2, LUA_TBOOLEAN);
+    sx_model_track_energy(m, lua_toboolean(L, 2));
+    return 0;
+}
+
+void sx_lua_bonds_register(lua_State *L)
+{
+    static const luaL_Reg methods[] = {
+        {"bond", model_bond},
+        {"bond_count", model_bond_count},
+        {"cracks", model_cracks},
+        {"crack_count", model_crack_count},
+        {"track_energy", model_track_energy},
+        {NULL, NULL},
+    };
+    luaL_setfuncs(L, methods, 0);
+}
