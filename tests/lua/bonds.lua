@@ -38,8 +38,9 @@ do
   check("bond breaks in tension", m:crack_count() == 1 and m:crack_count("tension") == 1 and m:bond_count() == 0,
         m:crack_count())
   local c = m:cracks()[1]
+  -- the contact point is the middle of the opened gap; the bond failed at or past its strength sigma_c A
   check("crack record", c and c.mode == "tension" and c.kind == "parallel" and c.a == 1 and c.b == 2
-        and math.abs(c.pos[1] - 1) < 0.01 and c.fn < 0, c and c.mode)
+        and c.pos[1] > 1 and c.pos[1] < 1.05 and c.fn <= -2e7 and c.step > 0, c and c.pos[1])
 end
 
 do
