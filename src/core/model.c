@@ -496,12 +496,13 @@ uint64_t sx_model_state_hash(const sx_model *m)
     return h;
 }
 
-sx_energy sx_model_energy(const sx_model *m)
+sx_energy sx_model_energy(sx_model *m)
 {
     sx_energy e;
     memset(&e, 0, sizeof e);
-    /* materials may have changed since the last cycle */
-    if (refresh_laws((sx_model *)m)) return e;
+    /* materials or positions may have changed since the last cycle: the
+     * broad phase the next cycle would build anyway sees every overlap */
+    if (sx__prepare(m)) return e;
     kernels(m)->energy(m, &e);
     return e;
 }

@@ -330,6 +330,6 @@ typedef struct sx_energy {
 
 /// Energies of the current state (computed on demand, O(N + contacts)) and
 /// the accumulated terms.
-SX_API sx_energy sx_model_energy(const sx_model *m);
+SX_API sx_energy sx_model_energy(sx_model *m);
 /// Switches tracking of the accumulated terms on (reset to zero) or off.
 SX_API void sx_model_track_energy(sx_model *m, bool on);
