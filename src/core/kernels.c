@@ -883,7 +883,9 @@ static sx_status KERNEL(contacts)(sx_model *m)
 {
     sx_balls *B = &m->balls;
     const size_t nf = (size_t)(B->n * D), nt = (size_t)(B->n * RD);
-    if (B->fapp) {
+    if (nf == 0) {
+        /* no ball (the arrays may not exist yet): nothing to clear */
+    } else if (B->fapp) {
         memcpy(B->f, B->fapp, nf * sizeof(double));
         memcpy(B->t, B->tapp, nt * sizeof(double));
     } else {
