@@ -66,6 +66,7 @@ sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
     m->dt_stale = true;
     m->build_needed = true;
     m->guard_dirty = true;
+    m->threads = 1;
     return m;
 }
 
@@ -77,6 +78,9 @@ void sx_model_destroy(sx_model *m)
     sx__pairs_free(m, &m->bw);
     sx__walls_free(m);
     sx__bonds_free(m);
+    for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
+    sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
+    sx_alloc_free(&m->alloc, m->pool, (size_t)m->cap_pool, sizeof *m->pool);
     sx_alloc_free(&m->alloc, m->grid.start, (size_t)m->grid.cap_cells, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->grid.cell_of, (size_t)m->grid.cap_balls, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
@@ -91,6 +95,16 @@ double sx_model_time(const sx_model *m) { return m->time; }
 int64_t sx_model_step_count(const sx_model *m) { return m->step; }
 size_t sx_model_bytes(const sx_model *m) { return m->alloc.bytes; }
 void sx_model_interrupt(sx_model *m) { m->interrupt = 1; }
+
+sx_status sx_model_set_threads(sx_model *m, int threads)
+{
+    if (threads < 1 || threads > 1024)
+        return sx__fail(m, SX_EINVAL, "set_threads: the thread count must be in 1..1024 (got %d)", threads);
+    m->threads = threads;
+    return SX_OK;
+}
+
+int sx_model_threads(const sx_model *m) { return m->threads; }
 
 void sx_model_gravity(const sx_model *m, double out[3]) { memcpy(out, m->gravity, sizeof m->gravity); }
 

@@ -101,6 +101,24 @@ typedef struct sx_grid {
     int64_t cap_balls;
 } sx_grid;
 
+/* The ball-ball pass runs in fixed chunks of pairs, each accumulating into
+ * its own buffer over the ball range it touches; buffers are summed per ball
+ * in chunk order. The chunking depends only on the pair store, never on the
+ * thread count, so results are bit-identical for any number of threads. */
+typedef struct sx_chunk {
+    int64_t first, last;   /* pair range [first, last) */
+    int64_t lo, hi;        /* ball range touched, inclusive */
+    int64_t off;           /* offset of its buffer (in balls) in the pool */
+    /* results of the last pass */
+    double slip, viscous, released;
+    int64_t lost_bonds;
+    sx_crack *cracks;
+    int64_t ncracks, capcracks;
+    sx_status st;
+    int64_t err_a, err_b;
+    double err_un, err_r;
+} sx_chunk;
+
 /* Contact parameters of a pair of materials, or of a material and a wall
  * (4-22, 4-23, 4-27/4-28, 4-30, 4-49/4-50). */
 typedef struct sx_pair_law {
@@ -142,6 +160,11 @@ struct sx_model {
     int64_t nwall, cap_wall, next_wall_id;
 
     sx_pairs bb, bw;        /* ball-ball and ball-wall candidate pairs */
+    sx_chunk *chunks;       /* the ball-ball pass's chunks, planned at each build */
+    int64_t nchunk, cap_chunk;
+    double *pool;           /* chunk buffers: (dim + rdim) doubles per ball of each range */
+    int64_t cap_pool;
+    int threads;            /* OpenMP threads for the step (results do not depend on it) */
     sx_pair_law *law;       /* nmat x nmat contact parameters, refreshed each cycle */
     int law_n;
     double *scratch;        /* per-build scratch (sorting, timestep sums) */

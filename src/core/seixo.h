@@ -73,6 +73,11 @@ SX_API sx_status sx_model_set_gravity(sx_model *m, const double g[3]);
 /// guard) or SX_EINTERRUPT; the model stays consistent and inspectable.
 SX_API sx_status sx_model_cycle(sx_model *m, int64_t n);
 
+/// OpenMP threads used by the step (default 1). Results are bit-identical
+/// for any thread count: work is split in chunks that depend only on the model.
+SX_API sx_status sx_model_set_threads(sx_model *m, int threads);
+SX_API int sx_model_threads(const sx_model *m);
+
 /// Asks a running cycle to stop at the next step boundary (async-signal-safe).
 SX_API void sx_model_interrupt(sx_model *m);
 

@@ -1,0 +1,74 @@
+/* Threads: the step's results do not depend on the number of OpenMP
+ * threads (work is split in chunks fixed by the model, and partial sums are
+ * added in chunk order), so 1 and 2 threads give bit-identical states. */
+#include "scenes.h"
+
+#include <check.h>
+#include <stdlib.h>
+
+/* A dense bed big enough to be split into several chunks of pairs. */
+static sx_model *bed(int dim, int threads)
+{
+    const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
+    sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
+    sx_material_def md = sx_material_default_def();
+    md.kn = md.ks = 2e5;
+    md.density = 2500;
+    md.viscous_normal = 0.2;
+    md.damping = 0.1;
+    scene_material_def(m, "m", &md);
+    ck_assert_int_eq(sx_model_set_threads(m, threads), SX_OK);
+    const double r = 0.01, s = 2 * r - 1e-5;
+    const int nx = dim == 3 ? 16 : 100, ny = dim == 3 ? 16 : 60, nz = dim == 3 ? 16 : 1;
+    uint64_t seed = 7;
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                double x[3] = {r + i * s + scene_rng_uniform(&seed, -2e-6, 2e-6), r + j * s, r + k * s};
+                if (dim == 3) x[1] += scene_rng_uniform(&seed, -2e-6, 2e-6);
+                scene_ball(m, x, NULL, r);
+            }
+    const double lo[3] = {0, 0, 0}, hi[3] = {nx * s + r, dim == 3 ? ny * s + r : 10, 10};
+    scene_box_walls(m, lo, hi, 2e5, 0.5);
+    return m;
+}
+
+START_TEST(one_and_two_threads_bit_identical)
+{
+    const int dim = _i;
+    sx_model *a = bed(dim, 1), *b = bed(dim, 2);
+    ck_assert_int_eq(sx_model_threads(b), 2);
+    ck_assert_int_eq(sx_model_cycle(a, 300), SX_OK);
+    ck_assert_int_eq(sx_model_cycle(b, 300), SX_OK);
+    ck_assert_msg(sx_contact_count(a) > sx_ball_count(a), "the bed must be dense (%lld contacts)",
+                  (long long)sx_contact_count(a));
+    ck_assert_uint_eq(sx_model_state_hash(a), sx_model_state_hash(b));
+    sx_model_destroy(a);
+    sx_model_destroy(b);
+}
+END_TEST
+
+START_TEST(thread_count_validated)
+{
+    sx_model *m = scene_model(3, NULL, 1e-5, 1e5, 0.5, 2500);
+    ck_assert_int_eq(sx_model_set_threads(m, 0), SX_EINVAL);
+    ck_assert_int_eq(sx_model_set_threads(m, -3), SX_EINVAL);
+    ck_assert_int_eq(sx_model_threads(m), 1);
+    sx_model_destroy(m);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("threads");
+    TCase *tc = tcase_create("threads");
+    tcase_set_timeout(tc, 600);
+    tcase_add_loop_test(tc, one_and_two_threads_bit_identical, 2, 4);
+    tcase_add_test(tc, thread_count_validated);
+    suite_add_tcase(s, tc);
+    SRunner *r = srunner_create(s);
+    srunner_run_all(r, CK_NORMAL);
+    const int failed = srunner_ntests_failed(r);
+    srunner_free(r);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
