@@ -16,12 +16,33 @@
         (s)->field = q;                                                                    \
     } while (0)
 
+static sx_status balls_resize(sx_model *m, int64_t cap);
+static sx_status grow_index(sx_model *m, int64_t need);
+
 sx_status sx__balls_reserve(sx_model *m, int64_t cap)
 {
     sx_balls *b = &m->balls;
     if (cap <= b->cap) return SX_OK;
     if (cap < 2 * b->cap) cap = 2 * b->cap;
     if (cap < 64) cap = 64;
+    return balls_resize(m, cap);
+}
+
+sx_status sx_ball_reserve(sx_model *m, int64_t count)
+{
+    if (count < 0 || count > INT32_MAX / 4)
+        return sx__fail(m, SX_EINVAL, "ball_reserve: count must be in 0..%d (got %lld)", INT32_MAX / 4,
+                        (long long)count);
+    const int64_t need = m->balls.n + count;
+    if ((need > m->balls.cap && balls_resize(m, need)) || grow_index(m, m->balls.next_id + count + 1))
+        return sx__fail(m, SX_ENOMEM, "ball_reserve: out of memory for %lld balls", (long long)need);
+    return SX_OK;
+}
+
+/* Resizes every per-ball array to exactly cap balls. */
+static sx_status balls_resize(sx_model *m, int64_t cap)
+{
+    sx_balls *b = &m->balls;
     if (cap > INT32_MAX / 4) return SX_ENOMEM;
     const int d = m->dim, r = m->rdim;
     RESIZE(b, x, d);
@@ -275,11 +296,9 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
 
-sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
+/* Resizes every array of the pair store to exactly cap pairs. */
+static sx_status pairs_resize(sx_model *m, sx_pairs *p, int64_t cap)
 {
-    if (cap <= p->cap) return SX_OK;
-    if (cap < p->cap + p->cap / 2) cap = p->cap + p->cap / 2;
-    if (cap < 256) cap = 256;
     if (cap > INT32_MAX) return SX_ENOMEM;
     const int d = m->dim;
     RESIZE(p, a, 1);
@@ -292,6 +311,20 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, fn, 1);
     p->cap = cap;
     return SX_OK;
+}
+
+sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
+{
+    if (cap <= p->cap) return SX_OK;
+    if (cap < p->cap + p->cap / 2) cap = p->cap + p->cap / 2;
+    if (cap < 256) cap = 256;
+    return pairs_resize(m, p, cap);
+}
+
+void sx__pairs_fit(sx_model *m, sx_pairs *p)
+{
+    const int64_t want = p->n + p->n / 8 + 256;
+    if (p->cap > want + want / 4) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
 }
 
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)

@@ -429,6 +429,8 @@ static bool KERNEL(build)(sx_model *m)
               keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h) && plan_chunks(m);
     history_free(&h);
     if (!ok) return false;
+    sx__pairs_fit(m, &m->bb);
+    sx__pairs_fit(m, &m->bw);
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;
@@ -804,9 +806,12 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
     }
 }
 
-/* Splits the ball-ball pairs into chunks of about CHUNK_PAIRS (a function
- * of the pair count only) and sizes their buffers. Called after each build. */
-enum { CHUNK_PAIRS = 4096, MAX_CHUNKS = 256 };
+/* Splits the ball-ball pairs into chunks (their number a function of the
+ * pair count only) and sizes their buffers. Called after each build. Few,
+ * large chunks: each buffer spans its own balls plus about one layer of
+ * cells ahead, so the pool costs (1 + chunks x layer / N) times the force
+ * arrays. MAX_CHUNKS also bounds the useful thread count. */
+enum { CHUNK_PAIRS = 4096, MAX_CHUNKS = 8 };
 
 static bool plan_chunks(sx_model *m)
 {

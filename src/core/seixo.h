@@ -145,6 +145,9 @@ SX_API sx_ball_def sx_ball_default_def(void);
 /// Adds a ball; its stable id (>= 1) is written to *id.
 SX_API sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *id);
 SX_API sx_status sx_ball_remove(sx_model *m, int64_t id);
+/// Makes room for `count` more balls at once (optional: saves memory and
+/// copies when the number of balls to add is known).
+SX_API sx_status sx_ball_reserve(sx_model *m, int64_t count);
 SX_API int64_t sx_ball_count(const sx_model *m);
 /// Id of the ball at dense index i (0 <= i < count); the order changes when
 /// the broad phase re-sorts balls, ids never do.

@@ -1,0 +1,51 @@
+/* The complete state of a model as plain arrays, for the I/O layer.
+ *
+ * src/io (snapshots and restarts) is part of libseixo's implementation, not
+ * a user of its public API: a bit-for-bit restart needs every array the
+ * step reads, so it includes model_internal.h and reads the stores
+ * directly. What is delicate is done here instead, next to the stores:
+ * sizing every array of an empty model for a given number of balls,
+ * pairs, bonds, ... with the model's tracked allocator, and, once the I/O
+ * layer has filled them, rebuilding what is derived (the id -> index map,
+ * the intact-bond count) and checking every cross reference, so a damaged
+ * file can never leave a model that crashes the step.
+ *
+ * What a continuing run reads and what is derived:
+ *   saved    balls (all arrays, dense order, incl. x_build and applied
+ *            loads), next ball id, both pair stores with their history,
+ *            bonds, crack log, walls (definition, frame, force, moment,
+ *            distance moved), materials with BPM parameters, and every
+ *            scalar of sx_model below `dim` (timestep state, skin, time,
+ *            step, builds, build flag, guard, energy tracking);
+ *   derived  id -> index map, intact bonds (here), pair laws (refreshed by
+ *            every cycle), the grid and scratch (rebuilt by every build).
+ */
+#pragma once
+
+#include "model_internal.h"
+
+/// How many entries each store holds.
+typedef struct sx_state_sizes {
+    int64_t balls;        ///< balls (dense)
+    int64_t next_ball_id; ///< ids in use are 1 .. next_ball_id - 1
+    bool applied;         ///< the applied force / moment arrays exist
+    int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
+    bool bb_bonds;        ///< the ball-ball store carries bond slots
+    int64_t bonds;        ///< bond slots (intact or broken)
+    int64_t cracks;       ///< entries of the crack log
+    int64_t walls;
+    int materials;
+} sx_state_sizes;
+
+/// The sizes of m's stores now.
+void sx__state_sizes(const sx_model *m, sx_state_sizes *out);
+
+/// Sizes every store of m, a model just made by sx_model_create and never
+/// used, to hold exactly s (arrays zeroed, counts set). SX_EINVAL when m is
+/// not empty or a size is out of range, SX_ENOMEM; the message is in m.
+sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s);
+
+/// After the arrays are filled: rebuilds the id -> index map and the
+/// intact-bond count and checks every index, id, kind and material
+/// reference. SX_EINVAL with a message naming the first inconsistency.
+sx_status sx__state_finish(sx_model *m);
