@@ -756,7 +756,7 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
                 const double fdn = -2 * law->beta_n * sqrt(mstar * kn) * vn;
                 fd += fdn;
                 double work = fdn * vn;
-                if (!slip) {
+                if (!slip && law->beta_s > 0) {
                     const double cs = 2 * law->beta_s * sqrt(mstar * ks);
                     for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                     work += dot(dsh, vs);
@@ -959,7 +959,7 @@ static sx_status wall_contacts(sx_model *m)
             const double fdn = -2 * law.beta_n * sqrt(mass * kn) * vn;
             fd += fdn;
             double work = fdn * vn;
-            if (!slip) {
+            if (!slip && law.beta_s > 0) {
                 const double cs = 2 * law.beta_s * sqrt(mass * ks);
                 for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                 work += dot(dsh, vs);
@@ -1355,4 +1355,5 @@ const sx_kernels KERNEL(sx_kernels) = {
     .energy = KERNEL(energy),
     .each_contact = KERNEL(each_contact),
     .count_contacts = KERNEL(count_contacts),
+    .plan = plan_chunks,
 };
