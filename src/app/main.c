@@ -1,6 +1,14 @@
 /* seixo: the executable. `seixo script.lua [args]` runs a script,
  * `seixo -e stat` a chunk, and `seixo` alone (or -i) an interactive
- * session; the `seixo` module is preloaded and global.
+ * session; the `seixo` module is preloaded and global, the pure-Lua library
+ * (the repository's lua/ directory) is on package.path, and `help` is a
+ * global that documents every function.
+ *
+ * The interactive session uses readline when built with it: line editing,
+ * a history file (~/.seixo_history, or $SEIXO_HISTORY; empty disables it),
+ * and tab completion that walks the Lua value before the cursor (globals,
+ * table keys, the methods and fields of seixo objects). A long cycle shows
+ * a progress line on stderr when stderr is a terminal.
  *
  * Modelled on the reference interpreter lua.c: everything runs inside one
  * protected call (pmain), every chunk under lua_pcall with a message
@@ -11,11 +19,14 @@
 #include <lauxlib.h>
 #include <lua.h>
 #include <lualib.h>
+#include <errno.h>
 #include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/select.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifdef SX_HAVE_READLINE
@@ -33,7 +44,10 @@ typedef struct options {
     int script;        // argv index of the script; argc when there is none
     bool interactive;  // -i
     bool has_chunks;   // some -e
+    long threads;      // --threads N (0: not given)
 } options;
+
+enum { MAX_THREADS = 4096 };
 
 static void usage(FILE *out)
 {
@@ -42,11 +56,15 @@ static void usage(FILE *out)
             "  -e stat        run the Lua chunk 'stat' (may be repeated)\n"
             "  -i             enter the interactive mode after the script\n"
             "  -t             show a traceback with each error\n"
+            "  --threads N    threads for the core (recorded in seixo.threads; the\n"
+            "                 core runs on one thread for now)\n"
             "  -v, --version  show the version\n"
             "  -h, --help     show this help\n"
             "  --             stop handling options\n"
             "  -              run the standard input as the script\n"
-            "With no script and no -e, seixo starts the interactive mode.\n",
+            "With no script and no -e, seixo starts the interactive mode.\n"
+            "Environment: SEIXO_LUA_PATH (the directory of the Lua library),\n"
+            "SEIXO_HISTORY (the REPL's history file; empty: none).\n",
             progname);
 }
 
@@ -161,13 +179,259 @@ static void create_arg_table(lua_State *L, char **argv, int argc, int script)
 
 /* ------------------------------------------------------------------ REPL */
 
-/* Reads one line, without its newline, onto the stack; false at the end of input. */
-static bool push_line(lua_State *L, bool first, bool tty)
+#ifdef SX_HAVE_READLINE
+/* ----- tab completion: walk the value before the cursor in a protected call */
+
+static char **matches;  // the candidates of the current completion, NULL-terminated
+static size_t nmatches, match_at;
+
+static void clear_matches(void)
+{
+    for (size_t i = 0; i < nmatches; i++) free(matches[i]);
+    free(matches);
+    matches = NULL;
+    nmatches = match_at = 0;
+}
+
+static void add_match(const char *prefix, size_t plen, const char *name, const char *suffix)
+{
+    char **grown = realloc(matches, (nmatches + 2) * sizeof *matches);
+    if (!grown) return;
+    matches = grown;
+    const size_t n = strlen(name), k = strlen(suffix);
+    char *m = malloc(plen + n + k + 1);
+    if (!m) return;
+    memcpy(m, prefix, plen);
+    memcpy(m + plen, name, n);
+    memcpy(m + plen + n, suffix, k + 1);
+    matches[nmatches++] = m;
+    matches[nmatches] = NULL;
+}
+
+static bool is_name(const char *s)
+{
+    if (!(*s == '_' || (*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z'))) return false;
+    for (s++; *s; s++)
+        if (!(*s == '_' || (*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9')))
+            return false;
+    return true;
+}
+
+/* Adds the string keys of the table at t that start with `partial`;
+ * functions get "(" after them, and only functions when methods_only. */
+static void add_keys(lua_State *L, int t, const char *prefix, size_t plen, const char *partial, bool methods_only)
+{
+    const size_t n = strlen(partial);
+    lua_pushnil(L);
+    while (lua_next(L, t)) {
+        if (lua_type(L, -2) == LUA_TSTRING) {
+            const char *k = lua_tostring(L, -2);
+            const bool fn = lua_type(L, -1) == LUA_TFUNCTION;
+            if (strncmp(k, partial, n) == 0 && is_name(k) && (fn || !methods_only) && strncmp(k, "__", 2) != 0)
+                add_match(prefix, plen, k, fn ? "(" : "");
+        }
+        lua_pop(L, 1);
+    }
+}
+
+/* Adds the names the value at v offers after `.` (or `:` when methods_only). */
+static void add_members(lua_State *L, int v, const char *prefix, size_t plen, const char *partial, bool methods_only)
+{
+    if (lua_type(L, v) == LUA_TTABLE) add_keys(L, v, prefix, plen, partial, methods_only);
+    if (!lua_getmetatable(L, v)) return;
+    const int mt = lua_gettop(L);
+    /* a seixo class: its methods and fields */
+    if (lua_getfield(L, mt, "__methods") == LUA_TTABLE) add_keys(L, lua_gettop(L), prefix, plen, partial, methods_only);
+    lua_pop(L, 1);
+    if (!methods_only && lua_getfield(L, mt, "__getters") == LUA_TTABLE) {
+        const int g = lua_gettop(L);
+        const size_t n = strlen(partial);
+        lua_pushnil(L);
+        while (lua_next(L, g)) {
+            const char *k = lua_tostring(L, -2);
+            if (k && strncmp(k, partial, n) == 0) add_match(prefix, plen, k, "");
+            lua_pop(L, 1);
+        }
+    }
+    lua_settop(L, mt);
+    /* an __index table (strings, plain Lua classes), one level */
+    if (lua_getfield(L, mt, "__index") == LUA_TTABLE) add_keys(L, lua_gettop(L), prefix, plen, partial, methods_only);
+    lua_settop(L, mt - 1);
+}
+
+/* The completion proper, run under lua_pcall: the text is the light userdata argument. */
+static int gather(lua_State *L)
+{
+    static const char *const keywords[] = {"and",  "break", "do",     "else", "elseif", "end",   "false",
+                                           "for",  "function", "goto", "if",   "in",     "local", "nil",
+                                           "not",  "or",    "repeat", "return", "then",  "true",  "until",
+                                           "while", NULL};
+    const char *text = lua_touserdata(L, 1);
+    const char *sep = strpbrk(text, ".:") ? text + strlen(text) : NULL;
+    if (sep)
+        while (sep > text && sep[-1] != '.' && sep[-1] != ':') sep--;
+    if (!sep) {  // a global name or a keyword
+        lua_pushglobaltable(L);
+        add_keys(L, lua_gettop(L), "", 0, text, false);
+        for (int i = 0; keywords[i]; i++)
+            if (strncmp(keywords[i], text, strlen(text)) == 0) add_match("", 0, keywords[i], " ");
+        return 0;
+    }
+    /* walk a.b.c, the part before the last separator */
+    lua_pushglobaltable(L);
+    const char *p = text;
+    while (p < sep - 1) {
+        const char *q = p;
+        while (q < sep - 1 && *q != '.' && *q != ':') q++;
+        if (*q == ':' && q < sep - 1) return 0;  // a method call in the middle: nothing to walk
+        lua_pushlstring(L, p, (size_t)(q - p));
+        if (!is_name(lua_tostring(L, -1))) return 0;
+        lua_gettable(L, -2);  // may run __index: hence the protected call
+        lua_remove(L, -2);
+        p = q + 1;
+    }
+    add_members(L, lua_gettop(L), text, (size_t)(sep - text), sep, sep[-1] == ':');
+    return 0;
+}
+
+static char *next_match(const char *text, int state)
+{
+    (void)text;
+    if (state == 0) match_at = 0;
+    return match_at < nmatches ? strdup(matches[match_at++]) : NULL;
+}
+
+static char **complete(const char *text, int start, int end)
+{
+    (void)start;
+    (void)end;
+    rl_attempted_completion_over = 1;  // no file names
+    rl_completion_append_character = '\0';
+    clear_matches();
+    lua_State *L = global_L;
+    const int top = lua_gettop(L);
+    lua_pushcfunction(L, gather);
+    lua_pushlightuserdata(L, (void *)text);
+    lua_pcall(L, 1, 0, 0);  // a failure only means fewer matches
+    lua_settop(L, top);
+    return nmatches ? rl_completion_matches(text, next_match) : NULL;
+}
+
+/* ----- the history file */
+
+static char *history_path(void)
+{
+    const char *env = getenv("SEIXO_HISTORY");
+    if (env) return *env ? strdup(env) : NULL;
+    const char *home = getenv("HOME");
+    if (!home || !*home) return NULL;
+    const char *name = "/.seixo_history";
+    char *path = malloc(strlen(home) + strlen(name) + 1);
+    if (path) {
+        strcpy(path, home);
+        strcat(path, name);
+    }
+    return path;
+}
+
+/* Written to a temporary name then renamed, so a crash never truncates it. */
+static void save_history(const char *path)
+{
+    const size_t n = strlen(path);
+    char *tmp = malloc(n + 5);
+    if (!tmp) return;
+    memcpy(tmp, path, n);
+    memcpy(tmp + n, ".tmp", 5);
+    if (write_history(tmp) == 0) rename(tmp, path);
+    else remove(tmp);
+    free(tmp);
+}
+
+/* ----- Ctrl-C at the prompt abandons the statement being typed
+ *
+ * readline's callback interface, with the wait for input in our hands (as
+ * Python's REPL does): a SIGINT only sets a flag, which interrupts the
+ * pselect() and is seen before the next character is read. */
+
+static volatile sig_atomic_t prompt_interrupted;
+static char *typed_line;
+static bool line_done;
+
+static void on_prompt_sigint(int sig)
+{
+    (void)sig;
+    prompt_interrupted = 1;
+}
+
+static void on_line(char *line)
+{
+    typed_line = line;
+    line_done = true;
+    rl_callback_handler_remove();
+}
+
+/* A line typed at the prompt (malloc'd), NULL at the end of input or when
+ * Ctrl-C abandoned it (then *cancelled). */
+static char *read_line(const char *prompt, bool *cancelled)
+{
+    struct sigaction sa, old;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_prompt_sigint;  // no SA_RESTART: select() returns
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old);
+    prompt_interrupted = 0;
+    typed_line = NULL;
+    line_done = false;
+    rl_catch_signals = 0;
+    /* SIGINT is blocked but while pselect() waits: one landing between the
+     * flag's check and the wait still ends the wait */
+    sigset_t block, orig;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigprocmask(SIG_BLOCK, &block, &orig);
+    rl_callback_handler_install(prompt, on_line);
+    while (!line_done) {
+        fd_set in;
+        FD_ZERO(&in);
+        FD_SET(STDIN_FILENO, &in);
+        const int ready = prompt_interrupted ? -1 : pselect(STDIN_FILENO + 1, &in, NULL, NULL, NULL, &orig);
+        if (prompt_interrupted) {
+            fputs("^C", stdout);
+            fflush(stdout);
+            rl_free_line_state();
+            rl_callback_sigcleanup();
+            rl_callback_handler_remove();
+            rl_crlf();
+            *cancelled = true;
+            break;
+        }
+        if (ready < 0) {
+            if (errno == EINTR) continue;
+            rl_callback_handler_remove();
+            break;
+        }
+        rl_callback_read_char();
+    }
+    sigprocmask(SIG_SETMASK, &orig, NULL);
+    sigaction(SIGINT, &old, NULL);
+    return typed_line;
+}
+#endif
+
+/* Reads one line, without its newline, onto the stack; false at the end of
+ * input. A Ctrl-C at the prompt gives an empty line and sets *cancelled. */
+static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
 {
     const char *prompt = first ? "> " : ">> ";
+    *cancelled = false;
 #ifdef SX_HAVE_READLINE
     if (tty) {
-        char *line = readline(prompt);
+        char *line = read_line(prompt, cancelled);
+        if (*cancelled) {
+            free(line);
+            lua_pushliteral(L, "");
+            return true;
+        }
         if (!line) return false;
         lua_pushstring(L, line);
         free(line);
@@ -220,7 +484,13 @@ static int multiline(lua_State *L, bool tty)
         size_t len;
         const char *code = lua_tolstring(L, -1, &len);
         const int status = luaL_loadbuffer(L, code, len, "=stdin");
-        if (!incomplete(L, status) || !push_line(L, false, tty)) return status;
+        bool cancelled = false;
+        if (!incomplete(L, status) || !push_line(L, false, tty, &cancelled)) return status;
+        if (cancelled) {  // Ctrl-C abandons the whole statement
+            lua_settop(L, 0);
+            lua_pushliteral(L, "");
+            return luaL_loadbuffer(L, "", 0, "=stdin");
+        }
         lua_remove(L, -2);  // the message
         lua_pushliteral(L, "\n");
         lua_insert(L, -2);
@@ -233,7 +503,8 @@ static int multiline(lua_State *L, bool tty)
 static int load_entry(lua_State *L, bool tty)
 {
     lua_settop(L, 0);
-    if (!push_line(L, true, tty)) return -1;
+    bool cancelled;
+    if (!push_line(L, true, tty, &cancelled)) return -1;
     int status = try_return(L);
     if (status != LUA_OK) status = multiline(L, tty);
 #ifdef SX_HAVE_READLINE
@@ -309,7 +580,19 @@ static int show(lua_State *L)
 static void repl(lua_State *L)
 {
     const bool tty = isatty(STDIN_FILENO);
-    if (tty) printf("seixo %s (%s); Ctrl-D quits, Ctrl-C stops a cycle\n", SX_VERSION, LUA_RELEASE);
+    if (tty) printf("seixo %s (%s); help() for help, Ctrl-D quits, Ctrl-C stops a cycle\n", SX_VERSION, LUA_RELEASE);
+#ifdef SX_HAVE_READLINE
+    char *hist = NULL;
+    if (tty) {
+        global_L = L;
+        rl_readline_name = "seixo";
+        rl_attempted_completion_function = complete;
+        rl_completer_word_break_characters = " \t\n\"\\'`@$><=;|&{}()[],+-*/%^~#";
+        stifle_history(1000);
+        hist = history_path();
+        if (hist) read_history(hist);
+    }
+#endif
     int status;
     while ((status = load_entry(L, tty)) != -1) {
         if (status == LUA_OK) status = docall(L, 0, LUA_MULTRET);
@@ -322,6 +605,11 @@ static void repl(lua_State *L)
     }
     lua_settop(L, 0);
     if (tty) putchar('\n');
+#ifdef SX_HAVE_READLINE
+    if (hist) save_history(hist);
+    free(hist);
+    clear_matches();
+#endif
 }
 
 /* ----------------------------------------------------------------- main */
@@ -334,6 +622,73 @@ static bool run_chunks(lua_State *L, char **argv, int script)
     return true;
 }
 
+/* ----------------------------------------------------- the Lua library */
+
+static bool has_library(const char *dir)
+{
+    struct stat st;
+    lua_State *L = global_L;
+    const char *probe = lua_pushfstring(L, "%s/seixo", dir);
+    const bool ok = stat(probe, &st) == 0 && S_ISDIR(st.st_mode);
+    lua_pop(L, 1);
+    return ok;
+}
+
+/* The directory of the pure-Lua library: $SEIXO_LUA_PATH, else lua/ beside
+ * the executable's directory (a build directory in the source tree) or the
+ * installed share/seixo/lua, else the source tree the executable was built
+ * from. Pushes it, or nil when none has a seixo/ directory. */
+static void push_library_dir(lua_State *L)
+{
+    const char *env = getenv("SEIXO_LUA_PATH");
+    if (env && *env) {
+        lua_pushstring(L, env);
+        return;
+    }
+    char exe[4096];
+    const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n > 0) {
+        exe[n] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash) *slash = 0;
+        const char *const rel[] = {"/../lua", "/../share/seixo/lua"};
+        for (size_t i = 0; i < sizeof rel / sizeof *rel; i++) {
+            const char *dir = lua_pushfstring(L, "%s%s", exe, rel[i]);
+            if (has_library(dir)) return;
+            lua_pop(L, 1);
+        }
+    }
+#ifdef SX_LUA_DIR
+    if (has_library(SX_LUA_DIR)) {
+        lua_pushstring(L, SX_LUA_DIR);
+        return;
+    }
+#endif
+    lua_pushnil(L);
+}
+
+/* package.path gets the library first; `help` becomes a global. */
+static void open_library(lua_State *L)
+{
+    push_library_dir(L);
+    if (!lua_isnil(L, -1)) {
+        lua_getglobal(L, "package");
+        lua_pushfstring(L, "%s/?.lua;%s/?/init.lua;", lua_tostring(L, -2), lua_tostring(L, -2));
+        lua_getfield(L, -2, "path");
+        lua_concat(L, 2);
+        lua_setfield(L, -2, "path");
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    static const char help[] =
+        "function help(...)\n"
+        "  local ok, h = pcall(require, 'seixo.help')\n"
+        "  if not ok then error('help is not available: ' .. tostring(h), 2) end\n"
+        "  return h.help(...)\n"
+        "end\n";
+    if (luaL_loadbuffer(L, help, sizeof help - 1, "=help") == LUA_OK) lua_call(L, 0, 0);
+}
+
 /* The whole session, inside one protected call. */
 static int pmain(lua_State *L)
 {
@@ -344,6 +699,13 @@ static int pmain(lua_State *L)
     luaL_checkversion(L);
     luaL_openlibs(L);
     sx_lua_open(L);
+    global_L = L;
+    open_library(L);
+    sx_lua_set_progress(L, isatty(STDERR_FILENO));
+    lua_getglobal(L, "seixo");
+    lua_pushinteger(L, o->threads > 0 ? o->threads : 1);
+    lua_setfield(L, -2, "threads");
+    lua_pop(L, 1);
     create_arg_table(L, argv, argc, o->script);
     bool ok = run_chunks(L, argv, o->script);
     if (ok && o->script < argc) ok = run_script(L, argv, o->script, argc) == LUA_OK;
@@ -374,6 +736,15 @@ static enum parsed parse(int argc, char **argv, options *o)
             o->interactive = true;
         } else if (strcmp(a, "-t") == 0) {
             show_traceback = true;
+        } else if (strcmp(a, "--threads") == 0 || strncmp(a, "--threads=", 10) == 0) {
+            const char *v = a[9] == '=' ? a + 10 : (++i < argc ? argv[i] : NULL);
+            char *end = NULL;
+            const long t = v ? strtol(v, &end, 10) : 0;
+            if (!v || !*v || *end || t < 1 || t > MAX_THREADS) {
+                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d\n", progname, MAX_THREADS);
+                return BAD;
+            }
+            o->threads = t;
         } else if (strcmp(a, "-v") == 0 || strcmp(a, "--version") == 0) {
             printf("seixo %s (%s)\n", SX_VERSION, LUA_RELEASE);
             return DONE;

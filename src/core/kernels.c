@@ -11,6 +11,7 @@
  */
 #include "model_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -255,11 +256,16 @@ static bool grid_setup(sx_model *m)
         }
         if (b->rad[i] > rmax) rmax = b->rad[i];
     }
+    /* a scene spread wider than a double can hold (e.g. balls at +-1e300)
+     * has an infinite extent: take the largest finite one, so the cells
+     * widen until they fit (at worst one cell, still correct) */
+    double extent[D];
+    for (int k = 0; k < D; k++) extent[k] = isfinite(hi[k] - lo[k]) ? hi[k] - lo[k] : DBL_MAX;
     double cell = 2 * rmax + m->skin;
     const double limit = 2.0 * (double)b->n + 64;
     for (;;) {
         double cells = 1;
-        for (int k = 0; k < D; k++) cells *= floor((hi[k] - lo[k]) / cell) + 1;
+        for (int k = 0; k < D; k++) cells *= floor(extent[k] / cell) + 1;
         if (cells <= limit) break;
         cell *= 1.5;
     }
@@ -267,7 +273,7 @@ static bool grid_setup(sx_model *m)
     g->ncells = 1;
     for (int k = 0; k < 3; k++) {
         g->lo[k] = k < D ? lo[k] : 0;
-        g->nc[k] = k < D ? (int64_t)floor((hi[k] - lo[k]) / cell) + 1 : 1;
+        g->nc[k] = k < D ? (int64_t)floor(extent[k] / cell) + 1 : 1;
         g->ncells *= g->nc[k];
     }
     if (g->ncells + 1 > g->cap_cells) {
@@ -288,8 +294,8 @@ static bool grid_setup(sx_model *m)
 static inline void cell_coords(const sx_grid *g, const double *x, int64_t *c)
 {
     for (int k = 0; k < D; k++) {
-        int64_t v = (int64_t)((x[k] - g->lo[k]) / g->cell);
-        c[k] = v < 0 ? 0 : v >= g->nc[k] ? g->nc[k] - 1 : v;
+        const double q = (x[k] - g->lo[k]) / g->cell; /* NaN when both are infinite: cell 0 */
+        c[k] = q >= (double)g->nc[k] ? g->nc[k] - 1 : q >= 0 ? (int64_t)q : 0;
     }
 }
 

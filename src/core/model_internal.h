@@ -196,6 +196,7 @@ typedef struct sx_kernels {
     void (*energy)(const sx_model *m, sx_energy *e);
     bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
     int64_t (*count_contacts)(const sx_model *m);
+    bool (*plan)(sx_model *m);                  /* chunks of the ball-ball pass for the pair store as it is (a restore) */
 } sx_kernels;
 
 extern const sx_kernels sx_kernels_2d, sx_kernels_3d;

@@ -1,9 +1,13 @@
-/* Balls: m:ball{...} adds one, m:ball(id) finds one, m:balls() iterates.
- * A ball object is a handle (model, id); its fields read and write the
- * core's state, and every access checks that the ball still exists. */
+/* Balls: m:ball{...} adds one, m:ball(id) finds one, m:balls([filter])
+ * iterates. A ball object is a handle (model, id); its fields read and
+ * write the core's state, and every access checks that the ball still
+ * exists. Two fields live on the Lua side, in the model's state: the group
+ * name (the core stores a number, groups.c maps names) and `extra`, a
+ * table of user values per ball, dropped when the ball is removed. */
 #include "bindings.h"
 
-static const sx_lua_kind ball_kind = {"seixo.ball", "ball", sx_ball_exists};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists};
+#define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */
 static sx_model *check_ball(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &ball_kind, id); }
@@ -148,7 +152,7 @@ static int fix_word(lua_State *L, int dim, int idx)
 }
 
 /* nil or {} frees every component; a word or an array of words fixes those. */
-static unsigned fix_value(lua_State *L, int dim, int idx)
+unsigned sx_lua_fixmask(lua_State *L, int dim, int idx)
 {
     if (lua_isnil(L, idx)) return 0;
     if (lua_type(L, idx) == LUA_TSTRING) return (unsigned)fix_word(L, dim, idx);
@@ -158,7 +162,7 @@ static unsigned fix_value(lua_State *L, int dim, int idx)
     const lua_Unsigned n = lua_rawlen(L, idx);
     for (lua_Unsigned k = 1; k <= n; k++) {
         lua_rawgeti(L, idx, (lua_Integer)k);
-        mask |= (unsigned)fix_word(L, dim, -1);
+        mask |= (unsigned)fix_word(L, dim, lua_gettop(L));
         lua_pop(L, 1);
     }
     return mask;
@@ -184,17 +188,175 @@ static int set_fix(lua_State *L)
 {
     int64_t id;
     sx_model *m = check_ball(L, &id);
-    sx_lua_check(L, m, sx_ball_set_fixity(m, id, fix_value(L, sx_model_dim(m), 3)));
+    sx_lua_check(L, m, sx_ball_set_fixity(m, id, sx_lua_fixmask(L, sx_model_dim(m), 3)));
     return 0;
+}
+
+/* --------------------------------------------------- group and extras */
+
+static int get_group(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    int32_t g;
+    sx_lua_check(L, m, sx_ball_group(m, id, &g));
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_push_group_name(L, lua_gettop(L), g);
+    return 1;
+}
+
+static int set_group(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    if (!lua_isnil(L, 3) && lua_type(L, 3) != LUA_TSTRING)
+        return luaL_error(L, "field 'group': group name or nil expected, got %s", luaL_typename(L, 3));
+    lua_getiuservalue(L, 1, 1);
+    const int32_t g = lua_isnil(L, 3) ? 0 : sx_lua_group_id(L, lua_gettop(L), lua_tostring(L, 3), true);
+    sx_lua_check(L, m, sx_ball_set_group(m, id, g));
+    return 0;
+}
+
+/* Pushes the extras table of the ball at index 1, created when `create`
+ * (else nil when it has none). */
+static void push_extras(lua_State *L, bool create)
+{
+    int64_t id;
+    check_ball(L, &id);
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, "extras");
+    lua_remove(L, -2);
+    if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL && create) {
+        lua_pop(L, 1);
+        lua_newtable(L);
+        lua_pushvalue(L, -1);
+        lua_rawseti(L, -3, (lua_Integer)id);
+    }
+    lua_remove(L, -2);
+}
+
+static int get_extra(lua_State *L)
+{
+    push_extras(L, true);
+    return 1;
+}
+
+/* b.extra = {...} replaces the ball's extras; nil drops them. */
+static int set_extra_table(lua_State *L)
+{
+    int64_t id;
+    check_ball(L, &id);
+    if (!lua_isnil(L, 3) && !lua_istable(L, 3))
+        return luaL_error(L, "field 'extra': table or nil expected, got %s", luaL_typename(L, 3));
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, "extras");
+    lua_pushvalue(L, 3);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    return 0;
+}
+
+/* b:set_extra(key, value) */
+static int ball_set_extra(lua_State *L)
+{
+    luaL_checkany(L, 2);
+    if (lua_isnil(L, 2) || (lua_type(L, 2) == LUA_TNUMBER && lua_tonumber(L, 2) != lua_tonumber(L, 2)))
+        return luaL_argerror(L, 1, "a key other than nil and NaN expected");
+    luaL_checkany(L, 3);
+    push_extras(L, true);
+    lua_pushvalue(L, 2);
+    lua_pushvalue(L, 3);
+    lua_rawset(L, -3);
+    return 0;
+}
+
+/* b:get_extra(key[, default]) */
+static int ball_get_extra(lua_State *L)
+{
+    luaL_checkany(L, 2);
+    lua_settop(L, 3);  // the default, nil when absent
+    push_extras(L, false);
+    if (lua_istable(L, -1)) {
+        lua_pushvalue(L, 2);
+        lua_rawget(L, -2);
+    } else {
+        lua_pushnil(L);
+    }
+    if (lua_isnil(L, -1)) lua_pushvalue(L, 3);
+    return 1;
 }
 
 /* ------------------------------------------------- methods, metamethods */
 
+static void forget_extras(lua_State *L, int model, int64_t id)
+{
+    sx_lua_state(L, model, "extras");
+    lua_pushnil(L);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    lua_pop(L, 1);
+}
+
+/* Queued removals: ball ids positive, wall ids negative, in the state's `queue`. */
+static bool queue_removal(lua_State *L, int model, int64_t signed_id)
+{
+    if (sx_lua_modelud(L, model)->callback == 0) return false;
+    sx_lua_state(L, model, "queue");
+    lua_pushinteger(L, (lua_Integer)signed_id);
+    lua_rawseti(L, -2, (lua_Integer)lua_rawlen(L, -2) + 1);
+    lua_pop(L, 1);
+    return true;
+}
+
+void sx_lua_remove_ball(lua_State *L, int model, int64_t id)
+{
+    model = lua_absindex(L, model);
+    if (queue_removal(L, model, id)) return;
+    sx_model *m = sx_lua_checkmodel(L, model);
+    sx_lua_check(L, m, sx_ball_remove(m, id));
+    forget_extras(L, model, id);
+}
+
+void sx_lua_remove_wall(lua_State *L, int model, int64_t id)
+{
+    model = lua_absindex(L, model);
+    if (queue_removal(L, model, -id)) return;
+    sx_model *m = sx_lua_checkmodel(L, model);
+    sx_lua_check(L, m, sx_wall_remove(m, id));
+}
+
+void sx_lua_apply_removals(lua_State *L, int model)
+{
+    model = lua_absindex(L, model);
+    sx_lua_model *ud = sx_lua_modelud(L, model);
+    if (ud->callback > 0 || !ud->m) return;
+    lua_getiuservalue(L, model, 1);
+    if (lua_getfield(L, -1, "queue") != LUA_TTABLE) {
+        lua_pop(L, 2);
+        return;
+    }
+    /* detach the queue first: a failure below must not replay it */
+    lua_pushnil(L);
+    lua_setfield(L, -3, "queue");
+    const int q = lua_gettop(L);
+    for (lua_Integer i = 1; lua_rawgeti(L, q, i) == LUA_TNUMBER; i++) {
+        const int64_t sid = (int64_t)lua_tointeger(L, -1);
+        lua_pop(L, 1);
+        /* an object removed twice, or already gone, is skipped */
+        if (sid > 0 && sx_ball_exists(ud->m, sid)) {
+            sx_lua_check(L, ud->m, sx_ball_remove(ud->m, sid));
+            forget_extras(L, model, sid);
+        } else if (sid < 0 && sx_wall_exists(ud->m, -sid)) {
+            sx_lua_check(L, ud->m, sx_wall_remove(ud->m, -sid));
+        }
+    }
+    lua_settop(L, q - 2);
+}
+
 static int ball_remove(lua_State *L)
 {
     int64_t id;
-    sx_model *m = check_ball(L, &id);
-    sx_lua_check(L, m, sx_ball_remove(m, id));
+    check_ball(L, &id);
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_remove_ball(L, -1, id);
     return 0;
 }
 
@@ -202,18 +364,9 @@ static int ball_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &ball_
 
 /* ------------------------------------------------------- model methods */
 
-/* The material of a new ball when the table names none: the only one. */
-static int sole_material(lua_State *L, const sx_model *m)
-{
-    const int n = sx_material_count(m);
-    if (n == 0) return luaL_argerror(L, 2, "no material defined yet; add one with m:material(name, {...})");
-    if (n > 1) return luaL_argerror(L, 2, "field 'material' is required when the model has several materials");
-    return 0;
-}
-
 static int add_ball(lua_State *L, sx_model *m)
 {
-    static const char *const keys[] = {"pos", "radius", "vel", "spin", "material", NULL};
+    static const char *const keys[] = {"pos", "radius", "vel", "spin", "material", "group", NULL};
     const int dim = sx_model_dim(m);
     sx_lua_checkkeys(L, 2, keys);
     sx_ball_def d = sx_ball_default_def();
@@ -221,11 +374,12 @@ static int add_ball(lua_State *L, sx_model *m)
     d.radius = sx_lua_checknumfield(L, 2, "radius");
     sx_lua_optvecfield(L, 2, "vel", dim, d.vel);
     sx_lua_optvecfield(L, 2, "spin", sx_lua_rdim(dim), d.spin);
-    const char *name = sx_lua_optstrfield(L, 2, "material");
-    d.material = name ? find_material(L, m, name) : sole_material(L, m);
-    if (d.material < 0) return luaL_argerror(L, 2, lua_pushfstring(L, "field 'material': %s", lua_tostring(L, -1)));
+    d.material = sx_lua_material_arg(L, m, 2, "material", sx_lua_optstrfield(L, 2, "material"));
+    const char *group = sx_lua_optstrfield(L, 2, "group");
+    const int32_t g = group ? sx_lua_group_id(L, 1, group, true) : 0;
     int64_t id;
     sx_lua_check(L, m, sx_ball_add(m, &d, &id));
+    if (g) sx_lua_check(L, m, sx_ball_set_group(m, id, g));
     sx_lua_pushhandle(L, 1, &ball_kind, id);
     return 1;
 }
@@ -244,9 +398,25 @@ static int model_ball(lua_State *L)
 
 static int next_ball(lua_State *L) { return sx_lua_nexthandle(L, &ball_kind); }
 
+/* m:balls([filter]): an iterator over a snapshot of the balls (that pass the filter). */
 static int model_balls(lua_State *L)
 {
-    sx_lua_pushiterator(L, 1, sx_ball_count, sx_ball_id_at, next_ball);
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    if (lua_isnoneornil(L, 2)) {
+        sx_lua_pushiterator(L, 1, sx_ball_count, sx_ball_id_at, next_ball);
+        return 1;
+    }
+    sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
+    sx_lua_filter f;
+    sx_lua_filter_read(L, 1, 2, &f);
+    int64_t n;
+    const int64_t *ids = sx_lua_filter_ids(L, m, &f, &n);
+    lua_createtable(L, n < 1 << 30 ? (int)n : 1 << 30, 0);
+    for (int64_t i = 0; i < n; i++) {
+        lua_pushinteger(L, (lua_Integer)ids[i]);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    sx_lua_pushiterator_ids(L, 1, -1, next_ball);
     return 1;
 }
 
@@ -256,14 +426,15 @@ static int model_ball_count(lua_State *L)
     return 1;
 }
 
+const luaL_Reg sx_lua_balls_methods[] = {
+    {"ball", model_ball},
+    {"balls", model_balls},
+    {"ball_count", model_ball_count},
+    {NULL, NULL},
+};
+
 void sx_lua_balls_register(lua_State *L)
 {
-    static const luaL_Reg model_methods[] = {
-        {"ball", model_ball},
-        {"balls", model_balls},
-        {"ball_count", model_ball_count},
-        {NULL, NULL},
-    };
     static const luaL_Reg meta[] = {
         {"__tostring", ball_tostring},
         {"__eq", sx_lua_handle_eq},
@@ -271,6 +442,8 @@ void sx_lua_balls_register(lua_State *L)
     };
     static const luaL_Reg ball_methods[] = {
         {"remove", ball_remove},
+        {"set_extra", ball_set_extra},
+        {"get_extra", ball_get_extra},
         {NULL, NULL},
     };
     static const luaL_Reg getters[] = {
@@ -288,6 +461,8 @@ void sx_lua_balls_register(lua_State *L)
         {"material", get_material},
         {"fix", get_fix},
         {"damping", get_damping},
+        {"group", get_group},
+        {"extra", get_extra},
         {NULL, NULL},
     };
     static const luaL_Reg setters[] = {
@@ -300,9 +475,10 @@ void sx_lua_balls_register(lua_State *L)
         {"material", set_material},
         {"fix", set_fix},
         {"damping", set_damping},
+        {"group", set_group},
+        {"extra", set_extra_table},
         {NULL, NULL},
     };
-    luaL_setfuncs(L, model_methods, 0);
     sx_lua_newclass(L, ball_kind.tname, ball_kind.name, meta, ball_methods, getters, setters);
     lua_pop(L, 1);
 }

@@ -1,8 +1,14 @@
 /* Private declarations shared by the binding files of the `seixo` Lua module.
  *
- * Objects: a model userdata owns one sx_model (model.c); balls and walls
- * are handles (util.c): an id, with the model userdata as their uservalue so
+ * Objects: a model userdata owns one sx_model (model.c) and a Lua table of
+ * the state that lives on the Lua side (group names, user extras,
+ * callbacks, histories, queued removals); balls, walls and contacts are
+ * handles (util.c): an id, with the model userdata as their uservalue so
  * the model outlives them. No core pointer is ever given to Lua.
+ *
+ * Model methods come from several files: each exports a luaL_Reg array of
+ * model methods below, and seixo_lua.c installs every array listed in its
+ * table. A new binding file adds its array here and one line there.
  *
  * Vectors are Lua arrays of `n` numbers, n the model's dimension; a
  * rotational quantity of a 2D model (spin, moment) has one component and is
@@ -16,36 +22,149 @@
 
 #include "seixo.h"
 
+/* pi to double precision (M_PI is not C11) */
+#define SX_LUA_PI 3.14159265358979323846
+
 /// Components of a rotational vector (spin, moment): 3 in 3D, 1 (about z) in 2D.
 static inline int sx_lua_rdim(int dim) { return dim == 3 ? 3 : 1; }
 
+/* ------------------------------------------------ model methods by file */
+
+extern const luaL_Reg sx_lua_model_methods[];     ///< model.c: materials, time, timestep, gravity, energy, summary
+extern const luaL_Reg sx_lua_run_methods[];       ///< run.c: cycle, solve, on, off
+extern const luaL_Reg sx_lua_balls_methods[];     ///< balls.c: ball, balls, ball_count
+extern const luaL_Reg sx_lua_walls_methods[];     ///< walls.c: wall, walls, wall_count
+extern const luaL_Reg sx_lua_contacts_methods[];  ///< contacts.c: contacts
+extern const luaL_Reg sx_lua_groups_methods[];    ///< groups.c: group, groups, set, sum, mean, count, remove
+extern const luaL_Reg sx_lua_history_methods[];   ///< history.c: history, histories, history_csv
+extern const luaL_Reg sx_lua_generate_methods[];  ///< generate.c: generate
+extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
+
+/* Classes other than the model's; each leaves nothing on the stack. */
+void sx_lua_balls_register(lua_State *L);
+void sx_lua_walls_register(lua_State *L);
+void sx_lua_contacts_register(lua_State *L);
+/// io.c: adds m:save, m:vars, m:output to the model class and load, xdmf to
+/// the module table on the top of the stack (call after both exist).
+void sx_lua_io_register(lua_State *L);
+
 /* ---------------------------------------------------------- model.c */
+
+#define SX_LUA_MODEL "seixo.model"
+
+/// The model userdata. Its uservalue is the state table (sx_lua_state).
+typedef struct sx_lua_model {
+    sx_model *m;   ///< NULL once closed
+    int running;   ///< inside m:cycle / m:solve / a relaxation of m:generate
+    int callback;  ///< depth of user callbacks being run (removals are queued while > 0)
+} sx_lua_model;
 
 /// seixo.model{...}: the constructor.
 int sx_lua_model_new(lua_State *L);
-/// Creates the model class; leaves its methods table on the stack for the
-/// other files to add their model methods to.
-void sx_lua_model_register(lua_State *L);
+/// Creates the model class with the methods of every array in `sets`
+/// (NULL-terminated); leaves nothing on the stack.
+void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[]);
 /// The model of the model userdata at idx, or NULL if it has been closed.
 sx_model *sx_lua_tomodel(lua_State *L, int idx);
 /// Like sx_lua_tomodel, but a closed model is a Lua error.
 sx_model *sx_lua_checkmodel(lua_State *L, int idx);
-
-/* --------------------------------------------------- balls.c, walls.c */
-
-/// Add the ball (wall) methods to the model methods table on the top of
-/// the stack, and create the ball (wall) class.
-void sx_lua_balls_register(lua_State *L);
-void sx_lua_walls_register(lua_State *L);
+/// The userdata at idx (a Lua error if it is not a model, closed or not).
+sx_lua_model *sx_lua_modelud(lua_State *L, int idx);
+/// Pushes the table `field` of the state of the model userdata at idx,
+/// creating it when absent.
+void sx_lua_state(lua_State *L, int idx, const char *field);
+/// Material for a new ball: the named one, or the model's only material.
+/// Raises an argument error on `arg` naming the field `key` otherwise.
+int sx_lua_material_arg(lua_State *L, const sx_model *m, int arg, const char *key, const char *name);
 
 /* ---------------------------------------------------------- bonds.c */
 
-/// Adds m:bond, m:bond_count, m:cracks, m:crack_count, m:track_energy to the
-/// model methods table on the top of the stack.
-void sx_lua_bonds_register(lua_State *L);
 /// Reads the material keys model, shear_modulus, poisson, modulus,
 /// stiffness_ratio into d and the `bond` sub-table into bpm (*has_bpm).
 void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm);
+
+/* ------------------------------------------------ balls.c, walls.c */
+
+extern const struct sx_lua_kind sx_lua_ball_kind, sx_lua_wall_kind;
+
+/// Removes a ball (wall) of the model userdata at `model` and forgets its
+/// extras, or queues the removal while a callback runs.
+void sx_lua_remove_ball(lua_State *L, int model, int64_t id);
+void sx_lua_remove_wall(lua_State *L, int model, int64_t id);
+/// Applies the queued removals (when no callback runs).
+void sx_lua_apply_removals(lua_State *L, int model);
+/// A fixity value (nil, a word or an array of words) as a core mask;
+/// errors name the field `fix`.
+unsigned sx_lua_fixmask(lua_State *L, int dim, int idx);
+
+/* ----------------------------------------------------------- groups.c */
+
+/// The number of the named group of the model userdata at `model`:
+/// created when `create`, else 0 when there is no such group.
+int32_t sx_lua_group_id(lua_State *L, int model, const char *name, bool create);
+/// Pushes the name of group number g (nil for 0).
+void sx_lua_push_group_name(lua_State *L, int model, int32_t g);
+
+/* ----------------------------------------------------------- region.c */
+
+enum { SX_REGION_BOX, SX_REGION_SPHERE, SX_REGION_CYLINDER, SX_REGION_DISK, SX_REGION_POLYGON };
+
+/// A region of space: 3D box, sphere, cylinder; 2D box, disk, polygon.
+typedef struct sx_lua_region {
+    int kind, dim;
+    double lo[3], hi[3];  ///< box; the bounding box of every kind
+    double c[3], r;       ///< sphere, disk: centre and radius; cylinder: first end centre and radius
+    double axis[3], len;  ///< cylinder: unit axis from the first end to the second, length
+    const double *poly;   ///< polygon: n (x, y) pairs, held by a userdata on the Lua stack
+    int n;
+    double volume;        ///< m^3 (2D: m^2, the area of a unit-thickness slice)
+} sx_lua_region;
+
+/// Reads the region table at idx ({box = {min, max}}, {sphere = {center =,
+/// radius =}}, ...); errors are argument errors on `arg` naming `key`. May
+/// leave one value (the polygon's storage) on the stack: call it with a
+/// known top and restore it when the region is no longer used.
+void sx_lua_region_read(lua_State *L, int idx, int dim, int arg, const char *key, sx_lua_region *g);
+/// Whether a ball of radius r at x lies inside the region (r = 0: its centre).
+bool sx_lua_region_contains(const sx_lua_region *g, const double *x, double r);
+
+/* ----------------------------------------------------------- select.c */
+
+/// Which balls a bulk operation applies to: a group, a region (by centre)
+/// and a Lua predicate `where`, all optional.
+typedef struct sx_lua_filter {
+    int32_t group;       ///< 0: any
+    bool has_region;
+    sx_lua_region region;
+    int where;           ///< stack index of the predicate, 0 for none
+    int model;           ///< stack index of the model userdata
+} sx_lua_filter;
+
+/// The keys a filter reads, for the unknown-key check of a bulk call.
+extern const char *const sx_lua_filter_keys[];
+/// Reads the filter keys (group, region, where) of the table at arg (none
+/// when arg is nil or absent). May push values: keep them until done.
+void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f);
+/// Whether ball `id` passes the filter (calls the predicate, if any).
+bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t id);
+/// Collects the ids of the balls that pass into a Lua-owned array pushed on
+/// the stack; returns it, its length in *n.
+int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
+
+/* ----------------------------------------------------------- run.c */
+
+/// Cycles n steps of the model userdata at `model` without user callbacks
+/// (generation's relaxation): interruptible like m:cycle; a Lua error on failure.
+void sx_lua_cycle_plain(lua_State *L, int model, int64_t n);
+/// Calls the function below its nargs arguments as a user callback of the
+/// model at `model`: removals are queued while it runs and applied after.
+void sx_lua_user_call(lua_State *L, int model, int nargs, int nres);
+/// The model is cycling: an operation that cannot run inside a callback raises.
+void sx_lua_check_not_running(lua_State *L, int model, const char *what);
+/// Records the histories due at the model's current step (history.c).
+void sx_lua_history_record(lua_State *L, int model);
+/// The smallest step > s at which a history is due, or INT64_MAX.
+int64_t sx_lua_history_next(lua_State *L, int model, int64_t s);
 
 /* ----------------------------------------------------------- util.c */
 
@@ -58,6 +177,8 @@ int sx_lua_find(const char *s, const char *const list[]);
 void sx_lua_pushlist(lua_State *L, const char *const list[]);
 /// Argument `arg` must be a table whose keys are all in `keys`.
 void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[]);
+/// Like sx_lua_checkkeys, for a table at idx that is the field `field` of argument `arg`.
+void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, const char *const keys[]);
 
 /// Reads the value at idx as n numbers into out; returns NULL, or pushes and
 /// returns a message saying what is wrong.
@@ -74,14 +195,22 @@ bool sx_lua_optvecfield(lua_State *L, int arg, const char *key, int n, double *o
 void sx_lua_checkvecfield(lua_State *L, int arg, const char *key, int n, double *out);
 bool sx_lua_optnumfield(lua_State *L, int arg, const char *key, double *out);
 double sx_lua_checknumfield(lua_State *L, int arg, const char *key);
+/// An integer field in [lo, hi] (a float with an integer value is accepted).
+bool sx_lua_optintfield(lua_State *L, int arg, const char *key, int64_t lo, int64_t hi, int64_t *out);
+/// A finite number field in [lo, hi].
+bool sx_lua_optrangefield(lua_State *L, int arg, const char *key, double lo, double hi, double *out);
 /// A string field, or NULL when absent; valid while the table holds it.
 const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key);
+/// Raises "bad argument #arg to 'f' (field 'key': msg)".
+int sx_lua_fielderror(lua_State *L, int arg, const char *key, const char *msg);
 
 /// Creates the class `tname` ("seixo.ball"): metamethods `meta`, and an
 /// __index/__newindex pair that resolves `methods`, then the field `getters`
 /// and `setters` (called directly with the stack object, key[, value]), and
 /// errors on anything else naming `kind` ("ball") and the valid fields.
-/// Leaves the methods table on the stack.
+/// The metatable also holds __methods, __getters and __setters (the REPL
+/// completes and help() documents from them). Leaves the methods table on
+/// the stack.
 void sx_lua_newclass(lua_State *L, const char *tname, const char *kind, const luaL_Reg meta[],
                      const luaL_Reg methods[], const luaL_Reg getters[], const luaL_Reg setters[]);
 
@@ -97,11 +226,16 @@ void sx_lua_pushhandle(lua_State *L, int model, const sx_lua_kind *k, int64_t id
 /// The id of the handle at idx and its model; a closed model or a removed
 /// object is a Lua error.
 sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id);
+/// The id of a handle of kind k or an integer id at idx, or -1 (nothing pushed).
+int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k);
 /// __tostring of a handle: "seixo.ball 7", with "(removed)" or "(model closed)".
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.
 int sx_lua_handle_eq(lua_State *L);
 
+/// Pushes a generic-for iterator over the ids in the Lua array at `ids`
+/// (which it takes over), stepped by `next` (see sx_lua_nexthandle).
+void sx_lua_pushiterator_ids(lua_State *L, int model, int ids, lua_CFunction next);
 /// Pushes a generic-for iterator over a snapshot of the object ids of the
 /// model userdata at `model`, stepped by `next` (see sx_lua_nexthandle).
 void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_model *),

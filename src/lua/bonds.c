@@ -192,15 +192,11 @@ static int model_track_energy(lua_State *L)
     return 0;
 }
 
-void sx_lua_bonds_register(lua_State *L)
-{
-    static const luaL_Reg methods[] = {
-        {"bond", model_bond},
-        {"bond_count", model_bond_count},
-        {"cracks", model_cracks},
-        {"crack_count", model_crack_count},
-        {"track_energy", model_track_energy},
-        {NULL, NULL},
-    };
-    luaL_setfuncs(L, methods, 0);
-}
+const luaL_Reg sx_lua_bonds_methods[] = {
+    {"bond", model_bond},
+    {"bond_count", model_bond_count},
+    {"cracks", model_cracks},
+    {"crack_count", model_crack_count},
+    {"track_energy", model_track_energy},
+    {NULL, NULL},
+};

@@ -1,36 +1,58 @@
 /* seixo.model: the model userdata owns one sx_model. __gc, __close and
  * m:close() destroy it; any later use is a Lua error, never a crash (balls
- * and walls of a closed model report it too).
+ * and walls of a closed model report it too). A model cannot be closed
+ * while it cycles (from one of its own callbacks): the cycle holds it.
  *
- * A SIGINT handler cannot know the models, so the cycle binding lists the
- * model it is cycling in a small static registry that sx_lua_interrupt_all()
- * walks. Only models inside sx_model_cycle are listed: a listed model is
- * always alive. */
+ * The userdata's uservalue is the model's Lua-side state, a table of
+ * tables created on first use (sx_lua_state): group names, user extras,
+ * callbacks, histories, queued removals.
+ *
+ * This file holds the constructor, the class (assembled from the method
+ * arrays of every binding file), materials, time, timestep, gravity,
+ * energies and the summary that print(m) shows; cycling is in run.c. */
 #include "bindings.h"
-#include "seixo_lua.h"
 
 #include <inttypes.h>
 #include <math.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 
-#define SX_LUA_MODEL "seixo.model"
+sx_lua_model *sx_lua_modelud(lua_State *L, int idx) { return luaL_checkudata(L, idx, SX_LUA_MODEL); }
 
-typedef struct model_ud {
-    sx_model *m;  // NULL once closed
-} model_ud;
-
-sx_model *sx_lua_tomodel(lua_State *L, int idx)
-{
-    return ((model_ud *)luaL_checkudata(L, idx, SX_LUA_MODEL))->m;
-}
+sx_model *sx_lua_tomodel(lua_State *L, int idx) { return sx_lua_modelud(L, idx)->m; }
 
 sx_model *sx_lua_checkmodel(lua_State *L, int idx)
 {
     sx_model *m = sx_lua_tomodel(L, idx);
     if (!m) luaL_error(L, "the model has been closed");
     return m;
+}
+
+void sx_lua_state(lua_State *L, int idx, const char *field)
+{
+    idx = lua_absindex(L, idx);
+    lua_getiuservalue(L, idx, 1);
+    if (lua_getfield(L, -1, field) != LUA_TTABLE) {
+        lua_pop(L, 1);
+        lua_newtable(L);
+        lua_pushvalue(L, -1);
+        lua_setfield(L, -3, field);
+    }
+    lua_remove(L, -2);
+}
+
+int sx_lua_material_arg(lua_State *L, const sx_model *m, int arg, const char *key, const char *name)
+{
+    if (name) {
+        const int i = sx_material_find(m, name);
+        if (i < 0) sx_lua_fielderror(L, arg, key, lua_pushfstring(L, "no material named '%s'", name));
+        return i;
+    }
+    const int n = sx_material_count(m);
+    if (n == 0) return luaL_argerror(L, arg, "no material defined yet; add one with m:material(name, {...})");
+    if (n > 1)
+        return luaL_argerror(L, arg, lua_pushfstring(L, "field '%s' is required when the model has several materials", key));
+    return 0;
 }
 
 int sx_lua_model_new(lua_State *L)
@@ -49,9 +71,11 @@ int sx_lua_model_new(lua_State *L)
         sx_lua_optnumfield(L, 1, "skin", &d.skin);
     }
     /* the userdata first: if Lua runs out of memory, no model leaks */
-    model_ud *u = lua_newuserdatauv(L, sizeof *u, 0);
-    u->m = NULL;
+    sx_lua_model *u = lua_newuserdatauv(L, sizeof *u, 1);
+    memset(u, 0, sizeof *u);
     luaL_setmetatable(L, SX_LUA_MODEL);
+    lua_newtable(L);
+    lua_setiuservalue(L, -2, 1);
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "%s", err);
@@ -60,23 +84,113 @@ int sx_lua_model_new(lua_State *L)
 
 static int model_close(lua_State *L)
 {
-    model_ud *u = luaL_checkudata(L, 1, SX_LUA_MODEL);
+    sx_lua_model *u = sx_lua_modelud(L, 1);
+    if (u->running) return luaL_error(L, "the model is cycling; close it after the cycle returns");
     sx_model_destroy(u->m);
     u->m = NULL;
     return 0;
 }
 
-static int model_tostring(lua_State *L)
+/* __gc cannot run while the model cycles (the cycle holds it on the stack). */
+static int model_gc(lua_State *L)
 {
-    const sx_model *m = sx_lua_tomodel(L, 1);
-    if (!m)
+    sx_lua_model *u = sx_lua_modelud(L, 1);
+    sx_model_destroy(u->m);
+    u->m = NULL;
+    return 0;
+}
+
+/* ------------------------------------------------------------ summary */
+
+/* Pushes "a, b, c" for the strings of the array at idx, "none" when empty. */
+static void push_joined(lua_State *L, int idx)
+{
+    idx = lua_absindex(L, idx);
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, idx);
+    if (n == 0) {
+        lua_pushliteral(L, "none");
+        return;
+    }
+    luaL_checkstack(L, 2, NULL);
+    lua_pushliteral(L, "");
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, idx, i);
+        lua_pushfstring(L, "%s%s", i > 1 ? ", " : "", luaL_tolstring(L, -1, NULL));
+        lua_remove(L, -2);
+        lua_remove(L, -2);
+        lua_concat(L, 2);
+    }
+}
+
+/* Pushes the names of the state's histories and the number of callbacks. */
+static void push_histories(lua_State *L, int *ncb)
+{
+    sx_lua_state(L, 1, "histories");
+    const int t = lua_gettop(L);
+    lua_newtable(L);
+    for (lua_Integer i = 1; lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
+        lua_getfield(L, -1, "name");
+        lua_rawseti(L, t + 1, i);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    push_joined(L, -1);
+    lua_replace(L, t);
+    lua_settop(L, t);
+    sx_lua_state(L, 1, "callbacks");
+    *ncb = 0;
+    lua_pushnil(L);
+    while (lua_next(L, -2)) {
+        lua_pop(L, 1);
+        ++*ncb;
+    }
+    lua_pop(L, 1);
+}
+
+static int model_summary(lua_State *L)
+{
+    sx_model *m = sx_lua_tomodel(L, 1);
+    if (!m) {
         lua_pushliteral(L, "seixo.model (closed)");
+        return 1;
+    }
+    lua_settop(L, 1);
+    const int dim = sx_model_dim(m);
+    const double dt = sx_model_timestep(m);
+    double g[3];
+    sx_model_gravity(m, g);
+    lua_createtable(L, sx_material_count(m), 0);
+    for (int i = 0; i < sx_material_count(m); i++) {
+        lua_pushstring(L, sx_material_name(m, i));
+        lua_rawseti(L, -2, i + 1);
+    }
+    push_joined(L, -1);
+    lua_replace(L, 2);
+    sx_lua_state(L, 1, "group_names");
+    push_joined(L, -1);
+    lua_replace(L, 3);
+    int ncb;
+    push_histories(L, &ncb);
+    const sx_energy e = sx_model_energy(m);
+    lua_pushfstring(L, "seixo.model %dD: %I balls, %I walls, %I contacts\n", dim, (lua_Integer)sx_ball_count(m),
+                    (lua_Integer)sx_wall_count(m), (lua_Integer)sx_contact_count(m));
+    lua_pushfstring(L, "  step %I, time %f s, timestep ", (lua_Integer)sx_model_step_count(m), sx_model_time(m));
+    if (isnan(dt))
+        lua_pushliteral(L, "automatic (no ball yet)\n");
     else
-        lua_pushfstring(L, "seixo.model (%dD, %I balls, %I walls, step %I, time %f s)", sx_model_dim(m),
-                        (lua_Integer)sx_ball_count(m), (lua_Integer)sx_wall_count(m),
-                        (lua_Integer)sx_model_step_count(m), sx_model_time(m));
+        lua_pushfstring(L, "%f s\n", dt);
+    if (dim == 3)
+        lua_pushfstring(L, "  gravity {%f, %f, %f} m/s^2\n", g[0], g[1], g[2]);
+    else
+        lua_pushfstring(L, "  gravity {%f, %f} m/s^2\n", g[0], g[1]);
+    lua_pushfstring(L, "  materials: %s; groups: %s\n", lua_tostring(L, 2), lua_tostring(L, 3));
+    lua_pushfstring(L, "  unbalanced ratio %f, kinetic energy %f J\n", sx_model_unbalanced_ratio(m), e.kinetic);
+    lua_pushfstring(L, "  histories: %s; callbacks: %d", lua_tostring(L, 4), ncb);
+    lua_concat(L, 7);
     return 1;
 }
+
+/* ----------------------------------------------------------- materials */
 
 static int model_material(lua_State *L)
 {
@@ -108,55 +222,38 @@ static int model_material(lua_State *L)
     return 1;  // the name: materials are referred to by name everywhere
 }
 
-/* ------------------------------------------------------------ cycling */
-
-enum { MAX_CYCLING = 16 };  // deeper nested cycles run unlisted, not interruptible
-_Static_assert(ATOMIC_POINTER_LOCK_FREE == 2 && ATOMIC_INT_LOCK_FREE == 2,
-               "a signal handler may only touch lock-free atomics");
-static _Atomic(sx_model *) cycling[MAX_CYCLING];
-static atomic_int ncycling;
-/* Set by every interrupt, cleared when a cycle starts: catches a SIGINT that
- * lands before sx_model_cycle has reset the model's own flag. */
-static atomic_int pending;
-
-int sx_lua_interrupt_all(void)
+static void setnum(lua_State *L, const char *k, double v)
 {
-    atomic_store(&pending, 1);
-    const int n = atomic_load(&ncycling);
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+}
+
+/* m:materials(): name -> its properties, as m:material takes them. */
+static int model_materials(lua_State *L)
+{
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const int n = sx_material_count(m);
+    lua_createtable(L, 0, n);
     for (int i = 0; i < n; i++) {
-        sx_model *m = atomic_load(&cycling[i]);
-        if (m) sx_model_interrupt(m);
+        sx_material_def d;
+        sx_lua_check(L, m, sx_material_get(m, i, &d));
+        lua_createtable(L, 0, 12);
+        lua_pushstring(L, d.model == SX_MODEL_HERTZ ? "hertz" : "linear");
+        lua_setfield(L, -2, "model");
+        setnum(L, "density", d.density);
+        setnum(L, "kn", d.kn);
+        setnum(L, "ks", d.ks);
+        setnum(L, "friction", d.friction);
+        setnum(L, "damping", d.damping);
+        setnum(L, "viscous_normal", d.viscous_normal);
+        setnum(L, "viscous_shear", d.viscous_shear);
+        setnum(L, "modulus", d.modulus);
+        setnum(L, "stiffness_ratio", d.stiffness_ratio);
+        setnum(L, "shear_modulus", d.shear_modulus);
+        setnum(L, "poisson", d.poisson);
+        lua_setfield(L, -2, sx_material_name(m, i));
     }
-    return n;
-}
-
-static sx_status cycle_listed(sx_model *m, int64_t n)
-{
-    atomic_store(&pending, 0);
-    const int slot = atomic_load(&ncycling);
-    const bool listed = slot < MAX_CYCLING;
-    if (listed) {
-        atomic_store(&cycling[slot], m);
-        atomic_store(&ncycling, slot + 1);
-    }
-    sx_status st = sx_model_cycle(m, n);
-    if (listed) {
-        atomic_store(&ncycling, slot);
-        atomic_store(&cycling[slot], NULL);
-    }
-    if (st == SX_OK && atomic_load(&pending)) st = SX_EINTERRUPT;
-    return st;
-}
-
-static int model_cycle(lua_State *L)
-{
-    sx_model *m = sx_lua_checkmodel(L, 1);
-    const lua_Integer n = luaL_checkinteger(L, 2);
-    luaL_argcheck(L, n >= 0, 2, "the number of steps must be >= 0");
-    const sx_status st = cycle_listed(m, (int64_t)n);
-    if (st == SX_EINTERRUPT) return luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(m));
-    sx_lua_check(L, m, st);
-    return 0;
+    return 1;
 }
 
 /* ----------------------------------------------------- time and state */
@@ -199,10 +296,17 @@ static int model_critical_timestep(lua_State *L)
     return push_timestep(L, m, sx_model_critical_timestep(m));
 }
 
+/* m:set_timestep(dt) fixes it; m:set_timestep() or ("auto") returns to the automatic one. */
 static int model_set_timestep(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    sx_lua_check(L, m, sx_model_set_timestep(m, luaL_optnumber(L, 2, 0)));
+    double dt = 0;
+    if (lua_type(L, 2) == LUA_TSTRING) {
+        if (strcmp(lua_tostring(L, 2), "auto") != 0) return luaL_argerror(L, 2, "number expected (a timestep in s) or 'auto'");
+    } else {
+        dt = luaL_optnumber(L, 2, 0);
+    }
+    sx_lua_check(L, m, sx_model_set_timestep(m, dt));
     return 0;
 }
 
@@ -228,6 +332,12 @@ static int model_set_gravity(lua_State *L)
 static int model_contact_count(lua_State *L)
 {
     lua_pushinteger(L, (lua_Integer)sx_contact_count(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
+static int model_ratio(lua_State *L)
+{
+    lua_pushnumber(L, sx_model_unbalanced_ratio(sx_lua_checkmodel(L, 1)));
     return 1;
 }
 
@@ -262,31 +372,36 @@ static int model_bytes(lua_State *L)
     return 1;
 }
 
-void sx_lua_model_register(lua_State *L)
+const luaL_Reg sx_lua_model_methods[] = {
+    {"close", model_close},
+    {"summary", model_summary},
+    {"material", model_material},
+    {"materials", model_materials},
+    {"dim", model_dim},
+    {"time", model_time},
+    {"step", model_step},
+    {"timestep", model_timestep},
+    {"set_timestep", model_set_timestep},
+    {"critical_timestep", model_critical_timestep},
+    {"gravity", model_gravity},
+    {"set_gravity", model_set_gravity},
+    {"contact_count", model_contact_count},
+    {"ratio", model_ratio},
+    {"energy", model_energy},
+    {"hash", model_hash},
+    {"bytes", model_bytes},
+    {NULL, NULL},
+};
+
+void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[])
 {
     static const luaL_Reg meta[] = {
-        {"__gc", model_close},
+        {"__gc", model_gc},
         {"__close", model_close},
-        {"__tostring", model_tostring},
+        {"__tostring", model_summary},
         {NULL, NULL},
     };
-    static const luaL_Reg methods[] = {
-        {"close", model_close},
-        {"material", model_material},
-        {"cycle", model_cycle},
-        {"dim", model_dim},
-        {"time", model_time},
-        {"step", model_step},
-        {"timestep", model_timestep},
-        {"set_timestep", model_set_timestep},
-        {"critical_timestep", model_critical_timestep},
-        {"gravity", model_gravity},
-        {"set_gravity", model_set_gravity},
-        {"contact_count", model_contact_count},
-        {"energy", model_energy},
-        {"hash", model_hash},
-        {"bytes", model_bytes},
-        {NULL, NULL},
-    };
-    sx_lua_newclass(L, SX_LUA_MODEL, "model", meta, methods, NULL, NULL);
+    sx_lua_newclass(L, SX_LUA_MODEL, "model", meta, NULL, NULL, NULL);
+    for (int i = 0; sets[i]; i++) luaL_setfuncs(L, sets[i], 0);
+    lua_pop(L, 1);
 }

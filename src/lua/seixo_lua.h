@@ -6,7 +6,7 @@
 
 #include "seixo.h"
 
-/// The module loader: returns the `seixo` table (seixo.model, seixo.version).
+/// The module loader: returns the `seixo` table (seixo.model, seixo.version, ...).
 SX_API int luaopen_seixo(lua_State *L);
 
 /// Makes the module available in L: in package.preload, in package.loaded
@@ -14,6 +14,13 @@ SX_API int luaopen_seixo(lua_State *L);
 SX_API void sx_lua_open(lua_State *L);
 
 /// Interrupts every cycle running in this process: each stops at its next
-/// step boundary and m:cycle raises "interrupted at step N".
-/// Async-signal-safe. Returns the number of cycles that were running.
+/// step boundary and m:cycle (m:solve) raises "interrupted at step N".
+/// Async-signal-safe. Returns the number of cycles running, or 0 when the
+/// innermost one is running a Lua callback: the caller then has to stop that
+/// Lua code itself (the seixo executable sets a hook, as lua.c does).
 SX_API int sx_lua_interrupt_all(void);
+
+/// Switches the progress line of long cycles (steps, time, steps/s, ETA on
+/// stderr) on or off for this state; off by default. The executable turns
+/// it on when stderr is a terminal.
+SX_API void sx_lua_set_progress(lua_State *L, int on);

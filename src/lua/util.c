@@ -12,6 +12,7 @@
 #include "bindings.h"
 
 #include <limits.h>
+#include <math.h>
 #include <string.h>
 
 void sx_lua_check(lua_State *L, const sx_model *m, sx_status st)
@@ -55,17 +56,35 @@ static const char *push_key(lua_State *L, int idx)
     return luaL_tolstring(L, idx, NULL);
 }
 
-void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[])
+/* The first key of the table at idx that is not in keys, pushed as a
+ * message; NULL when every key is valid. */
+static const char *bad_key(lua_State *L, int idx, const char *const keys[])
 {
-    luaL_checktype(L, arg, LUA_TTABLE);
+    idx = lua_absindex(L, idx);
     lua_pushnil(L);
-    while (lua_next(L, arg)) {
+    while (lua_next(L, idx)) {
         lua_pop(L, 1);
         if (lua_type(L, -1) == LUA_TSTRING && sx_lua_find(lua_tostring(L, -1), keys) >= 0) continue;
         const char *key = push_key(L, -1);
         sx_lua_pushlist(L, keys);
-        luaL_argerror(L, arg, lua_pushfstring(L, "unknown key %s (valid keys: %s)", key, lua_tostring(L, -1)));
+        return lua_pushfstring(L, "unknown key %s (valid keys: %s)", key, lua_tostring(L, -1));
     }
+    return NULL;
+}
+
+void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[])
+{
+    luaL_checktype(L, arg, LUA_TTABLE);
+    const char *msg = bad_key(L, arg, keys);
+    if (msg) luaL_argerror(L, arg, msg);
+}
+
+void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, const char *const keys[])
+{
+    if (!lua_istable(L, idx))
+        sx_lua_fielderror(L, arg, field, lua_pushfstring(L, "table expected, got %s", luaL_typename(L, idx)));
+    const char *msg = bad_key(L, idx, keys);
+    if (msg) sx_lua_fielderror(L, arg, field, msg);
 }
 
 /* ------------------------------------------------------------- vectors */
@@ -123,9 +142,14 @@ static int rawfield(lua_State *L, int arg, const char *key)
     return lua_rawget(L, arg);
 }
 
-static int field_error(lua_State *L, int arg, const char *key, const char *msg)
+int sx_lua_fielderror(lua_State *L, int arg, const char *key, const char *msg)
 {
     return luaL_argerror(L, arg, lua_pushfstring(L, "field '%s': %s", key, msg));
+}
+
+static int field_error(lua_State *L, int arg, const char *key, const char *msg)
+{
+    return sx_lua_fielderror(L, arg, key, msg);
 }
 
 static int field_missing(lua_State *L, int arg, const char *key)
@@ -160,6 +184,29 @@ double sx_lua_checknumfield(lua_State *L, int arg, const char *key)
     double v = 0;
     sx_lua_checkvecfield(L, arg, key, 1, &v);
     return v;
+}
+
+bool sx_lua_optintfield(lua_State *L, int arg, const char *key, int64_t lo, int64_t hi, int64_t *out)
+{
+    double v = 0;
+    if (!sx_lua_optnumfield(L, arg, key, &v)) return false;
+    /* the bounds are checked on the double, so no conversion overflows */
+    if (!(v >= (double)lo && v <= (double)hi) || v != floor(v))
+        field_error(L, arg, key,
+                    lua_pushfstring(L, "integer in [%I, %I] expected, got %f", (lua_Integer)lo, (lua_Integer)hi, v));
+    *out = (int64_t)v;
+    if (*out < lo) *out = lo;  // hi rounded up to a double may admit hi + 1
+    if (*out > hi) *out = hi;
+    return true;
+}
+
+bool sx_lua_optrangefield(lua_State *L, int arg, const char *key, double lo, double hi, double *out)
+{
+    double v = 0;
+    if (!sx_lua_optnumfield(L, arg, key, &v)) return false;
+    if (!(v >= lo && v <= hi)) field_error(L, arg, key, lua_pushfstring(L, "number in [%f, %f] expected, got %f", lo, hi, v));
+    *out = v;
+    return true;
 }
 
 const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key)
@@ -242,6 +289,14 @@ void sx_lua_newclass(lua_State *L, const char *tname, const char *kind, const lu
     lua_pushcclosure(L, object_newindex, 4);
     lua_setfield(L, mt, "__newindex");
 
+    /* the class's names, for completion and help() */
+    lua_pushvalue(L, methods_at);
+    lua_setfield(L, mt, "__methods");
+    lua_pushvalue(L, getters_at);
+    lua_setfield(L, mt, "__getters");
+    push_regs(L, setters);
+    lua_setfield(L, mt, "__setters");
+
     lua_settop(L, methods_at);
     lua_remove(L, mt);
 }
@@ -305,24 +360,40 @@ int sx_lua_handle_eq(lua_State *L)
     return 1;
 }
 
+int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k)
+{
+    if (lua_isinteger(L, idx)) return (int64_t)lua_tointeger(L, idx);
+    const handle *h = luaL_testudata(L, idx, k->tname);
+    return h ? h->id : -1;
+}
+
 /* ----------------------------------------------------------- iterators */
 
 /* The closure's upvalues: the model userdata, the table of ids, the
  * position reached in it. */
+void sx_lua_pushiterator_ids(lua_State *L, int model, int ids, lua_CFunction next)
+{
+    model = lua_absindex(L, model);
+    ids = lua_absindex(L, ids);
+    lua_pushvalue(L, model);
+    lua_pushvalue(L, ids);
+    lua_pushinteger(L, 0);
+    lua_pushcclosure(L, next, 3);
+}
+
 void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_model *),
                          int64_t (*id_at)(const sx_model *, int64_t), lua_CFunction next)
 {
     model = lua_absindex(L, model);
     const sx_model *m = sx_lua_checkmodel(L, model);
     const int64_t n = count(m);
-    lua_pushvalue(L, model);
     lua_createtable(L, n < INT_MAX ? (int)n : INT_MAX, 0);
     for (int64_t i = 0; i < n; i++) {
         lua_pushinteger(L, (lua_Integer)id_at(m, i));
         lua_rawseti(L, -2, (lua_Integer)i + 1);
     }
-    lua_pushinteger(L, 0);
-    lua_pushcclosure(L, next, 3);
+    sx_lua_pushiterator_ids(L, model, -1, next);
+    lua_remove(L, -2);
 }
 
 int sx_lua_nexthandle(lua_State *L, const sx_lua_kind *k)

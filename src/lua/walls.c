@@ -31,7 +31,8 @@ static const struct shape {
     [SX_WALL_SEGMENT] = {2, "rect", segment_keys},
 };
 
-static const sx_lua_kind wall_kind = {"seixo.wall", "wall", sx_wall_exists};
+const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists};
+#define wall_kind sx_lua_wall_kind
 
 /* The wall of the handle at index 1: live, in an open model. */
 static sx_model *check_wall(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &wall_kind, id); }
@@ -118,8 +119,9 @@ static int set_vel(lua_State *L)
 static int wall_remove(lua_State *L)
 {
     int64_t id;
-    sx_model *m = check_wall(L, &id);
-    sx_lua_check(L, m, sx_wall_remove(m, id));
+    check_wall(L, &id);
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_remove_wall(L, -1, id);
     return 0;
 }
 
@@ -246,14 +248,15 @@ static int model_wall_count(lua_State *L)
     return 1;
 }
 
+const luaL_Reg sx_lua_walls_methods[] = {
+    {"wall", model_wall},
+    {"walls", model_walls},
+    {"wall_count", model_wall_count},
+    {NULL, NULL},
+};
+
 void sx_lua_walls_register(lua_State *L)
 {
-    static const luaL_Reg model_methods[] = {
-        {"wall", model_wall},
-        {"walls", model_walls},
-        {"wall_count", model_wall_count},
-        {NULL, NULL},
-    };
     static const luaL_Reg meta[] = {
         {"__tostring", wall_tostring},
         {"__eq", sx_lua_handle_eq},
@@ -282,7 +285,6 @@ void sx_lua_walls_register(lua_State *L)
         {"vel", set_vel},
         {NULL, NULL},
     };
-    luaL_setfuncs(L, model_methods, 0);
     sx_lua_newclass(L, wall_kind.tname, wall_kind.name, meta, wall_methods, getters, setters);
     lua_pop(L, 1);
 }

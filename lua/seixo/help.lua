@@ -1,0 +1,283 @@
+-- seixo.help: short documentation of every function, method and field,
+-- behind the REPL's help():
+--   help()              an overview
+--   help(seixo), help(m), help(b), help(w), help(c)   what an object offers
+--   help(m.cycle), help("cycle"), help("model:cycle"), help("ball.pos")
+-- docs/lua-api.md is the full reference; tests/lua/help.lua checks that
+-- both cover every name the bindings define.
+
+local H = {}
+
+-- name -> {signature, text}; units in brackets
+local entries = {
+  -- the module
+  ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0}",
+    "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic."},
+  ["seixo.version"] = {"seixo.version", "The version string."},
+  ["seixo.progress"] = {"seixo.progress([on]) -> was_on",
+    "The progress line of long cycles on stderr (steps, time, steps/s, ETA); on by default when stderr is a terminal."},
+  ["seixo.threads"] = {"seixo.threads", "The thread count given with --threads (default 1); the core runs on one thread for now."},
+  ["help"] = {"help([x])", "Help on x: a function, an object (model, ball, wall, contact), or a name such as \"cycle\" or \"ball.pos\"."},
+
+  -- model: set-up
+  ["model:material"] = {"m:material(name, {density =, kn =, ks =, friction =, damping =, ...}) -> name",
+    "Defines or redefines a material. density [kg/m^3], kn, ks [N/m], friction, damping (local, in [0, 1)), viscous_normal, viscous_shear (critical-damping ratios), model = 'linear' | 'hertz' (shear_modulus [Pa], poisson), modulus [Pa] and stiffness_ratio (BPM), bond = {...} (bond micro-parameters)."},
+  ["model:materials"] = {"m:materials() -> {name = {density =, kn =, ...}}", "Every material and its properties."},
+  ["model:ball"] = {"m:ball{pos =, radius =, vel =, spin =, material =, group =} -> ball;  m:ball(id) -> ball | nil",
+    "Adds a ball (pos [m], radius [m], vel [m/s], spin [rad/s]), or finds one by id."},
+  ["model:balls"] = {"m:balls([filter]) -> iterator", "for b in m:balls() do ... end; filter = {group =, region =, where = fn}. Iterates over a snapshot."},
+  ["model:ball_count"] = {"m:ball_count() -> n", "Number of balls."},
+  ["model:wall"] = {"m:wall{kind = 'plane' | 'line' | 'rect' | 'segment' | 'box', ...} -> wall (a box: array of walls)",
+    "Adds a wall: plane/line {point, normal}, rect {corner, edge1, edge2}, segment {p1, p2}, box {min, max}; kn, ks [N/m], friction, vel [m/s]."},
+  ["model:walls"] = {"m:walls() -> iterator", "for w in m:walls() do ... end"},
+  ["model:wall_count"] = {"m:wall_count() -> n", "Number of walls."},
+  ["model:generate"] = {"m:generate{region =, radius =, count = | porosity =, method =, seed =, ...} -> n, porosity",
+    "Generates balls in a region: method 'random' (non-overlapping), 'distribute' (overlapping to a porosity, then relaxed), 'expand' (radius expansion to a porosity), 'lattice' (packing = square|hex|cubic|fcc). radius = r or {rmin, rmax} [m]; distribution 'uniform' | 'normal' (mean, std); material, group, tries, relax = {steps, ratio, calm}."},
+  ["model:close"] = {"m:close()", "Frees the model now; any later use is an error."},
+  ["model:summary"] = {"m:summary() -> text", "The summary print(m) shows."},
+
+  -- model: time and cycling
+  ["model:cycle"] = {"m:cycle(n)", "Takes n steps, running callbacks and histories. Ctrl-C stops it at a step boundary (error 'interrupted at step N')."},
+  ["model:solve"] = {"m:solve{ratio =, steps =, time =, every = 100} -> reason, ratio, steps",
+    "Cycles until the mean unbalanced-force ratio <= ratio (checked every `every` steps), or `steps` steps, or `time` [s] of model time; reason is 'ratio', 'steps' or 'time'. With no limit: ratio = 1e-5."},
+  ["model:on"] = {"m:on(point, fn[, {every = N}]) -> id",
+    "Calls fn(m) at step boundaries s with s % N == 0: point 'after' (alias 'cycle') once step s is taken, 'before' before step s + 1."},
+  ["model:off"] = {"m:off(id) -> removed", "Removes a callback added by m:on."},
+  ["model:dim"] = {"m:dim() -> 2 | 3", "The model's dimension."},
+  ["model:time"] = {"m:time() -> t", "Model time [s]."},
+  ["model:step"] = {"m:step() -> n", "Steps taken."},
+  ["model:timestep"] = {"m:timestep() -> dt", "The timestep the next step uses [s]."},
+  ["model:set_timestep"] = {"m:set_timestep(dt | 'auto')", "Fixes the timestep [s], or returns to the automatic one (no argument, 0 or 'auto')."},
+  ["model:critical_timestep"] = {"m:critical_timestep() -> dt", "The critical timestep estimate sqrt(m/k), without the safety factor [s]."},
+  ["model:gravity"] = {"m:gravity() -> g", "Gravity [m/s^2]."},
+  ["model:set_gravity"] = {"m:set_gravity(g)", "Sets gravity [m/s^2]."},
+  ["model:ratio"] = {"m:ratio() -> r", "PFC's mean unbalanced-force ratio: mean |F + m g| over the mean contact force."},
+  ["model:energy"] = {"m:energy() -> {kinetic =, gravitational =, strain =, ...}", "Energies [J]; accumulated terms (slip, local_damping, viscous, boundary_work, bond_released) need m:track_energy(true)."},
+  ["model:contact_count"] = {"m:contact_count() -> n", "Contacts of the last step."},
+  ["model:contacts"] = {"m:contacts([{ball =, wall =, kind =}]) -> iterator", "for c in m:contacts() do ... end over a snapshot of the last step's contacts."},
+  ["model:hash"] = {"m:hash() -> hex", "A hash of the full state: equal hashes, bit-identical states."},
+  ["model:bytes"] = {"m:bytes() -> n", "Memory held by the model [bytes]."},
+
+  -- model: groups and bulk operations
+  ["model:group"] = {"m:group(name, filter | fn) -> n", "Puts the selected balls (filter {group, region, where} or a predicate fn(ball)) in the group; returns how many."},
+  ["model:groups"] = {"m:groups() -> {name = count}", "Every group and its number of balls."},
+  ["model:set"] = {"m:set{group =, region =, where =, vel =, spin =, applied_force =, applied_moment =, radius =, damping =, material =, fix =} -> n",
+    "Sets fields of the selected balls at once (in C); returns how many."},
+  ["model:sum"] = {"m:sum(field[, filter]) -> value", "Sum of a ball field over the selection: pos, vel, spin, force, moment, applied_force, applied_moment, radius, mass, inertia, damping, volume, speed, kinetic."},
+  ["model:mean"] = {"m:mean(field[, filter]) -> value | nil", "Mean of a ball field over the selection (nil when empty)."},
+  ["model:min"] = {"m:min(field[, filter]) -> value | nil", "Smallest value (per component) over the selection."},
+  ["model:max"] = {"m:max(field[, filter]) -> value | nil", "Largest value (per component) over the selection."},
+  ["model:count"] = {"m:count([filter]) -> n", "Number of selected balls (a region selects by centre)."},
+  ["model:remove_balls"] = {"m:remove_balls(filter) -> n", "Removes the selected balls (queued while a callback runs)."},
+
+  -- model: histories
+  ["model:history"] = {"m:history(name, source[, {every = N}]);  m:history(name) -> {steps, times, values}",
+    "Records a time series every N steps: source a function(m) -> number, a builtin (time, step, timestep, ratio, contacts, balls, kinetic, gravitational, strain, ...), or {ball = b | wall = w, field =, component =}."},
+  ["model:histories"] = {"m:histories() -> names", "The histories' names."},
+  ["model:history_remove"] = {"m:history_remove(name)", "Stops and forgets a history."},
+  ["model:history_csv"] = {"m:history_csv(path[, names])", "Writes step, time and the histories as CSV (to a temporary name, then renamed)."},
+
+  -- model: bonds
+  ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
+  ["model:bond_count"] = {"m:bond_count() -> n", "Intact bonds."},
+  ["model:cracks"] = {"m:cracks() -> {{time, step, pos, mode, kind, a, b, fn, fs, mn, ms}, ...}", "The log of broken bonds."},
+  ["model:crack_count"] = {"m:crack_count([mode]) -> n", "Broken bonds, all or of mode 'tension' | 'shear'."},
+  ["model:track_energy"] = {"m:track_energy(on)", "Starts (from zero) or stops accumulating dissipated energies and boundary work."},
+
+  -- ball
+  ["ball:remove"] = {"b:remove()", "Removes the ball (queued while a callback runs)."},
+  ["ball:set_extra"] = {"b:set_extra(key, value)", "Stores a user value with the ball (same as b.extra[key] = value)."},
+  ["ball:get_extra"] = {"b:get_extra(key[, default]) -> value", "A user value stored with the ball."},
+  ["ball.id"] = {"b.id", "The ball's stable id (read-only)."},
+  ["ball.pos"] = {"b.pos", "Position [m]."},
+  ["ball.vel"] = {"b.vel", "Velocity [m/s]."},
+  ["ball.spin"] = {"b.spin", "Angular velocity [rad/s] (2D: a number, about z)."},
+  ["ball.force"] = {"b.force", "Contact plus applied force of the last step [N] (read-only)."},
+  ["ball.moment"] = {"b.moment", "Contact plus applied moment of the last step [N m] (read-only; 2D: a number)."},
+  ["ball.applied_force"] = {"b.applied_force", "A constant external force added every step [N]."},
+  ["ball.applied_moment"] = {"b.applied_moment", "A constant external moment added every step [N m]."},
+  ["ball.radius"] = {"b.radius", "Radius [m]; mass and inertia follow the density."},
+  ["ball.mass"] = {"b.mass", "Mass [kg] (read-only)."},
+  ["ball.inertia"] = {"b.inertia", "Moment of inertia [kg m^2] (read-only)."},
+  ["ball.material"] = {"b.material", "The material's name."},
+  ["ball.fix"] = {"b.fix", "Fixed velocity components: {'vx', 'vy', 'vz', 'wx', 'wy', 'wz'}, or 'vel', 'spin', 'all'; nil or {} frees them."},
+  ["ball.damping"] = {"b.damping", "Local damping coefficient in [0, 1)."},
+  ["ball.group"] = {"b.group", "The group's name, or nil."},
+  ["ball.extra"] = {"b.extra", "A table of user values kept with the ball: b.extra.tag = 1."},
+
+  -- wall
+  ["wall:remove"] = {"w:remove()", "Removes the wall (queued while a callback runs)."},
+  ["wall.id"] = {"w.id", "The wall's stable id."},
+  ["wall.kind"] = {"w.kind", "'plane', 'line', 'rect' or 'segment'."},
+  ["wall.force"] = {"w.force", "Resultant force of the balls on the wall in the last step [N]."},
+  ["wall.moment"] = {"w.moment", "Its moment about the wall's reference point [N m]."},
+  ["wall.vel"] = {"w.vel", "Imposed velocity [m/s] (writable)."},
+  ["wall.point"] = {"w.point", "Plane/line: a point on it; rect: its corner; segment: its first end [m]."},
+  ["wall.normal"] = {"w.normal", "Plane/line: the unit normal towards the balls."},
+  ["wall.edge1"] = {"w.edge1", "Rect: first edge; segment: second end minus first [m]."},
+  ["wall.edge2"] = {"w.edge2", "Rect: second edge [m]."},
+  ["wall.kn"] = {"w.kn", "Normal stiffness [N/m]."},
+  ["wall.ks"] = {"w.ks", "Shear stiffness [N/m]."},
+  ["wall.friction"] = {"w.friction", "Friction coefficient."},
+
+  -- contact
+  ["contact.a"] = {"c.a", "The first entity: a ball."},
+  ["contact.b"] = {"c.b", "The second entity: a ball or a wall."},
+  ["contact.kind"] = {"c.kind", "'ball-ball' or 'ball-wall'."},
+  ["contact.normal"] = {"c.normal", "Unit normal from a to b."},
+  ["contact.point"] = {"c.point", "Contact point [m]."},
+  ["contact.overlap"] = {"c.overlap", "Overlap [m] (> 0 when touching)."},
+  ["contact.fn"] = {"c.fn", "Normal force [N], compression positive."},
+  ["contact.fs"] = {"c.fs", "Shear force on b [N]."},
+  ["contact.force"] = {"c.force", "Total contact force on b [N] (a feels the opposite)."},
+  ["contact.kn"] = {"c.kn", "Normal stiffness [N/m]."},
+  ["contact.ks"] = {"c.ks", "Shear stiffness [N/m]."},
+  ["contact.bond"] = {"c.bond", "nil, 'contact', 'parallel' or 'both'."},
+  ["contact.pb_fn"] = {"c.pb_fn", "Parallel-bond normal force [N], compression positive."},
+  ["contact.pb_fs"] = {"c.pb_fs", "Parallel-bond shear force on b [N]."},
+  ["contact.pb_moment"] = {"c.pb_moment", "Parallel-bond moment on b [N m]."},
+  ["contact.pb_radius"] = {"c.pb_radius", "Parallel-bond radius [m]."},
+
+  -- seixo.util
+  ["util.add"] = {"util.add(a, b)", "a + b"},
+  ["util.sub"] = {"util.sub(a, b)", "a - b"},
+  ["util.scale"] = {"util.scale(a, s)", "s a"},
+  ["util.dot"] = {"util.dot(a, b)", "a . b"},
+  ["util.cross"] = {"util.cross(a, b)", "a x b (2D: the z component)"},
+  ["util.norm"] = {"util.norm(a)", "|a|"},
+  ["util.dist"] = {"util.dist(a, b)", "|a - b|"},
+  ["util.normalize"] = {"util.normalize(a)", "a / |a|"},
+  ["util.lerp"] = {"util.lerp(a, b, t)", "a + t (b - a)"},
+  ["util.show"] = {"util.show(v[, depth]) -> text", "A readable text of any value, tables in full."},
+  ["util.print"] = {"util.print(...)", "Prints values with util.show."},
+  ["util.read_csv"] = {"util.read_csv(path) -> {header, columns, rows}", "Reads a CSV written by m:history_csv."},
+}
+H.entries = entries
+
+-- The classes, from the metatables the bindings registered.
+local classes = {model = "seixo.model", ball = "seixo.ball", wall = "seixo.wall", contact = "seixo.contact"}
+
+local function class_of(x)
+  local mt = getmetatable(x)
+  if type(mt) ~= "table" then return nil end
+  for kind, tname in pairs(classes) do
+    if mt.__name == tname then return kind, mt end
+  end
+end
+
+local function registry_class(kind)
+  local reg = debug.getregistry()
+  return reg[classes[kind]]
+end
+
+-- The entry names of a function value, by identity.
+local function name_of_function(fn)
+  for kind in pairs(classes) do
+    local mt = registry_class(kind)
+    if mt and mt.__methods then
+      for name, f in pairs(mt.__methods) do
+        if f == fn then return kind .. ":" .. name end
+      end
+    end
+  end
+  local seixo = package.loaded.seixo
+  if seixo then
+    for name, f in pairs(seixo) do
+      if f == fn then return "seixo." .. name end
+    end
+  end
+  local util = package.loaded["seixo.util"]
+  if util then
+    for name, f in pairs(util) do
+      if f == fn then return "util." .. name end
+    end
+  end
+  if fn == rawget(_G, "help") then return "help" end
+end
+
+local function sorted(t)
+  table.sort(t)
+  return t
+end
+
+local function entry_text(name)
+  local e = entries[name]
+  if not e then return nil end
+  return e[1] .. "\n  " .. e[2]
+end
+
+-- One line per name: "  name  text" (text cut to fit).
+local function listing(title, names)
+  local out = {title}
+  for _, name in ipairs(names) do
+    local e = entries[name]
+    local text = e and e[2] or "(undocumented)"
+    if #text > 64 then text = text:sub(1, 61) .. "..." end
+    out[#out + 1] = string.format("  %-22s %s", name:match("[:%.]([%w_]+)$") or name, text)
+  end
+  return table.concat(out, "\n")
+end
+
+local function members(prefix)
+  local names = {}
+  for name in pairs(entries) do
+    if name:sub(1, #prefix) == prefix then names[#names + 1] = name end
+  end
+  return sorted(names)
+end
+
+local function object_text(kind)
+  local parts = {}
+  local methods = members(kind .. ":")
+  if #methods > 0 then parts[#parts + 1] = listing(kind .. " methods (" .. kind:sub(1, 1) .. ":name(...)):", methods) end
+  local fields = members(kind .. ".")
+  if #fields > 0 then parts[#parts + 1] = listing(kind .. " fields (" .. kind:sub(1, 1) .. ".name):", fields) end
+  return table.concat(parts, "\n")
+end
+
+local overview = [[
+seixo: a DEM simulator driven from Lua.
+  local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
+  m:material("rock", {density = 2650, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.7})
+  m:wall{kind = "box", min = {0, 0, 0}, max = {0.05, 0.05, 0.1}}
+  m:generate{count = 2000, radius = {0.8e-3, 1.2e-3}, region = {box = {{0, 0, 0}, {0.05, 0.05, 0.1}}}, seed = 7}
+  m:history("ke", "kinetic", {every = 100})
+  m:solve{ratio = 1e-4}
+  print(m)
+help(m) lists the model's methods, help(b) a ball's fields, help("solve") one entry;
+help("util") the vector helpers of require "seixo.util". The full reference: docs/lua-api.md.]]
+
+--- The help text of x (see the top of this file).
+function H.text(x)
+  if x == nil then return overview end
+  if type(x) == "function" then
+    local name = name_of_function(x)
+    return name and entry_text(name) or "no help for this function"
+  end
+  if x == package.loaded.seixo then return listing("seixo:", members("seixo.")) end
+  if x == package.loaded["seixo.util"] then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
+  local kind = class_of(x)
+  if kind then return object_text(kind) end
+  if type(x) ~= "string" then return "no help for a " .. type(x) .. "; try help()" end
+  if entries[x] then return entry_text(x) end
+  if classes[x] then return object_text(x) end
+  if x == "seixo" then return listing("seixo:", members("seixo.")) end
+  if x == "util" then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
+  -- a bare name: every entry it ends
+  local found = {}
+  for name in pairs(entries) do
+    if name:match("[:%.]([%w_]+)$") == x then found[#found + 1] = name end
+  end
+  if #found == 0 then return "no help for '" .. x .. "'; try help()" end
+  sorted(found)
+  local out = {}
+  for i, name in ipairs(found) do out[i] = entry_text(name) end
+  return table.concat(out, "\n")
+end
+
+--- Prints the help text of x.
+function H.help(x)
+  print(H.text(x))
+end
+
+return H

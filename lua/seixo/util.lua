@@ -1,0 +1,215 @@
+-- seixo.util: pure-Lua helpers on top of the bindings.
+--   local util = require "seixo.util"
+-- Vectors are arrays of 2 or 3 numbers, as the bindings use them; every
+-- function returns a new table and never changes its arguments.
+
+local util = {}
+
+-- The checks raise at `level` (default 3: the caller of the util function
+-- that called them), so the message points at the user's script.
+local function check_vec(v, name, fn, level)
+  level = level or 3
+  if type(v) ~= "table" or rawlen(v) ~= 2 and rawlen(v) ~= 3 then
+    error(string.format("bad argument '%s' to 'util.%s' (vector of 2 or 3 numbers expected, got %s)",
+                        name, fn, type(v) == "table" and rawlen(v) .. " components" or type(v)), level)
+  end
+  for k = 1, rawlen(v) do
+    if type(rawget(v, k)) ~= "number" then
+      error(string.format("bad argument '%s' to 'util.%s' (component %d: number expected, got %s)",
+                          name, fn, k, type(rawget(v, k))), level)
+    end
+  end
+end
+
+local function check_pair(a, b, fn)
+  check_vec(a, "a", fn, 4)
+  check_vec(b, "b", fn, 4)
+  if rawlen(a) ~= rawlen(b) then
+    error(string.format("bad arguments to 'util.%s' (vectors of %d and %d components)", fn, rawlen(a), rawlen(b)), 3)
+  end
+end
+
+local function check_number(s, name, fn)
+  if type(s) ~= "number" then
+    error(string.format("bad argument '%s' to 'util.%s' (number expected, got %s)", name, fn, type(s)), 3)
+  end
+end
+
+--- a + b
+function util.add(a, b)
+  check_pair(a, b, "add")
+  local r = {}
+  for k = 1, #a do r[k] = a[k] + b[k] end
+  return r
+end
+
+--- a - b
+function util.sub(a, b)
+  check_pair(a, b, "sub")
+  local r = {}
+  for k = 1, #a do r[k] = a[k] - b[k] end
+  return r
+end
+
+--- s a
+function util.scale(a, s)
+  check_vec(a, "a", "scale")
+  check_number(s, "s", "scale")
+  local r = {}
+  for k = 1, #a do r[k] = a[k] * s end
+  return r
+end
+
+--- a . b
+function util.dot(a, b)
+  check_pair(a, b, "dot")
+  local s = 0
+  for k = 1, #a do s = s + a[k] * b[k] end
+  return s
+end
+
+--- a x b: a vector in 3D, the scalar z component in 2D
+function util.cross(a, b)
+  check_pair(a, b, "cross")
+  if #a == 2 then return a[1] * b[2] - a[2] * b[1] end
+  return {a[2] * b[3] - a[3] * b[2], a[3] * b[1] - a[1] * b[3], a[1] * b[2] - a[2] * b[1]}
+end
+
+--- |a|
+function util.norm(a)
+  check_vec(a, "a", "norm")
+  local s = 0
+  for k = 1, #a do s = s + a[k] * a[k] end
+  return math.sqrt(s)
+end
+
+--- |a - b|
+function util.dist(a, b)
+  check_pair(a, b, "dist")
+  local s = 0
+  for k = 1, #a do s = s + (a[k] - b[k]) ^ 2 end
+  return math.sqrt(s)
+end
+
+--- a / |a|; an error for the zero vector
+function util.normalize(a)
+  check_vec(a, "a", "normalize")
+  local n = util.norm(a)
+  if n == 0 then error("bad argument 'a' to 'util.normalize' (the zero vector has no direction)", 2) end
+  return util.scale(a, 1 / n)
+end
+
+--- a + t (b - a)
+function util.lerp(a, b, t)
+  check_pair(a, b, "lerp")
+  check_number(t, "t", "lerp")
+  local r = {}
+  for k = 1, #a do r[k] = a[k] + t * (b[k] - a[k]) end
+  return r
+end
+
+---------------------------------------------------------------- printing
+
+-- (raw access throughout: printing never runs a table's metamethods)
+local function is_array(t)
+  local n = rawlen(t)
+  local count = 0
+  for _ in next, t do count = count + 1 end
+  return count == n
+end
+
+local function key_text(k)
+  if type(k) == "string" and k:match("^[%a_][%w_]*$") then return k end
+  if type(k) == "string" then return string.format("[%q]", k) end
+  return "[" .. tostring(k) .. "]"
+end
+
+local function sorted_keys(t)
+  local keys = {}
+  for k in next, t do keys[#keys + 1] = k end
+  table.sort(keys, function(a, b)
+    local ta, tb = type(a), type(b)
+    if ta ~= tb then return ta < tb end
+    if ta == "number" or ta == "string" then return a < b end
+    return tostring(a) < tostring(b)
+  end)
+  return keys
+end
+
+local function show(v, depth, indent, seen)
+  if type(v) == "string" then return string.format("%q", v) end
+  if type(v) ~= "table" then
+    local ok, text = pcall(tostring, v)
+    return ok and text or "<" .. type(v) .. " whose __tostring fails>"
+  end
+  local mt = getmetatable(v)
+  if type(mt) == "table" and rawget(mt, "__tostring") then
+    local ok, text = pcall(tostring, v)
+    return ok and text or "<" .. type(v) .. " whose __tostring fails>"
+  end
+  if seen[v] then return "<cycle>" end
+  if depth <= 0 then return "{...}" end
+  seen[v] = true
+  local parts = {}
+  if is_array(v) then
+    for i = 1, rawlen(v) do parts[i] = show(rawget(v, i), depth - 1, indent, seen) end
+  else
+    for _, k in ipairs(sorted_keys(v)) do
+      parts[#parts + 1] = key_text(k) .. " = " .. show(rawget(v, k), depth - 1, indent, seen)
+    end
+  end
+  seen[v] = nil
+  local flat = "{" .. table.concat(parts, ", ") .. "}"
+  if #flat <= 78 or #parts == 0 then return flat end
+  local pad = string.rep("  ", indent + 1)
+  for i = 1, #parts do
+    parts[i] = pad .. parts[i]:gsub("\n", "\n  ")
+  end
+  return "{\n" .. table.concat(parts, ",\n") .. "\n" .. string.rep("  ", indent) .. "}"
+end
+
+--- A readable text of any value: tables in full (keys sorted, cycles marked), to `depth` levels (default 4).
+function util.show(v, depth)
+  if depth ~= nil and math.type(depth) ~= "integer" then
+    error("bad argument 'depth' to 'util.show' (integer expected, got " .. type(depth) .. ")", 2)
+  end
+  return show(v, depth or 4, 0, {})
+end
+
+--- Prints each argument with util.show, separated by tabs.
+function util.print(...)
+  local out = {}
+  for i = 1, select("#", ...) do out[i] = util.show((select(i, ...))) end
+  print(table.concat(out, "\t"))
+end
+
+---------------------------------------------------------------- CSV
+
+--- Reads a CSV file written by m:history_csv: returns {header = {...}, columns = {name = {values}}};
+--- empty cells are nil, numbers are numbers.
+function util.read_csv(path)
+  if type(path) ~= "string" then
+    error("bad argument 'path' to 'util.read_csv' (string expected, got " .. type(path) .. ")", 2)
+  end
+  local f, err = io.open(path, "r")
+  if not f then error("util.read_csv: " .. err, 2) end
+  local header, columns, row = nil, {}, 0
+  for line in f:lines() do
+    local cells = {}
+    for cell in (line .. ","):gmatch("([^,]*),") do cells[#cells + 1] = cell end
+    if not header then
+      header = cells
+      for _, name in ipairs(header) do columns[name] = {} end
+    else
+      row = row + 1
+      for i, name in ipairs(header) do
+        local cell = cells[i]
+        if cell and cell ~= "" then columns[name][row] = tonumber(cell) or cell end
+      end
+    end
+  end
+  f:close()
+  return {header = header or {}, columns = columns, rows = row}
+end
+
+return util

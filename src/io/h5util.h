@@ -1,0 +1,107 @@
+/* Shared HDF5 helpers of the I/O layer: one error context per operation,
+ * attributes and datasets of plain arrays, and files written to a
+ * temporary name and renamed when complete.
+ *
+ * Errors: HDF5's own printing is switched off while a context is open;
+ * the first failure is kept as one line "'<file>': <problem>" (with the
+ * innermost HDF5 message when it says more), later ones are dropped, and
+ * every helper returns false (or a negative id) once the context failed, so
+ * a sequence of calls can be checked once at the end. */
+#pragma once
+
+#include <hdf5.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct sx_h5 {
+    const char *path;      ///< the file, named in messages
+    char *err;             ///< where the first failure goes (may be NULL)
+    size_t errlen;
+    bool failed;
+    int compression;       ///< deflate level of datasets written (0: none)
+    H5E_auto2_t old_func;  ///< HDF5's error printer, restored by sx_h5_end
+    void *old_data;
+} sx_h5;
+
+/// Opens an error context for an operation on `path`.
+void sx_h5_begin(sx_h5 *h, const char *path, char *err, size_t errlen);
+/// Closes it (restores HDF5's error printing).
+void sx_h5_end(sx_h5 *h);
+/// Records a failure "'<path>': <message>" unless one is recorded; returns false.
+bool sx_h5_fail(sx_h5 *h, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/// Like sx_h5_fail, with HDF5's innermost message appended in parentheses.
+bool sx_h5_fail_h5(sx_h5 *h, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* --------------------------------------------------------------- files */
+
+/// A temporary name beside `path` (same folder, so rename is atomic):
+/// "<dir>/.<name>.tmp-<pid>-<n>". False if it does not fit.
+bool sx_h5_temp_name(const char *path, char *out, size_t len);
+/// The file access list of seixo files: with `latest` the 1.10 format
+/// (every piece of metadata checksummed; snapshots), else the 1.8 format
+/// (which a writer killed mid-write leaves openable; series).
+hid_t sx_h5_fapl(bool latest);
+/// The file creation list of every seixo file (small chunk-index nodes).
+hid_t sx_h5_fcpl(void);
+/// Flushes `tmp` to disk and renames it over `path`, then syncs the folder.
+bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path);
+/// fsync of a file by name (after HDF5 has closed it).
+bool sx_h5_sync_path(const char *path);
+
+/* ---------------------------------------------------------- attributes */
+
+bool sx_h5_attr_str(sx_h5 *h, hid_t obj, const char *name, const char *value);
+/// n values; n == 0 writes an empty attribute; scalar when `scalar`.
+bool sx_h5_attr_f64(sx_h5 *h, hid_t obj, const char *name, const double *v, size_t n, bool scalar);
+bool sx_h5_attr_i64(sx_h5 *h, hid_t obj, const char *name, const int64_t *v, size_t n, bool scalar);
+static inline bool sx_h5_attr_double(sx_h5 *h, hid_t obj, const char *name, double v)
+{
+    return sx_h5_attr_f64(h, obj, name, &v, 1, true);
+}
+static inline bool sx_h5_attr_int(sx_h5 *h, hid_t obj, const char *name, int64_t v)
+{
+    return sx_h5_attr_i64(h, obj, name, &v, 1, true);
+}
+
+/// Whether obj has the attribute (false, without failing, if not).
+bool sx_h5_has_attr(hid_t obj, const char *name);
+/// Reads n numbers (a scalar when n == 1) converted to double / int64.
+/// A missing attribute fails when `required`, else leaves v untouched and
+/// returns true. `where` names the object in messages ("/model").
+bool sx_h5_get_f64(sx_h5 *h, hid_t obj, const char *where, const char *name, double *v, size_t n, bool required);
+bool sx_h5_get_i64(sx_h5 *h, hid_t obj, const char *where, const char *name, int64_t *v, size_t n, bool required);
+/// Number of elements of an attribute (0 if absent or empty).
+size_t sx_h5_attr_len(hid_t obj, const char *name);
+/// Reads a string attribute into out (truncated to len - 1); false without
+/// failing when absent or not a string.
+bool sx_h5_get_str(hid_t obj, const char *name, char *out, size_t len);
+
+/* ------------------------------------------------------------ datasets */
+
+/// A fixed-length, NUL-padded UTF-8 string type of n bytes (caller closes).
+hid_t sx_h5_string_type(size_t n);
+
+/// An HDF5 enum of the given names and values on `base` (caller closes).
+hid_t sx_h5_enum(hid_t base, const char *const names[], const int values[], int n);
+
+/// Writes an n x per array (1-D when per == 1) of memory type `mem`
+/// stored as `file`: chunked, Fletcher-32 checksummed, deflated at the
+/// context's level; `units` (may be NULL) as an attribute.
+bool sx_h5_write(sx_h5 *h, hid_t loc, const char *name, hid_t mem, hid_t file, const void *data, int64_t n, int per,
+                 const char *units);
+/// Rows of a dataset whose rows have `per` components; -1 (failing when
+/// `required`, else silently) when absent or shaped otherwise.
+int64_t sx_h5_rows(sx_h5 *h, hid_t loc, const char *where, const char *name, int per, bool required);
+/// Reads an n x per dataset into data (converted to `mem`). A missing
+/// dataset fails when `required`, else data is untouched and true returned.
+bool sx_h5_read(sx_h5 *h, hid_t loc, const char *where, const char *name, hid_t mem, void *data, int64_t n, int per,
+                bool required);
+
+/// Creates (or opens when it exists) a group.
+hid_t sx_h5_group(sx_h5 *h, hid_t loc, const char *name);
+/// Opens a group; fails (when `required`) if absent.
+hid_t sx_h5_open_group(sx_h5 *h, hid_t loc, const char *name, bool required);
+
+/// Closes any HDF5 id (ignores negative ids).
+void sx_h5_close(hid_t id);

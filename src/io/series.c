@@ -1,0 +1,869 @@
+/* Output series: snapshots for viewing, appended to one HDF5 file, with
+ * an XDMF file beside it that ParaView (or VisIt) opens as a time series.
+ *
+ * Each snapshot is a group /snapshots/NNNNNN holding the balls as points
+ * (always 3 components per vector, z = 0 in 2D, so viewers need no
+ * special case), ball-ball contacts and bonds as line cells between ball
+ * centres (connectivity into the balls' points), ball-wall contacts as
+ * lines from the centre to the contact point, and walls as quadrilaterals
+ * (3D) or segments (2D); an infinite wall is drawn across the balls'
+ * bounding box.
+ *
+ * Nothing is lost on a crash: the file is created under a temporary name
+ * and renamed; each snapshot is written, flushed and synced before the
+ * root's `count` of complete snapshots is raised (readers ignore groups
+ * beyond it), and the XDMF is updated last, by one write that replaces
+ * its closing tags. The 1.8 file format keeps a file whose writer was
+ * killed openable. */
+#include "io_internal.h"
+#include "state.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+struct sx_series {
+    char *path;       /* the .h5 */
+    char *xmf;        /* the .xmf beside it */
+    char *base;       /* the .h5's name as the .xmf refers to it */
+    hid_t file;
+    int dim;
+    unsigned fields;
+    int compression;
+    int64_t count;    /* complete snapshots */
+    int xfd;          /* the .xmf, open for writing */
+    off_t xoff;       /* where its closing tags start */
+};
+
+static const struct {
+    unsigned bit;
+    const char *name;
+} field_names[] = {
+    {SX_OUT_ID, "id"},           {SX_OUT_RADIUS, "radius"},     {SX_OUT_VELOCITY, "velocity"},
+    {SX_OUT_SPIN, "spin"},       {SX_OUT_FORCE, "force"},       {SX_OUT_MOMENT, "moment"},
+    {SX_OUT_GROUP, "group"},     {SX_OUT_MATERIAL, "material"}, {SX_OUT_MASS, "mass"},
+    {SX_OUT_CONTACTS, "contacts"}, {SX_OUT_BONDS, "bonds"},     {SX_OUT_WALLS, "walls"},
+};
+enum { NFIELDS = sizeof field_names / sizeof *field_names };
+
+const char *sx_series_field_name(unsigned bit)
+{
+    for (int k = 0; k < NFIELDS; k++)
+        if (field_names[k].bit == bit) return field_names[k].name;
+    return NULL;
+}
+
+unsigned sx_series_field_bit(const char *name)
+{
+    for (int k = 0; k < NFIELDS; k++)
+        if (strcmp(field_names[k].name, name) == 0) return field_names[k].bit;
+    return 0;
+}
+
+int64_t sx_series_count(const sx_series *s) { return s->count; }
+const char *sx_series_path(const sx_series *s) { return s->path; }
+
+/* ------------------------------------------------------------ buffers */
+
+typedef struct buf {
+    char *p;
+    size_t n, cap;
+    bool oom;
+} buf;
+
+static void put(buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void put(buf *b, const char *fmt, ...)
+{
+    if (b->oom) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        const int k = vsnprintf(b->p ? b->p + b->n : NULL, b->p ? b->cap - b->n : 0, fmt, ap);
+        va_end(ap);
+        if (k < 0) {
+            b->oom = true;
+            return;
+        }
+        if (b->p && b->n + (size_t)k < b->cap) {
+            b->n += (size_t)k;
+            return;
+        }
+        size_t cap = b->cap ? 2 * b->cap : 4096;
+        while (cap < b->n + (size_t)k + 1) cap *= 2;
+        char *q = realloc(b->p, cap);
+        if (!q) {
+            b->oom = true;
+            return;
+        }
+        b->p = q;
+        b->cap = cap;
+    }
+}
+
+/* ---------------------------------------------------------------- XDMF */
+
+/* What the XDMF needs to know of a snapshot (stored as its attributes). */
+typedef struct snap {
+    double time;
+    int64_t step, balls, contacts, wall_contacts, bonds, walls;
+    unsigned fields;
+    int dim;
+} snap;
+
+static const char xmf_trailer[] = "  </Grid>\n </Domain>\n</Xdmf>\n";
+
+static void xmf_header(buf *b)
+{
+    put(b, "<?xml version=\"1.0\" ?>\n"
+           "<!-- seixo output series: the snapshots of the .h5 beside this file, for ParaView or VisIt -->\n"
+           "<Xdmf Version=\"2.0\">\n <Domain>\n"
+           "  <Grid Name=\"seixo\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+}
+
+static void xml_escaped(buf *b, const char *s)
+{
+    for (; *s; s++) {
+        switch (*s) {
+        case '&': put(b, "&amp;"); break;
+        case '<': put(b, "&lt;"); break;
+        case '>': put(b, "&gt;"); break;
+        case '"': put(b, "&quot;"); break;
+        default: put(b, "%c", *s);
+        }
+    }
+}
+
+/* A DataItem naming a dataset of snapshot k. */
+static void item(buf *b, const char *base, int64_t k, const char *ds, int64_t rows, int cols, const char *type,
+                 int precision)
+{
+    if (cols > 1)
+        put(b, "<DataItem Dimensions=\"%lld %d\" ", (long long)rows, cols);
+    else
+        put(b, "<DataItem Dimensions=\"%lld\" ", (long long)rows);
+    put(b, "NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">", type, precision);
+    xml_escaped(b, base);
+    put(b, ":/snapshots/%06lld/%s</DataItem>", (long long)k, ds);
+}
+
+static void attribute(buf *b, const char *base, int64_t k, const char *name, const char *ds, int64_t rows, int cols,
+                      const char *type, int precision, bool cell)
+{
+    put(b, "     <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"%s\">", name, cols == 3 ? "Vector" : "Scalar",
+        cell ? "Cell" : "Node");
+    item(b, base, k, ds, rows, cols, type, precision);
+    put(b, "</Attribute>\n");
+}
+
+static void geometry(buf *b, const char *base, int64_t k, const char *ds, int64_t rows)
+{
+    put(b, "     <Geometry GeometryType=\"XYZ\">");
+    item(b, base, k, ds, rows, 3, "Float", 8);
+    put(b, "</Geometry>\n");
+}
+
+static void lines(buf *b, const char *base, int64_t k, const char *ds, int64_t cells, int nodes, const char *topo)
+{
+    put(b, "     <Topology TopologyType=\"%s\" NumberOfElements=\"%lld\"", topo, (long long)cells);
+    if (strcmp(topo, "Quadrilateral") != 0) put(b, " NodesPerElement=\"%d\"", nodes);
+    put(b, ">");
+    item(b, base, k, ds, cells, nodes, "Int", 4);
+    put(b, "</Topology>\n");
+}
+
+static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
+{
+    const unsigned f = s->fields;
+    put(b, "   <Grid Name=\"step %lld\" GridType=\"Collection\" CollectionType=\"Spatial\">\n", (long long)s->step);
+    put(b, "    <Time Value=\"%.17g\"/>\n", s->time);
+    /* balls: points with their fields */
+    put(b, "    <Grid Name=\"balls\" GridType=\"Uniform\">\n");
+    /* explicit vertices: the Xdmf3 readers make no cells of an implicit Polyvertex */
+    lines(b, base, k, "balls/vertices", s->balls, 1, "Polyvertex");
+    geometry(b, base, k, "balls/position", s->balls);
+    if (f & SX_OUT_ID) attribute(b, base, k, "id", "balls/id", s->balls, 1, "Int", 8, false);
+    if (f & SX_OUT_RADIUS) attribute(b, base, k, "radius", "balls/radius", s->balls, 1, "Float", 8, false);
+    if (f & SX_OUT_VELOCITY) attribute(b, base, k, "velocity", "balls/velocity", s->balls, 3, "Float", 8, false);
+    if (f & SX_OUT_SPIN) attribute(b, base, k, "spin", "balls/spin", s->balls, 3, "Float", 8, false);
+    if (f & SX_OUT_FORCE) attribute(b, base, k, "force", "balls/force", s->balls, 3, "Float", 8, false);
+    if (f & SX_OUT_MOMENT) attribute(b, base, k, "moment", "balls/moment", s->balls, 3, "Float", 8, false);
+    if (f & SX_OUT_GROUP) attribute(b, base, k, "group", "balls/group", s->balls, 1, "Int", 4, false);
+    if (f & SX_OUT_MATERIAL) attribute(b, base, k, "material", "balls/material", s->balls, 1, "Int", 4, false);
+    if (f & SX_OUT_MASS) attribute(b, base, k, "mass", "balls/mass", s->balls, 1, "Float", 8, false);
+    put(b, "    </Grid>\n");
+    if ((f & SX_OUT_CONTACTS) && s->contacts > 0) {
+        put(b, "    <Grid Name=\"contacts\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "contacts/connectivity", s->contacts, 2, "Polyline");
+        geometry(b, base, k, "balls/position", s->balls);
+        attribute(b, base, k, "normal_force", "contacts/normal_force", s->contacts, 1, "Float", 8, true);
+        attribute(b, base, k, "shear_force", "contacts/shear_force", s->contacts, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "contacts/force", s->contacts, 3, "Float", 8, true);
+        attribute(b, base, k, "overlap", "contacts/overlap", s->contacts, 1, "Float", 8, true);
+        attribute(b, base, k, "bond", "contacts/bond", s->contacts, 1, "Int", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_CONTACTS) && s->wall_contacts > 0) {
+        put(b, "    <Grid Name=\"wall_contacts\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "wall_contacts/connectivity", s->wall_contacts, 2, "Polyline");
+        geometry(b, base, k, "wall_contacts/points", 2 * s->wall_contacts);
+        attribute(b, base, k, "normal_force", "wall_contacts/normal_force", s->wall_contacts, 1, "Float", 8, true);
+        attribute(b, base, k, "shear_force", "wall_contacts/shear_force", s->wall_contacts, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "wall_contacts/force", s->wall_contacts, 3, "Float", 8, true);
+        attribute(b, base, k, "wall", "wall_contacts/wall", s->wall_contacts, 1, "Int", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_BONDS) && s->bonds > 0) {
+        put(b, "    <Grid Name=\"bonds\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "bonds/connectivity", s->bonds, 2, "Polyline");
+        geometry(b, base, k, "balls/position", s->balls);
+        attribute(b, base, k, "kind", "bonds/kind", s->bonds, 1, "Int", 8, true);
+        attribute(b, base, k, "normal_force", "bonds/normal_force", s->bonds, 1, "Float", 8, true);
+        attribute(b, base, k, "shear_force", "bonds/shear_force", s->bonds, 3, "Float", 8, true);
+        attribute(b, base, k, "moment", "bonds/moment", s->bonds, 3, "Float", 8, true);
+        attribute(b, base, k, "radius", "bonds/radius", s->bonds, 1, "Float", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_WALLS) && s->walls > 0) {
+        const bool quad = s->dim == 3; /* 3D: quadrilaterals */
+        put(b, "    <Grid Name=\"walls\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "walls/connectivity", s->walls, quad ? 4 : 2, quad ? "Quadrilateral" : "Polyline");
+        geometry(b, base, k, "walls/points", s->walls * (quad ? 4 : 2));
+        attribute(b, base, k, "id", "walls/id", s->walls, 1, "Int", 8, true);
+        attribute(b, base, k, "velocity", "walls/velocity", s->walls, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "walls/force", s->walls, 3, "Float", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    put(b, "   </Grid>\n");
+}
+
+/* ---------------------------------------------------------- gathering */
+
+/* Growable arrays of one snapshot's cells. */
+typedef struct cells {
+    int64_t n, cap, per_i, per_d;
+    int32_t *conn;  /* per_i ints per cell */
+    double *d;      /* per_d doubles per cell */
+} cells;
+
+static double *cells_push(cells *c, const int32_t *conn)
+{
+    if (c->n == c->cap) {
+        const int64_t cap = c->cap ? 2 * c->cap : 1024;
+        int32_t *q = realloc(c->conn, (size_t)(cap * c->per_i) * sizeof *q);
+        if (!q) return NULL;
+        c->conn = q;
+        double *r = realloc(c->d, (size_t)(cap * c->per_d) * sizeof *r);
+        if (!r) return NULL;
+        c->d = r;
+        c->cap = cap;
+    }
+    memcpy(c->conn + c->n * c->per_i, conn, (size_t)c->per_i * sizeof *conn);
+    return c->d + c->n++ * c->per_d;
+}
+
+/* Per ball-ball contact: fn, shear(3), force(3), overlap, bond, a, b.
+ * Per wall contact: points(6), fn, shear(3), force(3), wall.
+ * Per bond: kind, fn, shear(3), moment(3), radius. */
+enum { BB_D = 11, BW_D = 14, BD_D = 9 };
+
+typedef struct gather {
+    const sx_model *m;
+    cells bb, bw, bd;
+    bool oom;
+} gather;
+
+static bool collect(const sx_contact_info *ci, void *ud)
+{
+    gather *g = ud;
+    const sx_model *m = g->m;
+    double force[3];
+    for (int k = 0; k < 3; k++) force[k] = ci->fn * ci->normal[k] + ci->shear[k];
+    if (ci->is_wall) {
+        const int64_t i = sx__ball_index(m, ci->a);
+        const int32_t conn[2] = {(int32_t)(2 * g->bw.n), (int32_t)(2 * g->bw.n + 1)};
+        double *d = cells_push(&g->bw, conn);
+        if (!d) return !(g->oom = true);
+        for (int k = 0; k < 3; k++) {
+            d[k] = k < m->dim ? m->balls.x[i * m->dim + k] : 0;
+            d[3 + k] = ci->point[k];
+            d[7 + k] = ci->shear[k];
+            d[10 + k] = force[k];
+        }
+        d[6] = ci->fn;
+        d[13] = (double)ci->b;
+        return true;
+    }
+    const int32_t conn[2] = {(int32_t)sx__ball_index(m, ci->a), (int32_t)sx__ball_index(m, ci->b)};
+    double *d = cells_push(&g->bb, conn);
+    if (!d) return !(g->oom = true);
+    d[0] = ci->fn;
+    for (int k = 0; k < 3; k++) d[1 + k] = ci->shear[k], d[4 + k] = force[k];
+    d[7] = ci->overlap;
+    d[8] = ci->bond;
+    if (ci->bond) {
+        double *e = cells_push(&g->bd, conn);
+        if (!e) return !(g->oom = true);
+        e[0] = ci->bond;
+        e[1] = ci->pb_fn;
+        for (int k = 0; k < 3; k++) e[2 + k] = ci->pb_fs[k];
+        /* 2D: the moment is the scalar about z */
+        for (int k = 0; k < 3; k++) e[5 + k] = m->dim == 3 ? ci->pb_moment[k] : (k == 2 ? ci->pb_moment[0] : 0);
+        e[8] = ci->pb_radius;
+    }
+    return true;
+}
+
+/* Column k (of `per`) of the cells' doubles, `width` consecutive columns. */
+static double *column(const cells *c, int k, int width)
+{
+    double *out = malloc((size_t)(c->n > 0 ? c->n : 1) * (size_t)width * sizeof *out);
+    if (!out) return NULL;
+    for (int64_t i = 0; i < c->n; i++)
+        for (int j = 0; j < width; j++) out[i * width + j] = c->d[i * c->per_d + k + j];
+    return out;
+}
+
+static void write_col(sx_h5 *h, hid_t g, const char *name, const cells *c, int k, int width, const char *units,
+                      bool as_int)
+{
+    double *v = column(c, k, width);
+    if (!v) {
+        sx_h5_fail(h, "out of memory");
+        return;
+    }
+    if (as_int) {
+        int64_t *iv = malloc((size_t)(c->n > 0 ? c->n : 1) * (size_t)width * sizeof *iv);
+        if (!iv) {
+            sx_h5_fail(h, "out of memory");
+        } else {
+            for (int64_t i = 0; i < c->n * width; i++) iv[i] = (int64_t)v[i];
+            sx_h5_write(h, g, name, H5T_NATIVE_INT64, H5T_STD_I64LE, iv, c->n, width, units);
+        }
+        free(iv);
+    } else {
+        sx_h5_write(h, g, name, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, v, c->n, width, units);
+    }
+    free(v);
+}
+
+/* A 3-component copy of a dim- (or rdim-) component per-ball array; a 2D
+ * rotational scalar goes to z. */
+static double *widen(const sx_model *m, const double *src, int per, bool rot)
+{
+    const int64_t n = m->balls.n;
+    double *out = calloc((size_t)(n > 0 ? n : 1) * 3, sizeof *out);
+    if (!out) return NULL;
+    for (int64_t i = 0; i < n; i++) {
+        if (rot && per == 1) out[i * 3 + 2] = src[i];
+        else
+            for (int k = 0; k < per; k++) out[i * 3 + k] = src[i * per + k];
+    }
+    return out;
+}
+
+static void write_vec(sx_h5 *h, hid_t g, const char *name, const sx_model *m, const double *src, int per, bool rot,
+                      const char *units)
+{
+    double *v = widen(m, src, per, rot);
+    if (!v) {
+        sx_h5_fail(h, "out of memory");
+        return;
+    }
+    sx_h5_write(h, g, name, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, v, m->balls.n, 3, units);
+    free(v);
+}
+
+static void write_balls(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f)
+{
+    const sx_balls *b = &m->balls;
+    const int64_t n = b->n;
+    hid_t g = sx_h5_group(h, snapg, "balls");
+    write_vec(h, g, "position", m, b->x, m->dim, false, "m");
+    int32_t *vert = malloc((size_t)(n > 0 ? n : 1) * sizeof *vert);
+    if (!vert) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        for (int64_t i = 0; i < n; i++) vert[i] = (int32_t)i;
+        sx_h5_write(h, g, "vertices", H5T_NATIVE_INT32, H5T_STD_I32LE, vert, n, 1, NULL);
+        free(vert);
+    }
+    if (f & SX_OUT_VELOCITY) write_vec(h, g, "velocity", m, b->v, m->dim, false, "m/s");
+    if (f & SX_OUT_SPIN) write_vec(h, g, "spin", m, b->w, m->rdim, true, "rad/s");
+    if (f & SX_OUT_FORCE) write_vec(h, g, "force", m, b->f, m->dim, false, "N");
+    if (f & SX_OUT_MOMENT) write_vec(h, g, "moment", m, b->t, m->rdim, true, "N m");
+    if (f & SX_OUT_RADIUS) sx_h5_write(h, g, "radius", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, b->rad, n, 1, "m");
+    if (f & SX_OUT_GROUP) sx_h5_write(h, g, "group", H5T_NATIVE_INT32, H5T_STD_I32LE, b->group, n, 1, NULL);
+    if (f & (SX_OUT_ID | SX_OUT_MATERIAL | SX_OUT_MASS)) {
+        int64_t *iv = malloc((size_t)(n > 0 ? n : 1) * sizeof *iv);
+        double *dv = malloc((size_t)(n > 0 ? n : 1) * sizeof *dv);
+        if (!iv || !dv) {
+            sx_h5_fail(h, "out of memory");
+        } else {
+            if (f & SX_OUT_ID) {
+                for (int64_t i = 0; i < n; i++) iv[i] = b->id[i];
+                sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, iv, n, 1, NULL);
+            }
+            if (f & SX_OUT_MATERIAL) {
+                int32_t *mv = (int32_t *)iv;
+                for (int64_t i = 0; i < n; i++) mv[i] = b->mat[i];
+                sx_h5_write(h, g, "material", H5T_NATIVE_INT32, H5T_STD_I32LE, mv, n, 1, NULL);
+            }
+            if (f & SX_OUT_MASS) {
+                for (int64_t i = 0; i < n; i++) dv[i] = 1.0 / b->inv_mass[i];
+                sx_h5_write(h, g, "mass", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, dv, n, 1, "kg");
+            }
+        }
+        free(iv);
+        free(dv);
+    }
+    sx_h5_close(g);
+}
+
+static void write_cells(sx_h5 *h, hid_t g, const cells *c)
+{
+    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, c->conn, c->n, (int)c->per_i, NULL);
+}
+
+/* Walls as drawable cells: a 3D plane as a square across the balls'
+ * bounding box, a rectangle as itself; a 2D line as a segment across the
+ * box, a segment as itself. */
+static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m)
+{
+    const int64_t nw = m->nwall;
+    const int d = m->dim, per = d == 3 ? 4 : 2;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int64_t i = 0; i < m->balls.n; i++)
+        for (int k = 0; k < d; k++) {
+            const double x = m->balls.x[i * d + k], r = m->balls.rad[i];
+            if (i == 0 || x - r < lo[k]) lo[k] = x - r;
+            if (i == 0 || x + r > hi[k]) hi[k] = x + r;
+        }
+    double c[3], diag = 0;
+    for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    const double half = diag > 0 ? 0.6 * sqrt(diag) : 1.0;
+    double *pts = calloc((size_t)(nw * per * 3 + 1), sizeof *pts);
+    double *vel = calloc((size_t)(nw * 3 + 1), sizeof *vel), *frc = calloc((size_t)(nw * 3 + 1), sizeof *frc);
+    int32_t *conn = calloc((size_t)(nw * per + 1), sizeof *conn);
+    int64_t *ids = calloc((size_t)(nw + 1), sizeof *ids);
+    if (!pts || !vel || !frc || !conn || !ids) {
+        sx_h5_fail(h, "out of memory");
+        goto done;
+    }
+    for (int64_t w = 0; w < nw; w++) {
+        const sx_wall *wl = &m->walls[w];
+        const sx_wall_def *def = &wl->def;
+        double *p = pts + w * per * 3;
+        if (def->kind == SX_WALL_RECT || def->kind == SX_WALL_SEGMENT) {
+            for (int k = 0; k < 3; k++) {
+                p[k] = def->point[k];
+                p[3 + k] = def->point[k] + def->edge1[k];
+                if (per == 4) {
+                    p[6 + k] = def->point[k] + def->edge1[k] + def->edge2[k];
+                    p[9 + k] = def->point[k] + def->edge2[k];
+                }
+            }
+        } else {
+            /* the projection of the box's centre on the wall, and in-plane axes */
+            const double *n = def->normal;
+            double t = 0;
+            for (int k = 0; k < d; k++) t += (c[k] - def->point[k]) * n[k];
+            double o[3];
+            for (int k = 0; k < 3; k++) o[k] = c[k] - t * (k < d ? n[k] : 0);
+            if (d == 2) {
+                const double u[2] = {-n[1], n[0]};
+                for (int k = 0; k < 2; k++) p[k] = o[k] - half * u[k], p[3 + k] = o[k] + half * u[k];
+            } else {
+                const int a = fabs(n[0]) < fabs(n[1]) ? (fabs(n[0]) < fabs(n[2]) ? 0 : 2) : (fabs(n[1]) < fabs(n[2]) ? 1 : 2);
+                double e[3] = {0, 0, 0}, u[3], v[3];
+                e[a] = 1;
+                u[0] = n[1] * e[2] - n[2] * e[1], u[1] = n[2] * e[0] - n[0] * e[2], u[2] = n[0] * e[1] - n[1] * e[0];
+                const double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+                for (int k = 0; k < 3; k++) u[k] /= lu;
+                v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+                const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+                for (int q = 0; q < 4; q++)
+                    for (int k = 0; k < 3; k++) p[q * 3 + k] = o[k] + half * (s[q][0] * u[k] + s[q][1] * v[k]);
+            }
+        }
+        for (int q = 0; q < per; q++) conn[w * per + q] = (int32_t)(w * per + q);
+        for (int k = 0; k < d; k++) vel[w * 3 + k] = def->vel[k], frc[w * 3 + k] = wl->force[k];
+        ids[w] = wl->id;
+    }
+    hid_t g = sx_h5_group(h, snapg, "walls");
+    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, nw * per, 3, "m");
+    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, nw, per, NULL);
+    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, nw, 1, NULL);
+    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, nw, 3, "m/s");
+    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, nw, 3, "N");
+    sx_h5_close(g);
+done:
+    free(pts);
+    free(vel);
+    free(frc);
+    free(conn);
+    free(ids);
+}
+
+static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f, snap *s)
+{
+    memset(s, 0, sizeof *s);
+    s->time = m->time;
+    s->step = m->step;
+    s->balls = m->balls.n;
+    s->fields = f;
+    s->dim = m->dim;
+    write_balls(h, snapg, m, f);
+    if (f & (SX_OUT_CONTACTS | SX_OUT_BONDS)) {
+        gather g = {.m = m};
+        g.bb.per_i = g.bw.per_i = g.bd.per_i = 2;
+        g.bb.per_d = BB_D, g.bw.per_d = BW_D, g.bd.per_d = BD_D;
+        sx_contact_each(m, collect, &g);
+        if (g.oom) {
+            sx_h5_fail(h, "out of memory");
+        } else {
+            if (f & SX_OUT_CONTACTS) {
+                s->contacts = g.bb.n;
+                s->wall_contacts = g.bw.n;
+                hid_t c = sx_h5_group(h, snapg, "contacts");
+                write_cells(h, c, &g.bb);
+                write_col(h, c, "normal_force", &g.bb, 0, 1, "N", false);
+                write_col(h, c, "shear_force", &g.bb, 1, 3, "N", false);
+                write_col(h, c, "force", &g.bb, 4, 3, "N", false);
+                write_col(h, c, "overlap", &g.bb, 7, 1, "m", false);
+                write_col(h, c, "bond", &g.bb, 8, 1, NULL, true);
+                sx_h5_close(c);
+                c = sx_h5_group(h, snapg, "wall_contacts");
+                write_cells(h, c, &g.bw);
+                double *pts = column(&g.bw, 0, 6); /* two points per contact */
+                if (!pts) sx_h5_fail(h, "out of memory");
+                else sx_h5_write(h, c, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, 2 * g.bw.n, 3, "m");
+                free(pts);
+                write_col(h, c, "normal_force", &g.bw, 6, 1, "N", false);
+                write_col(h, c, "shear_force", &g.bw, 7, 3, "N", false);
+                write_col(h, c, "force", &g.bw, 10, 3, "N", false);
+                write_col(h, c, "wall", &g.bw, 13, 1, NULL, true);
+                sx_h5_close(c);
+            }
+            if (f & SX_OUT_BONDS) {
+                s->bonds = g.bd.n;
+                hid_t c = sx_h5_group(h, snapg, "bonds");
+                write_cells(h, c, &g.bd);
+                write_col(h, c, "kind", &g.bd, 0, 1, NULL, true);
+                write_col(h, c, "normal_force", &g.bd, 1, 1, "N", false);
+                write_col(h, c, "shear_force", &g.bd, 2, 3, "N", false);
+                write_col(h, c, "moment", &g.bd, 5, 3, "N m", false);
+                write_col(h, c, "radius", &g.bd, 8, 1, "m", false);
+                sx_h5_close(c);
+            }
+        }
+        free(g.bb.conn), free(g.bb.d), free(g.bw.conn), free(g.bw.d), free(g.bd.conn), free(g.bd.d);
+    }
+    if (f & SX_OUT_WALLS) {
+        s->walls = m->nwall;
+        write_walls(h, snapg, m);
+    }
+    sx_h5_attr_double(h, snapg, "time", s->time);
+    sx_h5_attr_int(h, snapg, "step", s->step);
+    sx_h5_attr_double(h, snapg, "timestep", m->dt);
+    sx_h5_attr_int(h, snapg, "balls", s->balls);
+    sx_h5_attr_int(h, snapg, "contacts", s->contacts);
+    sx_h5_attr_int(h, snapg, "wall_contacts", s->wall_contacts);
+    sx_h5_attr_int(h, snapg, "bonds", s->bonds);
+    sx_h5_attr_int(h, snapg, "walls", s->walls);
+    sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
+}
+
+/* -------------------------------------------------------- the series */
+
+/* path with its .h5 / .hdf5 / .hdf extension replaced by .xmf (or .xmf appended). */
+static char *xmf_path_of(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    size_t keep = strlen(path);
+    if (dot && (!slash || dot > slash) &&
+        (strcmp(dot, ".h5") == 0 || strcmp(dot, ".hdf5") == 0 || strcmp(dot, ".hdf") == 0))
+        keep = (size_t)(dot - path);
+    char *out = malloc(keep + 5);
+    if (out) {
+        memcpy(out, path, keep);
+        memcpy(out + keep, ".xmf", 5);
+    }
+    return out;
+}
+
+static char *dup_str(const char *s)
+{
+    const size_t n = strlen(s) + 1;
+    char *p = malloc(n);
+    if (p) memcpy(p, s, n);
+    return p;
+}
+
+static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
+{
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06lld", (long long)k);
+    hid_t g = sx_h5_open_group(h, file, name, true);
+    if (g < 0) return false;
+    int64_t f = 0;
+    memset(s, 0, sizeof *s);
+    s->dim = dim;
+    sx_h5_get_f64(h, g, name, "time", &s->time, 1, true);
+    sx_h5_get_i64(h, g, name, "step", &s->step, 1, true);
+    sx_h5_get_i64(h, g, name, "balls", &s->balls, 1, true);
+    sx_h5_get_i64(h, g, name, "contacts", &s->contacts, 1, true);
+    sx_h5_get_i64(h, g, name, "wall_contacts", &s->wall_contacts, 1, true);
+    sx_h5_get_i64(h, g, name, "bonds", &s->bonds, 1, true);
+    sx_h5_get_i64(h, g, name, "walls", &s->walls, 1, true);
+    sx_h5_get_i64(h, g, name, "fields", &f, 1, true);
+    s->fields = (unsigned)f;
+    sx_h5_close(g);
+    return !h->failed;
+}
+
+/* Writes a whole file under a temporary name and renames it over path. */
+static bool write_whole(sx_h5 *h, const char *path, const char *data, size_t n)
+{
+    char tmp[4096];
+    if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path of '%s' is too long", path);
+    FILE *f = fopen(tmp, "wb");
+    if (!f) return sx_h5_fail(h, "cannot create '%s': %s", tmp, strerror(errno));
+    const bool ok = fwrite(data, 1, n, f) == n;
+    if (fclose(f) != 0 || !ok) {
+        remove(tmp);
+        return sx_h5_fail(h, "cannot write '%s': %s", tmp, strerror(errno));
+    }
+    if (!sx_h5_commit(h, tmp, path)) {
+        remove(tmp);
+        return false;
+    }
+    return true;
+}
+
+/* The whole XDMF from the first `count` snapshots of file; *trailer_at:
+ * the offset of its closing tags. */
+static bool xmf_rewrite(sx_h5 *h, const char *xmf, const char *base, hid_t file, int dim, int64_t count,
+                        off_t *trailer_at)
+{
+    buf b = {0};
+    xmf_header(&b);
+    for (int64_t k = 0; k < count && !h->failed; k++) {
+        snap s;
+        if (read_snap(h, file, dim, k, &s)) xmf_step(&b, base, k, &s);
+    }
+    const size_t at = b.n;
+    put(&b, "%s", xmf_trailer);
+    bool ok = !h->failed;
+    if (ok && b.oom) ok = sx_h5_fail(h, "out of memory");
+    if (ok) ok = write_whole(h, xmf, b.p, b.n);
+    free(b.p);
+    if (ok && trailer_at) *trailer_at = (off_t)at;
+    return ok;
+}
+
+static bool sync_file(hid_t file)
+{
+    void *handle = NULL;
+    if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) return false;
+    if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle) fsync(*(int *)handle);
+    return true;
+}
+
+static void fields_text(unsigned f, char *out, size_t len)
+{
+    out[0] = 0;
+    size_t n = 0;
+    for (int k = 0; k < NFIELDS; k++)
+        if (f & field_names[k].bit) {
+            const int w = snprintf(out + n, len - n, "%s%s", n ? " " : "", field_names[k].name);
+            if (w < 0 || (size_t)w >= len - n) break;
+            n += (size_t)w;
+        }
+}
+
+/* A new, empty series file: written under a temporary name, then renamed. */
+static bool create_file(sx_h5 *h, const char *path, int dim, const sx_series_opts *o, unsigned fields)
+{
+    char tmp[4096];
+    if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path is too long");
+    hid_t fapl = sx_h5_fapl(false);
+    hid_t fcpl = sx_h5_fcpl();
+    hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
+    if (f < 0) sx_h5_fail_h5(h, "cannot create a file in its folder");
+    sx_h5_close(fapl);
+    sx_h5_close(fcpl);
+    if (f < 0) return false;
+    char text[256];
+    fields_text(fields, text, sizeof text);
+    sx_io_write_provenance(h, f, "series", dim, o ? &o->provenance : NULL);
+    sx_h5_attr_str(h, f, "fields", text);
+    sx_h5_attr_int(h, f, "count", 0);
+    sx_h5_close(sx_h5_group(h, f, "snapshots"));
+    if (H5Fclose(f) < 0) sx_h5_fail_h5(h, "cannot complete the file");
+    if (!h->failed) sx_h5_commit(h, tmp, path);
+    if (h->failed) remove(tmp);
+    return !h->failed;
+}
+
+sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, path ? path : "", err, errlen);
+    sx_series *s = calloc(1, sizeof *s);
+    if (s) {
+        s->file = -1;
+        s->xfd = -1;
+    }
+    const unsigned fields = o && o->fields ? o->fields : SX_OUT_DEFAULT;
+    if (!s) {
+        sx_h5_fail(&h, "out of memory");
+    } else if (!path || !*path) {
+        sx_h5_fail(&h, "an empty path");
+    } else if (dim != 2 && dim != 3) {
+        sx_h5_fail(&h, "dim must be 2 or 3");
+    } else if (!(s->path = dup_str(path)) || !(s->xmf = xmf_path_of(path))) {
+        sx_h5_fail(&h, "out of memory");
+    } else {
+        const char *slash = strrchr(path, '/');
+        s->base = dup_str(slash ? slash + 1 : path);
+        s->dim = dim;
+        s->fields = fields;
+        s->compression = o && o->compression > 0 ? (o->compression > 9 ? 9 : o->compression) : 0;
+        const bool append = o && o->append && access(path, F_OK) == 0;
+        if (!s->base) {
+            sx_h5_fail(&h, "out of memory");
+        } else if (append) {
+            int d = 0, version = 0;
+            s->file = sx_io_open(&h, path, true, "series", dim, &d, &version);
+            if (s->file >= 0) sx_h5_get_i64(&h, s->file, "/", "count", &s->count, 1, true);
+        } else if (create_file(&h, path, dim, o, fields)) {
+            hid_t fapl = sx_h5_fapl(false);
+            s->file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : -1;
+            if (s->file < 0) sx_h5_fail_h5(&h, "cannot reopen the new series");
+            sx_h5_close(fapl);
+        }
+        if (!h.failed && s->count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
+        if (!h.failed && xmf_rewrite(&h, s->xmf, s->base, s->file, s->dim, s->count, &s->xoff)) {
+            s->xfd = open(s->xmf, O_WRONLY);
+            if (s->xfd < 0) sx_h5_fail(&h, "cannot open '%s': %s", s->xmf, strerror(errno));
+        }
+    }
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    if (failed) {
+        sx_series_close(s, NULL, 0);
+        return NULL;
+    }
+    return s;
+}
+
+sx_status sx_series_write(sx_series *s, const sx_model *m, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, s->path, err, errlen);
+    h.compression = s->compression;
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
+    snap sn;
+    if (m->dim != s->dim) {
+        sx_h5_fail(&h, "the series holds %dD models, this one is %dD", s->dim, m->dim);
+    } else if (s->file < 0) {
+        sx_h5_fail(&h, "the series is closed");
+    } else {
+        /* a group left by a write that failed or was killed is dropped; if
+         * its object cannot be read to delete it, its link is moved aside */
+        if (H5Lexists(s->file, name, H5P_DEFAULT) > 0 && H5Ldelete(s->file, name, H5P_DEFAULT) < 0) {
+            char aside[80];
+            snprintf(aside, sizeof aside, "/snapshots/incomplete-%06lld-%ld", (long long)s->count, (long)getpid());
+            H5Lmove(s->file, name, s->file, aside, H5P_DEFAULT, H5P_DEFAULT);
+        }
+        H5Eclear2(H5E_DEFAULT);
+        hid_t g = H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
+        else write_snapshot(&h, g, m, s->fields, &sn);
+        sx_h5_close(g);
+        /* the snapshot is on disk before the count says it is complete */
+        if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
+        if (!h.failed) sx_h5_attr_int(&h, s->file, "count", s->count + 1);
+        if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot count");
+    }
+    if (!h.failed) {
+        s->count++;
+        /* the XDMF last: this step and the closing tags in one write */
+        buf b = {0};
+        xmf_step(&b, s->base, s->count - 1, &sn);
+        const size_t step_len = b.n;
+        put(&b, "%s", xmf_trailer);
+        const ssize_t w = b.oom ? -1 : pwrite(s->xfd, b.p, b.n, s->xoff);
+        if (w == (ssize_t)b.n) {
+            s->xoff += (off_t)step_len;
+            fsync(s->xfd);
+        } else {
+            /* rewrite it whole from the file (a write cut short would leave it unreadable) */
+            xmf_rewrite(&h, s->xmf, s->base, s->file, s->dim, s->count, &s->xoff);
+            close(s->xfd);
+            s->xfd = open(s->xmf, O_WRONLY);
+        }
+        free(b.p);
+    }
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    return failed ? SX_EINVAL : SX_OK;
+}
+
+sx_status sx_series_close(sx_series *s, char *err, size_t errlen)
+{
+    if (!s) return SX_OK;
+    sx_h5 h;
+    sx_h5_begin(&h, s->path ? s->path : "", err, errlen);
+    if (s->xfd >= 0) close(s->xfd);
+    if (s->file >= 0 && H5Fclose(s->file) < 0) sx_h5_fail_h5(&h, "cannot close the series");
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    free(s->path);
+    free(s->xmf);
+    free(s->base);
+    free(s);
+    return failed ? SX_EINVAL : SX_OK;
+}
+
+sx_status sx_series_write_xdmf(const char *h5path, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, h5path ? h5path : "", err, errlen);
+    int dim = 0, version = 0;
+    hid_t f = h5path && *h5path ? sx_io_open(&h, h5path, false, "series", 0, &dim, &version) : -1;
+    if (!h5path || !*h5path) sx_h5_fail(&h, "an empty path");
+    int64_t count = 0;
+    char *xmf = xmf_path_of(h5path ? h5path : "");
+    const char *slash = h5path ? strrchr(h5path, '/') : NULL;
+    if (f >= 0 && sx_h5_get_i64(&h, f, "/", "count", &count, 1, true)) {
+        if (!xmf) sx_h5_fail(&h, "out of memory");
+        else if (count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
+        else xmf_rewrite(&h, xmf, slash ? slash + 1 : h5path, f, dim, count, NULL);
+    }
+    free(xmf);
+    if (f >= 0) H5Fclose(f);
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    return failed ? SX_EINVAL : SX_OK;
+}
+
+int64_t sx_series_read_count(const char *path, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, path ? path : "", err, errlen);
+    int dim = 0, version = 0;
+    int64_t count = -1;
+    hid_t f = path && *path ? sx_io_open(&h, path, false, "series", 0, &dim, &version) : -1;
+    if (f >= 0 && !sx_h5_get_i64(&h, f, "/", "count", &count, 1, true)) count = -1;
+    if (f >= 0) H5Fclose(f);
+    sx_h5_end(&h);
+    return count;
+}

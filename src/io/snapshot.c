@@ -1,0 +1,764 @@
+/* Snapshots: the complete state of a model in one HDF5 file, read back
+ * into a model that continues bit-for-bit like the saved one.
+ *
+ * The I/O layer is part of libseixo's implementation: it includes the
+ * core's private layout (through state.h) and writes every array a
+ * continuing run reads, in the stores' own dense order, so nothing is
+ * recomputed on load except what state.c derives (the id map, the bond
+ * count, the chunk plan). Doubles are stored as IEEE 754 binary64, so the
+ * bits survive. The layout is documented in docs/file-format.md; each
+ * array is listed once below and used by both the writer and the reader.
+ *
+ * A save goes to a temporary file beside the target, is flushed to disk
+ * and renamed over the target; a load checks the file before it trusts
+ * any of it, then lets state.c check every cross reference. */
+#include "io_internal.h"
+#include "state.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { T_F64, T_I32, T_U16, T_U8 };
+
+static hid_t mem_type(int t)
+{
+    switch (t) {
+    case T_F64: return H5T_NATIVE_DOUBLE;
+    case T_I32: return H5T_NATIVE_INT32;
+    case T_U16: return H5T_NATIVE_UINT16;
+    default: return H5T_NATIVE_UINT8;
+    }
+}
+
+static hid_t file_type(int t)
+{
+    switch (t) {
+    case T_F64: return H5T_IEEE_F64LE;
+    case T_I32: return H5T_STD_I32LE;
+    case T_U16: return H5T_STD_U16LE;
+    default: return H5T_STD_U8LE;
+    }
+}
+
+/* One array of a store: n rows of `per` components. */
+typedef struct field {
+    const char *name;
+    int type;
+    void *data;
+    int per;
+    const char *units;
+} field;
+
+#define F(nm, ty, ptr, p, u) (field){nm, ty, (void *)(ptr), p, u}
+
+/* Every per-ball array (applied loads only when the store has them). */
+static int ball_fields(const sx_model *m, field *f)
+{
+    const sx_balls *b = &m->balls;
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = F("id", T_I32, b->id, 1, NULL);
+    f[n++] = F("position", T_F64, b->x, d, "m");
+    f[n++] = F("velocity", T_F64, b->v, d, "m/s");
+    f[n++] = F("spin", T_F64, b->w, r, "rad/s");
+    f[n++] = F("force", T_F64, b->f, d, "N");
+    f[n++] = F("moment", T_F64, b->t, r, "N m");
+    f[n++] = F("position_at_build", T_F64, b->x_build, d, "m");
+    f[n++] = F("radius", T_F64, b->rad, 1, "m");
+    f[n++] = F("inv_mass", T_F64, b->inv_mass, 1, "1/kg");
+    f[n++] = F("inv_inertia", T_F64, b->inv_inertia, 1, "1/(kg m^2)");
+    f[n++] = F("damping", T_F64, b->alpha, 1, "1");
+    f[n++] = F("material", T_U16, b->mat, 1, NULL);
+    f[n++] = F("fixity", T_U8, b->fix, 1, NULL);
+    f[n++] = F("group", T_I32, b->group, 1, NULL);
+    if (b->fapp) {
+        f[n++] = F("applied_force", T_F64, b->fapp, d, "N");
+        f[n++] = F("applied_moment", T_F64, b->tapp, r, "N m");
+    }
+    return n;
+}
+
+/* Every array of a pair store (bond slots only when it has them). */
+static int pair_fields(const sx_model *m, const sx_pairs *p, field *f)
+{
+    const int d = m->dim;
+    int n = 0;
+    f[n++] = F("a", T_I32, p->a, 1, NULL);
+    f[n++] = F("b", T_I32, p->b, 1, NULL);
+    f[n++] = F("shear_force", T_F64, p->fs, d, "N");
+    f[n++] = F("normal", T_F64, p->nold, d, "1");
+    f[n++] = F("touching", T_U8, p->touching, 1, NULL);
+    f[n++] = F("overlap", T_F64, p->un, 1, "m");
+    f[n++] = F("normal_force", T_F64, p->fn, 1, "N");
+    if (p->bond) f[n++] = F("bond", T_I32, p->bond, 1, NULL);
+    return n;
+}
+
+static int bond_fields(const sx_model *m, field *f)
+{
+    const sx_bonds *b = &m->bonds;
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = F("kind", T_U8, b->kind, 1, NULL);
+    f[n++] = F("ball_a", T_I32, b->ida, 1, NULL);
+    f[n++] = F("ball_b", T_I32, b->idb, 1, NULL);
+    f[n++] = F("contact_normal_strength", T_F64, b->cb_n, 1, "N");
+    f[n++] = F("contact_shear_strength", T_F64, b->cb_s, 1, "N");
+    f[n++] = F("radius", T_F64, b->rbar, 1, "m");
+    f[n++] = F("kn", T_F64, b->kn, 1, "Pa/m");
+    f[n++] = F("ks", T_F64, b->ks, 1, "Pa/m");
+    f[n++] = F("tensile_strength", T_F64, b->sigma_c, 1, "Pa");
+    f[n++] = F("cohesion", T_F64, b->tau_c, 1, "Pa");
+    f[n++] = F("normal_force", T_F64, b->fn, 1, "N");
+    f[n++] = F("shear_force", T_F64, b->fs, d, "N");
+    f[n++] = F("twist_moment", T_F64, b->mn, 1, "N m");
+    f[n++] = F("bending_moment", T_F64, b->ms, r, "N m");
+    return n;
+}
+
+enum { MAX_FIELDS = 24 };
+
+static bool write_fields(sx_h5 *h, hid_t g, const field *f, int nf, int64_t rows)
+{
+    for (int i = 0; i < nf; i++)
+        sx_h5_write(h, g, f[i].name, mem_type(f[i].type), file_type(f[i].type), f[i].data, rows, f[i].per, f[i].units);
+    return !h->failed;
+}
+
+static bool read_fields(sx_h5 *h, hid_t g, const char *where, const field *f, int nf, int64_t rows)
+{
+    for (int i = 0; i < nf; i++) sx_h5_read(h, g, where, f[i].name, mem_type(f[i].type), f[i].data, rows, f[i].per, true);
+    return !h->failed;
+}
+
+/* ------------------------------------------------------------- scalars */
+
+/* The model's scalars, as attributes of /model. */
+typedef struct scalar {
+    const char *name;
+    double *f;      /* a double ... */
+    int64_t *i;     /* ... or an integer */
+    bool *b;        /* ... or a flag (stored as an integer 0/1) */
+    int *n;         /* ... or an int */
+} scalar;
+
+static int model_scalars(sx_model *m, scalar *s)
+{
+    int n = 0;
+#define D(nm, p) s[n++] = (scalar){nm, p, NULL, NULL, NULL}
+#define I(nm, p) s[n++] = (scalar){nm, NULL, p, NULL, NULL}
+#define B(nm, p) s[n++] = (scalar){nm, NULL, NULL, p, NULL}
+#define N(nm, p) s[n++] = (scalar){nm, NULL, NULL, NULL, p}
+    D("timestep_user", &m->dt_user);
+    D("timestep", &m->dt);
+    D("timestep_prev", &m->dt_prev);
+    D("timestep_safety", &m->dt_safety);
+    B("timestep_stale", &m->dt_stale);
+    D("skin", &m->skin);
+    D("skin_user", &m->skin_user);
+    D("time", &m->time);
+    I("step", &m->step);
+    I("builds", &m->builds);
+    B("build_needed", &m->build_needed);
+    N("threads", &m->threads);
+    I("next_wall_id", &m->next_wall_id);
+    D("guard_energy", &m->guard_e0);
+    D("guard_scale", &m->guard_scale);
+    B("guard_on", &m->guard_on);
+    B("guard_dirty", &m->guard_dirty);
+    B("track_energy", &m->track_energy);
+    D("energy_kinetic", &m->acc.kinetic);
+    D("energy_gravitational", &m->acc.gravitational);
+    D("energy_strain", &m->acc.strain);
+    D("energy_bond_strain", &m->acc.bond_strain);
+    D("energy_slip", &m->acc.slip);
+    D("energy_local_damping", &m->acc.local_damping);
+    D("energy_viscous", &m->acc.viscous);
+    D("energy_boundary_work", &m->acc.boundary_work);
+    D("energy_bond_released", &m->acc.bond_released);
+#undef D
+#undef I
+#undef B
+#undef N
+    return n;
+}
+
+static void write_scalars(sx_h5 *h, hid_t g, sx_model *m)
+{
+    scalar s[40];
+    const int n = model_scalars(m, s);
+    for (int k = 0; k < n; k++) {
+        if (s[k].f) sx_h5_attr_double(h, g, s[k].name, *s[k].f);
+        else if (s[k].i) sx_h5_attr_int(h, g, s[k].name, *s[k].i);
+        else if (s[k].b) sx_h5_attr_int(h, g, s[k].name, *s[k].b ? 1 : 0);
+        else sx_h5_attr_int(h, g, s[k].name, *s[k].n);
+    }
+    sx_h5_attr_f64(h, g, "gravity", m->gravity, (size_t)m->dim, false);
+}
+
+static void read_scalars(sx_h5 *h, hid_t g, sx_model *m)
+{
+    scalar s[40];
+    const int n = model_scalars(m, s);
+    for (int k = 0; k < n; k++) {
+        if (s[k].f) {
+            sx_h5_get_f64(h, g, "/model", s[k].name, s[k].f, 1, true);
+        } else {
+            int64_t v = 0;
+            if (!sx_h5_get_i64(h, g, "/model", s[k].name, &v, 1, true)) return;
+            if (s[k].i) *s[k].i = v;
+            else if (s[k].b) *s[k].b = v != 0;
+            else *s[k].n = v >= -1000000 && v <= 1000000 ? (int)v : -1; /* out of range: caught by the check */
+        }
+    }
+    sx_h5_get_f64(h, g, "/model", "gravity", m->gravity, (size_t)m->dim, true);
+}
+
+/* ----------------------------------------------------------- materials */
+
+static const char *const model_names[] = {"linear", "hertz"};
+static const int model_values[] = {SX_MODEL_LINEAR, SX_MODEL_HERTZ};
+
+/* A material's numbers: its definition, then its BPM parameters. */
+#define MAT_NUMBERS 22
+static const char *const mat_names[MAT_NUMBERS] = {
+    "density", "kn", "ks", "modulus", "stiffness_ratio", "shear_modulus", "poisson", "friction", "damping",
+    "viscous_normal", "viscous_shear",
+    "bond_radius_multiplier", "bond_modulus", "bond_stiffness_ratio", "bond_tensile_strength",
+    "bond_tensile_strength_sd", "bond_cohesion", "bond_cohesion_sd", "bond_normal_strength",
+    "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd"};
+static const char *const mat_units[MAT_NUMBERS] = {
+    "kg/m^3", "N/m", "N/m", "Pa", "1", "Pa", "1", "1", "1", "1", "1",
+    "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N"};
+
+static double *mat_number(sx_material *t, int k)
+{
+    sx_material_def *d = &t->def;
+    sx_bpm_def *b = &t->bpm;
+    double *p[MAT_NUMBERS] = {&d->density, &d->kn, &d->ks, &d->modulus, &d->stiffness_ratio, &d->shear_modulus,
+                              &d->poisson, &d->friction, &d->damping, &d->viscous_normal, &d->viscous_shear,
+                              &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
+                              &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
+                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+    return p[k];
+}
+
+static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
+{
+    hid_t g = sx_h5_group(h, f, "materials");
+    const int n = m->nmat;
+    char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
+    int *model = calloc((size_t)n + 1, sizeof *model);
+    double *col = calloc((size_t)n + 1, sizeof *col);
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, model_names, model_values, 2);
+    hid_t file = sx_h5_enum(H5T_STD_U8LE, model_names, model_values, 2);
+    if (!names || !model || !col || mem < 0 || file < 0) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        for (int i = 0; i < n; i++) {
+            memcpy(names + (size_t)i * sizeof m->mats[0].name, m->mats[i].name, sizeof m->mats[0].name);
+            model[i] = (int)m->mats[i].def.model;
+        }
+        sx_io_write_strings(h, g, "name", names, sizeof m->mats[0].name, n);
+        sx_h5_write(h, g, "model", mem, file, model, n, 1, NULL);
+        for (int k = 0; k < MAT_NUMBERS; k++) {
+            for (int i = 0; i < n; i++) col[i] = *mat_number(&m->mats[i], k);
+            sx_h5_write(h, g, mat_names[k], H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, col, n, 1, mat_units[k]);
+        }
+    }
+    sx_h5_close(mem);
+    sx_h5_close(file);
+    free(names);
+    free(model);
+    free(col);
+    sx_h5_close(g);
+}
+
+static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
+{
+    const int n = m->nmat;
+    char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
+    int *model = calloc((size_t)n + 1, sizeof *model);
+    double *col = calloc((size_t)n + 1, sizeof *col);
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, model_names, model_values, 2);
+    if (!names || !model || !col || mem < 0) {
+        sx_h5_fail(h, "out of memory");
+    } else if (sx_io_read_strings(h, g, "/materials", "name", names, sizeof m->mats[0].name, n) &&
+               sx_h5_read(h, g, "/materials", "model", mem, model, n, 1, true)) {
+        for (int i = 0; i < n; i++) {
+            memcpy(m->mats[i].name, names + (size_t)i * sizeof m->mats[0].name, sizeof m->mats[0].name);
+            m->mats[i].def.model = (sx_contact_model)model[i];
+        }
+        for (int k = 0; k < MAT_NUMBERS && !h->failed; k++)
+            if (sx_h5_read(h, g, "/materials", mat_names[k], H5T_NATIVE_DOUBLE, col, n, 1, true))
+                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], k) = col[i];
+    }
+    sx_h5_close(mem);
+    free(names);
+    free(model);
+    free(col);
+}
+
+/* --------------------------------------------------------------- walls */
+
+static const char *const wall_kind_names[] = {"plane", "line", "rect", "segment"};
+static const int wall_kind_values[] = {SX_WALL_PLANE, SX_WALL_LINE, SX_WALL_RECT, SX_WALL_SEGMENT};
+
+/* The walls' arrays, gathered from (or scattered to) the array of structs. */
+typedef struct wall_cols {
+    int64_t *id;
+    int *kind;
+    double *point, *normal, *edge1, *edge2, *vel, *kn, *ks, *friction;
+    double *u, *v, *len_u, *len_v, *seg_len, *force, *moment, *moved;
+} wall_cols;
+
+static bool wall_cols_alloc(wall_cols *c, int64_t n)
+{
+    memset(c, 0, sizeof *c);
+    const size_t k = (size_t)(n > 0 ? n : 1);
+    c->id = calloc(k, sizeof *c->id);
+    c->kind = calloc(k, sizeof *c->kind);
+    double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment};
+    double **sc[] = {&c->kn, &c->ks, &c->friction, &c->len_u, &c->len_v, &c->seg_len, &c->moved};
+    bool ok = c->id && c->kind;
+    for (size_t i = 0; i < sizeof vec / sizeof *vec; i++) ok &= (*vec[i] = calloc(3 * k, sizeof(double))) != NULL;
+    for (size_t i = 0; i < sizeof sc / sizeof *sc; i++) ok &= (*sc[i] = calloc(k, sizeof(double))) != NULL;
+    return ok;
+}
+
+static void wall_cols_free(wall_cols *c)
+{
+    void *p[] = {c->id, c->kind, c->point, c->normal, c->edge1, c->edge2, c->vel, c->kn, c->ks, c->friction,
+                 c->u, c->v, c->len_u, c->len_v, c->seg_len, c->force, c->moment, c->moved};
+    for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
+}
+
+/* Vectors of dim components (the moment: rdim); scalars one. */
+static int wall_fields(const sx_model *m, const wall_cols *c, field *f)
+{
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = F("point", T_F64, c->point, d, "m");
+    f[n++] = F("normal", T_F64, c->normal, d, "1");
+    f[n++] = F("edge1", T_F64, c->edge1, d, "m");
+    f[n++] = F("edge2", T_F64, c->edge2, d, "m");
+    f[n++] = F("velocity", T_F64, c->vel, d, "m/s");
+    f[n++] = F("kn", T_F64, c->kn, 1, "N/m");
+    f[n++] = F("ks", T_F64, c->ks, 1, "N/m");
+    f[n++] = F("friction", T_F64, c->friction, 1, "1");
+    f[n++] = F("frame_u", T_F64, c->u, d, "1");
+    f[n++] = F("frame_v", T_F64, c->v, d, "1");
+    f[n++] = F("length_u", T_F64, c->len_u, 1, "m");
+    f[n++] = F("length_v", T_F64, c->len_v, 1, "m");
+    f[n++] = F("segment_length", T_F64, c->seg_len, 1, "m");
+    f[n++] = F("force", T_F64, c->force, d, "N");
+    f[n++] = F("moment", T_F64, c->moment, r, "N m");
+    f[n++] = F("moved", T_F64, c->moved, 1, "m");
+    return n;
+}
+
+static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bool to_cols)
+{
+    const int d = m->dim, r = m->rdim;
+#define V(arr, fld, k)                                                       \
+    do {                                                                     \
+        for (int j = 0; j < (k); j++) {                                      \
+            if (to_cols) c->arr[i * (k) + j] = fld[j];                       \
+            else fld[j] = c->arr[i * (k) + j];                               \
+        }                                                                    \
+    } while (0)
+#define S(arr, fld)                              \
+    do {                                         \
+        if (to_cols) c->arr[i] = fld;            \
+        else fld = c->arr[i];                    \
+    } while (0)
+    V(point, w->def.point, d);
+    V(normal, w->def.normal, d);
+    V(edge1, w->def.edge1, d);
+    V(edge2, w->def.edge2, d);
+    V(vel, w->def.vel, d);
+    V(u, w->u, d);
+    V(v, w->v, d);
+    V(force, w->force, d);
+    V(moment, w->moment, r);
+    S(kn, w->def.kn);
+    S(ks, w->def.ks);
+    S(friction, w->def.friction);
+    S(len_u, w->len_u);
+    S(len_v, w->len_v);
+    S(seg_len, w->seg_len);
+    S(moved, w->moved);
+    S(id, w->id);
+    if (to_cols) c->kind[i] = (int)w->def.kind;
+    else w->def.kind = (sx_wall_kind)c->kind[i];
+#undef V
+#undef S
+}
+
+static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
+{
+    hid_t g = sx_h5_group(h, f, "walls");
+    const int64_t n = m->nwall;
+    wall_cols c;
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, 4);
+    hid_t file = sx_h5_enum(H5T_STD_U8LE, wall_kind_names, wall_kind_values, 4);
+    if (!wall_cols_alloc(&c, n) || mem < 0 || file < 0) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        for (int64_t i = 0; i < n; i++) wall_copy(m, &m->walls[i], &c, i, true);
+        sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, c.id, n, 1, NULL);
+        sx_h5_write(h, g, "kind", mem, file, c.kind, n, 1, NULL);
+        field fl[MAX_FIELDS];
+        write_fields(h, g, fl, wall_fields(m, &c, fl), n);
+    }
+    wall_cols_free(&c);
+    sx_h5_close(mem);
+    sx_h5_close(file);
+    sx_h5_close(g);
+}
+
+static void load_walls(sx_h5 *h, hid_t g, sx_model *m)
+{
+    const int64_t n = m->nwall;
+    wall_cols c;
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, 4);
+    if (!wall_cols_alloc(&c, n) || mem < 0) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        field fl[MAX_FIELDS];
+        sx_h5_read(h, g, "/walls", "id", H5T_NATIVE_INT64, c.id, n, 1, true);
+        sx_h5_read(h, g, "/walls", "kind", mem, c.kind, n, 1, true);
+        if (read_fields(h, g, "/walls", fl, wall_fields(m, &c, fl), n))
+            for (int64_t i = 0; i < n; i++) wall_copy(m, &m->walls[i], &c, i, false);
+    }
+    wall_cols_free(&c);
+    sx_h5_close(mem);
+}
+
+/* -------------------------------------------------------------- cracks */
+
+static const char *const mode_names[] = {"tension", "shear"};
+static const int mode_values[] = {SX_CRACK_TENSION, SX_CRACK_SHEAR};
+static const char *const bond_kind_names[] = {"contact", "parallel"};
+static const int bond_kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL};
+
+typedef struct crack_cols {
+    double *time, *pos, *fn, *fs, *mn, *ms;
+    int64_t *step, *a, *b;
+    int *mode, *kind;
+} crack_cols;
+
+static bool crack_cols_alloc(crack_cols *c, int64_t n)
+{
+    const size_t k = (size_t)(n > 0 ? n : 1);
+    c->time = calloc(k, sizeof(double));
+    c->pos = calloc(3 * k, sizeof(double));
+    c->fn = calloc(k, sizeof(double));
+    c->fs = calloc(k, sizeof(double));
+    c->mn = calloc(k, sizeof(double));
+    c->ms = calloc(k, sizeof(double));
+    c->step = calloc(k, sizeof(int64_t));
+    c->a = calloc(k, sizeof(int64_t));
+    c->b = calloc(k, sizeof(int64_t));
+    c->mode = calloc(k, sizeof(int));
+    c->kind = calloc(k, sizeof(int));
+    return c->time && c->pos && c->fn && c->fs && c->mn && c->ms && c->step && c->a && c->b && c->mode && c->kind;
+}
+
+static void crack_cols_free(crack_cols *c)
+{
+    void *p[] = {c->time, c->pos, c->fn, c->fs, c->mn, c->ms, c->step, c->a, c->b, c->mode, c->kind};
+    for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
+}
+
+/* Reads (write = false) or writes the crack log through its columns. */
+static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
+{
+    const int64_t n = m->cracks.n;
+    const int d = m->dim;
+    crack_cols c;
+    hid_t mm = sx_h5_enum(H5T_NATIVE_INT, mode_names, mode_values, 2);
+    hid_t mf = sx_h5_enum(H5T_STD_U8LE, mode_names, mode_values, 2);
+    hid_t km = sx_h5_enum(H5T_NATIVE_INT, bond_kind_names, bond_kind_values, 2);
+    hid_t kf = sx_h5_enum(H5T_STD_U8LE, bond_kind_names, bond_kind_values, 2);
+    if (!crack_cols_alloc(&c, n) || mm < 0 || mf < 0 || km < 0 || kf < 0) {
+        sx_h5_fail(h, "out of memory");
+        goto done;
+    }
+    if (write)
+        for (int64_t i = 0; i < n; i++) {
+            const sx_crack *e = &m->cracks.ev[i];
+            c.time[i] = e->time, c.step[i] = e->step, c.a[i] = e->a, c.b[i] = e->b;
+            c.fn[i] = e->fn, c.fs[i] = e->fs, c.mn[i] = e->mn, c.ms[i] = e->ms;
+            c.mode[i] = (int)e->mode, c.kind[i] = (int)e->kind;
+            for (int k = 0; k < d; k++) c.pos[i * d + k] = e->pos[k];
+        }
+    struct {
+        const char *name;
+        hid_t mem, file;
+        void *data;
+        int per;
+        const char *units;
+    } cols[] = {
+        {"time", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.time, 1, "s"},
+        {"step", H5T_NATIVE_INT64, H5T_STD_I64LE, c.step, 1, NULL},
+        {"position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.pos, d, "m"},
+        {"mode", mm, mf, c.mode, 1, NULL},
+        {"kind", km, kf, c.kind, 1, NULL},
+        {"ball_a", H5T_NATIVE_INT64, H5T_STD_I64LE, c.a, 1, NULL},
+        {"ball_b", H5T_NATIVE_INT64, H5T_STD_I64LE, c.b, 1, NULL},
+        {"normal_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.fn, 1, "N"},
+        {"shear_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.fs, 1, "N"},
+        {"twist_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.mn, 1, "N m"},
+        {"bending_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.ms, 1, "N m"},
+    };
+    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) {
+        if (write) sx_h5_write(h, g, cols[k].name, cols[k].mem, cols[k].file, cols[k].data, n, cols[k].per, cols[k].units);
+        else sx_h5_read(h, g, "/cracks", cols[k].name, cols[k].mem, cols[k].data, n, cols[k].per, true);
+    }
+    if (!write && !h->failed)
+        for (int64_t i = 0; i < n; i++) {
+            sx_crack *e = &m->cracks.ev[i];
+            memset(e, 0, sizeof *e);
+            e->time = c.time[i], e->step = c.step[i], e->a = c.a[i], e->b = c.b[i];
+            e->fn = c.fn[i], e->fs = c.fs[i], e->mn = c.mn[i], e->ms = c.ms[i];
+            e->mode = (sx_crack_mode)c.mode[i], e->kind = (sx_bond_kind)c.kind[i];
+            for (int k = 0; k < d; k++) e->pos[k] = c.pos[i * d + k];
+        }
+done:
+    crack_cols_free(&c);
+    sx_h5_close(mm);
+    sx_h5_close(mf);
+    sx_h5_close(km);
+    sx_h5_close(kf);
+}
+
+/* ---------------------------------------------------------------- save */
+
+static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
+{
+    sx_io_write_provenance(h, f, "snapshot", m->dim, o ? &o->provenance : NULL);
+    sx_h5_attr_double(h, f, "time", m->time);
+    sx_h5_attr_int(h, f, "step", m->step);
+    char hash[17];
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)sx_model_state_hash(m));
+    sx_h5_attr_str(h, f, "state_hash", hash); /* for comparing runs; not checked on load */
+
+    hid_t g = sx_h5_group(h, f, "model");
+    write_scalars(h, g, m);
+    sx_h5_close(g);
+    save_materials(h, f, m);
+
+    field fl[MAX_FIELDS];
+    g = sx_h5_group(h, f, "balls");
+    sx_h5_attr_int(h, g, "count", m->balls.n);
+    sx_h5_attr_int(h, g, "next_id", m->balls.next_id < 1 ? 1 : m->balls.next_id);
+    write_fields(h, g, fl, ball_fields(m, fl), m->balls.n);
+    sx_h5_close(g);
+
+    g = sx_h5_group(h, f, "contacts");
+    hid_t p = sx_h5_group(h, g, "ball_ball");
+    sx_h5_attr_int(h, p, "count", m->bb.n);
+    write_fields(h, p, fl, pair_fields(m, &m->bb, fl), m->bb.n);
+    sx_h5_close(p);
+    p = sx_h5_group(h, g, "ball_wall");
+    sx_h5_attr_int(h, p, "count", m->bw.n);
+    write_fields(h, p, fl, pair_fields(m, &m->bw, fl), m->bw.n);
+    sx_h5_close(p);
+    sx_h5_close(g);
+
+    g = sx_h5_group(h, f, "bonds");
+    sx_h5_attr_int(h, g, "count", m->bonds.n);
+    sx_h5_attr_int(h, g, "intact", m->bonds.intact);
+    write_fields(h, g, fl, bond_fields(m, fl), m->bonds.n);
+    sx_h5_close(g);
+
+    g = sx_h5_group(h, f, "cracks");
+    sx_h5_attr_int(h, g, "count", m->cracks.n);
+    crack_io(h, g, m, true);
+    sx_h5_close(g);
+
+    save_walls(h, f, m);
+
+    if (o && o->ntrees > 0) {
+        g = sx_h5_group(h, f, "lua");
+        for (int k = 0; k < o->ntrees; k++) sx_io_write_tree(h, g, o->trees[k].name, &o->trees[k].tree);
+        sx_h5_close(g);
+    }
+}
+
+sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapshot_opts *opts, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, path, err, errlen);
+    h.compression = opts && opts->compression > 0 ? (opts->compression > 9 ? 9 : opts->compression) : 0;
+    char tmp[4096];
+    if (!path || !*path) {
+        sx_h5_fail(&h, "an empty path");
+    } else if (!sx_h5_temp_name(path, tmp, sizeof tmp)) {
+        sx_h5_fail(&h, "the path is too long");
+    } else {
+        hid_t fapl = sx_h5_fapl(true);
+        hid_t fcpl = sx_h5_fcpl();
+        hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
+        if (f < 0) sx_h5_fail_h5(&h, "cannot create a file in its folder");
+        sx_h5_close(fapl);
+        sx_h5_close(fcpl);
+        if (f >= 0) {
+            /* the model is only read; the arrays are taken as they are */
+            save_all(&h, f, (sx_model *)m, opts);
+            if (H5Fclose(f) < 0) sx_h5_fail_h5(&h, "cannot complete the file");
+            if (!h.failed) sx_h5_commit(&h, tmp, path);
+            if (h.failed) remove(tmp);
+        }
+    }
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    return failed ? SX_EINVAL : SX_OK;
+}
+
+/* ---------------------------------------------------------------- load */
+
+/* The sizes of every store, from the file's datasets (their row counts
+ * are what the reads below check against). */
+static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
+{
+    memset(s, 0, sizeof *s);
+    hid_t g = sx_h5_open_group(h, f, "/balls", true);
+    if (g < 0) return false;
+    s->balls = sx_h5_rows(h, g, "/balls", "id", 1, true);
+    sx_h5_get_i64(h, g, "/balls", "next_id", &s->next_ball_id, 1, true);
+    s->applied = H5Lexists(g, "applied_force", H5P_DEFAULT) > 0;
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/contacts/ball_ball", true);
+    s->bb = sx_h5_rows(h, g, "/contacts/ball_ball", "a", 1, true);
+    s->bb_bonds = g >= 0 && H5Lexists(g, "bond", H5P_DEFAULT) > 0;
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/contacts/ball_wall", true);
+    s->bw = sx_h5_rows(h, g, "/contacts/ball_wall", "a", 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/bonds", true);
+    s->bonds = sx_h5_rows(h, g, "/bonds", "kind", 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/cracks", true);
+    s->cracks = sx_h5_rows(h, g, "/cracks", "time", 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/walls", true);
+    s->walls = sx_h5_rows(h, g, "/walls", "id", 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/materials", true);
+    const int64_t nm = sx_h5_rows(h, g, "/materials", "name", 1, true);
+    sx_h5_close(g);
+    s->materials = nm >= 0 && nm <= UINT16_MAX ? (int)nm : -1;
+    (void)d;
+    return !h->failed;
+}
+
+/* Reads one group's fields. */
+static void load_group(sx_h5 *h, hid_t f, const char *path, const field *fl, int nf, int64_t rows)
+{
+    hid_t g = sx_h5_open_group(h, f, path, true);
+    if (g >= 0) read_fields(h, g, path, fl, nf, rows);
+    sx_h5_close(g);
+}
+
+static void load_trees(sx_h5 *h, hid_t f, sx_snapshot_info *info)
+{
+    if (H5Lexists(f, "/lua", H5P_DEFAULT) <= 0) return;
+    hid_t g = sx_h5_open_group(h, f, "/lua", true);
+    H5G_info_t gi;
+    if (g < 0 || H5Gget_info(g, &gi) < 0) {
+        sx_h5_fail_h5(h, "damaged: cannot list /lua");
+        sx_h5_close(g);
+        return;
+    }
+    if (gi.nlinks > 1024) {
+        sx_h5_fail(h, "damaged: /lua lists %llu entries", (unsigned long long)gi.nlinks);
+        sx_h5_close(g);
+        return;
+    }
+    info->trees = calloc(gi.nlinks + 1, sizeof *info->trees);
+    if (!info->trees) sx_h5_fail(h, "out of memory");
+    for (hsize_t k = 0; k < gi.nlinks && !h->failed; k++) {
+        sx_io_named_tree *t = &info->trees[info->ntrees];
+        const ssize_t len = H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, k, t->name, sizeof t->name,
+                                               H5P_DEFAULT);
+        if (len < 0 || (size_t)len >= sizeof t->name) {
+            sx_h5_fail(h, "damaged: a name in /lua is unreadable or too long");
+            break;
+        }
+        if (sx_io_read_tree(h, g, "/lua", t->name, &t->tree)) info->ntrees++;
+    }
+    sx_h5_close(g);
+}
+
+sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *info, char *err, size_t errlen)
+{
+    sx_h5 h;
+    sx_h5_begin(&h, path ? path : "", err, errlen);
+    sx_snapshot_info local;
+    if (!info) info = &local;
+    memset(info, 0, sizeof *info);
+    sx_model *m = NULL;
+    int d = 0, version = 0;
+    hid_t f = path && *path ? sx_io_open(&h, path, false, "snapshot", want_dim, &d, &version)
+                            : (sx_h5_fail(&h, "an empty path"), -1);
+    sx_state_sizes s;
+    if (f >= 0 && read_sizes(&h, f, d, &s)) {
+        sx_model_def def = sx_model_default_def();
+        def.dim = d;
+        char cerr[256];
+        m = sx_model_create(&def, cerr, sizeof cerr);
+        if (!m) sx_h5_fail(&h, "%s", cerr);
+        else if (sx__state_alloc(m, &s)) sx_h5_fail(&h, "damaged or too large: %s", sx_model_error(m));
+    }
+    if (m && !h.failed) {
+        info->format_version = version;
+        sx_h5_get_str(f, "seixo_version", info->seixo_version, sizeof info->seixo_version);
+        sx_h5_get_str(f, "git_commit", info->git_commit, sizeof info->git_commit);
+        sx_h5_get_str(f, "script", info->script, sizeof info->script);
+        sx_h5_get_str(f, "script_sha256", info->script_sha256, sizeof info->script_sha256);
+
+        hid_t g = sx_h5_open_group(&h, f, "/model", true);
+        if (g >= 0) read_scalars(&h, g, m);
+        sx_h5_close(g);
+        g = sx_h5_open_group(&h, f, "/materials", true);
+        if (g >= 0) load_materials(&h, g, m);
+        sx_h5_close(g);
+
+        field fl[MAX_FIELDS];
+        load_group(&h, f, "/balls", fl, ball_fields(m, fl), m->balls.n);
+        load_group(&h, f, "/contacts/ball_ball", fl, pair_fields(m, &m->bb, fl), m->bb.n);
+        load_group(&h, f, "/contacts/ball_wall", fl, pair_fields(m, &m->bw, fl), m->bw.n);
+        load_group(&h, f, "/bonds", fl, bond_fields(m, fl), m->bonds.n);
+        g = sx_h5_open_group(&h, f, "/cracks", true);
+        if (g >= 0) crack_io(&h, g, m, false);
+        sx_h5_close(g);
+        g = sx_h5_open_group(&h, f, "/walls", true);
+        if (g >= 0) load_walls(&h, g, m);
+        sx_h5_close(g);
+        load_trees(&h, f, info);
+        if (!h.failed && sx__state_finish(m)) sx_h5_fail(&h, "damaged: %s", sx_model_error(m));
+    }
+    if (f >= 0 && H5Fclose(f) < 0) sx_h5_fail_h5(&h, "cannot close the file");
+    const bool failed = h.failed;
+    sx_h5_end(&h);
+    if (failed) {
+        sx_model_destroy(m);
+        sx_snapshot_info_free(info);
+        return NULL;
+    }
+    if (info == &local) sx_snapshot_info_free(info);
+    if (m) m->err[0] = 0;
+    return m;
+}
+
+void sx_snapshot_info_free(sx_snapshot_info *info)
+{
+    if (!info) return;
+    for (int k = 0; k < info->ntrees; k++) sx_io_tree_free(&info->trees[k].tree);
+    free(info->trees);
+    info->trees = NULL;
+    info->ntrees = 0;
+}

@@ -1,0 +1,887 @@
+/* m:generate{...}: assemblies of balls in a region, reproducible from a seed.
+ *
+ * Methods:
+ *   random      non-overlapping random placement (with the balls already
+ *               there too), largest first; a clear error when a ball finds
+ *               no room after `tries` attempts. `count` or `porosity`.
+ *   distribute  PFC's ball distribute: radii up to the target porosity,
+ *               centres placed at random with overlaps, then relaxed.
+ *               Overlaps above a fifth of the smaller radius are first
+ *               pushed apart geometrically (the core's stability guard
+ *               refuses overlaps beyond a radius), then the model cycles
+ *               with the user's materials, gravity off and velocities
+ *               zeroed every `calm` steps, until the mean unbalanced-force
+ *               ratio reaches relax.ratio or relax.steps have run.
+ *   expand      PFC's radius expansion: non-overlapping placement at
+ *               reduced radii, then growth by stages of at most 2 % to
+ *               the radii of the target porosity, cycling between stages,
+ *               then the same relaxation.
+ *   lattice     regular packings of touching balls: square or hex (2D),
+ *               cubic or fcc (3D); every site whose ball lies in the region.
+ * Radii: `radius = r` or `{rmin, rmax}` with distribution "uniform"
+ * (default) or "normal" (mean, std; truncated to [rmin, rmax]). When both
+ * count and porosity are given (distribute, expand), the drawn radii are
+ * scaled by one factor to reach the porosity exactly.
+ *
+ * The RNG is xoshiro256** seeded through splitmix64: the same seed and
+ * arguments give bit-identical assemblies on every run. Overlap checks go
+ * through a uniform cell grid of the region, so placement is O(N). Every
+ * working array is a Lua userdata: an error anywhere frees them. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bindings.h"
+
+enum { MAX_GENERATE = 10000000 };
+
+/* ------------------------------------------------------------------ RNG */
+
+typedef struct rng {
+    uint64_t s[4];
+} rng;
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static void rng_seed(rng *r, uint64_t seed)
+{
+    for (int i = 0; i < 4; i++) r->s[i] = splitmix64(&seed);
+}
+
+static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+static uint64_t rng_next(rng *r)
+{
+    uint64_t *s = r->s;
+    const uint64_t out = rotl(s[1] * 5, 7) * 9;
+    const uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return out;
+}
+
+/* uniform in [0, 1) */
+static double rng_uniform(rng *r) { return (double)(rng_next(r) >> 11) * 0x1.0p-53; }
+
+/* standard normal (Box-Muller, one value per call) */
+static double rng_normal(rng *r)
+{
+    const double u = 1 - rng_uniform(r);  // (0, 1]
+    const double v = rng_uniform(r);
+    return sqrt(-2 * log(u)) * cos(2 * SX_LUA_PI * v);
+}
+
+/* ------------------------------------------------------------ parameters */
+
+enum { M_RANDOM, M_DISTRIBUTE, M_EXPAND, M_LATTICE };
+static const char *const method_names[] = {"random", "distribute", "expand", "lattice", NULL};
+enum { P_SQUARE, P_HEX, P_CUBIC, P_FCC };
+static const char *const packing_names[] = {"square", "hex", "cubic", "fcc", NULL};
+enum { D_UNIFORM, D_NORMAL };
+static const char *const dist_names[] = {"uniform", "normal", NULL};
+
+typedef struct gen {
+    int dim, method, packing, dist, material;
+    int32_t group;
+    int64_t count, tries;
+    bool has_count, has_porosity;
+    double porosity, rmin, rmax, mean, std;
+    sx_lua_region region;
+    uint64_t seed;
+    bool relax;
+    int64_t relax_steps, calm;
+    double relax_ratio;
+} gen;
+
+static double ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_LUA_PI * r * r * r : SX_LUA_PI * r * r; }
+
+static void read_radius(lua_State *L, gen *g)
+{
+    lua_pushliteral(L, "radius");
+    const int t = lua_rawget(L, 2);
+    if (t == LUA_TNUMBER) {
+        g->rmin = g->rmax = lua_tonumber(L, -1);
+    } else if (t == LUA_TTABLE && lua_rawlen(L, -1) == 2) {
+        lua_rawgeti(L, -1, 1);
+        lua_rawgeti(L, -2, 2);
+        if (!lua_isnumber(L, -2) || !lua_isnumber(L, -1) || lua_type(L, -1) != LUA_TNUMBER || lua_type(L, -2) != LUA_TNUMBER)
+            sx_lua_fielderror(L, 2, "radius", "two numbers {rmin, rmax} expected");
+        g->rmin = lua_tonumber(L, -2);
+        g->rmax = lua_tonumber(L, -1);
+        lua_pop(L, 2);
+    } else if (t == LUA_TNIL) {
+        sx_lua_fielderror(L, 2, "radius", "is required: a radius r or a range {rmin, rmax} in m");
+    } else {
+        sx_lua_fielderror(L, 2, "radius", lua_pushfstring(L, "a number or {rmin, rmax} expected, got %s", lua_typename(L, t)));
+    }
+    lua_pop(L, 1);
+    if (!(g->rmin > 0 && g->rmax >= g->rmin && isfinite(g->rmax)))
+        sx_lua_fielderror(L, 2, "radius", "radii must be finite, > 0, and rmin <= rmax");
+}
+
+static void read_relax(lua_State *L, gen *g)
+{
+    static const char *const keys[] = {"steps", "ratio", "calm", NULL};
+    g->relax = true;
+    g->relax_steps = 20000;
+    g->relax_ratio = 1e-3;
+    g->calm = 10;
+    lua_pushliteral(L, "relax");
+    const int t = lua_rawget(L, 2);
+    if (t == LUA_TBOOLEAN) {
+        g->relax = lua_toboolean(L, -1);
+    } else if (t == LUA_TTABLE) {
+        const int r = lua_gettop(L);
+        sx_lua_checksubkeys(L, r, 2, "relax", keys);
+        sx_lua_optintfield(L, r, "steps", 0, 1000000000, &g->relax_steps);
+        sx_lua_optintfield(L, r, "calm", 1, 1000000, &g->calm);
+        if (sx_lua_optnumfield(L, r, "ratio", &g->relax_ratio) && !(g->relax_ratio > 0))
+            sx_lua_fielderror(L, 2, "relax", "'ratio' must be > 0");
+    } else if (t != LUA_TNIL) {
+        sx_lua_fielderror(L, 2, "relax", lua_pushfstring(L, "boolean or {steps =, ratio =, calm =} expected, got %s",
+                                                         lua_typename(L, t)));
+    }
+    lua_pop(L, 1);
+}
+
+static int pick(lua_State *L, const char *key, const char *const names[], int dflt)
+{
+    const char *s = sx_lua_optstrfield(L, 2, key);
+    if (!s) return dflt;
+    const int i = sx_lua_find(s, names);
+    if (i < 0) {
+        sx_lua_pushlist(L, names);
+        sx_lua_fielderror(L, 2, key, lua_pushfstring(L, "unknown '%s' (valid: %s)", s, lua_tostring(L, -1)));
+    }
+    return i;
+}
+
+/* Reads the arguments; leaves the region's storage (if any) on the stack. */
+static void read_gen(lua_State *L, const sx_model *m, gen *g)
+{
+    static const char *const keys[] = {"count", "porosity", "radius", "distribution", "mean",   "std",   "region",
+                                       "seed",  "material", "group",  "method",       "packing", "tries", "relax",
+                                       NULL};
+    sx_lua_checkkeys(L, 2, keys);
+    memset(g, 0, sizeof *g);
+    g->dim = sx_model_dim(m);
+    g->packing = pick(L, "packing", packing_names, -1);
+    g->method = pick(L, "method", method_names, g->packing >= 0 ? M_LATTICE : M_RANDOM);
+    if (g->packing >= 0 && g->method != M_LATTICE) sx_lua_fielderror(L, 2, "packing", "only for method = 'lattice'");
+    if (g->method == M_LATTICE) {
+        if (g->packing < 0) g->packing = g->dim == 2 ? P_HEX : P_FCC;
+        if ((g->packing <= P_HEX) != (g->dim == 2))
+            sx_lua_fielderror(L, 2, "packing", g->dim == 2 ? "'square' or 'hex' in 2D" : "'cubic' or 'fcc' in 3D");
+    }
+    read_radius(L, g);
+    g->dist = pick(L, "distribution", dist_names, D_UNIFORM);
+    g->mean = 0.5 * (g->rmin + g->rmax);
+    g->std = (g->rmax - g->rmin) / 6;
+    const bool has_mean = sx_lua_optnumfield(L, 2, "mean", &g->mean), has_std = sx_lua_optnumfield(L, 2, "std", &g->std);
+    if ((has_mean || has_std) && g->dist != D_NORMAL)
+        sx_lua_fielderror(L, 2, has_mean ? "mean" : "std", "only for distribution = 'normal'");
+    if (g->dist == D_NORMAL) {
+        if (!(g->mean >= g->rmin && g->mean <= g->rmax)) sx_lua_fielderror(L, 2, "mean", "must lie in [rmin, rmax]");
+        if (!(g->std >= 0 && isfinite(g->std))) sx_lua_fielderror(L, 2, "std", "must be finite and >= 0");
+    }
+    g->has_count = sx_lua_optintfield(L, 2, "count", 0, MAX_GENERATE, &g->count);
+    g->has_porosity = sx_lua_optnumfield(L, 2, "porosity", &g->porosity);
+    if (g->has_porosity && !(g->porosity > 0 && g->porosity < 1))
+        sx_lua_fielderror(L, 2, "porosity", "must lie in (0, 1)");
+    switch (g->method) {
+    case M_RANDOM:
+        if (g->has_count == g->has_porosity) luaL_argerror(L, 2, "give 'count' or 'porosity' (one of them)");
+        break;
+    case M_DISTRIBUTE:
+    case M_EXPAND:
+        if (!g->has_porosity) luaL_argerror(L, 2, lua_pushfstring(L, "field 'porosity' is required by method '%s'",
+                                                                  method_names[g->method]));
+        break;
+    case M_LATTICE:
+        if (g->has_porosity) sx_lua_fielderror(L, 2, "porosity", "a lattice's porosity follows from its packing");
+        if (g->rmin != g->rmax) sx_lua_fielderror(L, 2, "radius", "a lattice takes one radius");
+        break;
+    }
+    int64_t seed = 1;
+    sx_lua_optintfield(L, 2, "seed", 0, (int64_t)1 << 53, &seed);
+    g->seed = (uint64_t)seed;
+    g->tries = 10000;
+    sx_lua_optintfield(L, 2, "tries", 1, 100000000, &g->tries);
+    read_relax(L, g);
+    g->material = sx_lua_material_arg(L, m, 2, "material", sx_lua_optstrfield(L, 2, "material"));
+    const char *group = sx_lua_optstrfield(L, 2, "group");
+    if (group) g->group = sx_lua_group_id(L, 1, group, true);
+    lua_pushliteral(L, "region");
+    if (lua_rawget(L, 2) == LUA_TNIL) luaL_argerror(L, 2, "field 'region' is required");
+    const int top = lua_gettop(L);
+    sx_lua_region_read(L, top, g->dim, 2, "region", &g->region);
+    lua_remove(L, top);  // the table; the polygon's storage, if any, stays
+}
+
+/* --------------------------------------------------------------- radii */
+
+static double draw_radius(lua_State *L, const gen *g, rng *r)
+{
+    if (g->rmin == g->rmax) return g->rmin;
+    if (g->dist == D_UNIFORM) return g->rmin + (g->rmax - g->rmin) * rng_uniform(r);
+    for (int k = 0; k < 100000; k++) {
+        const double x = g->mean + g->std * rng_normal(r);
+        if (x >= g->rmin && x <= g->rmax) return x;
+    }
+    luaL_argerror(L, 2, "the normal distribution (mean, std) almost never falls in [rmin, rmax]");
+    return 0;
+}
+
+/* Draws the radii: `count` of them, or as many as the porosity takes;
+ * scaled to the porosity when both are given. Pushes their storage. */
+static double *draw_radii(lua_State *L, gen *g, rng *r)
+{
+    const double target = g->has_porosity ? (1 - g->porosity) * g->region.volume : 0;
+    if (!g->has_count) {
+        /* count the balls first, with a copy of the generator, so one array suffices */
+        rng probe = *r;
+        double solid = 0;
+        int64_t n = 0;
+        while (solid < target) {
+            if (n >= MAX_GENERATE)
+                luaL_argerror(L, 2, lua_pushfstring(L, "this porosity needs more than %d balls of these radii", MAX_GENERATE));
+            solid += ball_volume(g->dim, draw_radius(L, g, &probe));
+            n++;
+        }
+        g->count = n;
+    }
+    double *rad = lua_newuserdatauv(L, (size_t)(g->count > 0 ? g->count : 1) * sizeof *rad, 0);
+    double solid = 0;
+    for (int64_t i = 0; i < g->count; i++) {
+        rad[i] = draw_radius(L, g, r);
+        solid += ball_volume(g->dim, rad[i]);
+    }
+    if (g->has_count && g->has_porosity && g->count > 0) {
+        const double k = pow(target / solid, 1.0 / g->dim);
+        for (int64_t i = 0; i < g->count; i++) rad[i] *= k;
+        g->rmin *= k;
+        g->rmax *= k;
+    }
+    return rad;
+}
+
+/* ---------------------------------------------------------------- grid */
+
+/* A uniform cell grid over the balls at x[i*3], r[i]; cell size h >= the
+ * largest sum of two radii, so that a ball's neighbours are in the 3^dim
+ * cells around its own. */
+typedef struct grid {
+    int dim;
+    double lo[3], h;
+    int64_t n[3], ncell;
+    int64_t *head, *next;  // per cell, per ball; -1 ends a list
+    double *x, *r;         // 3 per ball, 1 per ball
+    int64_t count, cap;
+} grid;
+
+static int64_t cell_coord(const grid *gr, int k, double v)
+{
+    double c = floor((v - gr->lo[k]) / gr->h);
+    if (!(c >= 0)) c = 0;  // also NaN
+    if (c > (double)(gr->n[k] - 1)) c = (double)(gr->n[k] - 1);
+    return (int64_t)c;
+}
+
+static int64_t cell_of(const grid *gr, const double *x)
+{
+    int64_t c = 0;
+    for (int k = gr->dim - 1; k >= 0; k--) c = c * gr->n[k] + cell_coord(gr, k, x[k]);
+    return c;
+}
+
+/* Pushes the grid's storage (two userdata) over the box [lo, hi] for cap balls. */
+static void grid_init(lua_State *L, grid *gr, int dim, const double *lo, const double *hi, double h, int64_t cap)
+{
+    memset(gr, 0, sizeof *gr);
+    gr->dim = dim;
+    gr->cap = cap;
+    const double target = fmax(1024.0, 2.0 * (double)cap);
+    for (;;) {
+        double cells = 1;
+        for (int k = 0; k < dim; k++) cells *= floor((hi[k] - lo[k]) / h) + 3;
+        if (cells <= target) break;
+        h *= pow(cells / target, 1.0 / dim) * 1.01;
+    }
+    gr->h = h;
+    gr->ncell = 1;
+    for (int k = 0; k < dim; k++) {
+        gr->lo[k] = lo[k] - h;
+        gr->n[k] = (int64_t)floor((hi[k] - lo[k]) / h) + 3;
+        gr->ncell *= gr->n[k];
+    }
+    gr->head = lua_newuserdatauv(L, (size_t)gr->ncell * sizeof *gr->head, 0);
+    for (int64_t c = 0; c < gr->ncell; c++) gr->head[c] = -1;
+    char *mem = lua_newuserdatauv(L, (size_t)(cap > 0 ? cap : 1) * (sizeof(int64_t) + 4 * sizeof(double)), 0);
+    gr->next = (int64_t *)mem;
+    gr->x = (double *)(mem + (size_t)(cap > 0 ? cap : 1) * sizeof(int64_t));
+    gr->r = gr->x + 3 * (cap > 0 ? cap : 1);
+}
+
+static void grid_add(grid *gr, const double *x, double r)
+{
+    const int64_t i = gr->count++;
+    for (int k = 0; k < 3; k++) gr->x[3 * i + k] = k < gr->dim ? x[k] : 0;
+    gr->r[i] = r;
+    const int64_t c = cell_of(gr, x);
+    gr->next[i] = gr->head[c];
+    gr->head[c] = i;
+}
+
+/* Calls fn(i, ud) for every ball in the cells around x; stops when fn returns true. */
+static bool grid_near(const grid *gr, const double *x, bool (*fn)(const grid *, int64_t, void *), void *ud)
+{
+    int64_t c0[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int k = 0; k < gr->dim; k++) {
+        c0[k] = cell_coord(gr, k, x[k]);
+        lo[k] = c0[k] > 0 ? c0[k] - 1 : 0;
+        hi[k] = c0[k] < gr->n[k] - 1 ? c0[k] + 1 : gr->n[k] - 1;
+    }
+    for (int64_t cz = lo[2]; cz <= hi[2]; cz++)
+        for (int64_t cy = lo[1]; cy <= hi[1]; cy++)
+            for (int64_t cx = lo[0]; cx <= hi[0]; cx++) {
+                const int64_t c = gr->dim == 3 ? (cz * gr->n[1] + cy) * gr->n[0] + cx : cy * gr->n[0] + cx;
+                for (int64_t i = gr->head[c]; i >= 0; i = gr->next[i])
+                    if (fn(gr, i, ud)) return true;
+            }
+    return false;
+}
+
+typedef struct probe {
+    const double *x;
+    double r;
+} probe;
+
+static bool overlaps_one(const grid *gr, int64_t i, void *ud)
+{
+    const probe *p = ud;
+    double d2 = 0;
+    for (int k = 0; k < gr->dim; k++) {
+        const double d = gr->x[3 * i + k] - p->x[k];
+        d2 += d * d;
+    }
+    const double s = gr->r[i] + p->r;
+    return d2 < s * s;
+}
+
+/* --------------------------------------------------------------- sampling */
+
+/* An orthonormal pair perpendicular to the unit vector a. */
+static void perpendicular(const double *a, double *e1, double *e2)
+{
+    const double t[3] = {fabs(a[0]) < 0.9 ? 1 : 0, fabs(a[0]) < 0.9 ? 0 : 1, 0};
+    e1[0] = a[1] * t[2] - a[2] * t[1];
+    e1[1] = a[2] * t[0] - a[0] * t[2];
+    e1[2] = a[0] * t[1] - a[1] * t[0];
+    const double l = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; k++) e1[k] /= l;
+    e2[0] = a[1] * e1[2] - a[2] * e1[1];
+    e2[1] = a[2] * e1[0] - a[0] * e1[2];
+    e2[2] = a[0] * e1[1] - a[1] * e1[0];
+}
+
+/* A point uniform in the disk/ball of unit radius (rejection from the square/cube). */
+static void unit_ball(rng *r, int dim, double *p)
+{
+    for (;;) {
+        double s = 0;
+        for (int k = 0; k < dim; k++) {
+            p[k] = 2 * rng_uniform(r) - 1;
+            s += p[k] * p[k];
+        }
+        if (s <= 1) return;
+    }
+}
+
+/* Whether a ball of radius rad can fit at all, by the region's own measure. */
+static bool fits(const sx_lua_region *g, double rad)
+{
+    switch (g->kind) {
+    case SX_REGION_BOX:
+        for (int k = 0; k < g->dim; k++)
+            if (g->hi[k] - g->lo[k] < 2 * rad) return false;
+        return true;
+    case SX_REGION_SPHERE:
+    case SX_REGION_DISK: return rad <= g->r;
+    case SX_REGION_CYLINDER: return rad <= g->r && 2 * rad <= g->len;
+    default: return true;  // a polygon: the tries decide
+    }
+}
+
+/* A centre for a ball of radius rad, uniform over where it fits in the region. */
+static void sample(const sx_lua_region *g, rng *r, double rad, const double *e1, const double *e2, double *x)
+{
+    double p[3] = {0, 0, 0};
+    switch (g->kind) {
+    case SX_REGION_BOX:
+    case SX_REGION_POLYGON:  // the bounding box; the caller checks containment
+        for (int k = 0; k < g->dim; k++) x[k] = g->lo[k] + rad + (g->hi[k] - g->lo[k] - 2 * rad) * rng_uniform(r);
+        return;
+    case SX_REGION_SPHERE:
+    case SX_REGION_DISK:
+        unit_ball(r, g->dim, p);
+        for (int k = 0; k < g->dim; k++) x[k] = g->c[k] + (g->r - rad) * p[k];
+        return;
+    case SX_REGION_CYLINDER: {
+        const double t = rad + (g->len - 2 * rad) * rng_uniform(r);
+        unit_ball(r, 2, p);
+        for (int k = 0; k < 3; k++)
+            x[k] = g->c[k] + t * g->axis[k] + (g->r - rad) * (p[0] * e1[k] + p[1] * e2[k]);
+        return;
+    }
+    }
+}
+
+/* ------------------------------------------------------- random placement */
+
+/* Sort order: radius descending, then index (a total order: deterministic). */
+static int by_radius(const void *a, const void *b)
+{
+    const double *ra = *(const double *const *)a, *rb = *(const double *const *)b;
+    if (*ra != *rb) return *ra < *rb ? 1 : -1;
+    return ra < rb ? -1 : ra > rb;
+}
+
+/* Sorts the radii in place, largest first. */
+static void sort_radii(lua_State *L, double *rad, int64_t n)
+{
+    const double **p = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *p, 0);
+    for (int64_t i = 0; i < n; i++) p[i] = &rad[i];
+    qsort(p, (size_t)n, sizeof *p, by_radius);
+    double *sorted = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *sorted, 0);
+    for (int64_t i = 0; i < n; i++) sorted[i] = *p[i];
+    memcpy(rad, sorted, (size_t)n * sizeof *rad);
+    lua_pop(L, 2);
+}
+
+/* Places n balls of radii rad (sorted, largest first) without overlaps
+ * among them and with the model's balls; writes centres to x (3 per ball).
+ * Pushes the grid's storage. */
+static void place_random(lua_State *L, const sx_model *m, const gen *g, rng *r, const double *rad, int64_t n, double *x)
+{
+    const sx_lua_region *reg = &g->region;
+    const int dim = g->dim;
+    if (n > 0 && !fits(reg, rad[0]))
+        luaL_argerror(L, 2, lua_pushfstring(L, "a ball of radius %f m does not fit in the region", rad[0]));
+    /* the model's balls near the region take part in the overlap checks */
+    const double rnew = n > 0 ? rad[0] : 0;
+    const int64_t nb = sx_ball_count(m);
+    double rold = 0;
+    int64_t near = 0;
+    grid *gr = NULL;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int64_t i = 0; i < nb; i++) {
+            const int64_t id = sx_ball_id_at(m, i);
+            double p[3], rb;
+            sx_ball_get_vec(m, id, SX_BALL_POS, p);
+            sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
+            bool in = true;
+            for (int k = 0; k < dim; k++) in &= p[k] > reg->lo[k] - rb - rnew && p[k] < reg->hi[k] + rb + rnew;
+            if (!in) continue;
+            if (gr) {
+                grid_add(gr, p, rb);
+            } else {
+                near++;
+                if (rb > rold) rold = rb;
+            }
+        }
+        if (!gr) {
+            gr = lua_newuserdatauv(L, sizeof *gr, 0);
+            grid_init(L, gr, dim, reg->lo, reg->hi, rnew + fmax(rnew, rold), near + n);
+        }
+    }
+    double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
+    if (reg->kind == SX_REGION_CYLINDER) perpendicular(reg->axis, e1, e2);
+    for (int64_t i = 0; i < n; i++) {
+        double *xi = x + 3 * i;
+        int64_t t = 0;
+        for (; t < g->tries; t++) {
+            sample(reg, r, rad[i], e1, e2, xi);
+            if (!sx_lua_region_contains(reg, xi, rad[i])) continue;
+            probe p = {xi, rad[i]};
+            if (!grid_near(gr, xi, overlaps_one, &p)) break;
+        }
+        if (t == g->tries)
+            luaL_error(L, "generate: placed %I of %I balls; no room for one of radius %f m after %I tries: lower the "
+                       "count or the radii, enlarge the region, or use method = 'distribute'",
+                       (lua_Integer)i, (lua_Integer)n, rad[i], (lua_Integer)g->tries);
+        grid_add(gr, xi, rad[i]);
+    }
+}
+
+/* ------------------------------------------------------- distribute */
+
+/* Moves x back inside where a ball of radius rad fits; false if it cannot (then x is unchanged). */
+static bool project(const sx_lua_region *g, double rad, double *x)
+{
+    if (sx_lua_region_contains(g, x, rad)) return true;
+    switch (g->kind) {
+    case SX_REGION_BOX:
+        for (int k = 0; k < g->dim; k++) x[k] = fmin(fmax(x[k], g->lo[k] + rad), g->hi[k] - rad);
+        return true;
+    case SX_REGION_SPHERE:
+    case SX_REGION_DISK: {
+        double d2 = 0;
+        for (int k = 0; k < g->dim; k++) d2 += (x[k] - g->c[k]) * (x[k] - g->c[k]);
+        const double d = sqrt(d2), s = d > 0 ? (g->r - rad) / d : 0;
+        for (int k = 0; k < g->dim; k++) x[k] = g->c[k] + (x[k] - g->c[k]) * s;
+        return true;
+    }
+    case SX_REGION_CYLINDER: {
+        double d[3], t = 0;
+        for (int k = 0; k < 3; k++) {
+            d[k] = x[k] - g->c[k];
+            t += d[k] * g->axis[k];
+        }
+        double q[3], q2 = 0;
+        for (int k = 0; k < 3; k++) {
+            q[k] = d[k] - t * g->axis[k];
+            q2 += q[k] * q[k];
+        }
+        const double tc = fmin(fmax(t, rad), g->len - rad), ql = sqrt(q2);
+        const double s = ql > g->r - rad ? (g->r - rad) / ql : 1;
+        for (int k = 0; k < 3; k++) x[k] = g->c[k] + tc * g->axis[k] + q[k] * s;
+        return true;
+    }
+    default: return false;
+    }
+}
+
+typedef struct push {
+    int64_t self;
+    double *dx;     // accumulated displacement, 3 per ball
+    double worst;   // largest overlap / smaller radius seen
+} push;
+
+static bool push_one(const grid *gr, int64_t j, void *ud)
+{
+    push *p = ud;
+    const int64_t i = p->self;
+    if (j <= i) return false;  // each pair once
+    double n[3] = {0, 0, 0}, d2 = 0;
+    for (int k = 0; k < gr->dim; k++) {
+        n[k] = gr->x[3 * j + k] - gr->x[3 * i + k];
+        d2 += n[k] * n[k];
+    }
+    /* radii inflated by 1 %: where there is room, the balls end apart */
+    const double s = 1.01 * (gr->r[i] + gr->r[j]);
+    if (d2 >= s * s) return false;
+    double d = sqrt(d2);
+    if (d == 0) {  // coincident centres: part them along x
+        n[0] = 1;
+        d = 1;
+        d2 = 0;
+    }
+    const double over = s - sqrt(d2);
+    const double rmin = fmin(gr->r[i], gr->r[j]);
+    if (over / rmin > p->worst) p->worst = over / rmin;
+    /* each moves by its share, the smaller ball the more */
+    const double wi = 0.6 * over * gr->r[j] / s, wj = 0.6 * over * gr->r[i] / s;
+    for (int k = 0; k < gr->dim; k++) {
+        p->dx[3 * i + k] -= wi * n[k] / d;
+        p->dx[3 * j + k] += wj * n[k] / d;
+    }
+    return false;
+}
+
+/* Pushes overlapping balls apart until no overlap exceeds `limit` of the
+ * smaller radius (or the iterations run out); returns the worst ratio left. */
+static double push_apart(lua_State *L, const gen *g, const double *rad, int64_t n, double *x, double limit)
+{
+    double worst = INFINITY, best = INFINITY;
+    double *dx = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * 3 * sizeof *dx, 0);
+    const int top = lua_gettop(L);
+    /* until the limit, or until 50 iterations bring no 1 % gain (a jammed packing) */
+    for (int it = 0, stalled = 0; it < 5000 && worst > limit && stalled < 50; it++) {
+        grid gr;
+        grid_init(L, &gr, g->dim, g->region.lo, g->region.hi, 2.02 * g->rmax, n);
+        for (int64_t i = 0; i < n; i++) grid_add(&gr, x + 3 * i, rad[i]);
+        memset(dx, 0, (size_t)n * 3 * sizeof *dx);
+        push p = {0, dx, 0};
+        for (int64_t i = 0; i < n; i++) {
+            p.self = i;
+            grid_near(&gr, x + 3 * i, push_one, &p);
+        }
+        worst = p.worst;
+        if (worst < 0.99 * best) {
+            best = worst;
+            stalled = 0;
+        } else {
+            stalled++;
+        }
+        for (int64_t i = 0; i < n; i++) {
+            double y[3];
+            for (int k = 0; k < 3; k++) y[k] = x[3 * i + k] + dx[3 * i + k];
+            if (project(&g->region, rad[i], y)) memcpy(x + 3 * i, y, sizeof y);
+        }
+        lua_settop(L, top);
+    }
+    return worst;
+}
+
+/* -------------------------------------------------------------- lattice */
+
+/* Lattice sites in the region: centres into a pushed array; returns their number. */
+static double *lattice(lua_State *L, const gen *g, int64_t *count)
+{
+    const double r = g->rmin, *lo = g->region.lo, *hi = g->region.hi;
+    const int dim = g->dim;
+    /* the cell: its edge lengths and its basis (in edge units) */
+    double a[3] = {2 * r, 2 * r, 2 * r};
+    double basis[4][3] = {{0, 0, 0}};
+    int nb = 1;
+    switch (g->packing) {
+    case P_HEX:
+        a[1] = 2 * sqrt(3.0) * r;
+        basis[1][0] = 0.5;
+        basis[1][1] = 0.5;
+        nb = 2;
+        break;
+    case P_FCC:
+        for (int k = 0; k < 3; k++) a[k] = 2 * sqrt(2.0) * r;
+        basis[1][0] = basis[1][1] = 0.5;
+        basis[2][0] = basis[2][2] = 0.5;
+        basis[3][1] = basis[3][2] = 0.5;
+        nb = 4;
+        break;
+    default: break;
+    }
+    int64_t ncell[3] = {1, 1, 1};
+    double sites = nb;
+    for (int k = 0; k < dim; k++) {
+        const double c = floor((hi[k] - lo[k] - 2 * r) / a[k]) + 2;
+        if (!(c >= 1)) {
+            *count = 0;
+            return lua_newuserdatauv(L, sizeof(double), 0);
+        }
+        sites *= c;
+        ncell[k] = (int64_t)fmin(c, 1e9);
+    }
+    const int64_t limit = g->has_count ? g->count : INT64_MAX;
+    /* the sites of the bounding box, of which the region keeps some: the first `count` suffice */
+    if (sites > (double)limit) sites = (double)limit;
+    if (sites > MAX_GENERATE)
+        luaL_argerror(L, 2, lua_pushfstring(L, "the lattice has too many sites (more than %d); use a larger radius "
+                                            "or give a count", MAX_GENERATE));
+    double *x = lua_newuserdatauv(L, (size_t)(sites > 1 ? sites : 1) * 3 * sizeof *x, 0);
+    int64_t n = 0;
+    const double shrink = r * (1 - 1e-9);  // touching the boundary counts as inside
+    for (int64_t k2 = 0; k2 < ncell[2] && n < limit; k2++)
+        for (int64_t k1 = 0; k1 < ncell[1] && n < limit; k1++)
+            for (int64_t k0 = 0; k0 < ncell[0] && n < limit; k0++)
+                for (int b = 0; b < nb && n < limit; b++) {
+                    const int64_t kk[3] = {k0, k1, k2};
+                    double p[3] = {0, 0, 0};
+                    for (int k = 0; k < dim; k++) p[k] = lo[k] + r + (kk[k] + basis[b][k]) * a[k];
+                    if (!sx_lua_region_contains(&g->region, p, shrink)) continue;
+                    memcpy(x + 3 * n, p, sizeof p);
+                    n++;
+                }
+    if (g->has_count && n < g->count)
+        luaL_argerror(L, 2, lua_pushfstring(L, "only %I lattice sites fit in the region (count %I)", (lua_Integer)n,
+                                            (lua_Integer)g->count));
+    *count = n;
+    return x;
+}
+
+/* ------------------------------------------------------------- the model */
+
+/* Restores the gravity when a relaxation ends, whichever way. */
+typedef struct gravity_guard {
+    sx_lua_model *ud;
+    double g[3];
+    bool armed;
+} gravity_guard;
+
+static int gravity_restore(lua_State *L)
+{
+    gravity_guard *gg = lua_touserdata(L, 1);
+    if (gg && gg->armed && gg->ud->m) sx_model_set_gravity(gg->ud->m, gg->g);
+    if (gg) gg->armed = false;
+    return 0;
+}
+
+static void push_gravity_guard(lua_State *L, sx_lua_model *ud)
+{
+    gravity_guard *gg = lua_newuserdatauv(L, sizeof *gg, 0);
+    gg->ud = ud;
+    sx_model_gravity(ud->m, gg->g);
+    gg->armed = true;
+    lua_createtable(L, 0, 1);
+    lua_pushcfunction(L, gravity_restore);
+    lua_setfield(L, -2, "__close");
+    lua_setmetatable(L, -2);
+    lua_toclose(L, -1);
+    static const double zero[3] = {0, 0, 0};
+    sx_model_set_gravity(ud->m, zero);
+}
+
+/* Adds the balls; all or none (a failure removes those added). Pushes their ids. */
+static int64_t *add_balls(lua_State *L, sx_model *m, const gen *g, const double *x, const double *rad, int64_t n)
+{
+    int64_t *ids = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *ids, 0);
+    for (int64_t i = 0; i < n; i++) {
+        sx_ball_def d = sx_ball_default_def();
+        memcpy(d.pos, x + 3 * i, sizeof d.pos);
+        d.radius = rad[i];
+        d.material = g->material;
+        sx_status st = sx_ball_add(m, &d, &ids[i]);
+        if (st == SX_OK && g->group) st = sx_ball_set_group(m, ids[i], g->group);
+        if (st != SX_OK) {
+            lua_pushstring(L, sx_model_error(m));
+            for (int64_t j = 0; j <= i; j++)
+                if (sx_ball_exists(m, ids[j])) sx_ball_remove(m, ids[j]);
+            luaL_error(L, "generate: %s", lua_tostring(L, -1));
+        }
+    }
+    return ids;
+}
+
+static void calm(sx_model *m, const int64_t *ids, int64_t n)
+{
+    static const double zero[3] = {0, 0, 0};
+    for (int64_t i = 0; i < n; i++) {
+        sx_ball_set_vec(m, ids[i], SX_BALL_VEL, zero);
+        sx_ball_set_vec(m, ids[i], SX_BALL_SPIN, zero);
+    }
+}
+
+typedef struct overlap_scan {
+    const sx_model *m;
+    double worst;  // largest overlap / smaller radius
+} overlap_scan;
+
+static bool scan_overlap(const sx_contact_info *c, void *ud)
+{
+    overlap_scan *o = ud;
+    double ra = 0, rb = 0;
+    sx_ball_get(o->m, c->a, SX_BALL_RADIUS, &ra);
+    if (!c->is_wall) sx_ball_get(o->m, c->b, SX_BALL_RADIUS, &rb);
+    const double r = c->is_wall ? ra : fmin(ra, rb);
+    if (r > 0 && c->overlap / r > o->worst) o->worst = c->overlap / r;
+    return true;
+}
+
+/* Relaxed: the ratio is reached, or no overlap exceeds 1e-3 of a radius
+ * (a loose assembly without gravity keeps a high ratio while its last
+ * contacts part, with forces of no consequence). */
+static bool relaxed(const sx_model *m, double ratio)
+{
+    if (sx_model_unbalanced_ratio(m) <= ratio) return true;
+    overlap_scan o = {m, 0};
+    sx_contact_each(m, scan_overlap, &o);
+    return o.worst <= 1e-3;
+}
+
+/* Cycles `steps`, calming every g->calm steps; with a ratio, stops once relaxed. */
+static void relax_cycles(lua_State *L, const gen *g, const int64_t *ids, int64_t n, int64_t steps, double ratio)
+{
+    sx_lua_model *ud = sx_lua_modelud(L, 1);
+    int64_t done = 0, since_check = 0;
+    while (done < steps) {
+        const int64_t k = steps - done < g->calm ? steps - done : g->calm;
+        sx_lua_cycle_plain(L, 1, k);
+        done += k;
+        since_check += k;
+        calm(ud->m, ids, n);
+        if (ratio > 0 && since_check >= 100) {
+            since_check = 0;
+            if (relaxed(ud->m, ratio)) break;
+        }
+    }
+}
+
+static int model_generate(lua_State *L)
+{
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_lua_model *ud = sx_lua_modelud(L, 1);
+    gen g;
+    read_gen(L, m, &g);
+    if ((g.method == M_DISTRIBUTE || g.method == M_EXPAND) && ud->running)
+        return luaL_error(L, "generate: method '%s' cycles the model, which a callback of a cycle cannot do",
+                          method_names[g.method]);
+    rng r;
+    rng_seed(&r, g.seed);
+    int64_t n = 0;
+    double *x = NULL, *rad = NULL;
+    if (g.method == M_LATTICE) {
+        x = lattice(L, &g, &n);
+        rad = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *rad, 0);
+        for (int64_t i = 0; i < n; i++) rad[i] = g.rmin;
+    } else {
+        rad = draw_radii(L, &g, &r);
+        n = g.count;
+        sort_radii(L, rad, n);
+        x = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * 3 * sizeof *x, 0);
+        memset(x, 0, (size_t)(n > 0 ? n : 1) * 3 * sizeof *x);
+    }
+    /* expansion starts from radii shrunk to a solid fraction random placement reaches easily */
+    double shrink = 1;
+    if (g.method == M_EXPAND) {
+        const double easy = g.dim == 3 ? 0.25 : 0.40;
+        shrink = fmin(1, pow(easy / (1 - g.porosity), 1.0 / g.dim));
+        for (int64_t i = 0; i < n; i++) rad[i] *= shrink;
+    }
+    if (g.method == M_RANDOM || g.method == M_EXPAND) {
+        place_random(L, m, &g, &r, rad, n, x);
+    } else if (g.method == M_DISTRIBUTE) {
+        double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
+        if (g.region.kind == SX_REGION_CYLINDER) perpendicular(g.region.axis, e1, e2);
+        for (int64_t i = 0; i < n; i++) {
+            if (!fits(&g.region, rad[i]))
+                return luaL_argerror(L, 2, lua_pushfstring(L, "a ball of radius %f m does not fit in the region", rad[i]));
+            int64_t t = 0;
+            do sample(&g.region, &r, rad[i], e1, e2, x + 3 * i);
+            while (!sx_lua_region_contains(&g.region, x + 3 * i, rad[i]) && ++t < g.tries);
+            if (t == g.tries) return luaL_error(L, "generate: the region leaves no room for a ball of radius %f m", rad[i]);
+        }
+        const double worst = push_apart(L, &g, rad, n, x, 0.01);
+        if (worst > 0.9)
+            return luaL_error(L, "generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
+                              "raise the porosity", g.porosity, worst);
+    }
+    m = sx_lua_checkmodel(L, 1);
+    const int64_t *ids = add_balls(L, m, &g, x, rad, n);
+    if (g.method == M_EXPAND && shrink < 1) {
+        const int top = lua_gettop(L);
+        push_gravity_guard(L, ud);
+        const int stages = (int)ceil(log(1 / shrink) / log(1.02));
+        for (int s = 1; s <= stages; s++) {
+            const double f = s == stages ? 1 / shrink : pow(1 / shrink, (double)s / stages);
+            for (int64_t i = 0; i < n; i++) sx_lua_check(L, ud->m, sx_ball_set(ud->m, ids[i], SX_BALL_RADIUS, rad[i] * f));
+            relax_cycles(L, &g, ids, n, 100, 0);
+        }
+        lua_settop(L, top);  // restores the gravity
+        for (int64_t i = 0; i < n; i++) rad[i] /= shrink;
+    }
+    if (g.relax && (g.method == M_DISTRIBUTE || g.method == M_EXPAND) && n > 0) {
+        const int top = lua_gettop(L);
+        push_gravity_guard(L, ud);
+        relax_cycles(L, &g, ids, n, g.relax_steps, g.relax_ratio);
+        lua_settop(L, top);
+    }
+    double solid = 0;
+    for (int64_t i = 0; i < n; i++) solid += ball_volume(g.dim, rad[i]);
+    lua_pushinteger(L, (lua_Integer)n);
+    lua_pushnumber(L, 1 - solid / g.region.volume);
+    return 2;
+}
+
+const luaL_Reg sx_lua_generate_methods[] = {
+    {"generate", model_generate},
+    {NULL, NULL},
+};

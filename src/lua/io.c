@@ -1,0 +1,555 @@
+/* Files: snapshots that restart bit-for-bit, and output series for ParaView.
+ *   m:save(path[, {compression = 0..9}])   -> skipped   write the whole model
+ *   seixo.load(path[, {dim = 2 | 3}])       -> model     read it back
+ *   m:vars()                                -> table     the user's variables, saved with the model
+ *   m:output{path =, every =, fields =, compression =, append =} -> output
+ *   output:write(), output:close(), output:count(), output:path()
+ *   seixo.xdmf(path)                        rebuild the .xmf of a series
+ *
+ * The user's variables (PFC saves FISH variables with the model): m:vars()
+ * is a table kept with the model; whatever plain data it holds (numbers,
+ * strings, booleans and nested tables of them) is saved by m:save and
+ * restored by seixo.load. The Lua-side state that is data, not code (group
+ * names, ball extras), is saved the same way. Values that cannot be saved
+ * (functions, userdata, a table met twice) are skipped and listed in the
+ * table m:save returns, e.g. {"vars.callback"}. Callbacks and outputs are
+ * code and open files: after a load, register them again (an output with
+ * append = true continues its series).
+ *
+ * An output writes the model at once, then after every `every` steps
+ * through an "after" callback (m:on); it closes with o:close(), when it is
+ * collected, or with the Lua state. */
+#include "bindings.h"
+#include "seixo_io.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define SX_LUA_OUTPUT "seixo.output"
+
+/* --------------------------------------------------- Lua values <-> trees */
+
+/* The state fields saved with the model: plain data kept by other files. */
+static const char *const saved_state[] = {"groups", "group_names", "extras", NULL};
+
+typedef struct ser {
+    sx_io_tree *tree;
+    int seen;     /* stack index: tables already written */
+    int skipped;  /* stack index: array of the paths skipped */
+    bool oom;
+} ser;
+
+static void skip(lua_State *L, ser *s, const char *path, const char *why)
+{
+    lua_pushfstring(L, "%s (%s)", path, why);
+    lua_rawseti(L, s->skipped, (lua_Integer)lua_rawlen(L, s->skipped) + 1);
+}
+
+static int64_t add(ser *s, const sx_io_node *n)
+{
+    const int64_t i = sx_io_tree_add(s->tree, n);
+    if (i < 0) s->oom = true;
+    return i;
+}
+
+/* Reads the key at idx into n; false if a key of that type cannot be saved. */
+static bool key_of(lua_State *L, int idx, sx_io_node *n)
+{
+    switch (lua_type(L, idx)) {
+    case LUA_TSTRING:
+        n->key_kind = SX_IO_STRING;
+        n->key_string = (char *)lua_tolstring(L, idx, &n->key_length);
+        return true;
+    case LUA_TNUMBER:
+        if (lua_isinteger(L, idx)) {
+            n->key_kind = SX_IO_INTEGER;
+            n->key_integer = (int64_t)lua_tointeger(L, idx);
+        } else {
+            n->key_kind = SX_IO_NUMBER;
+            n->key_number = lua_tonumber(L, idx);
+        }
+        return true;
+    case LUA_TBOOLEAN:
+        n->key_kind = SX_IO_BOOLEAN;
+        n->key_integer = lua_toboolean(L, idx);
+        return true;
+    default: return false;
+    }
+}
+
+/* "path.key" or "path[key]" for messages. */
+static const char *child_path(lua_State *L, const char *path, int key)
+{
+    if (lua_type(L, key) == LUA_TSTRING) return lua_pushfstring(L, "%s.%s", path, lua_tostring(L, key));
+    if (lua_type(L, key) == LUA_TNUMBER || lua_type(L, key) == LUA_TBOOLEAN) {
+        lua_pushvalue(L, key);
+        const char *k = luaL_tolstring(L, -1, NULL);
+        const char *p = lua_pushfstring(L, "%s[%s]", path, k);
+        lua_replace(L, -3);
+        lua_pop(L, 1);
+        return p;
+    }
+    return lua_pushfstring(L, "%s[%s]", path, luaL_typename(L, key));
+}
+
+/* Writes the entries of the table at idx as children of node `parent`. */
+static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char *path)
+{
+    idx = lua_absindex(L, idx);
+    luaL_checkstack(L, 8, "tables nested too deeply to save");
+    lua_pushvalue(L, idx);
+    lua_pushboolean(L, 1);
+    lua_rawset(L, s->seen);
+    lua_pushnil(L);
+    while (!s->oom && lua_next(L, idx)) {
+        const int key = lua_gettop(L) - 1, val = key + 1;
+        const char *p = child_path(L, path, key);
+        sx_io_node n;
+        memset(&n, 0, sizeof n);
+        n.parent = parent;
+        if (!key_of(L, key, &n)) {
+            skip(L, s, p, "its key is not a string, number or boolean");
+        } else {
+            switch (lua_type(L, val)) {
+            case LUA_TBOOLEAN:
+                n.kind = SX_IO_BOOLEAN;
+                n.integer = lua_toboolean(L, val);
+                add(s, &n);
+                break;
+            case LUA_TNUMBER:
+                if (lua_isinteger(L, val)) n.kind = SX_IO_INTEGER, n.integer = (int64_t)lua_tointeger(L, val);
+                else n.kind = SX_IO_NUMBER, n.number = lua_tonumber(L, val);
+                add(s, &n);
+                break;
+            case LUA_TSTRING:
+                n.kind = SX_IO_STRING;
+                n.string = (char *)lua_tolstring(L, val, &n.length);
+                add(s, &n);
+                break;
+            case LUA_TTABLE:
+                lua_pushvalue(L, val);
+                if (lua_rawget(L, s->seen) != LUA_TNIL) {
+                    lua_pop(L, 1);
+                    skip(L, s, p, "a table already saved at another place");
+                    break;
+                }
+                lua_pop(L, 1);
+                n.kind = SX_IO_TABLE;
+                const int64_t me = add(s, &n);
+                if (me >= 0) ser_table(L, s, val, me, p);
+                break;
+            default: skip(L, s, p, luaL_typename(L, val)); break;
+            }
+        }
+        lua_settop(L, key);
+    }
+}
+
+/* Builds the Lua table of a tree and leaves it on the stack. */
+static void push_tree(lua_State *L, const sx_io_tree *t)
+{
+    luaL_checkstack(L, 6, NULL);
+    lua_newtable(L);
+    const int root = lua_gettop(L);
+    lua_createtable(L, t->n < 1000000 ? (int)t->n : 0, 0); /* node index -> its table */
+    const int tables = root + 1;
+    for (int64_t i = 0; i < t->n; i++) {
+        const sx_io_node *n = &t->node[i];
+        if (n->parent < 0) lua_pushvalue(L, root);
+        else lua_rawgeti(L, tables, (lua_Integer)n->parent + 1);
+        switch (n->key_kind) {
+        case SX_IO_STRING: lua_pushlstring(L, n->key_string, n->key_length); break;
+        case SX_IO_INTEGER: lua_pushinteger(L, (lua_Integer)n->key_integer); break;
+        case SX_IO_BOOLEAN: lua_pushboolean(L, n->key_integer != 0); break;
+        default:
+            if (n->key_number != n->key_number) { /* NaN: not a key Lua can hold */
+                lua_pop(L, 1);
+                continue;
+            }
+            lua_pushnumber(L, n->key_number);
+            break;
+        }
+        switch (n->kind) {
+        case SX_IO_BOOLEAN: lua_pushboolean(L, n->integer != 0); break;
+        case SX_IO_INTEGER: lua_pushinteger(L, (lua_Integer)n->integer); break;
+        case SX_IO_NUMBER: lua_pushnumber(L, n->number); break;
+        case SX_IO_STRING: lua_pushlstring(L, n->string, n->length); break;
+        default:
+            lua_newtable(L);
+            lua_pushvalue(L, -1);
+            lua_rawseti(L, tables, (lua_Integer)i + 1);
+            break;
+        }
+        lua_rawset(L, -3);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+}
+
+/* ----------------------------------------------------------- save, load */
+
+/* The path of the script being run (its main chunk "@path"), or NULL. */
+static const char *script_path(lua_State *L)
+{
+    lua_Debug ar;
+    const char *found = NULL;
+    for (int level = 0; lua_getstack(L, level, &ar); level++) {
+        if (!lua_getinfo(L, "S", &ar)) continue;
+        if (strcmp(ar.what, "main") == 0 && ar.source[0] == '@') found = ar.source + 1;
+    }
+    return found;
+}
+
+/* Seeds the script used, if the Lua side recorded them (state "seeds"). */
+static int64_t *seeds_of(lua_State *L, int model, int *n)
+{
+    sx_lua_state(L, model, "seeds");
+    const lua_Integer k = (lua_Integer)lua_rawlen(L, -1);
+    int64_t *v = k > 0 && k < 100000 ? lua_newuserdatauv(L, (size_t)k * sizeof *v, 0) : NULL;
+    *n = 0;
+    for (lua_Integer i = 1; v && i <= k; i++) {
+        lua_rawgeti(L, -2, i);
+        if (lua_isinteger(L, -1)) v[(*n)++] = (int64_t)lua_tointeger(L, -1);
+        lua_pop(L, 1);
+    }
+    /* the userdata (if any) stays on the stack, above the seeds table */
+    return v;
+}
+
+typedef struct save_job {
+    sx_io_named_tree trees[2];
+} save_job;
+
+/* __gc / __close of a save job: the trees' C memory, whatever happens. */
+static int job_free(lua_State *L)
+{
+    save_job *j = lua_touserdata(L, 1);
+    for (int k = 0; k < 2; k++) sx_io_tree_free(&j->trees[k].tree);
+    return 0;
+}
+
+static int model_save(lua_State *L)
+{
+    static const char *const keys[] = {"compression", NULL};
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const char *path = luaL_checkstring(L, 2);
+    int64_t level = 0;
+    if (!lua_isnoneornil(L, 3)) {
+        sx_lua_checkkeys(L, 3, keys);
+        sx_lua_optintfield(L, 3, "compression", 0, 9, &level);
+    }
+    lua_settop(L, 3);
+    /* the trees' memory belongs to a to-be-closed job, freed on any error */
+    save_job *j = lua_newuserdatauv(L, sizeof *j, 0);
+    memset(j, 0, sizeof *j);
+    lua_createtable(L, 0, 1);
+    lua_pushcfunction(L, job_free);
+    lua_setfield(L, -2, "__close");
+    lua_setmetatable(L, -2);
+    lua_toclose(L, 4);
+    lua_newtable(L); /* 5: skipped paths */
+    lua_newtable(L); /* 6: tables seen */
+    ser s = {.skipped = 5, .seen = 6};
+
+    snprintf(j->trees[0].name, sizeof j->trees[0].name, "vars");
+    s.tree = &j->trees[0].tree;
+    sx_lua_state(L, 1, "vars");
+    ser_table(L, &s, -1, -1, "vars");
+    lua_pop(L, 1);
+
+    snprintf(j->trees[1].name, sizeof j->trees[1].name, "state");
+    s.tree = &j->trees[1].tree;
+    for (int k = 0; saved_state[k] && !s.oom; k++) {
+        sx_lua_state(L, 1, saved_state[k]);
+        sx_io_node n = {.parent = -1, .key_kind = SX_IO_STRING, .key_string = (char *)saved_state[k],
+                        .key_length = strlen(saved_state[k]), .kind = SX_IO_TABLE};
+        const int64_t me = add(&s, &n);
+        if (me >= 0) ser_table(L, &s, -1, me, saved_state[k]);
+        lua_pop(L, 1);
+    }
+    if (s.oom) return luaL_error(L, "'%s': out of memory", path);
+
+    sx_snapshot_opts o;
+    memset(&o, 0, sizeof o);
+    o.compression = (int)level;
+    o.trees = j->trees;
+    o.ntrees = 2;
+    o.provenance.script = script_path(L);
+    o.provenance.seeds = seeds_of(L, 1, &o.provenance.nseeds);
+    char err[1024];
+    if (sx_snapshot_save(m, path, &o, err, sizeof err)) return luaL_error(L, "%s", err);
+    lua_pushvalue(L, 5);
+    return 1;
+}
+
+static int info_free(lua_State *L)
+{
+    sx_snapshot_info_free(lua_touserdata(L, 1));
+    return 0;
+}
+
+static int seixo_load(lua_State *L)
+{
+    static const char *const keys[] = {"dim", NULL};
+    const char *path = luaL_checkstring(L, 1);
+    int64_t dim = 0;
+    if (!lua_isnoneornil(L, 2)) {
+        sx_lua_checkkeys(L, 2, keys);
+        sx_lua_optintfield(L, 2, "dim", 2, 3, &dim);
+    }
+    lua_settop(L, 2);
+    /* the userdata first, so the loaded model always has an owner */
+    lua_pushcfunction(L, sx_lua_model_new);
+    lua_call(L, 0, 1);
+    sx_lua_model *u = sx_lua_modelud(L, 3);
+    /* the trees read with it are freed by a to-be-closed value, whatever happens */
+    sx_snapshot_info *info = lua_newuserdatauv(L, sizeof *info, 0); /* 4 */
+    memset(info, 0, sizeof *info);
+    lua_createtable(L, 0, 1);
+    lua_pushcfunction(L, info_free);
+    lua_setfield(L, -2, "__close");
+    lua_setmetatable(L, -2);
+    lua_toclose(L, 4);
+    char err[1024];
+    sx_model *m = sx_snapshot_load(path, (int)dim, info, err, sizeof err);
+    if (!m) return luaL_error(L, "%s", err);
+    sx_model_destroy(u->m);
+    u->m = m;
+    /* the trees into the model's state */
+    for (int k = 0; k < info->ntrees; k++) {
+        const char *name = info->trees[k].name;
+        if (strcmp(name, "vars") != 0 && strcmp(name, "state") != 0) continue;
+        push_tree(L, &info->trees[k].tree);
+        lua_getiuservalue(L, 3, 1);
+        if (strcmp(name, "vars") == 0) {
+            lua_pushvalue(L, -2);
+            lua_setfield(L, -2, "vars");
+        } else {
+            for (int q = 0; saved_state[q]; q++)
+                if (lua_getfield(L, -2, saved_state[q]) == LUA_TTABLE) lua_setfield(L, -2, saved_state[q]);
+                else lua_pop(L, 1);
+        }
+        lua_pop(L, 2);
+    }
+    lua_pushvalue(L, 3);
+    return 1;
+}
+
+static int model_vars(lua_State *L)
+{
+    sx_lua_checkmodel(L, 1);
+    sx_lua_state(L, 1, "vars");
+    return 1;
+}
+
+/* -------------------------------------------------------------- outputs */
+
+typedef struct output {
+    sx_series *s;
+    int64_t every;
+} output;
+
+/* The output's uservalues: 1 the model, 2 its callback id. */
+static output *check_output(lua_State *L, int idx) { return luaL_checkudata(L, idx, SX_LUA_OUTPUT); }
+
+static void write_now(lua_State *L, output *o, const sx_model *m)
+{
+    char err[1024];
+    if (sx_series_write(o->s, m, err, sizeof err)) luaL_error(L, "%s", err);
+}
+
+/* The "after" callback: upvalue 1 is the output. */
+static int output_callback(lua_State *L)
+{
+    output *o = check_output(L, lua_upvalueindex(1));
+    if (o->s) write_now(L, o, sx_lua_checkmodel(L, 1));
+    return 0;
+}
+
+static int output_close(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    if (!o->s) return 0;
+    char err[1024];
+    const sx_status st = sx_series_close(o->s, err, sizeof err);
+    o->s = NULL;
+    /* stop the callback: m:off(id), if the model is still open */
+    if (lua_getiuservalue(L, 1, 1) == LUA_TUSERDATA && sx_lua_tomodel(L, -1)) {
+        lua_getfield(L, -1, "off");
+        lua_pushvalue(L, -2);
+        lua_getiuservalue(L, 1, 2);
+        lua_call(L, 2, 0);
+    }
+    lua_pop(L, 1);
+    if (st) return luaL_error(L, "%s", err);
+    return 0;
+}
+
+static int output_gc(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    if (o->s) sx_series_close(o->s, NULL, 0); /* no Lua calls while collecting */
+    o->s = NULL;
+    return 0;
+}
+
+static int output_write(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    if (!o->s) return luaL_error(L, "the output has been closed");
+    lua_getiuservalue(L, 1, 1);
+    write_now(L, o, sx_lua_checkmodel(L, -1));
+    return 0;
+}
+
+static int output_count(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    lua_pushinteger(L, o->s ? (lua_Integer)sx_series_count(o->s) : 0);
+    return 1;
+}
+
+static int output_path(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    if (!o->s) return luaL_error(L, "the output has been closed");
+    lua_pushstring(L, sx_series_path(o->s));
+    return 1;
+}
+
+static int output_tostring(lua_State *L)
+{
+    output *o = check_output(L, 1);
+    if (o->s)
+        lua_pushfstring(L, "seixo.output %s (every %I steps, %I snapshots)", sx_series_path(o->s), (lua_Integer)o->every,
+                        (lua_Integer)sx_series_count(o->s));
+    else
+        lua_pushliteral(L, "seixo.output (closed)");
+    return 1;
+}
+
+/* The SX_OUT_* bits of the `fields` array at idx (all names, or "all"). */
+static unsigned fields_of(lua_State *L, int idx, int arg)
+{
+    if (lua_isnil(L, idx)) return SX_OUT_DEFAULT;
+    if (!lua_istable(L, idx)) sx_lua_fielderror(L, arg, "fields", "an array of field names expected");
+    unsigned bits = 0;
+    for (lua_Integer i = 1; lua_rawgeti(L, idx, i) != LUA_TNIL; i++) {
+        const char *name = lua_tostring(L, -1);
+        const unsigned b = name ? sx_series_field_bit(name) : 0;
+        if (name && strcmp(name, "all") == 0) {
+            bits |= 2 * SX_OUT_WALLS - 1;
+        } else if (!b) {
+            luaL_Buffer buf;
+            luaL_buffinit(L, &buf);
+            for (unsigned k = 1; k <= SX_OUT_WALLS; k <<= 1) {
+                luaL_addstring(&buf, sx_series_field_name(k));
+                luaL_addstring(&buf, ", ");
+            }
+            luaL_addstring(&buf, "all");
+            luaL_pushresult(&buf);
+            sx_lua_fielderror(L, arg, "fields",
+                              lua_pushfstring(L, "unknown field '%s' (valid: %s)", name ? name : luaL_typename(L, -2),
+                                              lua_tostring(L, -1)));
+        }
+        bits |= b;
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    return bits ? bits : SX_OUT_DEFAULT;
+}
+
+static int model_output(lua_State *L)
+{
+    static const char *const keys[] = {"path", "every", "fields", "compression", "append", NULL};
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_lua_checkkeys(L, 2, keys);
+    const char *path = sx_lua_optstrfield(L, 2, "path");
+    if (!path) return sx_lua_fielderror(L, 2, "path", "a file name (.h5) is required");
+    int64_t every = 1000, level = 0;
+    sx_lua_optintfield(L, 2, "every", 1, INT64_MAX / 2, &every);
+    sx_lua_optintfield(L, 2, "compression", 0, 9, &level);
+    lua_getfield(L, 2, "fields");
+    const unsigned fields = fields_of(L, lua_gettop(L), 2);
+    lua_getfield(L, 2, "append");
+    const bool append = lua_toboolean(L, -1);
+    lua_settop(L, 2);
+
+    output *o = lua_newuserdatauv(L, sizeof *o, 2); /* 3 */
+    memset(o, 0, sizeof *o);
+    o->every = every;
+    luaL_setmetatable(L, SX_LUA_OUTPUT);
+    lua_pushvalue(L, 1);
+    lua_setiuservalue(L, 3, 1);
+    sx_series_opts so;
+    memset(&so, 0, sizeof so);
+    so.fields = fields;
+    so.compression = (int)level;
+    so.append = append;
+    so.provenance.script = script_path(L);
+    so.provenance.seeds = seeds_of(L, 1, &so.provenance.nseeds);
+    char err[1024];
+    o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
+    if (!o->s) return luaL_error(L, "%s", err);
+    lua_settop(L, 3);
+    write_now(L, o, m);
+    /* m:on("after", callback, {every = every}) */
+    lua_getfield(L, 1, "on");
+    lua_pushvalue(L, 1);
+    lua_pushliteral(L, "after");
+    lua_pushvalue(L, 3);
+    lua_pushcclosure(L, output_callback, 1);
+    lua_createtable(L, 0, 1);
+    lua_pushinteger(L, (lua_Integer)every);
+    lua_setfield(L, -2, "every");
+    lua_call(L, 4, 1);
+    lua_setiuservalue(L, 3, 2);
+    return 1;
+}
+
+static int seixo_xdmf(lua_State *L)
+{
+    const char *path = luaL_checkstring(L, 1);
+    char err[1024];
+    if (sx_series_write_xdmf(path, err, sizeof err)) return luaL_error(L, "%s", err);
+    return 0;
+}
+
+/* ------------------------------------------------------------- register */
+
+void sx_lua_io_register(lua_State *L)
+{
+    static const luaL_Reg model_methods[] = {
+        {"save", model_save},
+        {"vars", model_vars},
+        {"output", model_output},
+        {NULL, NULL},
+    };
+    static const luaL_Reg meta[] = {
+        {"__gc", output_gc},
+        {"__close", output_close},
+        {"__tostring", output_tostring},
+        {NULL, NULL},
+    };
+    static const luaL_Reg methods[] = {
+        {"write", output_write},
+        {"close", output_close},
+        {"count", output_count},
+        {"path", output_path},
+        {NULL, NULL},
+    };
+    static const luaL_Reg functions[] = {
+        {"load", seixo_load},
+        {"xdmf", seixo_xdmf},
+        {NULL, NULL},
+    };
+    /* the module table is on the top of the stack */
+    luaL_setfuncs(L, functions, 0);
+    /* the model class exists: its methods table takes ours */
+    luaL_getmetatable(L, SX_LUA_MODEL);
+    lua_getfield(L, -1, "__methods");
+    luaL_setfuncs(L, model_methods, 0);
+    lua_pop(L, 2);
+    sx_lua_newclass(L, SX_LUA_OUTPUT, "output", meta, methods, NULL, NULL);
+    lua_pop(L, 1);
+}

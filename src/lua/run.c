@@ -1,0 +1,536 @@
+/* Cycling: m:cycle(n), m:solve{ratio=, steps=, time=}, and the callbacks
+ * m:on(point, fn, {every=}) / m:off(id) they run.
+ *
+ * The core steps without ever calling Lua: a run cycles the core in
+ * chunks that end at the next step where something is due (a callback, a
+ * history sample, a ratio check, a progress refresh), and runs the Lua side
+ * between chunks, when the core is not locked. Everything is keyed to the
+ * model's absolute step count, so m:cycle(100) twice does exactly what
+ * m:cycle(200) does, callbacks and histories included.
+ *
+ * A callback with every = N runs at the step boundaries s with s % N == 0:
+ * "after" (alias "cycle") once the step s is taken, "before" when the step
+ * s + 1 is about to be taken. At one boundary the "after" callbacks run
+ * first, then the histories are recorded, then the "before" callbacks. Ball
+ * and wall removals a callback asks for are queued and applied when it
+ * returns.
+ *
+ * Interrupts: a SIGINT handler cannot know the models, so each run lists
+ * itself in a small static registry that sx_lua_interrupt_all() walks; it
+ * flags every listed run and interrupts its core cycle. A listed run is
+ * always alive: its record is a to-be-closed value of the running C frame,
+ * unlisted when the frame returns or unwinds. The same close resets the
+ * model's running state, so an error anywhere (in the core, a callback, an
+ * interrupt) leaves the model usable. */
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bindings.h"
+#include "seixo_lua.h"
+
+enum { MAX_RUNS = 16 };  // deeper nested runs are not listed, hence not interruptible
+_Static_assert(ATOMIC_POINTER_LOCK_FREE == 2 && ATOMIC_INT_LOCK_FREE == 2,
+               "a signal handler may only touch lock-free atomics");
+
+/* ------------------------------------------------------------ progress */
+
+static const char progress_key[] = "seixo.progress";
+
+void sx_lua_set_progress(lua_State *L, int on)
+{
+    lua_pushboolean(L, on);
+    lua_setfield(L, LUA_REGISTRYINDEX, progress_key);
+}
+
+static bool progress_on(lua_State *L)
+{
+    lua_getfield(L, LUA_REGISTRYINDEX, progress_key);
+    const bool on = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+    return on;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250 };
+
+typedef struct progress {
+    bool on, shown;
+    double start, last;    // wall-clock s
+    int64_t step0;         // model step at the start
+    int64_t chunk;         // steps per chunk, adapted to about 0.1 s
+} progress;
+
+static void progress_start(lua_State *L, progress *p, const sx_model *m)
+{
+    p->on = progress_on(L);
+    p->shown = false;
+    p->start = p->last = now();
+    p->step0 = sx_model_step_count(m);
+    p->chunk = 16;
+}
+
+/* One status line on stderr: steps, time, speed, and the ETA when `fraction` (of the run done) is known. */
+static void progress_show(progress *p, const sx_model *m, int64_t total, double fraction, double ratio, double target)
+{
+    const double t = now();
+    const int64_t done = sx_model_step_count(m) - p->step0;
+    const double rate = done / (t - p->start > 0 ? t - p->start : 1e-9);
+    /* aim the next chunk at 0.1 s of cycling */
+    const double want = rate * 0.1;
+    p->chunk = want < 1 ? 1 : want > 1e9 ? 1000000000 : (int64_t)want;
+    if (!p->on || t - p->start < PROGRESS_DELAY_MS * 1e-3 || t - p->last < PROGRESS_EVERY_MS * 1e-3) return;
+    p->last = t;
+    p->shown = true;
+    char line[256];
+    int k = 0;
+    if (total > 0)
+        k = snprintf(line, sizeof line, "step %lld of %lld", (long long)done, (long long)total);
+    else
+        k = snprintf(line, sizeof line, "step %lld", (long long)done);
+    k += snprintf(line + k, sizeof line - (size_t)k, "  time %.4g s  %.0f steps/s", sx_model_time(m), rate);
+    if (target > 0) k += snprintf(line + k, sizeof line - (size_t)k, "  ratio %.3g -> %.3g", ratio, target);
+    if (fraction > 0 && fraction <= 1)
+        snprintf(line + k, sizeof line - (size_t)k, "  ETA %.0f s", (t - p->start) * (1 - fraction) / fraction);
+    fprintf(stderr, "\r%s\033[K", line);
+    fflush(stderr);
+}
+
+static void progress_end(progress *p)
+{
+    if (!p->shown) return;
+    fputs("\r\033[K", stderr);
+    fflush(stderr);
+    p->shown = false;
+}
+
+typedef struct run {
+    sx_model *m;
+    sx_lua_model *ud;
+    atomic_int interrupted;  // set by sx_lua_interrupt_all
+    atomic_int in_lua;       // a user callback is running
+    int slot;                // its place in runs[], -1 when not listed
+    int saved_callback;      // ud->callback when the run started
+    bool open;               // not closed yet
+    progress progress;       // the progress line, cleared when the run ends
+} run;
+
+static _Atomic(run *) runs[MAX_RUNS];
+static atomic_int nruns;
+
+int sx_lua_interrupt_all(void)
+{
+    const int n = atomic_load(&nruns);
+    for (int i = 0; i < n; i++) {
+        run *r = atomic_load(&runs[i]);
+        if (!r) continue;
+        atomic_store(&r->interrupted, 1);
+        sx_model_interrupt(r->m);
+    }
+    /* a callback running Lua code is stopped by the caller's hook */
+    run *inner = n > 0 ? atomic_load(&runs[n - 1]) : NULL;
+    if (inner && atomic_load(&inner->in_lua)) return 0;
+    return n;
+}
+
+static run *innermost(void)
+{
+    const int n = atomic_load(&nruns);
+    return n > 0 ? atomic_load(&runs[n - 1]) : NULL;
+}
+
+/* __close of a run record: unlist it, give the model back. */
+static int run_close(lua_State *L)
+{
+    run *r = lua_touserdata(L, 1);
+    if (!r || !r->open) return 0;
+    r->open = false;
+    progress_end(&r->progress);
+    if (r->slot >= 0) {
+        atomic_store(&nruns, r->slot);
+        atomic_store(&runs[r->slot], NULL);
+    }
+    r->ud->running--;
+    r->ud->callback = r->saved_callback;
+    return 0;
+}
+
+/* Starts a run of the model userdata at `model`: pushes its record as a
+ * to-be-closed value. `what` names the operation in the refusal. */
+static run *run_open(lua_State *L, int model, const char *what)
+{
+    model = lua_absindex(L, model);
+    sx_lua_model *ud = sx_lua_modelud(L, model);
+    sx_model *m = sx_lua_checkmodel(L, model);
+    if (ud->running)
+        luaL_error(L, "%s: the model is already cycling (a callback cannot cycle its own model)", what);
+    run *r = lua_newuserdatauv(L, sizeof *r, 0);
+    memset(r, 0, sizeof *r);
+    r->m = m;
+    r->ud = ud;
+    r->slot = -1;
+    atomic_init(&r->interrupted, 0);
+    atomic_init(&r->in_lua, 0);
+    lua_createtable(L, 0, 1);
+    lua_pushcfunction(L, run_close);
+    lua_setfield(L, -2, "__close");
+    lua_setmetatable(L, -2);
+    ud->running++;
+    r->saved_callback = ud->callback;
+    r->open = true;
+    lua_toclose(L, -1);
+    const int slot = atomic_load(&nruns);
+    if (slot < MAX_RUNS) {
+        r->slot = slot;
+        atomic_store(&runs[slot], r);
+        atomic_store(&nruns, slot + 1);
+    }
+    return r;
+}
+
+static void check_interrupt(lua_State *L, run *r)
+{
+    if (atomic_load(&r->interrupted))
+        luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+}
+
+/* Cycles the core n steps; a failure is a Lua error (an interrupt says at which step). */
+static void core_cycle(lua_State *L, run *r, int64_t n)
+{
+    check_interrupt(L, r);
+    const sx_status st = sx_model_cycle(r->m, n);
+    if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
+        luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+    sx_lua_check(L, r->m, st);
+}
+
+void sx_lua_check_not_running(lua_State *L, int model, const char *what)
+{
+    if (sx_lua_modelud(L, model)->running) luaL_error(L, "%s: not allowed while the model is cycling", what);
+}
+
+void sx_lua_cycle_plain(lua_State *L, int model, int64_t n)
+{
+    const int top = lua_gettop(L);
+    run *r = run_open(L, model, "generate");
+    core_cycle(L, r, n);
+    lua_settop(L, top);
+}
+
+/* ------------------------------------------------------------ callbacks */
+
+static const char *const point_names[] = {"after", "before", "cycle", NULL};
+enum { POINT_AFTER, POINT_BEFORE };
+
+/* Calls the function below its nargs arguments on behalf of the user, as a
+ * callback of the model at `model`: removals are queued meanwhile and
+ * applied after; a SIGINT stops the Lua code (see sx_lua_interrupt_all). */
+void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
+{
+    model = lua_absindex(L, model);
+    sx_lua_model *ud = sx_lua_modelud(L, model);
+    run *r = innermost();
+    const bool mine = r && r->ud == ud;
+    ud->callback++;
+    if (mine) atomic_store(&r->in_lua, 1);
+    const int status = lua_pcall(L, nargs, nres, 0);
+    if (mine) atomic_store(&r->in_lua, 0);
+    ud->callback--;
+    /* what the callback queued is applied even when it failed */
+    if (ud->callback == 0) sx_lua_apply_removals(L, model);
+    if (status != LUA_OK) {
+        /* a Ctrl-C that stopped the callback reads like one that stopped the cycle */
+        if (mine && atomic_load(&r->interrupted))
+            luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
+        lua_error(L);
+    }
+}
+
+/* The smallest multiple of every that is > s. */
+static int64_t next_multiple(int64_t s, int64_t every)
+{
+    const int64_t q = s / every + 1;
+    return q > INT64_MAX / every ? INT64_MAX : q * every;
+}
+
+/* Runs the callbacks of `point` due at step s (registration order; a
+ * callback added or removed by another is seen at the next boundary). */
+static void fire(lua_State *L, int model, int point, int64_t s)
+{
+    sx_lua_state(L, model, "callbacks");
+    const int t = lua_gettop(L);
+    /* a snapshot of the list, as callbacks may change it */
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, t);
+    lua_createtable(L, (int)n, 0);
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, t, i);
+        lua_rawseti(L, t + 1, i);
+    }
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, t + 1, i);
+        const int e = lua_gettop(L);
+        lua_getfield(L, e, "point");
+        lua_getfield(L, e, "every");
+        lua_getfield(L, e, "removed");
+        const bool due = lua_tointeger(L, e + 1) == point && s % lua_tointeger(L, e + 2) == 0 && !lua_toboolean(L, e + 3);
+        lua_settop(L, e);
+        if (due) {
+            lua_getfield(L, e, "fn");
+            lua_pushvalue(L, model);
+            sx_lua_user_call(L, model, 1, 0);
+        }
+        lua_settop(L, t + 1);
+    }
+    lua_settop(L, t - 1);
+}
+
+/* The next step > s at which a callback or a history is due. */
+static int64_t next_event(lua_State *L, int model, int64_t s)
+{
+    int64_t next = sx_lua_history_next(L, model, s);
+    sx_lua_state(L, model, "callbacks");
+    for (lua_Integer i = 1; lua_rawgeti(L, -1, i) == LUA_TTABLE; i++) {
+        lua_getfield(L, -1, "every");
+        const int64_t at = next_multiple(s, (int64_t)lua_tointeger(L, -1));
+        if (at < next) next = at;
+        lua_pop(L, 2);
+    }
+    lua_pop(L, 2);
+    return next;
+}
+
+static bool has_before(lua_State *L, int model)
+{
+    sx_lua_state(L, model, "callbacks");
+    const int t = lua_gettop(L);
+    bool any = false;
+    for (lua_Integer i = 1; !any && lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
+        lua_getfield(L, -1, "point");
+        any = lua_tointeger(L, -1) == POINT_BEFORE;
+        lua_settop(L, t);
+    }
+    lua_settop(L, t - 1);
+    return any;
+}
+
+/* m:on(point, fn[, {every = N}]) -> id */
+static int model_on(lua_State *L)
+{
+    static const char *const keys[] = {"every", NULL};
+    sx_lua_checkmodel(L, 1);
+    const int point = luaL_checkoption(L, 2, NULL, point_names);
+    luaL_checktype(L, 3, LUA_TFUNCTION);
+    int64_t every = 1;
+    if (!lua_isnoneornil(L, 4)) {
+        sx_lua_checkkeys(L, 4, keys);
+        sx_lua_optintfield(L, 4, "every", 1, INT64_MAX / 2, &every);
+    }
+    sx_lua_state(L, 1, "next_callback");
+    lua_rawgeti(L, -1, 1);
+    const lua_Integer id = lua_tointeger(L, -1) + 1;
+    lua_pop(L, 1);
+    lua_pushinteger(L, id);
+    lua_rawseti(L, -2, 1);
+    sx_lua_state(L, 1, "callbacks");
+    lua_createtable(L, 0, 5);
+    lua_pushinteger(L, id);
+    lua_setfield(L, -2, "id");
+    lua_pushinteger(L, point == POINT_BEFORE ? POINT_BEFORE : POINT_AFTER);
+    lua_setfield(L, -2, "point");
+    lua_pushinteger(L, (lua_Integer)every);
+    lua_setfield(L, -2, "every");
+    lua_pushvalue(L, 3);
+    lua_setfield(L, -2, "fn");
+    lua_rawseti(L, -2, (lua_Integer)lua_rawlen(L, -2) + 1);
+    lua_pushinteger(L, id);
+    return 1;
+}
+
+/* m:off(id): removes a callback; true if there was one. */
+static int model_off(lua_State *L)
+{
+    sx_lua_checkmodel(L, 1);
+    const lua_Integer id = luaL_checkinteger(L, 2);
+    sx_lua_state(L, 1, "callbacks");
+    const int t = lua_gettop(L);
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, t);
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, t, i);
+        lua_getfield(L, -1, "id");
+        const bool hit = lua_tointeger(L, -1) == id;
+        lua_pop(L, 1);
+        if (!hit) {
+            lua_pop(L, 1);
+            continue;
+        }
+        lua_pushboolean(L, 1);
+        lua_setfield(L, -2, "removed");  // a snapshot being fired skips it
+        lua_pop(L, 1);
+        for (lua_Integer j = i; j < n; j++) {
+            lua_rawgeti(L, t, j + 1);
+            lua_rawseti(L, t, j);
+        }
+        lua_pushnil(L);
+        lua_rawseti(L, t, n);
+        lua_pushboolean(L, 1);
+        return 1;
+    }
+    lua_pushboolean(L, 0);
+    return 1;
+}
+
+/* ------------------------------------------------------------- the run */
+
+typedef struct limits {
+    int64_t steps;   // at most this many steps (INT64_MAX: no limit)
+    double time;     // stop once the model time reaches this (INFINITY: none)
+    double ratio;    // stop once the unbalanced ratio is <= this (0: none)
+    int64_t every;   // ratio check interval
+} limits;
+
+enum reason { BY_STEPS, BY_TIME, BY_RATIO };
+static const char *const reason_names[] = {"steps", "time", "ratio"};
+
+/* Steps to the first boundary at or after the model time t_end. */
+static int64_t steps_to_time(sx_model *m, double t_end)
+{
+    const double dt = sx_model_timestep(m);
+    if (!(dt > 0)) return 1;  // let the core say what is wrong
+    const double k = ceil((t_end - sx_model_time(m)) / dt - 1e-9);
+    return k < 1 ? 1 : k > 1e15 ? (int64_t)1e15 : (int64_t)k;
+}
+
+static bool time_reached(sx_model *m, double t_end)
+{
+    if (isinf(t_end)) return false;
+    const double dt = sx_model_timestep(m);
+    return sx_model_time(m) >= t_end - (dt > 0 ? 1e-9 * dt : 0);
+}
+
+/* Runs the model at stack index 1 until a limit stops it: returns why,
+ * and the last ratio measured (NaN when none was) in *ratio. */
+static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
+{
+    run *r = run_open(L, 1, "cycle");
+    sx_model *m = r->m;
+    const int top = lua_gettop(L);
+    const int64_t start = sx_model_step_count(m);
+    const double t0 = sx_model_time(m);
+    const bool before = has_before(L, 1);
+    progress *p = &r->progress;
+    progress_start(L, p, m);
+    *ratio = NAN;
+    enum reason why = BY_STEPS;
+    for (bool first = true;; first = false) {
+        const int64_t s = sx_model_step_count(m);
+        if (!first) {
+            fire(L, 1, POINT_AFTER, s);
+            sx_lua_history_record(L, 1);
+        }
+        sx_lua_apply_removals(L, 1);
+        const int64_t taken = s - start;
+        if (taken >= lim->steps) {
+            why = BY_STEPS;
+            break;
+        }
+        if (time_reached(m, lim->time)) {
+            why = BY_TIME;
+            break;
+        }
+        if (lim->ratio > 0 && !first && taken % lim->every == 0) {
+            *ratio = sx_model_unbalanced_ratio(m);
+            if (*ratio <= lim->ratio) {
+                why = BY_RATIO;
+                break;
+            }
+        }
+        check_interrupt(L, r);
+        if (before) fire(L, 1, POINT_BEFORE, s);
+        /* the next chunk: up to the first thing due */
+        int64_t n = lim->steps - taken;
+        const int64_t ev = next_event(L, 1, s) - s;
+        if (ev < n) n = ev;
+        if (lim->ratio > 0) {
+            const int64_t k = lim->every - taken % lim->every;
+            if (k < n) n = k;
+        }
+        if (!isinf(lim->time)) {
+            const int64_t k = steps_to_time(m, lim->time);
+            if (k < n) n = k;
+        }
+        if (p->on && p->chunk < n) n = p->chunk;
+        core_cycle(L, r, n);
+        double fraction = -1;
+        int64_t total = 0;
+        if (lim->steps < INT64_MAX) {
+            total = lim->steps;
+            fraction = (double)(sx_model_step_count(m) - start) / (double)lim->steps;
+        }
+        if (!isinf(lim->time)) {
+            const double f = (sx_model_time(m) - t0) / (lim->time - t0);
+            if (f > fraction) fraction = f;
+        }
+        progress_show(p, m, total, fraction, *ratio, lim->ratio);
+        lua_settop(L, top);
+    }
+    lua_settop(L, top - 1);  // closes the run
+    return why;
+}
+
+static int model_cycle(lua_State *L)
+{
+    sx_lua_checkmodel(L, 1);
+    const lua_Integer n = luaL_checkinteger(L, 2);
+    luaL_argcheck(L, n >= 0, 2, "the number of steps must be >= 0");
+    lua_settop(L, 1);
+    const limits lim = {(int64_t)n, INFINITY, 0, 1};
+    double ratio;
+    run_model(L, &lim, &ratio);
+    return 0;
+}
+
+/* m:solve{ratio=, steps=, time=, every=} -> reason, ratio, steps taken */
+static int model_solve(lua_State *L)
+{
+    static const char *const keys[] = {"ratio", "steps", "time", "every", NULL};
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    limits lim = {INT64_MAX, INFINITY, 0, 100};
+    if (!lua_isnoneornil(L, 2)) {
+        sx_lua_checkkeys(L, 2, keys);
+        double t;
+        if (sx_lua_optnumfield(L, 2, "time", &t)) {
+            if (!(t > 0 && t < INFINITY)) sx_lua_fielderror(L, 2, "time", "a duration > 0 s expected");
+            lim.time = sx_model_time(m) + t;
+        }
+        if (sx_lua_optnumfield(L, 2, "ratio", &lim.ratio) && !(lim.ratio > 0 && lim.ratio < INFINITY))
+            sx_lua_fielderror(L, 2, "ratio", "a ratio > 0 expected");
+        sx_lua_optintfield(L, 2, "steps", 0, INT64_MAX / 2, &lim.steps);
+        sx_lua_optintfield(L, 2, "every", 1, 1000000000, &lim.every);
+    }
+    if (lim.ratio == 0 && lim.steps == INT64_MAX && isinf(lim.time)) lim.ratio = 1e-5;  // PFC's default
+    lua_settop(L, 1);
+    const int64_t start = sx_model_step_count(m);
+    double ratio;
+    const enum reason why = run_model(L, &lim, &ratio);
+    lua_pushstring(L, reason_names[why]);
+    lua_pushnumber(L, isnan(ratio) ? sx_model_unbalanced_ratio(m) : ratio);
+    lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));
+    return 3;
+}
+
+const luaL_Reg sx_lua_run_methods[] = {
+    {"cycle", model_cycle},
+    {"solve", model_solve},
+    {"on", model_on},
+    {"off", model_off},
+    {NULL, NULL},
+};

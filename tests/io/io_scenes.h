@@ -1,0 +1,42 @@
+/* Scenes and helpers shared by the I/O tests: models that exercise every
+ * piece of state a restart must carry (walls of every kind, moving walls,
+ * friction, dashpots, bonds that break, applied loads, fixities, groups,
+ * removed balls, energy tracking). */
+#pragma once
+
+#include "scenes.h"
+#include "seixo_io.h"
+
+#include <check.h>
+#include <stdint.h>
+
+#define io_cycle(m, n) \
+    ck_assert_msg(sx_model_cycle((m), (n)) == SX_OK, "cycle failed: %s", sx_model_error(m))
+
+/// Balls settling under gravity in a box whose lid moves down, with two
+/// materials, a finite wall (3D rect / 2D segment) as an obstacle, an
+/// applied force, fixities, groups, a removed ball and energy tracking.
+sx_model *io_scene_granular(int dim, int nballs);
+/// A bonded lattice (parallel and contact bonds) pulled apart by its top
+/// layer while a wall presses on its side: bonds break, cracks are logged.
+sx_model *io_scene_bonded(int dim);
+/// Hertz-Mindlin balls dropped on a floor with a fixed user timestep.
+sx_model *io_scene_hertz(int dim);
+
+/// A fresh temporary folder (removed with io_rmdir); the path is static storage.
+const char *io_tmpdir(void);
+/// path = dir + "/" + name into out.
+const char *io_path(char *out, size_t len, const char *name);
+/// Removes the folder made by io_tmpdir and everything in it.
+void io_rmdir(void);
+
+/// Saves m to path (asserts success).
+void io_save(const sx_model *m, const char *path);
+/// Loads path (asserts success).
+sx_model *io_load(const char *path, int dim);
+/// No HDF5 object (file, group, dataset, ...) is left open.
+void io_assert_no_handles(void);
+/// Energies equal to the bit.
+void io_assert_same_energy(sx_model *a, sx_model *b);
+/// Same crack log, bond and contact counts, walls' forces (bits).
+void io_assert_same_extras(const sx_model *a, const sx_model *b);

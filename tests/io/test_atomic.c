@@ -1,0 +1,226 @@
+/* Nothing is lost: a writer killed in the middle of a save leaves the
+ * previous file intact (and loadable); a series whose writer is killed
+ * still opens with every complete snapshot, its XDMF lists them, and it can
+ * be continued. The writers are child processes killed with SIGKILL. */
+#include "io_scenes.h"
+
+#include <hdf5.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+/* A big model quickly: balls on a lattice (no O(n^2) placement). */
+static sx_model *lattice(int dim, int n)
+{
+    sx_model *m = scene_model(dim, NULL, 0, 1e6, 0.5, 2600);
+    const int side = dim == 3 ? (int)ceil(cbrt((double)n)) : (int)ceil(sqrt((double)n));
+    uint64_t s = 5;
+    for (int i = 0; i < n; i++) {
+        const double x[3] = {0.01 * (i % side), 0.01 * ((i / side) % side), dim == 3 ? 0.01 * (i / (side * side)) : 0};
+        const double v[3] = {scene_rng_uniform(&s, -1, 1), scene_rng_uniform(&s, -1, 1), dim == 3 ? 0.5 : 0};
+        sx_ball_def b = sx_ball_default_def();
+        memcpy(b.pos, x, sizeof x);
+        memcpy(b.vel, v, sizeof v);
+        b.radius = 0.004;
+        ck_assert_int_eq(sx_ball_add(m, &b, NULL), SX_OK);
+    }
+    return m;
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void sleep_ms(long ms)
+{
+    struct timespec t = {ms / 1000, (ms % 1000) * 1000000L};
+    nanosleep(&t, NULL);
+}
+
+START_TEST(killed_save_keeps_previous)
+{
+    char path[512];
+    io_path(path, sizeof path, "state.h5");
+    sx_model *a = io_scene_granular(3, 40);
+    io_cycle(a, 10);
+    io_save(a, path);
+    const uint64_t ha = sx_model_state_hash(a);
+    sx_model_destroy(a);
+    sx_model *big = lattice(3, 200000);
+    const uint64_t hb = sx_model_state_hash(big);
+
+    /* kill times from "before any save finished" to "after several", scaled
+     * by how long a save takes here (sanitizers and valgrind are slower) */
+    char timing[512];
+    const double t0 = now();
+    io_save(big, io_path(timing, sizeof timing, "timing.h5"));
+    const double t_save = now() - t0;
+    remove(timing);
+    printf("  one save of %lld balls: %.0f ms\n", (long long)sx_ball_count(big), 1e3 * t_save);
+    const long delays[] = {(long)(100 * t_save), (long)(600 * t_save), (long)(1500 * t_save), (long)(2500 * t_save),
+                           (long)(4200 * t_save)};
+    int saw_a = 0, saw_b = 0;
+    for (size_t k = 0; k < sizeof delays / sizeof *delays; k++) {
+        int go[2];
+        ck_assert_int_eq(pipe(go), 0);
+        const pid_t pid = fork();
+        ck_assert_int_ge(pid, 0);
+        if (pid == 0) { /* the writer: saves the big model again and again */
+            close(go[0]);
+            char c = 1, err[512];
+            ck_assert_int_eq(write(go[1], &c, 1), 1);
+            for (;;)
+                if (sx_snapshot_save(big, path, NULL, err, sizeof err)) _exit(3);
+        }
+        close(go[1]);
+        char c;
+        ck_assert_int_eq(read(go[0], &c, 1), 1);
+        close(go[0]);
+        sleep_ms(delays[k]);
+        kill(pid, SIGKILL);
+        int status;
+        waitpid(pid, &status, 0);
+        ck_assert_msg(WIFSIGNALED(status), "the writer ended by itself (status %d)", status);
+        sx_model *m = io_load(path, 3);
+        const uint64_t h = sx_model_state_hash(m);
+        ck_assert_msg(h == ha || h == hb, "killed after %ld ms: the file holds neither complete state", delays[k]);
+        saw_a += h == ha, saw_b += h == hb;
+        printf("  killed after %4ld ms: %s\n", delays[k], h == ha ? "the previous file" : "the completed save");
+        fflush(stdout);
+        sx_model_destroy(m);
+    }
+    ck_assert_msg(saw_a > 0 && saw_b > 0, "the kills did not cover both sides of a completed save");
+    sx_model_destroy(big);
+}
+END_TEST
+
+static int count_steps(const char *xmf)
+{
+    FILE *f = fopen(xmf, "rb");
+    ck_assert_ptr_nonnull(f);
+    char line[4096];
+    int n = 0;
+    bool closed = false;
+    while (fgets(line, sizeof line, f)) {
+        n += strstr(line, "<Time Value=") != NULL;
+        closed = strstr(line, "</Xdmf>") != NULL;
+    }
+    fclose(f);
+    ck_assert_msg(closed, "%s does not end with </Xdmf>", xmf);
+    return n;
+}
+
+/* Every dataset of every complete snapshot reads back. */
+static void read_all(const char *path, int64_t count)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    ck_assert(f >= 0);
+    for (int64_t k = 0; k < count; k++) {
+        char name[64];
+        const char *ds[] = {"balls/position", "balls/velocity", "balls/radius", "contacts/connectivity",
+                            "walls/points"};
+        for (size_t q = 0; q < sizeof ds / sizeof *ds; q++) {
+            snprintf(name, sizeof name, "/snapshots/%06lld/%s", (long long)k, ds[q]);
+            hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+            ck_assert_msg(d >= 0, "%s is missing", name);
+            hid_t s = H5Dget_space(d), t = H5Dget_type(d);
+            const hssize_t np = H5Sget_simple_extent_npoints(s);
+            void *buf = malloc((size_t)(np > 0 ? np : 1) * H5Tget_size(t));
+            ck_assert_msg(np == 0 || H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0, "%s unreadable", name);
+            free(buf);
+            H5Tclose(t);
+            H5Sclose(s);
+            H5Dclose(d);
+        }
+    }
+    H5Fclose(f);
+}
+
+START_TEST(killed_series_keeps_snapshots)
+{
+    char path[512], xmf[512];
+    io_path(path, sizeof path, "series.h5");
+    io_path(xmf, sizeof xmf, "series.xmf");
+    const long delays[] = {30, 250, 700};
+    for (size_t k = 0; k < sizeof delays / sizeof *delays; k++) {
+        int go[2];
+        ck_assert_int_eq(pipe(go), 0);
+        const pid_t pid = fork();
+        ck_assert_int_ge(pid, 0);
+        if (pid == 0) {
+            close(go[0]);
+            sx_model *m = io_scene_granular(3, 60);
+            sx_model *big = lattice(3, 50000);
+            char err[512];
+            sx_series_opts o;
+            memset(&o, 0, sizeof o);
+            o.fields = SX_OUT_DEFAULT | SX_OUT_MOMENT | SX_OUT_MASS | SX_OUT_MATERIAL;
+            sx_series *s = sx_series_open(path, 3, &o, err, sizeof err);
+            if (!s) _exit(3);
+            char c = 1;
+            ck_assert_int_eq(write(go[1], &c, 1), 1);
+            for (int i = 0;; i++) {
+                if (sx_series_write(s, i % 2 ? big : m, err, sizeof err)) _exit(4);
+                sx_model_cycle(m, 5);
+            }
+        }
+        close(go[1]);
+        char c;
+        ck_assert_int_eq(read(go[0], &c, 1), 1);
+        close(go[0]);
+        sleep_ms(delays[k]);
+        kill(pid, SIGKILL);
+        int status;
+        waitpid(pid, &status, 0);
+        ck_assert_msg(WIFSIGNALED(status), "the writer ended by itself (status %d)", status);
+        char err[512];
+        const int64_t count = sx_series_read_count(path, err, sizeof err);
+        ck_assert_msg(count >= 0, "%s", err);
+        read_all(path, count);
+        const int steps = count_steps(xmf);
+        printf("  killed after %4ld ms: %lld complete snapshots, %d in the XDMF\n", delays[k], (long long)count, steps);
+        fflush(stdout);
+        ck_assert(steps == count || steps == count - 1);
+        /* the series continues where it stopped; its XDMF is rebuilt */
+        sx_series_opts o;
+        memset(&o, 0, sizeof o);
+        o.append = true;
+        sx_series *s = sx_series_open(path, 3, &o, err, sizeof err);
+        ck_assert_msg(s, "%s", err);
+        ck_assert_int_eq(sx_series_count(s), count);
+        sx_model *m = io_scene_granular(3, 30);
+        ck_assert_msg(sx_series_write(s, m, err, sizeof err) == SX_OK, "%s", err);
+        ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+        sx_model_destroy(m);
+        ck_assert_int_eq(sx_series_read_count(path, err, sizeof err), count + 1);
+        ck_assert_int_eq(count_steps(xmf), count + 1);
+        read_all(path, count + 1);
+        io_assert_no_handles();
+    }
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("io_atomic");
+    TCase *tc = tcase_create("atomic");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, killed_save_keeps_previous);
+    tcase_add_test(tc, killed_series_keeps_snapshots);
+    suite_add_tcase(s, tc);
+    io_tmpdir();
+    SRunner *r = srunner_create(s);
+    srunner_run_all(r, CK_NORMAL);
+    const int failed = srunner_ntests_failed(r);
+    srunner_free(r);
+    io_rmdir();
+    return failed ? 1 : 0;
+}

@@ -1,0 +1,211 @@
+/* Restarts continue bit-for-bit: 2N steps straight and N steps + save +
+ * load + N steps give the same state hash, energies, crack log, bond and
+ * contact counts and wall forces, in 2D and 3D, for granular, bonded and
+ * Hertz scenes, saved at several points of the broad phase's cycle. */
+#include "io_scenes.h"
+
+#include <hdf5.h>
+#include <stdio.h>
+#include <string.h>
+
+typedef sx_model *(*scene_fn)(int dim);
+
+static sx_model *granular(int dim) { return io_scene_granular(dim, 150); }
+
+/* Runs the scene 2n steps straight, and n + save + load + n, and compares.
+ * `poke` changes a ball's position at step n in both runs (the save then
+ * happens with a rebuild pending and a dirty guard). */
+static void restart(scene_fn scene, int dim, int n, bool poke)
+{
+    sx_model *a = scene(dim), *b = scene(dim);
+    ck_assert_uint_eq(sx_model_state_hash(a), sx_model_state_hash(b));
+    io_cycle(a, n);
+    io_cycle(b, n);
+    if (poke) {
+        const int64_t id = sx_ball_id_at(a, sx_ball_count(a) / 2);
+        double x[3];
+        ck_assert_int_eq(sx_ball_get_vec(a, id, SX_BALL_POS, x), SX_OK);
+        x[0] += 1e-6;
+        ck_assert_int_eq(sx_ball_set_vec(a, id, SX_BALL_POS, x), SX_OK);
+        ck_assert_int_eq(sx_ball_set_vec(b, id, SX_BALL_POS, x), SX_OK);
+    }
+    io_cycle(a, n);
+
+    char path[512];
+    io_path(path, sizeof path, "restart.h5");
+    io_save(b, path);
+    sx_model *c = io_load(path, dim);
+    ck_assert_uint_eq(sx_model_state_hash(c), sx_model_state_hash(b));
+    /* the saved model and its copy continue alike, and like the straight run */
+    io_cycle(b, n);
+    io_cycle(c, n);
+    ck_assert_uint_eq(sx_model_state_hash(b), sx_model_state_hash(a));
+    ck_assert_msg(sx_model_state_hash(c) == sx_model_state_hash(a),
+                  "%dD restart after %d steps diverged (hash %016llx, straight %016llx)", dim, n,
+                  (unsigned long long)sx_model_state_hash(c), (unsigned long long)sx_model_state_hash(a));
+    io_assert_same_extras(a, c);
+    io_assert_same_energy(a, c);
+    sx_model_destroy(a);
+    sx_model_destroy(b);
+    sx_model_destroy(c);
+}
+
+START_TEST(granular_restart)
+{
+    const int dim = _i;
+    const int n[] = {1, 37, 800};
+    for (int k = 0; k < 3; k++) restart(granular, dim, n[k], false);
+    restart(granular, dim, 300, true);
+}
+END_TEST
+
+START_TEST(bonded_restart)
+{
+    const int dim = _i;
+    /* the specimen must have cracked before and after the save */
+    const int n = dim == 3 ? 150 : 250;
+    sx_model *m = io_scene_bonded(dim);
+    const int64_t bonds0 = sx_bond_count(m);
+    io_cycle(m, n);
+    const int64_t cracks1 = sx_crack_count(m);
+    io_cycle(m, n);
+    printf("%dD bonded: %lld bonds, %lld cracks at %d steps, %lld at %d\n", dim, (long long)bonds0,
+           (long long)cracks1, n, (long long)sx_crack_count(m), 2 * n);
+    ck_assert(cracks1 > 0 && sx_crack_count(m) > cracks1);
+    sx_model_destroy(m);
+    restart(io_scene_bonded, dim, n, false);
+    restart(io_scene_bonded, dim, 1, true);
+}
+END_TEST
+
+START_TEST(hertz_restart)
+{
+    restart(io_scene_hertz, _i, 500, false);
+}
+END_TEST
+
+/* Save, load, save again: the second file loads into the same state, and
+ * an empty model round-trips too. */
+START_TEST(resave)
+{
+    const int dim = _i;
+    sx_model *a = io_scene_bonded(dim);
+    io_cycle(a, 200);
+    char p1[512], p2[512];
+    io_save(a, io_path(p1, sizeof p1, "one.h5"));
+    sx_model *b = io_load(p1, dim);
+    io_save(b, io_path(p2, sizeof p2, "two.h5"));
+    sx_model *c = io_load(p2, 0);
+    ck_assert_uint_eq(sx_model_state_hash(c), sx_model_state_hash(a));
+    ck_assert_int_eq(sx_model_bytes(b), sx_model_bytes(c));
+    io_cycle(a, 100);
+    io_cycle(c, 100);
+    ck_assert_uint_eq(sx_model_state_hash(c), sx_model_state_hash(a));
+    sx_model_destroy(a);
+    sx_model_destroy(b);
+    sx_model_destroy(c);
+
+    sx_model_def d = sx_model_default_def();
+    d.dim = dim;
+    d.gravity[dim - 1] = -1;
+    sx_model *e = sx_model_create(&d, NULL, 0);
+    io_save(e, p1);
+    sx_model *f = io_load(p1, dim);
+    ck_assert_int_eq(sx_ball_count(f), 0);
+    double g[3];
+    sx_model_gravity(f, g);
+    ck_assert(g[dim - 1] == -1);
+    sx_model_destroy(e);
+    sx_model_destroy(f);
+}
+END_TEST
+
+/* A loaded model keeps its materials, walls, ids, groups, fixities. */
+START_TEST(contents)
+{
+    const int dim = _i;
+    sx_model *a = io_scene_granular(dim, 60);
+    io_cycle(a, 50);
+    char p[512];
+    io_save(a, io_path(p, sizeof p, "c.h5"));
+    sx_model *b = io_load(p, dim);
+    ck_assert_int_eq(sx_material_count(b), 2);
+    ck_assert_str_eq(sx_material_name(b, 1), "soft");
+    sx_material_def ma, mb;
+    sx_material_get(a, 1, &ma);
+    sx_material_get(b, 1, &mb);
+    ck_assert(memcmp(&ma, &mb, sizeof ma) == 0);
+    for (int64_t i = 0; i < sx_ball_count(a); i++) {
+        const int64_t id = sx_ball_id_at(a, i);
+        ck_assert_int_eq(sx_ball_id_at(b, i), id);
+        int32_t ga, gb;
+        unsigned fa, fb;
+        sx_ball_group(a, id, &ga), sx_ball_group(b, id, &gb);
+        sx_ball_fixity(a, id, &fa), sx_ball_fixity(b, id, &fb);
+        ck_assert_int_eq(ga, gb);
+        ck_assert_uint_eq(fa, fb);
+        double va[3], vb[3];
+        sx_ball_get_vec(a, id, SX_BALL_APPLIED_FORCE, va);
+        sx_ball_get_vec(b, id, SX_BALL_APPLIED_FORCE, vb);
+        ck_assert(memcmp(va, vb, sizeof va) == 0);
+    }
+    ck_assert(!sx_ball_exists(b, 4)); /* removed before the save */
+    ck_assert_int_eq(sx_wall_count(b), sx_wall_count(a));
+    for (int64_t i = 0; i < sx_wall_count(a); i++) {
+        sx_wall_def wa, wb;
+        sx_wall_get(a, sx_wall_id_at(a, i), &wa);
+        sx_wall_get(b, sx_wall_id_at(b, i), &wb);
+        ck_assert(memcmp(&wa, &wb, sizeof wa) == 0);
+    }
+    /* new balls and walls get fresh ids after a load, as they would have */
+    sx_ball_def bd = sx_ball_default_def();
+    bd.radius = 0.003;
+    bd.pos[0] = bd.pos[1] = 0.05;
+    int64_t ida, idb;
+    ck_assert_int_eq(sx_ball_add(a, &bd, &ida), SX_OK);
+    ck_assert_int_eq(sx_ball_add(b, &bd, &idb), SX_OK);
+    ck_assert_int_eq(ida, idb);
+    sx_wall_def wd = sx_wall_default_def(dim);
+    ck_assert_int_eq(sx_wall_add(a, &wd, &ida), SX_OK);
+    ck_assert_int_eq(sx_wall_add(b, &wd, &idb), SX_OK);
+    ck_assert_int_eq(ida, idb);
+    sx_model_destroy(a);
+    sx_model_destroy(b);
+}
+END_TEST
+
+/* Threads are a setting of the model: kept, and results do not depend on them. */
+START_TEST(threads_kept)
+{
+    sx_model *a = io_scene_granular(3, 100);
+    ck_assert_int_eq(sx_model_set_threads(a, 3), SX_OK);
+    io_cycle(a, 20);
+    char p[512];
+    io_save(a, io_path(p, sizeof p, "t.h5"));
+    sx_model *b = io_load(p, 3);
+    ck_assert_int_eq(sx_model_threads(b), 3);
+    sx_model_destroy(a);
+    sx_model_destroy(b);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("io_restart");
+    TCase *tc = tcase_create("restart");
+    tcase_set_timeout(tc, 600);
+    tcase_add_loop_test(tc, granular_restart, 2, 4);
+    tcase_add_loop_test(tc, bonded_restart, 2, 4);
+    tcase_add_loop_test(tc, hertz_restart, 2, 4);
+    tcase_add_loop_test(tc, resave, 2, 4);
+    tcase_add_loop_test(tc, contents, 2, 4);
+    tcase_add_test(tc, threads_kept);
+    suite_add_tcase(s, tc);
+    io_tmpdir(); /* one folder for every test (they run in child processes), removed at the end */
+    SRunner *r = srunner_create(s);
+    srunner_run_all(r, CK_NORMAL);
+    const int failed = srunner_ntests_failed(r);
+    srunner_free(r);
+    io_rmdir();
+    return failed ? 1 : 0;
+}

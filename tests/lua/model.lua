@@ -1,0 +1,229 @@
+-- Model-level behaviour: m:solve and its stopping rules, cycling in chunks,
+-- timestep and gravity, the summary, lifetime rules while cycling, and the
+-- progress display.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
+local HERE = "model.lua:"
+
+-- a column of n balls resting above a floor, under gravity
+local function column(dim, n)
+  local m = T.model(dim, {gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81}})
+  local r = 0.01
+  m:wall{kind = dim == 3 and "plane" or "line", point = T.zero(dim), normal = dim == 3 and {0, 0, 1} or {0, 1}}
+  for i = 1, n do
+    local pos = T.zero(dim)
+    pos[dim] = r + (i - 1) * 2.02 * r
+    m:ball{pos = pos, radius = r}
+  end
+  return m
+end
+
+test("solve stops on steps", function()
+  local m = column(3, 3)
+  local why, ratio, steps = m:solve{steps = 250}
+  eq(why, "steps")
+  eq(steps, 250)
+  eq(m:step(), 250)
+  check(ratio > 0, "a ratio is reported")
+  why, ratio, steps = m:solve{steps = 0}
+  eq(why, "steps")
+  eq(steps, 0)
+  eq(m:step(), 250)
+end)
+
+test("solve stops on time", function()
+  local m = column(2, 2)
+  m:set_timestep(1e-4)
+  local t0 = m:time()
+  local why, _, steps = m:solve{time = 0.0123}
+  eq(why, "time")
+  check(m:time() >= t0 + 0.0123 - 1e-12, "the time is reached")
+  check(m:time() < t0 + 0.0123 + 1e-4, "by the first step past it")
+  eq(steps, 123)
+  eq(m:step(), 123)
+end)
+
+test("solve stops on the unbalanced-force ratio", function()
+  for _, dim in ipairs({2, 3}) do
+    local m = column(dim, 4)
+    local why, ratio, steps = m:solve{ratio = 1e-4, every = 50, steps = 500000}
+    eq(why, "ratio", dim .. "D")
+    check(ratio <= 1e-4, "ratio reached: " .. ratio)
+    eq(m:ratio(), ratio)
+    eq(steps % 50, 0, "the ratio is checked every 50 steps")
+    check(steps > 50, "it took cycling to settle")
+    -- the settled column: the floor carries the weight
+    local weight = m:sum("mass") * 9.81
+    local floor
+    for w in m:walls() do floor = w end
+    near(-floor.force[dim], weight, 1e-3)
+  end
+end)
+
+test("solve with no limit uses ratio 1e-5; the first of several limits wins", function()
+  local m = column(3, 2)
+  local why, ratio = m:solve()
+  eq(why, "ratio")
+  check(ratio <= 1e-5)
+  local m2 = column(3, 2)
+  why = m2:solve{ratio = 1e-12, steps = 300}
+  eq(why, "steps")
+  eq(m2:step(), 300)
+end)
+
+test("solve arguments", function()
+  local m = column(3, 1)
+  raises(function() m:solve{ratoi = 1} end, HERE, "bad argument #1 to 'solve'", "unknown key 'ratoi'", "ratio, steps, time, every")
+  raises(function() m:solve{ratio = -1} end, HERE, "field 'ratio'")
+  raises(function() m:solve{ratio = 0 / 0} end, HERE, "field 'ratio'")
+  raises(function() m:solve{time = 0} end, HERE, "field 'time'")
+  raises(function() m:solve{time = math.huge} end, HERE, "field 'time'")
+  raises(function() m:solve{steps = -1} end, HERE, "field 'steps'")
+  raises(function() m:solve{steps = 1.5} end, HERE, "field 'steps'")
+  raises(function() m:solve{every = 0} end, HERE, "field 'every'")
+  raises(function() m:solve(5) end, HERE, "table expected")
+  eq(m:step(), 0)
+end)
+
+test("cycling in pieces equals one cycle, callbacks and histories included", function()
+  local function run(pieces)
+    local m = column(3, 5)
+    local calls = 0
+    m:on("cycle", function() calls = calls + 1 end, {every = 7})
+    m:history("z", {ball = 5, field = "pos", component = 3}, {every = 13})
+    for _, n in ipairs(pieces) do m:cycle(n) end
+    return m:hash(), calls, #m:history("z").values
+  end
+  local h1, c1, n1 = run({200})
+  local h2, c2, n2 = run({1, 99, 37, 63})
+  eq(h2, h1)
+  eq(c1, 200 // 7)
+  eq(c2, c1)
+  eq(n1, 200 // 13)
+  eq(n2, n1)
+end)
+
+test("timestep and gravity", function()
+  local m = column(3, 2)
+  m:set_timestep(2e-5)
+  eq(m:timestep(), 2e-5)
+  m:set_timestep("auto")
+  near(m:timestep(), 0.8 * m:critical_timestep(), 1e-12)
+  raises(function() m:set_timestep("fast") end, HERE, "'auto'")
+  m:set_gravity({0, 0, -1})
+  T.vec_eq(m:gravity(), {0, 0, -1})
+end)
+
+test("materials()", function()
+  local m = T.model(3)
+  m:material("steel", {density = 7800, kn = 2e9, friction = 0.2})
+  local all = m:materials()
+  eq(all.rock.density, 2000)
+  eq(all.rock.ks, 5e5)
+  eq(all.steel.kn, 2e9)
+  eq(all.steel.friction, 0.2)
+  eq(all.steel.model, "linear")
+end)
+
+test("print(m) shows a summary", function()
+  local m = column(3, 3)
+  m:ball(1).group = "bottom"
+  m:history("ke", "kinetic")
+  m:on("cycle", function() end)
+  m:cycle(10)
+  local s = tostring(m)
+  eq(s, m:summary())
+  for _, frag in ipairs({"seixo.model 3D: 3 balls, 1 walls", "step 10", "timestep", "gravity {0.0, 0.0, -9.81} m/s^2",
+                         "materials: rock", "groups: bottom", "unbalanced ratio", "kinetic energy", "histories: ke",
+                         "callbacks: 1"}) do
+    check(s:find(frag, 1, true), "summary lacks " .. frag .. ":\n" .. s)
+  end
+  local empty = seixo.model{dim = 2}
+  check(tostring(empty):find("automatic (no ball yet)", 1, true), tostring(empty))
+  empty:close()
+  eq(tostring(empty), "seixo.model (closed)")
+end)
+
+test("a model cannot be closed or re-cycled from its own callback", function()
+  local m = column(2, 2)
+  m:on("cycle", function() m:close() end, {every = 5})
+  raises(function() m:cycle(10) end, HERE, "cycling")
+  eq(m:step(), 5)
+  local id = m:on("cycle", function() m:cycle(1) end)
+  raises(function() m:cycle(10) end, "already cycling")
+  m:off(1)
+  m:off(id)
+  m:cycle(10)  -- usable again
+  eq(m:step(), 16)
+  -- another model may cycle from a callback
+  local other = column(2, 1)
+  m:on("cycle", function() other:cycle(2) end, {every = 2})
+  m:cycle(4)
+  eq(other:step(), 4)
+end)
+
+test("an error in the core leaves the model usable", function()
+  local m = T.model(3)
+  m:ball{pos = {0, 0, 0}, radius = 0.01}
+  m:ball{pos = {0.015, 0, 0}, radius = 0.01}
+  m:set_timestep(1)  -- far beyond the critical timestep
+  local err = raises(function() m:cycle(100) end, HERE, "unstable")
+  check(not err:find("interrupted"), err)
+  m:set_timestep(1e-6)
+  m:ball(1).pos = {-1, 0, 0}
+  m:ball(1).vel = {0, 0, 0}
+  m:ball(2).vel = {0, 0, 0}
+  m:cycle(3)
+end)
+
+test("progress: off when stderr is not a terminal, and nothing is printed", function()
+  local slow = [[
+    local m = seixo.model{dim = 2, timestep = 1e-4}
+    m:material("a")
+    m:ball{pos = {0, 0}, radius = 1}
+    m:on("cycle", function() local t = os.clock() while os.clock() - t < 0.02 do end end)
+    %s
+    m:cycle(80)
+    print("progress", seixo.progress())]]
+  local status, out = T.run("-e " .. T.quote(slow:format("")))
+  eq(status, 0, out)
+  check(out:find("progress\tfalse", 1, true), out)
+  check(not out:find("steps/s", 1, true), out)
+  -- forced on, the same run shows the line (steps, time, speed, ETA)
+  status, out = T.run("-e " .. T.quote(slow:format("seixo.progress(true)")))
+  eq(status, 0, out)
+  check(out:find("step %d+ of 80"), out)
+  check(out:find("steps/s", 1, true) and out:find("ETA", 1, true), out)
+  eq(seixo.progress(seixo.progress()), seixo.progress())
+  raises(function() seixo.progress("yes") end, HERE, "boolean expected")
+end)
+
+test("--threads is accepted and recorded", function()
+  local status, out = T.run("--threads 3 -e 'print(seixo.threads)'")
+  eq(status, 0, out)
+  eq(out, "3\n")
+  status, out = T.run("-e 'print(seixo.threads)'")
+  eq(out, "1\n")
+  status, out = T.run("--threads 0 -e 'print(1)'")
+  eq(status, 1)
+  check(out:find("'--threads' needs a whole number", 1, true), out)
+  status, out = T.run("--threads")
+  eq(status, 1)
+  status, out = T.run("--help")
+  check(out:find("--threads N", 1, true), out)
+end)
+
+test("the library is on package.path, help is global", function()
+  local status, out = T.run("-e " .. T.quote("print(require('seixo.util').norm({3, 4}), type(help))"))
+  eq(status, 0, out)
+  eq(out, "5.0\tfunction\n")
+  -- an override that has no library: require fails with a clear message
+  local cmd = "SEIXO_LUA_PATH=/nonexistent timeout 60 " .. T.quote(T.seixo) .. " -e " ..
+              T.quote("print(pcall(require, 'seixo.util'))") .. " 2>&1"
+  local p = io.popen(cmd)
+  out = p:read("a")
+  p:close()
+  check(out:find("false", 1, true) and out:find("/nonexistent/seixo/util.lua", 1, true), out)
+end)
+
+T.done()
