@@ -420,6 +420,10 @@ static void move_walls(sx_model *m, double *max_wall)
             s += w->def.vel[k] * w->def.vel[k];
         }
         w->moved += sqrt(s) * m->dt;
+        if (w->def.kind == SX_WALL_CYLINDER) {
+            w->def.radius += w->def.radial_vel * m->dt;
+            w->moved += fabs(w->def.radial_vel) * m->dt;
+        }
         if (w->moved > *max_wall) *max_wall = w->moved;
     }
 }
@@ -456,6 +460,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
         if ((st = k->contacts(m))) break;
         double max_disp, max_wall;
         if ((st = k->integrate(m, &max_disp))) break;
+        sx__walls_servo(m);
         move_walls(m, &max_wall);
         m->time += m->dt;
         m->dt_prev = m->dt;
