@@ -347,9 +347,12 @@ sx_status sx_model_set_timestep(sx_model *m, double dt)
  * orders of magnitude, the integration is unstable. */
 static bool unforced(const sx_model *m)
 {
-    for (int64_t w = 0; w < m->nwall; w++)
+    for (int64_t w = 0; w < m->nwall; w++) {
+        /* a servo sets its wall moving, and a cylinder's radius moves at radial_vel */
+        if (m->walls[w].servo_on || m->walls[w].def.radial_vel != 0) return false;
         for (int k = 0; k < m->dim; k++)
             if (m->walls[w].def.vel[k] != 0) return false;
+    }
     if (m->balls.fapp) return false;
     for (int64_t i = 0; i < m->balls.n; i++)
         if (m->balls.fix[i]) return false;
@@ -510,6 +513,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
     }
     for (int64_t w = 0; w < m->nwall; w++) {
         h = fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
+        h = fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
         h = fnv(h, m->walls[w].force, sizeof m->walls[w].force);
     }
     return h;

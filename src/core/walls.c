@@ -186,6 +186,7 @@ sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out)
 
 sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_radial_vel");
     if (!w) return SX_ENOTFOUND;
     if (w->def.kind != SX_WALL_CYLINDER)
@@ -228,6 +229,7 @@ sx_servo_def sx_servo_default_def(void)
 
 sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_servo");
     if (!w) return SX_ENOTFOUND;
     if (!isfinite(def->target))
@@ -245,6 +247,7 @@ sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def)
 
 sx_status sx_wall_clear_servo(sx_model *m, int64_t id)
 {
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_clear_servo");
     if (!w) return SX_ENOTFOUND;
     w->servo_on = false;
