@@ -222,6 +222,25 @@ static double wall_distance(const sx_wall *w, const double *x, double *n)
     }
     double q[D];
 #if D == 3
+    if (d->kind == SX_WALL_CYLINDER) { /* balls inside; n points from the surface towards the axis */
+        const double axial = dot(r, d->normal);
+        if (d->height > 0 && (axial < 0 || axial > d->height)) { /* beyond its open ends */
+            for (int k = 0; k < D; k++) n[k] = d->normal[k];
+            return INFINITY;
+        }
+        for (int k = 0; k < D; k++) q[k] = r[k] - axial * d->normal[k];
+        const double rho = sqrt(dot(q, q));
+        if (rho > 0) {
+            for (int k = 0; k < D; k++) n[k] = -q[k] / rho;
+        } else { /* on the axis: any radial direction */
+            const double e[3] = {fabs(d->normal[0]) < 0.9 ? 1.0 : 0.0, fabs(d->normal[0]) < 0.9 ? 0.0 : 1.0, 0};
+            double t[3];
+            spin_cross(d->normal, e, t);
+            const double tn = sqrt(dot(t, t));
+            for (int k = 0; k < D; k++) n[k] = t[k] / tn;
+        }
+        return d->radius - rho;
+    }
     double s = dot(r, w->u), t = dot(r, w->v);
     s = s < 0 ? 0 : s > w->len_u ? w->len_u : s;
     t = t < 0 ? 0 : t > w->len_v ? w->len_v : t;
@@ -928,7 +947,9 @@ static sx_status wall_contacts(sx_model *m)
         }
         double vb[D], vc[D];
         spin_cross(B->w + i * RD, rb, vb);
-        for (int k = 0; k < D; k++) vc[k] = (B->v[i * D + k] + vb[k]) - wl->def.vel[k];
+        /* the wall's surface velocity: its translation, and a cylinder's radial motion along -n */
+        for (int k = 0; k < D; k++)
+            vc[k] = (B->v[i * D + k] + vb[k]) - (wl->def.vel[k] - wl->def.radial_vel * n[k]);
         const double vn = dot(vc, n);
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
@@ -975,6 +996,9 @@ static sx_status wall_contacts(sx_model *m)
         for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k];
         p->un[c] = un;
         p->fn[c] = fd;
+        wl->load += fd;
+        wl->kn_sum += kn;
+        wl->contacts++;
         double mb[RD], mw[RD], arm[D];
         moment_of(rb, F, mb);
         for (int k = 0; k < D; k++) {
@@ -1009,15 +1033,18 @@ static sx_status KERNEL(contacts)(sx_model *m)
         memset(B->t, 0, nt * sizeof(double));
     }
     for (int64_t w = 0; w < m->nwall; w++) {
-        memset(m->walls[w].force, 0, sizeof m->walls[w].force);
-        memset(m->walls[w].moment, 0, sizeof m->walls[w].moment);
+        sx_wall *wl = &m->walls[w];
+        memset(wl->force, 0, sizeof wl->force);
+        memset(wl->moment, 0, sizeof wl->moment);
+        wl->load = wl->kn_sum = 0;
+        wl->contacts = 0;
     }
     sx_status st = ball_contacts(m);
     if (st) return st;
     if ((st = wall_contacts(m))) return st;
     if (m->track_energy) /* boundary work of the moving walls over this step */
         for (int64_t w = 0; w < m->nwall; w++)
-            m->acc.boundary_work -= dot(m->walls[w].force, m->walls[w].def.vel) * m->dt;
+            m->acc.boundary_work -= (dot(m->walls[w].force, m->walls[w].def.vel) + m->walls[w].def.radial_vel * m->walls[w].load) * m->dt;
     return SX_OK;
 }
 

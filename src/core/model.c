@@ -347,9 +347,12 @@ sx_status sx_model_set_timestep(sx_model *m, double dt)
  * orders of magnitude, the integration is unstable. */
 static bool unforced(const sx_model *m)
 {
-    for (int64_t w = 0; w < m->nwall; w++)
+    for (int64_t w = 0; w < m->nwall; w++) {
+        /* a servo sets its wall moving, and a cylinder's radius moves at radial_vel */
+        if (m->walls[w].servo_on || m->walls[w].def.radial_vel != 0) return false;
         for (int k = 0; k < m->dim; k++)
             if (m->walls[w].def.vel[k] != 0) return false;
+    }
     if (m->balls.fapp) return false;
     for (int64_t i = 0; i < m->balls.n; i++)
         if (m->balls.fix[i]) return false;
@@ -420,6 +423,10 @@ static void move_walls(sx_model *m, double *max_wall)
             s += w->def.vel[k] * w->def.vel[k];
         }
         w->moved += sqrt(s) * m->dt;
+        if (w->def.kind == SX_WALL_CYLINDER) {
+            w->def.radius += w->def.radial_vel * m->dt;
+            w->moved += fabs(w->def.radial_vel) * m->dt;
+        }
         if (w->moved > *max_wall) *max_wall = w->moved;
     }
 }
@@ -456,6 +463,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
         if ((st = k->contacts(m))) break;
         double max_disp, max_wall;
         if ((st = k->integrate(m, &max_disp))) break;
+        sx__walls_servo(m);
         move_walls(m, &max_wall);
         m->time += m->dt;
         m->dt_prev = m->dt;
@@ -505,6 +513,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
     }
     for (int64_t w = 0; w < m->nwall; w++) {
         h = fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
+        h = fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
         h = fnv(h, m->walls[w].force, sizeof m->walls[w].force);
     }
     return h;

@@ -72,6 +72,10 @@ typedef struct sx_wall {
     double len_u, len_v;
     double seg_len;        /* segment length */
     double force[3], moment[3];
+    double load, kn_sum;   /* sum of normal contact forces and stiffnesses, last step */
+    int64_t contacts;      /* its contacts in the last step */
+    bool servo_on;
+    sx_servo_def servo;
     double moved;          /* distance moved since the last broad-phase build */
 } sx_wall;
 
@@ -215,6 +219,7 @@ void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
 void sx__walls_free(sx_model *m);
 void sx__wall_prepare(sx_model *m, sx_wall *w);
+void sx__walls_servo(sx_model *m); /* servo velocities from the step's wall loads */
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);
 double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */

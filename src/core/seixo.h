@@ -203,6 +203,7 @@ typedef enum sx_wall_kind {
     SX_WALL_LINE,     ///< 2D infinite line: point + normal; balls live on the normal's side
     SX_WALL_RECT,     ///< 3D finite rectangle: corner + two edge vectors; two-sided
     SX_WALL_SEGMENT,  ///< 2D finite segment: two end points; two-sided
+    SX_WALL_CYLINDER, ///< 3D cylinder: axis point + axis direction (normal), radius, height; balls inside
 } sx_wall_kind;
 
 typedef struct sx_wall_def {
@@ -212,6 +213,9 @@ typedef struct sx_wall_def {
     double edge1[3];   ///< rect: first edge from the corner; segment: second end minus first
     double edge2[3];   ///< rect: second edge from the corner (orthogonal to edge1)
     double vel[3];     ///< m/s, imposed translational velocity
+    double radius;     ///< cylinder: m, its radius (changes at radial_vel)
+    double height;     ///< cylinder: m, its length along the axis from point (0: infinite)
+    double radial_vel; ///< cylinder: m/s, rate of change of the radius (> 0 expands)
     double kn, ks;     ///< N/m, wall stiffnesses (in series with the ball's, 4-22)
     double friction;   ///< Coulomb coefficient; the contact uses the smaller of ball and wall
 } sx_wall_def;
@@ -227,9 +231,32 @@ SX_API bool sx_wall_exists(const sx_model *m, int64_t id);
 /// The definition as it is now (point moved by the wall's motion).
 SX_API sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out);
 SX_API sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3]);
+/// Cylinder: the rate of change of its radius (m/s, > 0 expands).
+SX_API sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel);
 /// Resultant force (N) of the balls on the wall in the last step, and its
 /// moment (N m) about the wall's reference point (def.point; rect: its centre).
 SX_API sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], double moment[3]);
+
+/// PFC's servo: every step the wall's normal velocity is set to
+/// G (sigma - target), G = alpha A / (kn Nc dt), sigma = (sum of the normal
+/// contact forces on the wall) / A, kn the mean normal contact stiffness and
+/// Nc the number of contacts of the wall; positive moves the wall away from
+/// the balls (a cylinder expands). With no contact the wall approaches at max_speed.
+typedef struct sx_servo_def {
+    double target;     ///< Pa (2D: N/m, per unit thickness), compression positive
+    double area;       ///< m^2 (2D: m) the load acts on; update it as the specimen deforms
+    double alpha;      ///< gain factor, 0 < alpha <= 1 (PFC: 0.5)
+    double max_speed;  ///< m/s, bound on the wall speed (> 0)
+} sx_servo_def;
+
+SX_API sx_servo_def sx_servo_default_def(void); ///< alpha 0.5, no target, area 1, max_speed 1
+/// Puts a wall under servo control (plane, line, rect, segment, cylinder).
+SX_API sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def);
+SX_API sx_status sx_wall_clear_servo(sx_model *m, int64_t id);
+/// The servo's inputs after the last step, for a servo written in a script:
+/// the sum of the normal contact forces on the wall (N), its contact count
+/// and the mean normal stiffness of those contacts (N/m, 0 without contacts).
+SX_API sx_status sx_wall_load(const sx_model *m, int64_t id, double *normal_force, int64_t *contacts, double *kn);
 
 /* ------------------------------------------------------------- contacts */
 
@@ -320,6 +347,31 @@ typedef struct sx_crack {
 
 SX_API int64_t sx_crack_count(const sx_model *m);
 SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
+
+/* ---------------------------------------------------------- measurement */
+
+typedef enum sx_region_shape { SX_SHAPE_SPHERE, SX_SHAPE_BOX } sx_region_shape;
+
+/// A measurement region (PFC's measurement sphere/circle, or a box).
+typedef struct sx_region {
+    sx_region_shape shape;
+    double centre[3], radius;  ///< sphere (2D: circle)
+    double lo[3], hi[3];       ///< box (2D: rectangle)
+} sx_region;
+
+typedef struct sx_measurement {
+    double stress[3][3];   ///< Pa (2D: N/m), compression positive: -(1/V) sum over balls in the
+                           ///< region of their contacts' F (x_c - x); 2D fills [0..1][0..1]
+    double volume;         ///< m^3 (2D: m^2) of the region
+    double solid;          ///< m^3 of the balls whose centre is inside
+    double porosity;       ///< 1 - solid / volume
+    double coordination;   ///< ball-ball contacts per ball inside
+    double fabric[3][3];   ///< (1/Nc) sum n n over ball-ball contacts of balls inside
+    int64_t balls, contacts;
+} sx_measurement;
+
+/// Measures inside a region from the last step's contacts.
+SX_API sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out);
 
 /* ------------------------------------------------------------- energies */
 

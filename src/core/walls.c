@@ -38,7 +38,7 @@ void sx__wall_prepare(sx_model *m, sx_wall *w)
 {
     const int d = m->dim;
     sx_wall_def *def = &w->def;
-    if (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_LINE) {
+    if (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_LINE || def->kind == SX_WALL_CYLINDER) {
         const double n = norm(def->normal, d);
         for (int k = 0; k < d; k++) def->normal[k] /= n;
     } else if (def->kind == SX_WALL_RECT) {
@@ -69,10 +69,12 @@ static bool finite3(const double *v, int d)
 static sx_status validate(sx_model *m, const sx_wall_def *def)
 {
     const int d = m->dim;
-    const bool ok_kind = d == 3 ? (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_RECT)
+    const bool ok_kind = d == 3 ? (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_RECT ||
+                                   def->kind == SX_WALL_CYLINDER)
                                 : (def->kind == SX_WALL_LINE || def->kind == SX_WALL_SEGMENT);
     if (!ok_kind)
-        return sx__fail(m, SX_EINVAL, "wall_add: kind %d is not a %dD wall (3D: plane, rect; 2D: line, segment)",
+        return sx__fail(m, SX_EINVAL,
+                        "wall_add: kind %d is not a %dD wall (3D: plane, rect, cylinder; 2D: line, segment)",
                         (int)def->kind, d);
     if (!finite3(def->point, d) || !finite3(def->vel, d) || !finite3(def->normal, d) ||
         !finite3(def->edge1, d) || !finite3(def->edge2, d))
@@ -96,6 +98,14 @@ static sx_status validate(sx_model *m, const sx_wall_def *def)
     }
     case SX_WALL_SEGMENT:
         if (!(norm(def->edge1, 2) > 0)) return sx__fail(m, SX_EINVAL, "wall_add: the segment has zero length");
+        break;
+    case SX_WALL_CYLINDER:
+        if (!(norm(def->normal, 3) > 0)) return sx__fail(m, SX_EINVAL, "wall_add: the cylinder axis must not be zero");
+        if (!(def->radius > 0) || !isfinite(def->radius))
+            return sx__fail(m, SX_EINVAL, "wall_add: the cylinder radius must be > 0 m (got %g)", def->radius);
+        if (!(def->height >= 0) || !isfinite(def->height) || !isfinite(def->radial_vel))
+            return sx__fail(m, SX_EINVAL, "wall_add: the cylinder height must be >= 0 m (0: infinite) and "
+                                          "its radial velocity finite");
         break;
     }
     return SX_OK;
@@ -174,6 +184,18 @@ sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out)
     return SX_OK;
 }
 
+sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel)
+{
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_radial_vel");
+    if (!w) return SX_ENOTFOUND;
+    if (w->def.kind != SX_WALL_CYLINDER)
+        return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: wall %lld is not a cylinder", (long long)id);
+    if (!isfinite(radial_vel)) return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: the velocity must be finite");
+    w->def.radial_vel = radial_vel;
+    return SX_OK;
+}
+
 sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
 {
     m->guard_dirty = true; /* new energy baseline for the stability guard */
@@ -193,6 +215,79 @@ sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], double m
         if (moment) moment[k] = w->moment[k];
     }
     return SX_OK;
+}
+
+sx_servo_def sx_servo_default_def(void)
+{
+    sx_servo_def d;
+    memset(&d, 0, sizeof d);
+    d.area = 1;
+    d.alpha = 0.5;
+    d.max_speed = 1;
+    return d;
+}
+
+sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def)
+{
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_servo");
+    if (!w) return SX_ENOTFOUND;
+    if (!isfinite(def->target))
+        return sx__fail(m, SX_EINVAL, "wall_set_servo: the target stress must be finite (got %g)", def->target);
+    if (!(def->area > 0) || !isfinite(def->area))
+        return sx__fail(m, SX_EINVAL, "wall_set_servo: the area must be > 0 (got %g)", def->area);
+    if (!(def->alpha > 0 && def->alpha <= 1))
+        return sx__fail(m, SX_EINVAL, "wall_set_servo: alpha must be in (0, 1] (got %g)", def->alpha);
+    if (!(def->max_speed > 0) || !isfinite(def->max_speed))
+        return sx__fail(m, SX_EINVAL, "wall_set_servo: max_speed must be > 0 m/s (got %g)", def->max_speed);
+    w->servo = *def;
+    w->servo_on = true;
+    return SX_OK;
+}
+
+sx_status sx_wall_clear_servo(sx_model *m, int64_t id)
+{
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_clear_servo");
+    if (!w) return SX_ENOTFOUND;
+    w->servo_on = false;
+    return SX_OK;
+}
+
+sx_status sx_wall_load(const sx_model *m, int64_t id, double *normal_force, int64_t *contacts, double *kn)
+{
+    const sx_wall *w = lookup(m, id, "wall_load");
+    if (!w) return SX_ENOTFOUND;
+    if (normal_force) *normal_force = w->load;
+    if (contacts) *contacts = w->contacts;
+    if (kn) *kn = w->contacts ? w->kn_sum / (double)w->contacts : 0;
+    return SX_OK;
+}
+
+/* PFC's servo (DESIGN 1): the normal velocity G (sigma - target), positive
+ * away from the balls, from the loads of the step just computed. */
+void sx__walls_servo(sx_model *m)
+{
+    for (int64_t i = 0; i < m->nwall; i++) {
+        sx_wall *w = &m->walls[i];
+        if (!w->servo_on) continue;
+        const sx_servo_def *s = &w->servo;
+        double speed;
+        if (w->contacts == 0) {
+            speed = -s->max_speed; /* nothing to push on: approach the specimen */
+        } else {
+            const double kn = w->kn_sum / (double)w->contacts;
+            const double gain = s->alpha * s->area / (kn * (double)w->contacts * m->dt);
+            speed = gain * (w->load / s->area - s->target);
+            if (speed > s->max_speed) speed = s->max_speed;
+            if (speed < -s->max_speed) speed = -s->max_speed;
+        }
+        if (w->def.kind == SX_WALL_CYLINDER) {
+            w->def.radial_vel = speed;
+        } else {
+            for (int k = 0; k < m->dim; k++) w->def.vel[k] = -speed * w->def.normal[k];
+        }
+    }
 }
 
 void sx__walls_free(sx_model *m)

@@ -38,6 +38,9 @@ extern const luaL_Reg sx_lua_contacts_methods[];  ///< contacts.c: contacts
 extern const luaL_Reg sx_lua_groups_methods[];    ///< groups.c: group, groups, set, sum, mean, count, remove
 extern const luaL_Reg sx_lua_history_methods[];   ///< history.c: history, histories, history_csv
 extern const luaL_Reg sx_lua_generate_methods[];  ///< generate.c: generate
+extern const luaL_Reg sx_lua_lab_methods[];       ///< lab.c: measure
+/// lab.c: adds servo, load, radius, set_radial_vel to the wall class (after walls are registered).
+void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
 
 /* Classes other than the model's; each leaves nothing on the stack. */

@@ -7,12 +7,15 @@
 #include <stddef.h>
 #include <string.h>
 
-static const char *const kind_names[] = {"plane", "line", "rect", "segment", "box", NULL};
-enum { KIND_BOX = 4 };
-_Static_assert(SX_WALL_PLANE == 0 && SX_WALL_LINE == 1 && SX_WALL_RECT == 2 && SX_WALL_SEGMENT == 3,
+static const char *const kind_names[] = {"plane", "line", "rect", "segment", "cylinder", "box", NULL};
+enum { KIND_BOX = 5 };
+_Static_assert(SX_WALL_PLANE == 0 && SX_WALL_LINE == 1 && SX_WALL_RECT == 2 && SX_WALL_SEGMENT == 3 &&
+                   SX_WALL_CYLINDER == 4,
                "kind_names is indexed by sx_wall_kind");
 
 static const char *const plane_keys[] = {"kind", "point", "normal", "kn", "ks", "friction", "vel", NULL};
+static const char *const cylinder_keys[] = {"kind", "point", "axis",     "radius", "height", "radial_vel",
+                                            "kn",   "ks",    "friction", "vel",    NULL};
 static const char *const rect_keys[] = {"kind", "corner", "point", "edge1", "edge2", "kn", "ks", "friction", "vel",
                                         NULL};
 static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", NULL};
@@ -29,6 +32,7 @@ static const struct shape {
     [SX_WALL_LINE] = {2, "plane", plane_keys},
     [SX_WALL_RECT] = {3, "segment", rect_keys},
     [SX_WALL_SEGMENT] = {2, "rect", segment_keys},
+    [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
 };
 
 const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists};
@@ -176,6 +180,13 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
         for (int c = 0; c < dim; c++) d.edge1[c] = p2[c] - d.point[c];
         break;
     }
+    case SX_WALL_CYLINDER: /* balls inside; point on the axis, height along it (0: infinite) */
+        sx_lua_checkvecfield(L, 2, "point", dim, d.point);
+        sx_lua_checkvecfield(L, 2, "axis", dim, d.normal);
+        d.radius = sx_lua_checknumfield(L, 2, "radius");
+        sx_lua_optnumfield(L, 2, "height", &d.height);
+        sx_lua_optnumfield(L, 2, "radial_vel", &d.radial_vel);
+        break;
     }
     int64_t id;
     sx_lua_check(L, m, sx_wall_add(m, &d, &id));

@@ -1,0 +1,109 @@
+/* Measurement regions (DESIGN 1, "Measurement"): the average stress tensor,
+ * porosity, coordination number and fabric of the balls whose centre lies
+ * in a sphere (2D: circle) or a box, from the contacts of the last step.
+ *
+ * Stress (compression positive): sigma = -(1/V) sum over the balls inside,
+ * over their contacts, of F (x_c - x) with F the contact force on the ball
+ * (Love-Weber; for a ball-ball contact inside the region the two ends add up
+ * to F_on_b (x_b - x_a)). Porosity counts a ball's whole volume when its
+ * centre is inside, which is exact for a region holding whole balls (e.g. the
+ * specimen's box) and an approximation at a cut boundary. */
+#include "model_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct measure_ctx {
+    const sx_model *m;
+    const sx_region *r;
+    sx_measurement *out;
+    int64_t fabric_n;
+} measure_ctx;
+
+static bool inside(const sx_region *r, const double *x, int dim)
+{
+    if (r->shape == SX_SHAPE_SPHERE) {
+        double d2 = 0;
+        for (int k = 0; k < dim; k++) d2 += (x[k] - r->centre[k]) * (x[k] - r->centre[k]);
+        return d2 <= r->radius * r->radius;
+    }
+    for (int k = 0; k < dim; k++)
+        if (x[k] < r->lo[k] || x[k] > r->hi[k]) return false;
+    return true;
+}
+
+/* Adds -F (x_c - x) of one ball's side of a contact. */
+static void add_stress(sx_measurement *out, int dim, const double *f, const double *xc, const double *x)
+{
+    for (int i = 0; i < dim; i++)
+        for (int j = 0; j < dim; j++) out->stress[i][j] -= f[i] * (xc[j] - x[j]);
+}
+
+static bool visit(const sx_contact_info *ci, void *ud)
+{
+    measure_ctx *c = ud;
+    const sx_model *m = c->m;
+    const int dim = m->dim;
+    /* the force on b (ball-wall: on the ball, which is `a`) */
+    double f[3] = {0, 0, 0};
+    for (int k = 0; k < dim; k++) f[k] = ci->fn * ci->normal[k] + ci->shear[k];
+    const int64_t ia = sx__ball_index(m, ci->a);
+    const double *xa = m->balls.x + ia * dim;
+    if (ci->is_wall) {
+        if (!inside(c->r, xa, dim)) return true;
+        add_stress(c->out, dim, f, ci->point, xa);
+        return true;
+    }
+    const int64_t ib = sx__ball_index(m, ci->b);
+    const double *xb = m->balls.x + ib * dim;
+    const bool in_a = inside(c->r, xa, dim), in_b = inside(c->r, xb, dim);
+    if (!in_a && !in_b) return true;
+    double fa[3];
+    for (int k = 0; k < 3; k++) fa[k] = -f[k];
+    if (in_a) add_stress(c->out, dim, fa, ci->point, xa);
+    if (in_b) add_stress(c->out, dim, f, ci->point, xb);
+    c->out->contacts += in_a + in_b; /* contact ends inside: twice the contacts for the coordination */
+    for (int i = 0; i < dim; i++)
+        for (int j = 0; j < dim; j++) c->out->fabric[i][j] += ci->normal[i] * ci->normal[j];
+    c->fabric_n++;
+    return true;
+}
+
+sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out)
+{
+    const int dim = m->dim;
+    memset(out, 0, sizeof *out);
+    if (region->shape == SX_SHAPE_SPHERE) {
+        if (!(region->radius > 0) || !isfinite(region->radius))
+            return sx__fail(m, SX_EINVAL, "measure: the region's radius must be > 0 m (got %g)", region->radius);
+        const double r = region->radius;
+        out->volume = dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r;
+    } else if (region->shape == SX_SHAPE_BOX) {
+        out->volume = 1;
+        for (int k = 0; k < dim; k++) {
+            if (!(region->hi[k] > region->lo[k]))
+                return sx__fail(m, SX_EINVAL, "measure: the box must have hi > lo in every direction");
+            out->volume *= region->hi[k] - region->lo[k];
+        }
+    } else {
+        return sx__fail(m, SX_EINVAL, "measure: unknown region shape %d", (int)region->shape);
+    }
+    const sx_balls *b = &m->balls;
+    for (int64_t i = 0; i < b->n; i++) {
+        if (!inside(region, b->x + i * dim, dim)) continue;
+        const double r = b->rad[i];
+        out->solid += dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r;
+        out->balls++;
+    }
+    measure_ctx c = {m, region, out, 0};
+    sx_contact_each(m, visit, &c);
+    for (int i = 0; i < dim; i++)
+        for (int j = 0; j < dim; j++) {
+            out->stress[i][j] /= out->volume;
+            out->fabric[i][j] = c.fabric_n ? out->fabric[i][j] / (double)c.fabric_n : 0;
+        }
+    out->porosity = 1 - out->solid / out->volume;
+    out->coordination = out->balls ? (double)out->contacts / (double)out->balls : 0;
+    out->contacts = c.fabric_n;
+    return SX_OK;
+}

@@ -1,0 +1,51 @@
+-- Lua-level checks of the lab bindings: cylinder walls, servo control, measurement.
+local passed, failed = 0, 0
+local function check(name, ok, msg)
+  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(msg)) end
+end
+
+do
+  -- simple cubic block of whole cells: porosity 1 - pi/6, coordination 6 inside, fabric I/3
+  local m = seixo.model{dim = 3, timestep = 1e-6}
+  m:material("s", {kn = 1e7, ks = 1e7, density = 2500})
+  local r, s, n = 1e-3, 2e-3 - 1e-6, 6
+  for k = 0, n - 1 do for j = 0, n - 1 do for i = 0, n - 1 do
+    m:ball{pos = {i * s, j * s, k * s}, radius = r}
+  end end end
+  m:cycle(1)
+  local whole = m:measure{box = {min = {-s / 2, -s / 2, -s / 2}, max = {(n - 0.5) * s, (n - 0.5) * s, (n - 0.5) * s}}}
+  local expected = 1 - (4 / 3 * math.pi * r ^ 3) / s ^ 3
+  check("porosity of whole cells", math.abs(whole.porosity - expected) < 1e-12, whole.porosity)
+  local inner = m:measure{sphere = {center = {2.5 * s, 2.5 * s, 2.5 * s}, radius = 1.5 * s}}
+  check("coordination inside", math.abs(inner.coordination - 6) < 1e-12, inner.coordination)
+  check("fabric I/3", math.abs(inner.fabric[1][1] - 1 / 3) < 1e-12 and math.abs(inner.fabric[1][2]) < 1e-12,
+        inner.fabric[1][1])
+  check("compression positive", inner.stress[1][1] > 0 and inner.stress[3][3] > 0, inner.stress[1][1])
+  local ok, err = pcall(m.measure, m, {box = {min = {0, 0, 0}, max = {0, 1, 1}}})
+  check("empty box refused", not ok, err)
+  ok, err = pcall(m.measure, m, {sphere = {center = {0, 0, 0}, radius = 1}, box = {min = {0, 0, 0}, max = {1, 1, 1}}})
+  check("one region only", not ok, err)
+end
+
+do
+  -- one ball held by a servo-controlled cylinder: the load reaches target * area
+  local m = seixo.model{dim = 3, timestep = 1e-5}
+  m:material("s", {kn = 1e6, ks = 1e6, density = 2500, damping = 0.7})
+  local b = m:ball{pos = {0, 0, 0.005}, radius = 0.005}
+  b.fix = "all"
+  local c = m:wall{kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 1}, radius = 0.006, height = 0.01, kn = 1e6, ks = 1e6}
+  c:servo{target = 1e4, area = 1e-3, alpha = 0.5, max_speed = 0.05}
+  m:cycle(20000)
+  local load, contacts = c:load()
+  check("servo holds the target", contacts == 1 and math.abs(load / 1e-3 - 1e4) < 1e-3 * 1e4, load)
+  local radius = c:radius()
+  check("radius moved in", radius < 0.006 and radius > 0.0049, radius)
+  c:servo(nil)
+  local ok, err = pcall(c.servo, c, {target = 1, area = -1})
+  check("bad area refused", not ok and tostring(err):find("area"), err)
+  ok, err = pcall(m.wall, m, {kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 1}})
+  check("radius required", not ok and tostring(err):find("radius"), err)
+end
+
+print(string.format("%d passed, %d failed", passed, failed))
+if failed > 0 then os.exit(1) end
