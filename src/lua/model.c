@@ -79,6 +79,14 @@ int sx_lua_model_new(lua_State *L)
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "%s", err);
+    /* the executable's --threads N (seixo.threads); results do not depend on it */
+    if (lua_getglobal(L, "seixo") == LUA_TTABLE) {
+        lua_getfield(L, -1, "threads");
+        const lua_Integer t = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : 0;
+        if (t >= 1 && t <= 1024) sx_model_set_threads(u->m, (int)t);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
     return 1;
 }
 
