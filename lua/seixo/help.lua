@@ -16,7 +16,7 @@ local entries = {
   ["seixo.version"] = {"seixo.version", "The version string."},
   ["seixo.progress"] = {"seixo.progress([on]) -> was_on",
     "The progress line of long cycles on stderr (steps, time, steps/s, ETA); on by default when stderr is a terminal."},
-  ["seixo.threads"] = {"seixo.threads", "The thread count given with --threads (default 1); the core runs on one thread for now."},
+  ["seixo.threads"] = {"seixo.threads", "OpenMP threads for the step of each new model: --threads N (default 1); results do not depend on it."},
   ["help"] = {"help([x])", "Help on x: a function, an object (model, ball, wall, contact), or a name such as \"cycle\" or \"ball.pos\"."},
 
   -- model: set-up
@@ -27,8 +27,8 @@ local entries = {
     "Adds a ball (pos [m], radius [m], vel [m/s], spin [rad/s]), or finds one by id."},
   ["model:balls"] = {"m:balls([filter]) -> iterator", "for b in m:balls() do ... end; filter = {group =, region =, where = fn}. Iterates over a snapshot."},
   ["model:ball_count"] = {"m:ball_count() -> n", "Number of balls."},
-  ["model:wall"] = {"m:wall{kind = 'plane' | 'line' | 'rect' | 'segment' | 'box', ...} -> wall (a box: array of walls)",
-    "Adds a wall: plane/line {point, normal}, rect {corner, edge1, edge2}, segment {p1, p2}, box {min, max}; kn, ks [N/m], friction, vel [m/s]."},
+  ["model:wall"] = {"m:wall{kind = 'plane' | 'line' | 'rect' | 'segment' | 'cylinder' | 'box', ...} -> wall (a box: array of walls)",
+    "Adds a wall: plane/line {point, normal}, rect {corner, edge1, edge2}, segment {p1, p2}, cylinder {point, axis, radius, height, radial_vel}, box {min, max}; kn, ks [N/m], friction, vel [m/s]."},
   ["model:walls"] = {"m:walls() -> iterator", "for w in m:walls() do ... end"},
   ["model:wall_count"] = {"m:wall_count() -> n", "Number of walls."},
   ["model:generate"] = {"m:generate{region =, radius =, count = | porosity =, method =, seed =, ...} -> n, porosity",
@@ -84,6 +84,28 @@ local entries = {
   ["model:crack_count"] = {"m:crack_count([mode]) -> n", "Broken bonds, all or of mode 'tension' | 'shear'."},
   ["model:track_energy"] = {"m:track_energy(on)", "Starts (from zero) or stops accumulating dissipated energies and boundary work."},
 
+  -- model: files (src/lua/io.c)
+  ["model:save"] = {"m:save(path[, {compression = 0..9}]) -> skipped",
+    "Writes the whole model to an HDF5 snapshot that restarts bit-for-bit, with m:vars(), groups and extras; returns the paths of values it could not save."},
+  ["model:vars"] = {"m:vars() -> table", "The user's variables: plain data kept with the model and saved by m:save."},
+  ["model:output"] = {"m:output{path =, every =, fields =, compression =, append =} -> output",
+    "Writes the model now and every `every` steps to an HDF5 series with an .xmf for ParaView."},
+  ["seixo.load"] = {"seixo.load(path[, {dim = 2 | 3}]) -> model", "Reads a snapshot written by m:save; callbacks and outputs are registered again by the script."},
+  ["seixo.xdmf"] = {"seixo.xdmf(path)", "Rebuilds the .xmf file of an output series."},
+  ["output:write"] = {"o:write()", "Writes the model to the series now."},
+  ["output:close"] = {"o:close()", "Stops the output and closes its file."},
+  ["output:count"] = {"o:count() -> n", "Snapshots written."},
+  ["output:path"] = {"o:path() -> path", "The series' file."},
+
+  -- laboratory tests (src/lua/lab.c)
+  ["model:measure"] = {"m:measure(region) -> {stress =, fabric =, porosity =, coordination =, balls =, contacts =, volume =, solid =}",
+    "Measures in a box, sphere (3D) or disk (2D) region: the average stress tensor [Pa] (compression positive), the fabric tensor, porosity, coordination number."},
+  ["wall:servo"] = {"w:servo{target =, area =, alpha = 0.5, max_speed = 1}; w:servo(nil)",
+    "Puts the wall under servo control: its velocity follows G (stress - target), target [Pa] (2D: N/m) on area [m^2] (2D: m), speed bounded by max_speed [m/s]; nil releases it."},
+  ["wall:load"] = {"w:load() -> force, contacts, kn", "The servo's inputs after the last step: total normal contact force [N], contact count, mean contact kn [N/m]."},
+  ["wall:radius"] = {"w:radius() -> radius, radial_vel", "A cylinder's radius [m] and its rate of change [m/s]."},
+  ["wall:set_radial_vel"] = {"w:set_radial_vel(v)", "Sets a cylinder's radial velocity [m/s] (> 0 expands)."},
+
   -- ball
   ["ball:remove"] = {"b:remove()", "Removes the ball (queued while a callback runs)."},
   ["ball:set_extra"] = {"b:set_extra(key, value)", "Stores a user value with the ball (same as b.extra[key] = value)."},
@@ -108,7 +130,7 @@ local entries = {
   -- wall
   ["wall:remove"] = {"w:remove()", "Removes the wall (queued while a callback runs)."},
   ["wall.id"] = {"w.id", "The wall's stable id."},
-  ["wall.kind"] = {"w.kind", "'plane', 'line', 'rect' or 'segment'."},
+  ["wall.kind"] = {"w.kind", "'plane', 'line', 'rect', 'segment' or 'cylinder'."},
   ["wall.force"] = {"w.force", "Resultant force of the balls on the wall in the last step [N]."},
   ["wall.moment"] = {"w.moment", "Its moment about the wall's reference point [N m]."},
   ["wall.vel"] = {"w.vel", "Imposed velocity [m/s] (writable)."},
@@ -155,7 +177,8 @@ local entries = {
 H.entries = entries
 
 -- The classes, from the metatables the bindings registered.
-local classes = {model = "seixo.model", ball = "seixo.ball", wall = "seixo.wall", contact = "seixo.contact"}
+local classes = {model = "seixo.model", ball = "seixo.ball", wall = "seixo.wall", contact = "seixo.contact",
+                 output = "seixo.output"}
 
 local function class_of(x)
   local mt = getmetatable(x)

@@ -96,7 +96,9 @@ function util.normalize(a)
   check_vec(a, "a", "normalize")
   local n = util.norm(a)
   if n == 0 then error("bad argument 'a' to 'util.normalize' (the zero vector has no direction)", 2) end
-  return util.scale(a, 1 / n)
+  local r = {}
+  for k = 1, #a do r[k] = a[k] / n end
+  return r
 end
 
 --- a + t (b - a)

@@ -47,7 +47,7 @@ typedef struct options {
     long threads;      // --threads N (0: not given)
 } options;
 
-enum { MAX_THREADS = 4096 };
+enum { MAX_THREADS = 1024 };  // as many as sx_model_set_threads takes (model.c)
 
 static void usage(FILE *out)
 {

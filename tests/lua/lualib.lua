@@ -1,0 +1,95 @@
+-- The pure-Lua library (lua/seixo/*.lua): seixo.util's vectors, printer and
+-- CSV reader, loaded with require through the path the executable sets.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
+local HERE = "lualib.lua:"
+
+local util = require("seixo.util")
+
+test("require finds the library", function()
+  eq(package.loaded["seixo.util"], util)
+  check(package.searchpath("seixo.util", package.path):find("lua/seixo/util.lua", 1, true))
+  eq(require("seixo.util"), util)
+  eq(type(require("seixo.help").text), "function")
+end)
+
+test("vector arithmetic in 2D and 3D", function()
+  T.vec_eq(util.add({1, 2, 3}, {4, 5, 6}), {5, 7, 9})
+  T.vec_eq(util.sub({1, 2}, {4, 6}), {-3, -4})
+  T.vec_eq(util.scale({1, -2, 3}, 2), {2, -4, 6})
+  eq(util.dot({1, 2, 3}, {4, 5, 6}), 32)
+  T.vec_eq(util.cross({1, 0, 0}, {0, 1, 0}), {0, 0, 1})
+  T.vec_eq(util.cross({0, 1, 0}, {1, 0, 0}), {0, 0, -1})
+  eq(util.cross({1, 0}, {0, 1}), 1)
+  eq(util.cross({2, 3}, {4, 6}), 0)
+  eq(util.norm({3, 4}), 5)
+  eq(util.norm({2, 3, 6}), 7)
+  eq(util.dist({1, 1, 1}, {3, 4, 7}), 7)
+  T.vec_eq(util.normalize({0, 3, 4}), {0, 0.6, 0.8})
+  T.vec_eq(util.lerp({0, 0}, {10, 20}, 0.25), {2.5, 5})
+  -- arguments are never changed
+  local a, b = {1, 2, 3}, {1, 1, 1}
+  util.add(a, b)
+  util.scale(a, 3)
+  T.vec_eq(a, {1, 2, 3})
+  -- a ball's vectors work as they come
+  local m = T.model(3)
+  local p = m:ball{pos = {1, 2, 3}, radius = 0.1}
+  local q = m:ball{pos = {1, 2, 5}, radius = 0.1}
+  eq(util.dist(p.pos, q.pos), 2)
+end)
+
+test("vector errors name the function, the argument and the caller's line", function()
+  raises(function() util.add({1, 2}, {1, 2, 3}) end, HERE, "util.add", "2 and 3 components")
+  raises(function() util.add({1, 2, 3}, "x") end, HERE, "bad argument 'b' to 'util.add'", "got string")
+  raises(function() util.dot({1, "2"}, {1, 2}) end, HERE, "'a'", "component 2: number expected")
+  raises(function() util.scale({1, 2}, "2") end, HERE, "bad argument 's' to 'util.scale'")
+  raises(function() util.norm({1, 2, 3, 4}) end, HERE, "vector of 2 or 3 numbers")
+  raises(function() util.normalize({0, 0, 0}) end, HERE, "zero vector")
+  raises(function() util.lerp({0, 0}, {1, 1}) end, HERE, "bad argument 't'")
+end)
+
+test("show prints any value readably", function()
+  eq(util.show(1), "1")
+  eq(util.show("a\"b"), '"a\\"b"')
+  eq(util.show({1, 2, {3}}), "{1, 2, {3}}")
+  eq(util.show({b = 1, a = {x = true}, [3] = "c"}), '{[3] = "c", a = {x = true}, b = 1}')
+  eq(util.show({["key with space"] = 1}), '{["key with space"] = 1}')
+  local t = {}
+  t.self = t
+  eq(util.show(t), "{self = <cycle>}")
+  eq(util.show({{{{{1}}}}}, 2), "{{{...}}}")
+  eq(util.show({}), "{}")
+  -- long tables break over lines
+  local long = {}
+  for i = 1, 30 do long["field" .. i] = i end
+  local text = util.show(long)
+  check(text:find("\n  field1 = 1,", 1, true), text)
+  -- objects print as themselves; metamethods are never run
+  local m = T.model(2)
+  check(util.show({m:ball{pos = {0, 0}, radius = 1}}):find("{seixo.ball 1}", 1, true))
+  local trap = setmetatable({1}, {__index = function() error("no") end, __len = function() error("no") end,
+                                  __pairs = function() error("no") end})
+  eq(util.show(trap), "{1}")
+  raises(function() util.show({}, 1.5) end, HERE, "integer expected")
+end)
+
+test("read_csv reads what history_csv writes", function()
+  local m = seixo.model{dim = 2, timestep = 1e-3, gravity = {0, -10}}
+  m:material("a")
+  m:ball{pos = {0, 1}, radius = 0.1}
+  m:history("y", {ball = 1, field = "pos", component = "y"}, {every = 2})
+  m:cycle(6)
+  local path = os.tmpname()
+  m:history_csv(path)
+  local csv = util.read_csv(path)
+  os.remove(path)
+  T.vec_eq(csv.header, {"step", "time", "y"})
+  eq(csv.rows, 3)
+  T.vec_eq(csv.columns.step, {2, 4, 6})
+  T.vec_eq(csv.columns.y, m:history("y").values)  -- %.17g round-trips exactly
+  raises(function() util.read_csv("/nonexistent/file.csv") end, HERE, "util.read_csv")
+  raises(function() util.read_csv(3) end, HERE, "string expected")
+end)
+
+T.done()
