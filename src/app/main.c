@@ -5,7 +5,8 @@
  * global that documents every function.
  *
  * The interactive session uses readline when built with it: line editing,
- * a history file (~/.seixo_history, or $SEIXO_HISTORY; empty disables it),
+ * a history file (~/.seixo_history, or $SEIXO_HISTORY; empty disables it;
+ * each line is appended as it is entered),
  * and tab completion that walks the Lua value before the cursor (globals,
  * table keys, the methods and fields of seixo objects). A long cycle shows
  * a progress line on stderr when stderr is a terminal.
@@ -334,17 +335,28 @@ static char *history_path(void)
     return path;
 }
 
-/* Written to a temporary name then renamed, so a crash never truncates it. */
-static void save_history(const char *path)
+/* The history file: each line is appended as it is entered (so os.exit or
+ * a crash loses nothing), and the file is cut to the last 1000 lines at the end. */
+static char *hist_path;
+
+static void open_history(void)
 {
-    const size_t n = strlen(path);
-    char *tmp = malloc(n + 5);
-    if (!tmp) return;
-    memcpy(tmp, path, n);
-    memcpy(tmp + n, ".tmp", 5);
-    if (write_history(tmp) == 0) rename(tmp, path);
-    else remove(tmp);
-    free(tmp);
+    hist_path = history_path();
+    if (!hist_path) return;
+    if (read_history(hist_path) != 0) write_history(hist_path);  // create it
+}
+
+static void remember(const char *line)
+{
+    add_history(line);
+    if (hist_path) append_history(1, hist_path);
+}
+
+static void close_history(void)
+{
+    if (hist_path) history_truncate_file(hist_path, 1000);
+    free(hist_path);
+    hist_path = NULL;
 }
 
 /* ----- Ctrl-C at the prompt abandons the statement being typed
@@ -508,7 +520,7 @@ static int load_entry(lua_State *L, bool tty)
     int status = try_return(L);
     if (status != LUA_OK) status = multiline(L, tty);
 #ifdef SX_HAVE_READLINE
-    if (tty && lua_rawlen(L, 1) > 0) add_history(lua_tostring(L, 1));
+    if (tty && lua_rawlen(L, 1) > 0) remember(lua_tostring(L, 1));
 #endif
     lua_remove(L, 1);
     return status;
@@ -582,15 +594,13 @@ static void repl(lua_State *L)
     const bool tty = isatty(STDIN_FILENO);
     if (tty) printf("seixo %s (%s); help() for help, Ctrl-D quits, Ctrl-C stops a cycle\n", SX_VERSION, LUA_RELEASE);
 #ifdef SX_HAVE_READLINE
-    char *hist = NULL;
     if (tty) {
         global_L = L;
         rl_readline_name = "seixo";
         rl_attempted_completion_function = complete;
         rl_completer_word_break_characters = " \t\n\"\\'`@$><=;|&{}()[],+-*/%^~#";
         stifle_history(1000);
-        hist = history_path();
-        if (hist) read_history(hist);
+        open_history();
     }
 #endif
     int status;
@@ -606,8 +616,7 @@ static void repl(lua_State *L)
     lua_settop(L, 0);
     if (tty) putchar('\n');
 #ifdef SX_HAVE_READLINE
-    if (hist) save_history(hist);
-    free(hist);
+    close_history();
     clear_matches();
 #endif
 }

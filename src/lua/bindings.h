@@ -131,7 +131,7 @@ void sx_lua_region_read(lua_State *L, int idx, int dim, int arg, const char *key
 /// Whether a ball of radius r at x lies inside the region (r = 0: its centre).
 bool sx_lua_region_contains(const sx_lua_region *g, const double *x, double r);
 
-/* ----------------------------------------------------------- select.c */
+/* ------------------------------------------------- groups.c: filters */
 
 /// Which balls a bulk operation applies to: a group, a region (by centre)
 /// and a Lua predicate `where`, all optional.

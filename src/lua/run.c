@@ -308,20 +308,6 @@ static int64_t next_event(lua_State *L, int model, int64_t s)
     return next;
 }
 
-static bool has_before(lua_State *L, int model)
-{
-    sx_lua_state(L, model, "callbacks");
-    const int t = lua_gettop(L);
-    bool any = false;
-    for (lua_Integer i = 1; !any && lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
-        lua_getfield(L, -1, "point");
-        any = lua_tointeger(L, -1) == POINT_BEFORE;
-        lua_settop(L, t);
-    }
-    lua_settop(L, t - 1);
-    return any;
-}
-
 /* m:on(point, fn[, {every = N}]) -> id */
 static int model_on(lua_State *L)
 {
@@ -425,7 +411,6 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
     const int top = lua_gettop(L);
     const int64_t start = sx_model_step_count(m);
     const double t0 = sx_model_time(m);
-    const bool before = has_before(L, 1);
     progress *p = &r->progress;
     progress_start(L, p, m);
     *ratio = NAN;
@@ -454,7 +439,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             }
         }
         check_interrupt(L, r);
-        if (before) fire(L, 1, POINT_BEFORE, s);
+        fire(L, 1, POINT_BEFORE, s);
         /* the next chunk: up to the first thing due */
         int64_t n = lim->steps - taken;
         const int64_t ev = next_event(L, 1, s) - s;

@@ -2,7 +2,7 @@
 XDMF file, finds every snapshot, the balls with their fields, the contacts
 and bonds as line cells, and renders the balls as spheres into a PNG.
 
-    xvfb-run -a pvbatch paraview_check.py SERIES.xmf SNAPSHOTS BALLS RMIN RMAX OUT.png
+    pvbatch paraview_check.py SERIES.xmf SNAPSHOTS BALLS RMIN RMAX OUT.png
 
 Exits 0 when every check passes, 1 otherwise (with the reason)."""
 import sys
