@@ -196,6 +196,56 @@ static bool pair_selected(const sx_bond_def *def, int a, int b)
     return f < 0 || a == f || b == f;
 }
 
+/* Whether bonds of def's kind can join materials ma and mb: not Hertz (the
+ * seed, 4.3.3), and every parameter the bond needs is positive once the
+ * materials' values fill what the call leaves at 0. Checked for every
+ * candidate pair before any bond is installed, so a refused call changes nothing. */
+static sx_status check_pair(sx_model *m, const sx_bond_def *def, int ma, int mb)
+{
+    if (m->law[ma * m->law_n + mb].hertz)
+        return sx__fail(m, SX_EINVAL,
+                        "bond: materials '%s' and '%s' use the Hertz-Mindlin model, which is not to be combined "
+                        "with bonds (seed 4.3.3); use the linear model for bonded materials",
+                        m->mats[ma].name, m->mats[mb].name);
+    const sx_bpm_def *pa = &m->mats[ma].bpm, *pb = &m->mats[mb].bpm;
+    if (def->kind == SX_BOND_CONTACT) {
+        if (!(param(def->normal_strength, pa->normal_strength, pb->normal_strength) > 0) ||
+            !(param(def->shear_strength, pa->shear_strength, pb->shear_strength) > 0))
+            return sx__fail(m, SX_EINVAL,
+                            "bond: a contact bond between '%s' and '%s' needs normal_strength and shear_strength > 0 N "
+                            "(from the call or the materials' bond parameters)",
+                            m->mats[ma].name, m->mats[mb].name);
+        return SX_OK;
+    }
+    if (!(param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier) > 0) ||
+        !(param(def->modulus, pa->modulus, pb->modulus) > 0) ||
+        !(param(def->stiffness_ratio, pa->stiffness_ratio, pb->stiffness_ratio) > 0) ||
+        !(param(def->tensile_strength, pa->tensile_strength, pb->tensile_strength) > 0) ||
+        !(param(def->cohesion, pa->cohesion, pb->cohesion) > 0))
+        return sx__fail(m, SX_EINVAL,
+                        "bond: a parallel bond between '%s' and '%s' needs radius_multiplier, modulus, "
+                        "stiffness_ratio, tensile_strength and cohesion > 0 (from the call or the materials' bond "
+                        "parameters)",
+                        m->mats[ma].name, m->mats[mb].name);
+    return SX_OK;
+}
+
+/* The gap d - RA - RB of pair c, and its unit normal from a to b in n. */
+static double pair_gap(const sx_model *m, int64_t c, double *n)
+{
+    const int d = m->dim;
+    const sx_balls *B = &m->balls;
+    const int64_t i = m->bb.a[c], j = m->bb.b[c];
+    double dist = 0;
+    for (int k = 0; k < d; k++) {
+        n[k] = B->x[j * d + k] - B->x[i * d + k];
+        dist += n[k] * n[k];
+    }
+    dist = sqrt(dist);
+    for (int k = 0; k < d; k++) n[k] /= dist;
+    return dist - B->rad[i] - B->rad[j];
+}
+
 sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
 {
     if (m->locked) return sx__fail(m, SX_ELOCKED, "bond: the model is stepping");
@@ -225,24 +275,19 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
     const int d = m->dim;
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int ma = B->mat[p->a[c]], mb = B->mat[p->b[c]];
+        double n[3];
+        if (pair_selected(def, ma, mb) && pair_gap(m, c, n) < def->gap && (st = check_pair(m, def, ma, mb))) return st;
+    }
     uint64_t rng = def->seed;
     int64_t installed = 0;
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c], j = p->b[c];
         const int ma = B->mat[i], mb = B->mat[j];
         if (!pair_selected(def, ma, mb)) continue;
-        double n[3] = {0, 0, 0}, dist = 0;
-        for (int k = 0; k < d; k++) {
-            n[k] = B->x[j * d + k] - B->x[i * d + k];
-            dist += n[k] * n[k];
-        }
-        dist = sqrt(dist);
-        if (dist - B->rad[i] - B->rad[j] >= def->gap) continue;
-        if (m->law[ma * m->law_n + mb].hertz)
-            return sx__fail(m, SX_EINVAL,
-                            "bond: materials '%s' and '%s' use the Hertz-Mindlin model, which is not to be combined "
-                            "with bonds (seed 4.3.3); use the linear model for bonded materials",
-                            m->mats[ma].name, m->mats[mb].name);
+        double n[3] = {0, 0, 0};
+        if (pair_gap(m, c, n) >= def->gap) continue;
         int32_t slot = p->bond[c] - 1;
         if (slot < 0) {
             if (bonds_reserve(m, m->bonds.n + 1)) return sx__fail(m, SX_ENOMEM, "bond: out of memory");
@@ -268,10 +313,6 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
             const double lambda = param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier);
             const double ec = param(def->modulus, pa->modulus, pb->modulus);
             const double ratio = param(def->stiffness_ratio, pa->stiffness_ratio, pb->stiffness_ratio);
-            if (!(lambda > 0) || !(ec > 0) || !(ratio > 0))
-                return sx__fail(m, SX_EINVAL,
-                                "bond: a parallel bond needs radius_multiplier, modulus and stiffness_ratio > 0 "
-                                "(from the call or the materials' bond parameters)");
             const double ri = B->rad[i], rj = B->rad[j];
             b->rbar[slot] = lambda * (ri < rj ? ri : rj);             /* 4-53 */
             b->kn[slot] = ec / (ri + rj);                             /* 4-51 */
@@ -285,7 +326,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         b->kind[slot] |= (uint8_t)def->kind;
         if (!p->touching[c]) { /* the bond starts from the current geometry */
             for (int k = 0; k < d; k++) {
-                p->nold[c * d + k] = n[k] / dist;
+                p->nold[c * d + k] = n[k];
                 p->fs[c * d + k] = 0;
             }
             p->touching[c] = 1;

@@ -44,9 +44,11 @@ static bool visit(const sx_contact_info *ci, void *ud)
     measure_ctx *c = ud;
     const sx_model *m = c->m;
     const int dim = m->dim;
-    /* the force on b (ball-wall: on the ball, which is `a`) */
+    /* the force on b (ball-wall: on the ball, which is `a`): the contact's
+     * and, in parallel with it, its parallel bond's (4-32); the bond's moment
+     * is a couple and adds nothing to the average stress */
     double f[3] = {0, 0, 0};
-    for (int k = 0; k < dim; k++) f[k] = ci->fn * ci->normal[k] + ci->shear[k];
+    for (int k = 0; k < dim; k++) f[k] = (ci->fn + ci->pb_fn) * ci->normal[k] + ci->shear[k] + ci->pb_fs[k];
     const int64_t ia = sx__ball_index(m, ci->a);
     const double *xa = m->balls.x + ia * dim;
     if (ci->is_wall) {

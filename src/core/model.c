@@ -288,6 +288,20 @@ static sx_status check_models(sx_model *m)
                         "contact model: balls of material '%s' (hertz) and '%s' (linear) may touch; "
                         "a contact between Hertz and linear materials is not defined: use one model for both",
                         m->mats[hertz].name, m->mats[linear].name);
+    /* a material switched to Hertz (or a ball moved onto one) after bonds
+     * were installed: the seed's rule holds whenever it is cycled */
+    if (!used_hertz) return SX_OK;
+    const sx_bonds *b = &m->bonds;
+    for (int64_t s = 0; s < b->n; s++) {
+        if (!b->kind[s]) continue;
+        const int ka = m->balls.mat[m->balls.index_of[b->ida[s]]], kb = m->balls.mat[m->balls.index_of[b->idb[s]]];
+        if (m->mats[ka].def.model == SX_MODEL_HERTZ || m->mats[kb].def.model == SX_MODEL_HERTZ)
+            return sx__fail(m, SX_EINVAL,
+                            "contact model: balls %lld and %lld are bonded but material '%s' uses the Hertz-Mindlin "
+                            "model, which is not to be combined with bonds (seed 4.3.3); use the linear model",
+                            (long long)b->ida[s], (long long)b->idb[s],
+                            m->mats[m->mats[ka].def.model == SX_MODEL_HERTZ ? ka : kb].name);
+    }
     return SX_OK;
 }
 
@@ -359,11 +373,15 @@ static bool unforced(const sx_model *m)
     return true;
 }
 
+/* Kinetic, potential and the strain stored in contacts and bonds: a bonded
+ * specimen under load holds much of its energy in the bonds. */
+static double mechanical(const sx_energy *e) { return e->kinetic + e->gravitational + e->strain + e->bond_strain; }
+
 static double mechanical_energy(const sx_model *m)
 {
     sx_energy e;
     kernels(m)->energy(m, &e);
-    return e.kinetic + e.gravitational + e.strain;
+    return mechanical(&e);
 }
 
 static void guard_start(sx_model *m)
@@ -372,13 +390,13 @@ static void guard_start(sx_model *m)
     if (!m->guard_on) return;
     sx_energy e;
     kernels(m)->energy(m, &e);
-    m->guard_e0 = e.kinetic + e.gravitational + e.strain;
+    m->guard_e0 = mechanical(&e);
     /* the scale: the energy in play, with a floor of each ball's weight over its radius */
     double floor_e = 0, g = 0;
     for (int k = 0; k < m->dim; k++) g += m->gravity[k] * m->gravity[k];
     g = sqrt(g);
     for (int64_t i = 0; i < m->balls.n; i++) floor_e += g * m->balls.rad[i] / m->balls.inv_mass[i];
-    m->guard_scale = e.kinetic + e.strain + floor_e;
+    m->guard_scale = e.kinetic + e.strain + e.bond_strain + floor_e;
 }
 
 /* The ball with the largest translational kinetic energy: the one to name. */

@@ -201,14 +201,11 @@ START_TEST(energy_3d)
 }
 END_TEST
 
-/* The same 2D scene with shear dashpots as well. Known failure at the time of
- * writing: the automatic timestep ignores the dashpots, and the shear
- * dashpot (sized on the translational reduced mass) damps the spins several
- * times more than its ratio says (I = m R^2/2), amplified by local damping by
- * up to (1 + alpha); once bonds break, the spins of the balls near the floor
- * oscillate with period 2 steps (an explicit-dashpot instability, bounded by
- * slip), and the dissipation booked with the old velocity squared far exceeds
- * the work. */
+/* The same 2D scene with shear dashpots as well. The shear dashpot, sized on
+ * the translational reduced mass, damps the spins more than its ratio says
+ * (I = m R^2/2), amplified by local damping by up to (1 + alpha): the
+ * automatic timestep allows for the dashpots (critical_dt), without which
+ * the spins near the floor oscillate with period 2 steps once bonds break. */
 START_TEST(energy_2d_shear_dashpot)
 {
     sample s = hex_2d(0.2);

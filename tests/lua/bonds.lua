@@ -56,5 +56,79 @@ do
   check("unknown model named", not ok and tostring(err):find("plastic"), err)
 end
 
+do
+  -- a material switched to Hertz after its balls were bonded is refused when cycled
+  local m = seixo.model{dim = 3}
+  m:material("r", {kn = 1e7, ks = 1e7, density = 2500})
+  m:ball{pos = {0, 0, 0}, radius = 1}
+  m:ball{pos = {2, 0, 0}, radius = 1}
+  m:bond{kind = "contact", gap = 1e-6, normal_strength = 1e3, shear_strength = 1e3}
+  m:material("r", {model = "hertz", shear_modulus = 1e9, poisson = 0.2, density = 2500})
+  local ok, err = pcall(m.cycle, m, 1)
+  check("hertz after bonding refused", not ok and tostring(err):find("Hertz") and tostring(err):find("bonded"), err)
+end
+
+do
+  -- The stability guard counts the strain held by bonds: two bonded balls
+  -- stopped at their largest stretch hold all the energy in the bond, and
+  -- cycling them on at a tenth of the critical timestep is stable.
+  local m = seixo.model{dim = 3, timestep = 1e-7}
+  m:material("a", {kn = 1e7, ks = 1e7, density = 2500, friction = 0.5})
+  local R = 0.01
+  local a = m:ball{pos = {0, 0, 0}, radius = R}
+  local b = m:ball{pos = {2 * R + 1e-5, 0, 0}, radius = R}
+  m:ball{pos = {1, 1, 1}, radius = R, vel = {1e-4, 0, 0}}
+  m:bond{kind = "parallel", gap = 1e-4, radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 1,
+         tensile_strength = 1e15, cohesion = 1e15}
+  a.vel = {-0.005, 0, 0}; b.vel = {0.005, 0, 0}
+  local prev = math.huge
+  for _ = 1, 200000 do  -- until the balls turn back: the bond's largest stretch
+    m:cycle(1)
+    local rel = math.abs(b.vel[1] - a.vel[1])
+    if rel > prev then break end
+    prev = rel
+  end
+  a.vel = {0, 0, 0}; b.vel = {0, 0, 0}   -- a user change: a new energy baseline
+  local strain = m:energy().bond_strain
+  local ok, err = pcall(m.cycle, m, 50000)
+  check("guard counts bond strain", ok and strain > 0 and m:timestep() < 0.2 * m:critical_timestep(), err)
+end
+
+do
+  -- The average stress counts parallel-bond forces (4-32): two fixed disks
+  -- joined by a bond stretched by u carry the tension T = kn_bar A u, and
+  -- sigma_xx = -(1/V) sum F (x_c - x) = -T L / V with L the branch length.
+  local m = seixo.model{dim = 2, timestep = 1e-6}
+  m:material("s", {kn = 1e7, ks = 1e7, density = 2500, bond = {radius_multiplier = 1, modulus = 1e8,
+             stiffness_ratio = 1, tensile_strength = 1e12, cohesion = 1e12}})
+  local a = m:ball{pos = {0, 0}, radius = 1e-3}
+  local b = m:ball{pos = {2e-3, 0}, radius = 1e-3}
+  m:bond{kind = "parallel", gap = 1e-6}
+  a.fix = "all"; b.fix = "all"; b.vel = {1e-3, 0}
+  m:cycle(100)
+  local u = b.pos[1] - 2e-3
+  local T = 1e8 / 2e-3 * 2e-3 * u        -- kn_bar = Ec/(RA+RB), A = 2 R_bar (unit thickness)
+  local lo, hi = {-2e-3, -2e-3}, {4e-3, 2e-3}
+  local r = m:measure{box = {min = lo, max = hi}}
+  local V = (hi[1] - lo[1]) * (hi[2] - lo[2])
+  local expect = -T * 2e-3 / V
+  check("stress counts parallel bonds", u > 0 and math.abs(r.stress[1][1] - expect) < 1e-3 * math.abs(expect),
+        string.format("%g vs %g", r.stress[1][1], expect))
+end
+
+do
+  -- a bond without strengths would break at once: refused, and nothing installed
+  local m = seixo.model{dim = 2}
+  m:material("r", {kn = 1e7, ks = 1e7, density = 2500})
+  m:ball{pos = {0, 0}, radius = 1}
+  m:ball{pos = {2, 0}, radius = 1}
+  local ok, err = pcall(m.bond, m, {kind = "parallel", gap = 1e-6, radius_multiplier = 1, modulus = 1e9,
+                                    stiffness_ratio = 1, cohesion = 1e6})
+  check("parallel bond without tensile strength refused", not ok and tostring(err):find("tensile_strength"), err)
+  ok, err = pcall(m.bond, m, {kind = "contact", gap = 1e-6, normal_strength = 10})
+  check("contact bond without shear strength refused", not ok and tostring(err):find("shear_strength"), err)
+  check("nothing installed by refused calls", m:bond_count() == 0, m:bond_count())
+end
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end
