@@ -16,6 +16,7 @@ local entries = {
   ["seixo.version"] = {"seixo.version", "The version string."},
   ["seixo.progress"] = {"seixo.progress([on]) -> was_on",
     "The progress line of long cycles on stderr (steps, time, steps/s, ETA); on by default when stderr is a terminal."},
+  ["seixo.clock"] = {"seixo.clock() -> seconds", "Wall-clock seconds from a monotonic clock: the difference of two readings times a run."},
   ["seixo.threads"] = {"seixo.threads", "OpenMP threads for the step of each new model: --threads N (default 1); results do not depend on it."},
   ["help"] = {"help([x])", "Help on x: a function, an object (model, ball, wall, contact), or a name such as \"cycle\" or \"ball.pos\"."},
 

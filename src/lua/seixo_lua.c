@@ -6,6 +6,8 @@
 
 #include "bindings.h"
 
+#include <time.h>
+
 static const luaL_Reg *const model_methods[] = {
     sx_lua_model_methods,    sx_lua_run_methods,     sx_lua_balls_methods,
     sx_lua_walls_methods,    sx_lua_contacts_methods, sx_lua_groups_methods,
@@ -26,11 +28,22 @@ static int seixo_progress(lua_State *L)
     return 1;
 }
 
+/* seixo.clock(): wall-clock seconds from a monotonic clock, for timing runs
+ * (os.clock counts the CPU time of all threads, os.time whole seconds). */
+static int seixo_clock(lua_State *L)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    lua_pushnumber(L, (double)t.tv_sec + 1e-9 * (double)t.tv_nsec);
+    return 1;
+}
+
 int luaopen_seixo(lua_State *L)
 {
     static const luaL_Reg functions[] = {
         {"model", sx_lua_model_new},
         {"progress", seixo_progress},
+        {"clock", seixo_clock},
         {NULL, NULL},
     };
     sx_lua_model_register(L, model_methods);

@@ -24,4 +24,36 @@ test("piston2d: a servo in a callback reaches its target load", function()
   check(out:find("200 disks left", 1, true), out)
 end)
 
+-- the floor carries most of the weight once the balls are at rest (the
+-- side walls take some by friction: Janssen's silo effect)
+local function floor_share(out)
+  local load, weight = out:match("floor load ([%d.e+-]+) N[/m]* for a weight of ([%d.e+-]+)")
+  return load and tonumber(load) / tonumber(weight)
+end
+
+test("settle2d: disks settle on the ratio", function()
+  local status, out = example("settle2d.lua", "300")
+  eq(status, 0, out)
+  check(out:find("stopped on ratio", 1, true), out)
+  local share = floor_share(out)
+  check(share and share > 0.75 and share < 1.01, out)
+end)
+
+test("settle3d: spheres fall and come to bear on the floor", function()
+  local status, out = example("settle3d.lua", "300 30000")
+  eq(status, 0, out)
+  check(out:find("settle3d: 300 balls", 1, true), out)
+  local share = floor_share(out)
+  check(share and share > 0.75 and share < 1.01, out)
+end)
+
+test("bonded_break: a bonded specimen cracks and its energy balance closes", function()
+  local status, out = example("bonded_break.lua")
+  eq(status, 0, out)
+  local cracks = tonumber(out:match("intact bonds, (%d+) cracks"))
+  check(cracks and cracks > 0, out)
+  local residual = tonumber(out:match("residual ([%d.e+-]+)"))
+  check(residual and math.abs(residual) < 1e-2, out)
+end)
+
 T.done()
