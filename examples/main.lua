@@ -1,5 +1,6 @@
--- The default main job of `scripts/run`: for now, settle a 3D sample of
--- 2,000 spheres in a box (the lab-test issue replaces it with a
--- servo-controlled triaxial series).
-arg = {"2000", "40000"}
-dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "settle3d.lua")
+-- The default main job of `scripts/run`: a servo-controlled triaxial series
+-- (UCS and three confining stresses) on a bonded granite-like specimen,
+-- with the Mohr-Coulomb fit, a quasi-static check and the figures, written
+-- to lab-results/ (see examples/triaxial.lua).
+arg = {"lab-results"}
+dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "triaxial.lua")

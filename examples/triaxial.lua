@@ -1,0 +1,45 @@
+-- A triaxial series on a bonded granite-like specimen (3D), PFC-style:
+-- material genesis, unconfined compression (UCS), triaxial tests at three
+-- confining stresses, the Mohr-Coulomb fit of the peaks, and the check that
+-- the loading is quasi-static (the UCS again at half the strain rate).
+--   scripts/run examples/triaxial.lua [out_dir] [diameter_m] [strain_rate]
+-- Writes into out_dir (default lab-results/): the specimen (specimen.h5),
+-- per test a CSV of the stress-strain history and an HDF5 snapshot with its
+-- results, and the figures (series_stress.png, series_volumetric.png,
+-- series_cracks.png, series_mohr.png).
+local lab = require "seixo.lab"
+local out = arg and arg[1] or "lab-results"
+local diameter = tonumber(arg and arg[2]) or 0.03
+local rate = tonumber(arg and arg[3]) or 1.0          -- axial strain rate, 1/s
+local confining = {0, 5e6, 10e6, 20e6}                 -- Pa; 0 is the UCS
+local tolerance = 0.02                                 -- quasi-static: the peak may move this much at half the rate
+os.execute("mkdir -p '" .. out .. "'")
+local t0 = seixo.clock()
+
+-- Potyondy & Cundall's (2004) micro-parameters of Lac du Bonnet granite,
+-- on a coarse specimen (about 1,300 balls) so the series runs in minutes
+local spec = lab.specimen{dim = 3, shape = "cylinder", diameter = diameter, height = 2 * diameter,
+                          radius = {0.04 * diameter, 0.0667 * diameter}, material = lab.rock(),
+                          sigma0 = 0.1e6, seed = 1, path = out .. "/specimen.h5"}
+
+local series = lab.series(spec, {confining = confining, strain_rate = rate, out = out .. "/series"})
+local slow = lab.ucs(spec, {strain_rate = rate / 2, out = out .. "/ucs_half_rate", plot = false})
+
+local ucs = series.tests[1]
+local fit = series.fit
+print("")
+print(string.format("specimen: %d balls, %d parallel bonds, porosity %.3f, %.0f mm x %.0f mm", spec.balls, spec.bonds,
+                    spec.porosity, diameter * 1e3, 2 * diameter * 1e3))
+print(string.format("%-10s %12s %12s %10s %8s %16s", "test", "sigma3 MPa", "peak MPa", "E GPa", "nu", "cracks t/s"))
+for _, r in ipairs(series.tests) do
+  print(string.format("%-10s %12.3g %12.4g %10.4g %8.3f %10d / %-5d", r.kind, r.confining / 1e6, r.peak / 1e6,
+                      r.young / 1e9, r.poisson, r.cracks.tension, r.cracks.shear))
+end
+print(string.format("UCS %.4g MPa, E %.4g GPa, nu %.3f", ucs.peak / 1e6, ucs.young / 1e9, ucs.poisson))
+print(string.format("Mohr-Coulomb: c = %.4g MPa, phi = %.2f deg (R^2 %.4f, rms %.3g MPa over %d tests)", fit.c / 1e6,
+                    fit.phi, fit.r2, fit.rms / 1e6, fit.points))
+local change = math.abs(slow.peak / ucs.peak - 1)
+print(string.format("quasi-static: UCS %.4g MPa at %.3g/s and %.4g MPa at %.3g/s: %.2f %% apart (tolerance %.0f %%) -- %s",
+                    ucs.peak / 1e6, rate, slow.peak / 1e6, rate / 2, 100 * change, 100 * tolerance,
+                    change <= tolerance and "quasi-static" or "TOO FAST: lower the strain rate"))
+print(string.format("figures: %s/series_{stress,volumetric,cracks,mohr}.png; run time %.0f s", out, seixo.clock() - t0))

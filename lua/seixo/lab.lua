@@ -1,0 +1,909 @@
+-- seixo.lab: laboratory tests on bonded-particle specimens, PFC-style.
+--   local lab = require "seixo.lab"
+--   local spec = lab.specimen{dim = 3, shape = "cylinder", diameter = 0.03, height = 0.06, path = "rock.h5"}
+--   local r = lab.triaxial(spec, {confining = 10e6})
+--   local s = lab.series(spec, {confining = {0, 5e6, 10e6, 20e6}})   -- UCS, triaxials, Mohr-Coulomb
+--
+-- Specimen genesis follows Potyondy & Cundall (2004, "material genesis"):
+-- a polydisperse assembly is made by radius expansion in a vessel of walls,
+-- frictionless; the walls are servo-controlled to a small isotropic stress;
+-- friction is restored and parallel bonds installed between the touching
+-- balls (the BPM micro-parameters of the material, seed 4.4); the vessel is
+-- removed and the specimen relaxes, which reduces the locked-in stresses;
+-- the specimen is trimmed to its shape (a cylinder, a prism, a disk) and
+-- saved. Every test starts from that file.
+--
+-- Stresses are compression positive; strains are compression positive
+-- (a lateral expansion is a negative lateral strain); volumetric strain is
+-- the axial strain plus (dim - 1) lateral strains. In 2D (disks of unit
+-- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
+
+local lab = {}
+
+local pi = math.pi
+local plot_test, plot_brazilian, plot_series -- the figures, at the end
+
+-- ------------------------------------------------------------------ helpers
+
+local function fail(fmt, ...) error(string.format(fmt, ...), 3) end
+
+local function check_keys(t, fn, allowed)
+  if type(t) ~= "table" then error(string.format("lab.%s: a table of options expected, got %s", fn, type(t)), 3) end
+  local set = {}
+  for _, k in ipairs(allowed) do set[k] = true end
+  for k in pairs(t) do
+    if not set[k] then
+      table.sort(allowed)
+      error(string.format("lab.%s: unknown option '%s' (valid: %s)", fn, tostring(k), table.concat(allowed, ", ")), 3)
+    end
+  end
+end
+
+local function positive(v, what, fn)
+  if type(v) ~= "number" or not (v > 0) or v == math.huge then
+    error(string.format("lab.%s: %s must be a positive number (got %s)", fn, what, tostring(v)), 3)
+  end
+  return v
+end
+
+local function copy(t)
+  if type(t) ~= "table" then return t end
+  local r = {}
+  for k, v in pairs(t) do r[k] = copy(v) end
+  return r
+end
+
+local function merge(base, over)
+  local r = copy(base)
+  for k, v in pairs(over or {}) do
+    if type(v) == "table" and type(r[k]) == "table" then r[k] = merge(r[k], v) else r[k] = copy(v) end
+  end
+  return r
+end
+
+local function say(opts, fmt, ...)
+  local log = opts.log
+  if log == false then return end
+  (log or print)(string.format(fmt, ...))
+end
+
+-- The balls' bounding box including their radii, and the mean radius.
+local function extents(m)
+  local dim = m:dim()
+  local lo, hi = {}, {}
+  for k = 1, dim do lo[k], hi[k] = math.huge, -math.huge end
+  for b in m:balls() do
+    local p, r = b.pos, b.radius
+    for k = 1, dim do
+      if p[k] - r < lo[k] then lo[k] = p[k] - r end
+      if p[k] + r > hi[k] then hi[k] = p[k] + r end
+    end
+  end
+  return lo, hi
+end
+
+-- Writes text to path through a temporary name in the same folder, renamed
+-- when complete: an interrupted write never leaves a truncated file.
+local function write_file(path, text)
+  local tmp = string.format("%s.tmp%d", path, math.random(1, 1 << 30))
+  local f = assert(io.open(tmp, "w"))
+  local ok, err = f:write(text)
+  f:close()
+  if not ok then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(err), 2) end
+  local done, why = os.rename(tmp, path)
+  if not done then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(why), 2) end
+end
+
+--- Writes rows (arrays of numbers) under a header to a CSV file, atomically.
+function lab.write_csv(path, header, rows)
+  local out = {table.concat(header, ",")}
+  for _, row in ipairs(rows) do
+    local cells = {}
+    for k = 1, #header do cells[k] = row[k] == nil and "" or string.format("%.10g", row[k]) end
+    out[#out + 1] = table.concat(cells, ",")
+  end
+  write_file(path, table.concat(out, "\n") .. "\n")
+end
+
+-- -------------------------------------------------------------- materials
+
+--- Bonded-particle micro-parameters (4-49 ... 4-53) of a granite-like rock,
+--- after Potyondy & Cundall (2004, Lac du Bonnet granite), with overrides.
+function lab.rock(over)
+  return merge({
+    density = 2630, modulus = 62e9, stiffness_ratio = 2.5, friction = 0.5, damping = 0.7,
+    bond = {radius_multiplier = 1, modulus = 62e9, stiffness_ratio = 2.5,
+            tensile_strength = 157e6, tensile_strength_sd = 36e6, cohesion = 157e6, cohesion_sd = 36e6},
+  }, over)
+end
+
+-- The normal stiffness of a ball of radius r of material mat (4-49), for walls.
+local function ball_kn(mat, r, dim)
+  if mat.modulus and mat.modulus > 0 then return dim == 3 and 4 * r * mat.modulus or 2 * mat.modulus end
+  return mat.kn
+end
+
+-- ---------------------------------------------------------------- vessels
+
+-- A vessel of walls around the box [0, size]: six planes (four lines), or
+-- for a cylinder along axis `ax` a cylindrical wall closed by two planes.
+-- vessel.areas() gives the current area (2D: length) each wall loads.
+local function make_vessel(m, size, kn, cyl_axis)
+  local dim = m:dim()
+  local lo, hi = {}, {}
+  for k = 1, dim do lo[k], hi[k] = 0, size[k] end
+  local v = {}
+  if not cyl_axis then
+    v.walls = m:wall{kind = "box", min = lo, max = hi, kn = kn, ks = 0, friction = 0}
+    v.region = {box = {lo, hi}}
+    function v.areas() -- -x, +x, -y, +y[, -z, +z]: the product of the other two sizes
+      local w, areas = v.walls, {}
+      for k = 1, dim do
+        local a = 1
+        for j = 1, dim do if j ~= k then a = a * (w[2 * j].point[j] - w[2 * j - 1].point[j]) end end
+        areas[2 * k - 1], areas[2 * k] = a, a
+      end
+      return areas
+    end
+    return v
+  end
+  local ax = cyl_axis
+  local other = {}
+  for k = 1, 3 do if k ~= ax then other[#other + 1] = k end end
+  local radius = 0.5 * size[other[1]]
+  local point, e, p1, p2 = {}, {}, {}, {}
+  for k = 1, 3 do
+    point[k] = k == ax and 0 or radius
+    e[k] = k == ax and 1 or 0
+    p1[k], p2[k] = point[k], k == ax and size[k] or point[k]
+  end
+  local cyl = m:wall{kind = "cylinder", point = point, axis = e, radius = radius, height = 0, kn = kn, ks = 0,
+                     friction = 0}
+  local ne = {-e[1], -e[2], -e[3]}
+  local b1 = m:wall{kind = "plane", point = p1, normal = e, kn = kn, ks = 0, friction = 0}
+  local b2 = m:wall{kind = "plane", point = p2, normal = ne, kn = kn, ks = 0, friction = 0}
+  v.walls = {cyl, b1, b2}
+  v.region = {cylinder = {p1 = p1, p2 = p2, radius = radius}}
+  function v.areas()
+    local r, len = cyl:radius(), b2.point[ax] - b1.point[ax]
+    return {2 * pi * r * len, pi * r * r, pi * r * r}
+  end
+  return v
+end
+
+-- Servo-controls the walls of a vessel to the stress `target` and cycles
+-- until every wall is within `tol` of it and the unbalanced-force ratio is
+-- below `ratio`, or `max_steps` pass. Returns the steps taken and the worst
+-- relative stress error.
+local function servo_vessel(m, v, target, opts)
+  local every, start, worst = 200, m:step(), math.huge
+  while m:step() - start < opts.max_steps do
+    local areas = v.areas()
+    for i, w in ipairs(v.walls) do w:servo{target = target, area = areas[i], alpha = 0.5, max_speed = opts.max_speed} end
+    m:cycle(every)
+    areas = v.areas()
+    worst = 0
+    for i, w in ipairs(v.walls) do worst = math.max(worst, math.abs(w:load() / areas[i] / target - 1)) end
+    if worst < opts.tol and m:ratio() < opts.ratio then break end
+  end
+  return m:step() - start, worst
+end
+
+-- --------------------------------------------------------------- specimens
+
+local shapes = {
+  [3] = {cylinder = true, prism = true, disc = true},
+  [2] = {rect = true, disk = true},
+}
+
+-- The box a shape fills, the axis of its cylindrical vessel (3D cylinder:
+-- z; disc: y), and for a 2D disk the circle it is trimmed to.
+local function shape_of(opts, dim)
+  local shape = opts.shape
+  if dim == 3 and shape == "cylinder" then
+    local d, h = positive(opts.diameter, "diameter", "specimen"), positive(opts.height, "height", "specimen")
+    return {d, d, h}, 3
+  elseif dim == 3 and shape == "disc" then -- a Brazilian disc: axis along y, loaded along z
+    local d, t = positive(opts.diameter, "diameter", "specimen"), positive(opts.thickness, "thickness", "specimen")
+    return {d, t, d}, 2
+  elseif dim == 3 and shape == "prism" then
+    local w, h = positive(opts.width, "width", "specimen"), positive(opts.height, "height", "specimen")
+    return {w, opts.depth and positive(opts.depth, "depth", "specimen") or w, h}
+  elseif dim == 2 and shape == "rect" then
+    return {positive(opts.width, "width", "specimen"), positive(opts.height, "height", "specimen")}
+  elseif dim == 2 and shape == "disk" then
+    local d = positive(opts.diameter, "diameter", "specimen")
+    return {d, d}, nil, {center = {d / 2, d / 2}, radius = d / 2}
+  end
+end
+
+--- Makes a bonded specimen (material genesis) and saves it to opts.path.
+--- Returns a specimen table for the tests: {path, dim, shape, size, balls,
+--- bonds, porosity, floaters, sigma0, material, ...}.
+function lab.specimen(opts)
+  check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
+                                "porosity", "material", "sigma0", "gap", "seed", "path", "log", "max_steps"})
+  local dim = opts.dim or 3
+  if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
+  local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
+  if not shapes[dim][shape] then
+    local names = {}
+    for k in pairs(shapes[dim]) do names[#names + 1] = k end
+    table.sort(names)
+    fail("lab.specimen: shape '%s' is not a %dD shape (valid: %s)", tostring(shape), dim, table.concat(names, ", "))
+  end
+  local size, cyl_axis, trim = shape_of(merge(opts, {shape = shape}), dim)
+  local radius = opts.radius or {0.8e-3, 1.33e-3}
+  if type(radius) ~= "table" or #radius ~= 2 or not (radius[1] > 0) or not (radius[2] >= radius[1]) then
+    fail("lab.specimen: radius must be {rmin, rmax} with 0 < rmin <= rmax")
+  end
+  local mat = lab.rock(opts.material)
+  local sigma0 = opts.sigma0 or 0.1e6
+  positive(sigma0, "sigma0", "specimen")
+  local porosity = opts.porosity or (dim == 3 and 0.42 or 0.18)
+  local seed = opts.seed or 1
+  local path = opts.path or fail("lab.specimen: a path for the specimen file is required")
+  local t0 = seixo.clock()
+
+  local m = seixo.model{dim = dim}
+  -- genesis is frictionless (a dense packing); the rock's friction comes back before bonding
+  m:material("rock", merge(mat, {friction = 0}))
+  local rmean = 0.5 * (radius[1] + radius[2])
+  local kn = ball_kn(mat, rmean, dim)
+  local v = make_vessel(m, size, kn, cyl_axis)
+  local n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed}
+  say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps)", n, porosity, m:step())
+
+  -- the isotropic stress, by servo-controlled walls; a small sigma0 is a
+  -- tiny overlap (sigma0 d / kn), which the balls' vibrations disturb by a
+  -- few per cent: 2 % and a ratio of 1e-2 are close enough for a seating
+  -- stress (a frictionless packing also creeps as the walls close in)
+  local steps, err = servo_vessel(m, v, sigma0, {max_speed = 0.5, max_steps = opts.max_steps or 30000, tol = 0.02,
+                                                 ratio = 1e-2})
+  say(opts, "lab.specimen: isotropic stress %.3g Pa installed within %.2f %% (%d steps)", sigma0, 100 * err, steps)
+
+  -- floaters: balls with fewer than dim contacts carry nothing
+  local contacts = {}
+  for c in m:contacts{kind = "ball-ball"} do
+    if c.fn > 0 then
+      contacts[c.a.id] = (contacts[c.a.id] or 0) + 1
+      contacts[c.b.id] = (contacts[c.b.id] or 0) + 1
+    end
+  end
+  local floaters = 0
+  for b in m:balls() do if (contacts[b.id] or 0) < dim then floaters = floaters + 1 end end
+
+  m:material("rock", mat)
+  local gap = opts.gap or 1e-3 * radius[1]
+  local bonds = m:bond{kind = "parallel", gap = gap, seed = seed}
+  say(opts, "lab.specimen: %d parallel bonds (%.2f per ball), %d floaters", bonds, 2 * bonds / n, floaters)
+
+  -- out of the vessel: the specimen relaxes and its locked-in stresses fall
+  for _, w in ipairs(v.walls) do w:remove() end
+  m:solve{ratio = 1e-4, steps = 20000}
+  if trim then
+    local c, r = trim.center, trim.radius
+    local removed = m:remove_balls{where = function(b)
+      local p = b.pos
+      return (p[1] - c[1]) ^ 2 + (p[2] - c[2]) ^ 2 > r * r
+    end}
+    m:solve{ratio = 1e-4, steps = 20000}
+    say(opts, "lab.specimen: trimmed to a disk: %d balls removed, %d left", removed, m:ball_count())
+  end
+
+  local elo, ehi = extents(m)
+  local volume = 1
+  for k = 1, dim do volume = volume * (ehi[k] - elo[k]) end
+  if shape == "cylinder" or shape == "disc" or shape == "disk" then volume = volume * pi / 4 end
+  local solid = m:sum("volume")
+  local spec = {
+    path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
+    balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
+    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, genesis_steps = m:step(),
+    genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
+    depth = opts.depth, thickness = opts.thickness,
+  }
+  m:vars().lab_specimen = copy(spec)
+  m:save(path)
+  say(opts, "lab.specimen: %d balls, %d bonds, porosity %.3f, saved to %s (%.1f s)", spec.balls, spec.bonds,
+      spec.porosity, path, spec.genesis_time)
+  m:close()
+  return spec
+end
+
+--- The specimen saved at path (its table as lab.specimen returned it).
+function lab.open(path)
+  local m = seixo.load(path)
+  local spec = m:vars().lab_specimen
+  m:close()
+  if type(spec) ~= "table" then error("lab.open: " .. path .. " holds no lab specimen", 2) end
+  spec.path = path
+  return spec
+end
+
+-- -------------------------------------------------------------- the tests
+
+-- Loading direction: z in 3D, y in 2D.
+local function axis_of(dim) return dim end
+
+-- The lateral strain of an unconfined specimen, from the balls' motion:
+-- the displacement field u = c + B x fitted to every ball by least squares
+-- (the average strain of the assembly, robust to a loose ball at the
+-- surface), from positions x0 taken at the start. strain() returns the mean
+-- of -B_kk over the lateral directions k (compression positive).
+local function affine_strain(m, ax)
+  local dim = m:dim()
+  local x0, mean = {}, {}
+  for k = 1, dim do mean[k] = 0 end
+  local n = 0
+  for b in m:balls() do
+    local p = b.pos
+    x0[b.id] = p
+    for k = 1, dim do mean[k] = mean[k] + p[k] end
+    n = n + 1
+  end
+  for k = 1, dim do mean[k] = mean[k] / n end
+  -- C = sum (x0 - mean)(x0 - mean)^T and its inverse (dim <= 3: cofactors)
+  local C = {}
+  for i = 1, dim do C[i] = {} for j = 1, dim do C[i][j] = 0 end end
+  for _, p in pairs(x0) do
+    for i = 1, dim do for j = 1, dim do C[i][j] = C[i][j] + (p[i] - mean[i]) * (p[j] - mean[j]) end end
+  end
+  local inv = {}
+  if dim == 2 then
+    local det = C[1][1] * C[2][2] - C[1][2] * C[2][1]
+    inv = {{C[2][2] / det, -C[1][2] / det}, {-C[2][1] / det, C[1][1] / det}}
+  else
+    local function cof(i, j)
+      local r, c = {}, {}
+      for k = 1, 3 do if k ~= i then r[#r + 1] = k end; if k ~= j then c[#c + 1] = k end end
+      return ((i + j) % 2 == 0 and 1 or -1) * (C[r[1]][c[1]] * C[r[2]][c[2]] - C[r[1]][c[2]] * C[r[2]][c[1]])
+    end
+    local det = C[1][1] * cof(1, 1) + C[1][2] * cof(1, 2) + C[1][3] * cof(1, 3)
+    for i = 1, 3 do inv[i] = {} for j = 1, 3 do inv[i][j] = cof(j, i) / det end end
+  end
+  local lateral = {}
+  for k = 1, dim do if k ~= ax then lateral[#lateral + 1] = k end end
+  return function()
+    -- S_kj = sum (u_k - mean u_k)(x0_j - mean_j); the mean of u drops out since sum (x0 - mean) = 0
+    local S, total = {}, 0
+    for _, k in ipairs(lateral) do S[k] = {} for j = 1, dim do S[k][j] = 0 end end
+    for b in m:balls() do
+      local p0 = x0[b.id]
+      if p0 then
+        local p = b.pos
+        for _, k in ipairs(lateral) do
+          local u = p[k] - p0[k]
+          for j = 1, dim do S[k][j] = S[k][j] + u * (p0[j] - mean[j]) end
+        end
+      end
+    end
+    for _, k in ipairs(lateral) do
+      local bkk = 0
+      for j = 1, dim do bkk = bkk + S[k][j] * inv[j][k] end
+      total = total - bkk
+    end
+    return total / #lateral
+  end
+end
+
+-- The inertial number I = strain rate x mean diameter x sqrt(density / p):
+-- below about 1e-3 the loading is quasi-static (GDR MiDi 2004).
+local function inertial_number(rate, spec, p)
+  if not (p > 0) then return math.huge end
+  return rate * (spec.radius[1] + spec.radius[2]) * math.sqrt(spec.material.density / p)
+end
+
+local test_keys = {"confining", "strain_rate", "max_strain", "post_peak", "every", "out", "plot", "log",
+                   "lateral", "max_steps", "confine_tol", "name"}
+
+local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_strain", "axial_stress",
+                 "lateral_stress", "deviator", "cracks_tension", "cracks_shear", "ratio", "inertial"}
+
+-- A triaxial (confining > 0) or unconfined compression test.
+local function compression(spec, opts, fn)
+  check_keys(opts, fn, test_keys)
+  local dim, ax = spec.dim, axis_of(spec.dim)
+  if spec.shape == "disc" or spec.shape == "disk" then
+    fail("lab.%s: a %s specimen is for the Brazilian test; make a %s", fn, spec.shape,
+         dim == 3 and "cylinder or prism" or "rect")
+  end
+  local sigma3 = opts.confining or 0
+  if type(sigma3) ~= "number" or sigma3 < 0 then fail("lab.%s: confining must be a stress >= 0 Pa", fn) end
+  local rate = positive(opts.strain_rate or 1, "strain_rate", fn)
+  local max_strain = positive(opts.max_strain or 0.02, "max_strain", fn)
+  local post_peak = opts.post_peak or 0.7
+  if not (post_peak > 0 and post_peak < 1) then fail("lab.%s: post_peak must be in (0, 1)", fn) end
+  local every = opts.every or 100
+  local t0 = seixo.clock()
+
+  local m = seixo.load(spec.path)
+  local lo, hi = extents(m)
+  local centre = {}
+  for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
+  local kn, fr = spec.wall_kn, 0
+  -- platens: frictionless planes (lines) touching the specimen's ends
+  local down, up = {}, {}
+  for k = 1, dim do down[k], up[k] = 0, 0 end
+  up[ax], down[ax] = 1, -1
+  local p_lo, p_hi = copy(centre), copy(centre)
+  p_lo[ax], p_hi[ax] = lo[ax], hi[ax]
+  local kind = dim == 3 and "plane" or "line"
+  local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = kn, ks = 0, friction = fr}
+  local top = m:wall{kind = kind, point = p_hi, normal = down, kn = kn, ks = 0, friction = fr}
+
+  -- lateral confinement: a cylinder or planes (lines), servo-controlled
+  local lateral = {}
+  local use_cylinder = sigma3 > 0 and dim == 3 and spec.shape == "cylinder" and opts.lateral ~= "planes"
+  if sigma3 > 0 then
+    if use_cylinder then
+      local rmax = 0
+      for b in m:balls() do
+        local p = b.pos
+        rmax = math.max(rmax, math.sqrt((p[1] - centre[1]) ^ 2 + (p[2] - centre[2]) ^ 2) + b.radius)
+      end
+      local cpoint = copy(centre)
+      cpoint[3] = 0
+      lateral[1] = m:wall{kind = "cylinder", point = cpoint, axis = {0, 0, 1}, radius = rmax, height = 0, kn = kn,
+                          ks = 0, friction = fr}
+    else
+      for k = 1, dim do
+        if k ~= ax then
+          local n1, n2, q1, q2 = {}, {}, copy(centre), copy(centre)
+          for j = 1, dim do n1[j], n2[j] = 0, 0 end
+          n1[k], n2[k] = 1, -1
+          q1[k], q2[k] = lo[k], hi[k]
+          lateral[#lateral + 1] = m:wall{kind = kind, point = q1, normal = n1, kn = kn, ks = 0, friction = fr}
+          lateral[#lateral + 1] = m:wall{kind = kind, point = q2, normal = n2, kn = kn, ks = 0, friction = fr}
+        end
+      end
+    end
+  end
+
+  -- geometry of the moment: length, cross-section area, lateral areas
+  local function height() return top.point[ax] - bottom.point[ax] end
+  local function lateral_extent(k) -- the distance between the two walls normal to k
+    for i = 1, #lateral, 2 do
+      if lateral[i].normal[k] == 1 then return lateral[i + 1].point[k] - lateral[i].point[k] end
+    end
+  end
+  local width0 = {}
+  for k = 1, dim do width0[k] = hi[k] - lo[k] end
+  local function section()
+    if use_cylinder then return pi * lateral[1]:radius() ^ 2 end
+    if spec.shape == "cylinder" then return pi * (0.25 * (width0[1] + width0[2])) ^ 2 end
+    local a = 1
+    for k = 1, dim do if k ~= ax then a = a * (lateral_extent(k) or width0[k]) end end
+    return a
+  end
+  local function lateral_areas() -- per lateral wall
+    local h, areas = height(), {}
+    if use_cylinder then return {2 * pi * lateral[1]:radius() * h} end
+    for i = 1, #lateral do
+      local k
+      for j = 1, dim do if lateral[i].normal[j] ~= 0 then k = j end end
+      local a = h
+      for j = 1, dim do if j ~= k and j ~= ax then a = a * lateral_extent(j) end end
+      areas[i] = a
+    end
+    return areas
+  end
+  local function servo_lateral()
+    local areas = lateral_areas()
+    for i, w in ipairs(lateral) do w:servo{target = sigma3, area = areas[i], alpha = 0.5, max_speed = 0.05} end
+  end
+  local function lateral_stress()
+    if #lateral == 0 then return 0 end
+    local areas, s = lateral_areas(), 0
+    for i, w in ipairs(lateral) do s = s + w:load() / areas[i] end
+    return s / #lateral
+  end
+  local function axial_stress() return 0.5 * (top:load() + bottom:load()) / section() end
+
+  -- confinement: all walls servo-controlled to sigma3, then held there
+  local confine_steps = 0
+  if sigma3 > 0 then
+    local start, tol = m:step(), opts.confine_tol or 0.01
+    repeat
+      servo_lateral()
+      local s = section()
+      top:servo{target = sigma3, area = s, alpha = 0.5, max_speed = 0.05}
+      bottom:servo{target = sigma3, area = s, alpha = 0.5, max_speed = 0.05}
+      m:cycle(200)
+      local ok = math.abs(axial_stress() / sigma3 - 1) < tol and math.abs(lateral_stress() / sigma3 - 1) < tol
+    until (ok and m:ratio() < 1e-3) or m:step() - start >= (opts.max_steps or 400000) / 4
+    confine_steps = m:step() - start
+    top:servo(nil)
+    bottom:servo(nil)
+    say(opts, "lab.%s: confined at %.4g Pa in %d steps (axial %.4g, lateral %.4g Pa)", fn, sigma3, confine_steps,
+        axial_stress(), lateral_stress())
+  end
+
+  -- axial loading at a constant strain rate, both platens moving
+  local h0 = height()
+  local speed = 0.5 * rate * h0
+  local v_top, v_bottom = {}, {}
+  for k = 1, dim do v_top[k], v_bottom[k] = 0, 0 end
+  v_top[ax], v_bottom[ax] = -speed, speed
+  top.vel, bottom.vel = v_top, v_bottom
+  local lateral_strain
+  if #lateral == 0 then
+    lateral_strain = affine_strain(m, ax)
+  else -- from the walls: the cylinder's radius, or the distances between opposite walls
+    local function sizes()
+      if use_cylinder then return {(lateral[1]:radius())} end
+      local now = {}
+      for k = 1, dim do if k ~= ax then now[#now + 1] = lateral_extent(k) end end
+      return now
+    end
+    local lat0 = sizes()
+    lateral_strain = function()
+      local now, s = sizes(), 0
+      for i = 1, #lat0 do s = s + (lat0[i] - now[i]) / lat0[i] end
+      return s / #lat0
+    end
+  end
+
+  local rows, peak, peak_row = {}, -math.huge, nil
+  local start, t_start = m:step(), m:time()
+  local cracks0 = {m:crack_count("tension"), m:crack_count("shear")}
+  local max_steps = opts.max_steps or 400000
+  local ratio_sum, ratio_n, inertial_max = 0, 0, 0
+  local why = "max_strain"
+  while true do
+    if #lateral > 0 then servo_lateral() end
+    m:cycle(every)
+    local ea = (h0 - height()) / h0
+    local el = lateral_strain()
+    local sa, sl = axial_stress(), lateral_stress()
+    local q = sa - sl
+    local ratio = m:ratio()
+    local p = (sa + (dim - 1) * sl) / dim
+    local inertial = inertial_number(rate, spec, p)
+    if m:step() - start > 10 * every then -- past the first contact transients
+      ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
+      if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
+    end
+    local row = {m:step(), m:time() - t_start, ea, el, ea + (dim - 1) * el, sa, sl, q,
+                 m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial}
+    rows[#rows + 1] = row
+    if q > peak then peak, peak_row = q, #rows end
+    -- past the peak: a bonded specimen loses strength only by cracking, so
+    -- a drop without cracks is a transient (the platens seating)
+    if peak > 0 and q < post_peak * peak and ea > rows[peak_row][3] and row[9] + row[10] > 0 then
+      why = "post_peak"
+      break
+    end
+    if ea >= max_strain then break end
+    if m:step() - start >= max_steps then why = "max_steps"; break end
+  end
+
+  -- results: peak, secant modulus and Poisson's ratio at half the peak
+  local r = {kind = sigma3 > 0 and "triaxial" or "ucs", confining = sigma3, dim = dim, rows = rows,
+             columns = columns, stopped = why, steps = m:step() - start, confine_steps = confine_steps,
+             strain_rate = rate, platen_speed = speed}
+  local pr = rows[peak_row]
+  r.peak_deviator = peak
+  r.peak = peak + sigma3            -- sigma1 at failure
+  r.peak_strain = pr[3]
+  local half = 0.5 * peak
+  for i = 1, peak_row do
+    if rows[i][8] >= half then
+      local a = rows[i - 1] or {0, 0, 0, 0, 0, 0, 0, 0}
+      local b = rows[i]
+      local t = (b[8] - a[8]) > 0 and (half - a[8]) / (b[8] - a[8]) or 1
+      local ea = a[3] + t * (b[3] - a[3])
+      local el = a[4] + t * (b[4] - a[4])
+      r.young = half / ea
+      r.poisson = -el / ea
+      break
+    end
+  end
+  r.cracks = {tension = pr[9], shear = pr[10]}
+  r.cracks_total = {tension = rows[#rows][9], shear = rows[#rows][10]}
+  r.mean_ratio = ratio_n > 0 and ratio_sum / ratio_n or m:ratio()
+  r.inertial = inertial_max
+  r.wall_time = seixo.clock() - t0
+  r.warnings = {}
+  if r.inertial > 1e-3 then
+    r.warnings[#r.warnings + 1] = string.format("inertial number %.2g > 1e-3: the loading is too fast to be "
+                                                .. "quasi-static; lower strain_rate", r.inertial)
+  end
+  if r.mean_ratio > 0.01 then
+    r.warnings[#r.warnings + 1] = string.format("mean unbalanced-force ratio %.2g during loading: the specimen is "
+                                                .. "not near equilibrium; lower strain_rate", r.mean_ratio)
+  end
+  if why ~= "post_peak" then
+    r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
+  end
+  for _, w in ipairs(r.warnings) do say(opts, "lab.%s: warning: %s", fn, w) end
+  say(opts, "lab.%s: sigma3 %.4g MPa: peak %.4g MPa at strain %.4g, E %.4g GPa, nu %.3f, cracks %d tension / %d shear "
+      .. "(%d steps, %.1f s; ratio %.2g, inertial number %.2g)", fn, sigma3 / 1e6, r.peak / 1e6, r.peak_strain,
+      (r.young or 0) / 1e9, r.poisson or 0, r.cracks.tension, r.cracks.shear, r.steps, r.wall_time, r.mean_ratio,
+      r.inertial)
+
+  if opts.out then
+    lab.write_csv(opts.out .. ".csv", columns, rows)
+    local summary = copy(r)
+    summary.rows = nil
+    m:vars().lab_result = summary
+    m:save(opts.out .. ".h5")
+    if opts.plot ~= false then plot_test(r, opts.out) end
+  end
+  m:close()
+  return r
+end
+
+--- A triaxial test (confining = sigma3 > 0, by servo-controlled walls) or,
+--- with confining = 0, an unconfined compression test.
+function lab.triaxial(spec, opts) return compression(spec, opts or {}, "triaxial") end
+
+--- The unconfined (uniaxial) compression test: no lateral walls.
+function lab.ucs(spec, opts)
+  opts = copy(opts or {})
+  if opts.confining and opts.confining ~= 0 then fail("lab.ucs: the UCS test has no confining stress") end
+  opts.confining = 0
+  return compression(spec, opts, "ucs")
+end
+
+--- The Brazilian (indirect tensile) test of a disk (2D) or a disc (3D, axis
+--- y): two platens close at a constant speed; sigma_t = 2 F / (pi D t).
+function lab.brazilian(spec, opts)
+  opts = opts or {}
+  check_keys(opts, "brazilian", {"strain_rate", "post_peak", "every", "out", "plot", "log", "max_steps", "max_strain"})
+  local dim, ax = spec.dim, axis_of(spec.dim)
+  if spec.shape ~= "disc" and spec.shape ~= "disk" then
+    fail("lab.brazilian: the specimen must be a %s (got a %s)", dim == 3 and "disc" or "disk", spec.shape)
+  end
+  local rate = positive(opts.strain_rate or 1, "strain_rate", "brazilian")
+  local post_peak = opts.post_peak or 0.5
+  local every = opts.every or 100
+  local t0 = seixo.clock()
+  local m = seixo.load(spec.path)
+  local lo, hi = extents(m)
+  local centre = {}
+  for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
+  local up, down = {}, {}
+  for k = 1, dim do up[k], down[k] = 0, 0 end
+  up[ax], down[ax] = 1, -1
+  local p_lo, p_hi = copy(centre), copy(centre)
+  p_lo[ax], p_hi[ax] = lo[ax], hi[ax]
+  local kind = dim == 3 and "plane" or "line"
+  local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
+  local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
+  local d = hi[ax] - lo[ax]
+  local t = dim == 3 and hi[2] - lo[2] or 1
+  local speed = 0.5 * rate * d
+  local v1, v2 = {}, {}
+  for k = 1, dim do v1[k], v2[k] = 0, 0 end
+  v1[ax], v2[ax] = -speed, speed
+  top.vel, bottom.vel = v1, v2
+  local rows, peak, peak_row = {}, -math.huge, nil
+  local start, t_start = m:step(), m:time()
+  local max_steps = opts.max_steps or 400000
+  local max_strain = opts.max_strain or 0.05
+  local why = "max_strain"
+  local header = {"step", "time", "displacement", "force", "tensile_stress", "cracks_tension", "cracks_shear", "ratio"}
+  local cracks0 = m:crack_count()
+  local tension0, shear0 = m:crack_count("tension"), m:crack_count("shear")
+  while true do
+    m:cycle(every)
+    local disp = d - (top.point[ax] - bottom.point[ax])
+    local f = 0.5 * (top:load() + bottom:load())
+    local st = 2 * f / (pi * d * t)
+    rows[#rows + 1] = {m:step(), m:time() - t_start, disp, f, st, m:crack_count("tension") - tension0,
+                       m:crack_count("shear") - shear0, m:ratio()}
+    if f > peak then peak, peak_row = f, #rows end
+    local cracked = m:crack_count() > cracks0
+    if peak > 0 and f < post_peak * peak and disp > rows[peak_row][3] and cracked then why = "post_peak"; break end
+    if disp / d >= max_strain then break end
+    if m:step() - start >= max_steps then why = "max_steps"; break end
+  end
+  local r = {kind = "brazilian", dim = dim, rows = rows, columns = header, stopped = why, diameter = d,
+             thickness = t, peak_force = peak, tensile_strength = 2 * peak / (pi * d * t),
+             cracks = {tension = rows[peak_row][6], shear = rows[peak_row][7]}, steps = m:step() - start,
+             wall_time = seixo.clock() - t0, strain_rate = rate}
+  say(opts, "lab.brazilian: peak force %.4g N, tensile strength %.4g MPa, cracks %d tension / %d shear (%d steps, %.1f s)",
+      peak, r.tensile_strength / 1e6, r.cracks.tension, r.cracks.shear, r.steps, r.wall_time)
+  if opts.out then
+    lab.write_csv(opts.out .. ".csv", header, rows)
+    local summary = copy(r)
+    summary.rows = nil
+    m:vars().lab_result = summary
+    m:save(opts.out .. ".h5")
+    if opts.plot ~= false then plot_brazilian(r, opts.out) end
+  end
+  m:close()
+  return r
+end
+
+-- ------------------------------------------------------------ Mohr-Coulomb
+
+--- Fits the Mohr-Coulomb criterion sigma1 = UCS + N sigma3 to the failure
+--- states {{sigma3 =, sigma1 =}, ...} by least squares; N = (1 + sin phi) /
+--- (1 - sin phi) and UCS = 2 c sqrt(N). Returns {c =, phi = (degrees), N =,
+--- intercept =, r2 =, rms =, points =}.
+function lab.mohr_coulomb(points)
+  if type(points) ~= "table" or #points < 2 then error("lab.mohr_coulomb: two failure states or more expected", 2) end
+  local n, sx, sy, sxx, sxy = #points, 0, 0, 0, 0
+  for i, p in ipairs(points) do
+    local x, y = p.sigma3 or p[1], p.sigma1 or p[2]
+    if type(x) ~= "number" or type(y) ~= "number" then
+      error(string.format("lab.mohr_coulomb: point %d needs sigma3 and sigma1 numbers", i), 2)
+    end
+    sx, sy, sxx, sxy = sx + x, sy + y, sxx + x * x, sxy + x * y
+  end
+  local den = n * sxx - sx * sx
+  if not (den > 0) then error("lab.mohr_coulomb: the failure states need two different confining stresses", 2) end
+  local slope = (n * sxy - sx * sy) / den
+  local intercept = (sy - slope * sx) / n
+  local mean, ss_tot, ss_res = sy / n, 0, 0
+  for _, p in ipairs(points) do
+    local x, y = p.sigma3 or p[1], p.sigma1 or p[2]
+    ss_tot = ss_tot + (y - mean) ^ 2
+    ss_res = ss_res + (y - (intercept + slope * x)) ^ 2
+  end
+  local fit = {N = slope, intercept = intercept, points = n, rms = math.sqrt(ss_res / n),
+               r2 = ss_tot > 0 and 1 - ss_res / ss_tot or 1}
+  if slope >= 1 then
+    fit.phi = math.deg(math.asin((slope - 1) / (slope + 1)))
+    fit.c = intercept / (2 * math.sqrt(slope))
+  else -- strength falling with confinement: no Mohr-Coulomb envelope
+    fit.phi, fit.c = 0 / 0, 0 / 0
+    fit.warning = string.format("the fitted slope %.3g is below 1: no friction angle", slope)
+  end
+  return fit
+end
+
+--- A triaxial series: the tests at each confining stress (0 is a UCS), then
+--- the Mohr-Coulomb fit of their peaks, and the plots. opts as for
+--- lab.triaxial, with confining = {sigma3, ...}; opts.out is a prefix.
+function lab.series(spec, opts)
+  opts = copy(opts or {})
+  local list = opts.confining
+  if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
+  local results, points = {}, {}
+  local out = opts.out
+  for i, s3 in ipairs(list) do
+    local o = copy(opts)
+    o.confining = s3
+    o.out = out and string.format("%s_%s%g", out, s3 > 0 and "triaxial_" or "ucs", s3 > 0 and s3 / 1e6 or 0):gsub("ucs0$", "ucs")
+    o.plot = false
+    local r = s3 > 0 and lab.triaxial(spec, o) or lab.ucs(spec, o)
+    results[i] = r
+    points[i] = {sigma3 = s3, sigma1 = r.peak}
+  end
+  local fit = lab.mohr_coulomb(points)
+  say(opts, "lab.series: Mohr-Coulomb c %.4g MPa, phi %.2f deg (UCS of the fit %.4g MPa, R^2 %.4f, rms %.3g MPa)",
+      fit.c / 1e6, fit.phi, fit.intercept / 1e6, fit.r2, fit.rms / 1e6)
+  local s = {tests = results, fit = fit}
+  if out and opts.plot ~= false then plot_series(s, out) end
+  return s
+end
+
+-- ------------------------------------------------------------------ plots
+
+--- Whether gnuplot can be run (the plots are skipped, with a note, if not).
+function lab.have_gnuplot()
+  local ok = os.execute("command -v gnuplot > /dev/null 2>&1")
+  return ok == true or ok == 0
+end
+
+-- Runs a gnuplot script writing the PNG files outs (each to a temporary
+-- name, renamed when gnuplot succeeded).
+local function gnuplot(script, outs)
+  if not lab.have_gnuplot() then
+    io.stderr:write("lab: gnuplot not found (apt-get install gnuplot-nox): no plots\n")
+    return false
+  end
+  local tag = math.random(1, 1 << 30)
+  for _, o in ipairs(outs) do script = script:gsub("@" .. o.key .. "@", o.path .. ".tmp" .. tag) end
+  local gp = os.tmpname()
+  local f = assert(io.open(gp, "w"))
+  f:write(script)
+  f:close()
+  local ok = os.execute("gnuplot " .. gp .. " 2> " .. gp .. ".err")
+  local err = io.open(gp .. ".err"):read("a")
+  os.remove(gp)
+  os.remove(gp .. ".err")
+  if not (ok == true or ok == 0) then
+    for _, o in ipairs(outs) do os.remove(o.path .. ".tmp" .. tag) end
+    io.stderr:write("lab: gnuplot failed: " .. err .. "\n")
+    return false
+  end
+  for _, o in ipairs(outs) do os.rename(o.path .. ".tmp" .. tag, o.path) end
+  return true
+end
+
+local terminal = "set terminal pngcairo size 900,600 font ',11'\nset datafile separator ','\nset key autotitle columnhead\nset grid\n"
+
+--- The figures of one compression test: stress-strain with volumetric
+--- strain, and cracks against strain (PNG beside the CSV).
+function plot_test(r, out)
+  local csv = out .. ".csv"
+  local script = terminal .. string.format([[
+set output '@s@'
+set title '%s, confining %.4g MPa'
+set xlabel 'axial strain (%%)'
+set ylabel 'deviator stress (MPa)'
+set y2label 'volumetric strain (%%)'
+set y2tics
+plot '%s' using ($3*100):($8/1e6) with lines lw 2 title 'deviator', '' using ($3*100):($5*100) axes x1y2 with lines dt 2 title 'volumetric strain'
+set output '@c@'
+set title 'cracks'
+set ylabel 'cracks'
+unset y2label
+unset y2tics
+plot '%s' using ($3*100):9 with lines lw 2 title 'tension', '' using ($3*100):10 with lines lw 2 title 'shear'
+]], r.kind, r.confining / 1e6, csv, csv)
+  return gnuplot(script, {{key = "s", path = out .. "_stress.png"}, {key = "c", path = out .. "_cracks.png"}})
+end
+
+function plot_brazilian(r, out)
+  local csv = out .. ".csv"
+  local script = terminal .. string.format([[
+set output '@s@'
+set title 'Brazilian test'
+set xlabel 'platen displacement (mm)'
+set ylabel 'sigma_t = 2F/(pi D t) (MPa)'
+set y2label 'cracks'
+set y2tics
+plot '%s' using ($3*1e3):($5/1e6) with lines lw 2 title 'tensile stress', '' using ($3*1e3):($6+$7) axes x1y2 with lines dt 2 title 'cracks'
+]], csv)
+  return gnuplot(script, {{key = "s", path = out .. "_stress.png"}})
+end
+
+--- The figures of a series: the stress-strain curves and volumetric
+--- strains of every test, their crack counts, and the Mohr circles with the
+--- fitted envelope tau = c + sigma tan(phi).
+function plot_series(s, out)
+  local curves, vol, cracks = {}, {}, {}
+  for i, r in ipairs(s.tests) do
+    local csv = string.format("%s_%d.csv", out, i)
+    lab.write_csv(csv, r.columns, r.rows)
+    local name = r.confining > 0 and string.format("{/Symbol s}_3 = %g MPa", r.confining / 1e6) or "UCS"
+    curves[#curves + 1] = string.format("'%s' using ($3*100):($8/1e6) with lines lw 2 title '%s'", csv, name)
+    vol[#vol + 1] = string.format("'%s' using ($3*100):($5*100) with lines lw 2 title '%s'", csv, name)
+    cracks[#cracks + 1] = string.format("'%s' using ($3*100):($9+$10) with lines lw 2 title '%s'", csv, name)
+  end
+  local circles, smax = {}, 0
+  for _, r in ipairs(s.tests) do
+    local c, rad = 0.5 * (r.peak + r.confining) / 1e6, 0.5 * (r.peak - r.confining) / 1e6
+    circles[#circles + 1] = string.format("set object circle at %.6g,0 size %.6g fc rgb '#1f77b4' lw 2", c, rad)
+    smax = math.max(smax, c + rad)
+  end
+  local fit = s.fit
+  local env = fit.phi == fit.phi and string.format(
+    "plot [0:%.6g] %.6g + x * tan(%.6g * pi / 180) lw 2 dt 2 title sprintf('c = %.3g MPa, phi = %.1f deg')",
+    smax * 1.05, fit.c / 1e6, fit.phi, fit.c / 1e6, fit.phi) or "plot [0:1] 1/0 notitle"
+  local script = terminal .. string.format([[
+set output '@s@'
+set title 'stress-strain'
+set xlabel 'axial strain (%%)'
+set ylabel 'deviator stress (MPa)'
+set key left top
+plot %s
+set output '@v@'
+set title 'volumetric strain (compression positive)'
+set ylabel 'volumetric strain (%%)'
+plot %s
+set output '@c@'
+set title 'cracks'
+set ylabel 'cracks (tension + shear)'
+plot %s
+set output '@m@'
+set title 'Mohr circles at failure and the Mohr-Coulomb envelope'
+set xlabel 'normal stress (MPa)'
+set ylabel 'shear stress (MPa)'
+set size ratio -1
+set xrange [0:%.6g]
+set yrange [0:%.6g]
+%s
+%s
+]], table.concat(curves, ", "), table.concat(vol, ", "), table.concat(cracks, ", "), smax * 1.05, smax * 0.6,
+      table.concat(circles, "\n"), env)
+  return gnuplot(script, {{key = "s", path = out .. "_stress.png"}, {key = "v", path = out .. "_volumetric.png"},
+                          {key = "c", path = out .. "_cracks.png"}, {key = "m", path = out .. "_mohr.png"}})
+end
+
+return lab

@@ -1,0 +1,106 @@
+-- The lab-test library (seixo.lab): the Mohr-Coulomb fit against its closed
+-- form, and the whole pipeline on a tiny 2D specimen -- genesis, UCS,
+-- biaxial tests, the fit, the files and the quasi-static warnings.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
+local lab = require "seixo.lab"
+
+test("Mohr-Coulomb fit recovers c and phi from exact failure states", function()
+  -- sigma1 = 2 c sqrt(N) + N sigma3, N = (1 + sin phi) / (1 - sin phi)
+  for _, case in ipairs{{c = 10e6, phi = 30}, {c = 2.5e6, phi = 42.5}, {c = 40e6, phi = 12}} do
+    local s = math.sin(math.rad(case.phi))
+    local N = (1 + s) / (1 - s)
+    local pts = {}
+    for i, s3 in ipairs{0, 2e6, 7e6, 15e6, 30e6} do pts[i] = {sigma3 = s3, sigma1 = 2 * case.c * math.sqrt(N) + N * s3} end
+    local fit = lab.mohr_coulomb(pts)
+    near(fit.c, case.c, 1e-10)
+    near(fit.phi, case.phi, 1e-10)
+    near(fit.N, N, 1e-12)
+    near(fit.r2, 1, 1e-12)
+    check(fit.rms < 1e-6 * case.c, fit.rms)
+  end
+  raises(function() lab.mohr_coulomb{{sigma3 = 1, sigma1 = 2}} end, "two failure states")
+  raises(function() lab.mohr_coulomb{{sigma3 = 1, sigma1 = 2}, {sigma3 = 1, sigma1 = 3}} end, "two different")
+  local weak = lab.mohr_coulomb{{sigma3 = 0, sigma1 = 10}, {sigma3 = 10, sigma1 = 15}}
+  check(weak.warning and weak.phi ~= weak.phi, "a slope below 1 has no friction angle")
+end)
+
+local dir = os.tmpname()
+os.remove(dir)
+os.execute("mkdir -p '" .. dir .. "'")
+local spec
+local quiet = {log = false}
+
+test("genesis makes a bonded specimen and saves it", function()
+  spec = lab.specimen{dim = 2, shape = "rect", width = 0.01, height = 0.02, radius = {0.4e-3, 0.66e-3},
+                      seed = 3, path = dir .. "/spec.h5", log = false}
+  check(spec.balls > 100 and spec.bonds > spec.balls, string.format("%d balls, %d bonds", spec.balls, spec.bonds))
+  check(spec.porosity > 0.1 and spec.porosity < 0.3, spec.porosity)
+  local again = lab.open(spec.path)
+  eq(again.balls, spec.balls)
+  eq(again.bonds, spec.bonds)
+end)
+
+test("UCS and biaxial tests give finite peaks, moduli and a Mohr-Coulomb envelope", function()
+  local s = lab.series(spec, {confining = {0, 2e6, 5e6}, out = dir .. "/series", log = false})
+  eq(#s.tests, 3)
+  local prev = 0
+  for _, r in ipairs(s.tests) do
+    check(r.peak > r.confining and r.peak < math.huge, r.peak)
+    check(r.young > 1e9 and r.young < 1e12, r.young)          -- a rock-like modulus, Pa
+    -- a specimen 10 disks wide splits early: its secant Poisson's ratio is
+    -- only required to be a positive number here
+    check(r.poisson > 0 and r.poisson < math.huge, r.poisson)
+    check(r.cracks.tension + r.cracks.shear > 0, "cracks at the peak")
+    eq(r.stopped, "post_peak")
+    check(r.peak > prev, "strength grows with confinement")
+    prev = r.peak
+  end
+  local fit = s.fit
+  check(fit.c > 0 and fit.c < math.huge and fit.phi > 0 and fit.phi < 90, string.format("c %g phi %g", fit.c, fit.phi))
+  -- the history of each test is in a CSV whose peak matches the result
+  local csv = require("seixo.util").read_csv(dir .. "/series_ucs.csv")
+  local peak = 0
+  for _, q in ipairs(csv.columns.deviator) do peak = math.max(peak, q) end
+  near(peak, s.tests[1].peak, 1e-9)
+  -- and the snapshot carries the results
+  local m = seixo.load(dir .. "/series_ucs.h5")
+  near(m:vars().lab_result.peak, s.tests[1].peak, 1e-12)
+  m:close()
+  if lab.have_gnuplot() then
+    for _, f in ipairs{"stress", "volumetric", "cracks", "mohr"} do
+      local h = io.open(dir .. "/series_" .. f .. ".png", "rb")
+      check(h and h:read(4) == "\137PNG", "figure " .. f)
+      if h then h:close() end
+    end
+  end
+end)
+
+test("a loading far too fast is reported as not quasi-static", function()
+  local r = lab.ucs(spec, {strain_rate = 400, log = false})
+  check(#r.warnings > 0 and r.warnings[1]:find("quasi-static") or (r.warnings[1] or ""):find("equilibrium"),
+        table.concat(r.warnings, "; "))
+end)
+
+test("bad options name the problem", function()
+  raises(function() lab.triaxial(spec, {confinig = 1e6}) end, "unknown option 'confinig'")
+  raises(function() lab.triaxial(spec, {confining = -1}) end, "confining")
+  raises(function() lab.ucs(spec, {strain_rate = 0}) end, "strain_rate")
+  raises(function() lab.brazilian(spec, {}) end, "must be a disk")
+  raises(function() lab.specimen{dim = 2, shape = "cylinder", path = "x.h5"} end, "not a 2D shape")
+  raises(function() lab.specimen{dim = 3, shape = "cylinder", diameter = 0.01, path = "x.h5"} end, "height")
+  raises(function() lab.open(dir .. "/nothing.h5") end, "nothing.h5")
+end)
+
+test("the Brazilian test splits a disk", function()
+  local disk = lab.specimen{dim = 2, shape = "disk", diameter = 0.012, radius = {0.4e-3, 0.66e-3}, seed = 5,
+                            path = dir .. "/disk.h5", log = false}
+  local r = lab.brazilian(disk, {log = false})
+  eq(r.stopped, "post_peak")
+  check(r.tensile_strength > 0 and r.tensile_strength < math.huge, r.tensile_strength)
+  near(r.tensile_strength, 2 * r.peak_force / (math.pi * r.diameter * r.thickness), 1e-12)
+  check(r.cracks.tension > 0, "tensile cracks")
+end)
+
+os.execute("rm -rf '" .. dir .. "'")
+T.done()
