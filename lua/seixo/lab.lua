@@ -401,6 +401,47 @@ local function inertial_number(rate, spec, p)
   return rate * (spec.radius[1] + spec.radius[2]) * math.sqrt(spec.material.density / p)
 end
 
+-- A test's start: the specimen loaded from its file, its extents and
+-- centre, and the platens -- frictionless planes (lines) touching its ends
+-- along the loading axis.
+local function open_test(spec)
+  local dim, ax = spec.dim, axis_of(spec.dim)
+  local m = seixo.load(spec.path)
+  local lo, hi = extents(m)
+  local centre = {}
+  for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
+  local down, up = {}, {}
+  for k = 1, dim do down[k], up[k] = 0, 0 end
+  up[ax], down[ax] = 1, -1
+  local p_lo, p_hi = copy(centre), copy(centre)
+  p_lo[ax], p_hi[ax] = lo[ax], hi[ax]
+  local kind = dim == 3 and "plane" or "line"
+  local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
+  local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
+  return m, lo, hi, centre, bottom, top
+end
+
+-- Sets the platens closing at `speed` each along the loading axis.
+local function drive(top, bottom, dim, speed)
+  local v_top, v_bottom = {}, {}
+  for k = 1, dim do v_top[k], v_bottom[k] = 0, 0 end
+  v_top[dim], v_bottom[dim] = -speed, speed
+  top.vel, bottom.vel = v_top, v_bottom
+end
+
+-- A test's end: with opts.out, its history as CSV, the model with the
+-- result (history included) as HDF5, and its figures.
+local function finish(m, r, opts, plot)
+  if opts.out then
+    lab.write_csv(opts.out .. ".csv", r.columns, r.rows)
+    m:vars().lab_result = copy(r)
+    m:save(opts.out .. ".h5")
+    if opts.plot ~= false then plot(r, opts.out) end
+  end
+  m:close()
+  return r
+end
+
 local test_keys = {"confining", "intermediate", "strain_rate", "max_strain", "post_peak", "every", "out", "plot", "log",
                    "lateral", "max_steps", "confine_tol", "name"}
 
@@ -432,21 +473,9 @@ local function compression(spec, opts, fn)
   local every = opts.every or 100
   local t0 = seixo.clock()
 
-  local m = seixo.load(spec.path)
+  local m, lo, hi, centre, bottom, top = open_test(spec)
   local rate = opts.strain_rate or default_rate(m)
-  local lo, hi = extents(m)
-  local centre = {}
-  for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
-  local kn, fr = spec.wall_kn, 0
-  -- platens: frictionless planes (lines) touching the specimen's ends
-  local down, up = {}, {}
-  for k = 1, dim do down[k], up[k] = 0, 0 end
-  up[ax], down[ax] = 1, -1
-  local p_lo, p_hi = copy(centre), copy(centre)
-  p_lo[ax], p_hi[ax] = lo[ax], hi[ax]
-  local kind = dim == 3 and "plane" or "line"
-  local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = kn, ks = 0, friction = fr}
-  local top = m:wall{kind = kind, point = p_hi, normal = down, kn = kn, ks = 0, friction = fr}
+  local kn, fr, kind = spec.wall_kn, 0, dim == 3 and "plane" or "line"
 
   -- lateral confinement: a cylinder or planes (lines), servo-controlled
   local lateral = {}
@@ -546,10 +575,7 @@ local function compression(spec, opts, fn)
   -- axial loading at a constant strain rate, both platens moving
   local h0 = height()
   local speed = 0.5 * rate * h0
-  local v_top, v_bottom = {}, {}
-  for k = 1, dim do v_top[k], v_bottom[k] = 0, 0 end
-  v_top[ax], v_bottom[ax] = -speed, speed
-  top.vel, bottom.vel = v_top, v_bottom
+  drive(top, bottom, dim, speed)
   local lateral_strain
   if #lateral == 0 then
     lateral_strain = affine_strain(m, ax)
@@ -647,14 +673,7 @@ local function compression(spec, opts, fn)
       (r.young or 0) / 1e9, r.poisson or 0, r.cracks.tension, r.cracks.shear, r.steps, r.wall_time, r.mean_ratio,
       r.inertial)
 
-  if opts.out then
-    lab.write_csv(opts.out .. ".csv", columns, rows)
-    m:vars().lab_result = copy(r) -- the history (rows, columns) and the figures, kept with the model
-    m:save(opts.out .. ".h5")
-    if opts.plot ~= false then plot_test(r, opts.out) end
-  end
-  m:close()
-  return r
+  return finish(m, r, opts, plot_test)
 end
 
 --- A triaxial test (confining = sigma3 > 0, by servo-controlled walls) or,
@@ -682,26 +701,11 @@ function lab.brazilian(spec, opts)
   local post_peak = opts.post_peak or 0.5
   local every = opts.every or 100
   local t0 = seixo.clock()
-  local m = seixo.load(spec.path)
+  local m, lo, hi, _, bottom, top = open_test(spec)
   local rate = opts.strain_rate or default_rate(m)
-  local lo, hi = extents(m)
-  local centre = {}
-  for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
-  local up, down = {}, {}
-  for k = 1, dim do up[k], down[k] = 0, 0 end
-  up[ax], down[ax] = 1, -1
-  local p_lo, p_hi = copy(centre), copy(centre)
-  p_lo[ax], p_hi[ax] = lo[ax], hi[ax]
-  local kind = dim == 3 and "plane" or "line"
-  local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
-  local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
   local d = hi[ax] - lo[ax]
   local t = dim == 3 and hi[2] - lo[2] or 1
-  local speed = 0.5 * rate * d
-  local v1, v2 = {}, {}
-  for k = 1, dim do v1[k], v2[k] = 0, 0 end
-  v1[ax], v2[ax] = -speed, speed
-  top.vel, bottom.vel = v1, v2
+  drive(top, bottom, dim, 0.5 * rate * d)
   local rows, peak, peak_row = {}, -math.huge, nil
   local start, t_start = m:step(), m:time()
   local max_steps = opts.max_steps or 400000
@@ -729,14 +733,7 @@ function lab.brazilian(spec, opts)
              wall_time = seixo.clock() - t0, strain_rate = rate}
   say(opts, "lab.brazilian: peak force %.4g N, tensile strength %.4g MPa, cracks %d tension / %d shear (%d steps, %.1f s)",
       peak, r.tensile_strength / 1e6, r.cracks.tension, r.cracks.shear, r.steps, r.wall_time)
-  if opts.out then
-    lab.write_csv(opts.out .. ".csv", header, rows)
-    m:vars().lab_result = copy(r) -- the history (rows, columns) and the figures, kept with the model
-    m:save(opts.out .. ".h5")
-    if opts.plot ~= false then plot_brazilian(r, opts.out) end
-  end
-  m:close()
-  return r
+  return finish(m, r, opts, plot_brazilian)
 end
 
 -- ------------------------------------------------------------ Mohr-Coulomb
