@@ -104,9 +104,14 @@ static int msghandler(lua_State *L)
     return 1;
 }
 
+/* Raises "interrupted" in Lua code only. At the call or return of a C
+ * function it stays armed for the next Lua instruction: raising on entry
+ * would skip the function's body, and when that function is a __close
+ * (a seixo run giving its model back) the model would stay "cycling". */
 static void stop_hook(lua_State *L, lua_Debug *ar)
 {
-    (void)ar;
+    if ((ar->event == LUA_HOOKCALL || ar->event == LUA_HOOKRET) && lua_getinfo(L, "S", ar) && ar->what[0] == 'C')
+        return;
     lua_sethook(L, NULL, 0, 0);
     luaL_error(L, "interrupted");
 }

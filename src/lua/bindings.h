@@ -156,9 +156,20 @@ int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter 
 
 /* ----------------------------------------------------------- run.c */
 
-/// Cycles n steps of the model userdata at `model` without user callbacks
-/// (generation's relaxation): interruptible like m:cycle; a Lua error on failure.
-void sx_lua_cycle_plain(lua_State *L, int model, int64_t n);
+/// A run of a model: while its record is open the model counts as cycling
+/// and a Ctrl-C (sx_lua_interrupt_all) flags the run and stops its core cycle.
+typedef struct sx_lua_run sx_lua_run;
+/// Opens a run of the model userdata at `model` and pushes its record as a
+/// to-be-closed value (closed when the calling C function returns or raises,
+/// or by lua_settop below it). Refused while the model cycles (`what` names
+/// the caller in the message).
+sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
+/// Cycles the core n steps in the run, without user callbacks; an interrupt
+/// ("interrupted at step N") or a failure is a Lua error.
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n);
+/// Raises "interrupted at step N" when the run was interrupted: long C work
+/// between cycles calls it so that a Ctrl-C stops it too.
+void sx_lua_run_poll(lua_State *L, sx_lua_run *r);
 /// Calls the function below its nargs arguments as a user callback of the
 /// model at `model`: removals are queued while it runs and applied after.
 void sx_lua_user_call(lua_State *L, int model, int nargs, int nres);

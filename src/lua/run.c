@@ -21,7 +21,11 @@
  * always alive: its record is a to-be-closed value of the running C frame,
  * unlisted when the frame returns or unwinds. The same close resets the
  * model's running state, so an error anywhere (in the core, a callback, an
- * interrupt) leaves the model usable. */
+ * interrupt) leaves the model usable. That holds only if the close itself
+ * runs: the executable's interrupt hook must never raise on entering a C
+ * function (a __close is one), which is why it waits for Lua code (main.c).
+ * Long C work outside the core's cycle (generation) opens a run too and
+ * polls it, so a Ctrl-C stops it as promptly as a cycle. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -113,7 +117,7 @@ static void progress_end(progress *p)
     p->shown = false;
 }
 
-typedef struct run {
+struct sx_lua_run {
     sx_model *m;
     sx_lua_model *ud;
     atomic_int interrupted;  // set by sx_lua_interrupt_all
@@ -122,7 +126,8 @@ typedef struct run {
     int saved_callback;      // ud->callback when the run started
     bool open;               // not closed yet
     progress progress;       // the progress line, cleared when the run ends
-} run;
+};
+typedef sx_lua_run run;
 
 static _Atomic(run *) runs[MAX_RUNS];
 static atomic_int nruns;
@@ -164,9 +169,7 @@ static int run_close(lua_State *L)
     return 0;
 }
 
-/* Starts a run of the model userdata at `model`: pushes its record as a
- * to-be-closed value. `what` names the operation in the refusal. */
-static run *run_open(lua_State *L, int model, const char *what)
+sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
 {
     model = lua_absindex(L, model);
     sx_lua_model *ud = sx_lua_modelud(L, model);
@@ -184,10 +187,11 @@ static run *run_open(lua_State *L, int model, const char *what)
     lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__close");
     lua_setmetatable(L, -2);
+    /* to be closed before the model is taken, so that nothing can come between */
+    lua_toclose(L, -1);
     ud->running++;
     r->saved_callback = ud->callback;
     r->open = true;
-    lua_toclose(L, -1);
     const int slot = atomic_load(&nruns);
     if (slot < MAX_RUNS) {
         r->slot = slot;
@@ -197,16 +201,15 @@ static run *run_open(lua_State *L, int model, const char *what)
     return r;
 }
 
-static void check_interrupt(lua_State *L, run *r)
+void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 {
     if (atomic_load(&r->interrupted))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
 }
 
-/* Cycles the core n steps; a failure is a Lua error (an interrupt says at which step). */
-static void core_cycle(lua_State *L, run *r, int64_t n)
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
 {
-    check_interrupt(L, r);
+    sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle(r->m, n);
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
@@ -216,14 +219,6 @@ static void core_cycle(lua_State *L, run *r, int64_t n)
 void sx_lua_check_not_running(lua_State *L, int model, const char *what)
 {
     if (sx_lua_modelud(L, model)->running) luaL_error(L, "%s: not allowed while the model is cycling", what);
-}
-
-void sx_lua_cycle_plain(lua_State *L, int model, int64_t n)
-{
-    const int top = lua_gettop(L);
-    run *r = run_open(L, model, "generate");
-    core_cycle(L, r, n);
-    lua_settop(L, top);
 }
 
 /* ------------------------------------------------------------ callbacks */
@@ -406,7 +401,7 @@ static bool time_reached(sx_model *m, double t_end)
  * and the last ratio measured (NaN when none was) in *ratio. */
 static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
 {
-    run *r = run_open(L, 1, "cycle");
+    run *r = sx_lua_run_open(L, 1, "cycle");
     sx_model *m = r->m;
     const int top = lua_gettop(L);
     const int64_t start = sx_model_step_count(m);
@@ -438,7 +433,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
                 break;
             }
         }
-        check_interrupt(L, r);
+        sx_lua_run_poll(L, r);
         fire(L, 1, POINT_BEFORE, s);
         /* the next chunk: up to the first thing due */
         int64_t n = lim->steps - taken;
@@ -453,7 +448,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             if (k < n) n = k;
         }
         if (p->on && p->chunk < n) n = p->chunk;
-        core_cycle(L, r, n);
+        sx_lua_run_cycle(L, r, n);
         double fraction = -1;
         int64_t total = 0;
         if (lim->steps < INT64_MAX) {
