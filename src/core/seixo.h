@@ -145,6 +145,12 @@ SX_API sx_ball_def sx_ball_default_def(void);
 /// Adds a ball; its stable id (>= 1) is written to *id.
 SX_API sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *id);
 SX_API sx_status sx_ball_remove(sx_model *m, int64_t id);
+/// Removes the n balls listed (an id listed twice is removed once) in one
+/// pass over the contacts: O(balls + contacts) however many go. Their
+/// contacts and bonds go with them; the other contacts keep their history.
+/// All or nothing: an id that is not a ball fails with SX_ENOTFOUND and
+/// removes none.
+SX_API sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n);
 /// Makes room for `count` more balls at once (optional: saves memory and
 /// copies when the number of balls to add is known).
 SX_API sx_status sx_ball_reserve(sx_model *m, int64_t count);

@@ -306,14 +306,19 @@ static bool queue_removal(lua_State *L, int model, int64_t signed_id)
     return true;
 }
 
-void sx_lua_remove_ball(lua_State *L, int model, int64_t id)
+void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n)
 {
     model = lua_absindex(L, model);
-    if (queue_removal(L, model, id)) return;
+    if (sx_lua_modelud(L, model)->callback > 0) {
+        for (int64_t i = 0; i < n; i++) queue_removal(L, model, ids[i]);
+        return;
+    }
     sx_model *m = sx_lua_checkmodel(L, model);
-    sx_lua_check(L, m, sx_ball_remove(m, id));
-    forget_extras(L, model, id);
+    sx_lua_check(L, m, sx_ball_remove_many(m, ids, n));
+    for (int64_t i = 0; i < n; i++) forget_extras(L, model, ids[i]);
 }
+
+void sx_lua_remove_ball(lua_State *L, int model, int64_t id) { sx_lua_remove_balls(L, model, &id, 1); }
 
 void sx_lua_remove_wall(lua_State *L, int model, int64_t id)
 {
@@ -337,17 +342,20 @@ void sx_lua_apply_removals(lua_State *L, int model)
     lua_pushnil(L);
     lua_setfield(L, -3, "queue");
     const int q = lua_gettop(L);
+    /* the balls go together, in one pass over the contacts */
+    const lua_Unsigned len = lua_rawlen(L, q);
+    int64_t *balls = lua_newuserdatauv(L, (size_t)(len > 0 ? len : 1) * sizeof *balls, 0);
+    int64_t n = 0;
     for (lua_Integer i = 1; lua_rawgeti(L, q, i) == LUA_TNUMBER; i++) {
         const int64_t sid = (int64_t)lua_tointeger(L, -1);
         lua_pop(L, 1);
-        /* an object removed twice, or already gone, is skipped */
-        if (sid > 0 && sx_ball_exists(ud->m, sid)) {
-            sx_lua_check(L, ud->m, sx_ball_remove(ud->m, sid));
-            forget_extras(L, model, sid);
-        } else if (sid < 0 && sx_wall_exists(ud->m, -sid)) {
+        /* an object already gone is skipped (one listed twice goes once) */
+        if (sid > 0 && sx_ball_exists(ud->m, sid))
+            balls[n++] = sid;
+        else if (sid < 0 && sx_wall_exists(ud->m, -sid))
             sx_lua_check(L, ud->m, sx_wall_remove(ud->m, -sid));
-        }
     }
+    sx_lua_remove_balls(L, model, balls, n);
     lua_settop(L, q - 2);
 }
 

@@ -93,6 +93,9 @@ extern const struct sx_lua_kind sx_lua_ball_kind, sx_lua_wall_kind;
 /// Removes a ball (wall) of the model userdata at `model` and forgets its
 /// extras, or queues the removal while a callback runs.
 void sx_lua_remove_ball(lua_State *L, int model, int64_t id);
+/// Removes the n balls listed (each live, one listed twice goes once) in
+/// one pass over the contacts, or queues them while a callback runs.
+void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n);
 void sx_lua_remove_wall(lua_State *L, int model, int64_t id);
 /// Applies the queued removals (when no callback runs).
 void sx_lua_apply_removals(lua_State *L, int model);

@@ -743,12 +743,12 @@ static int64_t *add_balls(lua_State *L, sx_model *m, const gen *g, const double 
         memcpy(d.pos, x + 3 * i, sizeof d.pos);
         d.radius = rad[i];
         d.material = g->material;
+        ids[i] = 0;  // stays 0, no ball's id, when the add fails
         sx_status st = sx_ball_add(m, &d, &ids[i]);
         if (st == SX_OK && g->group) st = sx_ball_set_group(m, ids[i], g->group);
         if (st != SX_OK) {
             lua_pushstring(L, sx_model_error(m));
-            for (int64_t j = 0; j <= i; j++)
-                if (sx_ball_exists(m, ids[j])) sx_ball_remove(m, ids[j]);
+            sx_ball_remove_many(m, ids, ids[i] > 0 ? i + 1 : i);
             luaL_error(L, "generate: %s", lua_tostring(L, -1));
         }
     }

@@ -229,15 +229,14 @@ static int model_remove_balls(lua_State *L)
     sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     lua_settop(L, 2);
     int64_t n;
-    const int64_t *ids = select_balls(L, 2, &n);
+    int64_t *ids = select_balls(L, 2, &n);
     const sx_model *m = sx_lua_checkmodel(L, 1);
-    int64_t done = 0;
+    /* a predicate may have removed some of the selected balls */
+    int64_t live = 0;
     for (int64_t i = 0; i < n; i++)
-        if (sx_ball_exists(m, ids[i])) {
-            sx_lua_remove_ball(L, 1, ids[i]);
-            done++;
-        }
-    lua_pushinteger(L, (lua_Integer)done);
+        if (sx_ball_exists(m, ids[i])) ids[live++] = ids[i];
+    sx_lua_remove_balls(L, 1, ids, live);
+    lua_pushinteger(L, (lua_Integer)live);
     return 1;
 }
 
