@@ -6,7 +6,7 @@
  *
  * The interactive session uses readline when built with it: line editing,
  * a history file (~/.seixo_history, or $SEIXO_HISTORY; empty disables it;
- * each line is appended as it is entered),
+ * each statement is appended whole as it is entered),
  * and tab completion that walks the Lua value before the cursor (globals,
  * table keys, the methods and fields of seixo objects). A long cycle shows
  * a progress line on stderr when stderr is a terminal.
@@ -340,26 +340,53 @@ static char *history_path(void)
     return path;
 }
 
-/* The history file: each line is appended as it is entered (so os.exit or
- * a crash loses nothing), and the file is cut to the last 1000 lines at the end. */
+/* The history file: each entry is appended as it is entered (so os.exit or
+ * a crash loses nothing), and the file keeps the last 1000 entries.
+ *
+ * An entry is a whole statement, newlines and all. The file is readline's
+ * format with timestamps (bash's lithist): each entry follows a "#<seconds>"
+ * line, and readline reads a line without one as the continuation of the
+ * entry before, so a multi-line statement comes back whole. That takes a
+ * file that starts with a timestamp; a file of bare lines (written before)
+ * is rewritten in this format when it is opened. */
 static char *hist_path;
+
+static bool starts_with_timestamp(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return false;
+    char head[2] = {0, 0};
+    const bool stamped = fread(head, 1, 2, f) == 2 && head[0] == '#' && head[1] >= '0' && head[1] <= '9';
+    fclose(f);
+    return stamped;
+}
 
 static void open_history(void)
 {
     hist_path = history_path();
     if (!hist_path) return;
-    if (read_history(hist_path) != 0) write_history(hist_path);  // create it
+    history_comment_char = '#';  // the timestamps' mark
+    history_write_timestamps = 1;
+    const bool read = read_history(hist_path) == 0;
+    /* create it, or give it timestamps (entries read get the current time) */
+    if (!read || (history_length > 0 && !starts_with_timestamp(hist_path))) write_history(hist_path);
 }
 
-static void remember(const char *line)
+static void remember(const char *entry)
 {
-    add_history(line);
+    add_history(entry);
     if (hist_path) append_history(1, hist_path);
 }
 
+/* Cuts the file to its last 1000 entries: read back whole (the history is
+ * stifled to 1000), written anew. history_truncate_file counts lines, and
+ * could leave the file starting inside a multi-line entry. */
 static void close_history(void)
 {
-    if (hist_path) history_truncate_file(hist_path, 1000);
+    if (hist_path) {
+        clear_history();
+        if (read_history(hist_path) == 0) write_history(hist_path);
+    }
     free(hist_path);
     hist_path = NULL;
 }
