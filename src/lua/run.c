@@ -26,6 +26,7 @@
  * function (a __close is one), which is why it waits for Lua code (main.c).
  * Long C work outside the core's cycle (generation) opens a run too and
  * polls it, so a Ctrl-C stops it as promptly as a cycle. */
+#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -381,20 +382,33 @@ typedef struct limits {
 enum reason { BY_STEPS, BY_TIME, BY_RATIO };
 static const char *const reason_names[] = {"steps", "time", "ratio"};
 
-/* Steps to the first boundary at or after the model time t_end. */
-static int64_t steps_to_time(sx_model *m, double t_end)
+/* How far below t_end a step boundary still counts as reaching it: the
+ * rounding that n additions of the timestep to the model time can have
+ * accumulated (each at most half an ulp of the time, an ulp <= eps |t|; one
+ * more for t_end itself). Without it, 1 s in steps of 1e-5 s took 100001
+ * steps. Never more than half a step, so no run stops a step early. */
+static double time_slack(double t, double t_end, double dt, double n)
+{
+    const double rounding = (n + 1) * DBL_EPSILON * fmax(fabs(t), fabs(t_end));
+    return fmin(rounding, 0.5 * dt);
+}
+
+/* Steps to the first boundary at or after the model time t_end, `taken`
+ * steps into the run. */
+static int64_t steps_to_time(sx_model *m, double t_end, int64_t taken)
 {
     const double dt = sx_model_timestep(m);
     if (!(dt > 0)) return 1;  // let the core say what is wrong
-    const double k = ceil((t_end - sx_model_time(m)) / dt - 1e-9);
+    const double t = sx_model_time(m), left = (t_end - t) / dt;
+    const double k = ceil((t_end - time_slack(t, t_end, dt, (double)taken + left + 1) - t) / dt);
     return k < 1 ? 1 : k > 1e15 ? (int64_t)1e15 : (int64_t)k;
 }
 
-static bool time_reached(sx_model *m, double t_end)
+static bool time_reached(sx_model *m, double t_end, int64_t taken)
 {
     if (isinf(t_end)) return false;
-    const double dt = sx_model_timestep(m);
-    return sx_model_time(m) >= t_end - (dt > 0 ? 1e-9 * dt : 0);
+    const double dt = sx_model_timestep(m), t = sx_model_time(m);
+    return t >= t_end - (dt > 0 ? time_slack(t, t_end, dt, (double)taken) : 0);
 }
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
@@ -422,7 +436,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             why = BY_STEPS;
             break;
         }
-        if (time_reached(m, lim->time)) {
+        if (time_reached(m, lim->time, taken)) {
             why = BY_TIME;
             break;
         }
@@ -444,7 +458,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             if (k < n) n = k;
         }
         if (!isinf(lim->time)) {
-            const int64_t k = steps_to_time(m, lim->time);
+            const int64_t k = steps_to_time(m, lim->time, taken);
             if (k < n) n = k;
         }
         if (p->on && p->chunk < n) n = p->chunk;
