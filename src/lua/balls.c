@@ -6,7 +6,7 @@
  * table of user values per ball, dropped when the ball is removed. */
 #include "bindings.h"
 
-const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras"};
 #define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */
@@ -217,83 +217,12 @@ static int set_group(lua_State *L)
     return 0;
 }
 
-/* Pushes the extras table of the ball at index 1, created when `create`
- * (else nil when it has none). */
-static void push_extras(lua_State *L, bool create)
-{
-    int64_t id;
-    check_ball(L, &id);
-    lua_getiuservalue(L, 1, 1);
-    sx_lua_state(L, -1, "extras");
-    lua_remove(L, -2);
-    if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL && create) {
-        lua_pop(L, 1);
-        lua_newtable(L);
-        lua_pushvalue(L, -1);
-        lua_rawseti(L, -3, (lua_Integer)id);
-    }
-    lua_remove(L, -2);
-}
-
-static int get_extra(lua_State *L)
-{
-    push_extras(L, true);
-    return 1;
-}
-
-/* b.extra = {...} replaces the ball's extras; nil drops them. */
-static int set_extra_table(lua_State *L)
-{
-    int64_t id;
-    check_ball(L, &id);
-    if (!lua_isnil(L, 3) && !lua_istable(L, 3))
-        return luaL_error(L, "field 'extra': table or nil expected, got %s", luaL_typename(L, 3));
-    lua_getiuservalue(L, 1, 1);
-    sx_lua_state(L, -1, "extras");
-    lua_pushvalue(L, 3);
-    lua_rawseti(L, -2, (lua_Integer)id);
-    return 0;
-}
-
-/* b:set_extra(key, value) */
-static int ball_set_extra(lua_State *L)
-{
-    luaL_checkany(L, 2);
-    if (lua_isnil(L, 2) || (lua_type(L, 2) == LUA_TNUMBER && lua_tonumber(L, 2) != lua_tonumber(L, 2)))
-        return luaL_argerror(L, 1, "a key other than nil and NaN expected");
-    luaL_checkany(L, 3);
-    push_extras(L, true);
-    lua_pushvalue(L, 2);
-    lua_pushvalue(L, 3);
-    lua_rawset(L, -3);
-    return 0;
-}
-
-/* b:get_extra(key[, default]) */
-static int ball_get_extra(lua_State *L)
-{
-    luaL_checkany(L, 2);
-    lua_settop(L, 3);  // the default, nil when absent
-    push_extras(L, false);
-    if (lua_istable(L, -1)) {
-        lua_pushvalue(L, 2);
-        lua_rawget(L, -2);
-    } else {
-        lua_pushnil(L);
-    }
-    if (lua_isnil(L, -1)) lua_pushvalue(L, 3);
-    return 1;
-}
+static int get_extra(lua_State *L) { return sx_lua_extra_table(L, &ball_kind); }
+static int set_extra_table(lua_State *L) { return sx_lua_set_extra_table(L, &ball_kind); }
+static int ball_set_extra(lua_State *L) { return sx_lua_set_extra(L, &ball_kind); }
+static int ball_get_extra(lua_State *L) { return sx_lua_get_extra(L, &ball_kind); }
 
 /* ------------------------------------------------- methods, metamethods */
-
-static void forget_extras(lua_State *L, int model, int64_t id)
-{
-    sx_lua_state(L, model, "extras");
-    lua_pushnil(L);
-    lua_rawseti(L, -2, (lua_Integer)id);
-    lua_pop(L, 1);
-}
 
 /* Queued removals: ball ids positive, wall ids negative, in the state's `queue`. */
 static bool queue_removal(lua_State *L, int model, int64_t signed_id)
@@ -315,17 +244,23 @@ void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n)
     }
     sx_model *m = sx_lua_checkmodel(L, model);
     sx_lua_check(L, m, sx_ball_remove_many(m, ids, n));
-    for (int64_t i = 0; i < n; i++) forget_extras(L, model, ids[i]);
+    for (int64_t i = 0; i < n; i++) sx_lua_forget_extras(L, model, &ball_kind, ids[i]);
 }
 
 void sx_lua_remove_ball(lua_State *L, int model, int64_t id) { sx_lua_remove_balls(L, model, &id, 1); }
+
+/* A wall goes with its extras. */
+static void remove_wall_now(lua_State *L, int model, sx_model *m, int64_t id)
+{
+    sx_lua_check(L, m, sx_wall_remove(m, id));
+    sx_lua_forget_extras(L, model, &sx_lua_wall_kind, id);
+}
 
 void sx_lua_remove_wall(lua_State *L, int model, int64_t id)
 {
     model = lua_absindex(L, model);
     if (queue_removal(L, model, -id)) return;
-    sx_model *m = sx_lua_checkmodel(L, model);
-    sx_lua_check(L, m, sx_wall_remove(m, id));
+    remove_wall_now(L, model, sx_lua_checkmodel(L, model), id);
 }
 
 void sx_lua_apply_removals(lua_State *L, int model)
@@ -353,7 +288,7 @@ void sx_lua_apply_removals(lua_State *L, int model)
         if (sid > 0 && sx_ball_exists(ud->m, sid))
             balls[n++] = sid;
         else if (sid < 0 && sx_wall_exists(ud->m, -sid))
-            sx_lua_check(L, ud->m, sx_wall_remove(ud->m, -sid));
+            remove_wall_now(L, model, ud->m, -sid);
     }
     sx_lua_remove_balls(L, model, balls, n);
     lua_settop(L, q - 2);

@@ -236,6 +236,7 @@ typedef struct sx_lua_kind {
     const char *tname;                          ///< its class, "seixo.ball"
     const char *name;                           ///< its name in messages, "ball"
     bool (*exists)(const sx_model *, int64_t);  ///< whether an id is live
+    const char *extras;                         ///< the model state's table of user extras, by id
 } sx_lua_kind;
 
 /// Pushes a handle for the object `id` of the model userdata at `model`.
@@ -249,6 +250,17 @@ int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k);
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.
 int sx_lua_handle_eq(lua_State *L);
+
+/* User extras of the handle at index 1: a Lua table per object, dropped
+ * when the object is removed. The field `extra` (read: the table, created
+ * on first use; write: a table or nil) and the methods set_extra(key,
+ * value), get_extra(key[, default]). */
+int sx_lua_extra_table(lua_State *L, const sx_lua_kind *k);
+int sx_lua_set_extra_table(lua_State *L, const sx_lua_kind *k);
+int sx_lua_set_extra(lua_State *L, const sx_lua_kind *k);
+int sx_lua_get_extra(lua_State *L, const sx_lua_kind *k);
+/// Drops the extras of object `id` of the model userdata at `model`.
+void sx_lua_forget_extras(lua_State *L, int model, const sx_lua_kind *k, int64_t id);
 
 /// Pushes a generic-for iterator over the ids in the Lua array at `ids`
 /// (which it takes over), stepped by `next` (see sx_lua_nexthandle).

@@ -3,7 +3,7 @@
  *   m:wall{kind = "cylinder", point=, axis=, radius=, height=, radial_vel=, ...} (in walls.c)
  *   w:servo{target=, area=, alpha=, max_speed=}   (w:servo(nil) releases the wall)
  *   w:load()        -> normal force (N), contacts, mean contact kn (the servo's inputs)
- *   w.radius, w.radial_vel (cylinder; radial_vel writable)
+ *   w:radius() -> radius, radial_vel; w:set_radius(r), w:set_radial_vel(v) (cylinder)
  *   m:measure{sphere = {center =, radius =}} (2D: disk) or m:measure{box = {min, max}}
  *       -> {stress = {{...}}, porosity, coordination, fabric = {{...}}, balls, contacts, volume, solid} */
 #include "bindings.h"
@@ -47,6 +47,14 @@ static int wall_set_radial_vel(lua_State *L)
     int64_t id;
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
     sx_lua_check(L, m, sx_wall_set_radial_vel(m, id, luaL_checknumber(L, 2)));
+    return 0;
+}
+
+static int wall_set_radius(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
+    sx_lua_check(L, m, sx_wall_set(m, id, SX_WALL_RADIUS, luaL_checknumber(L, 2)));
     return 0;
 }
 
@@ -139,6 +147,7 @@ void sx_lua_lab_register(lua_State *L)
         {"load", wall_load},
         {"radius", wall_radius},
         {"set_radial_vel", wall_set_radial_vel},
+        {"set_radius", wall_set_radius},
         {NULL, NULL},
     };
     luaL_getmetatable(L, sx_lua_wall_kind.tname);

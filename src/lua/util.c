@@ -367,6 +367,81 @@ int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k)
     return h ? h->id : -1;
 }
 
+/* -------------------------------------------------------------- extras */
+
+/* Pushes the extras table of the handle at index 1 (k->extras of the
+ * model's state, keyed by id), created when `create`, else nil when none. */
+static void push_extras(lua_State *L, const sx_lua_kind *k, bool create)
+{
+    int64_t id;
+    sx_lua_checkhandle(L, 1, k, &id);
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, k->extras);
+    lua_remove(L, -2);
+    if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL && create) {
+        lua_pop(L, 1);
+        lua_newtable(L);
+        lua_pushvalue(L, -1);
+        lua_rawseti(L, -3, (lua_Integer)id);
+    }
+    lua_remove(L, -2);
+}
+
+int sx_lua_extra_table(lua_State *L, const sx_lua_kind *k)
+{
+    push_extras(L, k, true);
+    return 1;
+}
+
+int sx_lua_set_extra_table(lua_State *L, const sx_lua_kind *k)
+{
+    int64_t id;
+    sx_lua_checkhandle(L, 1, k, &id);
+    if (!lua_isnil(L, 3) && !lua_istable(L, 3))
+        return luaL_error(L, "%s field 'extra': table or nil expected, got %s", k->name, luaL_typename(L, 3));
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, k->extras);
+    lua_pushvalue(L, 3);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    return 0;
+}
+
+int sx_lua_set_extra(lua_State *L, const sx_lua_kind *k)
+{
+    luaL_checkany(L, 2);
+    if (lua_isnil(L, 2) || (lua_type(L, 2) == LUA_TNUMBER && lua_tonumber(L, 2) != lua_tonumber(L, 2)))
+        return luaL_argerror(L, 1, "a key other than nil and NaN expected");
+    luaL_checkany(L, 3);
+    push_extras(L, k, true);
+    lua_pushvalue(L, 2);
+    lua_pushvalue(L, 3);
+    lua_rawset(L, -3);
+    return 0;
+}
+
+int sx_lua_get_extra(lua_State *L, const sx_lua_kind *k)
+{
+    luaL_checkany(L, 2);
+    lua_settop(L, 3);  // the default, nil when absent
+    push_extras(L, k, false);
+    if (lua_istable(L, -1)) {
+        lua_pushvalue(L, 2);
+        lua_rawget(L, -2);
+    } else {
+        lua_pushnil(L);
+    }
+    if (lua_isnil(L, -1)) lua_pushvalue(L, 3);
+    return 1;
+}
+
+void sx_lua_forget_extras(lua_State *L, int model, const sx_lua_kind *k, int64_t id)
+{
+    sx_lua_state(L, model, k->extras);
+    lua_pushnil(L);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    lua_pop(L, 1);
+}
+
 /* ----------------------------------------------------------- iterators */
 
 /* The closure's upvalues: the model userdata, the table of ids, the
