@@ -244,8 +244,10 @@ void sx_lua_pushhandle(lua_State *L, int model, const sx_lua_kind *k, int64_t id
 /// The id of the handle at idx and its model; a closed model or a removed
 /// object is a Lua error.
 sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id);
-/// The id of a handle of kind k or an integer id at idx, or -1 (nothing pushed).
-int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k);
+/// Reads a handle of kind k of the model userdata at `model`, or an integer
+/// id, at idx into *id: returns NULL, or pushes and returns what is wrong (a
+/// handle of another model is refused, not read as a plain id).
+const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id);
 /// __tostring of a handle: "seixo.ball 7", with "(removed)" or "(model closed)".
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.

@@ -240,8 +240,10 @@ static void read_entity(lua_State *L, const sx_model *m, int src)
     const sx_lua_kind *k = src == SRC_BALL ? &sx_lua_ball_kind : &sx_lua_wall_kind;
     sx_lua_checksubkeys(L, 3, 3, k->name, src == SRC_BALL ? ball_keys : wall_keys);
     lua_getfield(L, 3, k->name);
-    const int64_t id = sx_lua_toid(L, -1, k);
-    if (id < 0 || !k->exists(m, id))
+    int64_t id;
+    const char *err = sx_lua_toid(L, -1, 1, k, &id);
+    if (err) sx_lua_fielderror(L, 3, k->name, err);
+    if (!k->exists(m, id))
         sx_lua_fielderror(L, 3, k->name, lua_pushfstring(L, "an existing %s (or its id) expected", k->name));
     lua_pop(L, 1);
     const char *const *fields = src == SRC_BALL ? ball_fields : wall_fields;

@@ -360,11 +360,23 @@ int sx_lua_handle_eq(lua_State *L)
     return 1;
 }
 
-int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k)
+const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id)
 {
-    if (lua_isinteger(L, idx)) return (int64_t)lua_tointeger(L, idx);
+    idx = lua_absindex(L, idx);
+    model = lua_absindex(L, model);
+    if (lua_isinteger(L, idx)) {
+        *id = (int64_t)lua_tointeger(L, idx);
+        return *id >= 1 ? NULL : lua_pushfstring(L, "%s ids are >= 1, got %I", k->name, (lua_Integer)*id);
+    }
     const handle *h = luaL_testudata(L, idx, k->tname);
-    return h ? h->id : -1;
+    if (!h) return lua_pushfstring(L, "%s or id expected, got %s", k->name, luaL_typename(L, idx));
+    /* an id means nothing in another model: never read one as a plain id */
+    lua_getiuservalue(L, idx, 1);
+    const bool mine = lua_rawequal(L, -1, model);
+    lua_pop(L, 1);
+    if (!mine) return lua_pushfstring(L, "%s %I belongs to another model", k->name, (lua_Integer)h->id);
+    *id = h->id;
+    return NULL;
 }
 
 /* -------------------------------------------------------------- extras */
