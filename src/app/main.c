@@ -769,7 +769,7 @@ static enum parsed parse(int argc, char **argv, options *o)
         }
         if (strcmp(a, "-e") == 0) {
             if (++i == argc) {
-                message("'-e' needs an argument");
+                message("'-e' needs an argument; seixo --help for usage");
                 return BAD;
             }
             o->has_chunks = true;
@@ -782,7 +782,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             char *end = NULL;
             const long t = v ? strtol(v, &end, 10) : 0;
             if (!v || !*v || *end || t < 1 || t > MAX_THREADS) {
-                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d\n", progname, MAX_THREADS);
+                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d; seixo --help for usage\n", progname,
+                        MAX_THREADS);
                 return BAD;
             }
             o->threads = t;
@@ -793,8 +794,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             usage(stdout);
             return DONE;
         } else {
-            fprintf(stderr, "%s: unrecognized option '%s'\n", progname, a);
-            usage(stderr);
+            /* one line, like every failure: the reason and where to look */
+            fprintf(stderr, "%s: unrecognized option '%s'; seixo --help for usage\n", progname, a);
             return BAD;
         }
     }

@@ -518,7 +518,7 @@ static void place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const
             if (!grid_near(gr, xi, overlaps_one, &p)) break;
         }
         if (t == g->tries)
-            luaL_error(L, "generate: placed %I of %I balls; no room for one of radius %f m after %I tries: lower the "
+            luaL_error(L, "m:generate: placed %I of %I balls; no room for one of radius %f m after %I tries: lower the "
                        "count or the radii, enlarge the region, or use method = 'distribute'",
                        (lua_Integer)i, (lua_Integer)n, rad[i], (lua_Integer)g->tries);
         grid_add(gr, xi, rad[i]);
@@ -749,7 +749,7 @@ static int64_t *add_balls(lua_State *L, sx_model *m, const gen *g, const double 
         if (st != SX_OK) {
             lua_pushstring(L, sx_model_error(m));
             sx_ball_remove_many(m, ids, ids[i] > 0 ? i + 1 : i);
-            luaL_error(L, "generate: %s", lua_tostring(L, -1));
+            luaL_error(L, "m:generate: %s", sx_lua_core_message(lua_tostring(L, -1)));
         }
     }
     return ids;
@@ -817,11 +817,11 @@ static int model_generate(lua_State *L)
     gen g;
     read_gen(L, m, &g);
     if ((g.method == M_DISTRIBUTE || g.method == M_EXPAND) && ud->running)
-        return luaL_error(L, "generate: method '%s' cycles the model, which a callback of a cycle cannot do",
+        return luaL_error(L, "m:generate: method '%s' cycles the model, which a callback of a cycle cannot do",
                           method_names[g.method]);
     /* the methods that cycle hold the model as a run from here on: a Ctrl-C
      * anywhere in them, cycling or not, stops them (see run.c) */
-    sx_lua_run *run = g.method == M_DISTRIBUTE || g.method == M_EXPAND ? sx_lua_run_open(L, 1, "generate") : NULL;
+    sx_lua_run *run = g.method == M_DISTRIBUTE || g.method == M_EXPAND ? sx_lua_run_open(L, 1, "m:generate") : NULL;
     rng r;
     rng_seed(&r, g.seed);
     int64_t n = 0;
@@ -855,11 +855,11 @@ static int model_generate(lua_State *L)
             int64_t t = 0;
             do sample(&g.region, &r, rad[i], e1, e2, x + 3 * i);
             while (!sx_lua_region_contains(&g.region, x + 3 * i, rad[i]) && ++t < g.tries);
-            if (t == g.tries) return luaL_error(L, "generate: the region leaves no room for a ball of radius %f m", rad[i]);
+            if (t == g.tries) return luaL_error(L, "m:generate: the region leaves no room for a ball of radius %f m", rad[i]);
         }
         const double worst = push_apart(L, run, &g, rad, n, x, 0.01);
         if (worst > 0.9)
-            return luaL_error(L, "generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
+            return luaL_error(L, "m:generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
                               "raise the porosity", g.porosity, worst);
     }
     m = sx_lua_checkmodel(L, 1);
@@ -870,7 +870,7 @@ static int model_generate(lua_State *L)
         const int stages = (int)ceil(log(1 / shrink) / log(1.02));
         for (int s = 1; s <= stages; s++) {
             const double f = s == stages ? 1 / shrink : pow(1 / shrink, (double)s / stages);
-            for (int64_t i = 0; i < n; i++) sx_lua_check(L, ud->m, sx_ball_set(ud->m, ids[i], SX_BALL_RADIUS, rad[i] * f));
+            for (int64_t i = 0; i < n; i++) sx_lua_check(L, ud->m, sx_ball_set(ud->m, ids[i], SX_BALL_RADIUS, rad[i] * f), "m:generate");
             relax_cycles(L, run, &g, ids, n, 100, 0);
         }
         lua_settop(L, top);  // restores the gravity

@@ -427,7 +427,7 @@ static int model_history_csv(lua_State *L)
     (void)base;
     const char *tmp = lua_pushfstring(L, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
-    if (!f) return luaL_error(L, "history_csv: cannot write '%s': %s", tmp, strerror(errno));
+    if (!f) return luaL_error(L, "m:history_csv: cannot write '%s': %s", tmp, strerror(errno));
     fputs("step,time", f);
     for (lua_Integer i = 0; i < nh; i++) {
         lua_getfield(L, s[i].entry, "name");
@@ -460,12 +460,12 @@ static int model_history_csv(lua_State *L)
     const bool ok = !ferror(f);
     if (fclose(f) != 0 || !ok) {
         remove(tmp);
-        return luaL_error(L, "history_csv: writing '%s' failed", tmp);
+        return luaL_error(L, "m:history_csv: writing '%s' failed", tmp);
     }
     if (rename(tmp, path) != 0) {
         const int err = errno;
         remove(tmp);
-        return luaL_error(L, "history_csv: cannot rename '%s' to '%s': %s", tmp, path, strerror(err));
+        return luaL_error(L, "m:history_csv: cannot rename '%s' to '%s': %s", tmp, path, strerror(err));
     }
     return 0;
 }

@@ -125,6 +125,7 @@ struct sx_lua_run {
     atomic_int in_lua;       // a user callback is running
     int slot;                // its place in runs[], -1 when not listed
     int saved_callback;      // ud->callback when the run started
+    const char *what;        // the Lua call, in messages ("m:solve")
     bool open;               // not closed yet
     progress progress;       // the progress line, cleared when the run ends
 };
@@ -182,6 +183,7 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     r->m = m;
     r->ud = ud;
     r->slot = -1;
+    r->what = what;
     atomic_init(&r->interrupted, 0);
     atomic_init(&r->in_lua, 0);
     lua_createtable(L, 0, 1);
@@ -214,12 +216,7 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
     const sx_status st = sx_model_cycle(r->m, n);
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
-    sx_lua_check(L, r->m, st);
-}
-
-void sx_lua_check_not_running(lua_State *L, int model, const char *what)
-{
-    if (sx_lua_modelud(L, model)->running) luaL_error(L, "%s: not allowed while the model is cycling", what);
+    sx_lua_check(L, r->m, st, r->what);
 }
 
 /* ------------------------------------------------------------ callbacks */
@@ -413,9 +410,9 @@ static bool time_reached(sx_model *m, double t_end, int64_t taken)
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
  * and the last ratio measured (NaN when none was) in *ratio. */
-static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
+static enum reason run_model(lua_State *L, const limits *lim, double *ratio, const char *what)
 {
-    run *r = sx_lua_run_open(L, 1, "cycle");
+    run *r = sx_lua_run_open(L, 1, what);
     sx_model *m = r->m;
     const int top = lua_gettop(L);
     const int64_t start = sx_model_step_count(m);
@@ -488,7 +485,7 @@ static int model_cycle(lua_State *L)
     lua_settop(L, 1);
     const limits lim = {(int64_t)n, INFINITY, 0, 1};
     double ratio;
-    run_model(L, &lim, &ratio);
+    run_model(L, &lim, &ratio, "m:cycle");
     return 0;
 }
 
@@ -514,7 +511,7 @@ static int model_solve(lua_State *L)
     lua_settop(L, 1);
     const int64_t start = sx_model_step_count(m);
     double ratio;
-    const enum reason why = run_model(L, &lim, &ratio);
+    const enum reason why = run_model(L, &lim, &ratio, "m:solve");
     lua_pushstring(L, reason_names[why]);
     lua_pushnumber(L, isnan(ratio) ? sx_model_unbalanced_ratio(m) : ratio);
     lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));

@@ -15,9 +15,24 @@
 #include <math.h>
 #include <string.h>
 
-void sx_lua_check(lua_State *L, const sx_model *m, sx_status st)
+/* The core names its own functions ("ball_set: radius must be ..."), which
+ * a script never calls: drop that name, the caller puts the Lua one. */
+const char *sx_lua_core_message(const char *msg)
 {
-    if (st != SX_OK) luaL_error(L, "%s", sx_model_error(m));
+    const char *p = msg;
+    while ((*p >= 'a' && *p <= 'z') || *p == '_') p++;
+    return p > msg && p[0] == ':' && p[1] == ' ' ? p + 2 : msg;
+}
+
+void sx_lua_check(lua_State *L, const sx_model *m, sx_status st, const char *what)
+{
+    if (st != SX_OK) luaL_error(L, "%s: %s", what, sx_lua_core_message(sx_model_error(m)));
+}
+
+void sx_lua_checkfield(lua_State *L, const sx_model *m, sx_status st, const char *kind)
+{
+    if (st != SX_OK)
+        luaL_error(L, "%s field '%s': %s", kind, lua_tostring(L, 2), sx_lua_core_message(sx_model_error(m)));
 }
 
 int sx_lua_find(const char *s, const char *const list[])
@@ -128,10 +143,10 @@ void sx_lua_pushvec(lua_State *L, const double *v, int n)
     }
 }
 
-void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *field)
+void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field)
 {
     const char *err = sx_lua_tovec(L, idx, n, out);
-    if (err) luaL_error(L, "field '%s': %s", field, err);
+    if (err) luaL_error(L, "%s field '%s': %s", kind, field, err);
 }
 
 /* ----------------------------------------------------- property tables */

@@ -49,7 +49,7 @@ static const sx_model *wall_def(lua_State *L, sx_wall_def *d)
 {
     int64_t id;
     const sx_model *m = check_wall(L, &id);
-    sx_lua_check(L, m, sx_wall_get(m, id, d));
+    sx_lua_checkfield(L, m, sx_wall_get(m, id, d), "wall");
     return m;
 }
 
@@ -101,7 +101,7 @@ static int push_resultant(lua_State *L, int which)
     int64_t id;
     const sx_model *m = check_wall(L, &id);
     double fm[2][3];
-    sx_lua_check(L, m, sx_wall_force(m, id, fm[0], fm[1]));
+    sx_lua_checkfield(L, m, sx_wall_force(m, id, fm[0], fm[1]), "wall");
     const int dim = sx_model_dim(m);
     sx_lua_pushvec(L, fm[which], which ? sx_lua_rdim(dim) : dim);
     return 1;
@@ -115,8 +115,8 @@ static int set_vel(lua_State *L)
     int64_t id;
     sx_model *m = check_wall(L, &id);
     double v[3] = {0, 0, 0};
-    sx_lua_checkvalue(L, 3, sx_model_dim(m), v, "vel");
-    sx_lua_check(L, m, sx_wall_set_vel(m, id, v));
+    sx_lua_checkvalue(L, 3, sx_model_dim(m), v, "wall", "vel");
+    sx_lua_checkfield(L, m, sx_wall_set_vel(m, id, v), "wall");
     return 0;
 }
 
@@ -125,8 +125,8 @@ static int set_point(lua_State *L)
     int64_t id;
     sx_model *m = check_wall(L, &id);
     double p[3] = {0, 0, 0};
-    sx_lua_checkvalue(L, 3, sx_model_dim(m), p, "point");
-    sx_lua_check(L, m, sx_wall_set_point(m, id, p));
+    sx_lua_checkvalue(L, 3, sx_model_dim(m), p, "wall", "point");
+    sx_lua_checkfield(L, m, sx_wall_set_point(m, id, p), "wall");
     return 0;
 }
 
@@ -135,8 +135,8 @@ static int set_scalar(lua_State *L, sx_wall_scalar which)
     int64_t id;
     sx_model *m = check_wall(L, &id);
     double v;
-    sx_lua_checkvalue(L, 3, 1, &v, lua_tostring(L, 2));
-    sx_lua_check(L, m, sx_wall_set(m, id, which, v));
+    sx_lua_checkvalue(L, 3, 1, &v, "wall", lua_tostring(L, 2));
+    sx_lua_checkfield(L, m, sx_wall_set(m, id, which, v), "wall");
     return 0;
 }
 
@@ -156,7 +156,7 @@ static int wall_remove(lua_State *L)
     int64_t id;
     check_wall(L, &id);
     lua_getiuservalue(L, 1, 1);
-    sx_lua_remove_wall(L, -1, id);
+    sx_lua_remove_wall(L, -1, id, "w:remove");
     return 0;
 }
 
@@ -220,7 +220,7 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
         break;
     }
     int64_t id;
-    sx_lua_check(L, m, sx_wall_add(m, &d, &id));
+    sx_lua_check(L, m, sx_wall_add(m, &d, &id), "m:wall");
     sx_lua_pushhandle(L, 1, &wall_kind, id);
     return 1;
 }
@@ -231,7 +231,7 @@ static int undo_box(lua_State *L, sx_model *m, const int64_t *ids, int n)
 {
     lua_pushstring(L, sx_model_error(m));
     for (int i = 0; i < n; i++) sx_wall_remove(m, ids[i]);
-    return luaL_error(L, "%s", lua_tostring(L, -1));
+    return luaL_error(L, "m:wall: %s", sx_lua_core_message(lua_tostring(L, -1)));
 }
 
 /* The walls of the box [min, max]: for each axis, the lower then the

@@ -48,6 +48,7 @@ local function raises(fn, ...)
       error(string.format("error %q lacks %q", err, fragment), 2)
     end
   end
+  return err
 end
 
 local HERE = "api.lua:"  -- errors must carry the script position
@@ -671,9 +672,56 @@ test("seixo -e, exit status and one-line errors", function()
   status, out = run("no/such/script.lua")
   eq(status, 1)
   check(out:match("^seixo: cannot open no/such/script.lua"), out)
+  -- a bad command line: one line, the reason and where to look
   status, out = run("--bogus")
   eq(status, 1)
-  check(out:match("^seixo: unrecognized option '%-%-bogus'"), out)
+  eq(out, "seixo: unrecognized option '--bogus'; seixo --help for usage\n")
+  status, out = run("-e")
+  eq(status, 1)
+  eq(out, "seixo: '-e' needs an argument; seixo --help for usage\n")
+  status, out = run("--threads x")
+  eq(status, 1)
+  eq(select(2, out:gsub("\n", "")), 1, out)
+  check(out:find("seixo --help for usage", 1, true), out)
+end)
+
+-- The core's messages name its C functions (ball_set, wall_add, ...): a
+-- script sees the Lua call or field instead, and the object's kind.
+test("errors name the Lua call, not the core's function", function()
+  local m = model3()
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.01}
+  local w = m:wall{kind = "plane", point = {0, 0, -1}, normal = {0, 0, 1}}
+  local function says(fn, ...)
+    local err = raises(fn, HERE, ...)
+    check(not err:find(": [%l]+_[%l_]*: "), "a core function's name in: " .. err)
+  end
+  says(function() b.radius = -1 end, "ball field 'radius': radius must be a positive finite number")
+  says(function() b.damping = 1 end, "ball field 'damping':")
+  says(function() b.vel = {1, 2} end, "ball field 'vel':", "3 components")
+  says(function() b.fix = "vq" end, "ball field 'fix': unknown fixity 'vq'")
+  says(function() b.material = "nope" end, "ball field 'material': no material named 'nope'")
+  says(function() b.group = 3 end, "ball field 'group':")
+  says(function() b.extra = 3 end, "ball field 'extra':")
+  says(function() m:ball{pos = {0, 0, 0}, radius = -1} end, "m:ball: radius must be")
+  says(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 0}} end, "m:wall: the normal must not be zero")
+  says(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 1, 1}, kn = -1} end, "m:wall: kn must be > 0")
+  says(function() w.kn = -1 end, "wall field 'kn': kn must be")
+  says(function() w.vel = {0 / 0, 0, 0} end, "wall field 'vel': velocity must be finite")
+  says(function() w.point = 1 end, "wall field 'point':")
+  says(function() w:servo{target = 1, area = -1} end, "w:servo: the area must be > 0")
+  says(function() w:set_radial_vel(1) end, "w:set_radial_vel: wall " .. w.id .. " is not a cylinder")
+  says(function() w:set_radius(1) end, "w:set_radius:", "not a cylinder")
+  says(function() seixo.model{dim = 3, timestep = -1} end, "seixo.model: timestep must be >= 0")
+  says(function() m:set_timestep(-1) end, "m:set_timestep: the timestep must be > 0 s")
+  says(function() m:set_gravity{0 / 0, 0, 0} end, "m:set_gravity: components must be finite")
+  says(function() m:material("x", {density = -1}) end, "m:material: material 'x': density must be > 0")
+  says(function() m:bond{kind = "contact", gap = -1} end, "m:bond: gap must be >= 0")
+  says(function() m:set{radius = -1} end, "m:set: field 'radius': radius must be")
+  says(function() m:set{fix = "vq"} end, "m:set: field 'fix': unknown fixity 'vq'")
+  local empty = model3()
+  says(function() empty:cycle(1) end, "m:cycle: no ball to estimate the automatic timestep")
+  says(function() empty:solve{steps = 1} end, "m:solve: no ball to estimate the automatic timestep")
+  says(function() empty:timestep() end, "m:timestep: no ball")
 end)
 
 test("seixo --version and --help", function()
