@@ -6,12 +6,13 @@
  *               no room after `tries` attempts. `count` or `porosity`.
  *   distribute  PFC's ball distribute: radii up to the target porosity,
  *               centres placed at random with overlaps, then relaxed.
- *               Overlaps above a fifth of the smaller radius are first
- *               pushed apart geometrically (the core's stability guard
- *               refuses overlaps beyond a radius), then the model cycles
- *               with the user's materials, gravity off and velocities
- *               zeroed every `calm` steps, until the mean unbalanced-force
- *               ratio reaches relax.ratio or relax.steps have run.
+ *               Overlaps above a hundredth of the smaller radius are
+ *               first pushed apart geometrically where there is room (the
+ *               core's stability guard refuses overlaps beyond a radius),
+ *               then the model cycles with the user's materials, gravity
+ *               off and velocities zeroed every `calm` steps, until the
+ *               mean unbalanced-force ratio reaches relax.ratio, no overlap
+ *               exceeds a thousandth of a radius, or relax.steps have run.
  *   expand      PFC's radius expansion: non-overlapping placement at
  *               reduced radii, then growth by stages of at most 2 % to
  *               the radii of the target porosity, cycling between stages,
