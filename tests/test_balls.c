@@ -6,6 +6,7 @@
 #include <check.h>
 #include <float.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define PI 3.14159265358979323846
@@ -511,6 +512,173 @@ START_TEST(remove_keeps_others)
 }
 END_TEST
 
+/* ---- bulk removal ---- */
+
+/* A contact by its entities, oriented a < b for ball-ball pairs (the store
+ * may hold either orientation: the vectors on b flip with it). */
+typedef struct rec {
+    int64_t a, b;
+    bool wall;
+    unsigned bond;
+    double fn, overlap, shear[3], normal[3];
+} rec;
+
+typedef struct recs {
+    rec *r;
+    int64_t n, cap;
+} recs;
+
+static bool record(const sx_contact_info *c, void *ud)
+{
+    recs *s = ud;
+    if (s->n == s->cap) {
+        s->cap = s->cap ? 2 * s->cap : 1024;
+        s->r = realloc(s->r, (size_t)s->cap * sizeof *s->r);
+        ck_assert_ptr_nonnull(s->r);
+    }
+    rec *r = &s->r[s->n++];
+    const bool flip = !c->is_wall && c->a > c->b;
+    r->a = flip ? c->b : c->a;
+    r->b = flip ? c->a : c->b;
+    r->wall = c->is_wall;
+    r->bond = c->bond;
+    r->fn = c->fn;
+    r->overlap = c->overlap;
+    for (int k = 0; k < 3; k++) {
+        r->shear[k] = flip ? -c->shear[k] : c->shear[k];
+        r->normal[k] = flip ? -c->normal[k] : c->normal[k];
+    }
+    return true;
+}
+
+static int by_key(const void *x, const void *y)
+{
+    const rec *p = x, *q = y;
+    if (p->wall != q->wall) return p->wall ? 1 : -1;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    return p->b < q->b ? -1 : p->b > q->b;
+}
+
+/* The contacts of the model, sorted by their entities. */
+static recs contacts_of(const sx_model *m)
+{
+    recs s = {NULL, 0, 0};
+    sx_contact_each(m, record, &s);
+    qsort(s.r, (size_t)s.n, sizeof *s.r, by_key);
+    return s;
+}
+
+static bool same_rec(const rec *p, const rec *q)
+{
+    if (by_key(p, q) || p->bond != q->bond || p->fn != q->fn || p->overlap != q->overlap) return false;
+    for (int k = 0; k < 3; k++)
+        if (p->shear[k] != q->shear[k] || p->normal[k] != q->normal[k]) return false;
+    return true;
+}
+
+/* A packed, partly bonded assembly in a box, its contacts with shear
+ * history: a grid of touching balls (radii 1 mm, spacing 1.998 mm, the
+ * walls as close), shaken by random velocities. ids gets n_side^dim ids. */
+static sx_model *packed(int dim, int n_side, int64_t *ids)
+{
+    const double r = 1e-3, a = 1.998e-3, g[3] = {0, -9.81, 0};
+    const double lo[3] = {-0.999e-3, -0.999e-3, -0.999e-3};
+    const double hi[3] = {lo[0] + n_side * a, lo[1] + n_side * a, lo[2] + n_side * a};
+    sx_model *m = scene_model(dim, g, 1e-6, 1e6, 0.5, 2650);
+    scene_box_walls(m, lo, hi, 1e6, 0.5);
+    uint64_t seed = 17;
+    const int n = dim == 2 ? n_side * n_side : n_side * n_side * n_side;
+    for (int i = 0; i < n; i++) {
+        const int c[3] = {i % n_side, i / n_side % n_side, i / (n_side * n_side)};
+        double x[3], v[3];
+        for (int k = 0; k < 3; k++) {
+            x[k] = c[k] * a;
+            v[k] = scene_rng_uniform(&seed, -0.05, 0.05);
+        }
+        ids[i] = scene_ball(m, x, v, r);
+    }
+    ck_assert_int_eq(sx_model_cycle(m, 200), SX_OK);
+    sx_bond_def b = sx_bond_default_def();
+    b.kind = SX_BOND_CONTACT;
+    b.gap = 0;
+    b.material_a = b.material_b = scene_material(m);
+    b.normal_strength = b.shear_strength = 1e9;
+    int64_t bonded = 0;
+    ck_assert_msg(sx_bond_install(m, &b, &bonded) == SX_OK, "%s", sx_model_error(m));
+    ck_assert_int_gt(bonded, 0);
+    ck_assert_int_eq(sx_model_cycle(m, 50), SX_OK);
+    return m;
+}
+
+static bool is_gone(int64_t id) { return id % 5 == 0 || id == 1 || id == 7; }
+
+/* Removing many balls at once leaves exactly the contacts (with their
+ * history and bonds) of the balls that stay, like removing them one by one. */
+START_TEST(remove_many_keeps_contacts)
+{
+    const int dim = _i;
+    enum { N = 729 }; /* 27 x 27 in 2D, 9 x 9 x 9 in 3D */
+    int64_t ids[N], gone[N + 2];
+    sx_model *m = packed(dim, dim == 2 ? 27 : 9, ids), *twin = packed(dim, dim == 2 ? 27 : 9, ids);
+    const recs before = contacts_of(m);
+    int64_t ng = 0;
+    for (int64_t i = 0; i < N; i++)
+        if (is_gone(ids[i])) gone[ng++] = ids[i];
+    gone[ng++] = 7; /* listed twice: removed once */
+    const int64_t nbonds = sx_bond_count(m);
+    /* all or nothing: one id that is not a ball removes none */
+    gone[ng] = N + 100;
+    ck_assert_int_eq(sx_ball_remove_many(m, gone, ng + 1), SX_ENOTFOUND);
+    ck_assert_msg_has(m, "no ball with id");
+    ck_assert_int_eq(sx_ball_count(m), N);
+    ck_assert_int_eq(sx_bond_count(m), nbonds);
+    ck_assert_int_eq(sx_ball_remove_many(m, gone, -1), SX_EINVAL);
+    ck_assert_int_eq(sx_ball_remove_many(m, gone, 0), SX_OK);
+
+    ck_assert_int_eq(sx_ball_remove_many(m, gone, ng), SX_OK);
+    for (int64_t j = 0; j < ng - 1; j++) ck_assert_int_eq(sx_ball_remove(twin, gone[j]), SX_OK);
+    const int64_t left = N - (ng - 1);
+    ck_assert_int_eq(sx_ball_count(m), left);
+    /* every id listed once among the dense indices */
+    bool seen[N + 1] = {false};
+    for (int64_t i = 0; i < left; i++) {
+        const int64_t id = sx_ball_id_at(m, i);
+        ck_assert(id >= 1 && id <= N && !is_gone(id) && !seen[id]);
+        seen[id] = true;
+    }
+    for (int64_t i = 0; i < N; i++) ck_assert(sx_ball_exists(m, ids[i]) == !is_gone(ids[i]));
+
+    /* the contacts before, less those of a removed ball, unchanged */
+    const recs after = contacts_of(m), one_by_one = contacts_of(twin);
+    int64_t kept = 0, bonds = 0;
+    for (int64_t c = 0; c < before.n; c++) {
+        const rec *r = &before.r[c];
+        if (is_gone(r->a) || (!r->wall && is_gone(r->b))) continue;
+        ck_assert_msg(kept < after.n && same_rec(r, &after.r[kept]), "contact %lld-%lld lost or changed",
+                      (long long)r->a, (long long)r->b);
+        bonds += r->bond != 0;
+        kept++;
+    }
+    ck_assert_int_eq(after.n, kept);
+    ck_assert_int_lt(kept, before.n);
+    ck_assert_int_gt(bonds, 0);
+    ck_assert_int_eq(sx_bond_count(m), bonds);
+    /* the same as removing them one by one */
+    ck_assert_int_eq(one_by_one.n, after.n);
+    for (int64_t c = 0; c < after.n; c++) ck_assert(same_rec(&after.r[c], &one_by_one.r[c]));
+    /* and the model steps on */
+    ck_assert_int_eq(sx_model_cycle(m, 50), SX_OK);
+    const recs later = contacts_of(m);
+    for (int64_t c = 0; c < later.n; c++) ck_assert(!is_gone(later.r[c].a) && (later.r[c].wall || !is_gone(later.r[c].b)));
+    free(before.r);
+    free(after.r);
+    free(one_by_one.r);
+    free(later.r);
+    sx_model_destroy(m);
+    sx_model_destroy(twin);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("balls");
@@ -525,6 +693,7 @@ int main(void)
     tcase_add_loop_test(tc, applied_loads_survive_growth, 2, 4);
     tcase_add_loop_test(tc, errors, 2, 4);
     tcase_add_loop_test(tc, remove_keeps_others, 2, 4);
+    tcase_add_loop_test(tc, remove_many_keeps_contacts, 2, 4);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -489,6 +489,87 @@ START_TEST(validation)
 END_TEST
 
 /* Removing a wall keeps the others' contacts and forces. */
+/* Writing a wall's point, stiffnesses, friction and (cylinder) radius: the
+ * next step's contact force follows (4-6, 4-22), bad values are refused
+ * and leave the wall as it was. */
+START_TEST(set_fields)
+{
+    const int dim = _i;
+    sx_model *m = scene_model(dim, NULL, 1e-9, KB, 0.5, 2650);
+    sx_wall_def w = sx_wall_default_def(dim);
+    w.kn = w.ks = KW;
+    int64_t wid;
+    ck_assert_int_eq(sx_wall_add(m, &w, &wid), SX_OK);
+    double x[3] = {0, 0, 0};
+    x[dim - 1] = R - UN;
+    const int64_t id = scene_ball(m, x, NULL, R);
+    ck_assert_int_eq(sx_ball_set_fixity(m, id, dim == 3 ? SX_FIX_VEL | SX_FIX_SPIN : SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ),
+                     SX_OK);
+    double f[3];
+#define NORMAL_FORCE() (ck_assert_cycle(m, 1), sx_ball_get_vec(m, id, SX_BALL_FORCE, f), f[dim - 1])
+    ck_assert_near(NORMAL_FORCE(), kn_series() * UN, 1e-9 * kn_series() * UN);
+    /* a stiffer wall */
+    ck_assert_int_eq(sx_wall_set(m, wid, SX_WALL_KN, 3 * KW), SX_OK);
+    const double k3 = KB * 3 * KW / (KB + 3 * KW);
+    ck_assert_near(NORMAL_FORCE(), k3 * UN, 1e-9 * k3 * UN);
+    /* the wall raised by UN: twice the overlap */
+    double p[3] = {0, 0, 0};
+    p[dim - 1] = UN;
+    ck_assert_int_eq(sx_wall_set_point(m, wid, p), SX_OK);
+    ck_assert_near(NORMAL_FORCE(), 2 * k3 * UN, 1e-8 * k3 * UN);
+    /* lowered out of reach: no contact at all */
+    p[dim - 1] = -2 * UN;
+    ck_assert_int_eq(sx_wall_set_point(m, wid, p), SX_OK);
+    ck_assert_double_eq(NORMAL_FORCE(), 0);
+    ck_assert_int_eq(sx_contact_count(m), 0);
+#undef NORMAL_FORCE
+    ck_assert_int_eq(sx_wall_set(m, wid, SX_WALL_KS, 0), SX_OK);
+    ck_assert_int_eq(sx_wall_set(m, wid, SX_WALL_FRICTION, 0.1), SX_OK);
+    /* refused, and nothing changes */
+    const struct {
+        sx_wall_scalar which;
+        double value;
+        const char *says;
+    } bad[] = {
+        {SX_WALL_KN, 0, "kn"},          {SX_WALL_KN, NAN, "kn"},  {SX_WALL_KN, INFINITY, "kn"},
+        {SX_WALL_KS, -1, "ks"},         {SX_WALL_FRICTION, -0.5, "friction"},
+        {SX_WALL_FRICTION, NAN, "friction"}, {SX_WALL_RADIUS, 1, "not a cylinder"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ck_assert_int_eq(sx_wall_set(m, wid, bad[i].which, bad[i].value), SX_EINVAL);
+        ck_assert_msg_has(m, bad[i].says);
+    }
+    const double inf[3] = {INFINITY, INFINITY, INFINITY};
+    ck_assert_int_eq(sx_wall_set_point(m, wid, inf), SX_EINVAL);
+    ck_assert_int_eq(sx_wall_set_point(m, wid + 100, p), SX_ENOTFOUND);
+    ck_assert_int_eq(sx_wall_set(m, wid + 100, SX_WALL_KN, 1), SX_ENOTFOUND);
+    sx_wall_def got;
+    ck_assert_int_eq(sx_wall_get(m, wid, &got), SX_OK);
+    ck_assert_double_eq(got.kn, 3 * KW);
+    ck_assert_double_eq(got.ks, 0);
+    ck_assert_double_eq(got.friction, 0.1);
+    ck_assert_double_eq(got.point[dim - 1], -2 * UN);
+    if (dim == 3) { /* a cylinder's radius: the ball on its axis touches it once the radius is R - UN */
+        sx_wall_def c = sx_wall_default_def(3);
+        c.kind = SX_WALL_CYLINDER;
+        c.point[2] = -1;
+        c.radius = 10 * R;
+        c.kn = c.ks = KW;
+        int64_t cid;
+        ck_assert_int_eq(sx_wall_add(m, &c, &cid), SX_OK);
+        ck_assert_cycle(m, 1);
+        ck_assert_int_eq(sx_contact_count(m), 0);
+        ck_assert_int_eq(sx_wall_set(m, cid, SX_WALL_RADIUS, R - UN), SX_OK);
+        ck_assert_cycle(m, 1);
+        ck_assert_int_gt(sx_contact_count(m), 0);
+        ck_assert_int_eq(sx_wall_set(m, cid, SX_WALL_RADIUS, 0), SX_EINVAL);
+        ck_assert_int_eq(sx_wall_get(m, cid, &got), SX_OK);
+        ck_assert_double_eq(got.radius, R - UN);
+    }
+    sx_model_destroy(m);
+}
+END_TEST
+
 START_TEST(remove_wall_keeps_others)
 {
     const int dim = _i;
@@ -530,6 +611,7 @@ int main(void)
     tcase_add_loop_test(tc, moving_wall_pushes, 2, 4);
     tcase_add_loop_test(tc, validation, 2, 4);
     tcase_add_loop_test(tc, remove_wall_keeps_others, 2, 4);
+    tcase_add_loop_test(tc, set_fields, 2, 4);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

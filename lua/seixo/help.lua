@@ -106,6 +106,7 @@ local entries = {
   ["wall:load"] = {"w:load() -> force, contacts, kn", "The servo's inputs after the last step: total normal contact force [N], contact count, mean contact kn [N/m]."},
   ["wall:radius"] = {"w:radius() -> radius, radial_vel", "A cylinder's radius [m] and its rate of change [m/s]."},
   ["wall:set_radial_vel"] = {"w:set_radial_vel(v)", "Sets a cylinder's radial velocity [m/s] (> 0 expands)."},
+  ["wall:set_radius"] = {"w:set_radius(r)", "Sets a cylinder's radius [m] (> 0)."},
 
   -- ball
   ["ball:remove"] = {"b:remove()", "Removes the ball (queued while a callback runs)."},
@@ -130,18 +131,21 @@ local entries = {
 
   -- wall
   ["wall:remove"] = {"w:remove()", "Removes the wall (queued while a callback runs)."},
+  ["wall:set_extra"] = {"w:set_extra(key, value)", "Stores a user value with the wall (same as w.extra[key] = value)."},
+  ["wall:get_extra"] = {"w:get_extra(key[, default]) -> value", "A user value stored with the wall."},
   ["wall.id"] = {"w.id", "The wall's stable id."},
   ["wall.kind"] = {"w.kind", "'plane', 'line', 'rect', 'segment' or 'cylinder'."},
   ["wall.force"] = {"w.force", "Resultant force of the balls on the wall in the last step [N]."},
   ["wall.moment"] = {"w.moment", "Its moment about the wall's reference point [N m]."},
   ["wall.vel"] = {"w.vel", "Imposed velocity [m/s] (writable)."},
-  ["wall.point"] = {"w.point", "Plane/line: a point on it; rect: its corner; segment: its first end [m]."},
+  ["wall.point"] = {"w.point", "Plane/line: a point on it; rect: its corner; segment: its first end; cylinder: its axis point [m] (writable: moves the wall)."},
   ["wall.normal"] = {"w.normal", "Plane/line: the unit normal towards the balls."},
   ["wall.edge1"] = {"w.edge1", "Rect: first edge; segment: second end minus first [m]."},
   ["wall.edge2"] = {"w.edge2", "Rect: second edge [m]."},
-  ["wall.kn"] = {"w.kn", "Normal stiffness [N/m]."},
-  ["wall.ks"] = {"w.ks", "Shear stiffness [N/m]."},
-  ["wall.friction"] = {"w.friction", "Friction coefficient."},
+  ["wall.kn"] = {"w.kn", "Normal stiffness [N/m] (writable, > 0)."},
+  ["wall.ks"] = {"w.ks", "Shear stiffness [N/m] (writable, >= 0)."},
+  ["wall.friction"] = {"w.friction", "Friction coefficient (writable, >= 0)."},
+  ["wall.extra"] = {"w.extra", "A table of user values kept with the wall: w.extra.tag = 1."},
 
   -- contact
   ["contact.a"] = {"c.a", "The first entity: a ball."},

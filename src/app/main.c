@@ -6,7 +6,7 @@
  *
  * The interactive session uses readline when built with it: line editing,
  * a history file (~/.seixo_history, or $SEIXO_HISTORY; empty disables it;
- * each line is appended as it is entered),
+ * each statement is appended whole as it is entered),
  * and tab completion that walks the Lua value before the cursor (globals,
  * table keys, the methods and fields of seixo objects). A long cycle shows
  * a progress line on stderr when stderr is a terminal.
@@ -104,9 +104,14 @@ static int msghandler(lua_State *L)
     return 1;
 }
 
+/* Raises "interrupted" in Lua code only. At the call or return of a C
+ * function it stays armed for the next Lua instruction: raising on entry
+ * would skip the function's body, and when that function is a __close
+ * (a seixo run giving its model back) the model would stay "cycling". */
 static void stop_hook(lua_State *L, lua_Debug *ar)
 {
-    (void)ar;
+    if ((ar->event == LUA_HOOKCALL || ar->event == LUA_HOOKRET) && lua_getinfo(L, "S", ar) && ar->what[0] == 'C')
+        return;
     lua_sethook(L, NULL, 0, 0);
     luaL_error(L, "interrupted");
 }
@@ -335,26 +340,53 @@ static char *history_path(void)
     return path;
 }
 
-/* The history file: each line is appended as it is entered (so os.exit or
- * a crash loses nothing), and the file is cut to the last 1000 lines at the end. */
+/* The history file: each entry is appended as it is entered (so os.exit or
+ * a crash loses nothing), and the file keeps the last 1000 entries.
+ *
+ * An entry is a whole statement, newlines and all. The file is readline's
+ * format with timestamps (bash's lithist): each entry follows a "#<seconds>"
+ * line, and readline reads a line without one as the continuation of the
+ * entry before, so a multi-line statement comes back whole. That takes a
+ * file that starts with a timestamp; a file of bare lines (written before)
+ * is rewritten in this format when it is opened. */
 static char *hist_path;
+
+static bool starts_with_timestamp(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return false;
+    char head[2] = {0, 0};
+    const bool stamped = fread(head, 1, 2, f) == 2 && head[0] == '#' && head[1] >= '0' && head[1] <= '9';
+    fclose(f);
+    return stamped;
+}
 
 static void open_history(void)
 {
     hist_path = history_path();
     if (!hist_path) return;
-    if (read_history(hist_path) != 0) write_history(hist_path);  // create it
+    history_comment_char = '#';  // the timestamps' mark
+    history_write_timestamps = 1;
+    const bool read = read_history(hist_path) == 0;
+    /* create it, or give it timestamps (entries read get the current time) */
+    if (!read || (history_length > 0 && !starts_with_timestamp(hist_path))) write_history(hist_path);
 }
 
-static void remember(const char *line)
+static void remember(const char *entry)
 {
-    add_history(line);
+    add_history(entry);
     if (hist_path) append_history(1, hist_path);
 }
 
+/* Cuts the file to its last 1000 entries: read back whole (the history is
+ * stifled to 1000), written anew. history_truncate_file counts lines, and
+ * could leave the file starting inside a multi-line entry. */
 static void close_history(void)
 {
-    if (hist_path) history_truncate_file(hist_path, 1000);
+    if (hist_path) {
+        clear_history();
+        if (read_history(hist_path) == 0) write_history(hist_path);
+    }
     free(hist_path);
     hist_path = NULL;
 }
@@ -737,7 +769,7 @@ static enum parsed parse(int argc, char **argv, options *o)
         }
         if (strcmp(a, "-e") == 0) {
             if (++i == argc) {
-                message("'-e' needs an argument");
+                message("'-e' needs an argument; seixo --help for usage");
                 return BAD;
             }
             o->has_chunks = true;
@@ -750,7 +782,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             char *end = NULL;
             const long t = v ? strtol(v, &end, 10) : 0;
             if (!v || !*v || *end || t < 1 || t > MAX_THREADS) {
-                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d\n", progname, MAX_THREADS);
+                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d; seixo --help for usage\n", progname,
+                        MAX_THREADS);
                 return BAD;
             }
             o->threads = t;
@@ -761,8 +794,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             usage(stdout);
             return DONE;
         } else {
-            fprintf(stderr, "%s: unrecognized option '%s'\n", progname, a);
-            usage(stderr);
+            /* one line, like every failure: the reason and where to look */
+            fprintf(stderr, "%s: unrecognized option '%s'; seixo --help for usage\n", progname, a);
             return BAD;
         }
     }

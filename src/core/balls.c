@@ -1,7 +1,8 @@
 /* Ball store: a structure of arrays indexed densely, with stable ids mapped
- * to dense indices. Removal swaps the last ball into the hole and patches
- * the candidate pairs that referred to either index, so contact history
- * survives deletions. */
+ * to dense indices. Removal fills the holes with the last balls and patches
+ * the candidate pairs in one pass over the pair store, however many balls
+ * go, so contact history survives deletions and removing k balls costs
+ * O(N + pairs), not O(k x pairs). */
 #include "model_internal.h"
 
 #include <math.h>
@@ -214,53 +215,83 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
     b->index_of[b->id[to]] = (int32_t)to;
 }
 
-/* Drops the pairs of ball `gone` and renames `last` to `gone` in the rest.
- * Ball-ball pairs keep a < b by swapping the ends (and flipping the
- * history's sign, which is expressed relative to a -> b). */
-static void patch_pairs_after_remove(sx_model *m, int32_t gone, int32_t last)
+/* Drops the pairs that have a removed ball (remap < 0; their bonds break)
+ * and renames the ends of the rest to the balls' new indices. Ball-ball
+ * pairs keep a < b by swapping the ends (and flipping the history's sign,
+ * which is expressed relative to a -> b). */
+static void patch_pairs_after_remove(sx_model *m, const int32_t *remap)
 {
     sx_pairs *p = &m->bb;
     int64_t k = 0;
     for (int64_t c = 0; c < p->n; c++) {
-        int32_t a = p->a[c], bb = p->b[c];
-        if (a == gone || bb == gone) {
+        const int32_t a = remap[p->a[c]], bb = remap[p->b[c]];
+        if (a < 0 || bb < 0) {
             if (p->bond && p->bond[c]) sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL);
             continue;
         }
         sx__pair_move(m, p, k, c);
-        p->a[k] = a == last ? gone : a;
-        p->b[k] = bb == last ? gone : bb;
-        if (p->a[k] > p->b[k]) sx__pair_flip(m, p, k);
+        p->a[k] = a;
+        p->b[k] = bb;
+        if (a > bb) sx__pair_flip(m, p, k);
         k++;
     }
     p->n = k;
     p = &m->bw;
     k = 0;
     for (int64_t c = 0; c < p->n; c++) {
-        if (p->a[c] == gone) continue;
+        const int32_t a = remap[p->a[c]];
+        if (a < 0) continue;
         sx__pair_move(m, p, k, c);
-        if (p->a[k] == last) p->a[k] = gone;
+        p->a[k] = a;
         k++;
     }
     p->n = k;
 }
 
-sx_status sx_ball_remove(sx_model *m, int64_t id)
+sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n)
 {
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball_remove: the model is stepping");
-    const int64_t i = sx__ball_index(m, id);
-    if (i < 0) return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)id);
+    if (n < 0) return sx__fail(m, SX_EINVAL, "ball_remove: the number of ids must be >= 0 (got %lld)", (long long)n);
     sx_balls *b = &m->balls;
-    const int64_t last = b->n - 1;
-    patch_pairs_after_remove(m, (int32_t)i, (int32_t)last);
-    if (i != last) move_ball(m, i, last);
-    b->index_of[id] = -1;
-    b->n--;
+    const int64_t nb = b->n;
+    for (int64_t j = 0; j < n; j++)
+        if (sx__ball_index(m, ids[j]) < 0)
+            return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)ids[j]);
+    if (n == 0) return SX_OK;
+    /* remap: old dense index -> new one, -1 for a removed ball */
+    int32_t *remap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)nb, sizeof *remap);
+    if (!remap) return sx__fail(m, SX_ENOMEM, "ball_remove: out of memory for %lld balls", (long long)nb);
+    for (int64_t i = 0; i < nb; i++) remap[i] = (int32_t)i;
+    int64_t gone = 0;
+    for (int64_t j = 0; j < n; j++) {
+        const int64_t i = sx__ball_index(m, ids[j]);
+        if (remap[i] < 0) continue; /* listed twice */
+        remap[i] = -1;
+        gone++;
+    }
+    /* the holes below the new count take the survivors above it, both in
+     * index order; so one removal moves the last ball into its hole */
+    const int64_t keep = nb - gone;
+    int64_t from = keep;
+    for (int64_t i = 0; i < keep; i++) {
+        if (remap[i] >= 0) continue;
+        while (remap[from] < 0) from++;
+        remap[from++] = (int32_t)i;
+    }
+    patch_pairs_after_remove(m, remap);
+    for (int64_t i = 0; i < nb; i++)
+        if (remap[i] < 0) b->index_of[b->id[i]] = -1;
+    for (int64_t i = keep; i < nb; i++)
+        if (remap[i] >= 0) move_ball(m, remap[i], i);
+    b->n = keep;
+    sx_alloc_free(&m->alloc, remap, (size_t)nb, sizeof *remap);
     m->build_needed = true;
     m->dt_stale = true;
     return SX_OK;
 }
+
+sx_status sx_ball_remove(sx_model *m, int64_t id) { return sx_ball_remove_many(m, &id, 1); }
 
 void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
 {

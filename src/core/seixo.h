@@ -145,6 +145,12 @@ SX_API sx_ball_def sx_ball_default_def(void);
 /// Adds a ball; its stable id (>= 1) is written to *id.
 SX_API sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *id);
 SX_API sx_status sx_ball_remove(sx_model *m, int64_t id);
+/// Removes the n balls listed (an id listed twice is removed once) in one
+/// pass over the contacts: O(balls + contacts) however many go. Their
+/// contacts and bonds go with them; the other contacts keep their history.
+/// All or nothing: an id that is not a ball fails with SX_ENOTFOUND and
+/// removes none.
+SX_API sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n);
 /// Makes room for `count` more balls at once (optional: saves memory and
 /// copies when the number of balls to add is known).
 SX_API sx_status sx_ball_reserve(sx_model *m, int64_t count);
@@ -231,6 +237,21 @@ SX_API bool sx_wall_exists(const sx_model *m, int64_t id);
 /// The definition as it is now (point moved by the wall's motion).
 SX_API sx_status sx_wall_get(const sx_model *m, int64_t id, sx_wall_def *out);
 SX_API sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3]);
+/// Moves the wall so that its reference point (def.point: a plane's or
+/// line's point, a rect's corner, a segment's first end, a cylinder's axis
+/// point) is at p (m): a translation, the rest of the wall follows.
+SX_API sx_status sx_wall_set_point(sx_model *m, int64_t id, const double p[3]);
+
+typedef enum sx_wall_scalar {
+    SX_WALL_KN,        ///< N/m, normal stiffness (> 0)
+    SX_WALL_KS,        ///< N/m, shear stiffness (>= 0)
+    SX_WALL_FRICTION,  ///< Coulomb coefficient (>= 0)
+    SX_WALL_RADIUS,    ///< cylinder: m, its radius (> 0)
+} sx_wall_scalar;
+
+/// Sets a stiffness, the friction or a cylinder's radius; the next step
+/// (and its timestep) uses the new value.
+SX_API sx_status sx_wall_set(sx_model *m, int64_t id, sx_wall_scalar which, double value);
 /// Cylinder: the rate of change of its radius (m/s, > 0 expands).
 SX_API sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel);
 /// Resultant force (N) of the balls on the wall in the last step, and its

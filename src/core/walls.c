@@ -206,6 +206,53 @@ sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
     return SX_OK;
 }
 
+sx_status sx_wall_set_point(sx_model *m, int64_t id, const double p[3])
+{
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_point");
+    if (!w) return SX_ENOTFOUND;
+    if (!finite3(p, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_point: the point must be finite");
+    for (int k = 0; k < m->dim; k++) w->def.point[k] = p[k];
+    m->build_needed = true; /* a jump, not a motion the skin covers */
+    return SX_OK;
+}
+
+sx_status sx_wall_set(sx_model *m, int64_t id, sx_wall_scalar which, double value)
+{
+    m->guard_dirty = true; /* new energy baseline for the stability guard */
+    sx_wall *w = (sx_wall *)lookup(m, id, "wall_set");
+    if (!w) return SX_ENOTFOUND;
+    switch (which) {
+    case SX_WALL_KN:
+        if (!(value > 0) || !isfinite(value))
+            return sx__fail(m, SX_EINVAL, "wall_set: kn must be a finite number > 0 N/m (got %g)", value);
+        w->def.kn = value;
+        m->dt_stale = true; /* the critical timestep sees the wall's contacts */
+        return SX_OK;
+    case SX_WALL_KS:
+        if (!(value >= 0) || !isfinite(value))
+            return sx__fail(m, SX_EINVAL, "wall_set: ks must be a finite number >= 0 N/m (got %g)", value);
+        w->def.ks = value;
+        m->dt_stale = true;
+        return SX_OK;
+    case SX_WALL_FRICTION:
+        if (!(value >= 0) || !isfinite(value))
+            return sx__fail(m, SX_EINVAL, "wall_set: friction must be a finite number >= 0 (got %g)", value);
+        w->def.friction = value;
+        return SX_OK;
+    case SX_WALL_RADIUS:
+        if (w->def.kind != SX_WALL_CYLINDER)
+            return sx__fail(m, SX_EINVAL, "wall_set: wall %lld is not a cylinder; only a cylinder has a radius",
+                            (long long)id);
+        if (!(value > 0) || !isfinite(value))
+            return sx__fail(m, SX_EINVAL, "wall_set: the cylinder radius must be a finite number > 0 m (got %g)", value);
+        w->def.radius = value;
+        m->build_needed = true; /* a jump, not a motion the skin covers */
+        return SX_OK;
+    }
+    return sx__fail(m, SX_EINVAL, "wall_set: unknown field %d", (int)which);
+}
+
 sx_status sx_wall_force(const sx_model *m, int64_t id, double force[3], double moment[3])
 {
     const sx_wall *w = lookup(m, id, "wall_force");

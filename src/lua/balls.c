@@ -6,7 +6,7 @@
  * table of user values per ball, dropped when the ball is removed. */
 #include "bindings.h"
 
-const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras"};
 #define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */
@@ -33,7 +33,7 @@ static int get_vec(lua_State *L, sx_ball_vec which)
     int64_t id;
     const sx_model *m = check_ball(L, &id);
     double v[3];
-    sx_lua_check(L, m, sx_ball_get_vec(m, id, which, v));
+    sx_lua_checkfield(L, m, sx_ball_get_vec(m, id, which, v), "ball");
     sx_lua_pushvec(L, v, vec_len(m, which));
     return 1;
 }
@@ -43,8 +43,8 @@ static int set_vec(lua_State *L, sx_ball_vec which)
     int64_t id;
     sx_model *m = check_ball(L, &id);
     double v[3] = {0, 0, 0};
-    sx_lua_checkvalue(L, 3, vec_len(m, which), v, lua_tostring(L, 2));
-    sx_lua_check(L, m, sx_ball_set_vec(m, id, which, v));
+    sx_lua_checkvalue(L, 3, vec_len(m, which), v, "ball", lua_tostring(L, 2));
+    sx_lua_checkfield(L, m, sx_ball_set_vec(m, id, which, v), "ball");
     return 0;
 }
 
@@ -53,7 +53,7 @@ static int get_scalar(lua_State *L, sx_ball_scalar which)
     int64_t id;
     const sx_model *m = check_ball(L, &id);
     double v;
-    sx_lua_check(L, m, sx_ball_get(m, id, which, &v));
+    sx_lua_checkfield(L, m, sx_ball_get(m, id, which, &v), "ball");
     lua_pushnumber(L, v);
     return 1;
 }
@@ -63,8 +63,8 @@ static int set_scalar(lua_State *L, sx_ball_scalar which)
     int64_t id;
     sx_model *m = check_ball(L, &id);
     double v;
-    sx_lua_checkvalue(L, 3, 1, &v, lua_tostring(L, 2));
-    sx_lua_check(L, m, sx_ball_set(m, id, which, v));
+    sx_lua_checkvalue(L, 3, 1, &v, "ball", lua_tostring(L, 2));
+    sx_lua_checkfield(L, m, sx_ball_set(m, id, which, v), "ball");
     return 0;
 }
 
@@ -100,7 +100,7 @@ static int get_material(lua_State *L)
     int64_t id;
     const sx_model *m = check_ball(L, &id);
     int mat;
-    sx_lua_check(L, m, sx_ball_material(m, id, &mat));
+    sx_lua_checkfield(L, m, sx_ball_material(m, id, &mat), "ball");
     lua_pushstring(L, sx_material_name(m, mat));
     return 1;
 }
@@ -110,10 +110,10 @@ static int set_material(lua_State *L)
     int64_t id;
     sx_model *m = check_ball(L, &id);
     if (lua_type(L, 3) != LUA_TSTRING)
-        return luaL_error(L, "field 'material': material name expected, got %s", luaL_typename(L, 3));
+        return luaL_error(L, "ball field 'material': material name expected, got %s", luaL_typename(L, 3));
     const int mat = find_material(L, m, lua_tostring(L, 3));
-    if (mat < 0) return luaL_error(L, "field 'material': %s", lua_tostring(L, -1));
-    sx_lua_check(L, m, sx_ball_set_material(m, id, mat));
+    if (mat < 0) return luaL_error(L, "ball field 'material': %s", lua_tostring(L, -1));
+    sx_lua_checkfield(L, m, sx_ball_set_material(m, id, mat), "ball");
     return 0;
 }
 
@@ -136,33 +136,33 @@ enum { FIX_COMPONENTS = 6 };
 _Static_assert(sizeof fix_names / sizeof fix_names[0] == sizeof fix_masks / sizeof fix_masks[0] + 1,
                "one mask pair per fixity word");
 
-static int fix_word(lua_State *L, int dim, int idx)
+static int fix_word(lua_State *L, int dim, int idx, const char *what)
 {
     if (lua_type(L, idx) != LUA_TSTRING)
-        return luaL_error(L, "field 'fix': fixity name expected, got %s", luaL_typename(L, idx));
+        return luaL_error(L, "%s: fixity name expected, got %s", what, luaL_typename(L, idx));
     const char *word = lua_tostring(L, idx);
     const int i = sx_lua_find(word, fix_names);
     if (i < 0) {
         sx_lua_pushlist(L, fix_names);
-        return luaL_error(L, "field 'fix': unknown fixity '%s' (valid: %s)", word, lua_tostring(L, -1));
+        return luaL_error(L, "%s: unknown fixity '%s' (valid: %s)", what, word, lua_tostring(L, -1));
     }
     const unsigned mask = fix_masks[i][dim == 3 ? 0 : 1];
-    if (!mask) return luaL_error(L, "field 'fix': a 2D ball has no '%s' (only vx, vy, wz)", word);
+    if (!mask) return luaL_error(L, "%s: a 2D ball has no '%s' (only vx, vy, wz)", what, word);
     return (int)mask;
 }
 
 /* nil or {} frees every component; a word or an array of words fixes those. */
-unsigned sx_lua_fixmask(lua_State *L, int dim, int idx)
+unsigned sx_lua_fixmask(lua_State *L, int dim, int idx, const char *what)
 {
     if (lua_isnil(L, idx)) return 0;
-    if (lua_type(L, idx) == LUA_TSTRING) return (unsigned)fix_word(L, dim, idx);
+    if (lua_type(L, idx) == LUA_TSTRING) return (unsigned)fix_word(L, dim, idx, what);
     if (!lua_istable(L, idx))
-        luaL_error(L, "field 'fix': string or array of strings expected, got %s", luaL_typename(L, idx));
+        luaL_error(L, "%s: string or array of strings expected, got %s", what, luaL_typename(L, idx));
     unsigned mask = 0;
     const lua_Unsigned n = lua_rawlen(L, idx);
     for (lua_Unsigned k = 1; k <= n; k++) {
         lua_rawgeti(L, idx, (lua_Integer)k);
-        mask |= (unsigned)fix_word(L, dim, lua_gettop(L));
+        mask |= (unsigned)fix_word(L, dim, lua_gettop(L), what);
         lua_pop(L, 1);
     }
     return mask;
@@ -173,7 +173,7 @@ static int get_fix(lua_State *L)
     int64_t id;
     const sx_model *m = check_ball(L, &id);
     unsigned mask;
-    sx_lua_check(L, m, sx_ball_fixity(m, id, &mask));
+    sx_lua_checkfield(L, m, sx_ball_fixity(m, id, &mask), "ball");
     lua_newtable(L);
     int n = 0;
     for (int i = 0; i < FIX_COMPONENTS; i++) {
@@ -188,7 +188,8 @@ static int set_fix(lua_State *L)
 {
     int64_t id;
     sx_model *m = check_ball(L, &id);
-    sx_lua_check(L, m, sx_ball_set_fixity(m, id, sx_lua_fixmask(L, sx_model_dim(m), 3)));
+    const unsigned mask = sx_lua_fixmask(L, sx_model_dim(m), 3, "ball field 'fix'");
+    sx_lua_checkfield(L, m, sx_ball_set_fixity(m, id, mask), "ball");
     return 0;
 }
 
@@ -199,7 +200,7 @@ static int get_group(lua_State *L)
     int64_t id;
     const sx_model *m = check_ball(L, &id);
     int32_t g;
-    sx_lua_check(L, m, sx_ball_group(m, id, &g));
+    sx_lua_checkfield(L, m, sx_ball_group(m, id, &g), "ball");
     lua_getiuservalue(L, 1, 1);
     sx_lua_push_group_name(L, lua_gettop(L), g);
     return 1;
@@ -210,90 +211,19 @@ static int set_group(lua_State *L)
     int64_t id;
     sx_model *m = check_ball(L, &id);
     if (!lua_isnil(L, 3) && lua_type(L, 3) != LUA_TSTRING)
-        return luaL_error(L, "field 'group': group name or nil expected, got %s", luaL_typename(L, 3));
+        return luaL_error(L, "ball field 'group': group name or nil expected, got %s", luaL_typename(L, 3));
     lua_getiuservalue(L, 1, 1);
     const int32_t g = lua_isnil(L, 3) ? 0 : sx_lua_group_id(L, lua_gettop(L), lua_tostring(L, 3), true);
-    sx_lua_check(L, m, sx_ball_set_group(m, id, g));
+    sx_lua_checkfield(L, m, sx_ball_set_group(m, id, g), "ball");
     return 0;
 }
 
-/* Pushes the extras table of the ball at index 1, created when `create`
- * (else nil when it has none). */
-static void push_extras(lua_State *L, bool create)
-{
-    int64_t id;
-    check_ball(L, &id);
-    lua_getiuservalue(L, 1, 1);
-    sx_lua_state(L, -1, "extras");
-    lua_remove(L, -2);
-    if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL && create) {
-        lua_pop(L, 1);
-        lua_newtable(L);
-        lua_pushvalue(L, -1);
-        lua_rawseti(L, -3, (lua_Integer)id);
-    }
-    lua_remove(L, -2);
-}
-
-static int get_extra(lua_State *L)
-{
-    push_extras(L, true);
-    return 1;
-}
-
-/* b.extra = {...} replaces the ball's extras; nil drops them. */
-static int set_extra_table(lua_State *L)
-{
-    int64_t id;
-    check_ball(L, &id);
-    if (!lua_isnil(L, 3) && !lua_istable(L, 3))
-        return luaL_error(L, "field 'extra': table or nil expected, got %s", luaL_typename(L, 3));
-    lua_getiuservalue(L, 1, 1);
-    sx_lua_state(L, -1, "extras");
-    lua_pushvalue(L, 3);
-    lua_rawseti(L, -2, (lua_Integer)id);
-    return 0;
-}
-
-/* b:set_extra(key, value) */
-static int ball_set_extra(lua_State *L)
-{
-    luaL_checkany(L, 2);
-    if (lua_isnil(L, 2) || (lua_type(L, 2) == LUA_TNUMBER && lua_tonumber(L, 2) != lua_tonumber(L, 2)))
-        return luaL_argerror(L, 1, "a key other than nil and NaN expected");
-    luaL_checkany(L, 3);
-    push_extras(L, true);
-    lua_pushvalue(L, 2);
-    lua_pushvalue(L, 3);
-    lua_rawset(L, -3);
-    return 0;
-}
-
-/* b:get_extra(key[, default]) */
-static int ball_get_extra(lua_State *L)
-{
-    luaL_checkany(L, 2);
-    lua_settop(L, 3);  // the default, nil when absent
-    push_extras(L, false);
-    if (lua_istable(L, -1)) {
-        lua_pushvalue(L, 2);
-        lua_rawget(L, -2);
-    } else {
-        lua_pushnil(L);
-    }
-    if (lua_isnil(L, -1)) lua_pushvalue(L, 3);
-    return 1;
-}
+static int get_extra(lua_State *L) { return sx_lua_extra_table(L, &ball_kind); }
+static int set_extra_table(lua_State *L) { return sx_lua_set_extra_table(L, &ball_kind); }
+static int ball_set_extra(lua_State *L) { return sx_lua_set_extra(L, &ball_kind); }
+static int ball_get_extra(lua_State *L) { return sx_lua_get_extra(L, &ball_kind); }
 
 /* ------------------------------------------------- methods, metamethods */
-
-static void forget_extras(lua_State *L, int model, int64_t id)
-{
-    sx_lua_state(L, model, "extras");
-    lua_pushnil(L);
-    lua_rawseti(L, -2, (lua_Integer)id);
-    lua_pop(L, 1);
-}
 
 /* Queued removals: ball ids positive, wall ids negative, in the state's `queue`. */
 static bool queue_removal(lua_State *L, int model, int64_t signed_id)
@@ -306,21 +236,35 @@ static bool queue_removal(lua_State *L, int model, int64_t signed_id)
     return true;
 }
 
-void sx_lua_remove_ball(lua_State *L, int model, int64_t id)
+void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n, const char *what)
 {
     model = lua_absindex(L, model);
-    if (queue_removal(L, model, id)) return;
+    if (sx_lua_modelud(L, model)->callback > 0) {
+        for (int64_t i = 0; i < n; i++) queue_removal(L, model, ids[i]);
+        return;
+    }
     sx_model *m = sx_lua_checkmodel(L, model);
-    sx_lua_check(L, m, sx_ball_remove(m, id));
-    forget_extras(L, model, id);
+    sx_lua_check(L, m, sx_ball_remove_many(m, ids, n), what);
+    for (int64_t i = 0; i < n; i++) sx_lua_forget_extras(L, model, &ball_kind, ids[i]);
 }
 
-void sx_lua_remove_wall(lua_State *L, int model, int64_t id)
+void sx_lua_remove_ball(lua_State *L, int model, int64_t id, const char *what)
+{
+    sx_lua_remove_balls(L, model, &id, 1, what);
+}
+
+/* A wall goes with its extras. */
+static void remove_wall_now(lua_State *L, int model, sx_model *m, int64_t id, const char *what)
+{
+    sx_lua_check(L, m, sx_wall_remove(m, id), what);
+    sx_lua_forget_extras(L, model, &sx_lua_wall_kind, id);
+}
+
+void sx_lua_remove_wall(lua_State *L, int model, int64_t id, const char *what)
 {
     model = lua_absindex(L, model);
     if (queue_removal(L, model, -id)) return;
-    sx_model *m = sx_lua_checkmodel(L, model);
-    sx_lua_check(L, m, sx_wall_remove(m, id));
+    remove_wall_now(L, model, sx_lua_checkmodel(L, model), id, what);
 }
 
 void sx_lua_apply_removals(lua_State *L, int model)
@@ -337,17 +281,20 @@ void sx_lua_apply_removals(lua_State *L, int model)
     lua_pushnil(L);
     lua_setfield(L, -3, "queue");
     const int q = lua_gettop(L);
+    /* the balls go together, in one pass over the contacts */
+    const lua_Unsigned len = lua_rawlen(L, q);
+    int64_t *balls = lua_newuserdatauv(L, (size_t)(len > 0 ? len : 1) * sizeof *balls, 0);
+    int64_t n = 0;
     for (lua_Integer i = 1; lua_rawgeti(L, q, i) == LUA_TNUMBER; i++) {
         const int64_t sid = (int64_t)lua_tointeger(L, -1);
         lua_pop(L, 1);
-        /* an object removed twice, or already gone, is skipped */
-        if (sid > 0 && sx_ball_exists(ud->m, sid)) {
-            sx_lua_check(L, ud->m, sx_ball_remove(ud->m, sid));
-            forget_extras(L, model, sid);
-        } else if (sid < 0 && sx_wall_exists(ud->m, -sid)) {
-            sx_lua_check(L, ud->m, sx_wall_remove(ud->m, -sid));
-        }
+        /* an object already gone is skipped (one listed twice goes once) */
+        if (sid > 0 && sx_ball_exists(ud->m, sid))
+            balls[n++] = sid;
+        else if (sid < 0 && sx_wall_exists(ud->m, -sid))
+            remove_wall_now(L, model, ud->m, -sid, "a queued wall removal");
     }
+    sx_lua_remove_balls(L, model, balls, n, "the queued ball removals");
     lua_settop(L, q - 2);
 }
 
@@ -356,7 +303,7 @@ static int ball_remove(lua_State *L)
     int64_t id;
     check_ball(L, &id);
     lua_getiuservalue(L, 1, 1);
-    sx_lua_remove_ball(L, -1, id);
+    sx_lua_remove_ball(L, -1, id, "b:remove");
     return 0;
 }
 
@@ -378,8 +325,8 @@ static int add_ball(lua_State *L, sx_model *m)
     const char *group = sx_lua_optstrfield(L, 2, "group");
     const int32_t g = group ? sx_lua_group_id(L, 1, group, true) : 0;
     int64_t id;
-    sx_lua_check(L, m, sx_ball_add(m, &d, &id));
-    if (g) sx_lua_check(L, m, sx_ball_set_group(m, id, g));
+    sx_lua_check(L, m, sx_ball_add(m, &d, &id), "m:ball");
+    if (g) sx_lua_check(L, m, sx_ball_set_group(m, id, g), "m:ball");
     sx_lua_pushhandle(L, 1, &ball_kind, id);
     return 1;
 }

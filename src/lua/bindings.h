@@ -91,14 +91,18 @@ void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has
 extern const struct sx_lua_kind sx_lua_ball_kind, sx_lua_wall_kind;
 
 /// Removes a ball (wall) of the model userdata at `model` and forgets its
-/// extras, or queues the removal while a callback runs.
-void sx_lua_remove_ball(lua_State *L, int model, int64_t id);
-void sx_lua_remove_wall(lua_State *L, int model, int64_t id);
+/// extras, or queues the removal while a callback runs; `what` names the
+/// Lua call in an error.
+void sx_lua_remove_ball(lua_State *L, int model, int64_t id, const char *what);
+/// Removes the n balls listed (each live, one listed twice goes once) in
+/// one pass over the contacts, or queues them while a callback runs.
+void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n, const char *what);
+void sx_lua_remove_wall(lua_State *L, int model, int64_t id, const char *what);
 /// Applies the queued removals (when no callback runs).
 void sx_lua_apply_removals(lua_State *L, int model);
 /// A fixity value (nil, a word or an array of words) as a core mask;
-/// errors name the field `fix`.
-unsigned sx_lua_fixmask(lua_State *L, int dim, int idx);
+/// errors start with `what` ("ball field 'fix'").
+unsigned sx_lua_fixmask(lua_State *L, int dim, int idx, const char *what);
 
 /* ----------------------------------------------------------- groups.c */
 
@@ -156,14 +160,23 @@ int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter 
 
 /* ----------------------------------------------------------- run.c */
 
-/// Cycles n steps of the model userdata at `model` without user callbacks
-/// (generation's relaxation): interruptible like m:cycle; a Lua error on failure.
-void sx_lua_cycle_plain(lua_State *L, int model, int64_t n);
+/// A run of a model: while its record is open the model counts as cycling
+/// and a Ctrl-C (sx_lua_interrupt_all) flags the run and stops its core cycle.
+typedef struct sx_lua_run sx_lua_run;
+/// Opens a run of the model userdata at `model` and pushes its record as a
+/// to-be-closed value (closed when the calling C function returns or raises,
+/// or by lua_settop below it). Refused while the model cycles (`what` names
+/// the caller in the message).
+sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
+/// Cycles the core n steps in the run, without user callbacks; an interrupt
+/// ("interrupted at step N") or a failure is a Lua error.
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n);
+/// Raises "interrupted at step N" when the run was interrupted: long C work
+/// between cycles calls it so that a Ctrl-C stops it too.
+void sx_lua_run_poll(lua_State *L, sx_lua_run *r);
 /// Calls the function below its nargs arguments as a user callback of the
 /// model at `model`: removals are queued while it runs and applied after.
 void sx_lua_user_call(lua_State *L, int model, int nargs, int nres);
-/// The model is cycling: an operation that cannot run inside a callback raises.
-void sx_lua_check_not_running(lua_State *L, int model, const char *what);
 /// Records the histories due at the model's current step (history.c).
 void sx_lua_history_record(lua_State *L, int model);
 /// The smallest step > s at which a history is due, or INT64_MAX.
@@ -171,8 +184,14 @@ int64_t sx_lua_history_next(lua_State *L, int model, int64_t s);
 
 /* ----------------------------------------------------------- util.c */
 
-/// Raises a Lua error with the model's message unless st is SX_OK.
-void sx_lua_check(lua_State *L, const sx_model *m, sx_status st);
+/// The core's message without the core function's name it starts with.
+const char *sx_lua_core_message(const char *msg);
+/// Unless st is SX_OK, raises the model's message as one of the Lua call
+/// `what` ("m:wall", "seixo.model"): "m:wall: the normal must not be zero".
+void sx_lua_check(lua_State *L, const sx_model *m, sx_status st, const char *what);
+/// The same for a field of an object of `kind` ("ball"), the field's name
+/// at stack index 2 (getters, setters): "ball field 'radius': ...".
+void sx_lua_checkfield(lua_State *L, const sx_model *m, sx_status st, const char *kind);
 
 /// Index of s in the NULL-terminated list, or -1.
 int sx_lua_find(const char *s, const char *const list[]);
@@ -188,8 +207,9 @@ void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, cons
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
 /// Pushes n components of v (a number when n == 1).
 void sx_lua_pushvec(lua_State *L, const double *v, int n);
-/// A value assigned to the field `field` of an object: n numbers, or an error naming the field.
-void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *field);
+/// A value assigned to the field `field` of an object of `kind`: n numbers,
+/// or an error naming both ("ball field 'vel': ...").
+void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field);
 
 /* Fields of the property table at `arg` (read raw; a bad value is an
  * argument error naming the field). The opt variants return false and leave
@@ -222,6 +242,7 @@ typedef struct sx_lua_kind {
     const char *tname;                          ///< its class, "seixo.ball"
     const char *name;                           ///< its name in messages, "ball"
     bool (*exists)(const sx_model *, int64_t);  ///< whether an id is live
+    const char *extras;                         ///< the model state's table of user extras, by id
 } sx_lua_kind;
 
 /// Pushes a handle for the object `id` of the model userdata at `model`.
@@ -229,12 +250,25 @@ void sx_lua_pushhandle(lua_State *L, int model, const sx_lua_kind *k, int64_t id
 /// The id of the handle at idx and its model; a closed model or a removed
 /// object is a Lua error.
 sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id);
-/// The id of a handle of kind k or an integer id at idx, or -1 (nothing pushed).
-int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k);
+/// Reads a handle of kind k of the model userdata at `model`, or an integer
+/// id, at idx into *id: returns NULL, or pushes and returns what is wrong (a
+/// handle of another model is refused, not read as a plain id).
+const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id);
 /// __tostring of a handle: "seixo.ball 7", with "(removed)" or "(model closed)".
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.
 int sx_lua_handle_eq(lua_State *L);
+
+/* User extras of the handle at index 1: a Lua table per object, dropped
+ * when the object is removed. The field `extra` (read: the table, created
+ * on first use; write: a table or nil) and the methods set_extra(key,
+ * value), get_extra(key[, default]). */
+int sx_lua_extra_table(lua_State *L, const sx_lua_kind *k);
+int sx_lua_set_extra_table(lua_State *L, const sx_lua_kind *k);
+int sx_lua_set_extra(lua_State *L, const sx_lua_kind *k);
+int sx_lua_get_extra(lua_State *L, const sx_lua_kind *k);
+/// Drops the extras of object `id` of the model userdata at `model`.
+void sx_lua_forget_extras(lua_State *L, int model, const sx_lua_kind *k, int64_t id);
 
 /// Pushes a generic-for iterator over the ids in the Lua array at `ids`
 /// (which it takes over), stepped by `next` (see sx_lua_nexthandle).

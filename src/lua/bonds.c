@@ -116,7 +116,7 @@ static int model_bond(lua_State *L)
     d.shear_strength = b.shear_strength;
     d.shear_strength_sd = b.shear_strength_sd;
     int64_t count = 0;
-    sx_lua_check(L, m, sx_bond_install(m, &d, &count));
+    sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
     lua_pushinteger(L, (lua_Integer)count);
     return 1;
 }
@@ -140,7 +140,7 @@ static int model_cracks(lua_State *L)
     lua_createtable(L, n > 0 && n < INT32_MAX ? (int)n : 0, 0);
     for (int64_t i = 0; i < n; i++) {
         sx_crack c;
-        sx_lua_check(L, m, sx_crack_get(m, i, &c));
+        sx_lua_check(L, m, sx_crack_get(m, i, &c), "m:cracks");
         lua_createtable(L, 0, 11);
         setnum(L, "time", c.time);
         lua_pushinteger(L, (lua_Integer)c.step);
@@ -177,7 +177,7 @@ static int model_crack_count(lua_State *L)
     int64_t count = 0;
     for (int64_t i = 0; i < n; i++) {
         sx_crack c;
-        sx_lua_check(L, m, sx_crack_get(m, i, &c));
+        sx_lua_check(L, m, sx_crack_get(m, i, &c), "m:crack_count");
         count += c.mode == want;
     }
     lua_pushinteger(L, (lua_Integer)count);

@@ -167,9 +167,9 @@ static int64_t entity_filter(lua_State *L, int arg, const char *key, const sx_lu
         lua_pop(L, 1);
         return -1;
     }
-    const int64_t id = sx_lua_toid(L, -1, k);
-    if (id < 0)
-        sx_lua_fielderror(L, arg, key, lua_pushfstring(L, "%s or id expected, got %s", k->name, luaL_typename(L, -1)));
+    int64_t id;
+    const char *err = sx_lua_toid(L, -1, 1, k, &id);
+    if (err) sx_lua_fielderror(L, arg, key, err);
     lua_pop(L, 1);
     return id;
 }

@@ -6,12 +6,13 @@
  *               no room after `tries` attempts. `count` or `porosity`.
  *   distribute  PFC's ball distribute: radii up to the target porosity,
  *               centres placed at random with overlaps, then relaxed.
- *               Overlaps above a fifth of the smaller radius are first
- *               pushed apart geometrically (the core's stability guard
- *               refuses overlaps beyond a radius), then the model cycles
- *               with the user's materials, gravity off and velocities
- *               zeroed every `calm` steps, until the mean unbalanced-force
- *               ratio reaches relax.ratio or relax.steps have run.
+ *               Overlaps above a hundredth of the smaller radius are
+ *               first pushed apart geometrically where there is room (the
+ *               core's stability guard refuses overlaps beyond a radius),
+ *               then the model cycles with the user's materials, gravity
+ *               off and velocities zeroed every `calm` steps, until the
+ *               mean unbalanced-force ratio reaches relax.ratio, no overlap
+ *               exceeds a thousandth of a radius, or relax.steps have run.
  *   expand      PFC's radius expansion: non-overlapping placement at
  *               reduced radii, then growth by stages of at most 2 % to
  *               the radii of the target porosity, cycling between stages,
@@ -471,7 +472,8 @@ static void sort_radii(lua_State *L, double *rad, int64_t n)
 /* Places n balls of radii rad (sorted, largest first) without overlaps
  * among them and with the model's balls; writes centres to x (3 per ball).
  * Pushes the grid's storage. */
-static void place_random(lua_State *L, const sx_model *m, const gen *g, rng *r, const double *rad, int64_t n, double *x)
+static void place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const gen *g, rng *r, const double *rad,
+                         int64_t n, double *x)
 {
     const sx_lua_region *reg = &g->region;
     const int dim = g->dim;
@@ -507,6 +509,7 @@ static void place_random(lua_State *L, const sx_model *m, const gen *g, rng *r, 
     double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
     if (reg->kind == SX_REGION_CYLINDER) perpendicular(reg->axis, e1, e2);
     for (int64_t i = 0; i < n; i++) {
+        if (run && i % 1024 == 0) sx_lua_run_poll(L, run);
         double *xi = x + 3 * i;
         int64_t t = 0;
         for (; t < g->tries; t++) {
@@ -516,7 +519,7 @@ static void place_random(lua_State *L, const sx_model *m, const gen *g, rng *r, 
             if (!grid_near(gr, xi, overlaps_one, &p)) break;
         }
         if (t == g->tries)
-            luaL_error(L, "generate: placed %I of %I balls; no room for one of radius %f m after %I tries: lower the "
+            luaL_error(L, "m:generate: placed %I of %I balls; no room for one of radius %f m after %I tries: lower the "
                        "count or the radii, enlarge the region, or use method = 'distribute'",
                        (lua_Integer)i, (lua_Integer)n, rad[i], (lua_Integer)g->tries);
         grid_add(gr, xi, rad[i]);
@@ -600,13 +603,15 @@ static bool push_one(const grid *gr, int64_t j, void *ud)
 
 /* Pushes overlapping balls apart until no overlap exceeds `limit` of the
  * smaller radius (or the iterations run out); returns the worst ratio left. */
-static double push_apart(lua_State *L, const gen *g, const double *rad, int64_t n, double *x, double limit)
+static double push_apart(lua_State *L, sx_lua_run *run, const gen *g, const double *rad, int64_t n, double *x,
+                         double limit)
 {
     double worst = INFINITY, best = INFINITY;
     double *dx = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * 3 * sizeof *dx, 0);
     const int top = lua_gettop(L);
     /* until the limit, or until 50 iterations bring no 1 % gain (a jammed packing) */
     for (int it = 0, stalled = 0; it < 5000 && worst > limit && stalled < 50; it++) {
+        sx_lua_run_poll(L, run);
         grid gr;
         grid_init(L, &gr, g->dim, g->region.lo, g->region.hi, 2.02 * g->rmax, n);
         for (int64_t i = 0; i < n; i++) grid_add(&gr, x + 3 * i, rad[i]);
@@ -739,13 +744,13 @@ static int64_t *add_balls(lua_State *L, sx_model *m, const gen *g, const double 
         memcpy(d.pos, x + 3 * i, sizeof d.pos);
         d.radius = rad[i];
         d.material = g->material;
+        ids[i] = 0;  // stays 0, no ball's id, when the add fails
         sx_status st = sx_ball_add(m, &d, &ids[i]);
         if (st == SX_OK && g->group) st = sx_ball_set_group(m, ids[i], g->group);
         if (st != SX_OK) {
             lua_pushstring(L, sx_model_error(m));
-            for (int64_t j = 0; j <= i; j++)
-                if (sx_ball_exists(m, ids[j])) sx_ball_remove(m, ids[j]);
-            luaL_error(L, "generate: %s", lua_tostring(L, -1));
+            sx_ball_remove_many(m, ids, ids[i] > 0 ? i + 1 : i);
+            luaL_error(L, "m:generate: %s", sx_lua_core_message(lua_tostring(L, -1)));
         }
     }
     return ids;
@@ -788,13 +793,14 @@ static bool relaxed(const sx_model *m, double ratio)
 }
 
 /* Cycles `steps`, calming every g->calm steps; with a ratio, stops once relaxed. */
-static void relax_cycles(lua_State *L, const gen *g, const int64_t *ids, int64_t n, int64_t steps, double ratio)
+static void relax_cycles(lua_State *L, sx_lua_run *run, const gen *g, const int64_t *ids, int64_t n, int64_t steps,
+                         double ratio)
 {
     sx_lua_model *ud = sx_lua_modelud(L, 1);
     int64_t done = 0, since_check = 0;
     while (done < steps) {
         const int64_t k = steps - done < g->calm ? steps - done : g->calm;
-        sx_lua_cycle_plain(L, 1, k);
+        sx_lua_run_cycle(L, run, k);
         done += k;
         since_check += k;
         calm(ud->m, ids, n);
@@ -812,8 +818,11 @@ static int model_generate(lua_State *L)
     gen g;
     read_gen(L, m, &g);
     if ((g.method == M_DISTRIBUTE || g.method == M_EXPAND) && ud->running)
-        return luaL_error(L, "generate: method '%s' cycles the model, which a callback of a cycle cannot do",
+        return luaL_error(L, "m:generate: method '%s' cycles the model, which a callback of a cycle cannot do",
                           method_names[g.method]);
+    /* the methods that cycle hold the model as a run from here on: a Ctrl-C
+     * anywhere in them, cycling or not, stops them (see run.c) */
+    sx_lua_run *run = g.method == M_DISTRIBUTE || g.method == M_EXPAND ? sx_lua_run_open(L, 1, "m:generate") : NULL;
     rng r;
     rng_seed(&r, g.seed);
     int64_t n = 0;
@@ -837,7 +846,7 @@ static int model_generate(lua_State *L)
         for (int64_t i = 0; i < n; i++) rad[i] *= shrink;
     }
     if (g.method == M_RANDOM || g.method == M_EXPAND) {
-        place_random(L, m, &g, &r, rad, n, x);
+        place_random(L, run, m, &g, &r, rad, n, x);
     } else if (g.method == M_DISTRIBUTE) {
         double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
         if (g.region.kind == SX_REGION_CYLINDER) perpendicular(g.region.axis, e1, e2);
@@ -847,11 +856,11 @@ static int model_generate(lua_State *L)
             int64_t t = 0;
             do sample(&g.region, &r, rad[i], e1, e2, x + 3 * i);
             while (!sx_lua_region_contains(&g.region, x + 3 * i, rad[i]) && ++t < g.tries);
-            if (t == g.tries) return luaL_error(L, "generate: the region leaves no room for a ball of radius %f m", rad[i]);
+            if (t == g.tries) return luaL_error(L, "m:generate: the region leaves no room for a ball of radius %f m", rad[i]);
         }
-        const double worst = push_apart(L, &g, rad, n, x, 0.01);
+        const double worst = push_apart(L, run, &g, rad, n, x, 0.01);
         if (worst > 0.9)
-            return luaL_error(L, "generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
+            return luaL_error(L, "m:generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
                               "raise the porosity", g.porosity, worst);
     }
     m = sx_lua_checkmodel(L, 1);
@@ -862,8 +871,8 @@ static int model_generate(lua_State *L)
         const int stages = (int)ceil(log(1 / shrink) / log(1.02));
         for (int s = 1; s <= stages; s++) {
             const double f = s == stages ? 1 / shrink : pow(1 / shrink, (double)s / stages);
-            for (int64_t i = 0; i < n; i++) sx_lua_check(L, ud->m, sx_ball_set(ud->m, ids[i], SX_BALL_RADIUS, rad[i] * f));
-            relax_cycles(L, &g, ids, n, 100, 0);
+            for (int64_t i = 0; i < n; i++) sx_lua_check(L, ud->m, sx_ball_set(ud->m, ids[i], SX_BALL_RADIUS, rad[i] * f), "m:generate");
+            relax_cycles(L, run, &g, ids, n, 100, 0);
         }
         lua_settop(L, top);  // restores the gravity
         for (int64_t i = 0; i < n; i++) rad[i] /= shrink;
@@ -871,7 +880,7 @@ static int model_generate(lua_State *L)
     if (g.relax && (g.method == M_DISTRIBUTE || g.method == M_EXPAND) && n > 0) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);
-        relax_cycles(L, &g, ids, n, g.relax_steps, g.relax_ratio);
+        relax_cycles(L, run, &g, ids, n, g.relax_steps, g.relax_ratio);
         lua_settop(L, top);
     }
     double solid = 0;

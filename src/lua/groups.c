@@ -183,7 +183,7 @@ static int model_group(lua_State *L)
     int64_t done = 0;
     for (int64_t i = 0; i < n; i++)
         if (sx_ball_exists(m, ids[i])) {
-            sx_lua_check(L, m, sx_ball_set_group(m, ids[i], g));
+            sx_lua_check(L, m, sx_ball_set_group(m, ids[i], g), "m:group");
             done++;
         }
     lua_pushinteger(L, (lua_Integer)done);
@@ -229,15 +229,14 @@ static int model_remove_balls(lua_State *L)
     sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     lua_settop(L, 2);
     int64_t n;
-    const int64_t *ids = select_balls(L, 2, &n);
+    int64_t *ids = select_balls(L, 2, &n);
     const sx_model *m = sx_lua_checkmodel(L, 1);
-    int64_t done = 0;
+    /* a predicate may have removed some of the selected balls */
+    int64_t live = 0;
     for (int64_t i = 0; i < n; i++)
-        if (sx_ball_exists(m, ids[i])) {
-            sx_lua_remove_ball(L, 1, ids[i]);
-            done++;
-        }
-    lua_pushinteger(L, (lua_Integer)done);
+        if (sx_ball_exists(m, ids[i])) ids[live++] = ids[i];
+    sx_lua_remove_balls(L, 1, ids, live, "m:remove_balls");
+    lua_pushinteger(L, (lua_Integer)live);
     return 1;
 }
 
@@ -286,7 +285,7 @@ static int model_set(lua_State *L)
         setting *s = &todo[nset];
         s->f = f;
         /* nil means absent here, so no fixity at all is written fix = {} */
-        if (f->kind == F_FIX && present) s->mask = sx_lua_fixmask(L, dim, lua_gettop(L));
+        if (f->kind == F_FIX && present) s->mask = sx_lua_fixmask(L, dim, lua_gettop(L), "m:set: field 'fix'");
         lua_pop(L, 1);
         if (!present) continue;
         switch (f->kind) {
@@ -318,7 +317,8 @@ static int model_set(lua_State *L)
             case F_MATERIAL: st = sx_ball_set_material(m, id, s->material); break;
             case F_FIX: st = sx_ball_set_fixity(m, id, s->mask); break;
             }
-            if (st != SX_OK) return luaL_error(L, "field '%s': %s", s->f->name, sx_model_error(m));
+            if (st != SX_OK)
+                return luaL_error(L, "m:set: field '%s': %s", s->f->name, sx_lua_core_message(sx_model_error(m)));
         }
         done++;
     }
@@ -358,20 +358,21 @@ static const char *const quantity_names[] = {"pos",    "vel",     "spin",    "fo
                                              "damping", "volume", "speed", "kinetic", NULL};
 
 /* The value of a quantity for ball id: its n components into v. */
-static void quantity_value(lua_State *L, const sx_model *m, const struct quantity *q, int64_t id, double *v)
+static void quantity_value(lua_State *L, const sx_model *m, const struct quantity *q, int64_t id, double *v,
+                           const char *what)
 {
     const int dim = sx_model_dim(m);
     double x[3], y[3], r;
     switch (q->kind) {
-    case Q_VEC: sx_lua_check(L, m, sx_ball_get_vec(m, id, (sx_ball_vec)q->which, v)); return;
-    case Q_SCALAR: sx_lua_check(L, m, sx_ball_get(m, id, (sx_ball_scalar)q->which, v)); return;
+    case Q_VEC: sx_lua_check(L, m, sx_ball_get_vec(m, id, (sx_ball_vec)q->which, v), what); return;
+    case Q_SCALAR: sx_lua_check(L, m, sx_ball_get(m, id, (sx_ball_scalar)q->which, v), what); return;
     case Q_VOLUME:
-        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_RADIUS, &r));
+        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_RADIUS, &r), what);
         v[0] = dim == 3 ? 4.0 / 3.0 * SX_LUA_PI * r * r * r : SX_LUA_PI * r * r;
         return;
     case Q_SPEED:
     case Q_KINETIC: {
-        sx_lua_check(L, m, sx_ball_get_vec(m, id, SX_BALL_VEL, x));
+        sx_lua_check(L, m, sx_ball_get_vec(m, id, SX_BALL_VEL, x), what);
         double v2 = 0;
         for (int k = 0; k < dim; k++) v2 += x[k] * x[k];
         if (q->kind == Q_SPEED) {
@@ -379,9 +380,9 @@ static void quantity_value(lua_State *L, const sx_model *m, const struct quantit
             return;
         }
         double mass, inertia, w2 = 0;
-        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_MASS, &mass));
-        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_INERTIA, &inertia));
-        sx_lua_check(L, m, sx_ball_get_vec(m, id, SX_BALL_SPIN, y));
+        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_MASS, &mass), what);
+        sx_lua_check(L, m, sx_ball_get(m, id, SX_BALL_INERTIA, &inertia), what);
+        sx_lua_check(L, m, sx_ball_get_vec(m, id, SX_BALL_SPIN, y), what);
         for (int k = 0; k < sx_lua_rdim(dim); k++) w2 += y[k] * y[k];
         v[0] = 0.5 * mass * v2 + 0.5 * inertia * w2;
         return;
@@ -390,6 +391,7 @@ static void quantity_value(lua_State *L, const sx_model *m, const struct quantit
 }
 
 enum { OP_SUM, OP_MEAN, OP_MIN, OP_MAX };
+static const char *const op_names[] = {"m:sum", "m:mean", "m:min", "m:max"};
 
 static int reduce(lua_State *L, int op)
 {
@@ -413,7 +415,7 @@ static int reduce(lua_State *L, int op)
     for (int64_t i = 0; i < n; i++) {
         if (!sx_ball_exists(m, ids[i])) continue;
         double v[3] = {0, 0, 0};
-        quantity_value(L, m, q, ids[i], v);
+        quantity_value(L, m, q, ids[i], v, op_names[op]);
         for (int k = 0; k < nc; k++) {
             if (op == OP_SUM || op == OP_MEAN) acc[k] += v[k];
             else if (used == 0 || (op == OP_MIN ? v[k] < acc[k] : v[k] > acc[k])) acc[k] = v[k];

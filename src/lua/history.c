@@ -240,8 +240,10 @@ static void read_entity(lua_State *L, const sx_model *m, int src)
     const sx_lua_kind *k = src == SRC_BALL ? &sx_lua_ball_kind : &sx_lua_wall_kind;
     sx_lua_checksubkeys(L, 3, 3, k->name, src == SRC_BALL ? ball_keys : wall_keys);
     lua_getfield(L, 3, k->name);
-    const int64_t id = sx_lua_toid(L, -1, k);
-    if (id < 0 || !k->exists(m, id))
+    int64_t id;
+    const char *err = sx_lua_toid(L, -1, 1, k, &id);
+    if (err) sx_lua_fielderror(L, 3, k->name, err);
+    if (!k->exists(m, id))
         sx_lua_fielderror(L, 3, k->name, lua_pushfstring(L, "an existing %s (or its id) expected", k->name));
     lua_pop(L, 1);
     const char *const *fields = src == SRC_BALL ? ball_fields : wall_fields;
@@ -425,7 +427,7 @@ static int model_history_csv(lua_State *L)
     (void)base;
     const char *tmp = lua_pushfstring(L, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
-    if (!f) return luaL_error(L, "history_csv: cannot write '%s': %s", tmp, strerror(errno));
+    if (!f) return luaL_error(L, "m:history_csv: cannot write '%s': %s", tmp, strerror(errno));
     fputs("step,time", f);
     for (lua_Integer i = 0; i < nh; i++) {
         lua_getfield(L, s[i].entry, "name");
@@ -458,12 +460,12 @@ static int model_history_csv(lua_State *L)
     const bool ok = !ferror(f);
     if (fclose(f) != 0 || !ok) {
         remove(tmp);
-        return luaL_error(L, "history_csv: writing '%s' failed", tmp);
+        return luaL_error(L, "m:history_csv: writing '%s' failed", tmp);
     }
     if (rename(tmp, path) != 0) {
         const int err = errno;
         remove(tmp);
-        return luaL_error(L, "history_csv: cannot rename '%s' to '%s': %s", tmp, path, strerror(err));
+        return luaL_error(L, "m:history_csv: cannot rename '%s' to '%s': %s", tmp, path, strerror(err));
     }
     return 0;
 }

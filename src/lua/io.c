@@ -10,7 +10,7 @@
  * is a table kept with the model; whatever plain data it holds (numbers,
  * strings, booleans and nested tables of them) is saved by m:save and
  * restored by seixo.load. The Lua-side state that is data, not code (group
- * names, ball extras), is saved the same way. Values that cannot be saved
+ * names, ball and wall extras), is saved the same way. Values that cannot be saved
  * (functions, userdata, a table met twice) are skipped and listed in the
  * table m:save returns, e.g. {"vars.callback"}. Callbacks and outputs are
  * code and open files: after a load, register them again (an output with
@@ -30,7 +30,7 @@
 /* --------------------------------------------------- Lua values <-> trees */
 
 /* The state fields saved with the model: plain data kept by other files. */
-static const char *const saved_state[] = {"groups", "group_names", "extras", NULL};
+static const char *const saved_state[] = {"groups", "group_names", "extras", "wall_extras", NULL};
 
 typedef struct ser {
     sx_io_tree *tree;

@@ -3,7 +3,7 @@
  *   m:wall{kind = "cylinder", point=, axis=, radius=, height=, radial_vel=, ...} (in walls.c)
  *   w:servo{target=, area=, alpha=, max_speed=}   (w:servo(nil) releases the wall)
  *   w:load()        -> normal force (N), contacts, mean contact kn (the servo's inputs)
- *   w.radius, w.radial_vel (cylinder; radial_vel writable)
+ *   w:radius() -> radius, radial_vel; w:set_radius(r), w:set_radial_vel(v) (cylinder)
  *   m:measure{sphere = {center =, radius =}} (2D: disk) or m:measure{box = {min, max}}
  *       -> {stress = {{...}}, porosity, coordination, fabric = {{...}}, balls, contacts, volume, solid} */
 #include "bindings.h"
@@ -16,7 +16,7 @@ static int wall_servo(lua_State *L)
     int64_t id;
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
     if (lua_isnoneornil(L, 2)) {
-        sx_lua_check(L, m, sx_wall_clear_servo(m, id));
+        sx_lua_check(L, m, sx_wall_clear_servo(m, id), "w:servo");
         return 0;
     }
     luaL_checktype(L, 2, LUA_TTABLE);
@@ -26,7 +26,7 @@ static int wall_servo(lua_State *L)
     sx_lua_optnumfield(L, 2, "area", &d.area);
     sx_lua_optnumfield(L, 2, "alpha", &d.alpha);
     sx_lua_optnumfield(L, 2, "max_speed", &d.max_speed);
-    sx_lua_check(L, m, sx_wall_set_servo(m, id, &d));
+    sx_lua_check(L, m, sx_wall_set_servo(m, id, &d), "w:servo");
     return 0;
 }
 
@@ -35,7 +35,7 @@ static int wall_load(lua_State *L)
     int64_t id, contacts = 0;
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
     double force = 0, kn = 0;
-    sx_lua_check(L, m, sx_wall_load(m, id, &force, &contacts, &kn));
+    sx_lua_check(L, m, sx_wall_load(m, id, &force, &contacts, &kn), "w:load");
     lua_pushnumber(L, force);
     lua_pushinteger(L, (lua_Integer)contacts);
     lua_pushnumber(L, kn);
@@ -46,7 +46,15 @@ static int wall_set_radial_vel(lua_State *L)
 {
     int64_t id;
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
-    sx_lua_check(L, m, sx_wall_set_radial_vel(m, id, luaL_checknumber(L, 2)));
+    sx_lua_check(L, m, sx_wall_set_radial_vel(m, id, luaL_checknumber(L, 2)), "w:set_radial_vel");
+    return 0;
+}
+
+static int wall_set_radius(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
+    sx_lua_check(L, m, sx_wall_set(m, id, SX_WALL_RADIUS, luaL_checknumber(L, 2)), "w:set_radius");
     return 0;
 }
 
@@ -55,7 +63,7 @@ static int wall_radius(lua_State *L)
     int64_t id;
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
     sx_wall_def d;
-    sx_lua_check(L, m, sx_wall_get(m, id, &d));
+    sx_lua_check(L, m, sx_wall_get(m, id, &d), "w:radius");
     lua_pushnumber(L, d.radius);
     lua_pushnumber(L, d.radial_vel);
     return 2;
@@ -103,7 +111,7 @@ static int model_measure(lua_State *L)
     sx_region r;
     read_region(L, m, 2, &r);
     sx_measurement out;
-    sx_lua_check(L, m, sx_measure(m, &r, &out));
+    sx_lua_check(L, m, sx_measure(m, &r, &out), "m:measure");
     const int dim = sx_model_dim(m);
     lua_createtable(L, 0, 8);
     push_tensor(L, out.stress, dim);
@@ -139,6 +147,7 @@ void sx_lua_lab_register(lua_State *L)
         {"load", wall_load},
         {"radius", wall_radius},
         {"set_radial_vel", wall_set_radial_vel},
+        {"set_radius", wall_set_radius},
         {NULL, NULL},
     };
     luaL_getmetatable(L, sx_lua_wall_kind.tname);

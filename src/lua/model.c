@@ -78,7 +78,7 @@ int sx_lua_model_new(lua_State *L)
     lua_setiuservalue(L, -2, 1);
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
-    if (!u->m) return luaL_error(L, "%s", err);
+    if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
     /* the executable's --threads N (seixo.threads); results do not depend on it */
     if (lua_getglobal(L, "seixo") == LUA_TTABLE) {
         lua_getfield(L, -1, "threads");
@@ -224,8 +224,8 @@ static int model_material(lua_State *L)
         sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
     }
     int index = -1;
-    sx_lua_check(L, m, sx_material_set(m, name, &d, &index));
-    if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm));
+    sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");
+    if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm), "m:material");
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
 }
@@ -244,7 +244,7 @@ static int model_materials(lua_State *L)
     lua_createtable(L, 0, n);
     for (int i = 0; i < n; i++) {
         sx_material_def d;
-        sx_lua_check(L, m, sx_material_get(m, i, &d));
+        sx_lua_check(L, m, sx_material_get(m, i, &d), "m:materials");
         lua_createtable(L, 0, 12);
         lua_pushstring(L, d.model == SX_MODEL_HERTZ ? "hertz" : "linear");
         lua_setfield(L, -2, "model");
@@ -285,9 +285,9 @@ static int model_step(lua_State *L)
 }
 
 /* The core reports a failed timestep query as NaN with a message. */
-static int push_timestep(lua_State *L, const sx_model *m, double dt)
+static int push_timestep(lua_State *L, const sx_model *m, double dt, const char *what)
 {
-    if (isnan(dt)) return luaL_error(L, "%s", sx_model_error(m));
+    if (isnan(dt)) return luaL_error(L, "%s: %s", what, sx_lua_core_message(sx_model_error(m)));
     lua_pushnumber(L, dt);
     return 1;
 }
@@ -295,13 +295,13 @@ static int push_timestep(lua_State *L, const sx_model *m, double dt)
 static int model_timestep(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    return push_timestep(L, m, sx_model_timestep(m));
+    return push_timestep(L, m, sx_model_timestep(m), "m:timestep");
 }
 
 static int model_critical_timestep(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    return push_timestep(L, m, sx_model_critical_timestep(m));
+    return push_timestep(L, m, sx_model_critical_timestep(m), "m:critical_timestep");
 }
 
 /* m:set_timestep(dt) fixes it; m:set_timestep() or ("auto") returns to the automatic one. */
@@ -314,7 +314,7 @@ static int model_set_timestep(lua_State *L)
     } else {
         dt = luaL_optnumber(L, 2, 0);
     }
-    sx_lua_check(L, m, sx_model_set_timestep(m, dt));
+    sx_lua_check(L, m, sx_model_set_timestep(m, dt), "m:set_timestep");
     return 0;
 }
 
@@ -333,7 +333,7 @@ static int model_set_gravity(lua_State *L)
     double g[3] = {0, 0, 0};
     const char *err = sx_lua_tovec(L, 2, sx_model_dim(m), g);
     if (err) return luaL_argerror(L, 2, err);
-    sx_lua_check(L, m, sx_model_set_gravity(m, g));
+    sx_lua_check(L, m, sx_model_set_gravity(m, g), "m:set_gravity");
     return 0;
 }
 

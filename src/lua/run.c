@@ -21,7 +21,12 @@
  * always alive: its record is a to-be-closed value of the running C frame,
  * unlisted when the frame returns or unwinds. The same close resets the
  * model's running state, so an error anywhere (in the core, a callback, an
- * interrupt) leaves the model usable. */
+ * interrupt) leaves the model usable. That holds only if the close itself
+ * runs: the executable's interrupt hook must never raise on entering a C
+ * function (a __close is one), which is why it waits for Lua code (main.c).
+ * Long C work outside the core's cycle (generation) opens a run too and
+ * polls it, so a Ctrl-C stops it as promptly as a cycle. */
+#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -113,16 +118,18 @@ static void progress_end(progress *p)
     p->shown = false;
 }
 
-typedef struct run {
+struct sx_lua_run {
     sx_model *m;
     sx_lua_model *ud;
     atomic_int interrupted;  // set by sx_lua_interrupt_all
     atomic_int in_lua;       // a user callback is running
     int slot;                // its place in runs[], -1 when not listed
     int saved_callback;      // ud->callback when the run started
+    const char *what;        // the Lua call, in messages ("m:solve")
     bool open;               // not closed yet
     progress progress;       // the progress line, cleared when the run ends
-} run;
+};
+typedef sx_lua_run run;
 
 static _Atomic(run *) runs[MAX_RUNS];
 static atomic_int nruns;
@@ -164,9 +171,7 @@ static int run_close(lua_State *L)
     return 0;
 }
 
-/* Starts a run of the model userdata at `model`: pushes its record as a
- * to-be-closed value. `what` names the operation in the refusal. */
-static run *run_open(lua_State *L, int model, const char *what)
+sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
 {
     model = lua_absindex(L, model);
     sx_lua_model *ud = sx_lua_modelud(L, model);
@@ -178,16 +183,18 @@ static run *run_open(lua_State *L, int model, const char *what)
     r->m = m;
     r->ud = ud;
     r->slot = -1;
+    r->what = what;
     atomic_init(&r->interrupted, 0);
     atomic_init(&r->in_lua, 0);
     lua_createtable(L, 0, 1);
     lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__close");
     lua_setmetatable(L, -2);
+    /* to be closed before the model is taken, so that nothing can come between */
+    lua_toclose(L, -1);
     ud->running++;
     r->saved_callback = ud->callback;
     r->open = true;
-    lua_toclose(L, -1);
     const int slot = atomic_load(&nruns);
     if (slot < MAX_RUNS) {
         r->slot = slot;
@@ -197,33 +204,19 @@ static run *run_open(lua_State *L, int model, const char *what)
     return r;
 }
 
-static void check_interrupt(lua_State *L, run *r)
+void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 {
     if (atomic_load(&r->interrupted))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
 }
 
-/* Cycles the core n steps; a failure is a Lua error (an interrupt says at which step). */
-static void core_cycle(lua_State *L, run *r, int64_t n)
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
 {
-    check_interrupt(L, r);
+    sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle(r->m, n);
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
-    sx_lua_check(L, r->m, st);
-}
-
-void sx_lua_check_not_running(lua_State *L, int model, const char *what)
-{
-    if (sx_lua_modelud(L, model)->running) luaL_error(L, "%s: not allowed while the model is cycling", what);
-}
-
-void sx_lua_cycle_plain(lua_State *L, int model, int64_t n)
-{
-    const int top = lua_gettop(L);
-    run *r = run_open(L, model, "generate");
-    core_cycle(L, r, n);
-    lua_settop(L, top);
+    sx_lua_check(L, r->m, st, r->what);
 }
 
 /* ------------------------------------------------------------ callbacks */
@@ -386,27 +379,40 @@ typedef struct limits {
 enum reason { BY_STEPS, BY_TIME, BY_RATIO };
 static const char *const reason_names[] = {"steps", "time", "ratio"};
 
-/* Steps to the first boundary at or after the model time t_end. */
-static int64_t steps_to_time(sx_model *m, double t_end)
+/* How far below t_end a step boundary still counts as reaching it: the
+ * rounding that n additions of the timestep to the model time can have
+ * accumulated (each at most half an ulp of the time, an ulp <= eps |t|; one
+ * more for t_end itself). Without it, 1 s in steps of 1e-5 s took 100001
+ * steps. Never more than half a step, so no run stops a step early. */
+static double time_slack(double t, double t_end, double dt, double n)
+{
+    const double rounding = (n + 1) * DBL_EPSILON * fmax(fabs(t), fabs(t_end));
+    return fmin(rounding, 0.5 * dt);
+}
+
+/* Steps to the first boundary at or after the model time t_end, `taken`
+ * steps into the run. */
+static int64_t steps_to_time(sx_model *m, double t_end, int64_t taken)
 {
     const double dt = sx_model_timestep(m);
     if (!(dt > 0)) return 1;  // let the core say what is wrong
-    const double k = ceil((t_end - sx_model_time(m)) / dt - 1e-9);
+    const double t = sx_model_time(m), left = (t_end - t) / dt;
+    const double k = ceil((t_end - time_slack(t, t_end, dt, (double)taken + left + 1) - t) / dt);
     return k < 1 ? 1 : k > 1e15 ? (int64_t)1e15 : (int64_t)k;
 }
 
-static bool time_reached(sx_model *m, double t_end)
+static bool time_reached(sx_model *m, double t_end, int64_t taken)
 {
     if (isinf(t_end)) return false;
-    const double dt = sx_model_timestep(m);
-    return sx_model_time(m) >= t_end - (dt > 0 ? 1e-9 * dt : 0);
+    const double dt = sx_model_timestep(m), t = sx_model_time(m);
+    return t >= t_end - (dt > 0 ? time_slack(t, t_end, dt, (double)taken) : 0);
 }
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
  * and the last ratio measured (NaN when none was) in *ratio. */
-static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
+static enum reason run_model(lua_State *L, const limits *lim, double *ratio, const char *what)
 {
-    run *r = run_open(L, 1, "cycle");
+    run *r = sx_lua_run_open(L, 1, what);
     sx_model *m = r->m;
     const int top = lua_gettop(L);
     const int64_t start = sx_model_step_count(m);
@@ -427,7 +433,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             why = BY_STEPS;
             break;
         }
-        if (time_reached(m, lim->time)) {
+        if (time_reached(m, lim->time, taken)) {
             why = BY_TIME;
             break;
         }
@@ -438,7 +444,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
                 break;
             }
         }
-        check_interrupt(L, r);
+        sx_lua_run_poll(L, r);
         fire(L, 1, POINT_BEFORE, s);
         /* the next chunk: up to the first thing due */
         int64_t n = lim->steps - taken;
@@ -449,11 +455,11 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio)
             if (k < n) n = k;
         }
         if (!isinf(lim->time)) {
-            const int64_t k = steps_to_time(m, lim->time);
+            const int64_t k = steps_to_time(m, lim->time, taken);
             if (k < n) n = k;
         }
         if (p->on && p->chunk < n) n = p->chunk;
-        core_cycle(L, r, n);
+        sx_lua_run_cycle(L, r, n);
         double fraction = -1;
         int64_t total = 0;
         if (lim->steps < INT64_MAX) {
@@ -479,7 +485,7 @@ static int model_cycle(lua_State *L)
     lua_settop(L, 1);
     const limits lim = {(int64_t)n, INFINITY, 0, 1};
     double ratio;
-    run_model(L, &lim, &ratio);
+    run_model(L, &lim, &ratio, "m:cycle");
     return 0;
 }
 
@@ -505,7 +511,7 @@ static int model_solve(lua_State *L)
     lua_settop(L, 1);
     const int64_t start = sx_model_step_count(m);
     double ratio;
-    const enum reason why = run_model(L, &lim, &ratio);
+    const enum reason why = run_model(L, &lim, &ratio, "m:solve");
     lua_pushstring(L, reason_names[why]);
     lua_pushnumber(L, isnan(ratio) ? sx_model_unbalanced_ratio(m) : ratio);
     lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));

@@ -15,9 +15,24 @@
 #include <math.h>
 #include <string.h>
 
-void sx_lua_check(lua_State *L, const sx_model *m, sx_status st)
+/* The core names its own functions ("ball_set: radius must be ..."), which
+ * a script never calls: drop that name, the caller puts the Lua one. */
+const char *sx_lua_core_message(const char *msg)
 {
-    if (st != SX_OK) luaL_error(L, "%s", sx_model_error(m));
+    const char *p = msg;
+    while ((*p >= 'a' && *p <= 'z') || *p == '_') p++;
+    return p > msg && p[0] == ':' && p[1] == ' ' ? p + 2 : msg;
+}
+
+void sx_lua_check(lua_State *L, const sx_model *m, sx_status st, const char *what)
+{
+    if (st != SX_OK) luaL_error(L, "%s: %s", what, sx_lua_core_message(sx_model_error(m)));
+}
+
+void sx_lua_checkfield(lua_State *L, const sx_model *m, sx_status st, const char *kind)
+{
+    if (st != SX_OK)
+        luaL_error(L, "%s field '%s': %s", kind, lua_tostring(L, 2), sx_lua_core_message(sx_model_error(m)));
 }
 
 int sx_lua_find(const char *s, const char *const list[])
@@ -128,10 +143,10 @@ void sx_lua_pushvec(lua_State *L, const double *v, int n)
     }
 }
 
-void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *field)
+void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field)
 {
     const char *err = sx_lua_tovec(L, idx, n, out);
-    if (err) luaL_error(L, "field '%s': %s", field, err);
+    if (err) luaL_error(L, "%s field '%s': %s", kind, field, err);
 }
 
 /* ----------------------------------------------------- property tables */
@@ -360,11 +375,98 @@ int sx_lua_handle_eq(lua_State *L)
     return 1;
 }
 
-int64_t sx_lua_toid(lua_State *L, int idx, const sx_lua_kind *k)
+const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id)
 {
-    if (lua_isinteger(L, idx)) return (int64_t)lua_tointeger(L, idx);
+    idx = lua_absindex(L, idx);
+    model = lua_absindex(L, model);
+    if (lua_isinteger(L, idx)) {
+        *id = (int64_t)lua_tointeger(L, idx);
+        return *id >= 1 ? NULL : lua_pushfstring(L, "%s ids are >= 1, got %I", k->name, (lua_Integer)*id);
+    }
     const handle *h = luaL_testudata(L, idx, k->tname);
-    return h ? h->id : -1;
+    if (!h) return lua_pushfstring(L, "%s or id expected, got %s", k->name, luaL_typename(L, idx));
+    /* an id means nothing in another model: never read one as a plain id */
+    lua_getiuservalue(L, idx, 1);
+    const bool mine = lua_rawequal(L, -1, model);
+    lua_pop(L, 1);
+    if (!mine) return lua_pushfstring(L, "%s %I belongs to another model", k->name, (lua_Integer)h->id);
+    *id = h->id;
+    return NULL;
+}
+
+/* -------------------------------------------------------------- extras */
+
+/* Pushes the extras table of the handle at index 1 (k->extras of the
+ * model's state, keyed by id), created when `create`, else nil when none. */
+static void push_extras(lua_State *L, const sx_lua_kind *k, bool create)
+{
+    int64_t id;
+    sx_lua_checkhandle(L, 1, k, &id);
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, k->extras);
+    lua_remove(L, -2);
+    if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL && create) {
+        lua_pop(L, 1);
+        lua_newtable(L);
+        lua_pushvalue(L, -1);
+        lua_rawseti(L, -3, (lua_Integer)id);
+    }
+    lua_remove(L, -2);
+}
+
+int sx_lua_extra_table(lua_State *L, const sx_lua_kind *k)
+{
+    push_extras(L, k, true);
+    return 1;
+}
+
+int sx_lua_set_extra_table(lua_State *L, const sx_lua_kind *k)
+{
+    int64_t id;
+    sx_lua_checkhandle(L, 1, k, &id);
+    if (!lua_isnil(L, 3) && !lua_istable(L, 3))
+        return luaL_error(L, "%s field 'extra': table or nil expected, got %s", k->name, luaL_typename(L, 3));
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_state(L, -1, k->extras);
+    lua_pushvalue(L, 3);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    return 0;
+}
+
+int sx_lua_set_extra(lua_State *L, const sx_lua_kind *k)
+{
+    luaL_checkany(L, 2);
+    if (lua_isnil(L, 2) || (lua_type(L, 2) == LUA_TNUMBER && lua_tonumber(L, 2) != lua_tonumber(L, 2)))
+        return luaL_argerror(L, 1, "a key other than nil and NaN expected");
+    luaL_checkany(L, 3);
+    push_extras(L, k, true);
+    lua_pushvalue(L, 2);
+    lua_pushvalue(L, 3);
+    lua_rawset(L, -3);
+    return 0;
+}
+
+int sx_lua_get_extra(lua_State *L, const sx_lua_kind *k)
+{
+    luaL_checkany(L, 2);
+    lua_settop(L, 3);  // the default, nil when absent
+    push_extras(L, k, false);
+    if (lua_istable(L, -1)) {
+        lua_pushvalue(L, 2);
+        lua_rawget(L, -2);
+    } else {
+        lua_pushnil(L);
+    }
+    if (lua_isnil(L, -1)) lua_pushvalue(L, 3);
+    return 1;
+}
+
+void sx_lua_forget_extras(lua_State *L, int model, const sx_lua_kind *k, int64_t id)
+{
+    sx_lua_state(L, model, k->extras);
+    lua_pushnil(L);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    lua_pop(L, 1);
 }
 
 /* ----------------------------------------------------------- iterators */

@@ -1,7 +1,9 @@
 /* Walls: m:wall{kind = ...} adds a plane or rect (3D), a line or segment
  * (2D), or a box: the planes (lines) of an axis-aligned box, facing inward.
  * m:walls() iterates. A wall object is a handle (model, id) like a ball:
- * its geometry is read back from the core, only its velocity is writable. */
+ * its fields read and write the core's state (its point, velocity,
+ * stiffnesses and friction are writable; its orientation and extent are
+ * fixed when it is made), and `extra` holds user values, as a ball's. */
 #include "bindings.h"
 
 #include <stddef.h>
@@ -35,7 +37,7 @@ static const struct shape {
     [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
 };
 
-const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists};
+const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras"};
 #define wall_kind sx_lua_wall_kind
 
 /* The wall of the handle at index 1: live, in an open model. */
@@ -47,7 +49,7 @@ static const sx_model *wall_def(lua_State *L, sx_wall_def *d)
 {
     int64_t id;
     const sx_model *m = check_wall(L, &id);
-    sx_lua_check(L, m, sx_wall_get(m, id, d));
+    sx_lua_checkfield(L, m, sx_wall_get(m, id, d), "wall");
     return m;
 }
 
@@ -99,7 +101,7 @@ static int push_resultant(lua_State *L, int which)
     int64_t id;
     const sx_model *m = check_wall(L, &id);
     double fm[2][3];
-    sx_lua_check(L, m, sx_wall_force(m, id, fm[0], fm[1]));
+    sx_lua_checkfield(L, m, sx_wall_force(m, id, fm[0], fm[1]), "wall");
     const int dim = sx_model_dim(m);
     sx_lua_pushvec(L, fm[which], which ? sx_lua_rdim(dim) : dim);
     return 1;
@@ -113,10 +115,39 @@ static int set_vel(lua_State *L)
     int64_t id;
     sx_model *m = check_wall(L, &id);
     double v[3] = {0, 0, 0};
-    sx_lua_checkvalue(L, 3, sx_model_dim(m), v, "vel");
-    sx_lua_check(L, m, sx_wall_set_vel(m, id, v));
+    sx_lua_checkvalue(L, 3, sx_model_dim(m), v, "wall", "vel");
+    sx_lua_checkfield(L, m, sx_wall_set_vel(m, id, v), "wall");
     return 0;
 }
+
+static int set_point(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    double p[3] = {0, 0, 0};
+    sx_lua_checkvalue(L, 3, sx_model_dim(m), p, "wall", "point");
+    sx_lua_checkfield(L, m, sx_wall_set_point(m, id, p), "wall");
+    return 0;
+}
+
+static int set_scalar(lua_State *L, sx_wall_scalar which)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    double v;
+    sx_lua_checkvalue(L, 3, 1, &v, "wall", lua_tostring(L, 2));
+    sx_lua_checkfield(L, m, sx_wall_set(m, id, which, v), "wall");
+    return 0;
+}
+
+static int set_kn(lua_State *L) { return set_scalar(L, SX_WALL_KN); }
+static int set_ks(lua_State *L) { return set_scalar(L, SX_WALL_KS); }
+static int set_friction(lua_State *L) { return set_scalar(L, SX_WALL_FRICTION); }
+
+static int get_extra(lua_State *L) { return sx_lua_extra_table(L, &wall_kind); }
+static int set_extra_table(lua_State *L) { return sx_lua_set_extra_table(L, &wall_kind); }
+static int wall_set_extra(lua_State *L) { return sx_lua_set_extra(L, &wall_kind); }
+static int wall_get_extra(lua_State *L) { return sx_lua_get_extra(L, &wall_kind); }
 
 /* ------------------------------------------------- methods, metamethods */
 
@@ -125,7 +156,7 @@ static int wall_remove(lua_State *L)
     int64_t id;
     check_wall(L, &id);
     lua_getiuservalue(L, 1, 1);
-    sx_lua_remove_wall(L, -1, id);
+    sx_lua_remove_wall(L, -1, id, "w:remove");
     return 0;
 }
 
@@ -189,7 +220,7 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
         break;
     }
     int64_t id;
-    sx_lua_check(L, m, sx_wall_add(m, &d, &id));
+    sx_lua_check(L, m, sx_wall_add(m, &d, &id), "m:wall");
     sx_lua_pushhandle(L, 1, &wall_kind, id);
     return 1;
 }
@@ -200,7 +231,7 @@ static int undo_box(lua_State *L, sx_model *m, const int64_t *ids, int n)
 {
     lua_pushstring(L, sx_model_error(m));
     for (int i = 0; i < n; i++) sx_wall_remove(m, ids[i]);
-    return luaL_error(L, "%s", lua_tostring(L, -1));
+    return luaL_error(L, "m:wall: %s", sx_lua_core_message(lua_tostring(L, -1)));
 }
 
 /* The walls of the box [min, max]: for each axis, the lower then the
@@ -275,6 +306,8 @@ void sx_lua_walls_register(lua_State *L)
     };
     static const luaL_Reg wall_methods[] = {
         {"remove", wall_remove},
+        {"set_extra", wall_set_extra},
+        {"get_extra", wall_get_extra},
         {NULL, NULL},
     };
     static const luaL_Reg getters[] = {
@@ -290,10 +323,16 @@ void sx_lua_walls_register(lua_State *L)
         {"kn", get_kn},
         {"ks", get_ks},
         {"friction", get_friction},
+        {"extra", get_extra},
         {NULL, NULL},
     };
     static const luaL_Reg setters[] = {
         {"vel", set_vel},
+        {"point", set_point},
+        {"kn", set_kn},
+        {"ks", set_ks},
+        {"friction", set_friction},
+        {"extra", set_extra_table},
         {NULL, NULL},
     };
     sx_lua_newclass(L, wall_kind.tname, wall_kind.name, meta, wall_methods, getters, setters);

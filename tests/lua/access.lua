@@ -80,6 +80,18 @@ test("contact filters and snapshots", function()
   raises(function() m:contacts{kind = "wall"} end, HERE, "field 'kind'")
   raises(function() m:contacts{ball = "a"} end, HERE, "field 'ball'")
   raises(function() m:contacts{balls = 1} end, HERE, "unknown key 'balls'")
+  raises(function() m:contacts{ball = -3} end, HERE, "field 'ball'", "ids are >= 1")
+  -- a ball or wall of another model is not taken for its id (the same ids
+  -- exist in both models here, so read as ids these would select contacts)
+  local other, oa, _, ofloor = pressed(3)
+  eq(oa.id, a.id)
+  raises(function() m:contacts{ball = oa} end, HERE, "field 'ball'", "ball " .. oa.id .. " belongs to another model")
+  raises(function() m:contacts{wall = ofloor} end, HERE, "field 'wall'", "belongs to another model")
+  raises(function() m:history("x", {ball = oa, field = "pos", component = 1}) end, HERE, "field 'ball'",
+         "belongs to another model")
+  raises(function() m:history("f", {wall = ofloor, field = "force", component = 3}) end, HERE, "field 'wall'",
+         "belongs to another model")
+  other:close()
   -- a contact object outlives the step; its model closing is an error, not a crash
   local it = m:contacts()
   local c = it()

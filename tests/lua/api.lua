@@ -48,6 +48,7 @@ local function raises(fn, ...)
       error(string.format("error %q lacks %q", err, fragment), 2)
     end
   end
+  return err
 end
 
 local HERE = "api.lua:"  -- errors must carry the script position
@@ -418,12 +419,88 @@ test("wall errors", function()
   raises(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 1, 1}, kn = -5} end, HERE, "kn")
   eq(m:wall_count(), 0)  -- a box that fails adds nothing
   local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
-  raises(function() w.point = {1, 1, 1} end, HERE, "wall field 'point' is read-only")
+  raises(function() w.normal = {1, 0, 0} end, HERE, "wall field 'normal' is read-only")
   raises(function() w.vel = {1, 1} end, HERE, "field 'vel'", "3 components")
   raises(function() return w.colour end, HERE, "wall has no field 'colour'")
   local m2 = model2()
   raises(function() m2:wall{kind = "plane", point = {0, 0}, normal = {0, 1}} end, HERE, "'line'")
   raises(function() m2:wall{kind = "segment", p1 = {0, 0}, p2 = {0, 0}} end, HERE, "zero length")
+end)
+
+-- A ball pressed 1 mm into a floor: the contact force follows what is
+-- written to the wall (springs in series, 4-22: K = kb kw / (kb + kw)).
+test("wall point, stiffness, friction and radius are writable", function()
+  local m = model3()
+  m:set_timestep(1e-5)
+  local floor = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
+  local b = m:ball{pos = {0, 0, 0.009}, radius = 0.01}
+  b.fix = "all"
+  local function fn()
+    m:cycle(1)
+    local f
+    for c in m:contacts{wall = floor} do f = c.fn end
+    return f
+  end
+  near(fn(), 0.5e6 * 0.001, 1e-9)
+  floor.kn = 3e6
+  eq(floor.kn, 3e6)
+  near(fn(), 0.75e6 * 0.001, 1e-9)
+  floor.point = {0, 0, 0.0005}
+  vec_eq(floor.point, {0, 0, 0.0005})
+  near(fn(), 0.75e6 * 0.0015, 1e-9)
+  floor.point = {0, 0, -0.002}  -- out of reach: no contact
+  eq(fn(), nil)
+  floor.point = {0, 0, 0}
+  floor.ks, floor.friction = 0, 0.1
+  eq(floor.ks, 0)
+  eq(floor.friction, 0.1)
+  near(fn(), 0.75e6 * 0.001, 1e-9)
+  floor.kn = 1e9
+  raises(function() floor.kn = 0 end, HERE, "kn", "> 0")
+  raises(function() floor.kn = 0 / 0 end, HERE, "kn")
+  raises(function() floor.ks = -1 end, HERE, "ks", ">= 0")
+  raises(function() floor.friction = -0.1 end, HERE, "friction", ">= 0")
+  raises(function() floor.kn = "stiff" end, HERE, "field 'kn'", "number expected")
+  raises(function() floor.point = {0, 0} end, HERE, "field 'point'", "3 components")
+  raises(function() floor.point = {0, 0, math.huge} end, HERE, "finite")
+  eq(floor.kn, 1e9)
+  -- a cylinder's radius
+  local cyl = m:wall{kind = "cylinder", point = {0, 0, -1}, axis = {0, 0, 1}, radius = 0.5}
+  cyl:set_radius(0.25)
+  eq(cyl:radius(), 0.25)
+  raises(function() cyl:set_radius(-1) end, HERE, "radius", "> 0")
+  raises(function() floor:set_radius(1) end, HERE, "not a cylinder")
+  -- a 2D wall
+  local m2 = model2()
+  local seg = m2:wall{kind = "segment", p1 = {0, 0}, p2 = {1, 0}}
+  seg.point = {1, 1}
+  vec_eq(seg.point, {1, 1})
+  vec_eq(seg.edge1, {1, 0})
+end)
+
+test("wall extras", function()
+  local m = model3()
+  local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  local v = m:wall{kind = "plane", point = {0, 0, 1}, normal = {0, 0, -1}}
+  w.extra.tag = "floor"
+  eq(w:get_extra("tag"), "floor")
+  w:set_extra("n", 3)
+  eq(w.extra.n, 3)
+  eq(v:get_extra("tag", "none"), "none")
+  eq(m:walls()().extra.tag, "floor", "another handle of the same wall")
+  -- kept by m:save, back after seixo.load
+  local path = os.tmpname() .. ".h5"
+  m:save(path)
+  local c = seixo.load(path)
+  os.remove(path)
+  eq(c:walls()().extra.tag, "floor")
+  w.extra = nil
+  eq(w:get_extra("tag"), nil)
+  w.extra = {tag = "again"}
+  raises(function() w.extra = 5 end, HERE, "wall field 'extra'", "table or nil")
+  raises(function() w:set_extra(nil, 1) end, HERE, "key")
+  w:remove()
+  raises(function() return w.extra end, HERE, "has been removed")
 end)
 
 ---------------------------------------------------------------- motion
@@ -595,9 +672,56 @@ test("seixo -e, exit status and one-line errors", function()
   status, out = run("no/such/script.lua")
   eq(status, 1)
   check(out:match("^seixo: cannot open no/such/script.lua"), out)
+  -- a bad command line: one line, the reason and where to look
   status, out = run("--bogus")
   eq(status, 1)
-  check(out:match("^seixo: unrecognized option '%-%-bogus'"), out)
+  eq(out, "seixo: unrecognized option '--bogus'; seixo --help for usage\n")
+  status, out = run("-e")
+  eq(status, 1)
+  eq(out, "seixo: '-e' needs an argument; seixo --help for usage\n")
+  status, out = run("--threads x")
+  eq(status, 1)
+  eq(select(2, out:gsub("\n", "")), 1, out)
+  check(out:find("seixo --help for usage", 1, true), out)
+end)
+
+-- The core's messages name its C functions (ball_set, wall_add, ...): a
+-- script sees the Lua call or field instead, and the object's kind.
+test("errors name the Lua call, not the core's function", function()
+  local m = model3()
+  local b = m:ball{pos = {0, 0, 0}, radius = 0.01}
+  local w = m:wall{kind = "plane", point = {0, 0, -1}, normal = {0, 0, 1}}
+  local function says(fn, ...)
+    local err = raises(fn, HERE, ...)
+    check(not err:find(": [%l]+_[%l_]*: "), "a core function's name in: " .. err)
+  end
+  says(function() b.radius = -1 end, "ball field 'radius': radius must be a positive finite number")
+  says(function() b.damping = 1 end, "ball field 'damping':")
+  says(function() b.vel = {1, 2} end, "ball field 'vel':", "3 components")
+  says(function() b.fix = "vq" end, "ball field 'fix': unknown fixity 'vq'")
+  says(function() b.material = "nope" end, "ball field 'material': no material named 'nope'")
+  says(function() b.group = 3 end, "ball field 'group':")
+  says(function() b.extra = 3 end, "ball field 'extra':")
+  says(function() m:ball{pos = {0, 0, 0}, radius = -1} end, "m:ball: radius must be")
+  says(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 0}} end, "m:wall: the normal must not be zero")
+  says(function() m:wall{kind = "box", min = {0, 0, 0}, max = {1, 1, 1}, kn = -1} end, "m:wall: kn must be > 0")
+  says(function() w.kn = -1 end, "wall field 'kn': kn must be")
+  says(function() w.vel = {0 / 0, 0, 0} end, "wall field 'vel': velocity must be finite")
+  says(function() w.point = 1 end, "wall field 'point':")
+  says(function() w:servo{target = 1, area = -1} end, "w:servo: the area must be > 0")
+  says(function() w:set_radial_vel(1) end, "w:set_radial_vel: wall " .. w.id .. " is not a cylinder")
+  says(function() w:set_radius(1) end, "w:set_radius:", "not a cylinder")
+  says(function() seixo.model{dim = 3, timestep = -1} end, "seixo.model: timestep must be >= 0")
+  says(function() m:set_timestep(-1) end, "m:set_timestep: the timestep must be > 0 s")
+  says(function() m:set_gravity{0 / 0, 0, 0} end, "m:set_gravity: components must be finite")
+  says(function() m:material("x", {density = -1}) end, "m:material: material 'x': density must be > 0")
+  says(function() m:bond{kind = "contact", gap = -1} end, "m:bond: gap must be >= 0")
+  says(function() m:set{radius = -1} end, "m:set: field 'radius': radius must be")
+  says(function() m:set{fix = "vq"} end, "m:set: field 'fix': unknown fixity 'vq'")
+  local empty = model3()
+  says(function() empty:cycle(1) end, "m:cycle: no ball to estimate the automatic timestep")
+  says(function() empty:solve{steps = 1} end, "m:solve: no ball to estimate the automatic timestep")
+  says(function() empty:timestep() end, "m:timestep: no ball")
 end)
 
 test("seixo --version and --help", function()

@@ -171,7 +171,7 @@ test("no room: a clear error, and nothing added", function()
   local before = m:ball_count()
   local err = raises(function()
     m:generate{count = 5000, radius = 2e-3, region = {box = {{0, 0, 0}, {0.02, 0.02, 0.02}}}, tries = 200}
-  end, HERE, "generate: placed", "of 5000 balls", "no room", "after 200 tries", "distribute")
+  end, HERE, "m:generate: placed", "of 5000 balls", "no room", "after 200 tries", "distribute")
   eq(m:ball_count(), before)
   raises(function() m:generate{count = 1, radius = 0.5, region = {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}}} end,
          HERE, "does not fit in the region")

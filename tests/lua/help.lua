@@ -90,4 +90,27 @@ test("help is a global of the executable", function()
   check(out:find("m:solve{ratio =", 1, true), out)
 end)
 
+-- The example session of docs/lua-api.md, typed into `seixo -i`: what it
+-- shows after each "> " line is exactly what the REPL prints (stdin is not
+-- a terminal, so no prompts are printed, only results and errors).
+test("the docs' example session prints what it shows", function()
+  local block = (doc .. "\n"):match("An example session.-\n\n(.-)\n\n")
+  check(block, "no example session in docs/lua-api.md")
+  local input, expected = {}, {}
+  for line in (block .. "\n"):gmatch("(.-)\n") do
+    local code = line:match("^    > (.*)$")
+    if code then
+      input[#input + 1] = code
+    else
+      expected[#expected + 1] = assert(line:match("^    (.*)$"), "not part of the session: " .. line)
+    end
+  end
+  check(#input > 5 and #expected > 3, "the session was read")
+  os.remove("ke.csv")
+  local status, out = T.run("-i", table.concat(input, "\n") .. "\n")
+  eq(status, 0, out)
+  eq(out, table.concat(expected, "\n") .. "\n")
+  check(os.remove("ke.csv"), "the session writes ke.csv")
+end)
+
 T.done()

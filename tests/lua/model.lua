@@ -43,6 +43,27 @@ test("solve stops on time", function()
   eq(m:step(), 123)
 end)
 
+-- The model time is a sum of timesteps, off by rounding: a duration that
+-- is a whole number of steps takes that many, not one more.
+test("solve{time} takes the whole number of steps the time is", function()
+  local m = seixo.model{dim = 2, timestep = 1e-5}
+  m:material("s", {})
+  m:ball{pos = {0, 0}, radius = 0.01}
+  local function steps(t)
+    local why, _, n = m:solve{time = t}
+    eq(why, "time")
+    return n
+  end
+  eq(steps(1.0), 100000)
+  eq(steps(0.5), 50000, "from t = 1 s")
+  m:set_timestep(0.1)
+  eq(steps(0.3), 3, "0.1 + 0.1 + 0.1 < 0.3")
+  m:set_timestep(1e-4)
+  -- past a boundary by more than rounding: one step more
+  eq(steps(0.01235), 124)
+  eq(steps(0.0123 + 1e-9), 124)
+end)
+
 test("solve stops on the unbalanced-force ratio", function()
   for _, dim in ipairs({2, 3}) do
     local m = column(dim, 4)

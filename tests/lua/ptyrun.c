@@ -11,6 +11,7 @@
  *   exit STATUS        wait for the program to end with this exit status
  *   file PATH TEXT     the file must contain TEXT ($VAR in PATH is expanded)
  *   remove PATH        delete the file if it exists ($VAR expanded)
+ *   write PATH TEXT    (re)write the file with TEXT, escapes as for send ($VAR expanded)
  * The output is matched with terminal escape sequences and carriage
  * returns removed. Each expect, reject, exit and file is a check; the first
  * failing one ends the run, showing the end of the transcript. Prints
@@ -282,6 +283,17 @@ int main(int argc, char **argv)
             char full[4096];
             expand(arg, full, sizeof full);
             remove(full);
+        } else if (strcmp(line, "write") == 0) {
+            char *text = strchr(arg, ' ');
+            if (text) *text++ = 0;
+            char full[4096];
+            expand(arg, full, sizeof full);
+            FILE *f = fopen(full, "w");
+            const size_t n = text ? unescape(text) : 0;
+            if (!f || fwrite(text ? text : "", 1, n, f) != n || fclose(f) != 0) {
+                fprintf(stderr, "ptyrun: line %d: cannot write %s\n", lineno, full);
+                return 2;
+            }
         } else if (strcmp(line, "file") == 0) {
             char *text = strchr(arg, ' ');
             if (text) *text++ = 0;
