@@ -660,14 +660,11 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     return true;
 }
 
-/* Ball-ball contacts of one chunk: 4-1 ... 4-21 with the contact models of
- * 4.3.3 - 4.3.5. The total force F acts on b and -F on a; forces and
- * moments go to the balls the chunk owns or to its spill buffer, energies,
- * cracks and errors to the chunk. `full` is a constant at each call site:
- * false compiles the common case alone (linear laws without a shear
- * dashpot, no bonds, no energy tracking) from the same lines, so both
- * instances give the same bits wherever both apply. */
-static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, sx_chunk *o, const bool full)
+/* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
+ * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
+ * a; forces and moments go to the balls the chunk owns or to its spill
+ * buffer, energies, cracks and errors to the chunk. */
+static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 {
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
@@ -675,7 +672,7 @@ static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, s
     const double *restrict im = B->inv_mass;
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
-    const int32_t *restrict bond = full ? p->bond : NULL;
+    const int32_t *restrict bond = p->bond;
     double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
@@ -697,7 +694,7 @@ static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, s
     o->st = SX_OK;
     const double dt = motion_dt(m);
     const int nlaw = m->law_n;
-    const bool track = full && m->track_energy;
+    const bool track = m->track_energy;
     for (int64_t c = o->first; c < o->last; c++) {
         const int64_t i = pa[c], j = pb[c];
         const int32_t slot = bond ? bond[c] - 1 : -1;
@@ -753,17 +750,10 @@ static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, s
         const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
         bool slip = false;
         if (active) {
-            if (full) {
-                fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
-            } else { /* the linear law of stiffness(), 4-6 */
-                kn = law->kn;
-                ks = law->ks;
-                fn = kn * un;
-            }
+            fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
             carry_apply(&rot, fs);
             double f0[D]; /* the shear force before this step's increment, for the slip energy */
-            if (track)
-                for (int k = 0; k < D; k++) f0[k] = fs[k];
+            for (int k = 0; k < D; k++) f0[k] = fs[k];
             const double ksdt = ks * dt;
             for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
             if (bonds & SX_BOND_CONTACT) {
@@ -804,16 +794,16 @@ static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, s
             }
             double fd = fn, dsh[D];
             bool shear_dashpot = false;
-            if ((law->beta_n > 0 || (full && law->beta_s > 0)) && un > 0) {
+            if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
                 /* viscous dashpots at the critical-damping ratios on the reduced mass
                  * m* = 1 / (1/ma + 1/mb): c = 2 beta sqrt(m* k), a per-law factor when k is */
                 const double sum_im = im[i] + im[j];
-                const double cn = full && (law->hertz || law->per_radius) ? 2 * law->beta_n * sqrt(kn / sum_im)
-                                                                         : sqrt(law->dash_n / sum_im);
+                const double cn = law->hertz || law->per_radius ? 2 * law->beta_n * sqrt(kn / sum_im)
+                                                                : sqrt(law->dash_n / sum_im);
                 const double fdn = -cn * vn;
                 fd += fdn;
                 double work = fdn * vn;
-                if (full && !slip && law->beta_s > 0) {
+                if (!slip && law->beta_s > 0) {
                     const double cs = 2 * law->beta_s * sqrt(ks / sum_im);
                     for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                     work += dot(dsh, vs);
@@ -873,10 +863,178 @@ static inline __attribute__((always_inline)) void ball_chunk_pass(sx_model *m, s
     }
 }
 
+/* The common case (linear laws without a shear dashpot, no bonds, no
+ * energy tracking) of ball_chunk_pass in batches of pairs:
+ * the pairs' inputs are gathered into short arrays, every formula runs as
+ * a loop over the batch that the compiler vectorises (branches become
+ * selects: a pair out of contact or slipping takes the same lanes, and
+ * multiplying by a scale of exactly 1 changes nothing), and the results
+ * are scattered in pair order. Each lane does the scalar pass's arithmetic
+ * in its order, so both give the same bits. */
+enum { BATCH = 16 };
+
+/* The batched pass is compiled twice where the compiler can pick at run
+ * time (GCC's function multi-versioning on x86-64 GNU/Linux): with AVX2,
+ * four lanes per instruction, and for the baseline ISA. Neither fuses
+ * (-ffp-contract=off) and both round every operation alike, so the two
+ * give the same bits. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
+#define SX_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SX_VECTOR_CLONES
+#endif
+
+SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
+    const double *restrict im = B->inv_mass;
+    const uint16_t *restrict mat = B->mat;
+    const int32_t *restrict pa = p->a, *restrict pb = p->b;
+    double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
+    uint8_t *restrict touching = p->touching;
+    double *restrict f = B->f, *restrict t = B->t;
+    const sx_pair_law *laws = m->law;
+    const int nlaw = m->law_n;
+    const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
+    double *restrict sf = m->pool + o->off * (D + RD), *restrict st = sf + nspill * D;
+    if (B->fapp) {
+        memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    } else {
+        memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    }
+    memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
+    o->slip = o->viscous = o->released = 0;
+    o->lost_bonds = 0;
+    o->ncracks = 0;
+    o->st = SX_OK;
+    const double dt = motion_dt(m);
+    /* the law's parameters per lane; with one material, filled once */
+    double kn[BATCH], ks[BATCH], mu[BATCH], dash[BATCH], bn[BATCH];
+    for (int q = 0; q < BATCH; q++)
+        kn[q] = laws->kn, ks[q] = laws->ks, mu[q] = laws->mu, dash[q] = laws->dash_n, bn[q] = laws->beta_n;
+
+    for (int64_t c0 = o->first; c0 < o->last; c0 += BATCH) {
+        const int nb = o->last - c0 < BATCH ? (int)(o->last - c0) : BATCH;
+        /* gathered inputs; lanes past nb repeat the batch's first pair */
+        double dx[D][BATCH], dv[D][BATCH], wi[RD][BATCH], wj[RD][BATCH], fs[D][BATCH], no[D][BATCH];
+        double ri[BATCH], rj[BATCH], sim[BATCH], live[BATCH];
+        for (int q = 0; nlaw > 1 && q < BATCH; q++) {
+            const int64_t c = c0 + (q < nb ? q : 0);
+            const sx_pair_law *law = &laws[mat[pa[c]] * nlaw + mat[pb[c]]];
+            kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
+        }
+        for (int q = 0; q < BATCH; q++) {
+            const int64_t c = c0 + (q < nb ? q : 0), i = pa[c], j = pb[c];
+            for (int k = 0; k < D; k++) {
+                dx[k][q] = x[j * D + k] - x[i * D + k];
+                dv[k][q] = v[j * D + k] - v[i * D + k];
+                fs[k][q] = fs_all[c * D + k];
+                no[k][q] = nold_all[c * D + k];
+            }
+            for (int k = 0; k < RD; k++) wi[k][q] = w[i * RD + k], wj[k][q] = w[j * RD + k];
+            ri[q] = rad[i], rj[q] = rad[j];
+            sim[q] = im[i] + im[j];
+            live[q] = touching[c];
+        }
+        /* results */
+        double n[D][BATCH], F[D][BATCH], ma[RD][BATCH], mj[RD][BATCH], un[BATCH], fdo[BATCH];
+        for (int q = 0; q < BATCH; q++) {
+            /* 4-1 ... 4-4 */
+            double d2 = 0;
+            for (int k = 0; k < D; k++) d2 += dx[k][q] * dx[k][q];
+            const double d = sqrt(d2), inv_d = 1.0 / d;
+            double nq[D];
+            for (int k = 0; k < D; k++) nq[k] = dx[k][q] * inv_d;
+            const double u = ri[q] + rj[q] - d;
+            const double la = ri[q] - 0.5 * u, lb = rj[q] - 0.5 * u;
+            /* 4-16, 4-17 as in ball_chunk_pass */
+            double ws[RD], wn[D], vc[D];
+            for (int k = 0; k < RD; k++) ws[k] = la * wi[k][q] + lb * wj[k][q];
+            spin_cross(ws, nq, wn);
+            for (int k = 0; k < D; k++) vc[k] = dv[k][q] - wn[k];
+            double vn = 0;
+            for (int k = 0; k < D; k++) vn += vc[k] * nq[k];
+            double vs[D];
+            for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * nq[k];
+            /* history: none for a new contact */
+            const bool had = live[q] != 0;
+            double g[D], nold[D];
+            for (int k = 0; k < D; k++) g[k] = had ? fs[k][q] : 0, nold[k] = had ? no[k][q] : nq[k];
+            double wab[RD];
+            for (int k = 0; k < RD; k++) wab[k] = wi[k][q] + wj[k][q];
+            carry rot;
+            carry_make(&rot, nold, nq, NULL, wab, dt);
+            carry_apply(&rot, g);
+            const double fn = kn[q] * u; /* 4-6 */
+            const double ksdt = ks[q] * dt;
+            for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+            /* 4-30/4-31 */
+            const double fmax = mu[q] * (fn > 0 ? fn : 0);
+            double f2 = 0;
+            for (int k = 0; k < D; k++) f2 += g[k] * g[k];
+            const double slip_sc = fmax / sqrt(f2); /* evaluated in every lane, taken where it slips */
+            const double sc = f2 > fmax * fmax ? slip_sc : 1.0;
+            for (int k = 0; k < D; k++) g[k] *= sc;
+            const bool active = u > 0;
+            const double cn = sqrt(dash[q] / sim[q]);
+            const double fdash = fn + -cn * vn;
+            const double fd = bn[q] > 0 && active ? fdash : fn;
+            for (int k = 0; k < D; k++) {
+                const double fk = fd * nq[k] + g[k]; /* 4-5 */
+                F[k][q] = active ? fk : 0;
+                fs[k][q] = active ? g[k] : 0;
+                n[k][q] = nq[k];
+            }
+            double Fq[D], nf[RD];
+            for (int k = 0; k < D; k++) Fq[k] = F[k][q];
+            moment_of(nq, Fq, nf); /* 4-21 */
+            for (int k = 0; k < RD; k++) ma[k][q] = la * nf[k], mj[k][q] = -lb * nf[k];
+            un[q] = u;
+            fdo[q] = active ? fd : 0;
+            live[q] = d2 < (ri[q] + rj[q]) * (ri[q] + rj[q]) ? (active ? 2 : 1) : 0;
+        }
+        for (int q = 0; q < nb; q++) {
+            const int64_t c = c0 + q, i = pa[c], j = pb[c];
+            if (live[q] == 0) { /* out of reach this step */
+                touching[c] = 0;
+                continue;
+            }
+            const double rmin = ri[q] < rj[q] ? ri[q] : rj[q];
+            if (un[q] > rmin) {
+                o->st = SX_EUNSTABLE;
+                o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un[q], o->err_r = rmin;
+                return;
+            }
+            for (int k = 0; k < D; k++) fs_all[c * D + k] = fs[k][q], nold_all[c * D + k] = n[k][q];
+            un_all[c] = un[q];
+            fn_all[c] = fdo[q];
+            touching[c] = live[q] == 2;
+            double *fi = f + i * D, *ti = t + i * RD, *fj, *tj;
+            if (j < own_hi) {
+                fj = f + j * D, tj = t + j * RD;
+            } else {
+                fj = sf + (j - own_hi) * D, tj = st + (j - own_hi) * RD;
+            }
+            for (int k = 0; k < D; k++) {
+                fi[k] -= F[k][q];
+                fj[k] += F[k][q];
+            }
+            for (int k = 0; k < RD; k++) {
+                ti[k] -= ma[k][q];
+                tj[k] += mj[k][q];
+            }
+        }
+    }
+}
+
 static void ball_chunk(sx_model *m, sx_chunk *o)
 {
-    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_pass(m, o, false);
-    else ball_chunk_pass(m, o, true);
+    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_batched(m, o);
+    else ball_chunk_pass(m, o);
 }
 
 /* Chunks of the ball-ball pass and blocks of the per-ball passes, planned
