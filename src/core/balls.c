@@ -324,8 +324,14 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
 
 void sx__pairs_fit(sx_model *m, sx_pairs *p)
 {
-    const int64_t want = p->n + p->n / 8 + 256;
-    if (p->cap > want + want / 4) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
+    const int64_t want = p->n + p->n / 16 + 256;
+    if (p->cap > want + want / 8) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
+}
+
+sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap)
+{
+    if (cap < p->n) cap = p->n;
+    return cap == p->cap ? SX_OK : pairs_resize(m, p, cap);
 }
 
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
@@ -416,7 +422,7 @@ size_t sx__balls_bytes(const sx_model *m)
     const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
     size_t per = (4 * d + 2 * r + 4) * sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint16_t) + sizeof(uint8_t);
     if (b->fapp) per += (d + r) * sizeof(double);
-    return c * per + (size_t)b->index_cap * sizeof(int32_t) + (size_t)m->grid.cap_balls * sizeof(int32_t);
+    return c * per + (size_t)b->index_cap * sizeof(int32_t);
 }
 
 size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p)

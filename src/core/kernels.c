@@ -301,12 +301,6 @@ static bool grid_setup(sx_model *m)
         g->start = q;
         g->cap_cells = g->ncells + 1;
     }
-    if (b->n > g->cap_balls) {
-        int32_t *q = sx_alloc_resize(&m->alloc, g->cell_of, (size_t)g->cap_balls, (size_t)b->cap, sizeof *q);
-        if (!q) return false;
-        g->cell_of = q;
-        g->cap_balls = b->cap;
-    }
     return true;
 }
 
@@ -330,21 +324,24 @@ static bool sort_balls(sx_model *m)
         free(order);
         return false;
     }
+    /* the cell of each ball lives in the scratch until the permutation needs it */
+    int32_t *cell_of = (int32_t *)scratch;
     memset(g->start, 0, (size_t)(g->ncells + 1) * sizeof *g->start);
     for (int64_t i = 0; i < n; i++) {
         int64_t c[3] = {0, 0, 0};
         cell_coords(g, b->x + i * D, c);
         const int64_t cell = c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]);
-        g->cell_of[i] = (int32_t)cell;
+        cell_of[i] = (int32_t)cell;
         g->start[cell + 1]++;
     }
     for (int64_t c = 0; c < g->ncells; c++) g->start[c + 1] += g->start[c];
-    for (int64_t i = 0; i < n; i++) order[g->start[g->cell_of[i]]++] = (int32_t)i;
+    for (int64_t i = 0; i < n; i++) order[g->start[cell_of[i]]++] = (int32_t)i;
     /* start[c] now holds the end of cell c: shift back to starts */
     for (int64_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
     g->start[0] = 0;
     sx__balls_permute(m, order, scratch);
     free(order);
+    sx__scratch_release(m); /* not kept between builds: the pairs come next */
     return true;
 }
 
@@ -370,15 +367,26 @@ static int half_stencil(int64_t (*off)[3])
     return n;
 }
 
-static bool build_ball_pairs(sx_model *m, const history *h)
+/* A candidate pair (i, j), i < j: counted when count is given, else stored. */
+static inline bool candidate(sx_model *m, const history *h, int32_t i, int32_t j, int64_t *count)
+{
+    if (count) {
+        (*count)++;
+        return true;
+    }
+    const int32_t *id = m->balls.id;
+    return pair_push(m, &m->bb, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0);
+}
+
+/* The grid's candidate pairs in cell order; with count, only counts them
+ * (a build counts first, so the store is sized once, without growing). */
+static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
 {
     const sx_grid *g = &m->grid;
     const sx_balls *b = &m->balls;
-    const int32_t *id = b->id;
-    sx_pairs *p = &m->bb;
     int64_t off[13][3];
     const int nst = half_stencil(off);
-    p->n = 0;
+    if (!count) m->bb.n = 0;
     for (int64_t cz = 0; cz < g->nc[2]; cz++)
         for (int64_t cy = 0; cy < g->nc[1]; cy++)
             for (int64_t cx = 0; cx < g->nc[0]; cx++) {
@@ -391,9 +399,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                         double dx[D];
                         for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                         const double reach = ri + b->rad[j];
-                        if (dot(dx, dx) < reach * reach &&
-                            !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
-                            return false;
+                        if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
                     }
                     for (int s = 0; s < nst; s++) {
                         const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
@@ -403,9 +409,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                             double dx[D];
                             for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                             const double reach = ri + b->rad[j];
-                            if (dot(dx, dx) < reach * reach &&
-                                !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
-                                return false;
+                            if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
                         }
                     }
                 }
@@ -450,7 +454,11 @@ static bool KERNEL(build)(sx_model *m)
         m->skin = 0.2 * sum / (double)m->balls.n;
     }
     history h;
-    bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h) &&
+    /* the pair store sized to the count, with 1/16 headroom for the bonded
+     * pairs and the next build, so it never grows by half again */
+    int64_t count = 0;
+    bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h, &count) &&
+              !sx__pairs_presize(m, &m->bb, count + count / 16 + 256) && build_ball_pairs(m, &h, NULL) &&
               keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h) && plan_chunks(m);
     history_free(&h);
     if (!ok) return false;
@@ -1544,6 +1552,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (dtr < best) best = dtr;
         }
     }
+    sx__scratch_release(m);
     return best;
 }
 

@@ -86,7 +86,6 @@ void sx_model_destroy(sx_model *m)
     sx_alloc_free(&m->alloc, m->wall_acc, (size_t)m->cap_wall_acc, sizeof *m->wall_acc);
     sx_alloc_free(&m->alloc, m->wlaw, (size_t)m->cap_wlaw, sizeof *m->wlaw);
     sx_alloc_free(&m->alloc, m->grid.start, (size_t)m->grid.cap_cells, sizeof(int32_t));
-    sx_alloc_free(&m->alloc, m->grid.cell_of, (size_t)m->grid.cap_balls, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
     sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof(double));
     sx_alloc_free(&m->alloc, m->mats, (size_t)m->cap_mat, sizeof *m->mats);
@@ -139,6 +138,13 @@ sx_status sx_model_set_gravity(sx_model *m, const double g[3])
     for (int k = 0; k < m->dim; k++) m->gravity[k] = g[k];
     m->guard_dirty = true;
     return SX_OK;
+}
+
+void sx__scratch_release(sx_model *m)
+{
+    sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof *m->scratch);
+    m->scratch = NULL;
+    m->scratch_cap = 0;
 }
 
 double *sx__scratch(sx_model *m, int64_t n)

@@ -101,8 +101,6 @@ typedef struct sx_grid {
     int64_t nc[3], ncells, cap_cells;
     int32_t *head;         /* first ball of each cell (after sorting: start index) */
     int32_t *start;        /* cells' start in sorted order (ncells + 1) */
-    int32_t *cell_of;      /* cell of each ball */
-    int64_t cap_balls;
 } sx_grid;
 
 /* The ball-ball pass runs in fixed chunks of pairs. Pairs are sorted by a
@@ -205,7 +203,7 @@ struct sx_model {
     bool law_plain;         /* every law linear, not per radius, without a shear dashpot */
     sx_pair_law *wlaw;      /* nmat x nwall laws of the ball-wall contacts, refreshed each step */
     int64_t cap_wlaw;
-    double *scratch;        /* per-build scratch (sorting, timestep sums) */
+    double *scratch;        /* scratch of one operation (sorting, timestep sums), released after it */
     int64_t scratch_cap;
     sx_grid grid;
     int64_t builds;         /* number of broad-phase builds so far */
@@ -250,8 +248,10 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
-/* Gives back what a build did not use, keeping 1/8 headroom for the next. */
+/* Gives back what a build did not use, keeping 1/16 headroom for the next. */
 void sx__pairs_fit(sx_model *m, sx_pairs *p);
+/* Resizes the store to exactly cap pairs (never below its count). */
+sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
 /* Bytes of the ball arrays (with the id map and the grid's per-ball cells), of a pair store. */
@@ -265,6 +265,7 @@ void sx__walls_servo(sx_model *m); /* servo velocities from the step's wall load
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);
 double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */
+void sx__scratch_release(sx_model *m);      /* gives the scratch back (it is not kept between uses) */
 /* Records a broken bond; false when out of memory (the event is dropped). */
 bool sx__crack_log(sx_model *m, const sx_crack *c);
 /* Drops kind bits from a bond; the bond's slot stays, and intact counts follow. */
