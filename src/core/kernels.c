@@ -686,7 +686,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
     const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
-    double *restrict sf = m->pool + o->off * (D + RD), *restrict st = sf + nspill * D;
+    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
     /* the owned balls start from the applied loads (or nothing), the spill buffer from zero */
     if (B->fapp) {
         memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
@@ -695,7 +695,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
         memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
     }
-    memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
+    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
     o->slip = o->viscous = o->released = 0;
     o->lost_bonds = 0;
     o->ncracks = 0;
@@ -885,7 +885,8 @@ enum { BATCH = 16 };
  * time (GCC's function multi-versioning on x86-64 GNU/Linux): with AVX2,
  * four lanes per instruction, and for the baseline ISA. Neither fuses
  * (-ffp-contract=off) and both round every operation alike, so the two
- * give the same bits. */
+ * give the same bits. AddressSanitizer builds keep the baseline alone (an
+ * ifunc resolver runs before the sanitizer is set up). */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
 #define SX_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
 #else
@@ -906,7 +907,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     const sx_pair_law *laws = m->law;
     const int nlaw = m->law_n;
     const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
-    double *restrict sf = m->pool + o->off * (D + RD), *restrict st = sf + nspill * D;
+    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
     if (B->fapp) {
         memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
         memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
@@ -914,7 +915,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
         memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
     }
-    memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
+    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
     o->slip = o->viscous = o->released = 0;
     o->lost_bonds = 0;
     o->ncracks = 0;
@@ -1158,13 +1159,14 @@ static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
         const sx_chunk *h = &m->chunks[c];
         const int64_t s0 = h->own_hi > o->b0 ? h->own_hi : o->b0, s1 = h->spill_hi < o->b1 ? h->spill_hi : o->b1;
         const int64_t len = h->spill_hi - h->own_hi;
+        if (s0 >= s1) continue;
         const double *restrict sf = m->pool + h->off * (D + RD), *restrict st = sf + len * D;
         for (int64_t i = s0; i < s1; i++) {
             for (int k = 0; k < D; k++) f[i * D + k] += sf[(i - h->own_hi) * D + k];
             for (int k = 0; k < RD; k++) t[i * RD + k] += st[(i - h->own_hi) * RD + k];
         }
     }
-    memset(acc, 0, (size_t)m->nwall * sizeof *acc);
+    if (m->nwall) memset(acc, 0, (size_t)m->nwall * sizeof *acc);
     o->slip = o->viscous = 0;
     o->st = SX_OK;
     sx_pairs *p = &m->bw;
@@ -1300,7 +1302,7 @@ static sx_status KERNEL(walls)(sx_model *m)
         m->cap_wall_acc = nb * nw;
     }
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
-    for (int64_t b = 0; b < nb; b++) wall_block(m, &m->blocks[b], m->wall_acc + b * nw);
+    for (int64_t b = 0; b < nb; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
     for (int64_t w = 0; w < nw; w++) {
         sx_wall *wl = &m->walls[w];
         memset(wl->force, 0, sizeof wl->force);
