@@ -306,10 +306,28 @@ int main(int argc, char **argv)
 
     st = sx_model_cycle(m, o.warmup);
     if (st) return fail(m, "warm-up cycle", st);
+    sx_model_profile_reset(m);
     const double t0 = now();
     st = sx_model_cycle(m, o.steps);
     const double seconds = now() - t0;
     if (st) return fail(m, "timed cycle", st);
+
+    /* the profile of the timed steps */
+    const sx_profile prof = sx_model_profile(m);
+    char table[2048];
+    sx_profile_format(&prof, n, table, sizeof table);
+    printf("# profile of the timed steps:\n");
+    for (const char *line = table; *line;) {
+        const char *end = strchr(line, '\n');
+        const int len = end ? (int)(end - line) : (int)strlen(line);
+        printf("#   %.*s\n", len, line);
+        line += len + (end != NULL);
+    }
+    const sx_memory mem = sx_model_memory(m);
+    printf("# memory: %.1f MB held (peak %.1f MB): balls %.1f B/ball, contacts %.1f B/contact (%lld pairs for %lld "
+           "contacts), bonds %zu B, working storage %.1f B/ball\n",
+           (double)mem.total / 1048576.0, (double)mem.peak / 1048576.0, mem.bytes_per_ball, mem.bytes_per_contact,
+           (long long)mem.pair_count, (long long)mem.contact_count, mem.bonds, (double)mem.work / (double)n);
 
     stats s = {0};
     sx_contact_each(m, gather, &s);
@@ -355,13 +373,17 @@ int main(int argc, char **argv)
     printf("SXBENCH code=seixo N=%lld dim=%d nx=%d ny=%d nz=%d threads_requested=%d threads=%d steps=%lld "
            "seconds=%.6f psps=%.6e contacts_per_ball=%.6f cpb_bb=%.6f bb_contacts=%lld bw_contacts=%lld "
            "mean_overlap=%.6e max_overlap=%.6e ke=%.6e lost=%lld outside=%lld model_bytes=%zu "
-           "bytes_per_ball=%.1f bytes_per_contact=%.1f maxrss_kb=%ld hash=%016" PRIx64 " dashpot=ratio:%.5f\n",
+           "bytes_per_ball=%.1f bytes_per_contact=%.1f maxrss_kb=%ld hash=%016" PRIx64 " dashpot=ratio:%.5f "
+           "ball_bytes_per_ball=%.1f contact_bytes_per_contact=%.1f model_peak=%zu "
+           "t_broad=%.6f t_balls=%.6f t_walls=%.6f t_motion=%.6f t_other=%.6f\n",
            (long long)n, o.dim, o.nx, o.ny, o.nz, o.threads, threads_used, (long long)o.steps, seconds,
            (double)n * (double)o.steps / seconds, (double)(2 * s.bb + s.bw) / (double)n,
            (double)(2 * s.bb) / (double)n, (long long)s.bb, (long long)s.bw,
            s.bb ? s.sum_overlap / (double)s.bb : 0.0, s.max_overlap, e.kinetic, (long long)(n - count),
            (long long)outside, bytes, (double)bytes / (double)n, contacts ? (double)bytes / (double)contacts : 0.0,
-           ru.ru_maxrss, sx_model_state_hash(m), DASHPOT_RATIO);
+           ru.ru_maxrss, sx_model_state_hash(m), DASHPOT_RATIO, mem.bytes_per_ball, mem.bytes_per_contact, mem.peak,
+           prof.seconds[SX_STAGE_BROAD_PHASE], prof.seconds[SX_STAGE_BALL_CONTACTS],
+           prof.seconds[SX_STAGE_WALL_CONTACTS], prof.seconds[SX_STAGE_INTEGRATION], prof.seconds[SX_STAGE_OTHER]);
     sx_model_destroy(m);
     return 0;
 }

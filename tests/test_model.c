@@ -1,6 +1,6 @@
 /* The model: creation and material validation, cycling and time, the
- * automatic timestep, interruption from another thread, memory accounting
- * and energies. */
+ * automatic timestep, interruption from another thread, memory accounting,
+ * the stage profile and energies. */
 #include "scenes.h"
 
 #include <check.h>
@@ -447,6 +447,100 @@ START_TEST(bytes_grow_with_balls)
 }
 END_TEST
 
+/* sx_model_memory splits the tracked bytes by owner; its parts add up. */
+START_TEST(memory_report)
+{
+    const int dim = _i;
+    const double g[3] = {0, 0, 0};
+    sx_model *m = scene_model(dim, g, 1e-5, 1e6, 0.5, 1000);
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2};
+    const int64_t n = dim == 3 ? 400 : 100;
+    scene_random_balls(m, n, lo, hi, 0.005, 0.01, 0.01, 0.2, 3, NULL);
+    ck_assert_cycle(m, 5);
+    const sx_memory r = sx_model_memory(m);
+    ck_assert_uint_eq(r.total, sx_model_bytes(m));
+    ck_assert_uint_eq(r.balls + r.contacts + r.bonds + r.work, r.total);
+    ck_assert(r.peak >= r.total);
+    ck_assert_int_eq(r.ball_count, n);
+    ck_assert_int_eq(r.contact_count, sx_contact_count(m));
+    ck_assert(r.pair_count >= r.contact_count && r.contact_count > 0);
+    ck_assert(r.bytes_per_ball == (double)r.balls / (double)n);
+    ck_assert(r.bytes_per_contact == (double)r.contacts / (double)r.contact_count);
+    /* the state of a ball is at least position, velocity, spin, force, moment, radius, mass */
+    ck_assert(r.bytes_per_ball >= (double)((4 * dim + 2 * (dim == 3 ? 3 : 1) + 2) * sizeof(double)));
+    sx_model_destroy(m);
+}
+END_TEST
+
+/* The stage timers: every step runs each of the step's stages once, the
+ * broad phase runs once per build, and the stages together account for the
+ * cycle's wall time (measured here around sx_model_cycle). No assertion on
+ * speed. */
+static double wall_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+START_TEST(profile_stages)
+{
+    const int dim = _i;
+    const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
+    sx_model *m = scene_model(dim, g, 2e-5, 1e6, 0.5, 1000);
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.3, 0.3, 0.3};
+    scene_box_walls(m, lo, hi, 1e6, 0.5);
+    const int64_t n = dim == 3 ? 600 : 150;
+    scene_random_balls(m, n, lo, hi, 0.005, 0.01, 0.5, 0.1, 5, NULL);
+    sx_profile p = sx_model_profile(m);
+    for (int s = 0; s < SX_STAGE_COUNT; s++) ck_assert(p.seconds[s] == 0 && p.calls[s] == 0);
+    const double t0 = wall_now();
+    for (int c = 0; c < 4; c++) ck_assert_cycle(m, 100);
+    const double wall = wall_now() - t0;
+    p = sx_model_profile(m);
+    ck_assert_int_eq(p.steps, 400);
+    ck_assert_int_eq(p.cycles, 4);
+    ck_assert_int_eq(p.calls[SX_STAGE_BALL_CONTACTS], 400);
+    ck_assert_int_eq(p.calls[SX_STAGE_WALL_CONTACTS], 400);
+    ck_assert_int_eq(p.calls[SX_STAGE_INTEGRATION], 400);
+    ck_assert_int_eq(p.calls[SX_STAGE_OTHER], 400);
+    ck_assert_int_eq(p.calls[SX_STAGE_CALLBACKS], 0);
+    /* balls thrown at 0.5 m/s use up the skin: the first build and some more */
+    ck_assert_msg(p.calls[SX_STAGE_BROAD_PHASE] >= 2 && p.calls[SX_STAGE_BROAD_PHASE] <= 400, "%lld builds",
+                  (long long)p.calls[SX_STAGE_BROAD_PHASE]);
+    double sum = 0;
+    for (int s = 0; s < SX_STAGE_COUNT; s++) {
+        ck_assert(p.seconds[s] >= 0);
+        sum += p.seconds[s];
+    }
+    ck_assert(p.seconds[SX_STAGE_BALL_CONTACTS] > 0 && p.seconds[SX_STAGE_INTEGRATION] > 0);
+    /* the stages tile the cycle: what falls between two clock reads is a
+     * few instructions per step; a busy machine may stretch either side */
+    ck_assert_msg(sum <= p.cycle_seconds * (1 + 1e-9) && sum >= 0.9 * p.cycle_seconds,
+                  "stages %.6f s, cycles %.6f s", sum, p.cycle_seconds);
+    ck_assert_msg(p.cycle_seconds <= wall * (1 + 1e-9) && p.cycle_seconds >= 0.8 * wall - 1e-4,
+                  "cycles %.6f s, measured around them %.6f s", p.cycle_seconds, wall);
+    /* time reported from outside, as the Lua layer reports its callbacks */
+    sx_model_profile_add(m, SX_STAGE_CALLBACKS, 0.25);
+    sx_model_profile_add(m, SX_STAGE_CALLBACKS, 0.5);
+    sx_model_profile_add(m, SX_STAGE_COUNT, 1.0); /* ignored */
+    p = sx_model_profile(m);
+    ck_assert_int_eq(p.calls[SX_STAGE_CALLBACKS], 2);
+    ck_assert(p.seconds[SX_STAGE_CALLBACKS] == 0.75);
+    char buf[1024];
+    const int need = sx_profile_format(&p, n, buf, sizeof buf);
+    ck_assert(need > 0 && (size_t)need < sizeof buf && strlen(buf) == (size_t)need);
+    for (int s = 0; s < SX_STAGE_COUNT; s++) ck_assert_ptr_nonnull(strstr(buf, sx_stage_name((sx_stage)s)));
+    ck_assert_int_eq(sx_profile_format(&p, n, buf, 10), need); /* truncated, still the full length */
+    ck_assert_uint_eq(strlen(buf), 9);
+    ck_assert_ptr_null(sx_stage_name(SX_STAGE_COUNT));
+    sx_model_profile_reset(m);
+    p = sx_model_profile(m);
+    ck_assert(p.steps == 0 && p.cycle_seconds == 0 && p.calls[SX_STAGE_INTEGRATION] == 0);
+    sx_model_destroy(m);
+}
+END_TEST
+
 /* -------------------------------------------------------------- energies */
 
 static double dot(const double *a, const double *b, int n)
@@ -645,6 +739,8 @@ int main(void)
     tcase_add_loop_test(tc, auto_timestep_free_ball, 2, 4);
     tcase_add_loop_test(tc, auto_timestep_contacts, 2, 4);
     tcase_add_loop_test(tc, bytes_grow_with_balls, 2, 4);
+    tcase_add_loop_test(tc, memory_report, 2, 4);
+    tcase_add_loop_test(tc, profile_stages, 2, 4);
     tcase_add_loop_test(tc, energy_by_hand, 2, 4);
     tcase_add_loop_test(tc, energy_of_new_overlaps, 2, 4);
     suite_add_tcase(s, tc);

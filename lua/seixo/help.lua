@@ -58,6 +58,10 @@ local entries = {
   ["model:contacts"] = {"m:contacts([{ball =, wall =, kind =}]) -> iterator", "for c in m:contacts() do ... end over a snapshot of the last step's contacts."},
   ["model:hash"] = {"m:hash() -> hex", "A hash of the full state: equal hashes, bit-identical states."},
   ["model:bytes"] = {"m:bytes() -> n", "Memory held by the model [bytes]."},
+  ["model:memory"] = {"m:memory() -> {total =, peak =, balls =, contacts =, bonds =, work =, per_ball =, per_contact =, ...}",
+    "Where the model's bytes are: ball arrays, contact store, bonds, working storage; bytes per ball and per contact."},
+  ["model:profile"] = {"m:profile([{print = true, reset = false}]) -> {broad_phase = {seconds =, calls =}, ..., total =}",
+    "Wall-clock time per stage of the step (broad phase, ball contacts, wall contacts, integration, callbacks, other) since the model was created or reset; prints the table unless print = false."},
 
   -- model: groups and bulk operations
   ["model:group"] = {"m:group(name, filter | fn) -> n", "Puts the selected balls (filter {group, region, where} or a predicate fn(ball)) in the group; returns how many."},

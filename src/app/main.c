@@ -46,6 +46,7 @@ typedef struct options {
     bool interactive;  // -i
     bool has_chunks;   // some -e
     long threads;      // --threads N (0: not given)
+    bool profile;      // --profile
 } options;
 
 enum { MAX_THREADS = 1024 };  // as many as sx_model_set_threads takes (model.c)
@@ -59,6 +60,8 @@ static void usage(FILE *out)
             "  -t             show a traceback with each error\n"
             "  --threads N    OpenMP threads for the step of every model (seixo.threads;\n"
             "                 results are bit-identical for any thread count)\n"
+            "  --profile      print each model's time per stage of the step on stderr\n"
+            "                 when it is closed or collected (see m:profile())\n"
             "  -v, --version  show the version\n"
             "  -h, --help     show this help\n"
             "  --             stop handling options\n"
@@ -743,6 +746,7 @@ static int pmain(lua_State *L)
     global_L = L;
     open_library(L);
     sx_lua_set_progress(L, isatty(STDERR_FILENO));
+    sx_lua_set_profile(L, o->profile);
     lua_getglobal(L, "seixo");
     lua_pushinteger(L, o->threads > 0 ? o->threads : 1);
     lua_setfield(L, -2, "threads");
@@ -787,6 +791,8 @@ static enum parsed parse(int argc, char **argv, options *o)
                 return BAD;
             }
             o->threads = t;
+        } else if (strcmp(a, "--profile") == 0) {
+            o->profile = true;
         } else if (strcmp(a, "-v") == 0 || strcmp(a, "--version") == 0) {
             printf("seixo %s (%s)\n", SX_VERSION, LUA_RELEASE);
             return DONE;

@@ -6,6 +6,7 @@
 #include "model_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Grows s->field from s->cap to cap elements of `per` components. */
@@ -354,8 +355,14 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
 
 void sx__pairs_fit(sx_model *m, sx_pairs *p)
 {
-    const int64_t want = p->n + p->n / 8 + 256;
-    if (p->cap > want + want / 4) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
+    const int64_t want = p->n + p->n / 16 + 256;
+    if (p->cap > want + want / 8) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
+}
+
+sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap)
+{
+    if (cap < p->n) cap = p->n;
+    return cap == p->cap ? SX_OK : pairs_resize(m, p, cap);
 }
 
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
@@ -384,6 +391,48 @@ void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k)
     if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
 }
 
+bool sx__pairs_sort(sx_model *m, sx_pairs *p)
+{
+    int64_t c = 1;
+    while (c < p->n && p->a[c - 1] <= p->a[c]) c++;
+    if (c >= p->n) return true;
+    const int64_t n = p->n, nb = m->balls.n;
+    const int d = m->dim;
+    /* counting sort: pos[c] is the new place of pair c */
+    int32_t *pos = malloc((size_t)n * sizeof *pos);
+    int64_t *count = calloc((size_t)nb + 1, sizeof *count);
+    void *tmp = malloc((size_t)(n * d) * sizeof(double));
+    if (!pos || !count || !tmp) {
+        free(pos);
+        free(count);
+        free(tmp);
+        return false;
+    }
+    for (c = 0; c < n; c++) count[p->a[c] + 1]++;
+    for (int64_t i = 0; i < nb; i++) count[i + 1] += count[i];
+    for (c = 0; c < n; c++) pos[c] = (int32_t)count[p->a[c]]++;
+#define SCATTER(field, per, type)                                                                  \
+    do {                                                                                           \
+        type *q = tmp;                                                                             \
+        for (int64_t e = 0; e < n; e++)                                                            \
+            for (int k = 0; k < (per); k++) q[(int64_t)pos[e] * (per) + k] = p->field[e * (per) + k]; \
+        memcpy(p->field, q, (size_t)(n * (per)) * sizeof(type));                                   \
+    } while (0)
+    SCATTER(a, 1, int32_t);
+    SCATTER(b, 1, int32_t);
+    SCATTER(fs, d, double);
+    SCATTER(nold, d, double);
+    SCATTER(touching, 1, uint8_t);
+    SCATTER(un, 1, double);
+    SCATTER(fn, 1, double);
+    if (p->bond) SCATTER(bond, 1, int32_t);
+#undef SCATTER
+    free(pos);
+    free(count);
+    free(tmp);
+    return true;
+}
+
 void sx__pairs_free(sx_model *m, sx_pairs *p)
 {
     const int64_t c = p->cap, d = m->dim;
@@ -396,6 +445,23 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->un, c, sizeof(double));
     free_field(m, p->fn, c, sizeof(double));
     memset(p, 0, sizeof *p);
+}
+
+size_t sx__balls_bytes(const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
+    size_t per = (4 * d + 2 * r + 4) * sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint16_t) + sizeof(uint8_t);
+    if (b->fapp) per += (d + r) * sizeof(double);
+    return c * per + (size_t)b->index_cap * sizeof(int32_t);
+}
+
+size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p)
+{
+    const size_t d = (size_t)m->dim;
+    size_t per = 2 * sizeof(int32_t) + (2 * d + 2) * sizeof(double) + sizeof(uint8_t);
+    if (p->bond) per += sizeof(int32_t);
+    return (size_t)p->cap * per;
 }
 
 /* ------------------------------------------------------------ accessors */

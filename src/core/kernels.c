@@ -301,12 +301,6 @@ static bool grid_setup(sx_model *m)
         g->start = q;
         g->cap_cells = g->ncells + 1;
     }
-    if (b->n > g->cap_balls) {
-        int32_t *q = sx_alloc_resize(&m->alloc, g->cell_of, (size_t)g->cap_balls, (size_t)b->cap, sizeof *q);
-        if (!q) return false;
-        g->cell_of = q;
-        g->cap_balls = b->cap;
-    }
     return true;
 }
 
@@ -330,21 +324,24 @@ static bool sort_balls(sx_model *m)
         free(order);
         return false;
     }
+    /* the cell of each ball lives in the scratch until the permutation needs it */
+    int32_t *cell_of = (int32_t *)scratch;
     memset(g->start, 0, (size_t)(g->ncells + 1) * sizeof *g->start);
     for (int64_t i = 0; i < n; i++) {
         int64_t c[3] = {0, 0, 0};
         cell_coords(g, b->x + i * D, c);
         const int64_t cell = c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]);
-        g->cell_of[i] = (int32_t)cell;
+        cell_of[i] = (int32_t)cell;
         g->start[cell + 1]++;
     }
     for (int64_t c = 0; c < g->ncells; c++) g->start[c + 1] += g->start[c];
-    for (int64_t i = 0; i < n; i++) order[g->start[g->cell_of[i]]++] = (int32_t)i;
+    for (int64_t i = 0; i < n; i++) order[g->start[cell_of[i]]++] = (int32_t)i;
     /* start[c] now holds the end of cell c: shift back to starts */
     for (int64_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
     g->start[0] = 0;
     sx__balls_permute(m, order, scratch);
     free(order);
+    sx__scratch_release(m); /* not kept between builds: the pairs come next */
     return true;
 }
 
@@ -370,15 +367,26 @@ static int half_stencil(int64_t (*off)[3])
     return n;
 }
 
-static bool build_ball_pairs(sx_model *m, const history *h)
+/* A candidate pair (i, j), i < j: counted when count is given, else stored. */
+static inline bool candidate(sx_model *m, const history *h, int32_t i, int32_t j, int64_t *count)
+{
+    if (count) {
+        (*count)++;
+        return true;
+    }
+    const int32_t *id = m->balls.id;
+    return pair_push(m, &m->bb, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0);
+}
+
+/* The grid's candidate pairs in cell order; with count, only counts them
+ * (a build counts first, so the store is sized once, without growing). */
+static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
 {
     const sx_grid *g = &m->grid;
     const sx_balls *b = &m->balls;
-    const int32_t *id = b->id;
-    sx_pairs *p = &m->bb;
     int64_t off[13][3];
     const int nst = half_stencil(off);
-    p->n = 0;
+    if (!count) m->bb.n = 0;
     for (int64_t cz = 0; cz < g->nc[2]; cz++)
         for (int64_t cy = 0; cy < g->nc[1]; cy++)
             for (int64_t cx = 0; cx < g->nc[0]; cx++) {
@@ -391,9 +399,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                         double dx[D];
                         for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                         const double reach = ri + b->rad[j];
-                        if (dot(dx, dx) < reach * reach &&
-                            !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
-                            return false;
+                        if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
                     }
                     for (int s = 0; s < nst; s++) {
                         const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
@@ -403,9 +409,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                             double dx[D];
                             for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                             const double reach = ri + b->rad[j];
-                            if (dot(dx, dx) < reach * reach &&
-                                !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
-                                return false;
+                            if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
                         }
                     }
                 }
@@ -435,7 +439,7 @@ static bool KERNEL(build)(sx_model *m)
 {
     if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
         m->bb.n = m->bw.n = 0;
-        m->nchunk = 0;
+        m->nchunk = m->nblock = 0;
         m->builds++;
         m->build_needed = false;
         m->dt_stale = true;
@@ -450,7 +454,11 @@ static bool KERNEL(build)(sx_model *m)
         m->skin = 0.2 * sum / (double)m->balls.n;
     }
     history h;
-    bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h) &&
+    /* the pair store sized to the count, with 1/16 headroom for the bonded
+     * pairs and the next build, so it never grows by half again */
+    int64_t count = 0;
+    bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h, &count) &&
+              !sx__pairs_presize(m, &m->bb, count + count / 16 + 256) && build_ball_pairs(m, &h, NULL) &&
               keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h) && plan_chunks(m);
     history_free(&h);
     if (!ok) return false;
@@ -483,7 +491,9 @@ static inline void carry_make(carry *r, const double *nold, const double *n, con
     r->c[1] = nold[2] * n[0] - nold[0] * n[2];
     r->c[2] = nold[0] * n[1] - nold[1] * n[0];
     /* 4-9: the mean spin projected on the normal (a wall does not spin) */
-    const double wbar = 0.5 * ((wa ? dot(wa, n) : 0) + dot(wb, n));
+    double ws[3];
+    for (int k = 0; k < 3; k++) ws[k] = wa ? wa[k] + wb[k] : wb[k];
+    const double wbar = 0.5 * dot(ws, n);
     for (int k = 0; k < 3; k++) r->wdt[k] = wbar * n[k] * dt;
 #else
     /* in 2D c is along z, and the spins are normal to n, so 4-15 is the identity */
@@ -658,17 +668,34 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     return true;
 }
 
-/* Ball-ball contacts of one chunk: 4-1 ... 4-21 with the contact models of
- * 4.3.3 - 4.3.5. The total force F acts on b and -F on a; forces and
- * moments go to the chunk's buffer, energies, cracks and errors to the chunk. */
-static void ball_chunk(sx_model *m, sx_chunk *o)
+/* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
+ * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
+ * a; forces and moments go to the balls the chunk owns or to its spill
+ * buffer, energies, cracks and errors to the chunk. */
+static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 {
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
-    const double *x = B->x, *v = B->v, *w = B->w, *rad = B->rad, *im = B->inv_mass;
-    double *const f = m->pool + o->off * (D + RD), *const t = f + (o->hi - o->lo + 1) * D;
-    const int64_t lo = o->lo;
-    memset(f, 0, (size_t)((o->hi - o->lo + 1) * (D + RD)) * sizeof(double));
+    const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
+    const double *restrict im = B->inv_mass;
+    const uint16_t *restrict mat = B->mat;
+    const int32_t *restrict pa = p->a, *restrict pb = p->b;
+    const int32_t *restrict bond = p->bond;
+    double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
+    uint8_t *restrict touching = p->touching;
+    double *restrict f = B->f, *restrict t = B->t;
+    const sx_pair_law *laws = m->law;
+    const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
+    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
+    /* the owned balls start from the applied loads (or nothing), the spill buffer from zero */
+    if (B->fapp) {
+        memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    } else {
+        memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    }
+    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
     o->slip = o->viscous = o->released = 0;
     o->lost_bonds = 0;
     o->ncracks = 0;
@@ -677,65 +704,66 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
     const int nlaw = m->law_n;
     const bool track = m->track_energy;
     for (int64_t c = o->first; c < o->last; c++) {
-        const int64_t i = p->a[c], j = p->b[c];
-        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
-        double n[D];
-        for (int k = 0; k < D; k++) n[k] = x[j * D + k] - x[i * D + k];
-        const double d2 = dot(n, n), rsum = rad[i] + rad[j];
-        const sx_pair_law *law = &m->law[B->mat[i] * nlaw + B->mat[j]];
-        double *fs = p->fs + c * D;
-        if (__builtin_expect(d2 >= rsum * rsum && slot < 0, 1)) {
-            if (p->touching[c] && track) { /* the shear spring's energy is released as the contact opens */
+        const int64_t i = pa[c], j = pb[c];
+        const int32_t slot = bond ? bond[c] - 1 : -1;
+        double dx[D];
+        for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
+        const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
+        const sx_pair_law *law = &laws[mat[i] * nlaw + mat[j]];
+        double *restrict fs = fs_all + c * D, *restrict nold = nold_all + c * D;
+        if (d2 >= rsum * rsum && slot < 0) {
+            if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
                 double kn, ks;
-                stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, 0, &kn, &ks);
+                stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
                 if (!law->hertz && ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
             }
-            p->touching[c] = 0;
+            touching[c] = 0;
             continue;
         }
         /* 4-1 ... 4-4 */
         const double d = sqrt(d2), inv_d = 1.0 / d;
-        for (int k = 0; k < D; k++) n[k] *= inv_d;
+        double n[D];
+        for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
         const double un = rsum - d;
-        const double rmin = rad[i] < rad[j] ? rad[i] : rad[j];
+        const double rmin = ri < rj ? ri : rj;
         if (un > rmin) {
             o->st = SX_EUNSTABLE;
             o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un, o->err_r = rmin;
             return;
         }
-        const double la = rad[i] - 0.5 * un, lb = rad[j] - 0.5 * un;
-        double ra[D], rb[D], xc[D];
-        for (int k = 0; k < D; k++) {
-            ra[k] = la * n[k];
-            rb[k] = -lb * n[k];
-            xc[k] = x[i * D + k] + ra[k];
-        }
-        /* 4-16: contact-point velocity of b relative to a */
-        double va[D], vb[D], vc[D];
-        spin_cross(w + i * RD, ra, va);
-        spin_cross(w + j * RD, rb, vb);
-        for (int k = 0; k < D; k++) vc[k] = (v[j * D + k] + vb[k]) - (v[i * D + k] + va[k]);
+        const double la = ri - 0.5 * un, lb = rj - 0.5 * un;
+        /* 4-16 with the arms la n from a and -lb n from b: the contact-point
+         * velocity of b relative to a is vb - va - (la wa + lb wb) x n */
+        const double *wi = w + i * RD, *wj = w + j * RD;
+        double ws[RD], wn[D], vc[D];
+        for (int k = 0; k < RD; k++) ws[k] = la * wi[k] + lb * wj[k];
+        spin_cross(ws, n, wn);
+        for (int k = 0; k < D; k++) vc[k] = (v[j * D + k] - v[i * D + k]) - wn[k];
         const double vn = dot(vc, n);
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k]; /* 4-17 */
 
-        if (!p->touching[c])
-            for (int k = 0; k < D; k++) fs[k] = 0, p->nold[c * D + k] = n[k];
+        if (!touching[c])
+            for (int k = 0; k < D; k++) fs[k] = 0, nold[k] = n[k];
         carry rot;
-        carry_make(&rot, p->nold + c * D, n, w + i * RD, w + j * RD, dt);
+        carry_make(&rot, nold, n, wi, wj, dt);
         unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
         const unsigned bonds_before = bonds;
+        double xc[D]; /* the contact point (4-4), for the crack log */
+        if (slot >= 0)
+            for (int k = 0; k < D; k++) xc[k] = x[i * D + k] + la * n[k];
 
         double kn, ks, fn = 0, F[D], mb[RD];
-        for (int k = 0; k < RD; k++) mb[k] = 0;
+        bool bond_moment = false;
         const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
         bool slip = false;
         if (active) {
-            fn = stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, un, &kn, &ks);
+            fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
             carry_apply(&rot, fs);
             double f0[D]; /* the shear force before this step's increment, for the slip energy */
             for (int k = 0; k < D; k++) f0[k] = fs[k];
-            for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt; /* 4-18 ... 4-20 */
+            const double ksdt = ks * dt;
+            for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
             if (bonds & SX_BOND_CONTACT) {
                 const double fsn = sqrt(dot(fs, fs));
                 if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
@@ -772,39 +800,45 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
                     slip = true;
                 }
             }
-            double fd = fn;
-            double dsh[D];
-            for (int k = 0; k < D; k++) dsh[k] = 0;
+            double fd = fn, dsh[D];
+            bool shear_dashpot = false;
             if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
-                /* viscous dashpots at the critical-damping ratios, on the reduced mass */
-                const double mstar = 1.0 / (im[i] + im[j]);
-                const double fdn = -2 * law->beta_n * sqrt(mstar * kn) * vn;
+                /* viscous dashpots at the critical-damping ratios on the reduced mass
+                 * m* = 1 / (1/ma + 1/mb): c = 2 beta sqrt(m* k), a per-law factor when k is */
+                const double sum_im = im[i] + im[j];
+                const double cn = law->hertz || law->per_radius ? 2 * law->beta_n * sqrt(kn / sum_im)
+                                                                : sqrt(law->dash_n / sum_im);
+                const double fdn = -cn * vn;
                 fd += fdn;
                 double work = fdn * vn;
                 if (!slip && law->beta_s > 0) {
-                    const double cs = 2 * law->beta_s * sqrt(mstar * ks);
+                    const double cs = 2 * law->beta_s * sqrt(ks / sum_im);
                     for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                     work += dot(dsh, vs);
+                    shear_dashpot = true;
                 }
                 if (track) o->viscous -= work * dt;
             }
-            for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k]; /* 4-5 */
-            p->fn[c] = fd;
+            for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k]; /* 4-5 */
+            if (shear_dashpot)
+                for (int k = 0; k < D; k++) F[k] += dsh[k];
+            fn_all[c] = fd;
         } else {
-            if (track && p->touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
+            if (track && touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
                 double kn0, ks0;
-                stiffness(law, rad[i], rad[j], 2 * rad[i] * rad[j] / rsum, 0, &kn0, &ks0);
+                stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn0, &ks0);
                 if (!law->hertz && ks0 > 0) o->slip += 0.5 * dot(fs, fs) / ks0;
             }
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
-            p->fn[c] = 0;
+            fn_all[c] = 0;
         }
-        p->un[c] = un;
+        un_all[c] = un;
         if (bonds & SX_BOND_PARALLEL) {
             double dtheta[RD];
-            for (int k = 0; k < RD; k++) dtheta[k] = (w[j * RD + k] - w[i * RD + k]) * dt;
-            if (!parallel_bond(m, o, slot, &rot, n, vn, vs, dtheta, xc, i, j, F, mb))
-                bonds &= ~(unsigned)SX_BOND_PARALLEL;
+            for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
+            for (int k = 0; k < RD; k++) mb[k] = 0;
+            if (parallel_bond(m, o, slot, &rot, n, vn, vs, dtheta, xc, i, j, F, mb)) bond_moment = true;
+            else bonds &= ~(unsigned)SX_BOND_PARALLEL;
         }
         if (bonds != bonds_before) { /* only this pair touches its bond slot */
             m->bonds.kind[slot] = (uint8_t)bonds;
@@ -813,34 +847,232 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
                 o->lost_bonds++;
             }
         }
-        for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
-        p->touching[c] = active || bonds;
-        /* 4-21 and 4-39 */
-        double ma[RD], mbc[RD];
-        moment_of(ra, F, ma);
-        moment_of(rb, F, mbc);
-        const int64_t li = i - lo, lj = j - lo;
+        for (int k = 0; k < D; k++) nold[k] = n[k];
+        touching[c] = active || bonds;
+        /* 4-21 and 4-39: both arms lie along n, so both moments are multiples of n x F */
+        double nf[RD];
+        moment_of(n, F, nf);
+        double *fi = f + i * D, *ti = t + i * RD, *fj, *tj;
+        if (j < own_hi) {
+            fj = f + j * D, tj = t + j * RD;
+        } else {
+            fj = sf + (j - own_hi) * D, tj = st + (j - own_hi) * RD;
+        }
         for (int k = 0; k < D; k++) {
-            f[li * D + k] -= F[k];
-            f[lj * D + k] += F[k];
+            fi[k] -= F[k];
+            fj[k] += F[k];
         }
         for (int k = 0; k < RD; k++) {
-            t[li * RD + k] -= ma[k] + mb[k];
-            t[lj * RD + k] += mbc[k] + mb[k];
+            double ma = la * nf[k], mj = -lb * nf[k];
+            if (bond_moment) ma += mb[k], mj += mb[k];
+            ti[k] -= ma;
+            tj[k] += mj;
         }
     }
 }
 
-/* Splits the ball-ball pairs into chunks (their number a function of the
- * pair count only) and sizes their buffers. Called after each build. Few,
- * large chunks: each buffer spans its own balls plus about one layer of
- * cells ahead, so the pool costs (1 + chunks x layer / N) times the force
- * arrays. MAX_CHUNKS also bounds the useful thread count. */
-enum { CHUNK_PAIRS = 4096, MAX_CHUNKS = 8 };
+/* The common case (linear laws without a shear dashpot, no bonds, no
+ * energy tracking) of ball_chunk_pass in batches of pairs:
+ * the pairs' inputs are gathered into short arrays, every formula runs as
+ * a loop over the batch that the compiler vectorises (branches become
+ * selects: a pair out of contact or slipping takes the same lanes, and
+ * multiplying by a scale of exactly 1 changes nothing), and the results
+ * are scattered in pair order. Each lane does the scalar pass's arithmetic
+ * in its order, so both give the same bits. */
+enum { BATCH = 16 };
+
+/* The batched pass is compiled twice where the compiler can pick at run
+ * time (GCC's function multi-versioning on x86-64 GNU/Linux): with AVX2,
+ * four lanes per instruction, and for the baseline ISA. Neither fuses
+ * (-ffp-contract=off) and both round every operation alike, so the two
+ * give the same bits. AddressSanitizer builds keep the baseline alone (an
+ * ifunc resolver runs before the sanitizer is set up). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
+#define SX_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SX_VECTOR_CLONES
+#endif
+
+SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
+    const double *restrict im = B->inv_mass;
+    const uint16_t *restrict mat = B->mat;
+    const int32_t *restrict pa = p->a, *restrict pb = p->b;
+    double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
+    uint8_t *restrict touching = p->touching;
+    double *restrict f = B->f, *restrict t = B->t;
+    const sx_pair_law *laws = m->law;
+    const int nlaw = m->law_n;
+    const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
+    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
+    if (B->fapp) {
+        memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    } else {
+        memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
+        memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
+    }
+    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
+    o->slip = o->viscous = o->released = 0;
+    o->lost_bonds = 0;
+    o->ncracks = 0;
+    o->st = SX_OK;
+    const double dt = motion_dt(m);
+    /* the law's parameters per lane; with one material, filled once */
+    double kn[BATCH], ks[BATCH], mu[BATCH], dash[BATCH], bn[BATCH];
+    for (int q = 0; q < BATCH; q++)
+        kn[q] = laws->kn, ks[q] = laws->ks, mu[q] = laws->mu, dash[q] = laws->dash_n, bn[q] = laws->beta_n;
+
+    for (int64_t c0 = o->first; c0 < o->last; c0 += BATCH) {
+        const int nb = o->last - c0 < BATCH ? (int)(o->last - c0) : BATCH;
+        /* gathered inputs; lanes past nb repeat the batch's first pair */
+        double dx[D][BATCH], dv[D][BATCH], wi[RD][BATCH], wj[RD][BATCH], fs[D][BATCH], no[D][BATCH];
+        double ri[BATCH], rj[BATCH], sim[BATCH], live[BATCH];
+        for (int q = 0; nlaw > 1 && q < BATCH; q++) {
+            const int64_t c = c0 + (q < nb ? q : 0);
+            const sx_pair_law *law = &laws[mat[pa[c]] * nlaw + mat[pb[c]]];
+            kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
+        }
+        for (int q = 0; q < BATCH; q++) {
+            const int64_t c = c0 + (q < nb ? q : 0), i = pa[c], j = pb[c];
+            for (int k = 0; k < D; k++) {
+                dx[k][q] = x[j * D + k] - x[i * D + k];
+                dv[k][q] = v[j * D + k] - v[i * D + k];
+                fs[k][q] = fs_all[c * D + k];
+                no[k][q] = nold_all[c * D + k];
+            }
+            for (int k = 0; k < RD; k++) wi[k][q] = w[i * RD + k], wj[k][q] = w[j * RD + k];
+            ri[q] = rad[i], rj[q] = rad[j];
+            sim[q] = im[i] + im[j];
+            live[q] = touching[c];
+        }
+        /* results */
+        double n[D][BATCH], F[D][BATCH], ma[RD][BATCH], mj[RD][BATCH], un[BATCH], fdo[BATCH];
+        for (int q = 0; q < BATCH; q++) {
+            /* 4-1 ... 4-4 */
+            double d2 = 0;
+            for (int k = 0; k < D; k++) d2 += dx[k][q] * dx[k][q];
+            const double d = sqrt(d2), inv_d = 1.0 / d;
+            double nq[D];
+            for (int k = 0; k < D; k++) nq[k] = dx[k][q] * inv_d;
+            const double u = ri[q] + rj[q] - d;
+            const double la = ri[q] - 0.5 * u, lb = rj[q] - 0.5 * u;
+            /* 4-16, 4-17 as in ball_chunk_pass */
+            double ws[RD], wn[D], vc[D];
+            for (int k = 0; k < RD; k++) ws[k] = la * wi[k][q] + lb * wj[k][q];
+            spin_cross(ws, nq, wn);
+            for (int k = 0; k < D; k++) vc[k] = dv[k][q] - wn[k];
+            double vn = 0;
+            for (int k = 0; k < D; k++) vn += vc[k] * nq[k];
+            double vs[D];
+            for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * nq[k];
+            /* history: none for a new contact */
+            const bool had = live[q] != 0;
+            double g[D], nold[D];
+            for (int k = 0; k < D; k++) g[k] = had ? fs[k][q] : 0, nold[k] = had ? no[k][q] : nq[k];
+            double wab[RD];
+            for (int k = 0; k < RD; k++) wab[k] = wi[k][q] + wj[k][q];
+            carry rot;
+            carry_make(&rot, nold, nq, NULL, wab, dt);
+            carry_apply(&rot, g);
+            const double fn = kn[q] * u; /* 4-6 */
+            const double ksdt = ks[q] * dt;
+            for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+            /* 4-30/4-31 */
+            const double fmax = mu[q] * (fn > 0 ? fn : 0);
+            double f2 = 0;
+            for (int k = 0; k < D; k++) f2 += g[k] * g[k];
+            const double slip_sc = fmax / sqrt(f2); /* evaluated in every lane, taken where it slips */
+            const double sc = f2 > fmax * fmax ? slip_sc : 1.0;
+            for (int k = 0; k < D; k++) g[k] *= sc;
+            const bool active = u > 0;
+            const double cn = sqrt(dash[q] / sim[q]);
+            const double fdash = fn + -cn * vn;
+            const double fd = bn[q] > 0 && active ? fdash : fn;
+            for (int k = 0; k < D; k++) {
+                const double fk = fd * nq[k] + g[k]; /* 4-5 */
+                F[k][q] = active ? fk : 0;
+                fs[k][q] = active ? g[k] : 0;
+                n[k][q] = nq[k];
+            }
+            double Fq[D], nf[RD];
+            for (int k = 0; k < D; k++) Fq[k] = F[k][q];
+            moment_of(nq, Fq, nf); /* 4-21 */
+            for (int k = 0; k < RD; k++) ma[k][q] = la * nf[k], mj[k][q] = -lb * nf[k];
+            un[q] = u;
+            fdo[q] = active ? fd : 0;
+            live[q] = d2 < (ri[q] + rj[q]) * (ri[q] + rj[q]) ? (active ? 2 : 1) : 0;
+        }
+        for (int q = 0; q < nb; q++) {
+            const int64_t c = c0 + q, i = pa[c], j = pb[c];
+            if (live[q] == 0) { /* out of reach this step */
+                touching[c] = 0;
+                continue;
+            }
+            const double rmin = ri[q] < rj[q] ? ri[q] : rj[q];
+            if (un[q] > rmin) {
+                o->st = SX_EUNSTABLE;
+                o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un[q], o->err_r = rmin;
+                return;
+            }
+            for (int k = 0; k < D; k++) fs_all[c * D + k] = fs[k][q], nold_all[c * D + k] = n[k][q];
+            un_all[c] = un[q];
+            fn_all[c] = fdo[q];
+            touching[c] = live[q] == 2;
+            double *fi = f + i * D, *ti = t + i * RD, *fj, *tj;
+            if (j < own_hi) {
+                fj = f + j * D, tj = t + j * RD;
+            } else {
+                fj = sf + (j - own_hi) * D, tj = st + (j - own_hi) * RD;
+            }
+            for (int k = 0; k < D; k++) {
+                fi[k] -= F[k][q];
+                fj[k] += F[k][q];
+            }
+            for (int k = 0; k < RD; k++) {
+                ti[k] -= ma[k][q];
+                tj[k] += mj[k][q];
+            }
+        }
+    }
+}
+
+static void ball_chunk(sx_model *m, sx_chunk *o)
+{
+    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_batched(m, o);
+    else ball_chunk_pass(m, o);
+}
+
+/* Chunks of the ball-ball pass and blocks of the per-ball passes, planned
+ * after each build (and on a restore) from the stores alone. Few, large
+ * chunks of whole a-groups: a chunk's spill buffer spans about one layer of
+ * cells ahead of its balls. MAX_CHUNKS also bounds the useful thread count
+ * of that pass; MOTION_BLOCKS that of the per-ball passes. */
+enum { CHUNK_PAIRS = 4096, MAX_CHUNKS = 8, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
+
+/* First index c of sorted a[0..n) with a[c] >= key. */
+static int64_t lower_bound(const int32_t *a, int64_t n, int64_t key)
+{
+    int64_t lo = 0, hi = n;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
 
 static bool plan_chunks(sx_model *m)
 {
+    /* ownership needs the pairs grouped by a: bonded pairs appended by a
+     * build, or a store patched by a removal, are put in order (stably, so
+     * each ball's contacts keep their order) */
+    if (!sx__pairs_sort(m, &m->bb) || !sx__pairs_sort(m, &m->bw)) return false;
     const sx_pairs *p = &m->bb;
+    const int64_t n = m->balls.n;
     int64_t k = (p->n + CHUNK_PAIRS - 1) / CHUNK_PAIRS;
     if (k < 1) k = 1;
     if (k > MAX_CHUNKS) k = MAX_CHUNKS;
@@ -851,21 +1083,25 @@ static bool plan_chunks(sx_model *m)
         m->cap_chunk = k;
     }
     m->nchunk = k;
+    /* chunk c starts at the a-group holding pair p->n c / k */
+    for (int64_t c = 0; c < k; c++) {
+        int64_t q = p->n * c / k;
+        while (q > 0 && q < p->n && p->a[q - 1] == p->a[q]) q--;
+        if (c > 0 && q < m->chunks[c - 1].first) q = m->chunks[c - 1].first;
+        m->chunks[c].first = q;
+        m->chunks[c].own_lo = c == 0 ? 0 : q < p->n ? p->a[q] : n;
+    }
     int64_t pool = 0;
     for (int64_t c = 0; c < k; c++) {
         sx_chunk *o = &m->chunks[c];
-        o->first = p->n * c / k;
-        o->last = p->n * (c + 1) / k;
-        int64_t lo = INT64_MAX, hi = -1;
-        for (int64_t q = o->first; q < o->last; q++) {
-            if (p->a[q] < lo) lo = p->a[q];
-            if (p->b[q] > hi) hi = p->b[q];
-        }
-        if (hi < 0) lo = hi = 0; /* an empty chunk keeps a one-ball buffer */
-        o->lo = lo;
-        o->hi = hi;
+        o->last = c + 1 < k ? m->chunks[c + 1].first : p->n;
+        o->own_hi = c + 1 < k ? m->chunks[c + 1].own_lo : n;
+        int64_t hi = o->own_hi;
+        for (int64_t q = o->first; q < o->last; q++)
+            if (p->b[q] + 1 > hi) hi = p->b[q] + 1;
+        o->spill_hi = hi;
         o->off = pool;
-        pool += hi - lo + 1;
+        pool += hi - o->own_hi;
     }
     if (pool * (D + RD) > m->cap_pool) {
         double *q = sx_alloc_resize(&m->alloc, m->pool, (size_t)m->cap_pool, (size_t)(pool * (D + RD)), sizeof *q);
@@ -873,34 +1109,32 @@ static bool plan_chunks(sx_model *m)
         m->pool = q;
         m->cap_pool = pool * (D + RD);
     }
+    /* blocks of at least MOTION_MIN balls, at most MOTION_BLOCKS of them */
+    if (!m->blocks) {
+        m->blocks = sx_alloc_resize(&m->alloc, NULL, 0, MOTION_BLOCKS, sizeof *m->blocks);
+        if (!m->blocks) return false;
+    }
+    int64_t nb = (n + MOTION_MIN - 1) / MOTION_MIN;
+    if (nb > MOTION_BLOCKS) nb = MOTION_BLOCKS;
+    const int64_t size = nb ? (n + nb - 1) / nb : 0;
+    m->nblock = nb;
+    for (int64_t b = 0; b < nb; b++) {
+        sx_block *o = &m->blocks[b];
+        o->b0 = b * size;
+        o->b1 = (b + 1) * size < n ? (b + 1) * size : n;
+        o->w0 = lower_bound(m->bw.a, m->bw.n, o->b0);
+        o->w1 = lower_bound(m->bw.a, m->bw.n, o->b1);
+    }
     return true;
 }
 
-/* Runs the chunks (in parallel), then sums each ball's force and moment
- * over the chunks in chunk order, and merges energies, cracks and errors in
- * chunk order too. */
-static sx_status ball_contacts(sx_model *m)
+/* Runs the chunks (in parallel), then merges energies, cracks and errors in
+ * chunk order. */
+static sx_status KERNEL(contacts)(sx_model *m)
 {
     const int64_t nchunk = m->nchunk;
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (m->bb.n > 2 * CHUNK_PAIRS)
     for (int64_t c = 0; c < nchunk; c++) ball_chunk(m, &m->chunks[c]);
-
-    sx_balls *B = &m->balls;
-    const int64_t n = B->n;
-#pragma omp parallel for schedule(static) num_threads(m->threads) if (n > 4 * CHUNK_PAIRS)
-    for (int64_t blk = 0; blk < (n + 1023) / 1024; blk++) {
-        const int64_t b0 = blk * 1024, b1 = b0 + 1024 < n ? b0 + 1024 : n;
-        for (int64_t c = 0; c < nchunk; c++) {
-            const sx_chunk *o = &m->chunks[c];
-            const int64_t s0 = o->lo > b0 ? o->lo : b0, s1 = o->hi + 1 < b1 ? o->hi + 1 : b1;
-            const int64_t len = o->hi - o->lo + 1;
-            const double *fb = m->pool + o->off * (D + RD), *tb = fb + len * D;
-            for (int64_t i = s0; i < s1; i++) {
-                for (int k = 0; k < D; k++) B->f[i * D + k] += fb[(i - o->lo) * D + k];
-                for (int k = 0; k < RD; k++) B->t[i * RD + k] += tb[(i - o->lo) * RD + k];
-            }
-        }
-    }
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
@@ -913,49 +1147,71 @@ static sx_status ball_contacts(sx_model *m)
     return SX_OK;
 }
 
-/* Ball-wall contacts: the wall is entity A (phi1 of 4-10), the ball B;
- * n points from the wall to the ball. */
-static sx_status wall_contacts(sx_model *m)
+/* The wall pass of one block: the chunks' spill buffers added in chunk
+ * order, then the block's ball-wall contacts. The wall is entity A (phi1
+ * of 4-10), the ball B; n points from the wall to the ball. Wall
+ * resultants go to the block's partial sums acc (one per wall). */
+static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
 {
     sx_balls *B = &m->balls;
+    double *restrict f = B->f, *restrict t = B->t;
+    for (int64_t c = 0; c < m->nchunk; c++) {
+        const sx_chunk *h = &m->chunks[c];
+        const int64_t s0 = h->own_hi > o->b0 ? h->own_hi : o->b0, s1 = h->spill_hi < o->b1 ? h->spill_hi : o->b1;
+        const int64_t len = h->spill_hi - h->own_hi;
+        if (s0 >= s1) continue;
+        const double *restrict sf = m->pool + h->off * (D + RD), *restrict st = sf + len * D;
+        for (int64_t i = s0; i < s1; i++) {
+            for (int k = 0; k < D; k++) f[i * D + k] += sf[(i - h->own_hi) * D + k];
+            for (int k = 0; k < RD; k++) t[i * RD + k] += st[(i - h->own_hi) * RD + k];
+        }
+    }
+    if (m->nwall) memset(acc, 0, (size_t)m->nwall * sizeof *acc);
+    o->slip = o->viscous = 0;
+    o->st = SX_OK;
     sx_pairs *p = &m->bw;
     const double dt = motion_dt(m);
     const bool track = m->track_energy;
-    for (int64_t c = 0; c < p->n; c++) {
+    for (int64_t c = o->w0; c < o->w1; c++) {
         const int64_t i = p->a[c];
-        sx_wall *wl = &m->walls[p->b[c]];
+        const sx_wall *wl = &m->walls[p->b[c]];
+        sx_wall_acc *wa = &acc[p->b[c]];
         const double *xi = B->x + i * D, r = B->rad[i];
         double *fs = p->fs + c * D;
         double n[D];
         const double dist = wall_distance(wl, xi, n);
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
+        const sx_pair_law *law = &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
         if (dist >= r) {
-            if (p->touching[c] && track && !law.hertz) {
+            if (p->touching[c] && track && !law->hertz) {
                 double kn, ks;
-                stiffness(&law, r, 0, r, 0, &kn, &ks);
-                if (ks > 0) m->acc.slip += 0.5 * dot(fs, fs) / ks;
+                stiffness(law, r, 0, r, 0, &kn, &ks);
+                if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
             }
             p->touching[c] = 0;
             continue;
         }
         const double un = r - dist; /* 4-3 */
-        if (un > r) return overlap_error(m, "ball and wall", B->id[i], wl->id, un, r);
-        double rb[D], xc[D];
-        for (int k = 0; k < D; k++) {
-            rb[k] = -(r - 0.5 * un) * n[k];
-            xc[k] = xi[k] + rb[k]; /* 4-4 */
+        if (un > r) {
+            o->st = SX_EUNSTABLE;
+            o->err_ball = B->id[i], o->err_wall = wl->id, o->err_un = un, o->err_r = r;
+            return;
         }
-        double vb[D], vc[D];
-        spin_cross(B->w + i * RD, rb, vb);
-        /* the wall's surface velocity: its translation, and a cylinder's radial motion along -n */
+        const double lb = r - 0.5 * un;
+        double xc[D];
+        for (int k = 0; k < D; k++) xc[k] = xi[k] - lb * n[k]; /* 4-4 */
+        /* the contact point's velocity: the ball's, with its arm -lb n, less the
+         * wall's surface velocity (its translation, and a cylinder's radial
+         * motion along -n) */
+        double wn[D], vc[D];
+        spin_cross(B->w + i * RD, n, wn);
         for (int k = 0; k < D; k++)
-            vc[k] = (B->v[i * D + k] + vb[k]) - (wl->def.vel[k] - wl->def.radial_vel * n[k]);
+            vc[k] = (B->v[i * D + k] - lb * wn[k]) - (wl->def.vel[k] - wl->def.radial_vel * n[k]);
         const double vn = dot(vc, n);
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
 
         double kn, ks;
-        const double fn = stiffness(&law, r, 0, r, un, &kn, &ks);
+        const double fn = stiffness(law, r, 0, r, un, &kn, &ks);
         if (!p->touching[c])
             for (int k = 0; k < D; k++) fs[k] = 0, p->nold[c * D + k] = n[k];
         carry rot;
@@ -963,15 +1219,16 @@ static sx_status wall_contacts(sx_model *m)
         carry_apply(&rot, fs);
         double f0[D];
         for (int k = 0; k < D; k++) f0[k] = fs[k];
-        for (int k = 0; k < D; k++) fs[k] -= ks * vs[k] * dt;
-        const double fmax = law.mu * fn, f2 = dot(fs, fs);
+        const double ksdt = ks * dt;
+        for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k];
+        const double fmax = law->mu * fn, f2 = dot(fs, fs);
         bool slip = false;
         if (f2 > fmax * fmax) {
             const double sc = fmax / sqrt(f2);
             if (track && ks > 0) { /* as for ball-ball contacts */
                 double e = 0;
                 for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                m->acc.slip += 0.5 * e / ks;
+                o->slip += 0.5 * e / ks;
             }
             for (int k = 0; k < D; k++) fs[k] *= sc;
             slip = true;
@@ -980,30 +1237,36 @@ static sx_status wall_contacts(sx_model *m)
         p->touching[c] = 1;
 
         double fd = fn, dsh[D], F[D];
-        for (int k = 0; k < D; k++) dsh[k] = 0;
-        if (law.beta_n > 0 || law.beta_s > 0) {
-            const double mass = 1.0 / B->inv_mass[i];
-            const double fdn = -2 * law.beta_n * sqrt(mass * kn) * vn;
+        bool shear_dashpot = false;
+        if (law->beta_n > 0 || law->beta_s > 0) {
+            /* the ball's full mass: c = 2 beta sqrt(m k) */
+            const double cn = law->hertz || law->per_radius ? 2 * law->beta_n * sqrt(kn / B->inv_mass[i])
+                                                            : sqrt(law->dash_n / B->inv_mass[i]);
+            const double fdn = -cn * vn;
             fd += fdn;
             double work = fdn * vn;
-            if (!slip && law.beta_s > 0) {
-                const double cs = 2 * law.beta_s * sqrt(mass * ks);
+            if (!slip && law->beta_s > 0) {
+                const double cs = 2 * law->beta_s * sqrt(ks / B->inv_mass[i]);
                 for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                 work += dot(dsh, vs);
+                shear_dashpot = true;
             }
-            if (track) m->acc.viscous -= work * dt;
+            if (track) o->viscous -= work * dt;
         }
-        for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k] + dsh[k];
+        for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k];
+        if (shear_dashpot)
+            for (int k = 0; k < D; k++) F[k] += dsh[k];
         p->un[c] = un;
         p->fn[c] = fd;
-        wl->load += fd;
-        wl->kn_sum += kn;
-        wl->contacts++;
-        double mb[RD], mw[RD], arm[D];
-        moment_of(rb, F, mb);
+        wa->load += fd;
+        wa->kn_sum += kn;
+        wa->contacts++;
+        /* 4-21: the ball's arm is -lb n */
+        double nf[RD], mw[RD], arm[D];
+        moment_of(n, F, nf);
         for (int k = 0; k < D; k++) {
-            B->f[i * D + k] += F[k];
-            wl->force[k] -= F[k];
+            f[i * D + k] += F[k];
+            wa->force[k] -= F[k];
             arm[k] = xc[k] - wl->def.point[k];
         }
 #if D == 3
@@ -1012,38 +1275,57 @@ static sx_status wall_contacts(sx_model *m)
 #endif
         moment_of(arm, F, mw);
         for (int k = 0; k < RD; k++) {
-            B->t[i * RD + k] += mb[k];
-            wl->moment[k] -= mw[k];
+            t[i * RD + k] -= lb * nf[k];
+            wa->moment[k] -= mw[k];
         }
     }
-    return SX_OK;
 }
 
-static sx_status KERNEL(contacts)(sx_model *m)
+/* The wall pass over all blocks (in parallel), then the walls' resultants,
+ * energies and errors summed in block order. */
+static sx_status KERNEL(walls)(sx_model *m)
 {
-    sx_balls *B = &m->balls;
-    const size_t nf = (size_t)(B->n * D), nt = (size_t)(B->n * RD);
-    if (nf == 0) {
-        /* no ball (the arrays may not exist yet): nothing to clear */
-    } else if (B->fapp) {
-        memcpy(B->f, B->fapp, nf * sizeof(double));
-        memcpy(B->t, B->tapp, nt * sizeof(double));
-    } else {
-        memset(B->f, 0, nf * sizeof(double));
-        memset(B->t, 0, nt * sizeof(double));
+    const int64_t nw = m->nwall, nb = m->nblock;
+    /* the laws of each material against each wall, for this step */
+    if (m->nmat * nw > m->cap_wlaw) {
+        sx_pair_law *q = sx_alloc_resize(&m->alloc, m->wlaw, (size_t)m->cap_wlaw, (size_t)(m->nmat * nw), sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+        m->wlaw = q;
+        m->cap_wlaw = m->nmat * nw;
     }
-    for (int64_t w = 0; w < m->nwall; w++) {
+    for (int a = 0; a < m->nmat; a++)
+        for (int64_t w = 0; w < nw; w++) m->wlaw[a * nw + w] = sx__wall_law(m, a, &m->walls[w]);
+    if (nb * nw > m->cap_wall_acc) {
+        sx_wall_acc *q = sx_alloc_resize(&m->alloc, m->wall_acc, (size_t)m->cap_wall_acc, (size_t)(nb * nw), sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+        m->wall_acc = q;
+        m->cap_wall_acc = nb * nw;
+    }
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
+    for (int64_t b = 0; b < nb; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
+    for (int64_t w = 0; w < nw; w++) {
         sx_wall *wl = &m->walls[w];
         memset(wl->force, 0, sizeof wl->force);
         memset(wl->moment, 0, sizeof wl->moment);
         wl->load = wl->kn_sum = 0;
         wl->contacts = 0;
     }
-    sx_status st = ball_contacts(m);
-    if (st) return st;
-    if ((st = wall_contacts(m))) return st;
+    for (int64_t b = 0; b < nb; b++) {
+        const sx_block *o = &m->blocks[b];
+        if (o->st) return overlap_error(m, "ball and wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
+        m->acc.slip += o->slip;
+        m->acc.viscous += o->viscous;
+        for (int64_t w = 0; w < nw; w++) {
+            const sx_wall_acc *a = &m->wall_acc[b * nw + w];
+            sx_wall *wl = &m->walls[w];
+            for (int k = 0; k < 3; k++) wl->force[k] += a->force[k], wl->moment[k] += a->moment[k];
+            wl->load += a->load;
+            wl->kn_sum += a->kn_sum;
+            wl->contacts += a->contacts;
+        }
+    }
     if (m->track_energy) /* boundary work of the moving walls over this step */
-        for (int64_t w = 0; w < m->nwall; w++)
+        for (int64_t w = 0; w < nw; w++)
             m->acc.boundary_work -= (dot(m->walls[w].force, m->walls[w].def.vel) + m->walls[w].def.radial_vel * m->walls[w].load) * m->dt;
     return SX_OK;
 }
@@ -1057,94 +1339,113 @@ static inline double damped(double force, double vel, double alpha)
     return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
 }
 
-/* 4-46 ... 4-48: central differences, velocities at half steps. Returns the
- * largest displacement since the last build in *max_disp. With energy
- * tracking, the damping's and applied loads' work use the mean of the old
- * and new velocities. */
-/* The law of motion of balls [b0, b1): partial sums of one block. */
-typedef struct motion_block {
-    double worst, damp_work, load_work;
-    int64_t bad; /* first ball with a non-finite state, or -1 */
-} motion_block;
-
-static void integrate_block(sx_model *m, int64_t b0, int64_t b1, motion_block *o)
+/* 4-46 ... 4-48: central differences, velocities at half steps, for the
+ * balls of one block; partial sums go to the block. With energy tracking,
+ * the damping's and applied loads' work use the mean of the old and new
+ * velocities. A free, undamped component takes v += (F/m + g) dt, the
+ * same lines in both instances: `plain` (a constant at each call site)
+ * compiles a block without fixities, damping or tracking alone. */
+static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_block *o, const bool plain)
 {
     sx_balls *B = &m->balls;
     const double dt = m->dt;
     /* the kick spans the time between the half-step velocities, t_{n+1/2} - t_{n-1/2} */
     const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
-    const double *g = m->gravity;
-    const bool track = m->track_energy;
-    o->worst = o->damp_work = o->load_work = 0;
-    o->bad = -1;
-    for (int64_t i = b0; i < b1; i++) {
-        const unsigned fix = B->fix[i];
-        const double a = B->alpha[i], im = B->inv_mass[i], ii = B->inv_inertia[i];
-        double *v = B->v + i * D, *x = B->x + i * D;
-        const double *f = B->f + i * D;
+    const double g[D] = {m->gravity[0], m->gravity[1]
+#if D == 3
+                         , m->gravity[2]
+#endif
+    };
+    const bool track = !plain && m->track_energy;
+    double *restrict xa = B->x, *restrict va = B->v, *restrict wa = B->w;
+    const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
+    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia, *restrict alpha = B->alpha;
+    const uint8_t *restrict fixa = B->fix;
+    double worst = 0, damp_work = 0, load_work = 0;
+    double check = 0; /* a sum of 0 x every new value: NaN once any is not finite */
+    for (int64_t i = o->b0; i < o->b1; i++) {
+        const unsigned fix = plain ? 0 : fixa[i];
+        const double a = plain ? 0 : alpha[i], im = ima[i], ii = iia[i];
+        double *v = va + i * D, *x = xa + i * D;
+        const double *f = fa + i * D;
         double disp2 = 0;
         for (int k = 0; k < D; k++) {
             if (!(fix & (SX_FIX_VX << k))) {
-                const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
-                const double fd = damped(force, v[k], a);
                 const double vold = v[k];
-                v[k] += fd * im * dtv; /* 4-46 */
-                if (track) {
-                    o->damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
-                    if (B->fapp) o->load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
+                if (a == 0) {
+                    v[k] += (f[k] * im + g[k]) * dtv; /* 4-46 with 4-40 */
+                } else {
+                    const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
+                    const double fd = damped(force, v[k], a);
+                    v[k] += fd * im * dtv; /* 4-46 */
+                    if (track) damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
                 }
+                if (track && B->fapp) load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
             }
             x[k] += v[k] * dt; /* 4-48 */
-            const double u = x[k] - B->x_build[i * D + k];
+            const double u = x[k] - xb[i * D + k];
             disp2 += u * u;
+            check += 0 * x[k] + 0 * v[k];
         }
-        double *w = B->w + i * RD;
-        const double *t = B->t + i * RD;
-        for (int k = 0; k < RD; k++)
+        double *w = wa + i * RD;
+        const double *t = ta + i * RD;
+        for (int k = 0; k < RD; k++) {
             if (!(fix & (SX_FIX_WX << k))) {
-                const double md = damped(t[k], w[k], a);
                 const double wold = w[k];
-                w[k] += md * ii * dtv; /* 4-47 */
-                if (track) {
-                    o->damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
-                    if (B->tapp) o->load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
+                if (a == 0) {
+                    w[k] += t[k] * ii * dtv; /* 4-47 */
+                } else {
+                    const double md = damped(t[k], w[k], a);
+                    w[k] += md * ii * dtv;
+                    if (track) damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
                 }
+                if (track && B->tapp) load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
             }
-        bool ok = true;
-        for (int k = 0; k < D; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
-        for (int k = 0; k < RD; k++) ok &= isfinite(w[k]);
-        if (!ok && o->bad < 0) o->bad = i;
-        if (disp2 > o->worst) o->worst = disp2;
+            check += 0 * w[k];
+        }
+        worst = disp2 > worst ? disp2 : worst;
     }
+    o->worst = worst;
+    o->damp_work = damp_work;
+    o->load_work = load_work;
+    o->bad = -1;
+    if (check != check) /* find the first ball to blame */
+        for (int64_t i = o->b0; i < o->b1 && o->bad < 0; i++) {
+            bool ok = true;
+            for (int k = 0; k < D; k++) ok &= isfinite(xa[i * D + k]) && isfinite(va[i * D + k]);
+            for (int k = 0; k < RD; k++) ok &= isfinite(wa[i * RD + k]);
+            if (!ok) o->bad = i;
+        }
 }
 
-/* 4-46 ... 4-48: central differences, velocities at half steps, in fixed
- * blocks of balls whose partial sums are added in block order (the same
- * bits for any thread count). Returns the largest displacement since the
- * last build in *max_disp. With energy tracking, the damping's and applied
- * loads' work use the mean of the old and new velocities. */
-enum { MOTION_BLOCK = 2048, MOTION_BLOCKS = 64 };
+static void integrate_block(sx_model *m, sx_block *o)
+{
+    bool plain = !m->track_energy;
+    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !m->balls.fix[i] && m->balls.alpha[i] == 0;
+    if (plain) motion_pass(m, o, true);
+    else motion_pass(m, o, false);
+}
 
+/* The law of motion in fixed blocks of balls whose partial sums are added
+ * in block order (the same bits for any thread count). Returns the largest
+ * displacement since the last build in *max_disp. */
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
-    const int64_t n = m->balls.n;
-    motion_block part[MOTION_BLOCKS];
-    int64_t size = (n + MOTION_BLOCKS - 1) / MOTION_BLOCKS;
-    if (size < MOTION_BLOCK) size = MOTION_BLOCK;
-    const int64_t nblk = (n + size - 1) / size;
-#pragma omp parallel for schedule(static) num_threads(m->threads) if (nblk > 1)
-    for (int64_t k = 0; k < nblk; k++) integrate_block(m, k * size, (k + 1) * size < n ? (k + 1) * size : n, &part[k]);
+    const int64_t nb = m->nblock;
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
+    for (int64_t b = 0; b < nb; b++) integrate_block(m, &m->blocks[b]);
     double worst = 0;
-    for (int64_t k = 0; k < nblk; k++) {
-        if (part[k].bad >= 0)
+    for (int64_t b = 0; b < nb; b++) {
+        const sx_block *o = &m->blocks[b];
+        if (o->bad >= 0)
             return sx__fail(m, SX_EUNSTABLE,
                             "unstable at step %lld: ball %lld has a non-finite position, velocity or spin; "
                             "the timestep %g s is likely too large (critical estimate %g s)",
-                            (long long)m->step, (long long)m->balls.id[part[k].bad], m->dt, KERNEL(critical_dt)(m));
-        if (part[k].worst > worst) worst = part[k].worst;
+                            (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(critical_dt)(m));
+        if (o->worst > worst) worst = o->worst;
         if (m->track_energy) {
-            m->acc.local_damping -= part[k].damp_work;
-            m->acc.boundary_work += part[k].load_work;
+            m->acc.local_damping -= o->damp_work;
+            m->acc.boundary_work += o->load_work;
         }
     }
     *max_disp = sqrt(worst);
@@ -1253,6 +1554,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (dtr < best) best = dtr;
         }
     }
+    sx__scratch_release(m);
     return best;
 }
 
@@ -1383,6 +1685,7 @@ static int64_t KERNEL(count_contacts)(const sx_model *m)
 const sx_kernels KERNEL(sx_kernels) = {
     .build = KERNEL(build),
     .contacts = KERNEL(contacts),
+    .walls = KERNEL(walls),
     .integrate = KERNEL(integrate),
     .critical_dt = KERNEL(critical_dt),
     .energy = KERNEL(energy),

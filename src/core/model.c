@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* How often the automatic timestep is re-estimated between builds, and how
  * often the energy guard looks at an unforced system. */
@@ -81,8 +82,10 @@ void sx_model_destroy(sx_model *m)
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->pool, (size_t)m->cap_pool, sizeof *m->pool);
+    sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
+    sx_alloc_free(&m->alloc, m->wall_acc, (size_t)m->cap_wall_acc, sizeof *m->wall_acc);
+    sx_alloc_free(&m->alloc, m->wlaw, (size_t)m->cap_wlaw, sizeof *m->wlaw);
     sx_alloc_free(&m->alloc, m->grid.start, (size_t)m->grid.cap_cells, sizeof(int32_t));
-    sx_alloc_free(&m->alloc, m->grid.cell_of, (size_t)m->grid.cap_balls, sizeof(int32_t));
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
     sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof(double));
     sx_alloc_free(&m->alloc, m->mats, (size_t)m->cap_mat, sizeof *m->mats);
@@ -94,6 +97,26 @@ int sx_model_dim(const sx_model *m) { return m->dim; }
 double sx_model_time(const sx_model *m) { return m->time; }
 int64_t sx_model_step_count(const sx_model *m) { return m->step; }
 size_t sx_model_bytes(const sx_model *m) { return m->alloc.bytes; }
+
+sx_memory sx_model_memory(const sx_model *m)
+{
+    sx_memory r;
+    memset(&r, 0, sizeof r);
+    r.total = m->alloc.bytes;
+    r.peak = m->alloc.peak;
+    r.balls = sx__balls_bytes(m);
+    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw);
+    const sx_bonds *k = &m->bonds;
+    const size_t per_bond = 1 + 2 * sizeof(int32_t) + (9 + (size_t)m->dim + (size_t)m->rdim) * sizeof(double);
+    r.bonds = (size_t)k->cap * per_bond + (size_t)m->cracks.cap * sizeof(sx_crack);
+    r.work = r.total - r.balls - r.contacts - r.bonds;
+    r.ball_count = m->balls.n;
+    r.pair_count = m->bb.n + m->bw.n;
+    r.contact_count = kernels(m)->count_contacts(m);
+    r.bytes_per_ball = r.ball_count ? (double)r.balls / (double)r.ball_count : 0;
+    r.bytes_per_contact = r.contact_count ? (double)r.contacts / (double)r.contact_count : 0;
+    return r;
+}
 void sx_model_interrupt(sx_model *m) { m->interrupt = 1; }
 
 sx_status sx_model_set_threads(sx_model *m, int threads)
@@ -115,6 +138,13 @@ sx_status sx_model_set_gravity(sx_model *m, const double g[3])
     for (int k = 0; k < m->dim; k++) m->gravity[k] = g[k];
     m->guard_dirty = true;
     return SX_OK;
+}
+
+void sx__scratch_release(sx_model *m)
+{
+    sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof *m->scratch);
+    m->scratch = NULL;
+    m->scratch_cap = 0;
 }
 
 double *sx__scratch(sx_model *m, int64_t n)
@@ -231,6 +261,7 @@ static sx_pair_law combine(const sx_material_def *a, double kn, double ks, doubl
     l.mu = a->friction < mu ? a->friction : mu;
     l.beta_n = bn;
     l.beta_s = bs;
+    l.dash_n = 4 * bn * bn * l.kn;
     l.per_radius = a->modulus > 0 || ec > 0;
     l.kn_a = a->kn, l.ks_a = a->ks, l.ec_a = a->modulus, l.ratio_a = a->stiffness_ratio;
     l.kn_b = kn, l.ks_b = ks, l.ec_b = ec, l.ratio_b = ratio;
@@ -258,6 +289,7 @@ static sx_status refresh_laws(sx_model *m)
         m->law = q;
         m->law_n = n;
     }
+    bool plain = true;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
             const sx_material_def *a = &m->mats[i].def, *b = &m->mats[j].def;
@@ -268,7 +300,9 @@ static sx_status refresh_laws(sx_model *m)
             l->hertz = a->model == SX_MODEL_HERTZ && b->model == SX_MODEL_HERTZ;
             l->g = 0.5 * (a->shear_modulus + b->shear_modulus);
             l->nu = 0.5 * (a->poisson + b->poisson);
+            if (l->hertz || l->per_radius || l->beta_s > 0) plain = false;
         }
+    m->law_plain = plain;
     return SX_OK;
 }
 
@@ -449,13 +483,28 @@ static void move_walls(sx_model *m, double *max_wall)
     }
 }
 
-sx_status sx_model_cycle(sx_model *m, int64_t n)
+static double now(void)
 {
-    if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
-    if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
-    m->err[0] = 0;
-    m->interrupt = 0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Closes a stage that began at t0; returns the time, the next stage's start. */
+static double stage_end(sx_model *m, sx_stage s, double t0)
+{
+    const double t = now();
+    m->prof.seconds[s] += t - t0;
+    m->prof.calls[s]++;
+    return t;
+}
+
+static sx_status cycle_steps(sx_model *m, int64_t n)
+{
+    double t = now();
+    const int64_t builds = m->builds;
     sx_status st = sx__prepare(m);
+    if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
     if (st) return st;
     if ((st = update_timestep(m))) return st;
     const sx_kernels *k = kernels(m);
@@ -466,33 +515,119 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
         guard_start(m);
         m->guard_dirty = false;
     }
+    double other = now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
+        t = now();
         if (m->interrupt) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
         }
         if (m->build_needed) {
-            if (!k->build(m)) {
+            const bool ok = k->build(m);
+            t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
+            if (!ok) {
                 st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
                 break;
             }
         }
-        if ((st = update_timestep(m))) break;
-        if ((st = k->contacts(m))) break;
+        st = update_timestep(m);
+        double t1 = now();
+        other += t1 - t;
+        if (st) break;
+        st = k->contacts(m);
+        t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
+        if (st) break;
+        st = k->walls(m);
+        t1 = stage_end(m, SX_STAGE_WALL_CONTACTS, t1);
+        if (st) break;
         double max_disp, max_wall;
-        if ((st = k->integrate(m, &max_disp))) break;
+        st = k->integrate(m, &max_disp);
+        t = stage_end(m, SX_STAGE_INTEGRATION, t1);
+        if (st) break;
         sx__walls_servo(m);
         move_walls(m, &max_wall);
         m->time += m->dt;
         m->dt_prev = m->dt;
         m->step++;
+        m->prof.steps++;
+        m->prof.calls[SX_STAGE_OTHER]++;
         /* Verlet criterion: two balls may close the gap by twice the largest
          * displacement, a ball and a wall by both of their displacements. */
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
-        if (m->step % GUARD_STEPS == 0 && (st = guard_check(m))) break;
+        if (m->step % GUARD_STEPS == 0) st = guard_check(m);
+        other += now() - t;
+        if (st) break;
     }
+    m->prof.seconds[SX_STAGE_OTHER] += other;
     m->locked = false;
     return st;
+}
+
+sx_status sx_model_cycle(sx_model *m, int64_t n)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
+    if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
+    m->err[0] = 0;
+    m->interrupt = 0;
+    const double t0 = now();
+    const sx_status st = cycle_steps(m, n);
+    m->prof.cycle_seconds += now() - t0;
+    m->prof.cycles++;
+    return st;
+}
+
+/* ------------------------------------------------------------- profile */
+
+sx_profile sx_model_profile(const sx_model *m) { return m->prof; }
+
+void sx_model_profile_reset(sx_model *m) { memset(&m->prof, 0, sizeof m->prof); }
+
+void sx_model_profile_add(sx_model *m, sx_stage stage, double seconds)
+{
+    if ((unsigned)stage >= SX_STAGE_COUNT || !(seconds >= 0)) return;
+    m->prof.seconds[stage] += seconds;
+    m->prof.calls[stage]++;
+}
+
+const char *sx_stage_name(sx_stage stage)
+{
+    static const char *const names[SX_STAGE_COUNT] = {"broad phase", "ball contacts", "wall contacts",
+                                                      "integration", "callbacks",     "other"};
+    return (unsigned)stage < SX_STAGE_COUNT ? names[stage] : NULL;
+}
+
+/* snprintf at offset *used of buf[len], counting what it needed in *need. */
+static void appendf(char *buf, size_t len, int *need, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static void appendf(char *buf, size_t len, int *need, const char *fmt, ...)
+{
+    char none[1];
+    const size_t used = (size_t)*need;
+    va_list ap;
+    va_start(ap, fmt);
+    const int w = buf && used < len ? vsnprintf(buf + used, len - used, fmt, ap) : vsnprintf(none, sizeof none, fmt, ap);
+    va_end(ap);
+    if (w > 0) *need += w;
+}
+
+int sx_profile_format(const sx_profile *p, int64_t balls, char *buf, size_t len)
+{
+    double total = 0;
+    for (int s = 0; s < SX_STAGE_COUNT; s++) total += p->seconds[s];
+    int need = 0;
+#define OUT(...) appendf(buf, len, &need, __VA_ARGS__)
+    OUT("%-14s %10s %7s %10s %12s\n", "stage", "seconds", "share", "calls", "us/call");
+    for (int s = 0; s < SX_STAGE_COUNT; s++) {
+        const double sec = p->seconds[s];
+        OUT("%-14s %10.4f %6.1f%% %10lld %12.2f\n", sx_stage_name((sx_stage)s), sec, total > 0 ? 100 * sec / total : 0.0,
+            (long long)p->calls[s], p->calls[s] ? 1e6 * sec / (double)p->calls[s] : 0.0);
+    }
+    OUT("%-14s %10.4f %6.1f%% %10lld steps in %lld cycles (%.4f s inside cycles)\n", "total", total, 100.0,
+        (long long)p->steps, (long long)p->cycles, p->cycle_seconds);
+    if (balls > 0 && p->cycle_seconds > 0 && p->steps > 0)
+        OUT("%lld balls: %.3g particle-steps per second inside cycles\n", (long long)balls,
+            (double)balls * (double)p->steps / p->cycle_seconds);
+#undef OUT
+    return need;
 }
 
 /* ---------------------------------------------------------------- state */

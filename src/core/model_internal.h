@@ -101,18 +101,21 @@ typedef struct sx_grid {
     int64_t nc[3], ncells, cap_cells;
     int32_t *head;         /* first ball of each cell (after sorting: start index) */
     int32_t *start;        /* cells' start in sorted order (ncells + 1) */
-    int32_t *cell_of;      /* cell of each ball */
-    int64_t cap_balls;
 } sx_grid;
 
-/* The ball-ball pass runs in fixed chunks of pairs, each accumulating into
- * its own buffer over the ball range it touches; buffers are summed per ball
- * in chunk order. The chunking depends only on the pair store, never on the
- * thread count, so results are bit-identical for any number of threads. */
+/* The ball-ball pass runs in fixed chunks of pairs. Pairs are sorted by a
+ * (a < b), so chunk c owns a contiguous range of balls: the a's of its
+ * pairs. It writes its own balls' forces straight into the balls' arrays
+ * (no other chunk touches them) and the balls beyond its range, which only
+ * b can reach, into a small spill buffer; the wall pass adds the spill
+ * buffers in chunk order. The chunking depends only on the pair store,
+ * never on the thread count, so results are bit-identical for any number
+ * of threads. */
 typedef struct sx_chunk {
     int64_t first, last;   /* pair range [first, last) */
-    int64_t lo, hi;        /* ball range touched, inclusive */
-    int64_t off;           /* offset of its buffer (in balls) in the pool */
+    int64_t own_lo, own_hi;/* balls [own_lo, own_hi) written directly */
+    int64_t spill_hi;      /* balls [own_hi, spill_hi) go to the spill buffer */
+    int64_t off;           /* offset of its spill buffer (in balls) in the pool */
     /* results of the last pass */
     double slip, viscous, released;
     int64_t lost_bonds;
@@ -123,11 +126,33 @@ typedef struct sx_chunk {
     double err_un, err_r;
 } sx_chunk;
 
+/* The per-ball passes (spill sums and wall contacts, then the law of
+ * motion) run in fixed blocks of balls; each block keeps partial sums
+ * (energies, wall resultants), added in block order. */
+typedef struct sx_wall_acc {
+    double force[3], moment[3], load, kn_sum;
+    int64_t contacts;
+} sx_wall_acc;
+
+#define SX_MOTION_BLOCKS 64 /* at most this many blocks */
+
+typedef struct sx_block {
+    int64_t b0, b1;        /* balls [b0, b1) */
+    int64_t w0, w1;        /* their ball-wall pairs [w0, w1) */
+    double worst, damp_work, load_work, slip, viscous;
+    int64_t bad;           /* first ball with a non-finite state, or -1 */
+    sx_status st;          /* a wall contact's overlap error */
+    int64_t err_ball, err_wall;
+    double err_un, err_r;
+    double t_walls, t_motion; /* seconds spent in each pass (profile) */
+} sx_block;
+
 /* Contact parameters of a pair of materials, or of a material and a wall
  * (4-22, 4-23, 4-27/4-28, 4-30, 4-49/4-50). */
 typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
+    double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
     bool hertz;             /* Hertz-Mindlin with g, nu (the means, 4-27) */
     double g, nu;
     /* BPM modulus mode (4-49/4-50): a side with ec > 0 has kn = 4 R ec (3D)
@@ -166,12 +191,19 @@ struct sx_model {
     sx_pairs bb, bw;        /* ball-ball and ball-wall candidate pairs */
     sx_chunk *chunks;       /* the ball-ball pass's chunks, planned at each build */
     int64_t nchunk, cap_chunk;
-    double *pool;           /* chunk buffers: (dim + rdim) doubles per ball of each range */
+    double *pool;           /* chunk spill buffers: (dim + rdim) doubles per spilled ball */
     int64_t cap_pool;
+    sx_block *blocks;       /* the per-ball passes' blocks (room for SX_MOTION_BLOCKS) */
+    int64_t nblock;
+    sx_wall_acc *wall_acc;  /* nblock x nwall partial wall resultants */
+    int64_t cap_wall_acc;
     int threads;            /* OpenMP threads for the step (results do not depend on it) */
     sx_pair_law *law;       /* nmat x nmat contact parameters, refreshed each cycle */
     int law_n;
-    double *scratch;        /* per-build scratch (sorting, timestep sums) */
+    bool law_plain;         /* every law linear, not per radius, without a shear dashpot */
+    sx_pair_law *wlaw;      /* nmat x nwall laws of the ball-wall contacts, refreshed each step */
+    int64_t cap_wlaw;
+    double *scratch;        /* scratch of one operation (sorting, timestep sums), released after it */
     int64_t scratch_cap;
     sx_grid grid;
     int64_t builds;         /* number of broad-phase builds so far */
@@ -180,6 +212,8 @@ struct sx_model {
     sx_cracks cracks;
     bool track_energy;
     sx_energy acc;          /* accumulated energy terms (slip, damping, work, ...) */
+
+    sx_profile prof;         /* stage timers of sx_model_cycle */
 
     /* stability guard: mechanical energy at the start of the current cycle */
     double guard_e0, guard_scale;
@@ -194,7 +228,8 @@ sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
 /* Dimension kernels (kernels.c, one instance per dimension). */
 typedef struct sx_kernels {
     bool (*build)(sx_model *m);                  /* broad phase + history transfer; false: out of memory */
-    sx_status (*contacts)(sx_model *m);          /* forces of all contacts */
+    sx_status (*contacts)(sx_model *m);          /* ball-ball forces (the balls' forces start here) */
+    sx_status (*walls)(sx_model *m);             /* the chunks' spill buffers, then ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
     double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
     void (*energy)(const sx_model *m, sx_energy *e);
@@ -213,16 +248,24 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
-/* Gives back what a build did not use, keeping 1/8 headroom for the next. */
+/* Gives back what a build did not use, keeping 1/16 headroom for the next. */
 void sx__pairs_fit(sx_model *m, sx_pairs *p);
+/* Resizes the store to exactly cap pairs (never below its count). */
+sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
+/* Bytes of the ball arrays (with the id map and the grid's per-ball cells), of a pair store. */
+size_t sx__balls_bytes(const sx_model *m);
+size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p);
+/* Sorts the store by a, stably (a no-op when it is); false when out of memory. */
+bool sx__pairs_sort(sx_model *m, sx_pairs *p);
 void sx__walls_free(sx_model *m);
 void sx__wall_prepare(sx_model *m, sx_wall *w);
 void sx__walls_servo(sx_model *m); /* servo velocities from the step's wall loads */
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);
 double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */
+void sx__scratch_release(sx_model *m);      /* gives the scratch back (it is not kept between uses) */
 /* Records a broken bond; false when out of memory (the event is dropped). */
 bool sx__crack_log(sx_model *m, const sx_crack *c);
 /* Drops kind bits from a bond; the bond's slot stays, and intact counts follow. */

@@ -93,6 +93,58 @@ SX_API uint64_t sx_model_state_hash(const sx_model *m);
 /// Bytes currently allocated by the model.
 SX_API size_t sx_model_bytes(const sx_model *m);
 
+/// Where the model's bytes are: the arrays at their capacities, by owner.
+typedef struct sx_memory {
+    size_t total;           ///< bytes held (sx_model_bytes), the parts below together
+    size_t peak;            ///< the highest total so far
+    size_t balls;           ///< per-ball arrays (state, properties, id map, the grid's cell of each ball)
+    size_t contacts;        ///< the candidate pairs with their contact history (ball-ball and ball-wall)
+    size_t bonds;           ///< the bond store and the crack log
+    size_t work;            ///< the step's working storage: chunk buffers, blocks, grid cells, scratch, laws, walls
+    int64_t ball_count;     ///< balls
+    int64_t pair_count;     ///< candidate pairs stored (touching or within the skin)
+    int64_t contact_count;  ///< touching pairs of the last step
+    double bytes_per_ball;    ///< balls / ball_count
+    double bytes_per_contact; ///< contacts / contact_count: what each contact costs, its candidates included
+} sx_memory;
+
+SX_API sx_memory sx_model_memory(const sx_model *m);
+
+/* -------------------------------------------------------------- profile */
+
+/// The stages of a step, timed by every sx_model_cycle (always on: a few
+/// clock reads per step).
+typedef enum sx_stage {
+    SX_STAGE_BROAD_PHASE,   ///< grid, sorting, candidate pairs, history transfer (when the skin is used up)
+    SX_STAGE_BALL_CONTACTS, ///< ball-ball contact forces
+    SX_STAGE_WALL_CONTACTS, ///< ball-wall contact forces, and the sums of the ball-ball pass's buffers
+    SX_STAGE_INTEGRATION,   ///< the law of motion
+    SX_STAGE_CALLBACKS,     ///< time an embedding layer reports with sx_model_profile_add (Lua callbacks)
+    SX_STAGE_OTHER,         ///< the rest of a cycle: timestep, servos, wall motion, stability guard
+    SX_STAGE_COUNT
+} sx_stage;
+
+typedef struct sx_profile {
+    double seconds[SX_STAGE_COUNT]; ///< s of wall-clock time spent in each stage
+    int64_t calls[SX_STAGE_COUNT];  ///< how often each ran: once per step, the broad phase per build,
+                                    ///< callbacks per sx_model_profile_add
+    double cycle_seconds;           ///< s of wall-clock time inside sx_model_cycle (all stages but callbacks)
+    int64_t cycles;                 ///< sx_model_cycle calls
+    int64_t steps;                  ///< steps taken
+} sx_profile;
+
+/// The profile accumulated since the model was created or last reset.
+SX_API sx_profile sx_model_profile(const sx_model *m);
+SX_API void sx_model_profile_reset(sx_model *m);
+/// Adds time spent on the model's behalf outside the core (one call of the stage).
+SX_API void sx_model_profile_add(sx_model *m, sx_stage stage, double seconds);
+/// "broad phase", "ball contacts", ... (NULL for a bad stage).
+SX_API const char *sx_stage_name(sx_stage stage);
+/// Writes a table of the profile (seconds, share, calls, time per call per
+/// stage; particle-steps per second) into buf like snprintf; balls is the
+/// number of balls for the rate (0: none printed). Returns the length it needed.
+SX_API int sx_profile_format(const sx_profile *p, int64_t balls, char *buf, size_t len);
+
 /* ------------------------------------------------------------ materials */
 
 typedef enum sx_contact_model {

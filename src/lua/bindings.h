@@ -67,6 +67,8 @@ int sx_lua_model_new(lua_State *L);
 /// Creates the model class with the methods of every array in `sets`
 /// (NULL-terminated); leaves nothing on the stack.
 void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[]);
+/* Pushes the model's profile table as text (sx_profile_format). */
+void sx_lua_push_profile_text(lua_State *L, const sx_model *m);
 /// The model of the model userdata at idx, or NULL if it has been closed.
 sx_model *sx_lua_tomodel(lua_State *L, int idx);
 /// Like sx_lua_tomodel, but a closed model is a Lua error.

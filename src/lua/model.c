@@ -90,10 +90,33 @@ int sx_lua_model_new(lua_State *L)
     return 1;
 }
 
+/* With the executable's --profile, a model that cycled prints its profile
+ * on stderr when it is closed or collected. */
+static const char profile_key[] = "seixo.profile";
+
+void sx_lua_set_profile(lua_State *L, int on)
+{
+    lua_pushboolean(L, on);
+    lua_setfield(L, LUA_REGISTRYINDEX, profile_key);
+}
+
+static void profile_at_end(lua_State *L, const sx_model *m)
+{
+    lua_getfield(L, LUA_REGISTRYINDEX, profile_key);
+    const bool on = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+    if (!on || !m || sx_model_profile(m).steps == 0) return;
+    sx_lua_push_profile_text(L, m);
+    fprintf(stderr, "seixo: profile of a %dD model of %lld balls at step %lld:\n%s", sx_model_dim(m),
+            (long long)sx_ball_count(m), (long long)sx_model_step_count(m), lua_tostring(L, -1));
+    lua_pop(L, 1);
+}
+
 static int model_close(lua_State *L)
 {
     sx_lua_model *u = sx_lua_modelud(L, 1);
     if (u->running) return luaL_error(L, "the model is cycling; close it after the cycle returns");
+    profile_at_end(L, u->m);
     sx_model_destroy(u->m);
     u->m = NULL;
     return 0;
@@ -103,6 +126,7 @@ static int model_close(lua_State *L)
 static int model_gc(lua_State *L)
 {
     sx_lua_model *u = sx_lua_modelud(L, 1);
+    profile_at_end(L, u->m);
     sx_model_destroy(u->m);
     u->m = NULL;
     return 0;
@@ -380,6 +404,91 @@ static int model_bytes(lua_State *L)
     return 1;
 }
 
+/* m:memory() -> {total =, peak =, balls =, contacts =, bonds =, work =, ...} */
+static int model_memory(lua_State *L)
+{
+    const sx_memory r = sx_model_memory(sx_lua_checkmodel(L, 1));
+    lua_createtable(L, 0, 11);
+    const struct {
+        const char *name;
+        size_t v;
+    } bytes[] = {{"total", r.total}, {"peak", r.peak}, {"balls", r.balls}, {"contacts", r.contacts},
+                 {"bonds", r.bonds}, {"work", r.work}};
+    for (size_t i = 0; i < sizeof bytes / sizeof bytes[0]; i++) {
+        lua_pushinteger(L, (lua_Integer)bytes[i].v);
+        lua_setfield(L, -2, bytes[i].name);
+    }
+    lua_pushinteger(L, (lua_Integer)r.ball_count);
+    lua_setfield(L, -2, "ball_count");
+    lua_pushinteger(L, (lua_Integer)r.pair_count);
+    lua_setfield(L, -2, "pair_count");
+    lua_pushinteger(L, (lua_Integer)r.contact_count);
+    lua_setfield(L, -2, "contact_count");
+    lua_pushnumber(L, r.bytes_per_ball);
+    lua_setfield(L, -2, "per_ball");
+    lua_pushnumber(L, r.bytes_per_contact);
+    lua_setfield(L, -2, "per_contact");
+    return 1;
+}
+
+/* The profile as text, for m:profile() and the executable's --profile. */
+void sx_lua_push_profile_text(lua_State *L, const sx_model *m)
+{
+    const sx_profile p = sx_model_profile(m);
+    const int need = sx_profile_format(&p, sx_ball_count(m), NULL, 0);
+    luaL_Buffer b;
+    char *out = luaL_buffinitsize(L, &b, (size_t)need + 1);
+    sx_profile_format(&p, sx_ball_count(m), out, (size_t)need + 1);
+    luaL_pushresultsize(&b, (size_t)need);
+}
+
+/* m:profile([{print = true, reset = false}]) -> {broad_phase = {seconds =, calls =}, ..., total =} */
+static int model_profile(lua_State *L)
+{
+    static const char *const keys[] = {"print", "reset", NULL};
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    bool print = true, reset = false;
+    if (!lua_isnoneornil(L, 2)) {
+        sx_lua_checkkeys(L, 2, keys);
+        if (lua_getfield(L, 2, "print") != LUA_TNIL) print = lua_toboolean(L, -1);
+        if (lua_getfield(L, 2, "reset") != LUA_TNIL) reset = lua_toboolean(L, -1);
+        lua_pop(L, 2);
+    }
+    const sx_profile p = sx_model_profile(m);
+    if (print) {
+        sx_lua_push_profile_text(L, m);
+        size_t len;
+        const char *text = lua_tolstring(L, -1, &len);
+        lua_writestring(text, len);
+        lua_pop(L, 1);
+    }
+    lua_createtable(L, 0, SX_STAGE_COUNT + 4);
+    double total = 0;
+    for (int s = 0; s < SX_STAGE_COUNT; s++) {
+        char key[32];
+        snprintf(key, sizeof key, "%s", sx_stage_name((sx_stage)s));
+        for (char *c = key; *c; c++)
+            if (*c == ' ') *c = '_';
+        lua_createtable(L, 0, 2);
+        lua_pushnumber(L, p.seconds[s]);
+        lua_setfield(L, -2, "seconds");
+        lua_pushinteger(L, (lua_Integer)p.calls[s]);
+        lua_setfield(L, -2, "calls");
+        lua_setfield(L, -2, key);
+        total += p.seconds[s];
+    }
+    lua_pushnumber(L, total);
+    lua_setfield(L, -2, "total");
+    lua_pushnumber(L, p.cycle_seconds);
+    lua_setfield(L, -2, "cycle_seconds");
+    lua_pushinteger(L, (lua_Integer)p.steps);
+    lua_setfield(L, -2, "steps");
+    lua_pushinteger(L, (lua_Integer)p.cycles);
+    lua_setfield(L, -2, "cycles");
+    if (reset) sx_model_profile_reset(m);
+    return 1;
+}
+
 const luaL_Reg sx_lua_model_methods[] = {
     {"close", model_close},
     {"summary", model_summary},
@@ -398,6 +507,8 @@ const luaL_Reg sx_lua_model_methods[] = {
     {"energy", model_energy},
     {"hash", model_hash},
     {"bytes", model_bytes},
+    {"memory", model_memory},
+    {"profile", model_profile},
     {NULL, NULL},
 };
 

@@ -235,8 +235,15 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
     const bool mine = r && r->ud == ud;
     ud->callback++;
     if (mine) atomic_store(&r->in_lua, 1);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     const int status = lua_pcall(L, nargs, nres, 0);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
     if (mine) atomic_store(&r->in_lua, 0);
+    /* the profile's callbacks stage: time spent in Lua on behalf of a cycle */
+    if (mine && ud->m)
+        sx_model_profile_add(ud->m, SX_STAGE_CALLBACKS,
+                             (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
     ud->callback--;
     /* what the callback queued is applied even when it failed */
     if (ud->callback == 0) sx_lua_apply_removals(L, model);

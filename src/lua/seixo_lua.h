@@ -24,3 +24,8 @@ SX_API int sx_lua_interrupt_all(void);
 /// stderr) on or off for this state; off by default. The executable turns
 /// it on when stderr is a terminal.
 SX_API void sx_lua_set_progress(lua_State *L, int on);
+
+/// Switches the end-of-model profile on or off for this state (off by
+/// default): a model that has cycled prints its m:profile() table on
+/// stderr when it is closed or collected. The executable's --profile.
+SX_API void sx_lua_set_profile(lua_State *L, int on);

@@ -182,11 +182,17 @@ typedef struct servo_case {
  *  2D: rho_b = 2650 x 0.8 kg/m^2, M ~ Kn/2 = 2.5e7 N/m, c ~ 110 m/s,
  *      rho_b c ~ 2.3e5 kg/(m s); 0.15 x 2e4 N/m / 2.3e5 = 0.013 m/s;
  *  3D: rho_b = 2650 x 0.6 kg/m^3, M ~ Kn/(2R) = 2.5e10 Pa, c ~ 4000 m/s,
- *      rho_b c ~ 6.3e6 kg/(m^2 s); 0.15 x 1e7 Pa / 6.3e6 = 0.24 m/s. */
+ *      rho_b c ~ 6.3e6 kg/(m^2 s); 0.15 x 1e7 Pa / 6.3e6 = 0.24 m/s.
+ * A random packing under local damping 0.7 (whose force flips with the sign
+ * of v) is chaotic: a change in the last bits of the arithmetic gives
+ * another packing, and about one seed in five rearranges late, after the
+ * window below starts (the cylinder's seed 6 before the kernels were
+ * rewritten, seed 2 after). The seeds are ones whose packings settle in
+ * time under both. */
 static const servo_case CASES[] = {
     {SPEC_BIAXIAL, 100, 0.45, 0.013, 230000, 3, "2D biaxial, 100 disks"},
     {SPEC_BOX, 125, 0.30, 0.2, 200000, 2, "3D box of planes, 125 spheres"},
-    {SPEC_CYLINDER, 125, 0.30, 0.2, 130000, 2, "3D cylinder with platens, 125 spheres"},
+    {SPEC_CYLINDER, 125, 0.30, 0.2, 130000, 3, "3D cylinder with platens, 125 spheres"},
 };
 
 START_TEST(random_packing_holds_target)

@@ -247,4 +247,59 @@ test("the library is on package.path, help is global", function()
   check(out:find("false", 1, true) and out:find("/nonexistent/seixo/util.lua", 1, true), out)
 end)
 
+test("m:profile times the stages and counts their calls", function()
+  for _, dim in ipairs({2, 3}) do
+    local m = column(dim, 4)
+    local fired = 0
+    m:on("after", function() fired = fired + 1 end, {every = 10})
+    m:history("ke", function(mm) return mm:energy().kinetic end, {every = 25})
+    m:cycle(200)
+    local p = m:profile{print = false}
+    eq(p.steps, 200)
+    eq(p.integration.calls, 200)
+    eq(p.ball_contacts.calls, 200)
+    eq(p.wall_contacts.calls, 200)
+    eq(p.other.calls, 200)
+    check(p.broad_phase.calls >= 1, "the first build is timed")
+    eq(fired, 20)
+    eq(p.callbacks.calls, 20 + 8, "every callback and history function") -- histories at 25, 50, ..., 200
+    local sum = 0
+    for _, k in ipairs({"broad_phase", "ball_contacts", "wall_contacts", "integration", "callbacks", "other"}) do
+      check(p[k].seconds >= 0, k)
+      sum = sum + p[k].seconds
+    end
+    near(p.total, sum, 1e-12)
+    check(p.total - p.callbacks.seconds <= p.cycle_seconds * (1 + 1e-9), "the core's stages run inside its cycles")
+    -- printing, and a reset after reading
+    local status, out = T.run("-e " .. T.quote("local m = seixo.model{dim = 2}; m:material('r'); " ..
+      "m:ball{pos = {0, 0}, radius = 0.1}; m:cycle(10); m:profile()"))
+    eq(status, 0, out)
+    check(out:find("ball contacts", 1, true) and out:find("integration", 1, true), out)
+    m:profile{print = false, reset = true}
+    eq(m:profile{print = false}.steps, 0)
+    raises(function() m:profile{nope = true} end, "nope")
+  end
+end)
+
+test("seixo --profile prints each model's profile at the end", function()
+  local status, out = T.run("--profile -e " .. T.quote("local m = seixo.model{dim = 3}; m:material('r'); " ..
+    "m:ball{pos = {0, 0, 0}, radius = 0.1}; m:cycle(10)"))
+  eq(status, 0, out)
+  check(out:find("profile of a 3D model of 1 balls at step 10", 1, true) and out:find("broad phase", 1, true), out)
+end)
+
+test("m:memory reports bytes per ball and per contact", function()
+  local m = column(3, 5)
+  m:cycle(50)
+  local r = m:memory()
+  eq(r.total, m:bytes())
+  eq(r.balls + r.contacts + r.bonds + r.work, r.total)
+  eq(r.ball_count, 5)
+  eq(r.contact_count, m:contact_count())
+  check(r.contact_count > 0 and r.pair_count >= r.contact_count)
+  near(r.per_ball, r.balls / 5, 1e-12)
+  near(r.per_contact, r.contacts / r.contact_count, 1e-12)
+  check(r.peak >= r.total)
+end)
+
 T.done()
