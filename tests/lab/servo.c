@@ -185,15 +185,17 @@ typedef struct servo_case {
  *      rho_b c ~ 6.3e6 kg/(m^2 s); 0.15 x 1e7 Pa / 6.3e6 = 0.24 m/s.
  * A random packing under local damping 0.7 (whose force flips with the sign
  * of v) is chaotic: a change in the last bits of the arithmetic gives
- * another packing, and about one seed in five rearranges late, after the
- * window below starts (the cylinder's seed 6 before the kernels were
- * rewritten, seed 2 after). The seeds are ones whose packings settle in
- * time under both. */
+ * another packing, and some rearrange late (a grain slips out of a jammed
+ * arch). The steady state is therefore taken where it is one: once the
+ * packing is near equilibrium (PFC's ratio below STEADY_RATIO) after the
+ * given steps, and the servo must hold the target over a window after it. */
 static const servo_case CASES[] = {
     {SPEC_BIAXIAL, 100, 0.45, 0.013, 230000, 3, "2D biaxial, 100 disks"},
     {SPEC_BOX, 125, 0.30, 0.2, 200000, 2, "3D box of planes, 125 spheres"},
-    {SPEC_CYLINDER, 125, 0.30, 0.2, 130000, 3, "3D cylinder with platens, 125 spheres"},
+    {SPEC_CYLINDER, 125, 0.30, 0.2, 130000, 2, "3D cylinder with platens, 125 spheres"},
 };
+
+#define STEADY_RATIO 1e-3
 
 START_TEST(random_packing_holds_target)
 {
@@ -236,25 +238,43 @@ START_TEST(random_packing_holds_target)
         spec_update_servos(&s);
         for (int j = 0; j < s.nservo; j++) hist[i * s.nservo + j] = spec_stress(&s, spec_servo_wall(&s, j)) / s.target;
     }
-    printf("%s, target %g %s, max_speed %g m/s, %d steps:\n", c->name, s.target, s.dim == 2 ? "N/m" : "Pa", c->vmax,
-           c->steps);
-    const int tail = nsamples - nsamples / 5;
+    /* the steady state: near equilibrium (at most as many steps again), then a window of a fifth of the samples */
+    int64_t settle = 0;
+    while (sx_model_unbalanced_ratio(s.m) > STEADY_RATIO && settle < c->steps) {
+        lab_cycle(s.m, SPEC_CHUNK);
+        spec_update_servos(&s);
+        settle += SPEC_CHUNK;
+    }
+    const double ratio = sx_model_unbalanced_ratio(s.m);
+    const int window = nsamples / 5;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < window; i++) {
+        lab_cycle(s.m, SPEC_CHUNK);
+        spec_update_servos(&s);
+        for (int j = 0; j < s.nservo; j++) {
+            const double v = spec_stress(&s, spec_servo_wall(&s, j)) / s.target;
+            lo[j] = fmin(lo[j], v), hi[j] = fmax(hi[j], v);
+        }
+    }
+    printf("%s, target %g %s, max_speed %g m/s, %d steps, then %lld to ratio %.2e, then a window of %d:\n", c->name,
+           s.target, s.dim == 2 ? "N/m" : "Pa", c->vmax, c->steps, (long long)settle, ratio, window * SPEC_CHUNK);
+    ck_assert_msg(ratio <= STEADY_RATIO, "%s: no steady state: ratio %.3g after %lld more steps", c->name, ratio,
+                  (long long)settle);
     for (int j = 0; j < s.nservo; j++) {
-        double lo = INFINITY, hi = -INFINITY;
         int settled = -1;
         for (int i = 0; i < nsamples; i++) {
             const double v = hist[i * s.nservo + j];
             if (fabs(v - 1) > 0.01) settled = -1;
             else if (settled < 0) settled = i;
-            if (i >= tail) lo = fmin(lo, v), hi = fmax(hi, v);
         }
-        const double final = hist[(nsamples - 1) * s.nservo + j];
-        printf("  servo %d: first contact at step %lld, peak %.4f x target, within 1 %% from step %d on; last 20 %%: "
-               "[%.6f, %.6f]; final %.8f\n", j, (long long)first[j], peak[j], settled * SPEC_CHUNK, lo, hi, final);
+        const double final = spec_stress(&s, spec_servo_wall(&s, j)) / s.target;
+        printf("  servo %d: first contact at step %lld, peak %.4f x target, within 1 %% from step %d on; steady "
+               "window: [%.6f, %.6f]; final %.8f\n", j, (long long)first[j], peak[j], settled * SPEC_CHUNK, lo[j],
+               hi[j], final);
         ck_assert_msg(first[j] > 0, "servo %d never touched the specimen", j);
         ck_assert_msg(peak[j] <= 1.2, "servo %d: overshoot to %.4f x target > 1.2", j, peak[j]);
-        ck_assert_msg(lo >= 0.99 && hi <= 1.01, "servo %d: the last 20 %% of the samples span [%.5f, %.5f] x target, "
-                      "not within 1 %%", j, lo, hi);
+        ck_assert_msg(lo[j] >= 0.99 && hi[j] <= 1.01, "servo %d: the steady window spans [%.5f, %.5f] x target, "
+                      "not within 1 %%", j, lo[j], hi[j]);
         LAB_CHECK("final servo wall stress / target", final, 1.0, 0.01);
     }
     free(hist);
