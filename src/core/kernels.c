@@ -375,6 +375,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
     const sx_grid *g = &m->grid;
     const sx_balls *b = &m->balls;
     const int32_t *id = b->id;
+    const int32_t *cl = b->clump; /* clumps: pebbles of one clump never pair (NULL without clumps) */
     sx_pairs *p = &m->bb;
     int64_t off[13][3];
     const int nst = half_stencil(off);
@@ -391,7 +392,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                         double dx[D];
                         for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                         const double reach = ri + b->rad[j];
-                        if (dot(dx, dx) < reach * reach &&
+                        if (dot(dx, dx) < reach * reach && !(cl && cl[i] && cl[i] == cl[j]) &&
                             !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
                             return false;
                     }
@@ -403,7 +404,7 @@ static bool build_ball_pairs(sx_model *m, const history *h)
                             double dx[D];
                             for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                             const double reach = ri + b->rad[j];
-                            if (dot(dx, dx) < reach * reach &&
+                            if (dot(dx, dx) < reach * reach && !(cl && cl[i] && cl[i] == cl[j]) &&
                                 !pair_push(m, p, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0))
                                 return false;
                         }
@@ -1077,7 +1078,9 @@ static void integrate_block(sx_model *m, int64_t b0, int64_t b1, motion_block *o
     const bool track = m->track_energy;
     o->worst = o->damp_work = o->load_work = 0;
     o->bad = -1;
+    const int32_t *cl = B->clump;
     for (int64_t i = b0; i < b1; i++) {
+        if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
         const unsigned fix = B->fix[i];
         const double a = B->alpha[i], im = B->inv_mass[i], ii = B->inv_inertia[i];
         double *v = B->v + i * D, *x = B->x + i * D;
@@ -1239,6 +1242,10 @@ static double KERNEL(critical_dt)(sx_model *m)
         else kn *= 2, ks *= 2; /* undo the series combination with itself */
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
+        if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
+            kt[i] = ktr, kr[i] = krot;
+            continue;
+        }
         /* Contact dashpots lower the stable timestep of the central differences: for
          * m x'' + c x' + k x = 0 with x' taken at the half step, stability needs
          * (w dt)^2 + 4 z (w dt) < 4, i.e. dt < (2/w)(sqrt(1 + z^2) - z), z = c / (2 sqrt(k m));
@@ -1253,6 +1260,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (dtr < best) best = dtr;
         }
     }
+    if (m->clumps) best = fmin(best, sx__clumps_critical_dt(m, kt, kr, ct, cr));
     return best;
 }
 
@@ -1287,12 +1295,14 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
     *e = m->acc;
     e->kinetic = e->gravitational = e->strain = e->bond_strain = 0;
     for (int64_t i = 0; i < B->n; i++) {
+        if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once, below */
         const double *v = B->v + i * D, *w = B->w + i * RD;
         double ww = 0;
         for (int k = 0; k < RD; k++) ww += w[k] * w[k];
         e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
         e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
     }
+    if (m->clumps) sx__clumps_energy(m, e);
     /* every overlap stores normal strain, even one no step has seen yet;
      * the shear spring only once the contact has history */
     const double zero[D] = {0};
