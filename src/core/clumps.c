@@ -1411,11 +1411,19 @@ void sx__clumps_energy(const sx_model *m, sx_energy *e)
     }
 }
 
-/* A clump's rating: the sums of its pebbles' contact stiffnesses for the
- * translation, and for the rotation each pebble's contacts at the largest
- * lever they can have about the centroid, |x_p - x| + R_p (a spring k at
- * lever l stiffens the rotation by at most k l^2), against the smallest
- * principal moment; the dashpots likewise, as in critical_dt. */
+/* A clump's rating. Translation: its mass against the sum of its pebbles'
+ * contact stiffnesses kt (and dashpots ct), as a ball's. Rotation about a
+ * principal axis i, for a pebble whose centre is at distance h from it:
+ * normal springs act through the pebble centre (lever <= h), shear springs
+ * at its surface (lever <= h + R), and bonds' rotational springs directly.
+ * critical_dt's sums are kt = normal + shear stiffness and kr = shear
+ * stiffness R^2 + rotational springs, so the stiffness about i is at most
+ *     K_i = sum over pebbles of kt h^2 + kr (1 + 2 h / R)
+ * (the shear part's (h + R)^2 - h^2 = R^2 (1 + 2 h / R) is charged to kr),
+ * which is exact for a pebble on the axis (h = 0: kr). The largest
+ * rotational frequency, the largest eigenvalue of I^-1 K, is at most its
+ * trace, w^2 <= sum_i K_i / I_i (the body frame diagonalises I). The
+ * dashpots enter likewise, with the largest damping ratio of the axes. */
 double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double *kr, const double *ct,
                               const double *cr)
 {
@@ -1425,26 +1433,33 @@ double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double 
     double best = INFINITY;
     for (int64_t c = 0; c < C->n; c++) {
         const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
-        double Kt = 0, Kr = 0, Ct = 0, Cr = 0;
+        const double s = C->scale[c], *body = C->tp_body + t->first * d, *I = C->inertia + c * r;
+        double Kt = 0, Ct = 0, Kr[3] = {0, 0, 0}, Cr[3] = {0, 0, 0};
         for (int64_t k = 0; k < t->n; k++) {
             const int64_t i = B->index_of[C->pebble[C->first[c] + k]];
-            double l2 = 0;
-            for (int j = 0; j < d; j++) l2 += (B->x[i * d + j] - C->x[c * d + j]) * (B->x[i * d + j] - C->x[c * d + j]);
-            const double lever = sqrt(l2) + B->rad[i];
             Kt += kt[i];
-            Kr += kr[i] + kt[i] * lever * lever;
             Ct += ct[i];
-            Cr += cr[i] + ct[i] * lever * lever;
+            for (int a = 0; a < r; a++) {
+                /* the pebble centre's distance from principal axis a (2D: from z) */
+                double h2 = 0;
+                for (int j = 0; j < d; j++)
+                    if (d == 2 || j != a) h2 += s * body[k * d + j] * s * body[k * d + j];
+                const double lever = 1 + 2 * sqrt(h2) / B->rad[i];
+                Kr[a] += kr[i] * lever + kt[i] * h2;
+                Cr[a] += cr[i] * lever + ct[i] * h2;
+            }
         }
-        const double mass = C->mass[c], imin = C->inertia[c * r], amp = 1 + C->alpha[c];
+        const double mass = C->mass[c], amp = 1 + C->alpha[c];
         if (Kt > 0) {
             const double z = amp * Ct / (2 * sqrt(Kt * mass));
             best = fmin(best, sqrt(mass / Kt) * (sqrt(1 + z * z) - z));
         }
-        if (Kr > 0) {
-            const double z = amp * Cr / (2 * sqrt(Kr * imin));
-            best = fmin(best, sqrt(imin / Kr) * (sqrt(1 + z * z) - z));
+        double w2 = 0, z = 0;
+        for (int a = 0; a < r; a++) {
+            w2 += Kr[a] / I[a];
+            if (Kr[a] > 0) z = fmax(z, amp * Cr[a] / (2 * sqrt(Kr[a] * I[a])));
         }
+        if (w2 > 0) best = fmin(best, (sqrt(1 + z * z) - z) / sqrt(w2));
     }
     return best;
 }

@@ -186,8 +186,11 @@ END_TEST
 
 /* The automatic timestep rates a clump as one body: its mass against the
  * sum of its pebbles' contact stiffnesses (a free pebble rated at its own
- * kn + ks), its smallest principal moment against those stiffnesses at
- * the lever |x_p - x| + R_p. */
+ * kn + ks = 2k, and ks R^2 for its rotation), and its rotation by the bound
+ * sum_i K_i / I_i over the principal axes, K_i = sum kt h^2 + kr (1 + 2 h / R)
+ * with h a pebble centre's distance from axis i. A dumbbell along x of
+ * pebbles 0.01 and 0.005 m: h = 0 about x, the distances from the centroid
+ * about y and z. */
 START_TEST(timestep_rating)
 {
     const double k = 1e6;
@@ -201,12 +204,12 @@ START_TEST(timestep_rating)
     ck_assert(sx_clump_inertia(m, id, I, NULL) == SX_OK);
     sx_clump_props p;
     ck_assert(sx_clump_template_props(m, t, &p) == SX_OK);
-    /* pebble levers from the centroid */
-    const double l1 = fabs(p.centroid[0]) + 0.01, l2 = fabs(0.03 - p.centroid[0]) + 0.005;
-    const double kt = 2 * k; /* kn + ks of a free pebble */
-    const double dt_t = sqrt(mass / (2 * kt));
-    const double kr = k * 0.01 * 0.01 + kt * l1 * l1 + k * 0.005 * 0.005 + kt * l2 * l2;
-    const double dt_r = sqrt(I[0] / kr);
+    const double d1 = fabs(p.centroid[0]), d2 = fabs(0.03 - p.centroid[0]);
+    const double kt = 2 * k;                           /* kn + ks of a free pebble */
+    const double kr1 = k * 0.01 * 0.01, kr2 = k * 0.005 * 0.005; /* ks R^2 */
+    const double k_axis = kr1 + kr2;
+    const double k_perp = kt * d1 * d1 + kr1 * (1 + 2 * d1 / 0.01) + kt * d2 * d2 + kr2 * (1 + 2 * d2 / 0.005);
+    const double dt_t = sqrt(mass / (2 * kt)), dt_r = 1 / sqrt(k_axis / I[0] + k_perp / I[1] + k_perp / I[2]);
     const double expect = fmin(dt_t, dt_r);
     ck_assert_double_eq_tol(sx_model_critical_timestep(m), expect, 1e-12 * expect);
     sx_model_destroy(m);
