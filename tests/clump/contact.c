@@ -165,6 +165,13 @@ START_TEST(self_contacts_and_energy)
         for (int j = 0; j < 3; j++) rot += 0.5 * ww[i] * I[i][j] * ww[j];
     const double ke = 0.5 * mass * v_dot(vv, vv, 3) + rot;
     ck_assert_double_eq_tol(sx_model_energy(m).kinetic, ke, 1e-12 * ke);
+    /* a measurement counts the union's volume once (the pebbles overlap) */
+    sx_region reg = {.shape = SX_SHAPE_SPHERE, .centre = {0, 0, 0}, .radius = 0.1};
+    sx_measurement meas;
+    ck_assert(sx_measure(m, &reg, &meas) == SX_OK);
+    double volume;
+    ck_assert(sx_clump_get(m, a, SX_CLUMP_VOLUME, &volume) == SX_OK);
+    ck_assert_double_eq_tol(meas.solid, volume, 1e-12 * volume);
     /* a second clump overlapping the first */
     const double q[4] = {cos(0.3), 0, 0, sin(0.3)};
     const int64_t b = ct_clump(m, t, c2, q, NULL, NULL);
