@@ -1584,18 +1584,6 @@ void sx__pebble_body(const sx_model *m, int64_t i, double centre[3], double *vol
 
 /* ------------------------------------------------------------- restore */
 
-void sx__clumps_sizes(const sx_model *m, sx_clump_sizes *out)
-{
-    memset(out, 0, sizeof *out);
-    const sx_clumps *C = m->clumps;
-    if (!C) return;
-    out->templates = C->ntpl;
-    out->template_pebbles = C->tp_n;
-    out->clumps = C->n;
-    out->pebbles = C->pn;
-    out->next_id = C->next_id;
-}
-
 sx_status sx__clumps_alloc(sx_model *m, const sx_clump_sizes *s)
 {
     if (s->templates == 0 && s->clumps == 0 && s->template_pebbles == 0 && s->pebbles == 0) return SX_OK;

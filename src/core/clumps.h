@@ -73,8 +73,6 @@ typedef struct sx_clump_sizes {
     int64_t template_pebbles, clumps, pebbles, next_id;
 } sx_clump_sizes;
 
-/* The sizes of m's clump store now (all zero without clumps). */
-void sx__clumps_sizes(const sx_model *m, sx_clump_sizes *out);
 /* Sizes the clump store of a model being restored (its balls already
  * sized) to exactly s; nothing is allocated when s is all zero. */
 sx_status sx__clumps_alloc(sx_model *m, const sx_clump_sizes *s);
