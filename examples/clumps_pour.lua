@@ -3,8 +3,8 @@
 -- Two grain shapes made of overlapping pebbles (an elongated "rice" grain
 -- of three spheres and a flat "tri" of three), generated at random
 -- orientations and sizes in the upper part of a box, fall under gravity
--- and settle; local damping (0.3, so they still fall briskly) brings them
--- to rest. Prints the settled
+-- and settle; local damping brings them to rest (0.3 while they fall, so
+-- they fall briskly, then 0.7). Prints the settled
 -- pile's porosity, the clumps' kinetic energy and how the long axes of the
 -- rice grains lie (settled grains lie flat: their long axis near
 -- horizontal). With an output name, writes a snapshot of the pile.
@@ -33,8 +33,10 @@ local n_tri = m:generate{template = "tri", scale = {0.8, 1.2}, count = count - c
 print(string.format("clumps_pour: %d rice + %d tri clumps (%d pebbles) in a %.0f mm box", n_rice, n_tri,
                     m:ball_count(), width / mm))
 
--- the fall first (while grains fly, one impact can make the mean force ratio look small), then settling
+-- the fall first (while grains fly, one impact can make the mean force ratio look small), then
+-- settling with PFC's quasi-static damping (the grains rock long under light damping)
 m:solve{time = 0.3}
+m:material("gravel", {density = 2650, kn = 5e5, ks = 5e5, friction = 0.5, damping = 0.7})
 local reason, r, steps = m:solve{ratio = ratio, steps = 200000}
 local top = 0
 for b in m:balls() do top = math.max(top, b.pos[3] + b.radius) end

@@ -1563,11 +1563,14 @@ void sx__clumps_unbalanced(const sx_model *m, double *sum, int64_t *bodies)
     }
 }
 
-void sx__clumps_update_mass(sx_model *m, int material)
+void sx__clumps_material_changed(sx_model *m, int material, bool density, bool damping)
 {
     sx_clumps *C = m->clumps;
-    for (int64_t c = 0; c < C->n; c++)
-        if (C->mat[c] == material) clump_mass(m, c);
+    for (int64_t c = 0; c < C->n; c++) {
+        if (C->mat[c] != material) continue;
+        if (density) clump_mass(m, c);
+        if (damping) C->alpha[c] = m->mats[material].def.damping;
+    }
 }
 
 void sx__pebble_body(const sx_model *m, int64_t i, double centre[3], double *volume)

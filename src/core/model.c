@@ -212,7 +212,8 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
         if (density_changed) sx__ball_update_mass(m, b);
         if (damping_changed) m->balls.alpha[b] = d->damping;
     }
-    if (density_changed && m->clumps) sx__clumps_update_mass(m, i); /* its pebbles carry the body's mass */
+    if ((density_changed || damping_changed) && m->clumps) /* the bodies of the material, as its balls */
+        sx__clumps_material_changed(m, i, density_changed, damping_changed);
     m->dt_stale = true;
     m->guard_dirty = true;
     if (out) *out = i;

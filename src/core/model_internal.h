@@ -258,8 +258,9 @@ uint64_t sx__clumps_hash(const sx_model *m, uint64_t h);
 bool sx__clumps_forced(const sx_model *m);
 /* Adds each clump's |F + M g| (free components) to *sum; *bodies counts a clump once, not its pebbles. */
 void sx__clumps_unbalanced(const sx_model *m, double *sum, int64_t *bodies);
-/* Mass and inertia of the clumps of a material whose density changed. */
-void sx__clumps_update_mass(sx_model *m, int material);
+/* A material was redefined: the mass and inertia (density changed) or
+ * the local damping (damping changed) of its clumps follow, as its balls'. */
+void sx__clumps_material_changed(sx_model *m, int material, bool density, bool damping);
 /* Ball i is a pebble: the reference point of its body (the clump's centroid)
  * and its share of the body's volume, for measurements. */
 void sx__pebble_body(const sx_model *m, int64_t i, double centre[3], double *volume);

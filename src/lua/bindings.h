@@ -200,8 +200,8 @@ void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[]);
 /// Like sx_lua_checkkeys, for a table at idx that is the field `field` of argument `arg`.
 void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, const char *const keys[]);
 
-/// Reads the value at idx as n numbers into out; returns NULL, or pushes and
-/// returns a message saying what is wrong.
+/// Reads the value at idx as n numbers (n <= 4) into out; returns NULL, or
+/// pushes and returns a message saying what is wrong.
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
 /// Pushes n components of v (a number when n == 1).
 void sx_lua_pushvec(lua_State *L, const double *v, int n);

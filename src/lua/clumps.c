@@ -214,7 +214,7 @@ static void push_template(lua_State *L, const sx_model *m, int t)
     lua_setfield(L, -2, "name");
     lua_createtable(L, (int)p.count, 0);
     for (int64_t k = 0; k < p.count; k++) {
-        double x[3], r;
+        double x[4], r; /* the centre, then the radius */
         sx_lua_check(L, m, sx_clump_template_pebble(m, t, k, x, &r));
         x[dim] = r;
         push_numbers(L, x, dim + 1);

@@ -278,6 +278,11 @@ START_TEST(fixities_and_guards)
     ck_assert(sx_clump_get(m, id, SX_CLUMP_MASS, &m1) == SX_OK);
     ck_assert_double_eq_tol(m1, m0 * 2000 / RHO, 1e-12 * m1);
     ck_assert_double_eq_tol(v_scalar(m, peb[1], SX_BALL_MASS), m1, 1e-12 * m1);
+    md.damping = 0.4; /* and so does a damping change */
+    ck_assert(sx_material_set(m, "light", &md, NULL) == SX_OK);
+    double alpha;
+    ck_assert(sx_clump_get(m, id, SX_CLUMP_DAMPING, &alpha) == SX_OK);
+    ck_assert(alpha == 0.4);
     /* removal takes the pebbles */
     const int64_t nb = sx_ball_count(m);
     ck_assert(sx_clump_remove(m, id) == SX_OK);
