@@ -5,11 +5,13 @@
  * energies and contacts, in 2D and 3D, saved while clumps fall, collide
  * and settle on each other, the walls and free balls, with one clump
  * removed, one fixed and energy tracking on. A file without clumps still
- * loads into a model without any. */
+ * loads into a model without any; output series carry the clump ids. */
 #include "io_scenes.h"
 
+#include <hdf5.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Clumps of two templates (one of overlapping pebbles) and a few balls
@@ -138,6 +140,50 @@ START_TEST(no_clumps)
 }
 END_TEST
 
+/* An output series gives every ball its clump id (0 for a free ball) next
+ * to its id, and the XDMF shows it as a point attribute. */
+START_TEST(series_clump_ids)
+{
+    sx_model *m = pour(3);
+    io_cycle(m, 10);
+    char path[512], err[256];
+    io_path(path, sizeof path, "series.h5");
+    sx_series *s = sx_series_open(path, 3, NULL, err, sizeof err);
+    ck_assert_msg(s != NULL, "%s", err);
+    ck_assert_msg(sx_series_write(s, m, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert(sx_series_close(s, err, sizeof err) == SX_OK);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    ck_assert(f >= 0);
+    const int64_t n = sx_ball_count(m);
+    int64_t *id = malloc((size_t)n * sizeof *id), *clump = malloc((size_t)n * sizeof *clump);
+    hid_t d = H5Dopen2(f, "/snapshots/000000/balls/id", H5P_DEFAULT);
+    ck_assert(d >= 0 && H5Dread(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, id) >= 0);
+    H5Dclose(d);
+    d = H5Dopen2(f, "/snapshots/000000/balls/clump", H5P_DEFAULT);
+    ck_assert(d >= 0 && H5Dread(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, clump) >= 0);
+    H5Dclose(d);
+    H5Fclose(f);
+    int64_t pebbles = 0;
+    for (int64_t i = 0; i < n; i++) {
+        ck_assert_int_eq(clump[i], sx_ball_clump(m, id[i]));
+        pebbles += clump[i] != 0;
+    }
+    ck_assert_int_eq(pebbles, 3 * sx_clump_count(m));
+    free(id);
+    free(clump);
+    /* the XDMF names the attribute */
+    io_path(path, sizeof path, "series.xmf");
+    FILE *x = fopen(path, "r");
+    ck_assert(x != NULL);
+    char buf[1 << 16];
+    const size_t len = fread(buf, 1, sizeof buf - 1, x);
+    buf[len] = 0;
+    fclose(x);
+    ck_assert(strstr(buf, "balls/clump") != NULL);
+    sx_model_destroy(m);
+}
+END_TEST
+
 int main(void)
 {
     io_tmpdir();
@@ -146,6 +192,7 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, clump_restart, 2, 4);
     tcase_add_test(tc, no_clumps);
+    tcase_add_test(tc, series_clump_ids);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
