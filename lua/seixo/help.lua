@@ -33,7 +33,7 @@ local entries = {
   ["model:walls"] = {"m:walls() -> iterator", "for w in m:walls() do ... end"},
   ["model:wall_count"] = {"m:wall_count() -> n", "Number of walls."},
   ["model:generate"] = {"m:generate{region =, radius =, count = | porosity =, method =, seed =, ...} -> n, porosity",
-    "Generates balls in a region: method 'random' (non-overlapping), 'distribute' (overlapping to a porosity, then relaxed), 'expand' (radius expansion to a porosity), 'lattice' (packing = square|hex|cubic|fcc). radius = r or {rmin, rmax} [m]; distribution 'uniform' | 'normal' (mean, std); material, group, tries, relax = {steps, ratio, calm}."},
+    "Generates balls in a region: method 'random' (non-overlapping), 'distribute' (overlapping to a porosity, then relaxed), 'expand' (radius expansion to a porosity), 'lattice' (packing = square|hex|cubic|fcc). radius = r or {rmin, rmax} [m]; distribution 'uniform' | 'normal' (mean, std); material, group, tries, relax = {steps, ratio, calm}. With template = name: clumps at random orientations, scale = s or {smin, smax} in place of radius (method 'random')."},
   ["model:close"] = {"m:close()", "Frees the model now; any later use is an error."},
   ["model:summary"] = {"m:summary() -> text", "The summary print(m) shows."},
 
@@ -132,6 +132,35 @@ local entries = {
   ["ball.damping"] = {"b.damping", "Local damping coefficient in [0, 1)."},
   ["ball.group"] = {"b.group", "The group's name, or nil."},
   ["ball.extra"] = {"b.extra", "A table of user values kept with the ball: b.extra.tag = 1."},
+  ["ball.clump"] = {"b.clump", "The clump a pebble belongs to, nil for a free ball (read-only)."},
+
+  -- clumps (src/lua/clumps.c)
+  ["model:clump_template"] = {"m:clump_template(name, pebbles | path[, {lines =}]) -> info;  m:clump_template(name) -> info | nil",
+    "Defines a clump template from pebbles {{x, y[, z], r}, ...} (or {pos =, radius =}) or a file of spheres (x y [z] r per line, # comments); returns {name, pebbles, volume, centroid, inertia, principal, axes, overlapping, error} per unit density."},
+  ["model:clump_templates"] = {"m:clump_templates() -> {name = info}", "Every clump template and its properties."},
+  ["model:clump"] = {"m:clump{template =, pos =, orientation =, scale = 1, vel =, spin =, material =, group =} -> clump;  m:clump(id) -> clump | nil",
+    "Adds a clump (a rigid body of its template's pebbles) with its centroid at pos [m]; orientation {w, x, y, z} or {axis =, angle =} (2D: an angle [rad]); or finds one by id."},
+  ["model:clumps"] = {"m:clumps() -> iterator", "for c in m:clumps() do ... end over a snapshot of the clumps."},
+  ["model:clump_count"] = {"m:clump_count() -> n", "Number of clumps."},
+  ["clump:remove"] = {"cl:remove()", "Removes the clump and its pebbles (not inside a callback)."},
+  ["clump.id"] = {"cl.id", "The clump's stable id (its own numbering, apart from balls')."},
+  ["clump.pos"] = {"cl.pos", "Centroid [m] (writable: moves the clump)."},
+  ["clump.vel"] = {"cl.vel", "Velocity of the centroid [m/s]."},
+  ["clump.spin"] = {"cl.spin", "Angular velocity in space [rad/s] (2D: a number)."},
+  ["clump.orientation"] = {"cl.orientation", "Unit quaternion {w, x, y, z} from the template frame to space (2D: the angle [rad]); writable."},
+  ["clump.force"] = {"cl.force", "Resultant of its pebbles' contact and applied forces of the last step [N] (read-only)."},
+  ["clump.moment"] = {"cl.moment", "Their moment about the centroid [N m] (read-only)."},
+  ["clump.angular_momentum"] = {"cl.angular_momentum", "Angular momentum about the centroid, in space [kg m^2/s] (read-only)."},
+  ["clump.mass"] = {"cl.mass", "Mass [kg] (read-only)."},
+  ["clump.volume"] = {"cl.volume", "Volume of the union of its pebbles [m^3] (2D: [m^2])."},
+  ["clump.inertia"] = {"cl.inertia", "Inertia tensor about the centroid in space axes [kg m^2] (2D: Izz, a number)."},
+  ["clump.principal"] = {"cl.principal", "Principal moments, ascending [kg m^2] (2D: a number)."},
+  ["clump.scale"] = {"cl.scale", "Its template's scale (read-only)."},
+  ["clump.template"] = {"cl.template", "Its template's name (read-only)."},
+  ["clump.material"] = {"cl.material", "The material of the body and its pebbles; its density gives the mass."},
+  ["clump.damping"] = {"cl.damping", "Local damping coefficient in [0, 1)."},
+  ["clump.fix"] = {"cl.fix", "Fixed components like b.fix; in 3D the spin is fixed as a whole ('spin') or not."},
+  ["clump.pebbles"] = {"cl.pebbles", "Its pebbles, an array of balls in template order (read-only)."},
 
   -- wall
   ["wall:remove"] = {"w:remove()", "Removes the wall (queued while a callback runs)."},
@@ -187,7 +216,7 @@ H.entries = entries
 
 -- The classes, from the metatables the bindings registered.
 local classes = {model = "seixo.model", ball = "seixo.ball", wall = "seixo.wall", contact = "seixo.contact",
-                 output = "seixo.output"}
+                 output = "seixo.output", clump = "seixo.clump"}
 
 local function class_of(x)
   local mt = getmetatable(x)
@@ -258,12 +287,15 @@ local function members(prefix)
   return sorted(names)
 end
 
+local letters = {clump = "cl"} -- where the first letter is another class's (c: contact)
+
 local function object_text(kind)
   local parts = {}
+  local letter = letters[kind] or kind:sub(1, 1)
   local methods = members(kind .. ":")
-  if #methods > 0 then parts[#parts + 1] = listing(kind .. " methods (" .. kind:sub(1, 1) .. ":name(...)):", methods) end
+  if #methods > 0 then parts[#parts + 1] = listing(kind .. " methods (" .. letter .. ":name(...)):", methods) end
   local fields = members(kind .. ".")
-  if #fields > 0 then parts[#parts + 1] = listing(kind .. " fields (" .. kind:sub(1, 1) .. ".name):", fields) end
+  if #fields > 0 then parts[#parts + 1] = listing(kind .. " fields (" .. letter .. ".name):", fields) end
   return table.concat(parts, "\n")
 end
 

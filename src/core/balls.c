@@ -65,6 +65,7 @@ static sx_status balls_resize(sx_model *m, int64_t cap)
         RESIZE(b, fapp, d);
         RESIZE(b, tapp, r);
     }
+    if (b->clump) RESIZE(b, clump, 1);
     b->cap = cap;
     return SX_OK;
 }
@@ -94,6 +95,7 @@ void sx__balls_free(sx_model *m)
     free_field(m, b->group, c, sizeof(int32_t));
     free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
     free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
+    free_field(m, b->clump, b->clump ? c : 0, sizeof(int32_t));
     free_field(m, b->index_of, b->index_cap, sizeof(int32_t));
     memset(b, 0, sizeof *b);
 }
@@ -102,6 +104,7 @@ void sx__balls_free(sx_model *m)
 void sx__ball_update_mass(sx_model *m, int64_t i)
 {
     sx_balls *b = &m->balls;
+    if (b->clump && b->clump[i]) return; /* a pebble carries its clump's mass (clumps.c) */
     const double r = b->rad[i], rho = m->mats[b->mat[i]].def.density;
     double mass, inertia;
     if (m->dim == 3) {
@@ -120,6 +123,15 @@ int64_t sx__ball_index(const sx_model *m, int64_t id)
     const sx_balls *b = &m->balls;
     if (id < 1 || id >= b->next_id) return -1;
     return b->index_of[id];
+}
+
+/* A pebble's motion, size and mass are its clump's (clumps.c): refused with a message. */
+static bool pebble(sx_model *m, int64_t i, const char *fn, const char *what)
+{
+    if (!m->balls.clump || !m->balls.clump[i]) return false;
+    sx__fail(m, SX_EINVAL, "%s: ball %lld is a pebble of clump %lld, which owns its %s", fn,
+             (long long)m->balls.id[i], (long long)m->balls.clump[i], what);
+    return true;
 }
 
 static sx_status grow_index(sx_model *m, int64_t need)
@@ -181,6 +193,7 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     b->alpha[i] = m->mats[def->material].def.damping;
     b->fix[i] = 0;
     b->group[i] = 0;
+    if (b->clump) b->clump[i] = 0;
     b->id[i] = (int32_t)id;
     b->index_of[id] = (int32_t)i;
     sx__ball_update_mass(m, i);
@@ -213,6 +226,7 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
     b->mat[to] = b->mat[from];
     b->fix[to] = b->fix[from];
     b->group[to] = b->group[from];
+    if (b->clump) b->clump[to] = b->clump[from];
     b->index_of[b->id[to]] = (int32_t)to;
 }
 
@@ -256,9 +270,11 @@ sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n)
     if (n < 0) return sx__fail(m, SX_EINVAL, "ball_remove: the number of ids must be >= 0 (got %lld)", (long long)n);
     sx_balls *b = &m->balls;
     const int64_t nb = b->n;
-    for (int64_t j = 0; j < n; j++)
-        if (sx__ball_index(m, ids[j]) < 0)
-            return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)ids[j]);
+    for (int64_t j = 0; j < n; j++) {
+        const int64_t i = sx__ball_index(m, ids[j]);
+        if (i < 0) return sx__fail(m, SX_ENOTFOUND, "ball_remove: no ball with id %lld", (long long)ids[j]);
+        if (pebble(m, i, "ball_remove", "pebbles (remove the clump)")) return SX_EINVAL;
+    }
     if (n == 0) return SX_OK;
     /* remap: old dense index -> new one, -1 for a removed ball */
     int32_t *remap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)nb, sizeof *remap);
@@ -324,6 +340,7 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     GATHER(mat, 1, uint16_t);
     GATHER(fix, 1, uint8_t);
     GATHER(group, 1, int32_t);
+    if (b->clump) GATHER(clump, 1, int32_t);
 #undef GATHER
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
@@ -483,6 +500,7 @@ static int64_t lookup(const sx_model *m, int64_t id, const char *fn)
     return i;
 }
 
+
 static sx_status ensure_applied(sx_model *m)
 {
     sx_balls *b = &m->balls;
@@ -538,6 +556,9 @@ sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const doub
         return sx__fail(m, SX_EINVAL, "ball_set_vec: force and moment are results of the step; set the applied force instead");
     if (which < SX_BALL_POS || which > SX_BALL_APPLIED_MOMENT)
         return sx__fail(m, SX_EINVAL, "ball_set_vec: unknown field %d", (int)which);
+    if ((which == SX_BALL_POS || which == SX_BALL_VEL || which == SX_BALL_SPIN) &&
+        pebble(m, i, "ball_set_vec", "position, velocity and spin (set the clump's)"))
+        return SX_EINVAL;
     if ((which == SX_BALL_APPLIED_FORCE || which == SX_BALL_APPLIED_MOMENT) && ensure_applied(m))
         return sx__fail(m, SX_ENOMEM, "ball_set_vec: out of memory");
     int n;
@@ -569,6 +590,9 @@ sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double valu
     const int64_t i = lookup(m, id, "ball_set");
     if (i < 0) return SX_ENOTFOUND;
     sx_balls *b = &m->balls;
+    if ((which == SX_BALL_RADIUS || which == SX_BALL_DAMPING) &&
+        pebble(m, i, "ball_set", "size and damping (set the clump's damping)"))
+        return SX_EINVAL;
     switch (which) {
     case SX_BALL_RADIUS:
         if (!(value > 0) || !isfinite(value))
@@ -605,6 +629,14 @@ sx_status sx_ball_set_material(sx_model *m, int64_t id, int material)
     if (i < 0) return SX_ENOTFOUND;
     if (material < 0 || material >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "ball_set_material: no material with index %d", material);
+    /* a pebble may take another material of its clump's density (its friction, stiffness), not another mass */
+    if (m->balls.clump && m->balls.clump[i]) {
+        int cm;
+        sx_clump_material(m, m->balls.clump[i], &cm);
+        if (m->mats[cm].def.density != m->mats[material].def.density &&
+            pebble(m, i, "ball_set_material", "mass: a pebble's material needs the clump's density"))
+            return SX_EINVAL;
+    }
     m->balls.mat[i] = (uint16_t)material;
     m->balls.alpha[i] = m->mats[material].def.damping;
     sx__ball_update_mass(m, i);
@@ -638,6 +670,7 @@ sx_status sx_ball_set_fixity(sx_model *m, int64_t id, unsigned mask)
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     const int64_t i = lookup(m, id, "ball_set_fixity");
     if (i < 0) return SX_ENOTFOUND;
+    if (pebble(m, i, "ball_set_fixity", "motion (fix the clump)")) return SX_EINVAL;
     const unsigned valid = m->dim == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WZ);
     if (mask & ~valid)
         return sx__fail(m, SX_EINVAL, "ball_set_fixity: mask 0x%x has components a %dD ball does not have", mask,

@@ -370,6 +370,8 @@ static int half_stencil(int64_t (*off)[3])
 /* A candidate pair (i, j), i < j: counted when count is given, else stored. */
 static inline bool candidate(sx_model *m, const history *h, int32_t i, int32_t j, int64_t *count)
 {
+    const int32_t *cl = m->balls.clump; /* clumps: pebbles of one clump never pair (NULL without clumps) */
+    if (cl && cl[i] && cl[i] == cl[j]) return true;
     if (count) {
         (*count)++;
         return true;
@@ -1361,9 +1363,11 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
     const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia, *restrict alpha = B->alpha;
     const uint8_t *restrict fixa = B->fix;
+    const int32_t *cl = B->clump;
     double worst = 0, damp_work = 0, load_work = 0;
     double check = 0; /* a sum of 0 x every new value: NaN once any is not finite */
     for (int64_t i = o->b0; i < o->b1; i++) {
+        if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
         const unsigned fix = plain ? 0 : fixa[i];
         const double a = plain ? 0 : alpha[i], im = ima[i], ii = iia[i];
         double *v = va + i * D, *x = xa + i * D;
@@ -1540,6 +1544,10 @@ static double KERNEL(critical_dt)(sx_model *m)
         else kn *= 2, ks *= 2; /* undo the series combination with itself */
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
+        if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
+            kt[i] = ktr, kr[i] = krot;
+            continue;
+        }
         /* Contact dashpots lower the stable timestep of the central differences: for
          * m x'' + c x' + k x = 0 with x' taken at the half step, stability needs
          * (w dt)^2 + 4 z (w dt) < 4, i.e. dt < (2/w)(sqrt(1 + z^2) - z), z = c / (2 sqrt(k m));
@@ -1554,6 +1562,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (dtr < best) best = dtr;
         }
     }
+    if (m->clumps) best = fmin(best, sx__clumps_critical_dt(m, kt, kr, ct, cr)); /* reads the sums above */
     sx__scratch_release(m);
     return best;
 }
@@ -1589,12 +1598,14 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
     *e = m->acc;
     e->kinetic = e->gravitational = e->strain = e->bond_strain = 0;
     for (int64_t i = 0; i < B->n; i++) {
+        if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once, below */
         const double *v = B->v + i * D, *w = B->w + i * RD;
         double ww = 0;
         for (int k = 0; k < RD; k++) ww += w[k] * w[k];
         e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
         e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
     }
+    if (m->clumps) sx__clumps_energy(m, e);
     /* every overlap stores normal strain, even one no step has seen yet;
      * the shear spring only once the contact has history */
     const double zero[D] = {0};

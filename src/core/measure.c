@@ -7,7 +7,14 @@
  * (Love-Weber; for a ball-ball contact inside the region the two ends add up
  * to F_on_b (x_b - x_a)). Porosity counts a ball's whole volume when its
  * centre is inside, which is exact for a region holding whole balls (e.g. the
- * specimen's box) and an approximation at a cut boundary. */
+ * specimen's box) and an approximation at a cut boundary.
+ *
+ * Clumps: a pebble counts its share of its clump's volume (the union, so
+ * overlaps are not counted twice), and its contacts' arms run from the
+ * clump's centroid, not the pebble's centre: the body carries load between
+ * its pebbles internally, and the arms from one point of the body count
+ * that internal stress too (for a body in equilibrium the sum of F (x_c - x)
+ * does not depend on the point). */
 #include "model_internal.h"
 
 #include <math.h>
@@ -32,6 +39,15 @@ static bool inside(const sx_region *r, const double *x, int dim)
     return true;
 }
 
+/* Where ball i's contact arms start: its centre, or its clump's centroid (into buf). */
+static const double *arm_origin(const sx_model *m, int64_t i, double *buf)
+{
+    if (!m->balls.clump || !m->balls.clump[i]) return m->balls.x + i * m->dim;
+    double volume;
+    sx__pebble_body(m, i, buf, &volume);
+    return buf;
+}
+
 /* Adds -F (x_c - x) of one ball's side of a contact. */
 static void add_stress(sx_measurement *out, int dim, const double *f, const double *xc, const double *x)
 {
@@ -51,9 +67,10 @@ static bool visit(const sx_contact_info *ci, void *ud)
     for (int k = 0; k < dim; k++) f[k] = (ci->fn + ci->pb_fn) * ci->normal[k] + ci->shear[k] + ci->pb_fs[k];
     const int64_t ia = sx__ball_index(m, ci->a);
     const double *xa = m->balls.x + ia * dim;
+    double ba[3], bb[3];
     if (ci->is_wall) {
         if (!inside(c->r, xa, dim)) return true;
-        add_stress(c->out, dim, f, ci->point, xa);
+        add_stress(c->out, dim, f, ci->point, arm_origin(m, ia, ba));
         return true;
     }
     const int64_t ib = sx__ball_index(m, ci->b);
@@ -62,8 +79,8 @@ static bool visit(const sx_contact_info *ci, void *ud)
     if (!in_a && !in_b) return true;
     double fa[3];
     for (int k = 0; k < 3; k++) fa[k] = -f[k];
-    if (in_a) add_stress(c->out, dim, fa, ci->point, xa);
-    if (in_b) add_stress(c->out, dim, f, ci->point, xb);
+    if (in_a) add_stress(c->out, dim, fa, ci->point, arm_origin(m, ia, ba));
+    if (in_b) add_stress(c->out, dim, f, ci->point, arm_origin(m, ib, bb));
     c->out->contacts += in_a + in_b; /* contact ends inside: twice the contacts for the coordination */
     for (int i = 0; i < dim; i++)
         for (int j = 0; j < dim; j++) c->out->fabric[i][j] += ci->normal[i] * ci->normal[j];
@@ -94,7 +111,9 @@ sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out)
     for (int64_t i = 0; i < b->n; i++) {
         if (!inside(region, b->x + i * dim, dim)) continue;
         const double r = b->rad[i];
-        out->solid += dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r;
+        double v = dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r, centre[3];
+        if (b->clump && b->clump[i]) sx__pebble_body(m, i, centre, &v); /* its share of the union */
+        out->solid += v;
         out->balls++;
     }
     measure_ctx c = {m, region, out, 0};

@@ -79,6 +79,7 @@ void sx_model_destroy(sx_model *m)
     sx__pairs_free(m, &m->bw);
     sx__walls_free(m);
     sx__bonds_free(m);
+    sx__clumps_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->pool, (size_t)m->cap_pool, sizeof *m->pool);
@@ -241,6 +242,8 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
         if (density_changed) sx__ball_update_mass(m, b);
         if (damping_changed) m->balls.alpha[b] = d->damping;
     }
+    if ((density_changed || damping_changed) && m->clumps) /* the bodies of the material, as its balls */
+        sx__clumps_material_changed(m, i, density_changed, damping_changed);
     m->dt_stale = true;
     m->guard_dirty = true;
     if (out) *out = i;
@@ -404,6 +407,7 @@ static bool unforced(const sx_model *m)
     if (m->balls.fapp) return false;
     for (int64_t i = 0; i < m->balls.n; i++)
         if (m->balls.fix[i]) return false;
+    if (m->clumps && sx__clumps_forced(m)) return false;
     return true;
 }
 
@@ -542,6 +546,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
+        if (!st && m->clumps) st = sx__clumps_step(m, &max_disp); /* clumps.c: the bodies move their pebbles */
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
         sx__walls_servo(m);
@@ -632,7 +637,7 @@ int sx_profile_format(const sx_profile *p, int64_t balls, char *buf, size_t len)
 
 /* ---------------------------------------------------------------- state */
 
-static uint64_t fnv(uint64_t h, const void *data, size_t n)
+uint64_t sx__fnv(uint64_t h, const void *data, size_t n)
 {
     const unsigned char *p = data;
     for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
@@ -644,31 +649,32 @@ uint64_t sx_model_state_hash(const sx_model *m)
     const sx_balls *b = &m->balls;
     const size_t n = (size_t)b->n, d = (size_t)m->dim, r = (size_t)m->rdim;
     uint64_t h = 0xcbf29ce484222325ULL;
-    h = fnv(h, &m->time, sizeof m->time);
-    h = fnv(h, &m->step, sizeof m->step);
-    h = fnv(h, &m->dt_prev, sizeof m->dt_prev);
-    h = fnv(h, b->id, n * sizeof *b->id);
-    h = fnv(h, b->x, n * d * sizeof(double));
-    h = fnv(h, b->v, n * d * sizeof(double));
-    h = fnv(h, b->w, n * r * sizeof(double));
-    h = fnv(h, b->f, n * d * sizeof(double));
-    h = fnv(h, b->t, n * r * sizeof(double));
-    h = fnv(h, b->rad, n * sizeof(double));
+    h = sx__fnv(h, &m->time, sizeof m->time);
+    h = sx__fnv(h, &m->step, sizeof m->step);
+    h = sx__fnv(h, &m->dt_prev, sizeof m->dt_prev);
+    h = sx__fnv(h, b->id, n * sizeof *b->id);
+    h = sx__fnv(h, b->x, n * d * sizeof(double));
+    h = sx__fnv(h, b->v, n * d * sizeof(double));
+    h = sx__fnv(h, b->w, n * r * sizeof(double));
+    h = sx__fnv(h, b->f, n * d * sizeof(double));
+    h = sx__fnv(h, b->t, n * r * sizeof(double));
+    h = sx__fnv(h, b->rad, n * sizeof(double));
     const sx_pairs *ps[2] = {&m->bb, &m->bw};
     for (int s = 0; s < 2; s++) {
         const sx_pairs *p = ps[s];
         for (int64_t c = 0; c < p->n; c++) {
             if (!p->touching[c]) continue;
             const int32_t ends[2] = {b->id[p->a[c]], s == 0 ? b->id[p->b[c]] : p->b[c]};
-            h = fnv(h, ends, sizeof ends);
-            h = fnv(h, p->fs + c * (int64_t)d, d * sizeof(double));
+            h = sx__fnv(h, ends, sizeof ends);
+            h = sx__fnv(h, p->fs + c * (int64_t)d, d * sizeof(double));
         }
     }
     for (int64_t w = 0; w < m->nwall; w++) {
-        h = fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
-        h = fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
-        h = fnv(h, m->walls[w].force, sizeof m->walls[w].force);
+        h = sx__fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
+        h = sx__fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
+        h = sx__fnv(h, m->walls[w].force, sizeof m->walls[w].force);
     }
+    if (m->clumps) h = sx__clumps_hash(m, h);
     return h;
 }
 
@@ -712,7 +718,9 @@ double sx_model_unbalanced_ratio(const sx_model *m)
     const sx_balls *b = &m->balls;
     const int d = m->dim;
     double unbalanced = 0;
+    int64_t bodies = b->n;
     for (int64_t i = 0; i < b->n; i++) {
+        if (b->clump && b->clump[i]) continue; /* a pebble is balanced with its clump, below */
         double s2 = 0;
         for (int k = 0; k < d; k++) {
             if (b->fix[i] & (SX_FIX_VX << k)) continue; /* a fixed component is balanced by its fixity */
@@ -721,9 +729,10 @@ double sx_model_unbalanced_ratio(const sx_model *m)
         }
         unbalanced += sqrt(s2);
     }
+    if (m->clumps) sx__clumps_unbalanced(m, &unbalanced, &bodies);
     double acc[2] = {0, 0};
     sx_contact_each(m, add_contact_force, acc);
-    if (b->n == 0) return 0;
+    if (bodies == 0) return 0;
     if (acc[1] == 0 || acc[0] == 0) return unbalanced > 0 ? INFINITY : 0;
-    return (unbalanced / (double)b->n) / (acc[0] / acc[1]);
+    return (unbalanced / (double)bodies) / (acc[0] / acc[1]);
 }

@@ -58,6 +58,7 @@ typedef struct sx_balls {
     uint16_t *mat;         /* material index */
     uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
     int32_t *group;        /* user group number (0: none) */
+    int32_t *clump;        /* clump id of each ball (0: a free ball); NULL while the model has no clumps */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
@@ -219,6 +220,8 @@ struct sx_model {
     double guard_e0, guard_scale;
     bool guard_on;
     bool guard_dirty;        /* the system was changed by the user: take a new energy baseline */
+
+    struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
 };
 
 /* error helper: formats into m->err and returns status */
@@ -278,3 +281,30 @@ void sx__bonds_free(sx_model *m);
 sx_status sx__prepare(sx_model *m);
 /* Law of a ball of material `mat` against a wall (wall stiffness in series). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
+/* FNV-1a over n bytes, continuing h (the state hash). */
+uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
+
+/* Clumps (clumps.c): the hooks of the other stages, all no-ops while
+ * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */
+/* The step of the bodies, after the balls': sums the pebbles' forces,
+ * integrates (4-42 ... 4-48), places the pebbles; raises *max_disp to the
+ * largest pebble displacement since the last build. */
+sx_status sx__clumps_step(sx_model *m, double *max_disp);
+/* Adds the clumps' kinetic (once per body) and gravitational energy. */
+void sx__clumps_energy(const sx_model *m, sx_energy *e);
+/* The smallest critical timestep of the clumps, from their pebbles' sums of
+ * contact stiffness kt, kr and dashpot ct, cr (per ball, as critical_dt has them). */
+double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double *kr, const double *ct,
+                              const double *cr);
+uint64_t sx__clumps_hash(const sx_model *m, uint64_t h);
+/* Some clump has a fixed component (energy may be injected). */
+bool sx__clumps_forced(const sx_model *m);
+/* Adds each clump's |F + M g| (free components) to *sum; *bodies counts a clump once, not its pebbles. */
+void sx__clumps_unbalanced(const sx_model *m, double *sum, int64_t *bodies);
+/* A material was redefined: the mass and inertia (density changed) or
+ * the local damping (damping changed) of its clumps follow, as its balls'. */
+void sx__clumps_material_changed(sx_model *m, int material, bool density, bool damping);
+/* Ball i is a pebble: the reference point of its body (the clump's centroid)
+ * and its share of the body's volume, for measurements. */
+void sx__pebble_body(const sx_model *m, int64_t i, double centre[3], double *volume);
+void sx__clumps_free(sx_model *m);

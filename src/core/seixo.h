@@ -81,7 +81,7 @@ SX_API int sx_model_threads(const sx_model *m);
 /// Asks a running cycle to stop at the next step boundary (async-signal-safe).
 SX_API void sx_model_interrupt(sx_model *m);
 
-/// PFC's mean unbalanced-force ratio: the mean over balls of |F + m g| (free
+/// PFC's mean unbalanced-force ratio: the mean over bodies (free balls and clumps) of |F + m g| (free
 /// components) over the mean contact force magnitude; 0 when at rest with no
 /// contacts, infinity when forces act but no contact carries any.
 SX_API double sx_model_unbalanced_ratio(const sx_model *m);
@@ -466,3 +466,114 @@ typedef struct sx_energy {
 SX_API sx_energy sx_model_energy(sx_model *m);
 /// Switches tracking of the accumulated terms on (reset to zero) or off.
 SX_API void sx_model_track_energy(sx_model *m, bool on);
+
+/* --------------------------------------------------------------- clumps */
+
+/* A clump is a rigid body made of balls ("pebbles", possibly overlapping)
+ * that moves as one: its translation by central differences like a ball
+ * (4-46, 4-48), its rotation by Euler's equations (4-42) in its principal
+ * frame. Its pebbles stay balls for contacts, walls, bonds (between pebbles
+ * of different clumps), contact models and queries; pebbles of one clump
+ * never touch each other. A pebble's position, velocity and spin follow
+ * its clump and cannot be set; it cannot be removed alone. A pebble
+ * reports its clump's mass (sx_ball_get SX_BALL_MASS) and smallest
+ * principal moment (SX_BALL_INERTIA).
+ *
+ * A clump is an instance of a template: pebble centres and radii in the
+ * template's own frame, placed with a position (of the centroid), an
+ * orientation and a scale. Templates are never removed, like materials. */
+
+typedef struct sx_clump_template_def {
+    const double *pos;    ///< m, pebble centres in the template frame, dim numbers per pebble
+    const double *radius; ///< m, pebble radii (> 0)
+    int64_t count;        ///< number of pebbles (>= 1)
+    int64_t lines;        ///< lines per axis integrating overlapping pebbles (0: default,
+                          ///< 512 in 3D, 65536 in 2D; at least 16); unused without overlaps
+} sx_clump_template_def;
+
+/// Mass properties of a template, per unit density at scale 1: mass = density
+/// scale^dim volume, inertia = density scale^(dim + 2) inertia.
+typedef struct sx_clump_props {
+    int64_t count;        ///< pebbles
+    bool overlapping;     ///< some pebbles overlap (the union was integrated numerically)
+    double volume;        ///< m^3 (2D: m^2 of a unit-thickness slice) of the union of the pebbles
+    double centroid[3];   ///< m, in the template frame
+    double inertia[3][3]; ///< m^5, about the centroid, template frame (2D: [2][2] = Izz, m^4)
+    double principal[3];  ///< principal moments, ascending (2D: [0] = Izz)
+    double axes[3][3];    ///< principal axes as the columns of a rotation, in the template frame (2D: identity)
+    double error;         ///< estimated relative error of volume, centroid and inertia (0: exact, no overlaps)
+} sx_clump_props;
+
+/// Adds a template (names are unique); writes its index (>= 0) to *out if not NULL.
+SX_API sx_status sx_clump_template_add(sx_model *m, const char *name, const sx_clump_template_def *def, int *out);
+/// Index of the named template, or -1.
+SX_API int sx_clump_template_find(const sx_model *m, const char *name);
+SX_API int sx_clump_template_count(const sx_model *m);
+SX_API const char *sx_clump_template_name(const sx_model *m, int t);
+SX_API sx_status sx_clump_template_props(const sx_model *m, int t, sx_clump_props *out);
+/// Pebble k of template t: centre (template frame, m) and radius (m).
+SX_API sx_status sx_clump_template_pebble(const sx_model *m, int t, int64_t k, double pos[3], double *radius);
+
+typedef struct sx_clump_def {
+    int template_index;     ///< a template of the model
+    double pos[3];          ///< m, where the centroid goes
+    double orientation[4];  ///< unit quaternion (w, x, y, z) turning the template frame into space
+                            ///< (normalised on input); 2D: a rotation about z (x = y = 0)
+    double scale;           ///< > 0: template lengths are multiplied by it
+    double vel[3];          ///< m/s, of the centroid
+    double spin[3];         ///< rad/s (2D: spin[0], about z)
+    int material;           ///< material of every pebble; its density gives the clump's mass
+} sx_clump_def;
+
+/// Template 0, at the origin, identity orientation, scale 1, at rest, material 0.
+SX_API sx_clump_def sx_clump_default_def(void);
+/// Adds a clump and its pebbles; its stable id (>= 1, its own numbering) is written to *id.
+SX_API sx_status sx_clump_add(sx_model *m, const sx_clump_def *def, int64_t *id);
+/// Removes a clump and its pebbles (and their contacts and bonds).
+SX_API sx_status sx_clump_remove(sx_model *m, int64_t id);
+SX_API int64_t sx_clump_count(const sx_model *m);
+SX_API int64_t sx_clump_id_at(const sx_model *m, int64_t i);
+SX_API bool sx_clump_exists(const sx_model *m, int64_t id);
+/// The clump a ball belongs to, 0 for a free ball (or no such ball).
+SX_API int64_t sx_ball_clump(const sx_model *m, int64_t ball_id);
+
+typedef enum sx_clump_vec {
+    SX_CLUMP_POS,      ///< m, centroid (settable: moves the clump)
+    SX_CLUMP_VEL,      ///< m/s (settable)
+    SX_CLUMP_SPIN,     ///< rad/s, in space (settable; 2D: [0])
+    SX_CLUMP_FORCE,    ///< N: the pebbles' contact and applied forces of the last step
+    SX_CLUMP_MOMENT,   ///< N m: their moment about the centroid
+    SX_CLUMP_ANGULAR_MOMENTUM, ///< kg m^2/s about the centroid, in space (2D: [0])
+} sx_clump_vec;
+
+SX_API sx_status sx_clump_get_vec(const sx_model *m, int64_t id, sx_clump_vec which, double out[3]);
+SX_API sx_status sx_clump_set_vec(sx_model *m, int64_t id, sx_clump_vec which, const double v[3]);
+/// The orientation as a unit quaternion (w, x, y, z) from the template frame to space.
+SX_API sx_status sx_clump_orientation(const sx_model *m, int64_t id, double q[4]);
+/// Turns the clump about its centroid (its spin in space is kept).
+SX_API sx_status sx_clump_set_orientation(sx_model *m, int64_t id, const double q[4]);
+
+typedef enum sx_clump_scalar {
+    SX_CLUMP_MASS,    ///< kg
+    SX_CLUMP_VOLUME,  ///< m^3 (2D: m^2)
+    SX_CLUMP_SCALE,   ///< of its template
+    SX_CLUMP_DAMPING, ///< local damping alpha (settable)
+} sx_clump_scalar;
+
+SX_API sx_status sx_clump_get(const sx_model *m, int64_t id, sx_clump_scalar which, double *out);
+SX_API sx_status sx_clump_set(sx_model *m, int64_t id, sx_clump_scalar which, double value);
+/// Principal moments (kg m^2, ascending; 2D: [0] = Izz) and the inertia tensor
+/// about the centroid in space axes (2D: [2][2]); either may be NULL.
+SX_API sx_status sx_clump_inertia(const sx_model *m, int64_t id, double principal[3], double tensor[3][3]);
+SX_API sx_status sx_clump_template_of(const sx_model *m, int64_t id, int *t);
+/// Writes up to cap pebble ids (in template order) and their number to *count.
+SX_API sx_status sx_clump_pebbles(const sx_model *m, int64_t id, int64_t *ids, int64_t cap, int64_t *count);
+/// Material of the clump (its pebbles may have others of the same density).
+SX_API sx_status sx_clump_material(const sx_model *m, int64_t id, int *material);
+/// Gives the clump and every pebble the material; mass and inertia follow its density.
+SX_API sx_status sx_clump_set_material(sx_model *m, int64_t id, int material);
+/// Fixities of the body (SX_FIX_*, space axes). In 3D the spin is fixed as a
+/// whole (SX_FIX_SPIN or none): a spin imposed on some axes only would need a
+/// constraint torque Euler's equations do not give.
+SX_API sx_status sx_clump_fixity(const sx_model *m, int64_t id, unsigned *mask);
+SX_API sx_status sx_clump_set_fixity(sx_model *m, int64_t id, unsigned mask);

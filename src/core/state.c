@@ -4,6 +4,8 @@
  * model grows, frees and reports its bytes like any other. */
 #include "state.h"
 
+#include "clumps.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -246,7 +248,7 @@ sx_status sx__state_finish(sx_model *m)
 {
     sx_status st;
     if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
-        (st = check_pairs(m)) || (st = check_bonds(m)))
+        (st = check_pairs(m)) || (st = check_bonds(m)) || (st = sx__clumps_finish(m)))
         return st;
     /* the ball-ball pass's chunks follow from the pair store alone: planned
      * again they are those the last build made */

@@ -19,6 +19,9 @@
  *            step, builds, build flag, guard, energy tracking);
  *   derived  id -> index map, intact bonds (here), pair laws (refreshed by
  *            every cycle), the grid and scratch (rebuilt by every build).
+ * Clumps (clumps.h) are sized and checked by their own module: the I/O
+ * layer calls sx__clumps_alloc after sx__state_alloc, and sx__state_finish
+ * calls sx__clumps_finish, which also rebuilds the balls' clump ids.
  */
 #pragma once
 

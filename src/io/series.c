@@ -114,6 +114,7 @@ typedef struct snap {
     int64_t step, balls, contacts, wall_contacts, bonds, walls;
     unsigned fields;
     int dim;
+    bool clumps; /* the balls carry their clump ids (pebbles of a clump, 0 for free balls) */
 } snap;
 
 static const char xmf_trailer[] = "  </Grid>\n </Domain>\n</Xdmf>\n";
@@ -196,6 +197,7 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
     if (f & SX_OUT_GROUP) attribute(b, base, k, "group", "balls/group", s->balls, 1, "Int", 4, false);
     if (f & SX_OUT_MATERIAL) attribute(b, base, k, "material", "balls/material", s->balls, 1, "Int", 4, false);
     if (f & SX_OUT_MASS) attribute(b, base, k, "mass", "balls/mass", s->balls, 1, "Float", 8, false);
+    if (s->clumps) attribute(b, base, k, "clump", "balls/clump", s->balls, 1, "Int", 8, false);
     put(b, "    </Grid>\n");
     if ((f & SX_OUT_CONTACTS) && s->contacts > 0) {
         put(b, "    <Grid Name=\"contacts\" GridType=\"Uniform\">\n");
@@ -408,6 +410,10 @@ static void write_balls(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f)
             if (f & SX_OUT_ID) {
                 for (int64_t i = 0; i < n; i++) iv[i] = b->id[i];
                 sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, iv, n, 1, NULL);
+                if (b->clump) { /* clumps: each ball's clump id, 0 for a free ball, with the ids */
+                    for (int64_t i = 0; i < n; i++) iv[i] = b->clump[i];
+                    sx_h5_write(h, g, "clump", H5T_NATIVE_INT64, H5T_STD_I64LE, iv, n, 1, NULL);
+                }
             }
             if (f & SX_OUT_MATERIAL) {
                 int32_t *mv = (int32_t *)iv;
@@ -518,6 +524,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     s->balls = m->balls.n;
     s->fields = f;
     s->dim = m->dim;
+    s->clumps = (f & SX_OUT_ID) && m->balls.clump;
     write_balls(h, snapg, m, f);
     if (f & (SX_OUT_CONTACTS | SX_OUT_BONDS)) {
         gather g = {.m = m};
@@ -577,6 +584,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     sx_h5_attr_int(h, snapg, "bonds", s->bonds);
     sx_h5_attr_int(h, snapg, "walls", s->walls);
     sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
+    if (s->clumps) sx_h5_attr_int(h, snapg, "clumps", 1);
 }
 
 /* -------------------------------------------------------- the series */
@@ -623,6 +631,9 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     sx_h5_get_i64(h, g, name, "walls", &s->walls, 1, true);
     sx_h5_get_i64(h, g, name, "fields", &f, 1, true);
     s->fields = (unsigned)f;
+    int64_t clumps = 0;
+    sx_h5_get_i64(h, g, name, "clumps", &clumps, 1, false); /* absent before clumps, and without them */
+    s->clumps = clumps != 0;
     sx_h5_close(g);
     return !h->failed;
 }

@@ -15,11 +15,13 @@
 #include "io_internal.h"
 #include "state.h"
 
+#include "clumps.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { T_F64, T_I32, T_U16, T_U8 };
+enum { T_F64, T_I32, T_U16, T_U8, T_I64 };
 
 static hid_t mem_type(int t)
 {
@@ -27,6 +29,7 @@ static hid_t mem_type(int t)
     case T_F64: return H5T_NATIVE_DOUBLE;
     case T_I32: return H5T_NATIVE_INT32;
     case T_U16: return H5T_NATIVE_UINT16;
+    case T_I64: return H5T_NATIVE_INT64;
     default: return H5T_NATIVE_UINT8;
     }
 }
@@ -37,6 +40,7 @@ static hid_t file_type(int t)
     case T_F64: return H5T_IEEE_F64LE;
     case T_I32: return H5T_STD_I32LE;
     case T_U16: return H5T_STD_U16LE;
+    case T_I64: return H5T_STD_I64LE;
     default: return H5T_STD_U8LE;
     }
 }
@@ -534,6 +538,211 @@ done:
     sx_h5_close(kf);
 }
 
+/* -------------------------------------------------------------- clumps */
+
+static void load_group(sx_h5 *h, hid_t f, const char *path, const field *fl, int nf, int64_t rows);
+
+/* The clump store (core clumps.h) in its own group /clumps, written only
+ * when the model has one: the templates (/clumps/templates, with their
+ * pebbles in /clumps/template_pebbles), every per-clump array, and the
+ * clumps' pebbles as ball ids (/clumps/pebbles; clump c owns the rows
+ * first_pebble[c] .. first_pebble[c] + its template's count). The balls'
+ * clump ids are derived from it on load (clumps.c). */
+
+static int clump_fields(const sx_model *m, field *f)
+{
+    const sx_clumps *C = m->clumps;
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = F("id", T_I32, C->id, 1, NULL);
+    f[n++] = F("template", T_I32, C->tpl_of, 1, NULL);
+    f[n++] = F("material", T_U16, C->mat, 1, NULL);
+    f[n++] = F("fixity", T_U8, C->fix, 1, NULL);
+    f[n++] = F("scale", T_F64, C->scale, 1, "1");
+    f[n++] = F("position", T_F64, C->x, d, "m");
+    f[n++] = F("velocity", T_F64, C->v, d, "m/s");
+    f[n++] = F(d == 3 ? "orientation" : "angle", T_F64, C->q, d == 3 ? 4 : 1, d == 3 ? "1" : "rad");
+    if (d == 3) f[n++] = F("angular_momentum", T_F64, C->L, 3, "kg m^2/s");
+    f[n++] = F("spin", T_F64, C->w, r, "rad/s");
+    f[n++] = F("force", T_F64, C->f, d, "N");
+    f[n++] = F("moment", T_F64, C->t, r, "N m");
+    f[n++] = F("damping", T_F64, C->alpha, 1, "1");
+    f[n++] = F("mass", T_F64, C->mass, 1, "kg");
+    f[n++] = F("inertia", T_F64, C->inertia, r, "kg m^2");
+    f[n++] = F("first_pebble", T_I64, C->first, 1, NULL);
+    return n;
+}
+
+static int template_pebble_fields(const sx_model *m, field *f)
+{
+    const sx_clumps *C = m->clumps;
+    const int d = m->dim;
+    int n = 0;
+    f[n++] = F("position", T_F64, C->tp_pos, d, "m");
+    f[n++] = F("radius", T_F64, C->tp_rad, 1, "m");
+    f[n++] = F("body_position", T_F64, C->tp_body, d, "m");
+    return n;
+}
+
+/* The templates' columns, gathered from (or scattered to) their structs. */
+typedef struct tpl_cols {
+    char *name;
+    int64_t *first, *count, *lines;
+    double *volume, *centroid, *inertia, *principal, *frame, *error, *power_sum;
+} tpl_cols;
+
+static bool tpl_cols_alloc(tpl_cols *c, int64_t n)
+{
+    const size_t k = (size_t)(n > 0 ? n : 1);
+    c->name = calloc(k, sizeof ((sx_clump_tpl *)0)->name);
+    c->first = calloc(k, sizeof(int64_t));
+    c->count = calloc(k, sizeof(int64_t));
+    c->lines = calloc(k, sizeof(int64_t));
+    c->volume = calloc(k, sizeof(double));
+    c->centroid = calloc(3 * k, sizeof(double));
+    c->inertia = calloc(9 * k, sizeof(double));
+    c->principal = calloc(3 * k, sizeof(double));
+    c->frame = calloc(4 * k, sizeof(double));
+    c->error = calloc(k, sizeof(double));
+    c->power_sum = calloc(k, sizeof(double));
+    return c->name && c->first && c->count && c->lines && c->volume && c->centroid && c->inertia && c->principal &&
+           c->frame && c->error && c->power_sum;
+}
+
+static void tpl_cols_free(tpl_cols *c)
+{
+    void *p[] = {c->name, c->first, c->count, c->lines, c->volume, c->centroid, c->inertia, c->principal,
+                 c->frame, c->error, c->power_sum};
+    for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
+}
+
+static void tpl_copy(sx_clump_tpl *t, tpl_cols *c, int64_t i, bool to_cols)
+{
+    const size_t w = sizeof t->name;
+#define S(arr, fld)                 \
+    do {                            \
+        if (to_cols) c->arr[i] = fld; \
+        else fld = c->arr[i];       \
+    } while (0)
+#define V(arr, fld, k)                                  \
+    do {                                                \
+        if (to_cols) memcpy(c->arr + i * (k), fld, (k) * sizeof(double)); \
+        else memcpy(fld, c->arr + i * (k), (k) * sizeof(double));         \
+    } while (0)
+    if (to_cols) memcpy(c->name + (size_t)i * w, t->name, w);
+    else memcpy(t->name, c->name + (size_t)i * w, w);
+    S(first, t->first);
+    S(count, t->n);
+    S(lines, t->lines);
+    S(volume, t->volume);
+    S(error, t->error);
+    S(power_sum, t->power_sum);
+    V(centroid, t->centroid, 3);
+    V(inertia, t->inertia, 9);
+    V(principal, t->principal, 3);
+    V(frame, t->frame, 4);
+#undef S
+#undef V
+}
+
+/* Reads (write = false) or writes the templates' columns. */
+static void templates_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
+{
+    sx_clumps *C = m->clumps;
+    const int64_t n = C->ntpl;
+    const size_t w = sizeof C->tpl[0].name;
+    tpl_cols c;
+    memset(&c, 0, sizeof c);
+    if (!tpl_cols_alloc(&c, n)) {
+        sx_h5_fail(h, "out of memory");
+        tpl_cols_free(&c);
+        return;
+    }
+    if (write)
+        for (int64_t i = 0; i < n; i++) tpl_copy(&C->tpl[i], &c, i, true);
+    struct {
+        const char *name;
+        hid_t mem, file;
+        void *data;
+        int per;
+        const char *units;
+    } cols[] = {
+        {"first_pebble", H5T_NATIVE_INT64, H5T_STD_I64LE, c.first, 1, NULL},
+        {"pebble_count", H5T_NATIVE_INT64, H5T_STD_I64LE, c.count, 1, NULL},
+        {"lines", H5T_NATIVE_INT64, H5T_STD_I64LE, c.lines, 1, NULL},
+        {"volume", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.volume, 1, m->dim == 3 ? "m^3" : "m^2"},
+        {"centroid", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.centroid, 3, "m"},
+        {"inertia", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.inertia, 9, m->dim == 3 ? "m^5" : "m^4"},
+        {"principal", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.principal, 3, m->dim == 3 ? "m^5" : "m^4"},
+        {"frame", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.frame, 4, "1"},
+        {"error", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.error, 1, "1"},
+        {"power_sum", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.power_sum, 1, m->dim == 3 ? "m^3" : "m^2"},
+    };
+    if (write) sx_io_write_strings(h, g, "name", c.name, w, n);
+    else sx_io_read_strings(h, g, "/clumps/templates", "name", c.name, w, n);
+    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) {
+        if (write) sx_h5_write(h, g, cols[k].name, cols[k].mem, cols[k].file, cols[k].data, n, cols[k].per, cols[k].units);
+        else sx_h5_read(h, g, "/clumps/templates", cols[k].name, cols[k].mem, cols[k].data, n, cols[k].per, true);
+    }
+    if (!write && !h->failed)
+        for (int64_t i = 0; i < n; i++) tpl_copy(&C->tpl[i], &c, i, false);
+    tpl_cols_free(&c);
+}
+
+static void save_clumps(sx_h5 *h, hid_t f, sx_model *m)
+{
+    sx_clumps *C = m->clumps;
+    if (!C) return;
+    field fl[MAX_FIELDS];
+    hid_t g = sx_h5_group(h, f, "clumps");
+    sx_h5_attr_int(h, g, "count", C->n);
+    sx_h5_attr_int(h, g, "next_id", C->next_id);
+    write_fields(h, g, fl, clump_fields(m, fl), C->n);
+    sx_h5_write(h, g, "pebbles", H5T_NATIVE_INT32, H5T_STD_I32LE, C->pebble, C->pn, 1, NULL);
+    hid_t t = sx_h5_group(h, g, "templates");
+    templates_io(h, t, m, true);
+    sx_h5_close(t);
+    t = sx_h5_group(h, g, "template_pebbles");
+    write_fields(h, t, fl, template_pebble_fields(m, fl), C->tp_n);
+    sx_h5_close(t);
+    sx_h5_close(g);
+}
+
+/* The clump store's sizes; all zero when the file has no /clumps. */
+static bool read_clump_sizes(sx_h5 *h, hid_t f, sx_clump_sizes *s)
+{
+    memset(s, 0, sizeof *s);
+    if (H5Lexists(f, "/clumps", H5P_DEFAULT) <= 0) return true;
+    hid_t g = sx_h5_open_group(h, f, "/clumps", true);
+    s->clumps = sx_h5_rows(h, g, "/clumps", "id", 1, true);
+    s->pebbles = sx_h5_rows(h, g, "/clumps", "pebbles", 1, true);
+    sx_h5_get_i64(h, g, "/clumps", "next_id", &s->next_id, 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/clumps/templates", true);
+    const int64_t nt = sx_h5_rows(h, g, "/clumps/templates", "name", 1, true);
+    s->templates = nt >= 0 && nt <= INT16_MAX ? (int)nt : -1;
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/clumps/template_pebbles", true);
+    s->template_pebbles = sx_h5_rows(h, g, "/clumps/template_pebbles", "radius", 1, true);
+    sx_h5_close(g);
+    return !h->failed;
+}
+
+static void load_clumps(sx_h5 *h, hid_t f, sx_model *m)
+{
+    sx_clumps *C = m->clumps;
+    if (!C) return;
+    field fl[MAX_FIELDS];
+    load_group(h, f, "/clumps", fl, clump_fields(m, fl), C->n);
+    hid_t g = sx_h5_open_group(h, f, "/clumps", true);
+    if (g >= 0) sx_h5_read(h, g, "/clumps", "pebbles", H5T_NATIVE_INT32, C->pebble, C->pn, 1, true);
+    sx_h5_close(g);
+    g = sx_h5_open_group(h, f, "/clumps/templates", true);
+    if (g >= 0) templates_io(h, g, m, false);
+    sx_h5_close(g);
+    load_group(h, f, "/clumps/template_pebbles", fl, template_pebble_fields(m, fl), C->tp_n);
+}
+
 /* ---------------------------------------------------------------- save */
 
 static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
@@ -580,6 +789,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     sx_h5_close(g);
 
     save_walls(h, f, m);
+    save_clumps(h, f, m);
 
     if (o && o->ntrees > 0) {
         g = sx_h5_group(h, f, "lua");
@@ -705,13 +915,15 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
     hid_t f = path && *path ? sx_io_open(&h, path, false, "snapshot", want_dim, &d, &version)
                             : (sx_h5_fail(&h, "an empty path"), -1);
     sx_state_sizes s;
-    if (f >= 0 && read_sizes(&h, f, d, &s)) {
+    sx_clump_sizes cs;
+    if (f >= 0 && read_sizes(&h, f, d, &s) && read_clump_sizes(&h, f, &cs)) {
         sx_model_def def = sx_model_default_def();
         def.dim = d;
         char cerr[256];
         m = sx_model_create(&def, cerr, sizeof cerr);
         if (!m) sx_h5_fail(&h, "%s", cerr);
-        else if (sx__state_alloc(m, &s)) sx_h5_fail(&h, "damaged or too large: %s", sx_model_error(m));
+        else if (sx__state_alloc(m, &s) || sx__clumps_alloc(m, &cs))
+            sx_h5_fail(&h, "damaged or too large: %s", sx_model_error(m));
     }
     if (m && !h.failed) {
         info->format_version = version;
@@ -738,6 +950,7 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         g = sx_h5_open_group(&h, f, "/walls", true);
         if (g >= 0) load_walls(&h, g, m);
         sx_h5_close(g);
+        load_clumps(&h, f, m);
         load_trees(&h, f, info);
         if (!h.failed && sx__state_finish(m)) sx_h5_fail(&h, "damaged: %s", sx_model_error(m));
     }

@@ -168,12 +168,8 @@ unsigned sx_lua_fixmask(lua_State *L, int dim, int idx, const char *what)
     return mask;
 }
 
-static int get_fix(lua_State *L)
+void sx_lua_pushfixmask(lua_State *L, unsigned mask)
 {
-    int64_t id;
-    const sx_model *m = check_ball(L, &id);
-    unsigned mask;
-    sx_lua_checkfield(L, m, sx_ball_fixity(m, id, &mask), "ball");
     lua_newtable(L);
     int n = 0;
     for (int i = 0; i < FIX_COMPONENTS; i++) {
@@ -181,6 +177,27 @@ static int get_fix(lua_State *L)
         lua_pushstring(L, fix_names[i]);
         lua_rawseti(L, -2, ++n);
     }
+}
+
+static int get_fix(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    unsigned mask;
+    sx_lua_checkfield(L, m, sx_ball_fixity(m, id, &mask), "ball");
+    sx_lua_pushfixmask(L, mask);
+    return 1;
+}
+
+/* b.clump: the clump a pebble belongs to, nil for a free ball. */
+static int get_clump(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    const int64_t c = sx_ball_clump(m, id);
+    if (!c) return 0;
+    lua_getiuservalue(L, 1, 1);
+    sx_lua_pushhandle(L, lua_gettop(L), &sx_lua_clump_kind, c);
     return 1;
 }
 
@@ -410,6 +427,7 @@ void sx_lua_balls_register(lua_State *L)
         {"damping", get_damping},
         {"group", get_group},
         {"extra", get_extra},
+        {"clump", get_clump},
         {NULL, NULL},
     };
     static const luaL_Reg setters[] = {

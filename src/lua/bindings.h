@@ -42,11 +42,13 @@ extern const luaL_Reg sx_lua_lab_methods[];       ///< lab.c: measure
 /// lab.c: adds servo, load, radius, set_radial_vel to the wall class (after walls are registered).
 void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
+extern const luaL_Reg sx_lua_clumps_methods[];    ///< clumps.c: clump_template(s), clump, clumps, clump_count
 
 /* Classes other than the model's; each leaves nothing on the stack. */
 void sx_lua_balls_register(lua_State *L);
 void sx_lua_walls_register(lua_State *L);
 void sx_lua_contacts_register(lua_State *L);
+void sx_lua_clumps_register(lua_State *L);
 /// io.c: adds m:save, m:vars, m:output to the model class and load, xdmf to
 /// the module table on the top of the stack (call after both exist).
 void sx_lua_io_register(lua_State *L);
@@ -105,6 +107,21 @@ void sx_lua_apply_removals(lua_State *L, int model);
 /// A fixity value (nil, a word or an array of words) as a core mask;
 /// errors start with `what` ("ball field 'fix'").
 unsigned sx_lua_fixmask(lua_State *L, int dim, int idx, const char *what);
+/// Pushes a core fixity mask as an array of component words ({"vx", "wz"}).
+void sx_lua_pushfixmask(lua_State *L, unsigned mask);
+
+/* ----------------------------------------------------------- clumps.c */
+
+extern const struct sx_lua_kind sx_lua_clump_kind;
+/// An orientation at idx (3D: {w, x, y, z} or {axis =, angle =}; 2D: an
+/// angle) as a quaternion; NULL, or a message pushed.
+const char *sx_lua_toorientation(lua_State *L, int idx, int dim, double q[4]);
+/// Pushes an orientation (3D: {w, x, y, z}; 2D: the angle about z).
+void sx_lua_pushorientation(lua_State *L, int dim, const double q[4]);
+/// The clump template named by field `key` of the table at arg (required).
+int sx_lua_template_arg(lua_State *L, const sx_model *m, int arg, const char *key);
+/// Puts every pebble of clump id in group number `group`.
+void sx_lua_clump_set_group(lua_State *L, sx_model *m, int64_t id, int32_t group);
 
 /* ----------------------------------------------------------- groups.c */
 
@@ -204,8 +221,8 @@ void sx_lua_checkkeys(lua_State *L, int arg, const char *const keys[]);
 /// Like sx_lua_checkkeys, for a table at idx that is the field `field` of argument `arg`.
 void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, const char *const keys[]);
 
-/// Reads the value at idx as n numbers into out; returns NULL, or pushes and
-/// returns a message saying what is wrong.
+/// Reads the value at idx as n numbers (n <= 4) into out; returns NULL, or
+/// pushes and returns a message saying what is wrong.
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
 /// Pushes n components of v (a number when n == 1).
 void sx_lua_pushvec(lua_State *L, const double *v, int n);

@@ -204,8 +204,13 @@ static int model_summary(lua_State *L)
     int ncb;
     push_histories(L, &ncb);
     const sx_energy e = sx_model_energy(m);
-    lua_pushfstring(L, "seixo.model %dD: %I balls, %I walls, %I contacts\n", dim, (lua_Integer)sx_ball_count(m),
-                    (lua_Integer)sx_wall_count(m), (lua_Integer)sx_contact_count(m));
+    if (sx_clump_count(m) > 0) /* the balls include the clumps' pebbles */
+        lua_pushfstring(L, "seixo.model %dD: %I balls (pebbles of %I clumps among them), %I walls, %I contacts\n", dim,
+                        (lua_Integer)sx_ball_count(m), (lua_Integer)sx_clump_count(m), (lua_Integer)sx_wall_count(m),
+                        (lua_Integer)sx_contact_count(m));
+    else
+        lua_pushfstring(L, "seixo.model %dD: %I balls, %I walls, %I contacts\n", dim, (lua_Integer)sx_ball_count(m),
+                        (lua_Integer)sx_wall_count(m), (lua_Integer)sx_contact_count(m));
     lua_pushfstring(L, "  step %I, time %f s, timestep ", (lua_Integer)sx_model_step_count(m), sx_model_time(m));
     if (isnan(dt))
         lua_pushliteral(L, "automatic (no ball yet)\n");

@@ -12,7 +12,7 @@ static const luaL_Reg *const model_methods[] = {
     sx_lua_model_methods,    sx_lua_run_methods,     sx_lua_balls_methods,
     sx_lua_walls_methods,    sx_lua_contacts_methods, sx_lua_groups_methods,
     sx_lua_history_methods,  sx_lua_generate_methods, sx_lua_bonds_methods,
-    sx_lua_lab_methods,      NULL,
+    sx_lua_lab_methods,      sx_lua_clumps_methods, NULL,
 };
 
 /* seixo.progress([on]): the progress line of long cycles; returns the previous setting. */
@@ -51,6 +51,7 @@ int luaopen_seixo(lua_State *L)
     sx_lua_walls_register(L);
     sx_lua_lab_register(L); /* lab.c: the walls' servo, load and radius */
     sx_lua_contacts_register(L);
+    sx_lua_clumps_register(L);
     luaL_newlib(L, functions);
     sx_lua_io_register(L); /* io.c: m:save, m:vars, m:output, seixo.load, seixo.xdmf */
     lua_pushliteral(L, SX_VERSION);

@@ -116,9 +116,11 @@ const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
     if (!lua_istable(L, idx))
         return lua_pushfstring(L, "array of %d numbers expected, got %s", n, luaL_typename(L, idx));
     const lua_Unsigned len = lua_rawlen(L, idx);
-    if (len != (lua_Unsigned)n)
+    if (len != (lua_Unsigned)n && n <= 3)
         return lua_pushfstring(L, "%d components expected in a %dD model, got %I", n, n, (lua_Integer)len);
-    double v[3];
+    if (len != (lua_Unsigned)n) /* a quaternion, a pebble {x, y, z, r} */
+        return lua_pushfstring(L, "%d components expected, got %I", n, (lua_Integer)len);
+    double v[4];
     for (int k = 0; k < n; k++) {
         const int t = lua_rawgeti(L, idx, k + 1);
         v[k] = lua_tonumber(L, -1);

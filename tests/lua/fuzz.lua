@@ -30,11 +30,12 @@ local keys = {"dim", "gravity", "timestep", "timestep_safety", "skin", "kn", "ks
               "edge1", "edge2", "p1", "p2", "min", "max", "count", "porosity", "distribution", "mean", "std",
               "region", "seed", "method", "packing", "tries", "relax", "steps", "ratio", "calm", "time", "every",
               "where", "box", "sphere", "cylinder", "disk", "polygon", "center", "fix", "applied_force",
-              "applied_moment", "ball", "wall", "field", "component", "gap", "materials", "fricton", 1, 2, 3}
+              "applied_moment", "ball", "wall", "field", "component", "gap", "materials", "fricton", "template",
+              "scale", "orientation", "axis", "angle", "lines", 1, 2, 3}
 local words = {"", "x", "rock", "auto", "cycle", "after", "before", "box", "plane", "line", "rect", "segment",
                "pos", "vel", "radius", "kinetic", "time", "ratio", "uniform", "normal", "random", "distribute",
                "expand", "lattice", "hex", "fcc", "square", "cubic", "vx", "all", "spin", "ball-ball", "top",
-               "linear", "hertz", "parallel", "contact", "tension", string.rep("z", 300), "a,b", "\0"}
+               "linear", "hertz", "parallel", "contact", "tension", "pair", string.rep("z", 300), "a,b", "\0"}
 local numbers = {0, 1, -1, 2, 3, 7, 0.5, -0.5, 100, 2 ^ 31, 2 ^ 53, 1e300, -1e300, 1e-320, math.huge, -math.huge,
                  0 / 0, -0.0, math.maxinteger, math.mininteger, 1e-3, 0.01, 0.1}
 
@@ -181,14 +182,17 @@ local function fresh_model(dim)
   local b = m:ball{pos = z, radius = 0.1, group = "top"}
   local b2 = m:ball{pos = dim == 3 and {0.15, 0, 0} or {0.15, 0}, radius = 0.1}
   local box = m:wall{kind = "box", min = dim == 3 and {-1, -1, -1} or {-1, -1}, max = dim == 3 and {1, 1, 1} or {1, 1}}
+  m:clump_template("pair", dim == 3 and {{0, 0, 0, 0.05}, {0.06, 0, 0, 0.05}} or {{0, 0, 0.05}, {0.06, 0, 0.05}})
+  local cl = m:clump{template = "pair", pos = dim == 3 and {0.5, 0.5, 0.5} or {0.5, 0.5}}
   m:history("ke", "kinetic")
   m:cycle(2)
   handles[#handles + 1] = b
   handles[#handles + 1] = b2
   handles[#handles + 1] = box[1]
+  handles[#handles + 1] = cl
   handles[#handles + 1] = m
   if #handles > 200 then table.remove(handles, 1) end
-  return m, b, box[1]
+  return m, b, box[1], cl
 end
 
 local function class(name) return debug.getregistry()[name] end
@@ -203,10 +207,12 @@ end
 local model_methods = names(class("seixo.model").__methods)
 local ball_methods = names(class("seixo.ball").__methods)
 local wall_methods = names(class("seixo.wall").__methods)
+local clump_methods = names(class("seixo.clump").__methods)
 local fields = {
   ball = {get = names(class("seixo.ball").__getters), set = names(class("seixo.ball").__setters)},
   wall = {get = names(class("seixo.wall").__getters), set = names(class("seixo.wall").__setters)},
   contact = {get = names(class("seixo.contact").__getters), set = {}},
+  clump = {get = names(class("seixo.clump").__getters), set = names(class("seixo.clump").__setters)},
 }
 assert(#model_methods > 40 and #fields.ball.set > 8, "the classes are found")
 
@@ -214,7 +220,7 @@ assert(#model_methods > 40 and #fields.ball.set > 8, "the classes are found")
 
 for round = 1, rounds do
   local dim = round % 2 == 0 and 3 or 2
-  local m, b, w = fresh_model(dim)
+  local m, b, w, cl = fresh_model(dim)
   -- the module
   for _, name in ipairs(names(seixo)) do
     if type(seixo[name]) == "function" then
@@ -245,7 +251,7 @@ for round = 1, rounds do
     call("model:" .. name .. " (junk self)", class("seixo.model").__methods[name], args, n)
   end
   -- ball and wall methods and fields
-  local objects = {{"ball", b, ball_methods}, {"wall", w, wall_methods}}
+  local objects = {{"ball", b, ball_methods}, {"wall", w, wall_methods}, {"clump", cl, clump_methods}}
   for _, o in ipairs(objects) do
     local kind, obj, methods = o[1], o[2], o[3]
     for _, name in ipairs(methods) do

@@ -7,8 +7,8 @@ local H = require("seixo.help")
 local util = require("seixo.util")
 local reg = debug.getregistry()
 local classes = {model = "seixo.model", ball = "seixo.ball", wall = "seixo.wall", contact = "seixo.contact",
-                 output = "seixo.output"}
-local letter = {model = "m", ball = "b", wall = "w", contact = "c", output = "o"}
+                 output = "seixo.output", clump = "seixo.clump"}
+local letter = {model = "m", ball = "b", wall = "w", contact = "c", output = "o", clump = "cl"}
 
 -- every name the bindings define: "model:cycle", "ball.pos", "seixo.model", "util.add"
 local function defined()
