@@ -1230,13 +1230,6 @@ sx_status sx_clump_set_fixity(sx_model *m, int64_t id, unsigned mask)
 
 /* ------------------------------------------------------------ the step */
 
-/* Local (non-viscous) damping, -alpha |F| sign(v) per component: the law
- * the balls follow (kernels.c), applied to a clump's generalised forces. */
-static inline double damped(double force, double vel, double alpha)
-{
-    if (alpha == 0 || vel == 0) return force;
-    return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
-}
 
 /* sin and cos of x. The drift's half-angles are w dt / 4 or w dt / 2,
  * small in any stable DEM run (w dt << 1, typically 1e-4 or less), where a
@@ -1352,7 +1345,7 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
         for (int k = 0; k < d; k++) {
             if (!(fix & (SX_FIX_VX << k))) {
                 const double force = F[k] + g[k] * mass; /* 4-40: the weight acts at the centroid */
-                const double fd = damped(force, v[k], a);
+                const double fd = sx__damped(force, v[k], a);
                 const double vold = v[k];
                 v[k] += fd / mass * dtv;
                 if (track) {
@@ -1375,7 +1368,7 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
                 double Tb[3], Lb[3], Md[3], dL[3];
                 mat_tvec(R, T, Tb);
                 mat_tvec(R, L, Lb);
-                for (int k = 0; k < 3; k++) Md[k] = damped(Tb[k], Lb[k] / I[k], a);
+                for (int k = 0; k < 3; k++) Md[k] = sx__damped(Tb[k], Lb[k] / I[k], a);
                 mat_vec(R, Md, dL);
                 for (int k = 0; k < 3; k++) L[k] += dL[k] * dtv;
                 if (track) { /* work at the mean of the old and new spins, as for balls */
@@ -1397,7 +1390,7 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
             worst = fmax(worst, place_pebbles(m, c, R));
         } else {
             if (!(fix & SX_FIX_WX)) {
-                const double md = damped(T[0], w[0], a), wold = w[0];
+                const double md = sx__damped(T[0], w[0], a), wold = w[0];
                 w[0] += md / I[0] * dtv; /* 4-47 about z */
                 if (track) {
                     damp_work += (md - T[0]) * 0.5 * (wold + w[0]) * dt;

@@ -1334,12 +1334,6 @@ static sx_status KERNEL(walls)(sx_model *m)
 
 /* --------------------------------------------------------- law of motion */
 
-/* Local (non-viscous) damping: -alpha |F| sign(v), per component. */
-static inline double damped(double force, double vel, double alpha)
-{
-    if (alpha == 0 || vel == 0) return force;
-    return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
-}
 
 /* 4-46 ... 4-48: central differences, velocities at half steps, for the
  * balls of one block; partial sums go to the block. With energy tracking,
@@ -1380,7 +1374,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                     v[k] += (f[k] * im + g[k]) * dtv; /* 4-46 with 4-40 */
                 } else {
                     const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
-                    const double fd = damped(force, v[k], a);
+                    const double fd = sx__damped(force, v[k], a);
                     v[k] += fd * im * dtv; /* 4-46 */
                     if (track) damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
                 }
@@ -1399,7 +1393,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 if (a == 0) {
                     w[k] += t[k] * ii * dtv; /* 4-47 */
                 } else {
-                    const double md = damped(t[k], w[k], a);
+                    const double md = sx__damped(t[k], w[k], a);
                     w[k] += md * ii * dtv;
                     if (track) damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
                 }

@@ -12,6 +12,7 @@
 #include "alloc.h"
 #include "seixo.h"
 
+#include <math.h>
 #include <signal.h>
 
 #define SX_ERRLEN 512
@@ -223,6 +224,14 @@ struct sx_model {
 
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
 };
+
+/* Local (non-viscous) damping, -alpha |F| sign(v) per component (DESIGN 1):
+ * the balls' law of motion (kernels.c) and the clumps' (clumps.c). */
+static inline double sx__damped(double force, double vel, double alpha)
+{
+    if (alpha == 0 || vel == 0) return force;
+    return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
+}
 
 /* error helper: formats into m->err and returns status */
 sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
