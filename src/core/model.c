@@ -512,9 +512,23 @@ uint64_t sx_model_state_hash(const sx_model *m)
         }
     }
     for (int64_t w = 0; w < m->nwall; w++) {
-        h = fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
-        h = fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
-        h = fnv(h, m->walls[w].force, sizeof m->walls[w].force);
+        const sx_wall *wl = &m->walls[w];
+        h = fnv(h, wl->def.point, sizeof wl->def.point);
+        h = fnv(h, &wl->def.radius, sizeof wl->def.radius);
+        h = fnv(h, wl->force, sizeof wl->force);
+        /* a servo drives its wall: its settings, the loads it read and the
+         * velocities it set are state a continuing run depends on */
+        h = fnv(h, wl->def.vel, sizeof wl->def.vel);
+        h = fnv(h, &wl->def.radial_vel, sizeof wl->def.radial_vel);
+        const uint8_t on = wl->servo_on;
+        h = fnv(h, &on, 1);
+        if (on) {
+            const double servo[4] = {wl->servo.target, wl->servo.area, wl->servo.alpha, wl->servo.max_speed};
+            h = fnv(h, servo, sizeof servo);
+        }
+        h = fnv(h, &wl->load, sizeof wl->load);
+        h = fnv(h, &wl->kn_sum, sizeof wl->kn_sum);
+        h = fnv(h, &wl->contacts, sizeof wl->contacts);
     }
     return h;
 }

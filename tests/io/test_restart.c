@@ -1,7 +1,8 @@
 /* Restarts continue bit-for-bit: 2N steps straight and N steps + save +
  * load + N steps give the same state hash, energies, crack log, bond and
- * contact counts and wall forces, in 2D and 3D, for granular, bonded and
- * Hertz scenes, saved at several points of the broad phase's cycle. */
+ * contact counts, wall definitions, forces and servo loads, in 2D and 3D,
+ * for granular, bonded, Hertz and servo-controlled (cylinder) scenes, saved
+ * at several points of the broad phase's cycle. */
 #include "io_scenes.h"
 
 #include <hdf5.h>
@@ -81,6 +82,40 @@ END_TEST
 START_TEST(hertz_restart)
 {
     restart(io_scene_hertz, _i, 500, false);
+}
+END_TEST
+
+/* Servo-controlled walls (a cylinder whose radius is servo-controlled in
+ * 3D) continue as they would have: settings, the loads they read and the
+ * velocities they set are all in the state hash. */
+START_TEST(servo_restart)
+{
+    const int dim = _i;
+    sx_model *m = io_scene_servo(dim);
+    double r0 = 0;
+    if (dim == 3) {
+        sx_wall_def w;
+        ck_assert_int_eq(sx_wall_get(m, sx_wall_id_at(m, 0), &w), SX_OK);
+        ck_assert_int_eq(w.kind, SX_WALL_CYLINDER);
+        r0 = w.radius;
+    }
+    io_cycle(m, 200);
+    /* the servos are acting: their walls carry load and move */
+    int moving = 0;
+    for (int64_t i = 0; i < sx_wall_count(m); i++) {
+        sx_wall_def w;
+        double load;
+        int64_t nc;
+        sx_wall_get(m, sx_wall_id_at(m, i), &w);
+        sx_wall_load(m, sx_wall_id_at(m, i), &load, &nc, NULL);
+        moving += nc > 0 && load > 0 && (w.radial_vel != 0 || w.vel[0] != 0 || w.vel[1] != 0 || w.vel[2] != 0);
+        if (w.kind == SX_WALL_CYLINDER) ck_assert(w.radius != r0);
+    }
+    ck_assert_int_eq(moving, 2);
+    sx_model_destroy(m);
+    const int n[] = {1, 150, 400};
+    for (int k = 0; k < 3; k++) restart(io_scene_servo, dim, n[k], false);
+    restart(io_scene_servo, dim, 100, true);
 }
 END_TEST
 
@@ -197,6 +232,7 @@ int main(void)
     tcase_add_loop_test(tc, granular_restart, 2, 4);
     tcase_add_loop_test(tc, bonded_restart, 2, 4);
     tcase_add_loop_test(tc, hertz_restart, 2, 4);
+    tcase_add_loop_test(tc, servo_restart, 2, 4);
     tcase_add_loop_test(tc, resave, 2, 4);
     tcase_add_loop_test(tc, contents, 2, 4);
     tcase_add_test(tc, threads_kept);
