@@ -629,6 +629,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     sx_h5_close(g);
 
     save_walls(h, f, m);
+    if (o) sx_io_histories_write(h, f, o->histories, o->nhistories);
 
     if (o && o->ntrees > 0) {
         g = sx_h5_group(h, f, "lua");
@@ -742,6 +743,20 @@ static void load_trees(sx_h5 *h, hid_t f, sx_snapshot_info *info)
     sx_h5_close(g);
 }
 
+/* The provenance's seeds (an empty attribute: none). */
+static void load_seeds(sx_h5 *h, hid_t f, sx_snapshot_info *info)
+{
+    const size_t n = sx_h5_attr_len(f, "seeds");
+    if (h->failed || n == 0) return;
+    if (n > 1000000) {
+        sx_h5_fail(h, "damaged: the root lists %zu seeds", n);
+        return;
+    }
+    info->seeds = malloc(n * sizeof *info->seeds);
+    if (!info->seeds) sx_h5_fail(h, "out of memory");
+    else if (sx_h5_get_i64(h, f, "/", "seeds", info->seeds, n, true)) info->nseeds = (int)n;
+}
+
 sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *info, char *err, size_t errlen)
 {
     sx_h5 h;
@@ -788,6 +803,8 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         if (g >= 0) load_walls(&h, g, m, version);
         sx_h5_close(g);
         load_trees(&h, f, info);
+        sx_io_histories_read(&h, f, &info->histories, &info->nhistories);
+        load_seeds(&h, f, info);
         if (!h.failed && sx__state_finish(m)) sx_h5_fail(&h, "damaged: %s", sx_model_error(m));
     }
     if (f >= 0 && H5Fclose(f) < 0) sx_h5_fail_h5(&h, "cannot close the file");
@@ -810,4 +827,10 @@ void sx_snapshot_info_free(sx_snapshot_info *info)
     free(info->trees);
     info->trees = NULL;
     info->ntrees = 0;
+    sx_io_histories_free(info->histories, info->nhistories);
+    info->histories = NULL;
+    info->nhistories = 0;
+    free(info->seeds);
+    info->seeds = NULL;
+    info->nseeds = 0;
 }
