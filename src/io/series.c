@@ -27,8 +27,6 @@
 #include "io_internal.h"
 #include "state.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -734,11 +732,36 @@ static bool xmf_write(sx_h5 *h, const char *xmf, buf *b)
     return ok;
 }
 
-static bool sync_file(hid_t file)
+/* The file's descriptor (sec2 driver), or -1. */
+static int file_fd(hid_t file)
 {
     void *handle = NULL;
-    if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) return false;
-    if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle) fsync(*(int *)handle);
+    return H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle ? *(int *)handle : -1;
+}
+
+/* H5Fflush writes a superblock recording the end of the space allocated so
+ * far, while some of that space (metadata the same flush writes later, the
+ * unused end of an aggregator block) is not yet on disk: a writer killed
+ * during the flush would leave a file shorter than its superblock says,
+ * which HDF5 refuses to open ("truncated file"). The file is first grown to
+ * that end, so it is never shorter than any superblock a flush writes (the
+ * flush trims it back to what is allocated when it completes). */
+static bool flush_file(hid_t file)
+{
+    const int fd = file_fd(file);
+    hsize_t size = 0;
+    struct stat st;
+    if (fd >= 0 && H5Fget_filesize(file, &size) >= 0 && fstat(fd, &st) == 0 && (hsize_t)st.st_size < size &&
+        ftruncate(fd, (off_t)size) != 0)
+        return false;
+    return H5Fflush(file, H5F_SCOPE_LOCAL) >= 0;
+}
+
+static bool sync_file(hid_t file)
+{
+    if (!flush_file(file)) return false;
+    const int fd = file_fd(file);
+    if (fd >= 0) fsync(fd);
     return true;
 }
 
@@ -974,7 +997,7 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         if (!h.failed) {
             if (m) sx_h5_attr_int(&h, s->file, "count", s->count + 1);
             hist_raise(&h, p, nh);
-            if (!h.failed && H5Fflush(s->file, H5F_SCOPE_LOCAL) < 0) sx_h5_fail_h5(&h, "cannot flush the counts");
+            if (!h.failed && !flush_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the counts");
         }
         if (!h.failed) {
             s->count += m ? 1 : 0;
