@@ -154,7 +154,7 @@ START_TEST(random_flips)
     const long n = file_size(from);
     uint64_t s = 2024;
     int failed = 0, loaded = 0;
-    for (int k = 0; k < 400; k++) {
+    for (int k = 0; k < 250; k++) {
         copy_file(from, p);
         flip(p, (long)(scene_rng_u64(&s) % (uint64_t)n));
         char err[1024] = "";
@@ -171,7 +171,7 @@ START_TEST(random_flips)
     }
     printf("  random flips: %d refused, %d loaded (bytes HDF5 does not read)\n", failed, loaded);
     fflush(stdout);
-    ck_assert(failed > 300);
+    ck_assert(failed > 190); /* most bytes of a small snapshot are read (checksummed) */
 }
 END_TEST
 
