@@ -77,10 +77,10 @@ local entries = {
 
   -- model: histories
   ["model:history"] = {"m:history(name, source[, {every = N}]);  m:history(name) -> {steps, times, values}",
-    "Records a time series every N steps: source a function(m) -> number, a builtin (time, step, timestep, ratio, contacts, balls, kinetic, gravitational, strain, ...), or {ball = b | wall = w, field =, component =}."},
+    "Records a time series every N steps: source a function(m) -> number, a builtin (time, step, timestep, ratio, contacts, balls, kinetic, gravitational, strain, ...), or {ball = b | wall = w, field =, component =}. Saved with the model; a loaded history of a function is detached until m:history(name, fn) gives it again."},
   ["model:histories"] = {"m:histories() -> names", "The histories' names."},
   ["model:history_remove"] = {"m:history_remove(name)", "Stops and forgets a history."},
-  ["model:history_csv"] = {"m:history_csv(path[, names])", "Writes step, time and the histories as CSV (to a temporary name, then renamed)."},
+  ["model:history_csv"] = {"m:history_csv(path[, names])", "Writes step, time and the histories as CSV (names quoted as needed; a unique temporary name, fsync, rename)."},
 
   -- model: bonds
   ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
@@ -91,11 +91,11 @@ local entries = {
 
   -- model: files (src/lua/io.c)
   ["model:save"] = {"m:save(path[, {compression = 0..9}]) -> skipped",
-    "Writes the whole model to an HDF5 snapshot that restarts bit-for-bit, with m:vars(), groups and extras; returns the paths of values it could not save."},
+    "Writes the whole model to an HDF5 snapshot that restarts bit-for-bit, with m:vars(), groups, extras, histories and seeds; returns the paths of values it could not save."},
   ["model:vars"] = {"m:vars() -> table", "The user's variables: plain data kept with the model and saved by m:save."},
   ["model:output"] = {"m:output{path =, every =, fields =, compression =, append =} -> output",
-    "Writes the model now and every `every` steps to an HDF5 series with an .xmf for ParaView."},
-  ["seixo.load"] = {"seixo.load(path[, {dim = 2 | 3}]) -> model", "Reads a snapshot written by m:save; callbacks and outputs are registered again by the script."},
+    "Writes the model now and every `every` steps to an HDF5 series with an .xmf for ParaView; the histories grow in it as the run goes."},
+  ["seixo.load"] = {"seixo.load(path[, {dim = 2 | 3}]) -> model", "Reads a snapshot written by m:save (histories recording on); callbacks, outputs and history functions are registered again by the script."},
   ["seixo.xdmf"] = {"seixo.xdmf(path)", "Rebuilds the .xmf file of an output series."},
   ["output:write"] = {"o:write()", "Writes the model to the series now."},
   ["output:close"] = {"o:close()", "Stops the output and closes its file."},

@@ -187,31 +187,73 @@ end
 
 ---------------------------------------------------------------- CSV
 
---- Reads a CSV file written by m:history_csv: returns {header = {...}, columns = {name = {values}}};
---- empty cells are nil, numbers are numbers.
+-- The records of a CSV text (RFC 4180): fields separated by commas, a
+-- quoted field may hold commas, doubled quotes and line breaks.
+local function csv_records(text)
+  local records, fields, i, n = {}, {}, 1, #text
+  local function finish_record()
+    records[#records + 1] = fields
+    fields = {}
+  end
+  while i <= n do
+    local field
+    if text:sub(i, i) == '"' then
+      local parts, j = {}, i + 1
+      while true do
+        local q = text:find('"', j, true)
+        if not q then error("util.read_csv: an unterminated quoted field", 3) end
+        parts[#parts + 1] = text:sub(j, q - 1)
+        if text:sub(q + 1, q + 1) == '"' then
+          parts[#parts + 1] = '"'
+          j = q + 2
+        else
+          i = q + 1
+          break
+        end
+      end
+      field = table.concat(parts)
+    else
+      local e = text:find("[,\r\n]", i) or n + 1
+      field = text:sub(i, e - 1)
+      i = e
+    end
+    fields[#fields + 1] = field
+    local c = text:sub(i, i)
+    if c == "," then
+      i = i + 1
+      if i > n then fields[#fields + 1] = "" end
+    elseif c == "\r" or c == "\n" then
+      i = i + ((c == "\r" and text:sub(i + 1, i + 1) == "\n") and 2 or 1)
+      finish_record()
+    elseif i <= n then
+      error("util.read_csv: text after a closing quote", 3)
+    end
+  end
+  if #fields > 0 then finish_record() end
+  return records
+end
+
+--- Reads a CSV file written by m:history_csv: returns {header = {...}, columns = {name = {values}}, rows = n};
+--- empty cells are nil, numbers are numbers; quoted names (with commas, quotes, line breaks) are read back.
 function util.read_csv(path)
   if type(path) ~= "string" then
     error("bad argument 'path' to 'util.read_csv' (string expected, got " .. type(path) .. ")", 2)
   end
-  local f, err = io.open(path, "r")
+  local f, err = io.open(path, "rb")
   if not f then error("util.read_csv: " .. err, 2) end
-  local header, columns, row = nil, {}, 0
-  for line in f:lines() do
-    local cells = {}
-    for cell in (line .. ","):gmatch("([^,]*),") do cells[#cells + 1] = cell end
-    if not header then
-      header = cells
-      for _, name in ipairs(header) do columns[name] = {} end
-    else
-      row = row + 1
-      for i, name in ipairs(header) do
-        local cell = cells[i]
-        if cell and cell ~= "" then columns[name][row] = tonumber(cell) or cell end
-      end
+  local text = f:read("a")
+  f:close()
+  local records = csv_records(text)
+  local header, columns = records[1] or {}, {}
+  for _, name in ipairs(header) do columns[name] = {} end
+  for row = 2, #records do
+    local cells = records[row]
+    for i, name in ipairs(header) do
+      local cell = cells[i]
+      if cell and cell ~= "" then columns[name][row - 1] = tonumber(cell) or cell end
     end
   end
-  f:close()
-  return {header = header or {}, columns = columns, rows = row}
+  return {header = header, columns = columns, rows = math.max(#records - 1, 0)}
 end
 
 return util

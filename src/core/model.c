@@ -670,9 +670,23 @@ uint64_t sx_model_state_hash(const sx_model *m)
         }
     }
     for (int64_t w = 0; w < m->nwall; w++) {
-        h = sx__fnv(h, m->walls[w].def.point, sizeof m->walls[w].def.point);
-        h = sx__fnv(h, &m->walls[w].def.radius, sizeof m->walls[w].def.radius);
-        h = sx__fnv(h, m->walls[w].force, sizeof m->walls[w].force);
+        const sx_wall *wl = &m->walls[w];
+        h = sx__fnv(h, wl->def.point, sizeof wl->def.point);
+        h = sx__fnv(h, &wl->def.radius, sizeof wl->def.radius);
+        h = sx__fnv(h, wl->force, sizeof wl->force);
+        /* a servo drives its wall: its settings, the loads it read and the
+         * velocities it set are state a continuing run depends on */
+        h = sx__fnv(h, wl->def.vel, sizeof wl->def.vel);
+        h = sx__fnv(h, &wl->def.radial_vel, sizeof wl->def.radial_vel);
+        const uint8_t on = wl->servo_on;
+        h = sx__fnv(h, &on, 1);
+        if (on) {
+            const double servo[4] = {wl->servo.target, wl->servo.area, wl->servo.alpha, wl->servo.max_speed};
+            h = sx__fnv(h, servo, sizeof servo);
+        }
+        h = sx__fnv(h, &wl->load, sizeof wl->load);
+        h = sx__fnv(h, &wl->kn_sum, sizeof wl->kn_sum);
+        h = sx__fnv(h, &wl->contacts, sizeof wl->contacts);
     }
     if (m->clumps) h = sx__clumps_hash(m, h);
     return h;

@@ -87,7 +87,8 @@ SX_API void sx_model_interrupt(sx_model *m);
 SX_API double sx_model_unbalanced_ratio(const sx_model *m);
 
 /// A 64-bit hash of the full dynamic state (positions, velocities, spins,
-/// forces, contact histories, walls, time); equal hashes mean bit-identical states.
+/// forces, contact histories, walls with their motion and servo, time);
+/// equal hashes mean bit-identical states.
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
 
 /// Bytes currently allocated by the model.

@@ -177,7 +177,8 @@ static sx_status check_walls(sx_model *m)
     for (int64_t i = 0; i < m->nwall; i++) {
         const sx_wall *w = &m->walls[i];
         const sx_wall_kind k = w->def.kind;
-        const bool ok = m->dim == 3 ? (k == SX_WALL_PLANE || k == SX_WALL_RECT) : (k == SX_WALL_LINE || k == SX_WALL_SEGMENT);
+        const bool ok = m->dim == 3 ? (k == SX_WALL_PLANE || k == SX_WALL_RECT || k == SX_WALL_CYLINDER)
+                                    : (k == SX_WALL_LINE || k == SX_WALL_SEGMENT);
         if (!ok) return sx__fail(m, SX_EINVAL, "state: wall %lld has kind %d, not a %dD wall", (long long)w->id, (int)k, m->dim);
         if (w->id < 1 || w->id > m->next_wall_id)
             return sx__fail(m, SX_EINVAL, "state: wall id %lld is outside 1..%lld", (long long)w->id,
@@ -188,6 +189,17 @@ static sx_status check_walls(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a non-finite point, normal or velocity", (long long)w->id);
         if ((k == SX_WALL_RECT && !(w->len_u > 0 && w->len_v > 0)) || (k == SX_WALL_SEGMENT && !(w->seg_len > 0)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a zero extent", (long long)w->id);
+        if (k == SX_WALL_CYLINDER &&
+            (!(w->def.radius > 0) || !isfinite(w->def.radius) || !(w->def.height >= 0) || !isfinite(w->def.height)))
+            return sx__fail(m, SX_EINVAL, "state: cylinder %lld has a radius <= 0 or a height < 0", (long long)w->id);
+        if (!isfinite(w->def.radial_vel) || !isfinite(w->load) || !isfinite(w->kn_sum) || w->contacts < 0)
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has a non-finite radial velocity or load, or a negative "
+                                          "contact count", (long long)w->id);
+        /* the servo divides by its area and is bounded by max_speed (sx_wall_set_servo's rules) */
+        const sx_servo_def *s = &w->servo;
+        if (w->servo_on && (!isfinite(s->target) || !(s->area > 0) || !isfinite(s->area) ||
+                            !(s->alpha > 0 && s->alpha <= 1) || !(s->max_speed > 0) || !isfinite(s->max_speed)))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has servo settings out of range", (long long)w->id);
     }
     return SX_OK;
 }

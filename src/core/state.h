@@ -13,7 +13,9 @@
  * What a continuing run reads and what is derived:
  *   saved    balls (all arrays, dense order, incl. x_build and applied
  *            loads), next ball id, both pair stores with their history,
- *            bonds, crack log, walls (definition, frame, force, moment,
+ *            bonds, crack log, walls (definition incl. a cylinder's radius,
+ *            height and radial velocity, frame, force, moment, the last
+ *            step's load, stiffness sum and contact count, servo settings,
  *            distance moved), materials with BPM parameters, and every
  *            scalar of sx_model below `dim` (timestep state, skin, time,
  *            step, builds, build flag, guard, energy tracking);

@@ -46,6 +46,13 @@ hid_t sx_h5_fapl(bool latest);
 hid_t sx_h5_fcpl(void);
 /// Flushes `tmp` to disk and renames it over `path`, then syncs the folder.
 bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path);
+/// The second half of sx_h5_commit, for a `tmp` already on disk: the
+/// rename and the folder's sync.
+bool sx_h5_rename(sx_h5 *h, const char *tmp, const char *path);
+/// Writes n bytes to a new temporary file beside `path` and flushes it to
+/// disk; its name goes to tmp (len bytes). False (failed) on any error, with
+/// nothing left behind.
+bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len);
 /// fsync of a file by name (after HDF5 has closed it).
 bool sx_h5_sync_path(const char *path);
 

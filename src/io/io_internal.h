@@ -27,3 +27,23 @@ bool sx_io_write_strings(sx_h5 *h, hid_t loc, const char *name, const char *s, s
 /// Reads a string dataset of n rows (of any fixed width) into buffers of
 /// `width` bytes each (a longer string is damage).
 bool sx_io_read_strings(sx_h5 *h, hid_t loc, const char *where, const char *name, char *out, size_t width, int64_t n);
+
+/* ------------------------------------------------------- histories */
+
+/// Checks a history's name and definition (fails naming the history).
+bool sx_io_history_valid(sx_h5 *h, const sx_io_history *x);
+/// Creates the group of history x under parent: its definition and
+/// `order` as attributes, empty datasets step, time, value without a
+/// maximum size in chunks of `chunk` rows, and count 0.
+hid_t sx_io_history_create(sx_h5 *h, hid_t parent, const sx_io_history *x, int64_t order, int64_t chunk);
+/// Writes samples [from, x->n) of x at rows [at, ...) of the history group
+/// g, extending its datasets (its count is left to the caller).
+bool sx_io_history_put(sx_h5 *h, hid_t g, const sx_io_history *x, int64_t from, int64_t at);
+/// The complete rows of the history group g and the step of its last one
+/// (INT64_MIN when none); `where` names it in messages.
+bool sx_io_history_tail(sx_h5 *h, hid_t g, const char *where, int64_t *count, int64_t *last);
+/// Writes the histories into a new group /histories of file (complete).
+bool sx_io_histories_write(sx_h5 *h, hid_t file, const sx_io_history *x, int n);
+/// Reads the histories of /histories (none when absent), in creation order.
+bool sx_io_histories_read(sx_h5 *h, hid_t file, sx_io_history **out, int *n);
+void sx_io_histories_free(sx_io_history *x, int n);

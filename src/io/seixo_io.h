@@ -11,7 +11,7 @@
 #include "seixo.h"
 
 /// The newest file format this build writes; it reads every format up to it.
-#define SX_IO_FORMAT_VERSION 1
+#define SX_IO_FORMAT_VERSION 2
 
 /* -------------------------------------------------------- value trees */
 
@@ -70,6 +70,39 @@ typedef struct sx_io_provenance {
 /// The commit seixo was built from ("unknown" outside a git checkout).
 const char *sx_io_git_commit(void);
 
+/* ----------------------------------------------------------- histories */
+
+/// What a history samples (the sources of the Lua layer's m:history).
+typedef enum sx_io_source {
+    SX_IO_SOURCE_FUNCTION = 1, ///< a Lua function: its samples are saved, the function is not
+    SX_IO_SOURCE_BUILTIN = 2,  ///< a builtin quantity named by `builtin` ("time", "kinetic", ...)
+    SX_IO_SOURCE_BALL = 3,     ///< a field of the ball `id`
+    SX_IO_SOURCE_WALL = 4,     ///< a field of the wall `id`
+} sx_io_source;
+
+/// A history: its definition and n samples, steps strictly increasing.
+/// Given to a writer its strings and arrays are borrowed; returned by a
+/// load they are owned (freed by sx_snapshot_info_free).
+typedef struct sx_io_history {
+    char *name;              ///< not empty, not ".", no '/' (it names an HDF5 group)
+    int64_t every;           ///< sampled after every step that is a multiple of it (>= 1)
+    sx_io_source source;
+    char *builtin;           ///< SX_IO_SOURCE_BUILTIN: its name (else NULL)
+    int64_t id;              ///< SX_IO_SOURCE_BALL / _WALL: the entity's id
+    char *field;             ///< SX_IO_SOURCE_BALL / _WALL: the field ("pos", "force", ...)
+    int component;           ///< of a vector field, 0-based (0 for a scalar field)
+    int64_t n;
+    int64_t *steps;
+    double *times;           ///< s
+    double *values;
+} sx_io_history;
+
+/// Writes histories as CSV: a header "step,time,<name>,..." (names quoted
+/// as RFC 4180 asks when they hold a comma, quote, CR or LF), then one row
+/// per step sampled by any of them, ascending, empty where a history has no
+/// sample. Written like every seixo file: a temporary name, fsync, rename.
+sx_status sx_history_csv_write(const char *path, const sx_io_history *h, int nh, char *err, size_t errlen);
+
 /* ----------------------------------------------------------- snapshots */
 
 typedef struct sx_snapshot_opts {
@@ -77,6 +110,8 @@ typedef struct sx_snapshot_opts {
     int compression;                    ///< deflate level 0 (none, default) .. 9
     const sx_io_named_tree *trees;      ///< stored under /lua (may be NULL)
     int ntrees;
+    const sx_io_history *histories;     ///< stored under /histories (may be NULL)
+    int nhistories;
 } sx_snapshot_opts;
 
 /// Writes the complete state of m to path: to a temporary file in the same
@@ -94,6 +129,10 @@ typedef struct sx_snapshot_info {
     char script_sha256[65];
     sx_io_named_tree *trees;  ///< the trees of /lua (owned; free with sx_snapshot_info_free)
     int ntrees;
+    sx_io_history *histories; ///< the histories of /histories, in their creation order (owned)
+    int nhistories;
+    int64_t *seeds;           ///< the provenance's seeds (owned)
+    int nseeds;
 } sx_snapshot_info;
 
 /// Reads a snapshot into a new model that continues exactly like the saved
@@ -139,9 +178,15 @@ typedef struct sx_series sx_series;
 /// its XDMF (path with .xmf instead of .h5) for models of dimension dim;
 /// with opts->append an existing series is continued. NULL on failure.
 sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *opts, char *err, size_t errlen);
-/// Appends the state of m as one snapshot, flushes the file and updates
-/// the XDMF: a crash after this returns loses nothing written so far.
-sx_status sx_series_write(sx_series *s, const sx_model *m, char *err, size_t errlen);
+/// Appends the state of m as one snapshot, and to the datasets of the
+/// histories h (nh of them, h may be NULL) their samples of steps after the
+/// last the series holds; flushes the file and updates the XDMF: a crash
+/// after this returns loses nothing written so far.
+sx_status sx_series_write(sx_series *s, const sx_model *m, const sx_io_history *h, int nh, char *err,
+                          size_t errlen);
+/// Appends only history samples (as sx_series_write does), e.g. those
+/// recorded after the last snapshot, before closing.
+sx_status sx_series_write_histories(sx_series *s, const sx_io_history *h, int nh, char *err, size_t errlen);
 /// Snapshots in the series.
 int64_t sx_series_count(const sx_series *s);
 const char *sx_series_path(const sx_series *s);

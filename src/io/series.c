@@ -9,17 +9,24 @@
  * (3D) or segments (2D); an infinite wall is drawn across the balls'
  * bounding box.
  *
+ * Histories grow beside the snapshots: /histories/<name> holds extendable
+ * datasets (history.c) to which each write appends the samples of steps
+ * after the last one the file holds.
+ *
  * Nothing is lost on a crash: the file is created under a temporary name
- * and renamed; each snapshot is written, flushed and synced before the
- * root's `count` of complete snapshots is raised (readers ignore groups
- * beyond it), and the XDMF is updated last, by one write that replaces
- * its closing tags. The 1.8 file format keeps a file whose writer was
- * killed openable. */
+ * and renamed; each snapshot and the history rows are written, flushed and
+ * synced before the `count`s of complete snapshots and rows are raised
+ * (readers ignore what lies beyond them). The XDMF is never patched in
+ * place: the new one (kept in memory, so no snapshot is read back) is
+ * written and synced under a temporary name before the counts are raised,
+ * and renamed over the old one right after, so it is always a complete
+ * document and lists the snapshots the counts say are complete; only a
+ * kill in the microseconds between the counts' write and the rename leaves
+ * it one snapshot behind (seixo.xdmf and append mode rebuild it). The 1.8
+ * file format keeps a file whose writer was killed openable. */
 #include "io_internal.h"
 #include "state.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -27,6 +34,18 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+typedef struct buf {
+    char *p;
+    size_t n, cap;
+    bool oom;
+} buf;
+
+/* A history the file holds: its complete rows and their last step. */
+typedef struct held {
+    char *name;
+    int64_t rows, last;
+} held;
 
 struct sx_series {
     char *path;       /* the .h5 */
@@ -37,8 +56,9 @@ struct sx_series {
     unsigned fields;
     int compression;
     int64_t count;    /* complete snapshots */
-    int xfd;          /* the .xmf, open for writing */
-    off_t xoff;       /* where its closing tags start */
+    buf xbody;        /* the XDMF without its closing tags: header and one grid per complete snapshot */
+    held *held;       /* histories met so far */
+    int nheld, capheld;
 };
 
 static const struct {
@@ -70,12 +90,6 @@ int64_t sx_series_count(const sx_series *s) { return s->count; }
 const char *sx_series_path(const sx_series *s) { return s->path; }
 
 /* ------------------------------------------------------------ buffers */
-
-typedef struct buf {
-    char *p;
-    size_t n, cap;
-    bool oom;
-} buf;
 
 static void put(buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void put(buf *b, const char *fmt, ...)
@@ -112,6 +126,7 @@ static void put(buf *b, const char *fmt, ...)
 typedef struct snap {
     double time;
     int64_t step, balls, contacts, wall_contacts, bonds, walls;
+    int64_t wall_cells, wall_points; /* a cylinder is drawn with many cells */
     unsigned fields;
     int dim;
     bool clumps; /* the balls carry their clump ids (pebbles of a clump, 0 for free balls) */
@@ -231,14 +246,15 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "radius", "bonds/radius", s->bonds, 1, "Float", 8, true);
         put(b, "    </Grid>\n");
     }
-    if ((f & SX_OUT_WALLS) && s->walls > 0) {
+    if ((f & SX_OUT_WALLS) && s->wall_cells > 0) {
         const bool quad = s->dim == 3; /* 3D: quadrilaterals */
+        const int64_t c = s->wall_cells;
         put(b, "    <Grid Name=\"walls\" GridType=\"Uniform\">\n");
-        lines(b, base, k, "walls/connectivity", s->walls, quad ? 4 : 2, quad ? "Quadrilateral" : "Polyline");
-        geometry(b, base, k, "walls/points", s->walls * (quad ? 4 : 2));
-        attribute(b, base, k, "id", "walls/id", s->walls, 1, "Int", 8, true);
-        attribute(b, base, k, "velocity", "walls/velocity", s->walls, 3, "Float", 8, true);
-        attribute(b, base, k, "force", "walls/force", s->walls, 3, "Float", 8, true);
+        lines(b, base, k, "walls/connectivity", c, quad ? 4 : 2, quad ? "Quadrilateral" : "Polyline");
+        geometry(b, base, k, "walls/points", s->wall_points);
+        attribute(b, base, k, "id", "walls/id", c, 1, "Int", 8, true);
+        attribute(b, base, k, "velocity", "walls/velocity", c, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "walls/force", c, 3, "Float", 8, true);
         put(b, "    </Grid>\n");
     }
     put(b, "   </Grid>\n");
@@ -436,10 +452,27 @@ static void write_cells(sx_h5 *h, hid_t g, const cells *c)
     sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, c->conn, c->n, (int)c->per_i, NULL);
 }
 
+/* Unit vectors u, v completing the unit normal n to a right-handed frame. */
+static void frame(const double *n, double *u, double *v)
+{
+    const int a = fabs(n[0]) < fabs(n[1]) ? (fabs(n[0]) < fabs(n[2]) ? 0 : 2) : (fabs(n[1]) < fabs(n[2]) ? 1 : 2);
+    double e[3] = {0, 0, 0};
+    e[a] = 1;
+    u[0] = n[1] * e[2] - n[2] * e[1], u[1] = n[2] * e[0] - n[0] * e[2], u[2] = n[0] * e[1] - n[1] * e[0];
+    const double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int k = 0; k < 3; k++) u[k] /= lu;
+    v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+}
+
+/* Facets around a cylinder: a 32-gon is within 0.5 % of its radius. */
+enum { CYL_SIDES = 32 };
+
 /* Walls as drawable cells: a 3D plane as a square across the balls'
- * bounding box, a rectangle as itself; a 2D line as a segment across the
- * box, a segment as itself. */
-static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m)
+ * bounding box, a rectangle as itself, a cylinder as CYL_SIDES
+ * quadrilaterals around its axis (from its first end over its height; an
+ * infinite one across the box); a 2D line as a segment across the box, a
+ * segment as itself. Every cell carries its wall's id, velocity and force. */
+static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
 {
     const int64_t nw = m->nwall;
     const int d = m->dim, per = d == 3 ? 4 : 2;
@@ -453,60 +486,91 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m)
     double c[3], diag = 0;
     for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     const double half = diag > 0 ? 0.6 * sqrt(diag) : 1.0;
-    double *pts = calloc((size_t)(nw * per * 3 + 1), sizeof *pts);
-    double *vel = calloc((size_t)(nw * 3 + 1), sizeof *vel), *frc = calloc((size_t)(nw * 3 + 1), sizeof *frc);
-    int32_t *conn = calloc((size_t)(nw * per + 1), sizeof *conn);
-    int64_t *ids = calloc((size_t)(nw + 1), sizeof *ids);
+    int64_t ncells = 0, npts = 0;
+    for (int64_t w = 0; w < nw; w++) {
+        const bool cyl = m->walls[w].def.kind == SX_WALL_CYLINDER;
+        ncells += cyl ? CYL_SIDES : 1;
+        npts += cyl ? 2 * CYL_SIDES : per;
+    }
+    double *pts = calloc((size_t)(npts * 3 + 1), sizeof *pts);
+    double *vel = calloc((size_t)(ncells * 3 + 1), sizeof *vel), *frc = calloc((size_t)(ncells * 3 + 1), sizeof *frc);
+    int32_t *conn = calloc((size_t)(ncells * per + 1), sizeof *conn);
+    int64_t *ids = calloc((size_t)(ncells + 1), sizeof *ids);
     if (!pts || !vel || !frc || !conn || !ids) {
         sx_h5_fail(h, "out of memory");
         goto done;
     }
+    int64_t cell = 0, pt = 0;
     for (int64_t w = 0; w < nw; w++) {
         const sx_wall *wl = &m->walls[w];
         const sx_wall_def *def = &wl->def;
-        double *p = pts + w * per * 3;
-        if (def->kind == SX_WALL_RECT || def->kind == SX_WALL_SEGMENT) {
-            for (int k = 0; k < 3; k++) {
-                p[k] = def->point[k];
-                p[3 + k] = def->point[k] + def->edge1[k];
-                if (per == 4) {
-                    p[6 + k] = def->point[k] + def->edge1[k] + def->edge2[k];
-                    p[9 + k] = def->point[k] + def->edge2[k];
+        double *p = pts + pt * 3;
+        const int64_t first = cell;
+        if (def->kind == SX_WALL_CYLINDER) {
+            const double *n = def->normal;
+            double u[3], v[3], t0 = 0, t1 = def->height;
+            frame(n, u, v);
+            if (!(def->height > 0)) { /* infinite: across the box, about the centre's projection */
+                double t = 0;
+                for (int k = 0; k < 3; k++) t += (c[k] - def->point[k]) * n[k];
+                t0 = t - half, t1 = t + half;
+            }
+            for (int j = 0; j < CYL_SIDES; j++) {
+                const double a = 2 * SX_PI * j / CYL_SIDES, ca = cos(a), sa = sin(a);
+                for (int k = 0; k < 3; k++) {
+                    const double radial = def->radius * (ca * u[k] + sa * v[k]);
+                    p[j * 3 + k] = def->point[k] + t0 * n[k] + radial;
+                    p[(CYL_SIDES + j) * 3 + k] = def->point[k] + t1 * n[k] + radial;
+                }
+                const int32_t j1 = (int32_t)((j + 1) % CYL_SIDES), b = (int32_t)pt;
+                int32_t *q = conn + (cell + j) * per;
+                q[0] = b + j, q[1] = b + j1, q[2] = b + CYL_SIDES + j1, q[3] = b + CYL_SIDES + j;
+            }
+            cell += CYL_SIDES, pt += 2 * CYL_SIDES;
+        } else {
+            if (def->kind == SX_WALL_RECT || def->kind == SX_WALL_SEGMENT) {
+                for (int k = 0; k < 3; k++) {
+                    p[k] = def->point[k];
+                    p[3 + k] = def->point[k] + def->edge1[k];
+                    if (per == 4) {
+                        p[6 + k] = def->point[k] + def->edge1[k] + def->edge2[k];
+                        p[9 + k] = def->point[k] + def->edge2[k];
+                    }
+                }
+            } else {
+                /* the projection of the box's centre on the wall, and in-plane axes */
+                const double *n = def->normal;
+                double t = 0;
+                for (int k = 0; k < d; k++) t += (c[k] - def->point[k]) * n[k];
+                double o[3];
+                for (int k = 0; k < 3; k++) o[k] = c[k] - t * (k < d ? n[k] : 0);
+                if (d == 2) {
+                    const double u[2] = {-n[1], n[0]};
+                    for (int k = 0; k < 2; k++) p[k] = o[k] - half * u[k], p[3 + k] = o[k] + half * u[k];
+                } else {
+                    double u[3], v[3];
+                    frame(n, u, v);
+                    const double sg[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+                    for (int q = 0; q < 4; q++)
+                        for (int k = 0; k < 3; k++) p[q * 3 + k] = o[k] + half * (sg[q][0] * u[k] + sg[q][1] * v[k]);
                 }
             }
-        } else {
-            /* the projection of the box's centre on the wall, and in-plane axes */
-            const double *n = def->normal;
-            double t = 0;
-            for (int k = 0; k < d; k++) t += (c[k] - def->point[k]) * n[k];
-            double o[3];
-            for (int k = 0; k < 3; k++) o[k] = c[k] - t * (k < d ? n[k] : 0);
-            if (d == 2) {
-                const double u[2] = {-n[1], n[0]};
-                for (int k = 0; k < 2; k++) p[k] = o[k] - half * u[k], p[3 + k] = o[k] + half * u[k];
-            } else {
-                const int a = fabs(n[0]) < fabs(n[1]) ? (fabs(n[0]) < fabs(n[2]) ? 0 : 2) : (fabs(n[1]) < fabs(n[2]) ? 1 : 2);
-                double e[3] = {0, 0, 0}, u[3], v[3];
-                e[a] = 1;
-                u[0] = n[1] * e[2] - n[2] * e[1], u[1] = n[2] * e[0] - n[0] * e[2], u[2] = n[0] * e[1] - n[1] * e[0];
-                const double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-                for (int k = 0; k < 3; k++) u[k] /= lu;
-                v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
-                const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-                for (int q = 0; q < 4; q++)
-                    for (int k = 0; k < 3; k++) p[q * 3 + k] = o[k] + half * (s[q][0] * u[k] + s[q][1] * v[k]);
-            }
+            for (int q = 0; q < per; q++) conn[cell * per + q] = (int32_t)(pt + q);
+            cell++, pt += per;
         }
-        for (int q = 0; q < per; q++) conn[w * per + q] = (int32_t)(w * per + q);
-        for (int k = 0; k < d; k++) vel[w * 3 + k] = def->vel[k], frc[w * 3 + k] = wl->force[k];
-        ids[w] = wl->id;
+        for (int64_t e = first; e < cell; e++) {
+            for (int k = 0; k < d; k++) vel[e * 3 + k] = def->vel[k], frc[e * 3 + k] = wl->force[k];
+            ids[e] = wl->id;
+        }
     }
+    sn->wall_cells = ncells;
+    sn->wall_points = npts;
     hid_t g = sx_h5_group(h, snapg, "walls");
-    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, nw * per, 3, "m");
-    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, nw, per, NULL);
-    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, nw, 1, NULL);
-    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, nw, 3, "m/s");
-    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, nw, 3, "N");
+    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, npts, 3, "m");
+    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, ncells, per, NULL);
+    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, ncells, 1, NULL);
+    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, ncells, 3, "m/s");
+    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, ncells, 3, "N");
     sx_h5_close(g);
 done:
     free(pts);
@@ -573,7 +637,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     }
     if (f & SX_OUT_WALLS) {
         s->walls = m->nwall;
-        write_walls(h, snapg, m);
+        write_walls(h, snapg, m, s);
     }
     sx_h5_attr_double(h, snapg, "time", s->time);
     sx_h5_attr_int(h, snapg, "step", s->step);
@@ -583,6 +647,8 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     sx_h5_attr_int(h, snapg, "wall_contacts", s->wall_contacts);
     sx_h5_attr_int(h, snapg, "bonds", s->bonds);
     sx_h5_attr_int(h, snapg, "walls", s->walls);
+    sx_h5_attr_int(h, snapg, "wall_cells", s->wall_cells);
+    sx_h5_attr_int(h, snapg, "wall_points", s->wall_points);
     sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
     if (s->clumps) sx_h5_attr_int(h, snapg, "clumps", 1);
 }
@@ -634,6 +700,11 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     int64_t clumps = 0;
     sx_h5_get_i64(h, g, name, "clumps", &clumps, 1, false); /* absent before clumps, and without them */
     s->clumps = clumps != 0;
+    /* format 1 drew one cell per wall, of 4 (3D) or 2 (2D) points */
+    s->wall_cells = s->walls;
+    s->wall_points = s->walls * (dim == 3 ? 4 : 2);
+    sx_h5_get_i64(h, g, name, "wall_cells", &s->wall_cells, 1, false);
+    sx_h5_get_i64(h, g, name, "wall_points", &s->wall_points, 1, false);
     sx_h5_close(g);
     return !h->failed;
 }
@@ -642,47 +713,66 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
 static bool write_whole(sx_h5 *h, const char *path, const char *data, size_t n)
 {
     char tmp[4096];
-    if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path of '%s' is too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) return sx_h5_fail(h, "cannot create '%s': %s", tmp, strerror(errno));
-    const bool ok = fwrite(data, 1, n, f) == n;
-    if (fclose(f) != 0 || !ok) {
-        remove(tmp);
-        return sx_h5_fail(h, "cannot write '%s': %s", tmp, strerror(errno));
-    }
-    if (!sx_h5_commit(h, tmp, path)) {
+    if (!sx_h5_write_temp(h, path, data, n, tmp, sizeof tmp)) return false;
+    if (!sx_h5_rename(h, tmp, path)) {
         remove(tmp);
         return false;
     }
     return true;
 }
 
-/* The whole XDMF from the first `count` snapshots of file; *trailer_at:
- * the offset of its closing tags. */
-static bool xmf_rewrite(sx_h5 *h, const char *xmf, const char *base, hid_t file, int dim, int64_t count,
-                        off_t *trailer_at)
+/* The XDMF of the first `count` snapshots of file, without its closing tags. */
+static bool xmf_body(sx_h5 *h, buf *b, const char *base, hid_t file, int dim, int64_t count)
 {
-    buf b = {0};
-    xmf_header(&b);
+    b->n = 0;
+    xmf_header(b);
     for (int64_t k = 0; k < count && !h->failed; k++) {
         snap s;
-        if (read_snap(h, file, dim, k, &s)) xmf_step(&b, base, k, &s);
+        if (read_snap(h, file, dim, k, &s)) xmf_step(b, base, k, &s);
     }
-    const size_t at = b.n;
-    put(&b, "%s", xmf_trailer);
-    bool ok = !h->failed;
-    if (ok && b.oom) ok = sx_h5_fail(h, "out of memory");
-    if (ok) ok = write_whole(h, xmf, b.p, b.n);
-    free(b.p);
-    if (ok && trailer_at) *trailer_at = (off_t)at;
+    return !h->failed && (!b->oom || sx_h5_fail(h, "out of memory"));
+}
+
+/* The body with its closing tags, written whole (temporary name, rename). */
+static bool xmf_write(sx_h5 *h, const char *xmf, buf *b)
+{
+    const size_t at = b->n;
+    put(b, "%s", xmf_trailer);
+    const bool ok = b->oom ? sx_h5_fail(h, "out of memory") : write_whole(h, xmf, b->p, b->n);
+    b->n = at;
     return ok;
+}
+
+/* The file's descriptor (sec2 driver), or -1. */
+static int file_fd(hid_t file)
+{
+    void *handle = NULL;
+    return H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle ? *(int *)handle : -1;
+}
+
+/* H5Fflush writes a superblock recording the end of the space allocated so
+ * far, while some of that space (metadata the same flush writes later, the
+ * unused end of an aggregator block) is not yet on disk: a writer killed
+ * during the flush would leave a file shorter than its superblock says,
+ * which HDF5 refuses to open ("truncated file"). The file is first grown to
+ * that end, so it is never shorter than any superblock a flush writes (the
+ * flush trims it back to what is allocated when it completes). */
+static bool flush_file(hid_t file)
+{
+    const int fd = file_fd(file);
+    hsize_t size = 0;
+    struct stat st;
+    if (fd >= 0 && H5Fget_filesize(file, &size) >= 0 && fstat(fd, &st) == 0 && (hsize_t)st.st_size < size &&
+        ftruncate(fd, (off_t)size) != 0)
+        return false;
+    return H5Fflush(file, H5F_SCOPE_LOCAL) >= 0;
 }
 
 static bool sync_file(hid_t file)
 {
-    void *handle = NULL;
-    if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) return false;
-    if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle) fsync(*(int *)handle);
+    if (!flush_file(file)) return false;
+    const int fd = file_fd(file);
+    if (fd >= 0) fsync(fd);
     return true;
 }
 
@@ -727,10 +817,7 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
     sx_h5 h;
     sx_h5_begin(&h, path ? path : "", err, errlen);
     sx_series *s = calloc(1, sizeof *s);
-    if (s) {
-        s->file = -1;
-        s->xfd = -1;
-    }
+    if (s) s->file = -1;
     const unsigned fields = o && o->fields ? o->fields : SX_OUT_DEFAULT;
     if (!s) {
         sx_h5_fail(&h, "out of memory");
@@ -753,6 +840,10 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
             int d = 0, version = 0;
             s->file = sx_io_open(&h, path, true, "series", dim, &d, &version);
             if (s->file >= 0) sx_h5_get_i64(&h, s->file, "/", "count", &s->count, 1, true);
+            /* what is appended now follows this format: an older reader must refuse the file */
+            if (s->file >= 0 && version < SX_IO_FORMAT_VERSION &&
+                sx_h5_attr_int(&h, s->file, "format_version", SX_IO_FORMAT_VERSION) && !sync_file(s->file))
+                sx_h5_fail_h5(&h, "cannot flush the series");
         } else if (create_file(&h, path, dim, o, fields)) {
             hid_t fapl = sx_h5_fapl(false);
             s->file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : -1;
@@ -760,10 +851,8 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
             sx_h5_close(fapl);
         }
         if (!h.failed && s->count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
-        if (!h.failed && xmf_rewrite(&h, s->xmf, s->base, s->file, s->dim, s->count, &s->xoff)) {
-            s->xfd = open(s->xmf, O_WRONLY);
-            if (s->xfd < 0) sx_h5_fail(&h, "cannot open '%s': %s", s->xmf, strerror(errno));
-        }
+        /* the XDMF of what the file holds now, kept in memory from here on */
+        if (!h.failed && xmf_body(&h, &s->xbody, s->base, s->file, s->dim, s->count)) xmf_write(&h, s->xmf, &s->xbody);
     }
     const bool failed = h.failed;
     sx_h5_end(&h);
@@ -774,58 +863,180 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
     return s;
 }
 
-sx_status sx_series_write(sx_series *s, const sx_model *m, char *err, size_t errlen)
+/* ------------------------------------------------------ history rows */
+
+/* A history being appended: its group, its entry in s->held and the rows
+ * written beyond the file's count. */
+typedef struct pending {
+    hid_t g;
+    int held;
+    int64_t rows, last;
+} pending;
+
+/* The entry of s->held for the history group g named `name` (read from the
+ * file the first time it is met); -1 on failure. */
+static int held_of(sx_h5 *h, sx_series *s, hid_t g, const char *name, bool fresh)
+{
+    for (int i = 0; i < s->nheld; i++)
+        if (strcmp(s->held[i].name, name) == 0) return i;
+    if (s->nheld == s->capheld) {
+        const int cap = s->capheld ? 2 * s->capheld : 8;
+        held *q = realloc(s->held, (size_t)cap * sizeof *q);
+        if (!q) return sx_h5_fail(h, "out of memory"), -1;
+        s->held = q;
+        s->capheld = cap;
+    }
+    held *e = &s->held[s->nheld];
+    e->rows = 0;
+    e->last = INT64_MIN;
+    if (!(e->name = dup_str(name))) return sx_h5_fail(h, "out of memory"), -1;
+    if (!fresh) {
+        char where[320];
+        snprintf(where, sizeof where, "/histories/%.300s", name);
+        if (!sx_io_history_tail(h, g, where, &e->rows, &e->last)) {
+            free(e->name);
+            return -1;
+        }
+    }
+    return s->nheld++;
+}
+
+/* Writes, beyond each history's complete rows, its samples of steps after
+ * the last one the file holds; nothing is counted yet. */
+static void hist_stage(sx_h5 *h, sx_series *s, const sx_io_history *x, int nh, pending *p)
+{
+    for (int i = 0; i < nh; i++) p[i].g = -1;
+    if (nh <= 0 || h->failed) return;
+    for (int i = 0; i < nh; i++) {
+        if (!sx_io_history_valid(h, &x[i])) return;
+        for (int j = 0; j < i; j++)
+            if (strcmp(x[i].name, x[j].name) == 0) {
+                sx_h5_fail(h, "two histories named '%s'", x[i].name);
+                return;
+            }
+    }
+    hid_t hg = sx_h5_group(h, s->file, "histories");
+    for (int i = 0; i < nh && !h->failed; i++) {
+        const sx_io_history *q = &x[i];
+        const bool fresh = H5Lexists(hg, q->name, H5P_DEFAULT) <= 0;
+        if (fresh) {
+            H5G_info_t gi;
+            /* rows are appended a few at a time: 8 KiB chunks */
+            p[i].g = H5Gget_info(hg, &gi) < 0 ? (sx_h5_fail_h5(h, "damaged: cannot list /histories"), -1)
+                                              : sx_io_history_create(h, hg, q, (int64_t)gi.nlinks, 1024);
+        } else {
+            p[i].g = sx_h5_open_group(h, hg, q->name, true);
+        }
+        if (p[i].g < 0) break;
+        p[i].held = held_of(h, s, p[i].g, q->name, fresh);
+        if (p[i].held < 0) break;
+        const held *e = &s->held[p[i].held];
+        /* the first sample after the file's last step (steps increase) */
+        int64_t lo = 0, hi = q->n;
+        while (lo < hi) {
+            const int64_t mid = lo + (hi - lo) / 2;
+            if (q->steps[mid] > e->last) hi = mid;
+            else lo = mid + 1;
+        }
+        sx_io_history_put(h, p[i].g, q, lo, e->rows);
+        p[i].rows = e->rows + (q->n - lo);
+        p[i].last = q->n > lo ? q->steps[q->n - 1] : e->last;
+    }
+    sx_h5_close(hg);
+}
+
+static void hist_raise(sx_h5 *h, const pending *p, int nh)
+{
+    for (int i = 0; i < nh && !h->failed; i++) sx_h5_attr_int(h, p[i].g, "count", p[i].rows);
+}
+
+static void hist_commit(sx_series *s, const pending *p, int nh)
+{
+    for (int i = 0; i < nh; i++) s->held[p[i].held].rows = p[i].rows, s->held[p[i].held].last = p[i].last;
+}
+
+/* ---------------------------------------------------------- writing */
+
+/* One write: a snapshot of m (none when NULL) and the histories' new
+ * rows, in the order that keeps every reader consistent (see the top). */
+static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x, int nh, char *err, size_t errlen)
 {
     sx_h5 h;
     sx_h5_begin(&h, s->path, err, errlen);
     h.compression = s->compression;
-    char name[48];
-    snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
+    pending *p = calloc((size_t)(nh > 0 ? nh : 0) + 1, sizeof *p);
     snap sn;
-    if (m->dim != s->dim) {
+    char tmp[4096];
+    bool have_tmp = false;
+    const size_t xat = s->xbody.n;
+    if (!p) {
+        sx_h5_fail(&h, "out of memory");
+    } else if (m && m->dim != s->dim) {
         sx_h5_fail(&h, "the series holds %dD models, this one is %dD", s->dim, m->dim);
     } else if (s->file < 0) {
         sx_h5_fail(&h, "the series is closed");
     } else {
-        /* a group left by a write that failed or was killed is dropped; if
-         * its object cannot be read to delete it, its link is moved aside */
-        if (H5Lexists(s->file, name, H5P_DEFAULT) > 0 && H5Ldelete(s->file, name, H5P_DEFAULT) < 0) {
-            char aside[80];
-            snprintf(aside, sizeof aside, "/snapshots/incomplete-%06lld-%ld", (long long)s->count, (long)getpid());
-            H5Lmove(s->file, name, s->file, aside, H5P_DEFAULT, H5P_DEFAULT);
+        if (m) {
+            char name[48];
+            snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
+            /* a group left by a write that failed or was killed is dropped; if
+             * its object cannot be read to delete it, its link is moved aside */
+            if (H5Lexists(s->file, name, H5P_DEFAULT) > 0 && H5Ldelete(s->file, name, H5P_DEFAULT) < 0) {
+                char aside[80];
+                snprintf(aside, sizeof aside, "/snapshots/incomplete-%06lld-%ld", (long long)s->count, (long)getpid());
+                H5Lmove(s->file, name, s->file, aside, H5P_DEFAULT, H5P_DEFAULT);
+            }
+            H5Eclear2(H5E_DEFAULT);
+            hid_t g = H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+            if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
+            else write_snapshot(&h, g, m, s->fields, &sn);
+            sx_h5_close(g);
         }
-        H5Eclear2(H5E_DEFAULT);
-        hid_t g = H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
-        else write_snapshot(&h, g, m, s->fields, &sn);
-        sx_h5_close(g);
-        /* the snapshot is on disk before the count says it is complete */
+        hist_stage(&h, s, x, nh, p);
+        /* 1. the data on disk before anything says it is complete */
         if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
-        if (!h.failed) sx_h5_attr_int(&h, s->file, "count", s->count + 1);
-        if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot count");
-    }
-    if (!h.failed) {
-        s->count++;
-        /* the XDMF last: this step and the closing tags in one write */
-        buf b = {0};
-        xmf_step(&b, s->base, s->count - 1, &sn);
-        const size_t step_len = b.n;
-        put(&b, "%s", xmf_trailer);
-        const ssize_t w = b.oom ? -1 : pwrite(s->xfd, b.p, b.n, s->xoff);
-        if (w == (ssize_t)b.n) {
-            s->xoff += (off_t)step_len;
-            fsync(s->xfd);
-        } else {
-            /* rewrite it whole from the file (a write cut short would leave it unreadable) */
-            xmf_rewrite(&h, s->xmf, s->base, s->file, s->dim, s->count, &s->xoff);
-            close(s->xfd);
-            s->xfd = open(s->xmf, O_WRONLY);
+        /* 2. the XDMF that lists it, on disk under a temporary name */
+        if (m && !h.failed) {
+            xmf_step(&s->xbody, s->base, s->count, &sn);
+            const size_t body = s->xbody.n;
+            put(&s->xbody, "%s", xmf_trailer);
+            if (s->xbody.oom) sx_h5_fail(&h, "out of memory");
+            else have_tmp = sx_h5_write_temp(&h, s->xmf, s->xbody.p, s->xbody.n, tmp, sizeof tmp);
+            s->xbody.n = body;
         }
-        free(b.p);
+        /* 3. the counts, and at once 4. the XDMF renamed into place */
+        if (!h.failed) {
+            if (m) sx_h5_attr_int(&h, s->file, "count", s->count + 1);
+            hist_raise(&h, p, nh);
+            if (!h.failed && !flush_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the counts");
+        }
+        if (!h.failed) {
+            s->count += m ? 1 : 0;
+            hist_commit(s, p, nh);
+            if (have_tmp && sx_h5_rename(&h, tmp, s->xmf)) have_tmp = false;
+            /* 5. the counts durable too */
+            if (!sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the counts");
+        } else {
+            s->xbody.n = xat;
+        }
     }
+    if (have_tmp) remove(tmp);
+    for (int i = 0; p && i < nh; i++) sx_h5_close(p[i].g);
+    free(p);
     const bool failed = h.failed;
     sx_h5_end(&h);
     return failed ? SX_EINVAL : SX_OK;
+}
+
+sx_status sx_series_write(sx_series *s, const sx_model *m, const sx_io_history *h, int nh, char *err,
+                          size_t errlen)
+{
+    return append(s, m, h, nh, err, errlen);
+}
+
+sx_status sx_series_write_histories(sx_series *s, const sx_io_history *h, int nh, char *err, size_t errlen)
+{
+    return append(s, NULL, h, nh, err, errlen);
 }
 
 sx_status sx_series_close(sx_series *s, char *err, size_t errlen)
@@ -833,10 +1044,12 @@ sx_status sx_series_close(sx_series *s, char *err, size_t errlen)
     if (!s) return SX_OK;
     sx_h5 h;
     sx_h5_begin(&h, s->path ? s->path : "", err, errlen);
-    if (s->xfd >= 0) close(s->xfd);
     if (s->file >= 0 && H5Fclose(s->file) < 0) sx_h5_fail_h5(&h, "cannot close the series");
     const bool failed = h.failed;
     sx_h5_end(&h);
+    for (int i = 0; i < s->nheld; i++) free(s->held[i].name);
+    free(s->held);
+    free(s->xbody.p);
     free(s->path);
     free(s->xmf);
     free(s->base);
@@ -854,11 +1067,13 @@ sx_status sx_series_write_xdmf(const char *h5path, char *err, size_t errlen)
     int64_t count = 0;
     char *xmf = xmf_path_of(h5path ? h5path : "");
     const char *slash = h5path ? strrchr(h5path, '/') : NULL;
+    buf b = {0};
     if (f >= 0 && sx_h5_get_i64(&h, f, "/", "count", &count, 1, true)) {
         if (!xmf) sx_h5_fail(&h, "out of memory");
         else if (count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
-        else xmf_rewrite(&h, xmf, slash ? slash + 1 : h5path, f, dim, count, NULL);
+        else if (xmf_body(&h, &b, slash ? slash + 1 : h5path, f, dim, count)) xmf_write(&h, xmf, &b);
     }
+    free(b.p);
     free(xmf);
     if (f >= 0) H5Fclose(f);
     const bool failed = h.failed;

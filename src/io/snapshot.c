@@ -21,15 +21,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { T_F64, T_I32, T_U16, T_U8, T_I64 };
+enum { T_F64, T_I64, T_I32, T_U16, T_U8 };
 
 static hid_t mem_type(int t)
 {
     switch (t) {
     case T_F64: return H5T_NATIVE_DOUBLE;
+    case T_I64: return H5T_NATIVE_INT64;
     case T_I32: return H5T_NATIVE_INT32;
     case T_U16: return H5T_NATIVE_UINT16;
-    case T_I64: return H5T_NATIVE_INT64;
     default: return H5T_NATIVE_UINT8;
     }
 }
@@ -38,9 +38,9 @@ static hid_t file_type(int t)
 {
     switch (t) {
     case T_F64: return H5T_IEEE_F64LE;
+    case T_I64: return H5T_STD_I64LE;
     case T_I32: return H5T_STD_I32LE;
     case T_U16: return H5T_STD_U16LE;
-    case T_I64: return H5T_STD_I64LE;
     default: return H5T_STD_U8LE;
     }
 }
@@ -130,9 +130,12 @@ static bool write_fields(sx_h5 *h, hid_t g, const field *f, int nf, int64_t rows
     return !h->failed;
 }
 
-static bool read_fields(sx_h5 *h, hid_t g, const char *where, const field *f, int nf, int64_t rows)
+/* Fields a file must have (required), or may lack because an older format
+ * did not write them (the data then keeps its zeros). */
+static bool read_fields(sx_h5 *h, hid_t g, const char *where, const field *f, int nf, int64_t rows, bool required)
 {
-    for (int i = 0; i < nf; i++) sx_h5_read(h, g, where, f[i].name, mem_type(f[i].type), f[i].data, rows, f[i].per, true);
+    for (int i = 0; i < nf; i++)
+        sx_h5_read(h, g, where, f[i].name, mem_type(f[i].type), f[i].data, rows, f[i].per, required);
     return !h->failed;
 }
 
@@ -306,15 +309,19 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
 
 /* --------------------------------------------------------------- walls */
 
-static const char *const wall_kind_names[] = {"plane", "line", "rect", "segment"};
-static const int wall_kind_values[] = {SX_WALL_PLANE, SX_WALL_LINE, SX_WALL_RECT, SX_WALL_SEGMENT};
+static const char *const wall_kind_names[] = {"plane", "line", "rect", "segment", "cylinder"};
+static const int wall_kind_values[] = {SX_WALL_PLANE, SX_WALL_LINE, SX_WALL_RECT, SX_WALL_SEGMENT, SX_WALL_CYLINDER};
+enum { WALL_KINDS = sizeof wall_kind_values / sizeof *wall_kind_values };
 
 /* The walls' arrays, gathered from (or scattered to) the array of structs. */
 typedef struct wall_cols {
-    int64_t *id;
+    int64_t *id, *contacts;
     int *kind;
+    uint8_t *servo_on;
     double *point, *normal, *edge1, *edge2, *vel, *kn, *ks, *friction;
     double *u, *v, *len_u, *len_v, *seg_len, *force, *moment, *moved;
+    double *radius, *height, *radial_vel, *load, *kn_sum;
+    double *target, *area, *alpha, *max_speed;
 } wall_cols;
 
 static bool wall_cols_alloc(wall_cols *c, int64_t n)
@@ -322,10 +329,14 @@ static bool wall_cols_alloc(wall_cols *c, int64_t n)
     memset(c, 0, sizeof *c);
     const size_t k = (size_t)(n > 0 ? n : 1);
     c->id = calloc(k, sizeof *c->id);
+    c->contacts = calloc(k, sizeof *c->contacts);
     c->kind = calloc(k, sizeof *c->kind);
+    c->servo_on = calloc(k, sizeof *c->servo_on);
     double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment};
-    double **sc[] = {&c->kn, &c->ks, &c->friction, &c->len_u, &c->len_v, &c->seg_len, &c->moved};
-    bool ok = c->id && c->kind;
+    double **sc[] = {&c->kn,     &c->ks,     &c->friction,   &c->len_u, &c->len_v,  &c->seg_len, &c->moved,
+                     &c->radius, &c->height, &c->radial_vel, &c->load,  &c->kn_sum, &c->target,  &c->area,
+                     &c->alpha,  &c->max_speed};
+    bool ok = c->id && c->contacts && c->kind && c->servo_on;
     for (size_t i = 0; i < sizeof vec / sizeof *vec; i++) ok &= (*vec[i] = calloc(3 * k, sizeof(double))) != NULL;
     for (size_t i = 0; i < sizeof sc / sizeof *sc; i++) ok &= (*sc[i] = calloc(k, sizeof(double))) != NULL;
     return ok;
@@ -333,12 +344,34 @@ static bool wall_cols_alloc(wall_cols *c, int64_t n)
 
 static void wall_cols_free(wall_cols *c)
 {
-    void *p[] = {c->id, c->kind, c->point, c->normal, c->edge1, c->edge2, c->vel, c->kn, c->ks, c->friction,
-                 c->u, c->v, c->len_u, c->len_v, c->seg_len, c->force, c->moment, c->moved};
+    void *p[] = {c->id,       c->contacts, c->kind,    c->servo_on,   c->point,  c->normal, c->edge1,  c->edge2,
+                 c->vel,      c->kn,       c->ks,      c->friction,   c->u,      c->v,      c->len_u,  c->len_v,
+                 c->seg_len,  c->force,    c->moment,  c->moved,      c->radius, c->height, c->radial_vel,
+                 c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed};
     for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
 }
 
-/* Vectors of dim components (the moment: rdim); scalars one. */
+/* The fields of format 2: cylinders, and the servo with the inputs it read
+ * in the last step (what sx_wall_load reports). */
+static int wall_fields2(const sx_model *m, const wall_cols *c, field *f)
+{
+    const bool d3 = m->dim == 3; /* a 2D servo acts per unit thickness */
+    int n = 0;
+    f[n++] = F("radius", T_F64, c->radius, 1, "m");
+    f[n++] = F("height", T_F64, c->height, 1, "m");
+    f[n++] = F("radial_velocity", T_F64, c->radial_vel, 1, "m/s");
+    f[n++] = F("normal_load", T_F64, c->load, 1, "N");
+    f[n++] = F("normal_stiffness_sum", T_F64, c->kn_sum, 1, "N/m");
+    f[n++] = F("contact_count", T_I64, c->contacts, 1, NULL);
+    f[n++] = F("servo", T_U8, c->servo_on, 1, NULL);
+    f[n++] = F("servo_target", T_F64, c->target, 1, d3 ? "Pa" : "N/m");
+    f[n++] = F("servo_area", T_F64, c->area, 1, d3 ? "m^2" : "m");
+    f[n++] = F("servo_alpha", T_F64, c->alpha, 1, "1");
+    f[n++] = F("servo_max_speed", T_F64, c->max_speed, 1, "m/s");
+    return n;
+}
+
+/* The fields of format 1. Vectors of dim components (the moment: rdim); scalars one. */
 static int wall_fields(const sx_model *m, const wall_cols *c, field *f)
 {
     const int d = m->dim, r = m->rdim;
@@ -394,8 +427,18 @@ static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bo
     S(seg_len, w->seg_len);
     S(moved, w->moved);
     S(id, w->id);
-    if (to_cols) c->kind[i] = (int)w->def.kind;
-    else w->def.kind = (sx_wall_kind)c->kind[i];
+    S(radius, w->def.radius);
+    S(height, w->def.height);
+    S(radial_vel, w->def.radial_vel);
+    S(load, w->load);
+    S(kn_sum, w->kn_sum);
+    S(contacts, w->contacts);
+    S(target, w->servo.target);
+    S(area, w->servo.area);
+    S(alpha, w->servo.alpha);
+    S(max_speed, w->servo.max_speed);
+    if (to_cols) c->kind[i] = (int)w->def.kind, c->servo_on[i] = w->servo_on;
+    else w->def.kind = (sx_wall_kind)c->kind[i], w->servo_on = c->servo_on[i] != 0;
 #undef V
 #undef S
 }
@@ -405,8 +448,8 @@ static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
     hid_t g = sx_h5_group(h, f, "walls");
     const int64_t n = m->nwall;
     wall_cols c;
-    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, 4);
-    hid_t file = sx_h5_enum(H5T_STD_U8LE, wall_kind_names, wall_kind_values, 4);
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, WALL_KINDS);
+    hid_t file = sx_h5_enum(H5T_STD_U8LE, wall_kind_names, wall_kind_values, WALL_KINDS);
     if (!wall_cols_alloc(&c, n) || mem < 0 || file < 0) {
         sx_h5_fail(h, "out of memory");
     } else {
@@ -415,6 +458,7 @@ static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
         sx_h5_write(h, g, "kind", mem, file, c.kind, n, 1, NULL);
         field fl[MAX_FIELDS];
         write_fields(h, g, fl, wall_fields(m, &c, fl), n);
+        write_fields(h, g, fl, wall_fields2(m, &c, fl), n);
     }
     wall_cols_free(&c);
     sx_h5_close(mem);
@@ -422,18 +466,21 @@ static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
     sx_h5_close(g);
 }
 
-static void load_walls(sx_h5 *h, hid_t g, sx_model *m)
+/* A format-1 file has no cylinder and no servo: its walls load with the
+ * format-2 fields at zero (no servo). */
+static void load_walls(sx_h5 *h, hid_t g, sx_model *m, int version)
 {
     const int64_t n = m->nwall;
     wall_cols c;
-    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, 4);
+    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, wall_kind_names, wall_kind_values, WALL_KINDS);
     if (!wall_cols_alloc(&c, n) || mem < 0) {
         sx_h5_fail(h, "out of memory");
     } else {
         field fl[MAX_FIELDS];
         sx_h5_read(h, g, "/walls", "id", H5T_NATIVE_INT64, c.id, n, 1, true);
         sx_h5_read(h, g, "/walls", "kind", mem, c.kind, n, 1, true);
-        if (read_fields(h, g, "/walls", fl, wall_fields(m, &c, fl), n))
+        if (read_fields(h, g, "/walls", fl, wall_fields(m, &c, fl), n, true) &&
+            read_fields(h, g, "/walls", fl, wall_fields2(m, &c, fl), n, version >= 2))
             for (int64_t i = 0; i < n; i++) wall_copy(m, &m->walls[i], &c, i, false);
     }
     wall_cols_free(&c);
@@ -790,6 +837,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
 
     save_walls(h, f, m);
     save_clumps(h, f, m);
+    if (o) sx_io_histories_write(h, f, o->histories, o->nhistories);
 
     if (o && o->ntrees > 0) {
         g = sx_h5_group(h, f, "lua");
@@ -869,7 +917,7 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
 static void load_group(sx_h5 *h, hid_t f, const char *path, const field *fl, int nf, int64_t rows)
 {
     hid_t g = sx_h5_open_group(h, f, path, true);
-    if (g >= 0) read_fields(h, g, path, fl, nf, rows);
+    if (g >= 0) read_fields(h, g, path, fl, nf, rows, true);
     sx_h5_close(g);
 }
 
@@ -901,6 +949,20 @@ static void load_trees(sx_h5 *h, hid_t f, sx_snapshot_info *info)
         if (sx_io_read_tree(h, g, "/lua", t->name, &t->tree)) info->ntrees++;
     }
     sx_h5_close(g);
+}
+
+/* The provenance's seeds (an empty attribute: none). */
+static void load_seeds(sx_h5 *h, hid_t f, sx_snapshot_info *info)
+{
+    const size_t n = sx_h5_attr_len(f, "seeds");
+    if (h->failed || n == 0) return;
+    if (n > 1000000) {
+        sx_h5_fail(h, "damaged: the root lists %zu seeds", n);
+        return;
+    }
+    info->seeds = malloc(n * sizeof *info->seeds);
+    if (!info->seeds) sx_h5_fail(h, "out of memory");
+    else if (sx_h5_get_i64(h, f, "/", "seeds", info->seeds, n, true)) info->nseeds = (int)n;
 }
 
 sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *info, char *err, size_t errlen)
@@ -948,10 +1010,12 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         if (g >= 0) crack_io(&h, g, m, false);
         sx_h5_close(g);
         g = sx_h5_open_group(&h, f, "/walls", true);
-        if (g >= 0) load_walls(&h, g, m);
+        if (g >= 0) load_walls(&h, g, m, version);
         sx_h5_close(g);
         load_clumps(&h, f, m);
         load_trees(&h, f, info);
+        sx_io_histories_read(&h, f, &info->histories, &info->nhistories);
+        load_seeds(&h, f, info);
         if (!h.failed && sx__state_finish(m)) sx_h5_fail(&h, "damaged: %s", sx_model_error(m));
     }
     if (f >= 0 && H5Fclose(f) < 0) sx_h5_fail_h5(&h, "cannot close the file");
@@ -974,4 +1038,10 @@ void sx_snapshot_info_free(sx_snapshot_info *info)
     free(info->trees);
     info->trees = NULL;
     info->ntrees = 0;
+    sx_io_histories_free(info->histories, info->nhistories);
+    info->histories = NULL;
+    info->nhistories = 0;
+    free(info->seeds);
+    info->seeds = NULL;
+    info->nseeds = 0;
 }

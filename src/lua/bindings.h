@@ -201,6 +201,26 @@ void sx_lua_history_record(lua_State *L, int model);
 /// The smallest step > s at which a history is due, or INT64_MAX.
 int64_t sx_lua_history_next(lua_State *L, int model, int64_t s);
 
+/* ---------------------------------------------- history.c: files */
+
+struct sx_io_history;
+/// Pushes a userdata that holds the histories of the model at `model` as
+/// C arrays for the I/O layer (freed when it is collected or closed) and
+/// returns them, *n of them: all, or those named in the array at `names`
+/// (0: all); with `passed` (the index of a table name -> step, 0: none)
+/// only the samples of later steps.
+struct sx_io_history *sx_lua_histories_push(lua_State *L, int model, int names, int passed, int *n);
+/// Adds histories read from the file `path` to the model at `model`; a
+/// history of a function comes back detached. An unknown source is a Lua
+/// error naming the file.
+void sx_lua_histories_restore(lua_State *L, int model, const struct sx_io_history *h, int n, const char *path);
+
+/* ----------------------------------------------------------- io.c */
+
+/// Records a random seed a call of the model at `model` used (once per
+/// seed, in order of first use): files list them as their provenance.
+void sx_lua_record_seed(lua_State *L, int model, int64_t seed);
+
 /* ----------------------------------------------------------- util.c */
 
 /// The core's message without the core function's name it starts with.

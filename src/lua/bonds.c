@@ -117,6 +117,7 @@ static int model_bond(lua_State *L)
     d.shear_strength_sd = b.shear_strength_sd;
     int64_t count = 0;
     sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
+    sx_lua_record_seed(L, 1, (int64_t)d.seed); /* the strengths drawn from it: the files' provenance lists it */
     lua_pushinteger(L, (lua_Integer)count);
     return 1;
 }

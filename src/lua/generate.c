@@ -1056,6 +1056,7 @@ static int model_generate(lua_State *L)
     }
     m = sx_lua_checkmodel(L, 1);
     const int64_t *ids = add_balls(L, m, &g, x, rad, n);
+    sx_lua_record_seed(L, 1, (int64_t)g.seed); /* the balls exist: the files' provenance lists it */
     if (g.method == M_EXPAND && shrink < 1) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);

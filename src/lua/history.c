@@ -3,7 +3,7 @@
  *   m:history(name)                           -> {name, every, steps, times, values}
  *   m:histories()                             -> the names, in creation order
  *   m:history_remove(name)
- *   m:history_csv(path[, names])              write step, time and each history as CSV
+ *   m:history_csv(path[, names])              write step, time and each history as CSV (src/io)
  * A source is a function(m) -> number, a builtin name (time, step,
  * timestep, ratio, contacts, balls, or an energy term: kinetic,
  * gravitational, strain, ...), or a field of one ball or wall:
@@ -14,13 +14,20 @@
  * "after" callbacks), so its samples do not depend on how the cycling was
  * split. The samples live in Lua arrays in the model's state, one entry
  * per history: {name, every, kind, fn | builtin | id, field, comp, steps,
- * times, values}. */
-#include <errno.h>
+ * times, values, last}.
+ *
+ * Histories go to files through the I/O layer (sx_io_history): m:save
+ * writes them with the model and seixo.load brings them back recording; an
+ * output series appends their new samples as it goes. A function cannot be
+ * saved: a history of a function comes back "detached", with its samples
+ * but recording nothing until m:history(name, fn) gives it a function
+ * again. */
 #include <math.h>
-#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bindings.h"
+#include "seixo_io.h"
 
 enum { SRC_FUNCTION, SRC_BUILTIN, SRC_BALL, SRC_WALL };
 
@@ -118,9 +125,10 @@ int64_t sx_lua_history_next(lua_State *L, int model, int64_t s)
     sx_lua_state(L, model, "histories");
     for (lua_Integer i = 1; lua_rawgeti(L, -1, i) == LUA_TTABLE; i++) {
         lua_getfield(L, -1, "every");
-        const int64_t at = next_multiple(s, (int64_t)lua_tointeger(L, -1));
-        if (at < next) next = at;
-        lua_pop(L, 2);
+        lua_getfield(L, -2, "detached");
+        const int64_t at = next_multiple(s, (int64_t)lua_tointeger(L, -2));
+        if (at < next && !lua_toboolean(L, -1)) next = at;
+        lua_pop(L, 3);
     }
     lua_pop(L, 2);
     return next;
@@ -137,7 +145,9 @@ void sx_lua_history_record(lua_State *L, int model)
         const int64_t s = sx_model_step_count(m);
         lua_getfield(L, e, "every");
         lua_getfield(L, e, "last");
-        const bool due = s % lua_tointeger(L, e + 1) == 0 && (lua_isnil(L, e + 2) || lua_tointeger(L, e + 2) != s);
+        lua_getfield(L, e, "detached"); /* a function not given again after a load */
+        const bool due = s % lua_tointeger(L, e + 1) == 0 && (lua_isnil(L, e + 2) || lua_tointeger(L, e + 2) != s) &&
+                         !lua_toboolean(L, e + 3);
         lua_settop(L, e);
         if (!due) {
             lua_settop(L, t);
@@ -183,10 +193,11 @@ void sx_lua_history_record(lua_State *L, int model)
 
 /* ------------------------------------------------------------- methods */
 
-/* Pushes the entry of the named history and returns its position, or 0 (nothing pushed). */
-static lua_Integer find_history(lua_State *L, const char *name)
+/* Pushes the entry of the named history of the model at `model` and
+ * returns its position, or 0 (nothing pushed). */
+static lua_Integer find_entry(lua_State *L, int model, const char *name)
 {
-    sx_lua_state(L, 1, "histories");
+    sx_lua_state(L, model, "histories");
     const int t = lua_gettop(L);
     for (lua_Integer i = 1; lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
         lua_getfield(L, -1, "name");
@@ -215,16 +226,20 @@ static void copy_array(lua_State *L, int from, const char *key)
     lua_setfield(L, -2, key);
 }
 
+static lua_Integer find_history(lua_State *L, const char *name) { return find_entry(L, 1, name); }
+
 /* The record of a history: a copy of its samples. */
 static int history_get(lua_State *L, const char *name)
 {
     if (!find_history(L, name)) return luaL_argerror(L, 2, lua_pushfstring(L, "no history named '%s'", name));
     const int e = lua_gettop(L);
-    lua_createtable(L, 0, 5);
+    lua_createtable(L, 0, 6);
     lua_pushstring(L, name);
     lua_setfield(L, -2, "name");
     lua_getfield(L, e, "every");
     lua_setfield(L, -2, "every");
+    if (lua_getfield(L, e, "detached") == LUA_TBOOLEAN) lua_setfield(L, -2, "detached");
+    else lua_pop(L, 1);
     copy_array(L, e, "steps");
     copy_array(L, e, "times");
     copy_array(L, e, "values");
@@ -280,15 +295,34 @@ static int model_history(lua_State *L)
 {
     static const char *const keys[] = {"every", NULL};
     const sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    size_t len;
+    const char *name = luaL_checklstring(L, 2, &len);
     if (lua_isnoneornil(L, 3)) return history_get(L, name);
-    luaL_argcheck(L, *name && !strpbrk(name, ",\"\n\r"), 2, "a name without commas, quotes or newlines expected");
+    /* a name is the name of its group in a file (and a CSV column, quoted as needed) */
+    luaL_argcheck(L, len > 0 && strlen(name) == len && !strchr(name, '/') && strcmp(name, ".") != 0, 2,
+                  "a name without '/' or NUL bytes, not \".\" expected (it names a group in files)");
     int64_t every = 1;
-    if (!lua_isnoneornil(L, 4)) {
+    const bool has_every = !lua_isnoneornil(L, 4);
+    if (has_every) {
         sx_lua_checkkeys(L, 4, keys);
         sx_lua_optintfield(L, 4, "every", 1, INT64_MAX / 2, &every);
     }
-    if (find_history(L, name)) return luaL_argerror(L, 2, lua_pushfstring(L, "a history named '%s' exists", name));
+    if (find_history(L, name)) {
+        /* a history of a function loaded from a file takes its function again */
+        lua_getfield(L, -1, "detached");
+        if (!lua_toboolean(L, -1) || !lua_isfunction(L, 3))
+            return luaL_argerror(L, 2, lua_pushfstring(L, "a history named '%s' exists", name));
+        lua_pop(L, 1);
+        lua_pushvalue(L, 3);
+        lua_setfield(L, -2, "fn");
+        lua_pushnil(L);
+        lua_setfield(L, -2, "detached");
+        if (has_every) {
+            lua_pushinteger(L, (lua_Integer)every);
+            lua_setfield(L, -2, "every");
+        }
+        return 0;
+    }
     lua_settop(L, 3);
     lua_createtable(L, 0, 10);
     lua_pushstring(L, name);
@@ -366,30 +400,190 @@ static int model_history_remove(lua_State *L)
     return 0;
 }
 
-/* ----------------------------------------------------------------- CSV */
+/* ------------------------------------------------------ to and from files */
 
-typedef struct series {
-    int entry;       // stack index of the history's entry
-    lua_Integer at;  // next sample, 1-based
-    lua_Integer n;
-} series;
+#define SX_LUA_EXPORT "seixo.histories_export"
 
-static lua_Integer step_at(lua_State *L, const series *s)
+/* Histories as C arrays for the I/O layer. The names are the Lua strings
+ * of the entries (alive while the model's state holds them: no Lua code
+ * runs while the I/O layer reads them); the arrays are the userdata's. */
+typedef struct exported {
+    int n;
+    sx_io_history *h;
+} exported;
+
+static int exported_free(lua_State *L)
 {
-    lua_getfield(L, s->entry, "steps");
-    lua_rawgeti(L, -1, s->at);
-    const lua_Integer v = lua_tointeger(L, -1);
-    lua_pop(L, 2);
-    return v;
+    exported *e = luaL_checkudata(L, 1, SX_LUA_EXPORT);
+    for (int i = 0; i < e->n; i++) free(e->h[i].steps), free(e->h[i].times), free(e->h[i].values);
+    free(e->h);
+    e->h = NULL;
+    e->n = 0;
+    return 0;
 }
 
-static double number_at(lua_State *L, const series *s, const char *array)
+/* The samples of steps after `after` of the entry at e, into x. */
+static void export_entry(lua_State *L, int e, int64_t after, sx_io_history *x)
 {
-    lua_getfield(L, s->entry, array);
-    lua_rawgeti(L, -1, s->at);
-    const double v = lua_tonumber(L, -1);
-    lua_pop(L, 2);
-    return v;
+    lua_getfield(L, e, "name");
+    x->name = (char *)lua_tostring(L, -1);
+    lua_getfield(L, e, "every");
+    x->every = (int64_t)lua_tointeger(L, -1);
+    lua_getfield(L, e, "kind");
+    const int src = (int)lua_tointeger(L, -1);
+    lua_pop(L, 3);
+    x->source = (sx_io_source)(src + 1); /* SRC_* follow sx_io_source's order */
+    if (src == SRC_BUILTIN) {
+        lua_getfield(L, e, "builtin");
+        x->builtin = (char *)builtin_names[lua_tointeger(L, -1)];
+        lua_pop(L, 1);
+    } else if (src == SRC_BALL || src == SRC_WALL) {
+        lua_getfield(L, e, "id");
+        lua_getfield(L, e, "field");
+        lua_getfield(L, e, "comp");
+        x->id = (int64_t)lua_tointeger(L, -3);
+        x->field = (char *)(src == SRC_BALL ? ball_fields : wall_fields)[lua_tointeger(L, -2)];
+        x->component = (int)lua_tointeger(L, -1);
+        lua_pop(L, 3);
+    }
+    lua_getfield(L, e, "steps");
+    lua_getfield(L, e, "times");
+    lua_getfield(L, e, "values");
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, -3);
+    /* the first sample after `after`, searched from the end (outputs pass only new samples) */
+    lua_Integer first = n + 1;
+    for (; first > 1; first--) {
+        lua_rawgeti(L, -3, first - 1);
+        const bool later = (int64_t)lua_tointeger(L, -1) > after;
+        lua_pop(L, 1);
+        if (!later) break;
+    }
+    const size_t k = (size_t)(n - first + 1);
+    x->steps = malloc((k ? k : 1) * sizeof *x->steps);
+    x->times = malloc((k ? k : 1) * sizeof *x->times);
+    x->values = malloc((k ? k : 1) * sizeof *x->values);
+    if (!x->steps || !x->times || !x->values) luaL_error(L, "out of memory for the samples of history '%s'", x->name);
+    for (lua_Integer i = first; i <= n; i++) {
+        const size_t j = (size_t)(i - first);
+        lua_rawgeti(L, -3, i);
+        lua_rawgeti(L, -3, i);
+        lua_rawgeti(L, -3, i);
+        x->steps[j] = (int64_t)lua_tointeger(L, -3);
+        x->times[j] = lua_tonumber(L, -2);
+        x->values[j] = lua_tonumber(L, -1);
+        lua_pop(L, 3);
+    }
+    x->n = (int64_t)k;
+    lua_pop(L, 3);
+}
+
+struct sx_io_history *sx_lua_histories_push(lua_State *L, int model, int names, int passed, int *n)
+{
+    model = lua_absindex(L, model);
+    names = names ? lua_absindex(L, names) : 0;
+    passed = passed ? lua_absindex(L, passed) : 0;
+    exported *e = lua_newuserdatauv(L, sizeof *e, 0);
+    memset(e, 0, sizeof *e);
+    if (luaL_newmetatable(L, SX_LUA_EXPORT)) {
+        lua_pushcfunction(L, exported_free);
+        lua_setfield(L, -2, "__gc");
+        lua_pushcfunction(L, exported_free);
+        lua_setfield(L, -2, "__close");
+    }
+    lua_setmetatable(L, -2);
+    const int top = lua_gettop(L);
+    sx_lua_state(L, model, "histories");
+    const lua_Integer count = (lua_Integer)lua_rawlen(L, names ? names : top + 1);
+    e->h = calloc((size_t)count + 1, sizeof *e->h);
+    if (!e->h) luaL_error(L, "out of memory");
+    for (lua_Integer i = 1; i <= count; i++) {
+        const char *name = NULL;
+        if (names) {
+            lua_rawgeti(L, names, i);
+            name = lua_tostring(L, -1);
+            lua_pop(L, 1); /* the caller's array keeps it */
+            if (!name || !find_entry(L, model, name)) luaL_error(L, "no history named '%s'", name ? name : "?");
+        } else {
+            lua_rawgeti(L, top + 1, i);
+        }
+        int64_t after = INT64_MIN;
+        if (passed) {
+            lua_getfield(L, -1, "name");
+            if (lua_rawget(L, passed) == LUA_TNUMBER) after = (int64_t)lua_tointeger(L, -1);
+            lua_pop(L, 1);
+        }
+        export_entry(L, lua_gettop(L), after, &e->h[e->n++]);
+        lua_pop(L, 1);
+    }
+    lua_settop(L, top);
+    *n = e->n;
+    return e->h;
+}
+
+/* Raises "'<file>': damaged: history '<name>' <why>". */
+static int damaged(lua_State *L, const char *path, const char *name, const char *why)
+{
+    return luaL_error(L, "'%s': damaged: history '%s' %s", path, name, why);
+}
+
+void sx_lua_histories_restore(lua_State *L, int model, const struct sx_io_history *h, int n, const char *path)
+{
+    model = lua_absindex(L, model);
+    const int dim = sx_model_dim(sx_lua_checkmodel(L, model));
+    sx_lua_state(L, model, "histories");
+    const int t = lua_gettop(L);
+    for (int i = 0; i < n; i++) {
+        const sx_io_history *x = &h[i];
+        lua_createtable(L, 0, 12);
+        lua_pushstring(L, x->name);
+        lua_setfield(L, -2, "name");
+        lua_pushinteger(L, (lua_Integer)x->every);
+        lua_setfield(L, -2, "every");
+        const int src = (int)x->source - 1;
+        lua_pushinteger(L, src);
+        lua_setfield(L, -2, "kind");
+        if (src == SRC_FUNCTION) {
+            lua_pushboolean(L, 1);
+            lua_setfield(L, -2, "detached");
+        } else if (src == SRC_BUILTIN) {
+            const int b = sx_lua_find(x->builtin, builtin_names);
+            if (b < 0) damaged(L, path, x->name, lua_pushfstring(L, "has an unknown builtin '%s'", x->builtin));
+            lua_pushinteger(L, b);
+            lua_setfield(L, -2, "builtin");
+        } else {
+            const int f = sx_lua_find(x->field, src == SRC_BALL ? ball_fields : wall_fields);
+            if (f < 0) damaged(L, path, x->name, lua_pushfstring(L, "has an unknown field '%s'", x->field));
+            if (x->component >= field_len(src, f, dim))
+                damaged(L, path, x->name, lua_pushfstring(L, "has component %d of '%s'", x->component, x->field));
+            lua_pushinteger(L, (lua_Integer)x->id);
+            lua_setfield(L, -2, "id");
+            lua_pushinteger(L, f);
+            lua_setfield(L, -2, "field");
+            lua_pushinteger(L, x->component);
+            lua_setfield(L, -2, "comp");
+        }
+        lua_createtable(L, x->n < INT32_MAX ? (int)x->n : 0, 0);
+        lua_createtable(L, x->n < INT32_MAX ? (int)x->n : 0, 0);
+        lua_createtable(L, x->n < INT32_MAX ? (int)x->n : 0, 0);
+        for (int64_t k = 0; k < x->n; k++) {
+            lua_pushinteger(L, (lua_Integer)x->steps[k]);
+            lua_rawseti(L, -4, (lua_Integer)k + 1);
+            lua_pushnumber(L, x->times[k]);
+            lua_rawseti(L, -3, (lua_Integer)k + 1);
+            lua_pushnumber(L, x->values[k]);
+            lua_rawseti(L, -2, (lua_Integer)k + 1);
+        }
+        lua_setfield(L, -4, "values");
+        lua_setfield(L, -3, "times");
+        lua_setfield(L, -2, "steps");
+        /* the last sample's step: it is not taken twice */
+        if (x->n > 0) {
+            lua_pushinteger(L, (lua_Integer)x->steps[x->n - 1]);
+            lua_setfield(L, -2, "last");
+        }
+        lua_rawseti(L, t, (lua_Integer)lua_rawlen(L, t) + 1);
+    }
+    lua_settop(L, t - 1);
 }
 
 /* m:history_csv(path[, names]): the union of the histories' steps as rows
@@ -409,64 +603,17 @@ static int model_history_csv(lua_State *L)
     luaL_checktype(L, 3, LUA_TTABLE);
     const lua_Integer nh = (lua_Integer)lua_rawlen(L, 3);
     luaL_argcheck(L, nh > 0, 3, "no history to write");
-    luaL_checkstack(L, (int)(nh + 20), "too many histories");
-    series *s = lua_newuserdatauv(L, (size_t)nh * sizeof *s, 0);
-    const int base = lua_gettop(L);
     for (lua_Integer i = 1; i <= nh; i++) {
         lua_rawgeti(L, 3, i);
         if (lua_type(L, -1) != LUA_TSTRING) return luaL_argerror(L, 3, "history names expected");
-        const char *name = lua_tostring(L, -1);
-        lua_pop(L, 1);
-        if (!find_history(L, name)) return luaL_argerror(L, 3, lua_pushfstring(L, "no history named '%s'", name));
-        s[i - 1].entry = lua_gettop(L);
-        s[i - 1].at = 1;
-        lua_getfield(L, -1, "steps");
-        s[i - 1].n = (lua_Integer)lua_rawlen(L, -1);
-        lua_pop(L, 1);
+        if (!find_history(L, lua_tostring(L, -1)))
+            return luaL_argerror(L, 3, lua_pushfstring(L, "no history named '%s'", lua_tostring(L, -1)));
+        lua_pop(L, 2);
     }
-    (void)base;
-    const char *tmp = lua_pushfstring(L, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return luaL_error(L, "m:history_csv: cannot write '%s': %s", tmp, strerror(errno));
-    fputs("step,time", f);
-    for (lua_Integer i = 0; i < nh; i++) {
-        lua_getfield(L, s[i].entry, "name");
-        fprintf(f, ",%s", lua_tostring(L, -1));
-        lua_pop(L, 1);
-    }
-    fputc('\n', f);
-    for (;;) {
-        lua_Integer row = LUA_MAXINTEGER;
-        double t = 0;
-        for (lua_Integer i = 0; i < nh; i++)
-            if (s[i].at <= s[i].n) {
-                const lua_Integer st = step_at(L, &s[i]);
-                if (st < row) {
-                    row = st;
-                    t = number_at(L, &s[i], "times");
-                }
-            }
-        if (row == LUA_MAXINTEGER) break;
-        fprintf(f, "%lld,%.17g", (long long)row, t);
-        for (lua_Integer i = 0; i < nh; i++) {
-            fputc(',', f);
-            if (s[i].at <= s[i].n && step_at(L, &s[i]) == row) {
-                fprintf(f, "%.17g", number_at(L, &s[i], "values"));
-                s[i].at++;
-            }
-        }
-        fputc('\n', f);
-    }
-    const bool ok = !ferror(f);
-    if (fclose(f) != 0 || !ok) {
-        remove(tmp);
-        return luaL_error(L, "m:history_csv: writing '%s' failed", tmp);
-    }
-    if (rename(tmp, path) != 0) {
-        const int err = errno;
-        remove(tmp);
-        return luaL_error(L, "m:history_csv: cannot rename '%s' to '%s': %s", tmp, path, strerror(err));
-    }
+    int n;
+    const sx_io_history *h = sx_lua_histories_push(L, 1, 3, 0, &n);
+    char err[1024];
+    if (sx_history_csv_write(path, h, n, err, sizeof err)) return luaL_error(L, "%s", err);
     return 0;
 }
 

@@ -6,6 +6,15 @@
  *   output:write(), output:close(), output:count(), output:path()
  *   seixo.xdmf(path)                        rebuild the .xmf of a series
  *
+ * Histories are saved with the model and come back recording (a history of
+ * a function comes back detached: m:history(name, fn) reattaches it, and
+ * m:save lists it among the skipped values); an output series appends the
+ * histories' samples as they grow, the last ones when it closes.
+ *
+ * Provenance: the seeds of m:generate and m:bond are recorded (state
+ * "seeds") and written as the files' `seeds` attribute; a loaded model
+ * takes them back from its file.
+ *
  * The user's variables (PFC saves FISH variables with the model): m:vars()
  * is a table kept with the model; whatever plain data it holds (numbers,
  * strings, booleans and nested tables of them) is saved by m:save and
@@ -200,7 +209,25 @@ static const char *script_path(lua_State *L)
     return found;
 }
 
-/* Seeds the script used, if the Lua side recorded them (state "seeds"). */
+void sx_lua_record_seed(lua_State *L, int model, int64_t seed)
+{
+    sx_lua_state(L, model, "seeds");
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, -1, i);
+        const bool seen = lua_tointeger(L, -1) == (lua_Integer)seed;
+        lua_pop(L, 1);
+        if (seen) {
+            lua_pop(L, 1);
+            return;
+        }
+    }
+    lua_pushinteger(L, (lua_Integer)seed);
+    lua_rawseti(L, -2, n + 1);
+    lua_pop(L, 1);
+}
+
+/* Seeds the script used, as recorded by sx_lua_record_seed (state "seeds"). */
 static int64_t *seeds_of(lua_State *L, int model, int *n)
 {
     sx_lua_state(L, model, "seeds");
@@ -274,6 +301,13 @@ static int model_save(lua_State *L)
     o.compression = (int)level;
     o.trees = j->trees;
     o.ntrees = 2;
+    o.histories = sx_lua_histories_push(L, 1, 0, 0, &o.nhistories);
+    for (int k = 0; k < o.nhistories; k++)
+        if (o.histories[k].source == SX_IO_SOURCE_FUNCTION) {
+            lua_pushfstring(L, "history '%s' (its function: the samples are saved, give it again after a load)",
+                            o.histories[k].name);
+            lua_rawseti(L, 5, (lua_Integer)lua_rawlen(L, 5) + 1);
+        }
     o.provenance.script = script_path(L);
     o.provenance.seeds = seeds_of(L, 1, &o.provenance.nseeds);
     char err[1024];
@@ -331,6 +365,13 @@ static int seixo_load(lua_State *L)
         }
         lua_pop(L, 2);
     }
+    sx_lua_histories_restore(L, 3, info->histories, info->nhistories, path);
+    sx_lua_state(L, 3, "seeds");
+    for (int k = 0; k < info->nseeds; k++) {
+        lua_pushinteger(L, (lua_Integer)info->seeds[k]);
+        lua_rawseti(L, -2, k + 1);
+    }
+    lua_pop(L, 1);
     lua_pushvalue(L, 3);
     return 1;
 }
@@ -349,20 +390,53 @@ typedef struct output {
     int64_t every;
 } output;
 
-/* The output's uservalues: 1 the model, 2 its callback id. */
+/* The output's uservalues: 1 the model, 2 its callback id, 3 the step of
+ * the last sample of each history handed to the series (name -> step). */
 static output *check_output(lua_State *L, int idx) { return luaL_checkudata(L, idx, SX_LUA_OUTPUT); }
 
-static void write_now(lua_State *L, output *o, const sx_model *m)
+/* A snapshot of m (NULL: none) and the histories' new samples, of the
+ * output at idx whose model userdata is at `model`. */
+static void write_now(lua_State *L, int idx, int model, const sx_model *m)
 {
+    idx = lua_absindex(L, idx);
+    model = lua_absindex(L, model);
+    output *o = check_output(L, idx);
+    lua_getiuservalue(L, idx, 3);
+    const int passed = lua_gettop(L);
+    int n;
+    const sx_io_history *h = sx_lua_histories_push(L, model, 0, passed, &n);
     char err[1024];
-    if (sx_series_write(o->s, m, err, sizeof err)) luaL_error(L, "%s", err);
+    const sx_status st = m ? sx_series_write(o->s, m, h, n, err, sizeof err)
+                           : sx_series_write_histories(o->s, h, n, err, sizeof err);
+    if (st) luaL_error(L, "%s", err);
+    for (int k = 0; k < n; k++)
+        if (h[k].n > 0) {
+            lua_pushinteger(L, (lua_Integer)h[k].steps[h[k].n - 1]);
+            lua_setfield(L, passed, h[k].name);
+        }
+    lua_settop(L, passed - 1);
+}
+
+/* The histories' samples since the last snapshot, before the output closes;
+ * a model already closed has its state still. */
+static void flush_histories(lua_State *L, int idx)
+{
+    idx = lua_absindex(L, idx);
+    if (lua_getiuservalue(L, idx, 1) == LUA_TUSERDATA) write_now(L, idx, -1, NULL);
+    lua_pop(L, 1);
+}
+
+static int flush_protected(lua_State *L)
+{
+    flush_histories(L, 1);
+    return 0;
 }
 
 /* The "after" callback: upvalue 1 is the output. */
 static int output_callback(lua_State *L)
 {
     output *o = check_output(L, lua_upvalueindex(1));
-    if (o->s) write_now(L, o, sx_lua_checkmodel(L, 1));
+    if (o->s) write_now(L, lua_upvalueindex(1), 1, sx_lua_checkmodel(L, 1));
     return 0;
 }
 
@@ -370,6 +444,11 @@ static int output_close(lua_State *L)
 {
     output *o = check_output(L, 1);
     if (!o->s) return 0;
+    /* a failure to write the last samples still closes the file */
+    lua_pushcfunction(L, flush_protected);
+    lua_pushvalue(L, 1);
+    const int fst = lua_pcall(L, 1, 0, 0);
+    const int failure = lua_gettop(L); /* the flush's error, if any */
     char err[1024];
     const sx_status st = sx_series_close(o->s, err, sizeof err);
     o->s = NULL;
@@ -381,14 +460,25 @@ static int output_close(lua_State *L)
         lua_call(L, 2, 0);
     }
     lua_pop(L, 1);
+    if (fst != LUA_OK) {
+        lua_settop(L, failure);
+        return lua_error(L);
+    }
     if (st) return luaL_error(L, "%s", err);
     return 0;
 }
 
+/* Collected (or the Lua state closes) without o:close(): the last samples
+ * are written too, and a failure cannot be raised from here, so it is
+ * dropped (o:close() reports it). */
 static int output_gc(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (o->s) sx_series_close(o->s, NULL, 0); /* no Lua calls while collecting */
+    if (!o->s) return 0;
+    lua_pushcfunction(L, flush_protected);
+    lua_pushvalue(L, 1);
+    lua_pcall(L, 1, 0, 0);
+    sx_series_close(o->s, NULL, 0);
     o->s = NULL;
     return 0;
 }
@@ -398,7 +488,7 @@ static int output_write(lua_State *L)
     output *o = check_output(L, 1);
     if (!o->s) return luaL_error(L, "the output has been closed");
     lua_getiuservalue(L, 1, 1);
-    write_now(L, o, sx_lua_checkmodel(L, -1));
+    write_now(L, 1, -1, sx_lua_checkmodel(L, -1));
     return 0;
 }
 
@@ -475,12 +565,14 @@ static int model_output(lua_State *L)
     const bool append = lua_toboolean(L, -1);
     lua_settop(L, 2);
 
-    output *o = lua_newuserdatauv(L, sizeof *o, 2); /* 3 */
+    output *o = lua_newuserdatauv(L, sizeof *o, 3); /* 3 */
     memset(o, 0, sizeof *o);
     o->every = every;
     luaL_setmetatable(L, SX_LUA_OUTPUT);
     lua_pushvalue(L, 1);
     lua_setiuservalue(L, 3, 1);
+    lua_newtable(L);
+    lua_setiuservalue(L, 3, 3);
     sx_series_opts so;
     memset(&so, 0, sizeof so);
     so.fields = fields;
@@ -492,7 +584,7 @@ static int model_output(lua_State *L)
     o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
     if (!o->s) return luaL_error(L, "%s", err);
     lua_settop(L, 3);
-    write_now(L, o, m);
+    write_now(L, 3, 1, m);
     /* m:on("after", callback, {every = every}) */
     lua_getfield(L, 1, "on");
     lua_pushvalue(L, 1);

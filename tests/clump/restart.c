@@ -150,7 +150,7 @@ START_TEST(series_clump_ids)
     io_path(path, sizeof path, "series.h5");
     sx_series *s = sx_series_open(path, 3, NULL, err, sizeof err);
     ck_assert_msg(s != NULL, "%s", err);
-    ck_assert_msg(sx_series_write(s, m, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
     ck_assert(sx_series_close(s, err, sizeof err) == SX_OK);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     ck_assert(f >= 0);

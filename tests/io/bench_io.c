@@ -104,7 +104,7 @@ int main(int argc, char **argv)
         const int k = 5;
         const double t0 = now();
         for (int i = 0; i < k; i++)
-            if (sx_series_write(s, m, err, sizeof err)) die("series write", err);
+            if (sx_series_write(s, m, NULL, 0, err, sizeof err)) die("series write", err);
         const double tw = (now() - t0) / k;
         sx_series_close(s, err, sizeof err);
         const double bytes = size_of(spaths[z]) / k;

@@ -1,6 +1,7 @@
 #include "io_scenes.h"
 
 #include <hdf5.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -166,6 +167,78 @@ sx_model *io_scene_hertz(int dim)
     return m;
 }
 
+sx_model *io_scene_servo(int dim)
+{
+    double g[3] = {0, 0, 0};
+    g[dim - 1] = -9.81;
+    sx_model *m = scene_model(dim, g, 0, 1e8, 0.5, 2650);
+    sx_material_def md;
+    ck_assert_int_eq(sx_material_get(m, scene_material(m), &md), SX_OK);
+    md.damping = 0.7;
+    scene_material_def(m, "m", &md);
+    /* a jittered lattice of balls (no O(n^2) placement), moving a little */
+    const double r = 1e-3, pitch = 2.05 * r;
+    const int side = dim == 3 ? 5 : 8, layers = dim == 3 ? 8 : 10;
+    uint64_t s = 77;
+    double hi[3] = {0, 0, 0}, rho = 0; /* the extent of the balls, and their largest distance from the z axis */
+    for (int k = 0; k < layers; k++)
+        for (int j = 0; j < side; j++)
+            for (int i = 0; i < (dim == 3 ? side : 1); i++) {
+                double x[3], v[3];
+                for (int q = 0; q < 3; q++) v[q] = dim == 3 || q < 2 ? scene_rng_uniform(&s, -0.05, 0.05) : 0;
+                if (dim == 3) {
+                    x[0] = (i - 0.5 * (side - 1)) * pitch, x[1] = (j - 0.5 * (side - 1)) * pitch;
+                    x[2] = r + k * pitch;
+                    /* the cylinder is round: leave out the lattice's corners */
+                    if (x[0] * x[0] + x[1] * x[1] > (0.5 * side * pitch - r) * (0.5 * side * pitch - r)) continue;
+                } else {
+                    x[0] = r + j * pitch, x[1] = r + k * pitch, x[2] = 0;
+                }
+                const double rad = r * (1 - 0.04 * scene_rng_uniform(&s, 0, 1));
+                scene_ball(m, x, v, rad);
+                for (int q = 0; q < dim; q++)
+                    if (x[q] + rad > hi[q]) hi[q] = x[q] + rad;
+                const double d = sqrt(x[0] * x[0] + x[1] * x[1]) + rad;
+                if (d > rho) rho = d;
+            }
+    sx_servo_def sv = sx_servo_default_def();
+    sv.alpha = 0.5;
+    sv.max_speed = 0.2;
+    if (dim == 3) {
+        /* radius and top platen pressing slightly on the outer balls */
+        sx_wall_def w = sx_wall_default_def(3);
+        w.kind = SX_WALL_CYLINDER;
+        w.point[2] = -0.5 * r;
+        w.radius = rho - 1e-3 * r;
+        hi[2] -= 1e-3 * r;
+        w.height = hi[2] + 2 * r;
+        w.friction = 0.2;
+        int64_t cyl;
+        ck_assert_msg(sx_wall_add(m, &w, &cyl) == SX_OK, "%s", sx_model_error(m));
+        const double p0[3] = {0, 0, 0}, n0[3] = {0, 0, 1}, p1[3] = {0, 0, hi[2]}, n1[3] = {0, 0, -1};
+        scene_halfspace(m, p0, n0, 1e8, 1e8, 0.3);
+        const int64_t top = scene_halfspace(m, p1, n1, 1e8, 1e8, 0.3);
+        sv.target = 1.5e4;
+        sv.area = 2 * 3.14159265358979 * w.radius * hi[2];
+        ck_assert_msg(sx_wall_set_servo(m, cyl, &sv) == SX_OK, "%s", sx_model_error(m));
+        sv.target = 2e4;
+        sv.area = 3.14159265358979 * w.radius * w.radius;
+        ck_assert_msg(sx_wall_set_servo(m, top, &sv) == SX_OK, "%s", sx_model_error(m));
+    } else {
+        const double lo[3] = {0, 0, 0};
+        scene_box_walls(m, lo, hi, 1e8, 0.3);
+        /* walls 2 and 4 of scene_box_walls: the far sides of x and y */
+        sv.target = 2e4;
+        sv.area = hi[1];
+        ck_assert_msg(sx_wall_set_servo(m, sx_wall_id_at(m, 1), &sv) == SX_OK, "%s", sx_model_error(m));
+        sv.target = 3e4;
+        sv.area = hi[0];
+        ck_assert_msg(sx_wall_set_servo(m, sx_wall_id_at(m, 3), &sv) == SX_OK, "%s", sx_model_error(m));
+    }
+    sx_model_track_energy(m, true);
+    return m;
+}
+
 /* ------------------------------------------------------------ helpers */
 
 static char tmpdir[256];
@@ -252,5 +325,19 @@ void io_assert_same_extras(const sx_model *a, const sx_model *b)
         sx_wall_force(a, sx_wall_id_at(a, i), fa, ma);
         sx_wall_force(b, sx_wall_id_at(b, i), fb, mb);
         ck_assert(memcmp(fa, fb, sizeof fa) == 0 && memcmp(ma, mb, sizeof ma) == 0);
+        sx_wall_def wa, wb;
+        sx_wall_get(a, sx_wall_id_at(a, i), &wa);
+        sx_wall_get(b, sx_wall_id_at(b, i), &wb);
+        ck_assert_int_eq(wa.kind, wb.kind);
+        ck_assert(memcmp(wa.point, wb.point, sizeof wa.point) == 0 && memcmp(wa.vel, wb.vel, sizeof wa.vel) == 0);
+        ck_assert(memcmp(&wa.radius, &wb.radius, sizeof wa.radius) == 0 &&
+                  memcmp(&wa.height, &wb.height, sizeof wa.height) == 0 &&
+                  memcmp(&wa.radial_vel, &wb.radial_vel, sizeof wa.radial_vel) == 0);
+        double la, lb, ka, kb;
+        int64_t na, nb;
+        sx_wall_load(a, sx_wall_id_at(a, i), &la, &na, &ka);
+        sx_wall_load(b, sx_wall_id_at(b, i), &lb, &nb, &kb);
+        ck_assert(memcmp(&la, &lb, sizeof la) == 0 && memcmp(&ka, &kb, sizeof ka) == 0);
+        ck_assert_int_eq(na, nb);
     }
 }

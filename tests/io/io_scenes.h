@@ -22,6 +22,11 @@ sx_model *io_scene_granular(int dim, int nballs);
 sx_model *io_scene_bonded(int dim);
 /// Hertz-Mindlin balls dropped on a floor with a fixed user timestep.
 sx_model *io_scene_hertz(int dim);
+/// A specimen squeezed by servo-controlled walls: 3D, a cylinder of finite
+/// height whose radius is servo-controlled, a fixed bottom platen and a
+/// servo-controlled top one; 2D, four lines of which two are servo-controlled.
+/// The walls start touching the balls, so the servos act from the first step.
+sx_model *io_scene_servo(int dim);
 
 /// A fresh temporary folder (removed with io_rmdir); the path is static storage.
 const char *io_tmpdir(void);
@@ -38,5 +43,6 @@ sx_model *io_load(const char *path, int dim);
 void io_assert_no_handles(void);
 /// Energies equal to the bit.
 void io_assert_same_energy(sx_model *a, sx_model *b);
-/// Same crack log, bond and contact counts, walls' forces (bits).
+/// Same crack log, bond and contact counts, walls' definitions, forces and
+/// servo loads (bits).
 void io_assert_same_extras(const sx_model *a, const sx_model *b);

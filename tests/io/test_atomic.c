@@ -1,7 +1,9 @@
 /* Nothing is lost: a writer killed in the middle of a save leaves the
  * previous file intact (and loadable); a series whose writer is killed
- * still opens with every complete snapshot, its XDMF lists them, and it can
- * be continued. The writers are child processes killed with SIGKILL. */
+ * still opens with every complete snapshot and every complete history
+ * row, its XDMF is a complete document listing exactly the complete
+ * snapshots, and it can be continued. The writers are child processes
+ * killed with SIGKILL. */
 #include "io_scenes.h"
 
 #include <hdf5.h>
@@ -118,6 +120,76 @@ static int count_steps(const char *xmf)
     return n;
 }
 
+/* The history the writers append: one sample per write, at step 5 i,
+ * whose value is a function of its step (so any row can be checked). */
+static double hvalue(int64_t step) { return 0.5 * (double)step + 1.0 / (1.0 + (double)step); }
+
+typedef struct hist_buf {
+    sx_io_history h;
+    int64_t steps[4096];
+    double times[4096], values[4096];
+} hist_buf;
+
+static void hist_init(hist_buf *b)
+{
+    memset(b, 0, sizeof *b);
+    b->h.name = "probe";
+    b->h.every = 5;
+    b->h.source = SX_IO_SOURCE_BUILTIN;
+    b->h.builtin = "time";
+    b->h.steps = b->steps, b->h.times = b->times, b->h.values = b->values;
+}
+
+static void hist_add(hist_buf *b, int64_t step)
+{
+    ck_assert_int_lt(b->h.n, 4096);
+    b->steps[b->h.n] = step, b->times[b->h.n] = 1e-3 * (double)step, b->values[b->h.n] = hvalue(step);
+    b->h.n++;
+}
+
+/* The complete rows of the series' history: counted, increasing, each
+ * value that of its step; returns them and the last step. */
+static int64_t check_history(const char *path, int64_t *last)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    ck_assert(f >= 0);
+    *last = -1;
+    if (H5Lexists(f, "/histories", H5P_DEFAULT) <= 0) {
+        H5Fclose(f);
+        return 0;
+    }
+    hid_t g = H5Gopen2(f, "/histories/probe", H5P_DEFAULT);
+    ck_assert(g >= 0);
+    int64_t count = -1;
+    hid_t a = H5Aopen(g, "count", H5P_DEFAULT);
+    ck_assert(a >= 0 && H5Aread(a, H5T_NATIVE_INT64, &count) >= 0);
+    H5Aclose(a);
+    hid_t ds = H5Dopen2(g, "step", H5P_DEFAULT), dv = H5Dopen2(g, "value", H5P_DEFAULT);
+    hid_t sp = H5Dget_space(ds);
+    hsize_t rows = 0, maxr = 0;
+    H5Sget_simple_extent_dims(sp, &rows, &maxr);
+    ck_assert(maxr == H5S_UNLIMITED);
+    ck_assert_msg(count >= 0 && (hsize_t)count <= rows, "count %lld of %llu rows", (long long)count,
+                  (unsigned long long)rows);
+    int64_t *st = malloc((rows + 1) * sizeof *st);
+    double *v = malloc((rows + 1) * sizeof *v);
+    ck_assert(H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, st) >= 0);
+    ck_assert(H5Dread(dv, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
+    for (int64_t i = 0; i < count; i++) {
+        ck_assert_msg(st[i] == 5 * i, "row %lld has step %lld", (long long)i, (long long)st[i]);
+        ck_assert(v[i] == hvalue(st[i]));
+    }
+    if (count > 0) *last = st[count - 1];
+    free(st);
+    free(v);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    H5Dclose(dv);
+    H5Gclose(g);
+    H5Fclose(f);
+    return count;
+}
+
 /* Every dataset of every complete snapshot reads back. */
 static void read_all(const char *path, int64_t count)
 {
@@ -165,10 +237,13 @@ START_TEST(killed_series_keeps_snapshots)
             o.fields = SX_OUT_DEFAULT | SX_OUT_MOMENT | SX_OUT_MASS | SX_OUT_MATERIAL;
             sx_series *s = sx_series_open(path, 3, &o, err, sizeof err);
             if (!s) _exit(3);
+            static hist_buf hb;
+            hist_init(&hb);
             char c = 1;
             ck_assert_int_eq(write(go[1], &c, 1), 1);
             for (int i = 0;; i++) {
-                if (sx_series_write(s, i % 2 ? big : m, err, sizeof err)) _exit(4);
+                hist_add(&hb, 5 * i);
+                if (sx_series_write(s, i % 2 ? big : m, &hb.h, 1, err, sizeof err)) _exit(4);
                 sx_model_cycle(m, 5);
             }
         }
@@ -186,22 +261,34 @@ START_TEST(killed_series_keeps_snapshots)
         ck_assert_msg(count >= 0, "%s", err);
         read_all(path, count);
         const int steps = count_steps(xmf);
-        printf("  killed after %4ld ms: %lld complete snapshots, %d in the XDMF\n", delays[k], (long long)count, steps);
+        int64_t last;
+        const int64_t rows = check_history(path, &last);
+        printf("  killed after %4ld ms: %lld complete snapshots, %d in the XDMF, %lld history rows\n", delays[k],
+               (long long)count, steps, (long long)rows);
         fflush(stdout);
-        ck_assert(steps == count || steps == count - 1);
-        /* the series continues where it stopped; its XDMF is rebuilt */
+        ck_assert_int_eq(steps, count);
+        /* a snapshot's rows are counted with it (one flush raises both) */
+        ck_assert(rows == count || rows == count + 1 || rows == count - 1);
+        /* the series continues where it stopped; its XDMF is rebuilt; the
+         * history takes only the samples after its last complete row */
         sx_series_opts o;
         memset(&o, 0, sizeof o);
         o.append = true;
         sx_series *s = sx_series_open(path, 3, &o, err, sizeof err);
         ck_assert_msg(s, "%s", err);
         ck_assert_int_eq(sx_series_count(s), count);
+        ck_assert_int_eq(count_steps(xmf), count);
         sx_model *m = io_scene_granular(3, 30);
-        ck_assert_msg(sx_series_write(s, m, err, sizeof err) == SX_OK, "%s", err);
+        static hist_buf hb;
+        hist_init(&hb);
+        for (int64_t i = 0; i <= rows + 2; i++) hist_add(&hb, 5 * i);
+        ck_assert_msg(sx_series_write(s, m, &hb.h, 1, err, sizeof err) == SX_OK, "%s", err);
         ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
         sx_model_destroy(m);
         ck_assert_int_eq(sx_series_read_count(path, err, sizeof err), count + 1);
         ck_assert_int_eq(count_steps(xmf), count + 1);
+        ck_assert_int_eq(check_history(path, &last), rows + 3);
+        ck_assert_int_eq(last, 5 * (rows + 2));
         read_all(path, count + 1);
         io_assert_no_handles();
     }

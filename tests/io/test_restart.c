@@ -1,10 +1,12 @@
 /* Restarts continue bit-for-bit: 2N steps straight and N steps + save +
  * load + N steps give the same state hash, energies, crack log, bond and
- * contact counts and wall forces, in 2D and 3D, for granular, bonded and
- * Hertz scenes, saved at several points of the broad phase's cycle. */
+ * contact counts, wall definitions, forces and servo loads, in 2D and 3D,
+ * for granular, bonded, Hertz and servo-controlled (cylinder) scenes, saved
+ * at several points of the broad phase's cycle. */
 #include "io_scenes.h"
 
 #include <hdf5.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -81,6 +83,40 @@ END_TEST
 START_TEST(hertz_restart)
 {
     restart(io_scene_hertz, _i, 500, false);
+}
+END_TEST
+
+/* Servo-controlled walls (a cylinder whose radius is servo-controlled in
+ * 3D) continue as they would have: settings, the loads they read and the
+ * velocities they set are all in the state hash. */
+START_TEST(servo_restart)
+{
+    const int dim = _i;
+    sx_model *m = io_scene_servo(dim);
+    double r0 = 0;
+    if (dim == 3) {
+        sx_wall_def w;
+        ck_assert_int_eq(sx_wall_get(m, sx_wall_id_at(m, 0), &w), SX_OK);
+        ck_assert_int_eq(w.kind, SX_WALL_CYLINDER);
+        r0 = w.radius;
+    }
+    io_cycle(m, 200);
+    /* the servos are acting: their walls carry load and move */
+    int moving = 0;
+    for (int64_t i = 0; i < sx_wall_count(m); i++) {
+        sx_wall_def w;
+        double load;
+        int64_t nc;
+        sx_wall_get(m, sx_wall_id_at(m, i), &w);
+        sx_wall_load(m, sx_wall_id_at(m, i), &load, &nc, NULL);
+        moving += nc > 0 && load > 0 && (w.radial_vel != 0 || w.vel[0] != 0 || w.vel[1] != 0 || w.vel[2] != 0);
+        if (w.kind == SX_WALL_CYLINDER) ck_assert(w.radius != r0);
+    }
+    ck_assert_int_eq(moving, 2);
+    sx_model_destroy(m);
+    const int n[] = {1, 150, 400};
+    for (int k = 0; k < 3; k++) restart(io_scene_servo, dim, n[k], false);
+    restart(io_scene_servo, dim, 100, true);
 }
 END_TEST
 
@@ -174,6 +210,86 @@ START_TEST(contents)
 }
 END_TEST
 
+/* Histories and seeds go into a snapshot and come back as they were (the
+ * bits of every sample, the definition, the order), in extendable
+ * datasets; a bad history is refused, leaving the file there intact. */
+START_TEST(histories_saved)
+{
+    sx_model *m = io_scene_granular(3, 40);
+    io_cycle(m, 30);
+    enum { N = 1000 };
+    static int64_t st[N];
+    static double t[N], v[N];
+    for (int i = 0; i < N; i++) st[i] = 3 * i + 1, t[i] = 1e-5 * i, v[i] = i % 7 ? 1.0 / (i + 0.5) : -0.0;
+    v[5] = NAN;
+    sx_io_history h[4];
+    memset(h, 0, sizeof h);
+    h[0] = (sx_io_history){.name = "zeta: kinetic", .every = 3, .source = SX_IO_SOURCE_BUILTIN, .builtin = "kinetic",
+                           .n = N, .steps = st, .times = t, .values = v};
+    h[1] = (sx_io_history){.name = "alpha", .every = 2, .source = SX_IO_SOURCE_BALL, .id = 7, .field = "pos",
+                           .component = 2, .n = 10, .steps = st, .times = t, .values = v};
+    h[2] = (sx_io_history){.name = "mid", .every = 1, .source = SX_IO_SOURCE_FUNCTION, .n = 0};
+    h[3] = (sx_io_history){.name = "w", .every = 5, .source = SX_IO_SOURCE_WALL, .id = 2, .field = "force",
+                           .component = 0, .n = 1, .steps = st, .times = t, .values = v};
+    const int64_t seeds[2] = {7, 1234567890123};
+    sx_snapshot_opts o;
+    memset(&o, 0, sizeof o);
+    o.histories = h;
+    o.nhistories = 4;
+    o.provenance.seeds = seeds;
+    o.provenance.nseeds = 2;
+    o.compression = 3;
+    char p[512], err[1024];
+    ck_assert_msg(sx_snapshot_save(m, io_path(p, sizeof p, "h.h5"), &o, err, sizeof err) == SX_OK, "%s", err);
+    sx_snapshot_info info;
+    sx_model *b = sx_snapshot_load(p, 3, &info, err, sizeof err);
+    ck_assert_msg(b, "%s", err);
+    ck_assert_int_eq(info.nhistories, 4);
+    for (int k = 0; k < 4; k++) {
+        const sx_io_history *x = &info.histories[k], *y = &h[k];
+        ck_assert_str_eq(x->name, y->name); /* creation order, not the names' */
+        ck_assert_int_eq(x->every, y->every);
+        ck_assert_int_eq(x->source, y->source);
+        ck_assert_int_eq(x->n, y->n);
+        ck_assert(x->n == 0 || (memcmp(x->steps, y->steps, (size_t)x->n * sizeof *x->steps) == 0 &&
+                                memcmp(x->times, y->times, (size_t)x->n * sizeof *x->times) == 0 &&
+                                memcmp(x->values, y->values, (size_t)x->n * sizeof *x->values) == 0));
+        if (y->builtin) ck_assert_str_eq(x->builtin, y->builtin);
+        if (y->field) {
+            ck_assert_str_eq(x->field, y->field);
+            ck_assert_int_eq(x->id, y->id);
+            ck_assert_int_eq(x->component, y->component);
+        }
+    }
+    ck_assert_int_eq(info.nseeds, 2);
+    ck_assert(info.seeds[0] == 7 && info.seeds[1] == 1234567890123);
+    sx_snapshot_info_free(&info);
+    sx_model_destroy(b);
+    /* extendable, chunked */
+    hid_t f = H5Fopen(p, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t d = H5Dopen2(f, "/histories/zeta: kinetic/value", H5P_DEFAULT);
+    hid_t s = H5Dget_space(d), pl = H5Dget_create_plist(d);
+    hsize_t dim, max;
+    H5Sget_simple_extent_dims(s, &dim, &max);
+    ck_assert(dim == N && max == H5S_UNLIMITED && H5Pget_layout(pl) == H5D_CHUNKED);
+    H5Pclose(pl);
+    H5Sclose(s);
+    H5Dclose(d);
+    H5Fclose(f);
+    /* refused before anything is written */
+    h[1].name = "a/b";
+    ck_assert_int_ne(sx_snapshot_save(m, p, &o, err, sizeof err), SX_OK);
+    ck_assert(strstr(err, "cannot name a group"));
+    h[1].name = "alpha";
+    st[3] = st[2];
+    ck_assert_int_ne(sx_snapshot_save(m, p, &o, err, sizeof err), SX_OK);
+    ck_assert(strstr(err, "steps do not increase"));
+    sx_model_destroy(io_load(p, 3)); /* the file saved before is intact */
+    sx_model_destroy(m);
+    io_assert_no_handles();
+}
+END_TEST
+
 /* Threads are a setting of the model: kept, and results do not depend on them. */
 START_TEST(threads_kept)
 {
@@ -197,9 +313,11 @@ int main(void)
     tcase_add_loop_test(tc, granular_restart, 2, 4);
     tcase_add_loop_test(tc, bonded_restart, 2, 4);
     tcase_add_loop_test(tc, hertz_restart, 2, 4);
+    tcase_add_loop_test(tc, servo_restart, 2, 4);
     tcase_add_loop_test(tc, resave, 2, 4);
     tcase_add_loop_test(tc, contents, 2, 4);
     tcase_add_test(tc, threads_kept);
+    tcase_add_test(tc, histories_saved);
     suite_add_tcase(s, tc);
     io_tmpdir(); /* one folder for every test (they run in child processes), removed at the end */
     SRunner *r = srunner_create(s);

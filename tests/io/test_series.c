@@ -1,10 +1,13 @@
 /* Output series: what a snapshot holds (positions, fields, contacts and
- * bonds as lines into the balls' points, wall contacts, walls), that the
- * XDMF lists each snapshot and is rebuilt identically from the file, that
- * h5dump reads the file, field selection, appending, and errors. */
+ * bonds as lines into the balls' points, wall contacts, walls, a cylinder
+ * as its surface), that the XDMF lists each snapshot and is rebuilt
+ * identically from the file, that h5dump reads the file, field selection,
+ * appending (to a format-1 series too), histories growing as extendable
+ * datasets, and errors. */
 #include "io_scenes.h"
 
 #include <hdf5.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,7 +77,7 @@ START_TEST(contents)
     for (int k = 0; k < 3; k++) {
         memset(counts[k], 0, sizeof counts[k]);
         sx_contact_each(m, count_contact, counts[k]);
-        ck_assert_msg(sx_series_write(s, m, err, sizeof err) == SX_OK, "%s", err);
+        ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
         io_cycle(m, 40);
     }
     ck_assert_int_eq(sx_series_count(s), 3);
@@ -152,10 +155,10 @@ START_TEST(fields_append_errors)
     sx_model *m = io_scene_granular(2, 40);
     sx_series *s = sx_series_open(path, 2, &o, err, sizeof err);
     ck_assert_msg(s, "%s", err);
-    ck_assert_int_eq(sx_series_write(s, m, err, sizeof err), SX_OK);
+    ck_assert_int_eq(sx_series_write(s, m, NULL, 0, err, sizeof err), SX_OK);
     /* a 3D model into a 2D series */
     sx_model *m3 = io_scene_granular(3, 20);
-    ck_assert_int_ne(sx_series_write(s, m3, err, sizeof err), SX_OK);
+    ck_assert_int_ne(sx_series_write(s, m3, NULL, 0, err, sizeof err), SX_OK);
     printf("  %s\n", err);
     fflush(stdout);
     ck_assert(strstr(err, path) && strstr(err, "2D"));
@@ -173,7 +176,7 @@ START_TEST(fields_append_errors)
     fflush(stdout);
     s = sx_series_open(path, 2, &o, err, sizeof err);
     ck_assert_msg(s, "%s", err);
-    ck_assert_int_eq(sx_series_write(s, m, err, sizeof err), SX_OK);
+    ck_assert_int_eq(sx_series_write(s, m, NULL, 0, err, sizeof err), SX_OK);
     ck_assert_int_eq(sx_series_count(s), 2);
     ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
     char xmf[512];
@@ -190,6 +193,222 @@ START_TEST(fields_append_errors)
     io_assert_no_handles();
     sx_model_destroy(m);
     sx_model_destroy(m3);
+}
+END_TEST
+
+/* A cylinder is drawn as its surface: 32 quadrilaterals around its axis
+ * over its height, every point at its radius; planes stay one square. */
+START_TEST(cylinder_surface)
+{
+    sx_model *m = io_scene_servo(3);
+    io_cycle(m, 50);
+    sx_wall_def cyl;
+    ck_assert_int_eq(sx_wall_get(m, sx_wall_id_at(m, 0), &cyl), SX_OK);
+    ck_assert_int_eq(cyl.kind, SX_WALL_CYLINDER);
+    char path[512], xmf[512], err[1024];
+    io_path(path, sizeof path, "cyl.h5");
+    io_path(xmf, sizeof xmf, "cyl.xmf");
+    sx_series *s = sx_series_open(path, 3, NULL, err, sizeof err);
+    ck_assert_msg(s, "%s", err);
+    ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hsize_t rows, cols, crows, ccols, irows, icols;
+    double *p = read_ds(f, 0, "walls/points", &rows, &cols);
+    double *c = read_ds(f, 0, "walls/connectivity", &crows, &ccols);
+    double *id = read_ds(f, 0, "walls/id", &irows, &icols);
+    H5Fclose(f);
+    ck_assert_uint_eq(rows, 64 + 4 + 4);
+    ck_assert_uint_eq(crows, 32 + 1 + 1);
+    ck_assert_uint_eq(ccols, 4);
+    ck_assert_uint_eq(irows, crows);
+    for (hsize_t i = 0; i < 64; i++) {
+        const double r = hypot(p[i * 3] - cyl.point[0], p[i * 3 + 1] - cyl.point[1]);
+        ck_assert_double_eq_tol(r, cyl.radius, 1e-12 * cyl.radius);
+        const double z = p[i * 3 + 2] - cyl.point[2];
+        ck_assert(fabs(z) < 1e-15 || fabs(z - cyl.height) < 1e-15);
+    }
+    for (hsize_t q = 0; q < 32; q++) {
+        ck_assert(id[q] == (double)sx_wall_id_at(m, 0));
+        for (int k = 0; k < 4; k++) ck_assert(c[q * 4 + k] >= 0 && c[q * 4 + k] < 64);
+    }
+    for (hsize_t q = 32; q < 34; q++)
+        for (int k = 0; k < 4; k++) ck_assert(c[q * 4 + k] >= 64 && c[q * 4 + k] < 72);
+    free(p);
+    free(c);
+    free(id);
+    char *text = slurp(xmf);
+    ck_assert(strstr(text, "<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"34\">"));
+    ck_assert(strstr(text, "<DataItem Dimensions=\"72 3\""));
+    free(text);
+    sx_model_destroy(m);
+    io_assert_no_handles();
+}
+END_TEST
+
+/* A history of k samples at steps 10, 20, ...: value = step^2 / 7. */
+typedef struct hbuf {
+    sx_io_history h;
+    int64_t st[64];
+    double t[64], v[64];
+} hbuf;
+
+static void hset(hbuf *b, const char *name, int64_t k)
+{
+    memset(b, 0, sizeof *b);
+    b->h.name = (char *)name;
+    b->h.every = 10;
+    b->h.source = SX_IO_SOURCE_WALL;
+    b->h.id = 3;
+    b->h.field = "force";
+    b->h.component = 1;
+    b->h.steps = b->st, b->h.times = b->t, b->h.values = b->v;
+    b->h.n = k;
+    for (int64_t i = 0; i < k; i++) b->st[i] = 10 * (i + 1), b->t[i] = 1e-4 * (double)(i + 1), b->v[i] = (double)(b->st[i] * b->st[i]) / 7;
+}
+
+/* The rows of /histories/<name> up to its count (asserting the layout). */
+static int64_t read_history(const char *path, const char *name, int64_t *st, double *v)
+{
+    /* the series may hold the file open: the same close degree as its writer */
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_fclose_degree(fapl, H5F_CLOSE_SEMI);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
+    ck_assert(f >= 0);
+    char g[128];
+    snprintf(g, sizeof g, "/histories/%s", name);
+    hid_t q = H5Gopen2(f, g, H5P_DEFAULT);
+    ck_assert_msg(q >= 0, "%s is missing", g);
+    int64_t count;
+    hid_t a = H5Aopen(q, "count", H5P_DEFAULT);
+    H5Aread(a, H5T_NATIVE_INT64, &count);
+    H5Aclose(a);
+    hid_t d = H5Dopen2(q, "step", H5P_DEFAULT), e = H5Dopen2(q, "value", H5P_DEFAULT);
+    hid_t sp = H5Dget_space(d), pl = H5Dget_create_plist(d);
+    hsize_t rows, max;
+    H5Sget_simple_extent_dims(sp, &rows, &max);
+    ck_assert(max == H5S_UNLIMITED);
+    ck_assert_int_eq(H5Pget_layout(pl), H5D_CHUNKED);
+    ck_assert_uint_eq(rows, (hsize_t)count);
+    ck_assert(H5Dread(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, st) >= 0);
+    ck_assert(H5Dread(e, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
+    H5Pclose(pl);
+    H5Sclose(sp);
+    H5Dclose(d);
+    H5Dclose(e);
+    H5Gclose(q);
+    H5Fclose(f);
+    return count;
+}
+
+/* Histories grow with the series: each write appends the samples after
+ * the last step the file holds (so passing more than new samples is
+ * harmless), a write of histories alone too, and an appended series
+ * continues them. */
+START_TEST(histories_grow)
+{
+    sx_model *m = io_scene_granular(2, 30);
+    char path[512], err[1024];
+    io_path(path, sizeof path, "hist.h5");
+    sx_series *s = sx_series_open(path, 2, NULL, err, sizeof err);
+    ck_assert_msg(s, "%s", err);
+    hbuf a, b;
+    hset(&a, "fy, wall \"3\"", 2);
+    hset(&b, "ke", 0);
+    b.h.source = SX_IO_SOURCE_BUILTIN, b.h.builtin = "kinetic", b.h.field = NULL;
+    sx_io_history both[2];
+    both[0] = a.h, both[1] = b.h;
+    ck_assert_msg(sx_series_write(s, m, both, 2, err, sizeof err) == SX_OK, "%s", err);
+    int64_t st[64];
+    double v[64];
+    ck_assert_int_eq(read_history(path, "fy, wall \"3\"", st, v), 2);
+    ck_assert_int_eq(read_history(path, "ke", st, v), 0);
+    /* all five samples given again: only the three new ones are appended */
+    hset(&a, "fy, wall \"3\"", 5);
+    ck_assert_msg(sx_series_write(s, m, &a.h, 1, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(read_history(path, "fy, wall \"3\"", st, v), 5);
+    for (int i = 0; i < 5; i++) ck_assert(st[i] == 10 * (i + 1) && v[i] == (double)(st[i] * st[i]) / 7);
+    /* only the new tail, without a snapshot */
+    a.h.steps += 5, a.h.times += 5, a.h.values += 5, a.h.n = 0;
+    hset(&b, "ke", 3);
+    ck_assert_msg(sx_series_write_histories(s, &b.h, 1, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(sx_series_count(s), 2);
+    ck_assert_int_eq(read_history(path, "ke", st, v), 3);
+    /* a history named so it cannot name a group, and the same name twice */
+    hset(&b, "a/b", 1);
+    ck_assert_int_ne(sx_series_write_histories(s, &b.h, 1, err, sizeof err), SX_OK);
+    ck_assert(strstr(err, "cannot name a group"));
+    both[0] = a.h, both[1] = a.h;
+    ck_assert_int_ne(sx_series_write_histories(s, both, 2, err, sizeof err), SX_OK);
+    ck_assert(strstr(err, "two histories"));
+    ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+
+    sx_series_opts o;
+    memset(&o, 0, sizeof o);
+    o.append = true;
+    s = sx_series_open(path, 2, &o, err, sizeof err);
+    ck_assert_msg(s, "%s", err);
+    hset(&a, "fy, wall \"3\"", 8);
+    ck_assert_msg(sx_series_write(s, m, &a.h, 1, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+    ck_assert_int_eq(read_history(path, "fy, wall \"3\"", st, v), 8);
+    for (int i = 0; i < 8; i++) ck_assert(st[i] == 10 * (i + 1));
+    ck_assert_int_eq(sx_series_read_count(path, err, sizeof err), 3);
+    sx_model_destroy(m);
+    io_assert_no_handles();
+}
+END_TEST
+
+/* Appending to a series of format 1 (no wall cell counts in its snapshots)
+ * keeps its XDMF right and marks the file format 2, which it now is. */
+START_TEST(append_to_format1)
+{
+    sx_model *m = io_scene_granular(3, 30);
+    char path[512], xmf[512], err[1024];
+    io_path(path, sizeof path, "old.h5");
+    io_path(xmf, sizeof xmf, "old.xmf");
+    sx_series *s = sx_series_open(path, 3, NULL, err, sizeof err);
+    ck_assert_msg(s, "%s", err);
+    ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+    char *before = slurp(xmf);
+    /* make it what format 1 wrote */
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    const int64_t one = 1;
+    hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+    H5Awrite(a, H5T_NATIVE_INT64, &one);
+    H5Aclose(a);
+    hid_t g = H5Gopen2(f, "/snapshots/000000", H5P_DEFAULT);
+    H5Adelete(g, "wall_cells");
+    H5Adelete(g, "wall_points");
+    H5Gclose(g);
+    H5Fclose(f);
+    ck_assert_int_eq(sx_series_write_xdmf(path, err, sizeof err), SX_OK);
+    char *rebuilt = slurp(xmf);
+    ck_assert_str_eq(before, rebuilt);
+    sx_series_opts o;
+    memset(&o, 0, sizeof o);
+    o.append = true;
+    s = sx_series_open(path, 3, &o, err, sizeof err);
+    ck_assert_msg(s, "%s", err);
+    ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
+    ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+    char *after = slurp(xmf);
+    ck_assert_int_eq(occurrences(after, "<Time Value="), 2);
+    ck_assert(strncmp(after, before, strlen(before) - strlen("  </Grid>\n </Domain>\n</Xdmf>\n")) == 0);
+    f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    int64_t v = 0;
+    a = H5Aopen(f, "format_version", H5P_DEFAULT);
+    H5Aread(a, H5T_NATIVE_INT64, &v);
+    H5Aclose(a);
+    H5Fclose(f);
+    ck_assert_int_eq(v, SX_IO_FORMAT_VERSION);
+    free(before);
+    free(rebuilt);
+    free(after);
+    sx_model_destroy(m);
+    io_assert_no_handles();
 }
 END_TEST
 
@@ -212,6 +431,9 @@ int main(void)
     tcase_add_loop_test(tc, contents, 2, 4);
     tcase_add_test(tc, fields_append_errors);
     tcase_add_test(tc, field_names);
+    tcase_add_test(tc, cylinder_surface);
+    tcase_add_test(tc, histories_grow);
+    tcase_add_test(tc, append_to_format1);
     suite_add_tcase(s, tc);
     io_tmpdir();
     SRunner *r = srunner_create(s);
