@@ -874,14 +874,37 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 }
 
 /* The common case (linear laws without a shear dashpot, no bonds, no
- * energy tracking) of ball_chunk_pass in batches of pairs:
- * the pairs' inputs are gathered into short arrays, every formula runs as
- * a loop over the batch that the compiler vectorises (branches become
- * selects: a pair out of contact or slipping takes the same lanes, and
- * multiplying by a scale of exactly 1 changes nothing), and the results
- * are scattered in pair order. Each lane does the scalar pass's arithmetic
- * in its order, so both give the same bits. */
-enum { BATCH = 16 };
+ * energy tracking) of ball_chunk_pass, four pairs at a time: each pair's
+ * inputs are loaded straight into one lane of vector registers, every
+ * formula runs on the four lanes at once (branches become selects: a pair
+ * out of contact or not slipping takes the same lanes, and multiplying by
+ * a scale of exactly 1 changes nothing), and the results are scattered
+ * in pair order. Each lane does the scalar pass's arithmetic in its
+ * order, so both give the same bits. */
+enum { LANES = 4 };
+
+/* Four doubles and four lane masks (-1 or 0), GCC's vector extensions:
+ * an AVX register in the avx2 clone below, two SSE2 halves in the
+ * baseline one; each operation is the IEEE operation of each lane. */
+typedef double vd __attribute__((vector_size(LANES * sizeof(double))));
+typedef int64_t vm __attribute__((vector_size(LANES * sizeof(int64_t))));
+
+/* (macros, not functions: a vector argument would change the baseline ABI) */
+#define VSEL(msk, a, b) ((vd)(((vm)(a) & (msk)) | ((vm)(b) & ~(msk))))
+#define VSQRT(a)                                                        \
+    __extension__({                                                     \
+        const vd a_ = (a);                                              \
+        vd r_;                                                          \
+        for (int q_ = 0; q_ < LANES; q_++) r_[q_] = sqrt(a_[q_]);       \
+        r_;                                                             \
+    })
+#define VANY(msk) (((msk)[0] | (msk)[1] | (msk)[2] | (msk)[3]) != 0)
+#define VZERO ((vd){0, 0, 0, 0})
+
+/* component k of each lane's element idx[q] of an array of `per` components */
+#define LANES_OF(arr, idx, per, k)                                                                          \
+    ((vd){(arr)[(idx)[0] * (per) + (k)], (arr)[(idx)[1] * (per) + (k)], (arr)[(idx)[2] * (per) + (k)],   \
+          (arr)[(idx)[3] * (per) + (k)]})
 
 /* The batched pass is compiled twice where the compiler can pick at run
  * time (GCC's function multi-versioning on x86-64 GNU/Linux): with AVX2,
@@ -923,112 +946,149 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     o->ncracks = 0;
     o->st = SX_OK;
     const double dt = motion_dt(m);
-    /* the law's parameters per lane; with one material, filled once */
-    double kn[BATCH], ks[BATCH], mu[BATCH], dash[BATCH], bn[BATCH];
-    for (int q = 0; q < BATCH; q++)
-        kn[q] = laws->kn, ks[q] = laws->ks, mu[q] = laws->mu, dash[q] = laws->dash_n, bn[q] = laws->beta_n;
+    /* the law's parameters per lane; with one material, the same in every lane */
+    vd kn = VZERO + laws->kn, ks = VZERO + laws->ks, mu = VZERO + laws->mu, dash = VZERO + laws->dash_n,
+       bn = VZERO + laws->beta_n;
+    /* the dashpot's sqrt(dash / (1/ma + 1/mb)) of the last lanes that needed one:
+     * balls of one size and material share it */
+    double memo_dash = NAN, memo_sim = NAN, memo_cn = 0;
 
-    for (int64_t c0 = o->first; c0 < o->last; c0 += BATCH) {
-        const int nb = o->last - c0 < BATCH ? (int)(o->last - c0) : BATCH;
-        /* gathered inputs; lanes past nb repeat the batch's first pair */
-        double dx[D][BATCH], dv[D][BATCH], wi[RD][BATCH], wj[RD][BATCH], fs[D][BATCH], no[D][BATCH];
-        double ri[BATCH], rj[BATCH], sim[BATCH], live[BATCH];
-        for (int q = 0; nlaw > 1 && q < BATCH; q++) {
-            const int64_t c = c0 + (q < nb ? q : 0);
-            const sx_pair_law *law = &laws[mat[pa[c]] * nlaw + mat[pb[c]]];
-            kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
+    for (int64_t c0 = o->first; c0 < o->last; c0 += LANES) {
+        const int nb = o->last - c0 < LANES ? (int)(o->last - c0) : LANES;
+        int64_t cc[LANES], i[LANES], j[LANES]; /* lanes past nb repeat the first pair */
+        for (int q = 0; q < LANES; q++) {
+            cc[q] = c0 + (q < nb ? q : 0);
+            i[q] = pa[cc[q]], j[q] = pb[cc[q]];
         }
-        for (int q = 0; q < BATCH; q++) {
-            const int64_t c = c0 + (q < nb ? q : 0), i = pa[c], j = pb[c];
-            for (int k = 0; k < D; k++) {
-                dx[k][q] = x[j * D + k] - x[i * D + k];
-                dv[k][q] = v[j * D + k] - v[i * D + k];
-                fs[k][q] = fs_all[c * D + k];
-                no[k][q] = nold_all[c * D + k];
+        if (nlaw > 1)
+            for (int q = 0; q < LANES; q++) {
+                const sx_pair_law *law = &laws[mat[i[q]] * nlaw + mat[j[q]]];
+                kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
             }
-            for (int k = 0; k < RD; k++) wi[k][q] = w[i * RD + k], wj[k][q] = w[j * RD + k];
-            ri[q] = rad[i], rj[q] = rad[j];
-            sim[q] = im[i] + im[j];
-            live[q] = touching[c];
+        vd dx[D], dv[D];
+        for (int k = 0; k < D; k++) {
+            dx[k] = LANES_OF(x, j, D, k) - LANES_OF(x, i, D, k);
+            dv[k] = LANES_OF(v, j, D, k) - LANES_OF(v, i, D, k);
         }
-        /* results */
-        double n[D][BATCH], F[D][BATCH], ma[RD][BATCH], mj[RD][BATCH], un[BATCH], fdo[BATCH];
-        for (int q = 0; q < BATCH; q++) {
-            /* 4-1 ... 4-4 */
-            double d2 = 0;
-            for (int k = 0; k < D; k++) d2 += dx[k][q] * dx[k][q];
-            const double d = sqrt(d2), inv_d = 1.0 / d;
-            double nq[D];
-            for (int k = 0; k < D; k++) nq[k] = dx[k][q] * inv_d;
-            const double u = ri[q] + rj[q] - d;
-            const double la = ri[q] - 0.5 * u, lb = rj[q] - 0.5 * u;
-            /* 4-16, 4-17 as in ball_chunk_pass */
-            double ws[RD], wn[D], vc[D];
-            for (int k = 0; k < RD; k++) ws[k] = la * wi[k][q] + lb * wj[k][q];
-            spin_cross(ws, nq, wn);
-            for (int k = 0; k < D; k++) vc[k] = dv[k][q] - wn[k];
-            double vn = 0;
-            for (int k = 0; k < D; k++) vn += vc[k] * nq[k];
-            double vs[D];
-            for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * nq[k];
-            /* history: none for a new contact */
-            const bool had = live[q] != 0;
-            double g[D], nold[D];
-            for (int k = 0; k < D; k++) g[k] = had ? fs[k][q] : 0, nold[k] = had ? no[k][q] : nq[k];
-            double wab[RD];
-            for (int k = 0; k < RD; k++) wab[k] = wi[k][q] + wj[k][q];
-            carry rot;
-            carry_make(&rot, nold, nq, NULL, wab, dt);
-            carry_apply(&rot, g);
-            const double fn = kn[q] * u; /* 4-6 */
-            const double ksdt = ks[q] * dt;
-            for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
-            /* 4-30/4-31 */
-            const double fmax = mu[q] * (fn > 0 ? fn : 0);
-            double f2 = 0;
-            for (int k = 0; k < D; k++) f2 += g[k] * g[k];
-            const double slip_sc = fmax / sqrt(f2); /* evaluated in every lane, taken where it slips */
-            const double sc = f2 > fmax * fmax ? slip_sc : 1.0;
+        const vd ri = LANES_OF(rad, i, 1, 0), rj = LANES_OF(rad, j, 1, 0);
+        const vm had = {-(int64_t)(touching[cc[0]] != 0), -(int64_t)(touching[cc[1]] != 0),
+                        -(int64_t)(touching[cc[2]] != 0), -(int64_t)(touching[cc[3]] != 0)};
+
+        /* 4-1 ... 4-4 */
+        vd d2 = dx[0] * dx[0];
+        for (int k = 1; k < D; k++) d2 += dx[k] * dx[k];
+        const vd d = VSQRT(d2), inv_d = 1.0 / d;
+        vd n[D];
+        for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
+        const vd rsum = ri + rj, u = rsum - d;
+        const vd la = ri - 0.5 * u, lb = rj - 0.5 * u;
+        /* 4-16, 4-17 as in ball_chunk_pass */
+        vd ws[RD], vc[D];
+#if D == 3
+        vd wsum[3]; /* for 4-15 */
+#endif
+        for (int k = 0; k < RD; k++) {
+            const vd wa = LANES_OF(w, i, RD, k), wb = LANES_OF(w, j, RD, k);
+            ws[k] = la * wa + lb * wb;
+#if D == 3
+            wsum[k] = wa + wb;
+#endif
+        }
+#if D == 3
+        vc[0] = dv[0] - (ws[1] * n[2] - ws[2] * n[1]);
+        vc[1] = dv[1] - (ws[2] * n[0] - ws[0] * n[2]);
+        vc[2] = dv[2] - (ws[0] * n[1] - ws[1] * n[0]);
+#else
+        vc[0] = dv[0] - -ws[0] * n[1];
+        vc[1] = dv[1] - ws[0] * n[0];
+#endif
+        vd vn = vc[0] * n[0];
+        for (int k = 1; k < D; k++) vn += vc[k] * n[k];
+        vd vs[D];
+        for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
+        /* history: none for a new contact */
+        vd g[D], no[D];
+        for (int k = 0; k < D; k++) {
+            g[k] = VSEL(had, LANES_OF(fs_all, cc, D, k), VZERO);
+            no[k] = VSEL(had, LANES_OF(nold_all, cc, D, k), n[k]);
+        }
+        /* 4-14 then 4-15 (carry_make, carry_apply) */
+#if D == 3
+        const vd c0v = no[1] * n[2] - no[2] * n[1], c1v = no[2] * n[0] - no[0] * n[2], c2v = no[0] * n[1] - no[1] * n[0];
+        vd t0 = c1v * g[2] - c2v * g[1], t1 = c2v * g[0] - c0v * g[2], t2 = c0v * g[1] - c1v * g[0];
+        g[0] += t0, g[1] += t1, g[2] += t2;
+        const vd wbar = 0.5 * (wsum[0] * n[0] + wsum[1] * n[1] + wsum[2] * n[2]);
+        const vd r0 = wbar * n[0] * dt, r1 = wbar * n[1] * dt, r2 = wbar * n[2] * dt;
+        t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
+        g[0] += t0, g[1] += t1, g[2] += t2;
+#else
+        const vd cz = no[0] * n[1] - no[1] * n[0], g0 = g[0];
+        g[0] -= cz * g[1];
+        g[1] += cz * g0;
+#endif
+        const vd fn = kn * u; /* 4-6 */
+        const vd ksdt = ks * dt;
+        for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+        /* 4-30/4-31 */
+        const vd fmax = mu * VSEL(fn > VZERO, fn, VZERO);
+        vd f2 = g[0] * g[0];
+        for (int k = 1; k < D; k++) f2 += g[k] * g[k];
+        const vm slips = f2 > fmax * fmax;
+        if (VANY(slips)) {
+            const vd sc = VSEL(slips, fmax / VSQRT(f2), VZERO + 1.0);
             for (int k = 0; k < D; k++) g[k] *= sc;
-            const bool active = u > 0;
-            const double cn = sqrt(dash[q] / sim[q]);
-            const double fdash = fn + -cn * vn;
-            const double fd = bn[q] > 0 && active ? fdash : fn;
-            for (int k = 0; k < D; k++) {
-                const double fk = fd * nq[k] + g[k]; /* 4-5 */
-                F[k][q] = active ? fk : 0;
-                fs[k][q] = active ? g[k] : 0;
-                n[k][q] = nq[k];
-            }
-            double Fq[D], nf[RD];
-            for (int k = 0; k < D; k++) Fq[k] = F[k][q];
-            moment_of(nq, Fq, nf); /* 4-21 */
-            for (int k = 0; k < RD; k++) ma[k][q] = la * nf[k], mj[k][q] = -lb * nf[k];
-            un[q] = u;
-            fdo[q] = active ? fd : 0;
-            live[q] = d2 < (ri[q] + rj[q]) * (ri[q] + rj[q]) ? (active ? 2 : 1) : 0;
         }
-        for (int q = 0; q < nb; q++) {
-            const int64_t c = c0 + q, i = pa[c], j = pb[c];
-            if (live[q] == 0) { /* out of reach this step */
+        const vm active = u > VZERO;
+        const vd sim = LANES_OF(im, i, 1, 0) + LANES_OF(im, j, 1, 0);
+        vd cn;
+        if (sim[0] == memo_sim && sim[1] == memo_sim && sim[2] == memo_sim && sim[3] == memo_sim &&
+            dash[0] == memo_dash && dash[1] == memo_dash && dash[2] == memo_dash && dash[3] == memo_dash) {
+            cn = VZERO + memo_cn;
+        } else {
+            cn = VSQRT(dash / sim);
+            memo_sim = sim[0], memo_dash = dash[0], memo_cn = cn[0];
+        }
+        const vd fd = VSEL(active & (bn > VZERO), fn + -cn * vn, fn);
+        vd F[D];
+        for (int k = 0; k < D; k++) {
+            F[k] = VSEL(active, fd * n[k] + g[k], VZERO); /* 4-5 */
+            g[k] = VSEL(active, g[k], VZERO);
+        }
+        /* 4-21: both arms lie along n */
+        vd nf[RD];
+#if D == 3
+        nf[0] = n[1] * F[2] - n[2] * F[1];
+        nf[1] = n[2] * F[0] - n[0] * F[2];
+        nf[2] = n[0] * F[1] - n[1] * F[0];
+#else
+        nf[0] = n[0] * F[1] - n[1] * F[0];
+#endif
+        vd ma[RD], mj[RD];
+        for (int k = 0; k < RD; k++) ma[k] = la * nf[k], mj[k] = -lb * nf[k];
+        const vd fdo = VSEL(active, fd, VZERO);
+        const vm live = d2 < rsum * rsum;
+        const vm bad = live & (u > VSEL(ri < rj, ri, rj));
+        for (int q = 0; q < LANES && q < nb; q++)
+            if (bad[q]) {
+                o->st = SX_EUNSTABLE;
+                o->err_a = B->id[i[q]], o->err_b = B->id[j[q]], o->err_un = u[q], o->err_r = ri[q] < rj[q] ? ri[q] : rj[q];
+                return;
+            }
+        for (int q = 0; q < LANES && q < nb; q++) {
+            const int64_t c = cc[q];
+            if (!live[q]) { /* out of reach this step */
                 touching[c] = 0;
                 continue;
             }
-            const double rmin = ri[q] < rj[q] ? ri[q] : rj[q];
-            if (un[q] > rmin) {
-                o->st = SX_EUNSTABLE;
-                o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un[q], o->err_r = rmin;
-                return;
-            }
-            for (int k = 0; k < D; k++) fs_all[c * D + k] = fs[k][q], nold_all[c * D + k] = n[k][q];
-            un_all[c] = un[q];
+            for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], nold_all[c * D + k] = n[k][q];
+            un_all[c] = u[q];
             fn_all[c] = fdo[q];
-            touching[c] = live[q] == 2;
-            double *fi = f + i * D, *ti = t + i * RD, *fj, *tj;
-            if (j < own_hi) {
-                fj = f + j * D, tj = t + j * RD;
+            touching[c] = active[q] != 0;
+            double *fi = f + i[q] * D, *ti = t + i[q] * RD, *fj, *tj;
+            if (j[q] < own_hi) {
+                fj = f + j[q] * D, tj = t + j[q] * RD;
             } else {
-                fj = sf + (j - own_hi) * D, tj = st + (j - own_hi) * RD;
+                fj = sf + (j[q] - own_hi) * D, tj = st + (j[q] - own_hi) * RD;
             }
             for (int k = 0; k < D; k++) {
                 fi[k] -= F[k][q];
