@@ -670,10 +670,28 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     return true;
 }
 
+/* A chunk's results start empty; the balls it clears start from their
+ * applied loads (or nothing). */
+static void chunk_start(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    const size_t nf = (size_t)((o->clear_hi - o->clear_lo) * D), nt = (size_t)((o->clear_hi - o->clear_lo) * RD);
+    if (B->fapp) {
+        memcpy(B->f + o->clear_lo * D, B->fapp + o->clear_lo * D, nf * sizeof(double));
+        memcpy(B->t + o->clear_lo * RD, B->tapp + o->clear_lo * RD, nt * sizeof(double));
+    } else {
+        memset(B->f + o->clear_lo * D, 0, nf * sizeof(double));
+        memset(B->t + o->clear_lo * RD, 0, nt * sizeof(double));
+    }
+    o->slip = o->viscous = o->released = 0;
+    o->lost_bonds = 0;
+    o->ncracks = 0;
+    o->st = SX_OK;
+}
+
 /* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
  * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
- * a; forces and moments go to the balls the chunk owns or to its spill
- * buffer, energies, cracks and errors to the chunk. */
+ * a; energies, cracks and errors go to the chunk. */
 static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 {
     sx_balls *B = &m->balls;
@@ -687,21 +705,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
-    const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
-    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
-    /* the owned balls start from the applied loads (or nothing), the spill buffer from zero */
-    if (B->fapp) {
-        memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
-        memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
-    } else {
-        memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
-        memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
-    }
-    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
-    o->slip = o->viscous = o->released = 0;
-    o->lost_bonds = 0;
-    o->ncracks = 0;
-    o->st = SX_OK;
+    chunk_start(m, o);
     const double dt = motion_dt(m);
     const int nlaw = m->law_n;
     const bool track = m->track_energy;
@@ -854,12 +858,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         /* 4-21 and 4-39: both arms lie along n, so both moments are multiples of n x F */
         double nf[RD];
         moment_of(n, F, nf);
-        double *fi = f + i * D, *ti = t + i * RD, *fj, *tj;
-        if (j < own_hi) {
-            fj = f + j * D, tj = t + j * RD;
-        } else {
-            fj = sf + (j - own_hi) * D, tj = st + (j - own_hi) * RD;
-        }
+        double *fi = f + i * D, *ti = t + i * RD, *fj = f + j * D, *tj = t + j * RD;
         for (int k = 0; k < D; k++) {
             fi[k] -= F[k];
             fj[k] += F[k];
@@ -931,20 +930,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
     const int nlaw = m->law_n;
-    const int64_t own_lo = o->own_lo, own_hi = o->own_hi, nspill = o->spill_hi - o->own_hi;
-    double *restrict sf = nspill ? m->pool + o->off * (D + RD) : NULL, *restrict st = nspill ? sf + nspill * D : NULL;
-    if (B->fapp) {
-        memcpy(f + own_lo * D, B->fapp + own_lo * D, (size_t)((own_hi - own_lo) * D) * sizeof(double));
-        memcpy(t + own_lo * RD, B->tapp + own_lo * RD, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
-    } else {
-        memset(f + own_lo * D, 0, (size_t)((own_hi - own_lo) * D) * sizeof(double));
-        memset(t + own_lo * RD, 0, (size_t)((own_hi - own_lo) * RD) * sizeof(double));
-    }
-    if (nspill) memset(sf, 0, (size_t)(nspill * (D + RD)) * sizeof(double));
-    o->slip = o->viscous = o->released = 0;
-    o->lost_bonds = 0;
-    o->ncracks = 0;
-    o->st = SX_OK;
+    chunk_start(m, o);
     const double dt = motion_dt(m);
     /* the law's parameters per lane; with one material, the same in every lane */
     vd kn = VZERO + laws->kn, ks = VZERO + laws->ks, mu = VZERO + laws->mu, dash = VZERO + laws->dash_n,
@@ -1084,12 +1070,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
             un_all[c] = u[q];
             fn_all[c] = fdo[q];
             touching[c] = active[q] != 0;
-            double *fi = f + i[q] * D, *ti = t + i[q] * RD, *fj, *tj;
-            if (j[q] < own_hi) {
-                fj = f + j[q] * D, tj = t + j[q] * RD;
-            } else {
-                fj = sf + (j[q] - own_hi) * D, tj = st + (j[q] - own_hi) * RD;
-            }
+            double *fi = f + i[q] * D, *ti = t + i[q] * RD, *fj = f + j[q] * D, *tj = t + j[q] * RD;
             for (int k = 0; k < D; k++) {
                 fi[k] -= F[k][q];
                 fj[k] += F[k][q];
@@ -1109,11 +1090,12 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
 }
 
 /* Chunks of the ball-ball pass and blocks of the per-ball passes, planned
- * after each build (and on a restore) from the stores alone. Few, large
- * chunks of whole a-groups: a chunk's spill buffer spans about one layer of
- * cells ahead of its balls. MAX_CHUNKS also bounds the useful thread count
- * of that pass; MOTION_BLOCKS that of the per-ball passes. */
-enum { CHUNK_PAIRS = 4096, MAX_CHUNKS = 8, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
+ * after each build (and on a restore) from the stores alone. A power of
+ * two of chunks (so that each phase splits evenly over 2, 4, ... threads)
+ * of at least CHUNK_PAIRS pairs, at most MAX_CHUNKS; MAX_CHUNKS / 2 bounds
+ * the useful thread count of that pass, MOTION_BLOCKS that of the per-ball
+ * passes. */
+enum { CHUNK_PAIRS = 1024, MAX_CHUNKS = 16, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
 
 /* First index c of sorted a[0..n) with a[c] >= key. */
 static int64_t lower_bound(const int32_t *a, int64_t n, int64_t key)
@@ -1135,9 +1117,8 @@ static bool plan_chunks(sx_model *m)
     if (!sx__pairs_sort(m, &m->bb) || !sx__pairs_sort(m, &m->bw)) return false;
     const sx_pairs *p = &m->bb;
     const int64_t n = m->balls.n;
-    int64_t k = (p->n + CHUNK_PAIRS - 1) / CHUNK_PAIRS;
-    if (k < 1) k = 1;
-    if (k > MAX_CHUNKS) k = MAX_CHUNKS;
+    int64_t k = 1;
+    while (2 * k <= MAX_CHUNKS && 2 * k * CHUNK_PAIRS <= p->n) k *= 2;
     if (k > m->cap_chunk) {
         sx_chunk *q = sx_alloc_resize(&m->alloc, m->chunks, (size_t)m->cap_chunk, (size_t)k, sizeof *q);
         if (!q) return false;
@@ -1145,31 +1126,39 @@ static bool plan_chunks(sx_model *m)
         m->cap_chunk = k;
     }
     m->nchunk = k;
-    /* chunk c starts at the a-group holding pair p->n c / k */
+    /* chunk c starts at the ball of pair p->n c / k, and at least where the
+     * chunk two before it reaches (its largest b), so that a chunk's b's
+     * fall in its own range or the next one's */
+    int64_t lo[MAX_CHUNKS + 1];
     for (int64_t c = 0; c < k; c++) {
-        int64_t q = p->n * c / k;
-        while (q > 0 && q < p->n && p->a[q - 1] == p->a[q]) q--;
-        if (c > 0 && q < m->chunks[c - 1].first) q = m->chunks[c - 1].first;
-        m->chunks[c].first = q;
-        m->chunks[c].own_lo = c == 0 ? 0 : q < p->n ? p->a[q] : n;
+        const int64_t q = p->n * c / k;
+        lo[c] = c == 0 ? 0 : q < p->n ? p->a[q] : n;
     }
-    int64_t pool = 0;
+    lo[k] = n;
+    for (int64_t c = 0; c < k; c++) {
+        if (c > 0 && lo[c] < lo[c - 1]) lo[c] = lo[c - 1];
+        sx_chunk *o = &m->chunks[c];
+        o->own_lo = lo[c];
+        o->first = lower_bound(p->a, p->n, lo[c]);
+        if (c >= 2) { /* chunk c - 2 is complete once chunk c - 1 starts */
+            const sx_chunk *e = &m->chunks[c - 2];
+            int64_t reach = lo[c - 1];
+            for (int64_t q = e->first; q < m->chunks[c - 1].first; q++)
+                if (p->b[q] + 1 > reach) reach = p->b[q] + 1;
+            if (reach > lo[c]) {
+                lo[c] = reach;
+                o->own_lo = reach;
+                o->first = lower_bound(p->a, p->n, reach);
+            }
+        }
+    }
     for (int64_t c = 0; c < k; c++) {
         sx_chunk *o = &m->chunks[c];
-        o->last = c + 1 < k ? m->chunks[c + 1].first : p->n;
         o->own_hi = c + 1 < k ? m->chunks[c + 1].own_lo : n;
-        int64_t hi = o->own_hi;
-        for (int64_t q = o->first; q < o->last; q++)
-            if (p->b[q] + 1 > hi) hi = p->b[q] + 1;
-        o->spill_hi = hi;
-        o->off = pool;
-        pool += hi - o->own_hi;
-    }
-    if (pool * (D + RD) > m->cap_pool) {
-        double *q = sx_alloc_resize(&m->alloc, m->pool, (size_t)m->cap_pool, (size_t)(pool * (D + RD)), sizeof *q);
-        if (!q) return false;
-        m->pool = q;
-        m->cap_pool = pool * (D + RD);
+        o->last = c + 1 < k ? m->chunks[c + 1].first : p->n;
+        /* the first phase clears the forces of every ball before either phase adds to them */
+        o->clear_lo = c % 2 == 0 ? o->own_lo : 0;
+        o->clear_hi = c % 2 == 0 ? (c + 2 < k ? m->chunks[c + 2].own_lo : n) : 0;
     }
     /* blocks of at least MOTION_MIN balls, at most MOTION_BLOCKS of them */
     if (!m->blocks) {
@@ -1190,13 +1179,16 @@ static bool plan_chunks(sx_model *m)
     return true;
 }
 
-/* Runs the chunks (in parallel), then merges energies, cracks and errors in
- * chunk order. */
+/* Runs the even chunks, then the odd ones (each phase in parallel), then
+ * merges energies, cracks and errors in chunk order. */
 static sx_status KERNEL(contacts)(sx_model *m)
 {
     const int64_t nchunk = m->nchunk;
-#pragma omp parallel for schedule(static) num_threads(m->threads) if (m->bb.n > 2 * CHUNK_PAIRS)
-    for (int64_t c = 0; c < nchunk; c++) ball_chunk(m, &m->chunks[c]);
+#pragma omp parallel num_threads(m->threads) if (nchunk > 2)
+    for (int64_t phase = 0; phase < 2; phase++) {
+#pragma omp for schedule(static)
+        for (int64_t c = phase; c < nchunk; c += 2) ball_chunk(m, &m->chunks[c]);
+    }
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
@@ -1209,25 +1201,14 @@ static sx_status KERNEL(contacts)(sx_model *m)
     return SX_OK;
 }
 
-/* The wall pass of one block: the chunks' spill buffers added in chunk
- * order, then the block's ball-wall contacts. The wall is entity A (phi1
- * of 4-10), the ball B; n points from the wall to the ball. Wall
- * resultants go to the block's partial sums acc (one per wall). */
+/* The wall pass of one block: the block's ball-wall contacts, after the
+ * ball-ball pass. The wall is entity A (phi1 of 4-10), the ball B; n
+ * points from the wall to the ball. Wall resultants go to the block's
+ * partial sums acc (one per wall). */
 static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
 {
     sx_balls *B = &m->balls;
     double *restrict f = B->f, *restrict t = B->t;
-    for (int64_t c = 0; c < m->nchunk; c++) {
-        const sx_chunk *h = &m->chunks[c];
-        const int64_t s0 = h->own_hi > o->b0 ? h->own_hi : o->b0, s1 = h->spill_hi < o->b1 ? h->spill_hi : o->b1;
-        const int64_t len = h->spill_hi - h->own_hi;
-        if (s0 >= s1) continue;
-        const double *restrict sf = m->pool + h->off * (D + RD), *restrict st = sf + len * D;
-        for (int64_t i = s0; i < s1; i++) {
-            for (int k = 0; k < D; k++) f[i * D + k] += sf[(i - h->own_hi) * D + k];
-            for (int k = 0; k < RD; k++) t[i * RD + k] += st[(i - h->own_hi) * RD + k];
-        }
-    }
     if (m->nwall) memset(acc, 0, (size_t)m->nwall * sizeof *acc);
     o->slip = o->viscous = 0;
     o->st = SX_OK;

@@ -82,7 +82,6 @@ void sx_model_destroy(sx_model *m)
     sx__clumps_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
-    sx_alloc_free(&m->alloc, m->pool, (size_t)m->cap_pool, sizeof *m->pool);
     sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
     sx_alloc_free(&m->alloc, m->wall_acc, (size_t)m->cap_wall_acc, sizeof *m->wall_acc);
     sx_alloc_free(&m->alloc, m->wlaw, (size_t)m->cap_wlaw, sizeof *m->wlaw);

@@ -107,17 +107,18 @@ typedef struct sx_grid {
 
 /* The ball-ball pass runs in fixed chunks of pairs. Pairs are sorted by a
  * (a < b), so chunk c owns a contiguous range of balls: the a's of its
- * pairs. It writes its own balls' forces straight into the balls' arrays
- * (no other chunk touches them) and the balls beyond its range, which only
- * b can reach, into a small spill buffer; the wall pass adds the spill
- * buffers in chunk order. The chunking depends only on the pair store,
- * never on the thread count, so results are bit-identical for any number
- * of threads. */
+ * pairs. The plan makes every b of chunk c fall in its own range or the
+ * next chunk's, so the even chunks write disjoint sets of balls, and so do
+ * the odd ones: the even chunks run (in parallel), then the odd ones,
+ * each adding its forces straight into the balls' arrays. An even chunk
+ * first clears its range and the next chunk's. The chunking depends only
+ * on the pair store, never on the thread count, so every ball receives
+ * its contributions in the same order, and results are bit-identical for
+ * any number of threads. */
 typedef struct sx_chunk {
     int64_t first, last;   /* pair range [first, last) */
-    int64_t own_lo, own_hi;/* balls [own_lo, own_hi) written directly */
-    int64_t spill_hi;      /* balls [own_hi, spill_hi) go to the spill buffer */
-    int64_t off;           /* offset of its spill buffer (in balls) in the pool */
+    int64_t own_lo, own_hi;/* balls [own_lo, own_hi): the a's of its pairs */
+    int64_t clear_lo, clear_hi; /* balls whose forces it starts from the applied loads (or zero) */
     /* results of the last pass */
     double slip, viscous, released;
     int64_t lost_bonds;
@@ -128,8 +129,8 @@ typedef struct sx_chunk {
     double err_un, err_r;
 } sx_chunk;
 
-/* The per-ball passes (spill sums and wall contacts, then the law of
- * motion) run in fixed blocks of balls; each block keeps partial sums
+/* The per-ball passes (wall contacts, then the law of motion) run in
+ * fixed blocks of balls; each block keeps partial sums
  * (energies, wall resultants), added in block order. */
 typedef struct sx_wall_acc {
     double force[3], moment[3], load, kn_sum;
@@ -146,7 +147,6 @@ typedef struct sx_block {
     sx_status st;          /* a wall contact's overlap error */
     int64_t err_ball, err_wall;
     double err_un, err_r;
-    double t_walls, t_motion; /* seconds spent in each pass (profile) */
 } sx_block;
 
 /* Contact parameters of a pair of materials, or of a material and a wall
@@ -193,8 +193,6 @@ struct sx_model {
     sx_pairs bb, bw;        /* ball-ball and ball-wall candidate pairs */
     sx_chunk *chunks;       /* the ball-ball pass's chunks, planned at each build */
     int64_t nchunk, cap_chunk;
-    double *pool;           /* chunk spill buffers: (dim + rdim) doubles per spilled ball */
-    int64_t cap_pool;
     sx_block *blocks;       /* the per-ball passes' blocks (room for SX_MOTION_BLOCKS) */
     int64_t nblock;
     sx_wall_acc *wall_acc;  /* nblock x nwall partial wall resultants */
@@ -241,7 +239,7 @@ sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
 typedef struct sx_kernels {
     bool (*build)(sx_model *m);                  /* broad phase + history transfer; false: out of memory */
     sx_status (*contacts)(sx_model *m);          /* ball-ball forces (the balls' forces start here) */
-    sx_status (*walls)(sx_model *m);             /* the chunks' spill buffers, then ball-wall forces */
+    sx_status (*walls)(sx_model *m);             /* ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
     double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
     void (*energy)(const sx_model *m, sx_energy *e);
