@@ -48,6 +48,44 @@ START_TEST(one_and_two_threads_bit_identical)
 }
 END_TEST
 
+/* Bonded pairs stay in the store whatever their gap: balls of the bed's
+ * bottom layer bonded to their neighbours and then lifted to the top pair
+ * with balls far away in the sorted order, so the ball-ball pass's chunks
+ * are planned around them; the bits still do not depend on the threads. */
+START_TEST(far_bonded_pairs_bit_identical)
+{
+    const int dim = _i;
+    sx_model *ms[2] = {bed(dim, 1), bed(dim, 2)};
+    for (int k = 0; k < 2; k++) {
+        sx_model *m = ms[k];
+        ck_assert_int_eq(sx_model_cycle(m, 1), SX_OK);
+        sx_bond_def bd = sx_bond_default_def();
+        bd.kind = SX_BOND_PARALLEL;
+        bd.radius_multiplier = 0.5;
+        bd.modulus = 1e3; /* weak: the lifted balls pull on their old neighbours without upsetting the bed */
+        bd.stiffness_ratio = 1;
+        bd.tensile_strength = bd.cohesion = 1e30;
+        bd.gap = 1e-6;
+        int64_t count = 0;
+        ck_assert_int_eq(sx_bond_install(m, &bd, &count), SX_OK);
+        ck_assert(count > sx_ball_count(m));
+        /* every 7th ball of the first rows goes 5 cm above the bed */
+        for (int64_t i = 0; i < sx_ball_count(m) / 8; i += 7) {
+            const int64_t id = sx_ball_id_at(m, i);
+            double x[3];
+            ck_assert_int_eq(sx_ball_get_vec(m, id, SX_BALL_POS, x), SX_OK);
+            x[dim - 1] += dim == 3 ? 0.4 : 1.3;
+            ck_assert_int_eq(sx_ball_set_vec(m, id, SX_BALL_POS, x), SX_OK);
+        }
+        ck_assert_msg(sx_model_cycle(m, 100) == SX_OK, "%s", sx_model_error(m));
+    }
+    ck_assert_int_eq(sx_bond_count(ms[0]), sx_bond_count(ms[1]));
+    ck_assert_uint_eq(sx_model_state_hash(ms[0]), sx_model_state_hash(ms[1]));
+    sx_model_destroy(ms[0]);
+    sx_model_destroy(ms[1]);
+}
+END_TEST
+
 START_TEST(thread_count_validated)
 {
     sx_model *m = scene_model(3, NULL, 1e-5, 1e5, 0.5, 2500);
@@ -64,6 +102,7 @@ int main(void)
     TCase *tc = tcase_create("threads");
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, one_and_two_threads_bit_identical, 2, 4);
+    tcase_add_loop_test(tc, far_bonded_pairs_bit_identical, 2, 4);
     tcase_add_test(tc, thread_count_validated);
     suite_add_tcase(s, tc);
     SRunner *r = srunner_create(s);

@@ -11,6 +11,7 @@
  */
 #include "model_internal.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -1159,6 +1160,8 @@ static bool plan_chunks(sx_model *m)
         /* the first phase clears the forces of every ball before either phase adds to them */
         o->clear_lo = c % 2 == 0 ? o->own_lo : 0;
         o->clear_hi = c % 2 == 0 ? (c + 2 < k ? m->chunks[c + 2].own_lo : n) : 0;
+        for (int64_t q = o->first; q < o->last; q++) /* what the two phases rely on */
+            assert(p->a[q] >= o->own_lo && p->a[q] < o->own_hi && (c + 2 >= k || p->b[q] < m->chunks[c + 2].own_lo));
     }
     /* blocks of at least MOTION_MIN balls, at most MOTION_BLOCKS of them */
     if (!m->blocks) {
