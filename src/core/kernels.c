@@ -906,6 +906,37 @@ typedef int64_t vm __attribute__((vector_size(LANES * sizeof(int64_t))));
     ((vd){(arr)[(idx)[0] * (per) + (k)], (arr)[(idx)[1] * (per) + (k)], (arr)[(idx)[2] * (per) + (k)],   \
           (arr)[(idx)[3] * (per) + (k)]})
 
+/* Four consecutive pairs' D-vectors (a pair's components adjacent in
+ * memory) to and from one vector per component, by shuffles. */
+static inline void load_lanes(const double *p, vd *out)
+{
+#if D == 3
+    vd m0, m1, m2;
+    memcpy(&m0, p, sizeof m0), memcpy(&m1, p + 4, sizeof m1), memcpy(&m2, p + 8, sizeof m2);
+    out[0] = __builtin_shuffle(__builtin_shuffle(m0, m1, (vm){0, 3, 6, 0}), m2, (vm){0, 1, 2, 5});
+    out[1] = __builtin_shuffle(__builtin_shuffle(m0, m1, (vm){1, 4, 7, 0}), m2, (vm){0, 1, 2, 6});
+    out[2] = __builtin_shuffle(__builtin_shuffle(m0, m1, (vm){2, 5, 0, 0}), m2, (vm){0, 1, 4, 7});
+#else
+    vd m0, m1;
+    memcpy(&m0, p, sizeof m0), memcpy(&m1, p + 4, sizeof m1);
+    out[0] = __builtin_shuffle(m0, m1, (vm){0, 2, 4, 6});
+    out[1] = __builtin_shuffle(m0, m1, (vm){1, 3, 5, 7});
+#endif
+}
+
+static inline void store_lanes(double *p, const vd *in)
+{
+#if D == 3
+    const vd o0 = __builtin_shuffle(__builtin_shuffle(in[0], in[1], (vm){0, 4, 1, 0}), in[2], (vm){0, 1, 4, 2});
+    const vd o1 = __builtin_shuffle(__builtin_shuffle(in[1], in[2], (vm){1, 5, 2, 0}), in[0], (vm){0, 1, 6, 2});
+    const vd o2 = __builtin_shuffle(__builtin_shuffle(in[0], in[1], (vm){3, 7, 0, 0}), in[2], (vm){6, 0, 1, 7});
+    memcpy(p, &o0, sizeof o0), memcpy(p + 4, &o1, sizeof o1), memcpy(p + 8, &o2, sizeof o2);
+#else
+    const vd o0 = __builtin_shuffle(in[0], in[1], (vm){0, 4, 1, 5}), o1 = __builtin_shuffle(in[0], in[1], (vm){2, 6, 3, 7});
+    memcpy(p, &o0, sizeof o0), memcpy(p + 4, &o1, sizeof o1);
+#endif
+}
+
 /* The batched pass is compiled twice where the compiler can pick at run
  * time (GCC's function multi-versioning on x86-64 GNU/Linux): with AVX2,
  * four lanes per instruction, and for the baseline ISA. Neither fuses
@@ -960,10 +991,30 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         const vd ri = LANES_OF(rad, i, 1, 0), rj = LANES_OF(rad, j, 1, 0);
         const vm had = {-(int64_t)(touching[cc[0]] != 0), -(int64_t)(touching[cc[1]] != 0),
                         -(int64_t)(touching[cc[2]] != 0), -(int64_t)(touching[cc[3]] != 0)};
+        /* the history as stored, four consecutive pairs by shuffles (a short
+         * batch copied to four pairs first) */
+        const bool full = nb == LANES;
+        double tail[2 * LANES * D + 2 * LANES];
+        const double *hfs = fs_all + c0 * D, *hno = nold_all + c0 * D, *hun = un_all + c0, *hfn = fn_all + c0;
+        if (!full) {
+            for (int q = 0; q < LANES; q++) {
+                memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
+                memcpy(tail + (LANES + q) * D, nold_all + cc[q] * D, D * sizeof(double));
+                tail[2 * LANES * D + q] = un_all[cc[q]];
+                tail[2 * LANES * D + LANES + q] = fn_all[cc[q]];
+            }
+            hfs = tail, hno = tail + LANES * D, hun = tail + 2 * LANES * D, hfn = hun + LANES;
+        }
+        vd fs_old[D], no_old[D], un_old, fn_old;
+        load_lanes(hfs, fs_old);
+        load_lanes(hno, no_old);
+        memcpy(&un_old, hun, sizeof un_old);
+        memcpy(&fn_old, hfn, sizeof fn_old);
 
         /* 4-1 ... 4-4 */
-        vd d2 = dx[0] * dx[0];
-        for (int k = 1; k < D; k++) d2 += dx[k] * dx[k];
+        /* sums from zero, as dot() (the sign of a zero sum) */
+        vd d2 = VZERO;
+        for (int k = 0; k < D; k++) d2 += dx[k] * dx[k];
         const vd d = VSQRT(d2), inv_d = 1.0 / d;
         vd n[D];
         for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
@@ -989,22 +1040,22 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         vc[0] = dv[0] - -ws[0] * n[1];
         vc[1] = dv[1] - ws[0] * n[0];
 #endif
-        vd vn = vc[0] * n[0];
-        for (int k = 1; k < D; k++) vn += vc[k] * n[k];
+        vd vn = VZERO;
+        for (int k = 0; k < D; k++) vn += vc[k] * n[k];
         vd vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
         /* history: none for a new contact */
         vd g[D], no[D];
         for (int k = 0; k < D; k++) {
-            g[k] = VSEL(had, LANES_OF(fs_all, cc, D, k), VZERO);
-            no[k] = VSEL(had, LANES_OF(nold_all, cc, D, k), n[k]);
+            g[k] = VSEL(had, fs_old[k], VZERO);
+            no[k] = VSEL(had, no_old[k], n[k]);
         }
         /* 4-14 then 4-15 (carry_make, carry_apply) */
 #if D == 3
         const vd c0v = no[1] * n[2] - no[2] * n[1], c1v = no[2] * n[0] - no[0] * n[2], c2v = no[0] * n[1] - no[1] * n[0];
         vd t0 = c1v * g[2] - c2v * g[1], t1 = c2v * g[0] - c0v * g[2], t2 = c0v * g[1] - c1v * g[0];
         g[0] += t0, g[1] += t1, g[2] += t2;
-        const vd wbar = 0.5 * (wsum[0] * n[0] + wsum[1] * n[1] + wsum[2] * n[2]);
+        const vd wbar = 0.5 * (((VZERO + wsum[0] * n[0]) + wsum[1] * n[1]) + wsum[2] * n[2]);
         const vd r0 = wbar * n[0] * dt, r1 = wbar * n[1] * dt, r2 = wbar * n[2] * dt;
         t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
         g[0] += t0, g[1] += t1, g[2] += t2;
@@ -1018,8 +1069,8 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
         /* 4-30/4-31 */
         const vd fmax = mu * VSEL(fn > VZERO, fn, VZERO);
-        vd f2 = g[0] * g[0];
-        for (int k = 1; k < D; k++) f2 += g[k] * g[k];
+        vd f2 = VZERO;
+        for (int k = 0; k < D; k++) f2 += g[k] * g[k];
         const vm slips = f2 > fmax * fmax;
         if (VANY(slips)) {
             const vd sc = VSEL(slips, fmax / VSQRT(f2), VZERO + 1.0);
@@ -1055,22 +1106,37 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         const vd fdo = VSEL(active, fd, VZERO);
         const vm live = d2 < rsum * rsum;
         const vm bad = live & (u > VSEL(ri < rj, ri, rj));
-        for (int q = 0; q < LANES && q < nb; q++)
-            if (bad[q]) {
-                o->st = SX_EUNSTABLE;
-                o->err_a = B->id[i[q]], o->err_b = B->id[j[q]], o->err_un = u[q], o->err_r = ri[q] < rj[q] ? ri[q] : rj[q];
-                return;
+        if (VANY(bad))
+            for (int q = 0; q < nb; q++)
+                if (bad[q]) {
+                    o->st = SX_EUNSTABLE;
+                    o->err_a = B->id[i[q]], o->err_b = B->id[j[q]], o->err_un = u[q];
+                    o->err_r = ri[q] < rj[q] ? ri[q] : rj[q];
+                    return;
+                }
+        /* a pair out of reach this step keeps its history, untouched */
+        if (full) {
+            vd keep[D];
+            for (int k = 0; k < D; k++) keep[k] = VSEL(live, g[k], fs_old[k]);
+            store_lanes(fs_all + c0 * D, keep);
+            for (int k = 0; k < D; k++) keep[k] = VSEL(live, n[k], no_old[k]);
+            store_lanes(nold_all + c0 * D, keep);
+            const vd un_new = VSEL(live, u, un_old), fn_new = VSEL(live, fdo, fn_old);
+            memcpy(un_all + c0, &un_new, sizeof un_new);
+            memcpy(fn_all + c0, &fn_new, sizeof fn_new);
+            for (int q = 0; q < LANES; q++) touching[c0 + q] = (live[q] & active[q]) != 0;
+        } else {
+            for (int q = 0; q < nb; q++) {
+                const int64_t c = cc[q];
+                touching[c] = (live[q] & active[q]) != 0;
+                if (!live[q]) continue;
+                for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], nold_all[c * D + k] = n[k][q];
+                un_all[c] = u[q];
+                fn_all[c] = fdo[q];
             }
-        for (int q = 0; q < LANES && q < nb; q++) {
-            const int64_t c = cc[q];
-            if (!live[q]) { /* out of reach this step */
-                touching[c] = 0;
-                continue;
-            }
-            for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], nold_all[c * D + k] = n[k][q];
-            un_all[c] = u[q];
-            fn_all[c] = fdo[q];
-            touching[c] = active[q] != 0;
+        }
+        for (int q = 0; q < nb; q++) {
+            if (!live[q]) continue;
             double *fi = f + i[q] * D, *ti = t + i[q] * RD, *fj = f + j[q] * D, *tj = t + j[q] * RD;
             for (int k = 0; k < D; k++) {
                 fi[k] -= F[k][q];
