@@ -353,10 +353,10 @@ static sx_status pairs_resize(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, a, 1);
     RESIZE(p, b, 1);
     RESIZE(p, fs, d);
-    RESIZE(p, nold, d);
+    RESIZE(p, geo, d);
     RESIZE(p, touching, 1);
     if (p->bond) RESIZE(p, bond, 1);
-    RESIZE(p, un, 1);
+    if (p->walls) RESIZE(p, un, 1);
     RESIZE(p, fn, 1);
     p->cap = cap;
     return SX_OK;
@@ -388,9 +388,9 @@ void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
     p->a[to] = p->a[from];
     p->b[to] = p->b[from];
     memmove(p->fs + to * d, p->fs + from * d, (size_t)d * sizeof(double));
-    memmove(p->nold + to * d, p->nold + from * d, (size_t)d * sizeof(double));
+    memmove(p->geo + to * d, p->geo + from * d, (size_t)d * sizeof(double));
     p->touching[to] = p->touching[from];
-    p->un[to] = p->un[from];
+    if (p->un) p->un[to] = p->un[from];
     p->fn[to] = p->fn[from];
     if (p->bond) p->bond[to] = p->bond[from];
 }
@@ -403,7 +403,7 @@ void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k)
     p->b[k] = a;
     for (int j = 0; j < d; j++) {
         p->fs[k * d + j] = -p->fs[k * d + j];
-        p->nold[k * d + j] = -p->nold[k * d + j];
+        p->geo[k * d + j] = -p->geo[k * d + j]; /* the relative position and the normal alike */
     }
     if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
 }
@@ -438,9 +438,9 @@ bool sx__pairs_sort(sx_model *m, sx_pairs *p)
     SCATTER(a, 1, int32_t);
     SCATTER(b, 1, int32_t);
     SCATTER(fs, d, double);
-    SCATTER(nold, d, double);
+    SCATTER(geo, d, double);
     SCATTER(touching, 1, uint8_t);
-    SCATTER(un, 1, double);
+    if (p->un) SCATTER(un, 1, double);
     SCATTER(fn, 1, double);
     if (p->bond) SCATTER(bond, 1, int32_t);
 #undef SCATTER
@@ -456,12 +456,14 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->a, c, sizeof(int32_t));
     free_field(m, p->b, c, sizeof(int32_t));
     free_field(m, p->fs, c * d, sizeof(double));
-    free_field(m, p->nold, c * d, sizeof(double));
+    free_field(m, p->geo, c * d, sizeof(double));
     free_field(m, p->touching, c, sizeof(uint8_t));
     free_field(m, p->bond, p->bond ? c : 0, sizeof(int32_t));
-    free_field(m, p->un, c, sizeof(double));
+    free_field(m, p->un, p->un ? c : 0, sizeof(double));
     free_field(m, p->fn, c, sizeof(double));
+    const bool walls = p->walls;
     memset(p, 0, sizeof *p);
+    p->walls = walls;
 }
 
 size_t sx__balls_bytes(const sx_model *m)
@@ -476,8 +478,9 @@ size_t sx__balls_bytes(const sx_model *m)
 size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p)
 {
     const size_t d = (size_t)m->dim;
-    size_t per = 2 * sizeof(int32_t) + (2 * d + 2) * sizeof(double) + sizeof(uint8_t);
+    size_t per = 2 * sizeof(int32_t) + (2 * d + 1) * sizeof(double) + sizeof(uint8_t);
     if (p->bond) per += sizeof(int32_t);
+    if (p->un) per += sizeof(double);
     return (size_t)p->cap * per;
 }
 

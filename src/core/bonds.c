@@ -324,9 +324,9 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         }
         if (!b->kind[slot]) b->intact++;
         b->kind[slot] |= (uint8_t)def->kind;
-        if (!p->touching[c]) { /* the bond starts from the current geometry */
+        if (!p->touching[c]) { /* the bond starts from the current geometry: the relative position */
             for (int k = 0; k < d; k++) {
-                p->nold[c * d + k] = n[k];
+                p->geo[c * d + k] = B->x[j * d + k] - B->x[i * d + k];
                 p->fs[c * d + k] = 0;
             }
             p->touching[c] = 1;

@@ -63,8 +63,8 @@ static inline void moment_of(const double *r, const double *f, double *out)
 
 /* ---------------------------------------------------------- broad phase */
 
-/* A pair's history as saved across a build: shear force (D), previous
- * normal (D), overlap and normal force of the last evaluation. */
+/* A pair's history as saved across a build: shear force (D), the last
+ * evaluation's geometry (D), overlap (ball-wall) and normal force. */
 #define REC (2 * D + 2)
 
 typedef struct history {
@@ -106,9 +106,9 @@ static void history_put(sx_model *m, history *h, uint64_t key, const sx_pairs *p
     double *r = h->rec + h->n * REC;
     for (int k = 0; k < D; k++) {
         r[k] = sgn * p->fs[c * D + k];
-        r[D + k] = sgn * p->nold[c * D + k];
+        r[D + k] = sgn * p->geo[c * D + k];
     }
-    r[2 * D] = p->un[c];
+    r[2 * D] = p->un ? p->un[c] : 0;
     r[2 * D + 1] = p->fn[c];
     const int32_t bond = p->bond ? p->bond[c] : 0;
     if (bond && sgn < 0) sx__bond_flip(m, bond - 1);
@@ -176,9 +176,9 @@ static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const hist
     const double *r = s >= 0 ? h->rec + s * REC : NULL;
     for (int k = 0; k < D; k++) {
         p->fs[c * D + k] = r ? sgn * r[k] : 0;
-        p->nold[c * D + k] = r ? sgn * r[D + k] : 0;
+        p->geo[c * D + k] = r ? sgn * r[D + k] : 0;
     }
-    p->un[c] = r ? r[2 * D] : 0;
+    if (p->un) p->un[c] = r ? r[2 * D] : 0;
     p->fn[c] = r ? r[2 * D + 1] : 0;
     p->touching[c] = r != NULL;
     if (p->bond) {
@@ -702,7 +702,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
     const int32_t *restrict bond = p->bond;
-    double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
+    double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
@@ -717,7 +717,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
         const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
         const sx_pair_law *law = &laws[mat[i] * nlaw + mat[j]];
-        double *restrict fs = fs_all + c * D, *restrict nold = nold_all + c * D;
+        double *restrict fs = fs_all + c * D, *restrict rel = geo_all + c * D;
         if (d2 >= rsum * rsum && slot < 0) {
             if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
                 double kn, ks;
@@ -750,8 +750,15 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k]; /* 4-17 */
 
-        if (!touching[c])
+        /* the previous normal, from the last evaluation's relative position as n
+         * was computed from dx (the same bits); none for a new contact */
+        double nold[D];
+        if (touching[c]) {
+            const double inv_r = 1.0 / sqrt(dot(rel, rel));
+            for (int k = 0; k < D; k++) nold[k] = rel[k] * inv_r;
+        } else {
             for (int k = 0; k < D; k++) fs[k] = 0, nold[k] = n[k];
+        }
         carry rot;
         carry_make(&rot, nold, n, wi, wj, dt);
         unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
@@ -839,7 +846,6 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
             fn_all[c] = 0;
         }
-        un_all[c] = un;
         if (bonds & SX_BOND_PARALLEL) {
             double dtheta[RD];
             for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
@@ -854,7 +860,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 o->lost_bonds++;
             }
         }
-        for (int k = 0; k < D; k++) nold[k] = n[k];
+        for (int k = 0; k < D; k++) rel[k] = dx[k];
         touching[c] = active || bonds;
         /* 4-21 and 4-39: both arms lie along n, so both moments are multiples of n x F */
         double nf[RD];
@@ -957,7 +963,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     const double *restrict im = B->inv_mass;
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
-    double *restrict fs_all = p->fs, *restrict nold_all = p->nold, *restrict un_all = p->un, *restrict fn_all = p->fn;
+    double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
@@ -983,6 +989,30 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
                 const sx_pair_law *law = &laws[mat[i[q]] * nlaw + mat[j[q]]];
                 kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
             }
+        /* the history as stored, four consecutive pairs by shuffles (a short
+         * batch copied to four pairs first) */
+        const bool full = nb == LANES;
+        double tail[2 * LANES * D + LANES];
+        const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D, *hfn = fn_all + c0;
+        if (!full) {
+            for (int q = 0; q < LANES; q++) {
+                memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
+                memcpy(tail + (LANES + q) * D, geo_all + cc[q] * D, D * sizeof(double));
+                tail[2 * LANES * D + q] = fn_all[cc[q]];
+            }
+            hfs = tail, hrel = tail + LANES * D, hfn = tail + 2 * LANES * D;
+        }
+        vd fs_old[D], rel_old[D], fn_old;
+        load_lanes(hfs, fs_old);
+        load_lanes(hrel, rel_old);
+        memcpy(&fn_old, hfn, sizeof fn_old);
+
+        /* the previous normal from the relative position as in ball_chunk_pass
+         * (first: its square root and division overlap the loads below) */
+        vd rr = VZERO;
+        for (int k = 0; k < D; k++) rr += rel_old[k] * rel_old[k];
+        const vd inv_r = 1.0 / VSQRT(rr);
+
         vd dx[D], dv[D];
         for (int k = 0; k < D; k++) {
             dx[k] = LANES_OF(x, j, D, k) - LANES_OF(x, i, D, k);
@@ -991,25 +1021,6 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         const vd ri = LANES_OF(rad, i, 1, 0), rj = LANES_OF(rad, j, 1, 0);
         const vm had = {-(int64_t)(touching[cc[0]] != 0), -(int64_t)(touching[cc[1]] != 0),
                         -(int64_t)(touching[cc[2]] != 0), -(int64_t)(touching[cc[3]] != 0)};
-        /* the history as stored, four consecutive pairs by shuffles (a short
-         * batch copied to four pairs first) */
-        const bool full = nb == LANES;
-        double tail[2 * LANES * D + 2 * LANES];
-        const double *hfs = fs_all + c0 * D, *hno = nold_all + c0 * D, *hun = un_all + c0, *hfn = fn_all + c0;
-        if (!full) {
-            for (int q = 0; q < LANES; q++) {
-                memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
-                memcpy(tail + (LANES + q) * D, nold_all + cc[q] * D, D * sizeof(double));
-                tail[2 * LANES * D + q] = un_all[cc[q]];
-                tail[2 * LANES * D + LANES + q] = fn_all[cc[q]];
-            }
-            hfs = tail, hno = tail + LANES * D, hun = tail + 2 * LANES * D, hfn = hun + LANES;
-        }
-        vd fs_old[D], no_old[D], un_old, fn_old;
-        load_lanes(hfs, fs_old);
-        load_lanes(hno, no_old);
-        memcpy(&un_old, hun, sizeof un_old);
-        memcpy(&fn_old, hfn, sizeof fn_old);
 
         /* 4-1 ... 4-4 */
         /* sums from zero, as dot() (the sign of a zero sum) */
@@ -1048,7 +1059,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         vd g[D], no[D];
         for (int k = 0; k < D; k++) {
             g[k] = VSEL(had, fs_old[k], VZERO);
-            no[k] = VSEL(had, no_old[k], n[k]);
+            no[k] = VSEL(had, rel_old[k] * inv_r, n[k]);
         }
         /* 4-14 then 4-15 (carry_make, carry_apply) */
 #if D == 3
@@ -1119,10 +1130,9 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
             vd keep[D];
             for (int k = 0; k < D; k++) keep[k] = VSEL(live, g[k], fs_old[k]);
             store_lanes(fs_all + c0 * D, keep);
-            for (int k = 0; k < D; k++) keep[k] = VSEL(live, n[k], no_old[k]);
-            store_lanes(nold_all + c0 * D, keep);
-            const vd un_new = VSEL(live, u, un_old), fn_new = VSEL(live, fdo, fn_old);
-            memcpy(un_all + c0, &un_new, sizeof un_new);
+            for (int k = 0; k < D; k++) keep[k] = VSEL(live, dx[k], rel_old[k]);
+            store_lanes(geo_all + c0 * D, keep);
+            const vd fn_new = VSEL(live, fdo, fn_old);
             memcpy(fn_all + c0, &fn_new, sizeof fn_new);
             for (int q = 0; q < LANES; q++) touching[c0 + q] = (live[q] & active[q]) != 0;
         } else {
@@ -1130,8 +1140,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
                 const int64_t c = cc[q];
                 touching[c] = (live[q] & active[q]) != 0;
                 if (!live[q]) continue;
-                for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], nold_all[c * D + k] = n[k][q];
-                un_all[c] = u[q];
+                for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], geo_all[c * D + k] = dx[k][q];
                 fn_all[c] = fdo[q];
             }
         }
@@ -1325,9 +1334,9 @@ static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
         double kn, ks;
         const double fn = stiffness(law, r, 0, r, un, &kn, &ks);
         if (!p->touching[c])
-            for (int k = 0; k < D; k++) fs[k] = 0, p->nold[c * D + k] = n[k];
+            for (int k = 0; k < D; k++) fs[k] = 0, p->geo[c * D + k] = n[k];
         carry rot;
-        carry_make(&rot, p->nold + c * D, n, NULL, B->w + i * RD, dt);
+        carry_make(&rot, p->geo + c * D, n, NULL, B->w + i * RD, dt);
         carry_apply(&rot, fs);
         double f0[D];
         for (int k = 0; k < D; k++) f0[k] = fs[k];
@@ -1345,7 +1354,7 @@ static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
             for (int k = 0; k < D; k++) fs[k] *= sc;
             slip = true;
         }
-        for (int k = 0; k < D; k++) p->nold[c * D + k] = n[k];
+        for (int k = 0; k < D; k++) p->geo[c * D + k] = n[k];
         p->touching[c] = 1;
 
         double fd = fn, dsh[D], F[D];
@@ -1735,15 +1744,24 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
 }
 
 /* Contacts are reported as the last force evaluation left them (the forces
- * the balls felt): normal, overlap, normal force (with its dashpot), the
- * elastic shear force and the bonds; the point is placed from ball a's
+ * the balls felt): normal, overlap (a ball-ball one from the evaluation's
+ * centre distance and the current radii), normal force (with its dashpot),
+ * the elastic shear force and the bonds; the point is placed from ball a's
  * current centre. */
 static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall,
                    bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
     const sx_balls *B = &m->balls;
     const int64_t i = p->a[c];
-    const double *n = p->nold + c * D, un = p->un[c];
+    double n[D], un;
+    if (is_wall) {
+        for (int k = 0; k < D; k++) n[k] = p->geo[c * D + k];
+        un = p->un[c];
+    } else { /* the normal and overlap of the relative position, as the step computed them */
+        const double *rel = p->geo + c * D, d = sqrt(dot(rel, rel)), inv_d = 1.0 / d;
+        for (int k = 0; k < D; k++) n[k] = rel[k] * inv_d;
+        un = B->rad[i] + B->rad[p->b[c]] - d;
+    }
     sx_contact_info ci;
     memset(&ci, 0, sizeof ci);
     const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])

@@ -84,17 +84,23 @@ typedef struct sx_wall {
 /* Candidate pairs of the broad phase with their history, in one flat
  * structure of arrays. Ball-ball pairs: a < b as dense indices, grouped by a
  * (CSR) in cell order. Ball-wall pairs: a the ball, b the wall's index.
- * History: the shear force on b (dim) and the contact normal of the last
- * step (dim), used by the rotation 4-7/4-14. touching = 0 means no history. */
+ * History: the shear force on b (dim) and the geometry of the last
+ * evaluation (dim), whose normal the rotation 4-7/4-14 starts from.
+ * touching = 0 means no history. */
 typedef struct sx_pairs {
     int64_t n, cap;
+    bool walls;            /* a ball-wall store (it keeps the overlap; a ball-ball one derives it) */
     int32_t *a, *b;
     double *fs;            /* shear force (dim) */
-    double *nold;          /* previous normal (dim) */
+    /* the last evaluation (dim): ball-ball, the relative position x_b - x_a,
+     * whose direction is the previous normal (n = r / |r|, as the step
+     * computes it, to the bit) and whose length gives the overlap; ball-wall,
+     * the previous unit normal */
+    double *geo;
     uint8_t *touching;     /* history is live (touching, or bonded) */
     int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
     /* the last force evaluation, for queries consistent with the balls' forces */
-    double *un;            /* overlap */
+    double *un;            /* overlap (ball-wall stores only) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
 } sx_pairs;
 

@@ -83,17 +83,25 @@ static int ball_fields(const sx_model *m, field *f)
     return n;
 }
 
-/* Every array of a pair store (bond slots only when it has them). */
-static int pair_fields(const sx_model *m, const sx_pairs *p, field *f)
+/* Every array of a pair store (bond slots only when it has them). The
+ * last evaluation's geometry: a ball-wall pair's normal and overlap; a
+ * ball-ball pair's relative position (format 3), or, reading a file of
+ * format 1 or 2, its normal and overlap (into `overlap`, see
+ * relative_from_normal). */
+static int pair_fields(const sx_model *m, const sx_pairs *p, field *f, double *overlap)
 {
     const int d = m->dim;
     int n = 0;
     f[n++] = F("a", T_I32, p->a, 1, NULL);
     f[n++] = F("b", T_I32, p->b, 1, NULL);
     f[n++] = F("shear_force", T_F64, p->fs, d, "N");
-    f[n++] = F("normal", T_F64, p->nold, d, "1");
+    if (p->walls || overlap) {
+        f[n++] = F("normal", T_F64, p->geo, d, "1");
+        f[n++] = F("overlap", T_F64, p->walls ? p->un : overlap, 1, "m");
+    } else {
+        f[n++] = F("relative_position", T_F64, p->geo, d, "m");
+    }
     f[n++] = F("touching", T_U8, p->touching, 1, NULL);
-    f[n++] = F("overlap", T_F64, p->un, 1, "m");
     f[n++] = F("normal_force", T_F64, p->fn, 1, "N");
     if (p->bond) f[n++] = F("bond", T_I32, p->bond, 1, NULL);
     return n;
@@ -816,11 +824,11 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     g = sx_h5_group(h, f, "contacts");
     hid_t p = sx_h5_group(h, g, "ball_ball");
     sx_h5_attr_int(h, p, "count", m->bb.n);
-    write_fields(h, p, fl, pair_fields(m, &m->bb, fl), m->bb.n);
+    write_fields(h, p, fl, pair_fields(m, &m->bb, fl, NULL), m->bb.n);
     sx_h5_close(p);
     p = sx_h5_group(h, g, "ball_wall");
     sx_h5_attr_int(h, p, "count", m->bw.n);
-    write_fields(h, p, fl, pair_fields(m, &m->bw, fl), m->bw.n);
+    write_fields(h, p, fl, pair_fields(m, &m->bw, fl, NULL), m->bw.n);
     sx_h5_close(p);
     sx_h5_close(g);
 
@@ -965,6 +973,24 @@ static void load_seeds(sx_h5 *h, hid_t f, sx_snapshot_info *info)
     else if (sx_h5_get_i64(h, f, "/", "seeds", info->seeds, n, true)) info->nseeds = (int)n;
 }
 
+/* A ball-ball pair of a format 1 or 2 file: the relative position from the
+ * stored normal and overlap, r = n (RA + RB - Un). The step then takes the
+ * normal back from it to within a rounding of the stored one, so a run
+ * continued from such a file follows the one that wrote it to round-off,
+ * not to the bit (format 3 stores r itself). */
+static void relative_from_normal(sx_model *m, const double *overlap)
+{
+    const int d = m->dim;
+    const sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int32_t a = p->a[c], b = p->b[c];
+        if (a < 0 || b < 0 || a >= B->n || b >= B->n) continue; /* sx__state_finish rejects the file */
+        const double dist = B->rad[a] + B->rad[b] - overlap[c];
+        for (int k = 0; k < d; k++) p->geo[c * d + k] *= dist;
+    }
+}
+
 sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *info, char *err, size_t errlen)
 {
     sx_h5 h;
@@ -1003,8 +1029,13 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
 
         field fl[MAX_FIELDS];
         load_group(&h, f, "/balls", fl, ball_fields(m, fl), m->balls.n);
-        load_group(&h, f, "/contacts/ball_ball", fl, pair_fields(m, &m->bb, fl), m->bb.n);
-        load_group(&h, f, "/contacts/ball_wall", fl, pair_fields(m, &m->bw, fl), m->bw.n);
+        double *overlap = NULL; /* formats 1 and 2 store a ball-ball pair's normal and overlap */
+        if (version < 3 && !(overlap = calloc((size_t)(m->bb.n > 0 ? m->bb.n : 1), sizeof *overlap)))
+            sx_h5_fail(&h, "out of memory");
+        load_group(&h, f, "/contacts/ball_ball", fl, pair_fields(m, &m->bb, fl, overlap), m->bb.n);
+        if (overlap && !h.failed) relative_from_normal(m, overlap);
+        free(overlap);
+        load_group(&h, f, "/contacts/ball_wall", fl, pair_fields(m, &m->bw, fl, NULL), m->bw.n);
         load_group(&h, f, "/bonds", fl, bond_fields(m, fl), m->bonds.n);
         g = sx_h5_open_group(&h, f, "/cracks", true);
         if (g >= 0) crack_io(&h, g, m, false);

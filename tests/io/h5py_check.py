@@ -12,10 +12,21 @@ d = sys.argv[1]
 with h5py.File(d + "/snapshot.h5", "r") as f:
     a = f.attrs
     assert a["format"] == b"seixo", a["format"]
-    assert a["format_version"] == 2 and a["kind"] == b"snapshot" and a["dim"] == 3
+    assert a["format_version"] == 3 and a["kind"] == b"snapshot" and a["dim"] == 3
     assert list(a["seeds"]) == [11], list(a["seeds"])
     x = f["balls/position"][:]
     assert x.shape == (60, 3) and np.all(np.isfinite(x))
+    # a ball-ball contact's geometry (format 3): the relative position of its
+    # last evaluation, one step's motion from the balls' current one
+    bb = f["contacts/ball_ball"]
+    assert bb["relative_position"].shape == (bb.attrs["count"], 3)
+    assert bb["relative_position"].attrs["units"] == b"m" and "normal" not in bb and "overlap" not in bb
+    on = bb["touching"][:] == 1
+    rel, pa, pb = bb["relative_position"][:][on], bb["a"][:][on], bb["b"][:][on]
+    rad = f["balls/radius"][:]
+    assert np.all(np.abs(rel - (x[pb] - x[pa])) < 1e-6), np.abs(rel - (x[pb] - x[pa])).max()
+    overlap = rad[pa] + rad[pb] - np.linalg.norm(rel, axis=1)
+    assert np.all(overlap > -1e-6), overlap.min()
     w = f["walls"]
     kinds = h5py.check_enum_dtype(w["kind"].dtype)
     assert kinds["cylinder"] == 4 and w["kind"][0] == 4, kinds
@@ -37,7 +48,7 @@ with h5py.File(d + "/snapshot.h5", "r") as f:
     assert abs(radius[-1] - w["radius"][0]) < 0.05 * w["radius"][0]
 
 with h5py.File(d + "/series.h5", "r") as f:
-    assert f.attrs["kind"] == b"series" and f.attrs["format_version"] == 2
+    assert f.attrs["kind"] == b"series" and f.attrs["format_version"] == 3
     count = f.attrs["count"]
     assert count == 7, count
     last = f["snapshots/%06d" % (count - 1)]
