@@ -370,15 +370,10 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     return pairs_resize(m, p, cap);
 }
 
-void sx__pairs_fit(sx_model *m, sx_pairs *p)
-{
-    const int64_t want = p->n + p->n / 16 + 256;
-    if (p->cap > want + want / 8) pairs_resize(m, p, want); /* on failure the larger arrays stay, still valid */
-}
-
 sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap)
 {
     if (cap < p->n) cap = p->n;
+    if (cap < 16) cap = 16; /* never an empty allocation */
     return cap == p->cap ? SX_OK : pairs_resize(m, p, cap);
 }
 

@@ -193,10 +193,14 @@ static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const hist
 }
 
 /* Bonded pairs stay in the store whatever their gap: those the grid did
- * not find again are appended (after the grid's pairs, in slot order). */
+ * not find again are appended (after the grid's pairs, in slot order; the
+ * store grown once to hold them). */
 static bool keep_bonded_pairs(sx_model *m, const history *h)
 {
     const sx_bonds *bs = &m->bonds;
+    int64_t lost = 0;
+    for (int64_t s = 0; s < bs->n; s++) lost += bs->kind[s] && !h->seen[s];
+    if (lost && sx__pairs_presize(m, &m->bb, m->bb.n + lost)) return false;
     for (int64_t s = 0; s < bs->n; s++) {
         if (!bs->kind[s] || h->seen[s]) continue;
         int32_t a = m->balls.index_of[bs->ida[s]], b = m->balls.index_of[bs->idb[s]];
@@ -420,20 +424,29 @@ static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
     return true;
 }
 
-/* Ball-wall candidates, ball-major so the contact loop walks balls in order. */
-static bool build_wall_pairs(sx_model *m, const history *h)
+/* Ball-wall candidates, ball-major so the contact loop walks balls in
+ * order; with count, only counts them (as build_ball_pairs). */
+static bool build_wall_pairs(sx_model *m, const history *h, int64_t *count)
 {
     const sx_balls *b = &m->balls;
     sx_pairs *p = &m->bw;
-    p->n = 0;
+    if (!count) p->n = 0;
     for (int64_t i = 0; i < b->n; i++)
         for (int64_t w = 0; w < m->nwall; w++) {
             double n[D];
             const double dist = wall_distance(&m->walls[w], b->x + i * D, n);
-            if (dist < b->rad[i] + m->skin && !pair_push(m, p, (int32_t)i, (int32_t)w, h, bw_key(b->id[i], w), 1.0))
-                return false;
+            if (dist >= b->rad[i] + m->skin) continue;
+            if (count) (*count)++;
+            else if (!pair_push(m, p, (int32_t)i, (int32_t)w, h, bw_key(b->id[i], w), 1.0)) return false;
         }
     return true;
+}
+
+/* Sizes a store for the count of a build's pairs, the history being saved. */
+static bool presize_for(sx_model *m, sx_pairs *p, int64_t count)
+{
+    p->n = 0;
+    return !sx__pairs_presize(m, p, count);
 }
 
 static bool plan_chunks(sx_model *m);
@@ -457,16 +470,15 @@ static bool KERNEL(build)(sx_model *m)
         m->skin = 0.2 * sum / (double)m->balls.n;
     }
     history h;
-    /* the pair store sized to the count, with 1/16 headroom for the bonded
-     * pairs and the next build, so it never grows by half again */
-    int64_t count = 0;
+    /* each pair store sized to its count first, so it holds no more than
+     * its pairs and never grows by half while it is filled */
+    int64_t count = 0, wall_count = 0;
     bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h, &count) &&
-              !sx__pairs_presize(m, &m->bb, count + count / 16 + 256) && build_ball_pairs(m, &h, NULL) &&
-              keep_bonded_pairs(m, &h) && build_wall_pairs(m, &h) && plan_chunks(m);
+              presize_for(m, &m->bb, count) && build_ball_pairs(m, &h, NULL) && keep_bonded_pairs(m, &h) &&
+              build_wall_pairs(m, &h, &wall_count) && presize_for(m, &m->bw, wall_count) &&
+              build_wall_pairs(m, &h, NULL) && plan_chunks(m);
     history_free(&h);
     if (!ok) return false;
-    sx__pairs_fit(m, &m->bb);
-    sx__pairs_fit(m, &m->bw);
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;

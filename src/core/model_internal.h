@@ -264,8 +264,6 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
-/* Gives back what a build did not use, keeping 1/16 headroom for the next. */
-void sx__pairs_fit(sx_model *m, sx_pairs *p);
 /* Resizes the store to exactly cap pairs (never below its count). */
 sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
