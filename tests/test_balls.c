@@ -679,6 +679,59 @@ START_TEST(remove_many_keeps_contacts)
 }
 END_TEST
 
+/* A ball's own damping and its group are stored only once some ball has
+ * them: until then each ball takes its material's damping and group 0,
+ * and the store costs that much less per ball. */
+START_TEST(damping_and_group_stored_when_used)
+{
+    const int dim = _i;
+    sx_model *m = scene_model(dim, NULL, 1e-4, 1e5, 0.5, 2000);
+    sx_material_def md;
+    ck_assert_int_eq(sx_material_get(m, scene_material(m), &md), SX_OK);
+    md.damping = 0.4;
+    ck_assert_int_eq(sx_material_set(m, "m", &md, NULL), SX_OK);
+    int64_t ids[3];
+    for (int k = 0; k < 3; k++) ids[k] = scene_ball(m, (double[3]){k, 0, 0}, NULL, 0.1);
+    const double lean = sx_model_memory(m).bytes_per_ball;
+    double a;
+    int32_t g;
+    ck_assert_int_eq(sx_ball_get(m, ids[1], SX_BALL_DAMPING, &a), SX_OK);
+    ck_assert_double_eq(a, 0.4);
+    ck_assert_int_eq(sx_ball_group(m, ids[1], &g), SX_OK);
+    ck_assert_int_eq(g, 0);
+    /* setting what a ball has already stores nothing */
+    ck_assert_int_eq(sx_ball_set(m, ids[1], SX_BALL_DAMPING, 0.4), SX_OK);
+    ck_assert_int_eq(sx_ball_set_group(m, ids[1], 0), SX_OK);
+    ck_assert(sx_model_memory(m).bytes_per_ball == lean);
+    /* one ball's own damping and group */
+    ck_assert_int_eq(sx_ball_set(m, ids[1], SX_BALL_DAMPING, 0.1), SX_OK);
+    ck_assert_int_eq(sx_ball_set_group(m, ids[2], 5), SX_OK);
+    ck_assert(sx_model_memory(m).bytes_per_ball > lean);
+    ck_assert_int_eq(sx_ball_get(m, ids[0], SX_BALL_DAMPING, &a), SX_OK);
+    ck_assert_double_eq(a, 0.4);
+    ck_assert_int_eq(sx_ball_get(m, ids[1], SX_BALL_DAMPING, &a), SX_OK);
+    ck_assert_double_eq(a, 0.1);
+    ck_assert_int_eq(sx_ball_group(m, ids[2], &g), SX_OK);
+    ck_assert_int_eq(g, 5);
+    ck_assert_int_eq(sx_ball_group(m, ids[0], &g), SX_OK);
+    ck_assert_int_eq(g, 0);
+    /* a new ball takes its material's damping and no group */
+    const int64_t late = scene_ball(m, (double[3]){5, 0, 0}, NULL, 0.1);
+    ck_assert_int_eq(sx_ball_get(m, late, SX_BALL_DAMPING, &a), SX_OK);
+    ck_assert_double_eq(a, 0.4);
+    ck_assert_int_eq(sx_ball_group(m, late, &g), SX_OK);
+    ck_assert_int_eq(g, 0);
+    /* redefining the material's damping sets it on all its balls, as always */
+    md.damping = 0.2;
+    ck_assert_int_eq(sx_material_set(m, "m", &md, NULL), SX_OK);
+    for (int k = 0; k < 3; k++) {
+        ck_assert_int_eq(sx_ball_get(m, ids[k], SX_BALL_DAMPING, &a), SX_OK);
+        ck_assert_double_eq(a, 0.2);
+    }
+    sx_model_destroy(m);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("balls");
@@ -688,6 +741,7 @@ int main(void)
     tcase_add_loop_test(tc, mass_inertia_formulas, 2, 4);
     tcase_add_loop_test(tc, radius_and_material_change_mass, 2, 4);
     tcase_add_loop_test(tc, fixity_masks, 2, 4);
+    tcase_add_loop_test(tc, damping_and_group_stored_when_used, 2, 4);
     tcase_add_loop_test(tc, fixity_under_gravity, 2, 4);
     tcase_add_loop_test(tc, applied_load_one_step, 2, 4);
     tcase_add_loop_test(tc, applied_loads_survive_growth, 2, 4);

@@ -56,11 +56,11 @@ static sx_status balls_resize(sx_model *m, int64_t cap)
     RESIZE(b, rad, 1);
     RESIZE(b, inv_mass, 1);
     RESIZE(b, inv_inertia, 1);
-    RESIZE(b, alpha, 1);
+    if (b->alpha) RESIZE(b, alpha, 1);
     RESIZE(b, id, 1);
     RESIZE(b, mat, 1);
     RESIZE(b, fix, 1);
-    RESIZE(b, group, 1);
+    if (b->group) RESIZE(b, group, 1);
     if (b->fapp) {
         RESIZE(b, fapp, d);
         RESIZE(b, tapp, r);
@@ -88,11 +88,11 @@ void sx__balls_free(sx_model *m)
     free_field(m, b->rad, c, sizeof(double));
     free_field(m, b->inv_mass, c, sizeof(double));
     free_field(m, b->inv_inertia, c, sizeof(double));
-    free_field(m, b->alpha, c, sizeof(double));
+    free_field(m, b->alpha, b->alpha ? c : 0, sizeof(double));
     free_field(m, b->id, c, sizeof(int32_t));
     free_field(m, b->mat, c, sizeof(uint16_t));
     free_field(m, b->fix, c, sizeof(uint8_t));
-    free_field(m, b->group, c, sizeof(int32_t));
+    free_field(m, b->group, b->group ? c : 0, sizeof(int32_t));
     free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
     free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
     free_field(m, b->clump, b->clump ? c : 0, sizeof(int32_t));
@@ -190,9 +190,9 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     }
     b->rad[i] = def->radius;
     b->mat[i] = (uint16_t)def->material;
-    b->alpha[i] = m->mats[def->material].def.damping;
+    if (b->alpha) b->alpha[i] = m->mats[def->material].def.damping;
     b->fix[i] = 0;
-    b->group[i] = 0;
+    if (b->group) b->group[i] = 0;
     if (b->clump) b->clump[i] = 0;
     b->id[i] = (int32_t)id;
     b->index_of[id] = (int32_t)i;
@@ -221,11 +221,11 @@ static void move_ball(sx_model *m, int64_t to, int64_t from)
     b->rad[to] = b->rad[from];
     b->inv_mass[to] = b->inv_mass[from];
     b->inv_inertia[to] = b->inv_inertia[from];
-    b->alpha[to] = b->alpha[from];
+    if (b->alpha) b->alpha[to] = b->alpha[from];
     b->id[to] = b->id[from];
     b->mat[to] = b->mat[from];
     b->fix[to] = b->fix[from];
-    b->group[to] = b->group[from];
+    if (b->group) b->group[to] = b->group[from];
     if (b->clump) b->clump[to] = b->clump[from];
     b->index_of[b->id[to]] = (int32_t)to;
 }
@@ -335,11 +335,11 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     GATHER(rad, 1, double);
     GATHER(inv_mass, 1, double);
     GATHER(inv_inertia, 1, double);
-    GATHER(alpha, 1, double);
+    if (b->alpha) GATHER(alpha, 1, double);
     GATHER(id, 1, int32_t);
     GATHER(mat, 1, uint16_t);
     GATHER(fix, 1, uint8_t);
-    GATHER(group, 1, int32_t);
+    if (b->group) GATHER(group, 1, int32_t);
     if (b->clump) GATHER(clump, 1, int32_t);
 #undef GATHER
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
@@ -465,7 +465,10 @@ size_t sx__balls_bytes(const sx_model *m)
 {
     const sx_balls *b = &m->balls;
     const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
-    size_t per = (4 * d + 2 * r + 4) * sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint16_t) + sizeof(uint8_t);
+    size_t per = (4 * d + 2 * r + 3) * sizeof(double) + sizeof(int32_t) + sizeof(uint16_t) + sizeof(uint8_t);
+    if (b->alpha) per += sizeof(double);
+    if (b->group) per += sizeof(int32_t);
+    if (b->clump) per += sizeof(int32_t);
     if (b->fapp) per += (d + r) * sizeof(double);
     return c * per + (size_t)b->index_cap * sizeof(int32_t);
 }
@@ -508,6 +511,35 @@ static sx_status ensure_applied(sx_model *m)
     b->tapp = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(c * m->rdim), sizeof(double));
     if (!b->fapp || !b->tapp) return SX_ENOMEM;
     return SX_OK;
+}
+
+sx_status sx__balls_expand(sx_model *m)
+{
+    sx_balls *b = &m->balls;
+    const size_t c = (size_t)b->cap;
+    if (!b->alpha) {
+        if (!(b->alpha = sx_alloc_resize(&m->alloc, NULL, 0, c, sizeof *b->alpha))) return SX_ENOMEM;
+        for (int64_t i = 0; i < b->n; i++) b->alpha[i] = m->mats[b->mat[i]].def.damping;
+    }
+    if (!b->group && !(b->group = sx_alloc_resize(&m->alloc, NULL, 0, c, sizeof *b->group))) return SX_ENOMEM;
+    return SX_OK;
+}
+
+void sx__balls_compact(sx_model *m)
+{
+    sx_balls *b = &m->balls;
+    bool own_damping = false, grouped = false;
+    for (int64_t i = 0; i < b->n && b->alpha && !own_damping; i++)
+        own_damping = b->alpha[i] != m->mats[b->mat[i]].def.damping;
+    for (int64_t i = 0; i < b->n && b->group && !grouped; i++) grouped = b->group[i] != 0;
+    if (!own_damping) {
+        free_field(m, b->alpha, b->alpha ? b->cap : 0, sizeof(double));
+        b->alpha = NULL;
+    }
+    if (!grouped) {
+        free_field(m, b->group, b->group ? b->cap : 0, sizeof(int32_t));
+        b->group = NULL;
+    }
 }
 
 /* Where a vector field lives and how many components it has. */
@@ -577,7 +609,7 @@ sx_status sx_ball_get(const sx_model *m, int64_t id, sx_ball_scalar which, doubl
     case SX_BALL_RADIUS: *out = b->rad[i]; return SX_OK;
     case SX_BALL_MASS: *out = 1.0 / b->inv_mass[i]; return SX_OK;
     case SX_BALL_INERTIA: *out = 1.0 / b->inv_inertia[i]; return SX_OK;
-    case SX_BALL_DAMPING: *out = b->alpha[i]; return SX_OK;
+    case SX_BALL_DAMPING: *out = sx__ball_damping(m, i); return SX_OK;
     }
     return sx__fail((sx_model *)m, SX_EINVAL, "ball_get: unknown field %d", (int)which);
 }
@@ -603,6 +635,8 @@ sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double valu
     case SX_BALL_DAMPING:
         if (!(value >= 0 && value < 1))
             return sx__fail(m, SX_EINVAL, "ball_set: local damping must be in [0, 1) (got %g)", value);
+        if (!b->alpha && value == sx__ball_damping(m, i)) return SX_OK; /* it follows its material already */
+        if (sx__balls_expand(m)) return sx__fail(m, SX_ENOMEM, "ball_set: out of memory");
         b->alpha[i] = value;
         return SX_OK;
     case SX_BALL_MASS:
@@ -636,7 +670,7 @@ sx_status sx_ball_set_material(sx_model *m, int64_t id, int material)
             return SX_EINVAL;
     }
     m->balls.mat[i] = (uint16_t)material;
-    m->balls.alpha[i] = m->mats[material].def.damping;
+    if (m->balls.alpha) m->balls.alpha[i] = m->mats[material].def.damping;
     sx__ball_update_mass(m, i);
     m->dt_stale = true;
     return SX_OK;
@@ -689,7 +723,7 @@ sx_status sx_ball_group(const sx_model *m, int64_t id, int32_t *group)
 {
     const int64_t i = lookup(m, id, "ball_group");
     if (i < 0) return SX_ENOTFOUND;
-    *group = m->balls.group[i];
+    *group = m->balls.group ? m->balls.group[i] : 0;
     return SX_OK;
 }
 
@@ -697,6 +731,8 @@ sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group)
 {
     const int64_t i = lookup(m, id, "ball_set_group");
     if (i < 0) return SX_ENOTFOUND;
+    if (!m->balls.group && group == 0) return SX_OK;
+    if (sx__balls_expand(m)) return sx__fail(m, SX_ENOMEM, "ball_set_group: out of memory");
     m->balls.group[i] = group;
     return SX_OK;
 }

@@ -1194,7 +1194,7 @@ sx_status sx_clump_set_material(sx_model *m, int64_t id, int material)
     for (int64_t k = 0; k < n; k++) {
         const int64_t i = m->balls.index_of[C->pebble[C->first[c] + k]];
         m->balls.mat[i] = (uint16_t)material;
-        m->balls.alpha[i] = m->mats[material].def.damping;
+        if (m->balls.alpha) m->balls.alpha[i] = m->mats[material].def.damping;
     }
     clump_mass(m, c);
     m->dt_stale = true;

@@ -1486,7 +1486,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     const bool track = !plain && m->track_energy;
     double *restrict xa = B->x, *restrict va = B->v, *restrict wa = B->w;
     const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
-    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia, *restrict alpha = B->alpha;
+    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia;
     const uint8_t *restrict fixa = B->fix;
     const int32_t *cl = B->clump;
     double worst = 0, damp_work = 0, load_work = 0;
@@ -1494,7 +1494,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     for (int64_t i = o->b0; i < o->b1; i++) {
         if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
         const unsigned fix = plain ? 0 : fixa[i];
-        const double a = plain ? 0 : alpha[i], im = ima[i], ii = iia[i];
+        const double a = plain ? 0 : sx__ball_damping(m, i), im = ima[i], ii = iia[i];
         double *v = va + i * D, *x = xa + i * D;
         const double *f = fa + i * D;
         double disp2 = 0;
@@ -1550,7 +1550,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
 static void integrate_block(sx_model *m, sx_block *o)
 {
     bool plain = !m->track_energy;
-    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !m->balls.fix[i] && m->balls.alpha[i] == 0;
+    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !m->balls.fix[i] && sx__ball_damping(m, i) == 0;
     if (plain) motion_pass(m, o, true);
     else motion_pass(m, o, false);
 }
@@ -1677,7 +1677,7 @@ static double KERNEL(critical_dt)(sx_model *m)
          * m x'' + c x' + k x = 0 with x' taken at the half step, stability needs
          * (w dt)^2 + 4 z (w dt) < 4, i.e. dt < (2/w)(sqrt(1 + z^2) - z), z = c / (2 sqrt(k m));
          * local damping scales a decelerating force by up to (1 + alpha), so z is scaled too. */
-        const double amp = 1 + B->alpha[i];
+        const double amp = 1 + sx__ball_damping(m, i);
         const double zt = amp * ct[i] / (2 * sqrt(ktr / B->inv_mass[i]));
         const double dtt = sqrt(1.0 / (B->inv_mass[i] * ktr)) * (sqrt(1 + zt * zt) - zt);
         if (dtt < best) best = dtt;

@@ -240,7 +240,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     for (int64_t b = 0; b < m->balls.n; b++) {
         if (m->balls.mat[b] != i) continue;
         if (density_changed) sx__ball_update_mass(m, b);
-        if (damping_changed) m->balls.alpha[b] = d->damping;
+        if (damping_changed && m->balls.alpha) m->balls.alpha[b] = d->damping; /* else it follows the material */
     }
     if ((density_changed || damping_changed) && m->clumps) /* the bodies of the material, as its balls */
         sx__clumps_material_changed(m, i, density_changed, damping_changed);

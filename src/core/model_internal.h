@@ -54,11 +54,15 @@ typedef struct sx_balls {
     double *x, *v, *w;     /* position (dim), velocity (dim), spin (rdim) */
     double *f, *t;         /* force (dim), moment (rdim) of the last step */
     double *x_build;       /* position at the last broad-phase build (dim) */
-    double *rad, *inv_mass, *inv_inertia, *alpha; /* radius, 1/m, 1/I, local damping */
+    double *rad, *inv_mass, *inv_inertia; /* radius, 1/m, 1/I */
     int32_t *id;           /* stable id of each dense index */
     uint16_t *mat;         /* material index */
     uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
-    int32_t *group;        /* user group number (0: none) */
+    /* allocated once some ball needs them (sx__balls_expand): local damping,
+     * NULL while every ball has its material's (sx__ball_damping); user
+     * group number, NULL while every ball is in none (0) */
+    double *alpha;
+    int32_t *group;
     int32_t *clump;        /* clump id of each ball (0: a free ball); NULL while the model has no clumps */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
@@ -229,6 +233,12 @@ struct sx_model {
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
 };
 
+/* Ball i's local damping: its own, or its material's. */
+static inline double sx__ball_damping(const sx_model *m, int64_t i)
+{
+    return m->balls.alpha ? m->balls.alpha[i] : m->mats[m->balls.mat[i]].def.damping;
+}
+
 /* Local (non-viscous) damping, -alpha |F| sign(v) per component (DESIGN 1):
  * the balls' law of motion (kernels.c) and the clumps' (clumps.c). */
 static inline double sx__damped(double force, double vel, double alpha)
@@ -262,6 +272,11 @@ void sx__balls_free(sx_model *m);
 /* new index i <- old index order[i]; scratch holds n * dim doubles */
 void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
+/* Allocates the per-ball damping (from the materials) and group (0) arrays
+ * if absent; SX_ENOMEM. Compact frees each again when it holds only what
+ * the materials or the default would (a loaded state, say). */
+sx_status sx__balls_expand(sx_model *m);
+void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
 /* Resizes the store to exactly cap pairs (never below its count). */

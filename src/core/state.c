@@ -57,6 +57,8 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     sx_balls *b = &m->balls;
     /* applied loads live at the balls' capacity: a store that had them keeps one */
     if ((s->balls > 0 || s->applied) && sx__balls_reserve(m, s->balls > 0 ? s->balls : 1)) goto nomem;
+    /* the damping and group arrays for the file to fill (sx__state_finish frees them when uniform) */
+    if (b->cap > 0 && sx__balls_expand(m)) goto nomem;
     if (s->applied) {
         if (!alloc_array(m, (void **)&b->fapp, b->cap * d, sizeof(double)) ||
             !alloc_array(m, (void **)&b->tapp, b->cap * r, sizeof(double)))
@@ -161,7 +163,8 @@ static sx_status check_balls(sx_model *m)
                             (int)b->mat[i], m->nmat);
         if (b->fix[i] & ~valid) return sx__fail(m, SX_EINVAL, "state: ball %lld has invalid fixity bits", (long long)id);
         if (!(b->rad[i] > 0) || !isfinite(b->rad[i]) || !(b->inv_mass[i] > 0) || !isfinite(b->inv_mass[i]) ||
-            !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) || !(b->alpha[i] >= 0 && b->alpha[i] < 1))
+            !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) || !(sx__ball_damping(m, i) >= 0) ||
+            !(sx__ball_damping(m, i) < 1))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a radius, mass, inertia or damping out of range",
                             (long long)id);
         if (!finite_all(b->x + i * d, d) || !finite_all(b->x_build + i * d, d) || !finite_all(b->v + i * d, d) ||
@@ -262,6 +265,7 @@ sx_status sx__state_finish(sx_model *m)
     if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
         (st = check_pairs(m)) || (st = check_bonds(m)) || (st = sx__clumps_finish(m)))
         return st;
+    sx__balls_compact(m);
     /* the ball-ball pass's chunks follow from the pair store alone: planned
      * again they are those the last build made */
     const sx_kernels *k = m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d;

@@ -416,7 +416,12 @@ static void write_balls(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f)
     if (f & SX_OUT_FORCE) write_vec(h, g, "force", m, b->f, m->dim, false, "N");
     if (f & SX_OUT_MOMENT) write_vec(h, g, "moment", m, b->t, m->rdim, true, "N m");
     if (f & SX_OUT_RADIUS) sx_h5_write(h, g, "radius", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, b->rad, n, 1, "m");
-    if (f & SX_OUT_GROUP) sx_h5_write(h, g, "group", H5T_NATIVE_INT32, H5T_STD_I32LE, b->group, n, 1, NULL);
+    if (f & SX_OUT_GROUP) { /* a store without groups: every ball in none (0) */
+        int32_t *none = b->group ? NULL : calloc((size_t)(n > 0 ? n : 1), sizeof *none);
+        if (!b->group && !none) sx_h5_fail(h, "out of memory");
+        else sx_h5_write(h, g, "group", H5T_NATIVE_INT32, H5T_STD_I32LE, b->group ? b->group : none, n, 1, NULL);
+        free(none);
+    }
     if (f & (SX_OUT_ID | SX_OUT_MATERIAL | SX_OUT_MASS)) {
         int64_t *iv = malloc((size_t)(n > 0 ? n : 1) * sizeof *iv);
         double *dv = malloc((size_t)(n > 0 ? n : 1) * sizeof *dv);

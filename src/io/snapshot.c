@@ -56,8 +56,35 @@ typedef struct field {
 
 #define F(nm, ty, ptr, p, u) (field){nm, ty, (void *)(ptr), p, u}
 
+/* The per-ball arrays as a file holds them, whether or not the store has
+ * its own: the damping (a ball's own, or its material's) and the group
+ * (0 when the store has none). A load reads into the store's own, which
+ * sx__state_alloc makes (and sx__state_finish gives back when uniform). */
+typedef struct ball_cols {
+    double *damping;
+    int32_t *group;
+    void *owned; /* what was allocated for a save */
+} ball_cols;
+
+static bool ball_cols_for_save(const sx_model *m, ball_cols *c)
+{
+    const sx_balls *b = &m->balls;
+    const size_t n = (size_t)(b->n > 0 ? b->n : 1);
+    memset(c, 0, sizeof *c);
+    c->damping = b->alpha, c->group = b->group;
+    if (b->alpha && b->group) return true;
+    char *q = c->owned = calloc(n, sizeof(double) + sizeof(int32_t));
+    if (!q) return false;
+    if (!b->alpha) {
+        c->damping = (double *)q;
+        for (int64_t i = 0; i < b->n; i++) c->damping[i] = sx__ball_damping(m, i);
+    }
+    if (!b->group) c->group = (int32_t *)(q + n * sizeof(double)); /* zeros */
+    return true;
+}
+
 /* Every per-ball array (applied loads only when the store has them). */
-static int ball_fields(const sx_model *m, field *f)
+static int ball_fields(const sx_model *m, const ball_cols *c, field *f)
 {
     const sx_balls *b = &m->balls;
     const int d = m->dim, r = m->rdim;
@@ -72,10 +99,10 @@ static int ball_fields(const sx_model *m, field *f)
     f[n++] = F("radius", T_F64, b->rad, 1, "m");
     f[n++] = F("inv_mass", T_F64, b->inv_mass, 1, "1/kg");
     f[n++] = F("inv_inertia", T_F64, b->inv_inertia, 1, "1/(kg m^2)");
-    f[n++] = F("damping", T_F64, b->alpha, 1, "1");
+    f[n++] = F("damping", T_F64, c->damping, 1, "1");
     f[n++] = F("material", T_U16, b->mat, 1, NULL);
     f[n++] = F("fixity", T_U8, b->fix, 1, NULL);
-    f[n++] = F("group", T_I32, b->group, 1, NULL);
+    f[n++] = F("group", T_I32, c->group, 1, NULL);
     if (b->fapp) {
         f[n++] = F("applied_force", T_F64, b->fapp, d, "N");
         f[n++] = F("applied_moment", T_F64, b->tapp, r, "N m");
@@ -818,7 +845,10 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     g = sx_h5_group(h, f, "balls");
     sx_h5_attr_int(h, g, "count", m->balls.n);
     sx_h5_attr_int(h, g, "next_id", m->balls.next_id < 1 ? 1 : m->balls.next_id);
-    write_fields(h, g, fl, ball_fields(m, fl), m->balls.n);
+    ball_cols bc;
+    if (!ball_cols_for_save(m, &bc)) sx_h5_fail(h, "out of memory");
+    else write_fields(h, g, fl, ball_fields(m, &bc, fl), m->balls.n);
+    free(bc.owned);
     sx_h5_close(g);
 
     g = sx_h5_group(h, f, "contacts");
@@ -1028,7 +1058,8 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         sx_h5_close(g);
 
         field fl[MAX_FIELDS];
-        load_group(&h, f, "/balls", fl, ball_fields(m, fl), m->balls.n);
+        const ball_cols bc = {m->balls.alpha, m->balls.group, NULL};
+        load_group(&h, f, "/balls", fl, ball_fields(m, &bc, fl), m->balls.n);
         double *overlap = NULL; /* formats 1 and 2 store a ball-ball pair's normal and overlap */
         if (version < 3 && !(overlap = calloc((size_t)(m->bb.n > 0 ? m->bb.n : 1), sizeof *overlap)))
             sx_h5_fail(&h, "out of memory");
