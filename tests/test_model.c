@@ -8,6 +8,7 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -728,6 +729,38 @@ START_TEST(cycle_without_balls)
 }
 END_TEST
 
+/* A step that leaves a ball's position, velocity or spin non-finite stops
+ * the cycle and names the ball; a finite state, however far it went (its
+ * displacement's square overflows), does not. */
+START_TEST(non_finite_state_stops)
+{
+    const int dim = _i;
+    for (int what = 0; what < 3; what++) {
+        sx_model *m = scene_model(dim, NULL, 1e-3, 1e5, 0.5, 1000);
+        const int64_t calm = scene_ball(m, (const double[3]){0, 0, 0}, NULL, 1e-3);
+        const int64_t id = scene_ball(m, (const double[3]){1, 1, 1}, NULL, 1e-3);
+        (void)calm;
+        if (what == 2) { /* 1e200 m/s: 1e197 m in a step, finite */
+            ck_assert_int_eq(sx_ball_set_vec(m, id, SX_BALL_VEL, (const double[3]){1e200, 0, 0}), SX_OK);
+            ck_assert_cycle(m, 3);
+            double x[3];
+            ck_assert_int_eq(sx_ball_get_vec(m, id, SX_BALL_POS, x), SX_OK);
+            ck_assert(isfinite(x[0]) && x[0] > 1e197);
+        } else { /* a force or a moment that no double can integrate */
+            const double big[3] = {DBL_MAX, DBL_MAX, DBL_MAX};
+            ck_assert_int_eq(sx_ball_set_vec(m, id, what == 0 ? SX_BALL_APPLIED_FORCE : SX_BALL_APPLIED_MOMENT, big),
+                             SX_OK);
+            ck_assert_int_eq(sx_model_cycle(m, 3), SX_EUNSTABLE);
+            ck_assert_msg_has(m, "non-finite");
+            char ball[32];
+            snprintf(ball, sizeof ball, "ball %lld ", (long long)id);
+            ck_assert_msg_has(m, ball);
+        }
+        sx_model_destroy(m);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("model");
@@ -743,6 +776,7 @@ int main(void)
     tcase_add_loop_test(tc, profile_stages, 2, 4);
     tcase_add_loop_test(tc, energy_by_hand, 2, 4);
     tcase_add_loop_test(tc, energy_of_new_overlaps, 2, 4);
+    tcase_add_loop_test(tc, non_finite_state_stops, 2, 4);
     suite_add_tcase(s, tc);
     /* these could hang if the interrupt or an empty grid were mishandled */
     TCase *tq = tcase_create("bounded");

@@ -1490,7 +1490,10 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     const uint8_t *restrict fixa = B->fix;
     const int32_t *cl = B->clump;
     double worst = 0, damp_work = 0, load_work = 0;
-    double check = 0; /* a sum of 0 x every new value: NaN once any is not finite */
+    /* the displacements' squares (a non-finite velocity makes its position
+     * so) and 0 x every spin: not finite once some value is not (or once
+     * the squares overflow; the search below tells) */
+    double check = 0;
     for (int64_t i = o->b0; i < o->b1; i++) {
         if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
         const unsigned fix = plain ? 0 : fixa[i];
@@ -1514,8 +1517,8 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - xb[i * D + k];
             disp2 += u * u;
-            check += 0 * x[k] + 0 * v[k];
         }
+        check += disp2;
         double *w = wa + i * RD;
         const double *t = ta + i * RD;
         for (int k = 0; k < RD; k++) {
@@ -1538,7 +1541,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     o->damp_work = damp_work;
     o->load_work = load_work;
     o->bad = -1;
-    if (check != check) /* find the first ball to blame */
+    if (!isfinite(check)) /* find the first ball to blame */
         for (int64_t i = o->b0; i < o->b1 && o->bad < 0; i++) {
             bool ok = true;
             for (int k = 0; k < D; k++) ok &= isfinite(xa[i * D + k]) && isfinite(va[i * D + k]);
@@ -1549,8 +1552,11 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
 
 static void integrate_block(sx_model *m, sx_block *o)
 {
-    bool plain = !m->track_energy;
-    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !m->balls.fix[i] && sx__ball_damping(m, i) == 0;
+    bool plain = !m->track_energy, undamped = true; /* undamped: no material has local damping */
+    for (int k = 0; k < m->nmat; k++) undamped &= m->mats[k].def.damping == 0;
+    const sx_balls *B = &m->balls;
+    for (int64_t i = o->b0; i < o->b1 && plain; i++)
+        plain = !B->fix[i] && (B->alpha ? B->alpha[i] == 0 : undamped || sx__ball_damping(m, i) == 0);
     if (plain) motion_pass(m, o, true);
     else motion_pass(m, o, false);
 }
