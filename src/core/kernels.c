@@ -215,16 +215,27 @@ static bool keep_bonded_pairs(sx_model *m, const history *h)
 }
 
 /* Distance from ball centre x to wall w: fills the unit normal from the wall
- * to the ball and returns the (signed, for planes) distance. */
-static double wall_distance(const sx_wall *w, const double *x, double *n)
+ * to the ball and returns the (signed, for planes) distance. Infinite walls
+ * inline, the others in finite_wall_distance. */
+static double finite_wall_distance(const sx_wall *w, const double *x, double *n);
+
+static inline double wall_distance(const sx_wall *w, const double *x, double *n)
+{
+    const sx_wall_def *d = &w->def;
+    if (d->kind == SX_WALL_PLANE || d->kind == SX_WALL_LINE) {
+        double r[D];
+        for (int k = 0; k < D; k++) r[k] = x[k] - d->point[k];
+        for (int k = 0; k < D; k++) n[k] = d->normal[k];
+        return dot(r, d->normal);
+    }
+    return finite_wall_distance(w, x, n);
+}
+
+static double finite_wall_distance(const sx_wall *w, const double *x, double *n)
 {
     const sx_wall_def *d = &w->def;
     double r[D];
     for (int k = 0; k < D; k++) r[k] = x[k] - d->point[k];
-    if (d->kind == SX_WALL_PLANE || d->kind == SX_WALL_LINE) {
-        for (int k = 0; k < D; k++) n[k] = d->normal[k];
-        return dot(r, d->normal);
-    }
     double q[D];
 #if D == 3
     if (d->kind == SX_WALL_CYLINDER) { /* balls inside; n points from the surface towards the axis */
@@ -906,6 +917,7 @@ enum { LANES = 4 };
  * baseline one; each operation is the IEEE operation of each lane. */
 typedef double vd __attribute__((vector_size(LANES * sizeof(double))));
 typedef int64_t vm __attribute__((vector_size(LANES * sizeof(int64_t))));
+typedef uint8_t v4u8 __attribute__((vector_size(LANES))); /* four pairs' touching flags */
 
 /* (macros, not functions: a vector argument would change the baseline ABI) */
 #define VSEL(msk, a, b) ((vd)(((vm)(a) & (msk)) | ((vm)(b) & ~(msk))))
@@ -1005,19 +1017,25 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
          * batch copied to four pairs first) */
         const bool full = nb == LANES;
         double tail[2 * LANES * D + LANES];
+        uint8_t tail_touching[LANES];
         const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D, *hfn = fn_all + c0;
+        const uint8_t *htouching = touching + c0;
         if (!full) {
             for (int q = 0; q < LANES; q++) {
                 memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
                 memcpy(tail + (LANES + q) * D, geo_all + cc[q] * D, D * sizeof(double));
                 tail[2 * LANES * D + q] = fn_all[cc[q]];
+                tail_touching[q] = touching[cc[q]];
             }
-            hfs = tail, hrel = tail + LANES * D, hfn = tail + 2 * LANES * D;
+            hfs = tail, hrel = tail + LANES * D, hfn = tail + 2 * LANES * D, htouching = tail_touching;
         }
         vd fs_old[D], rel_old[D], fn_old;
         load_lanes(hfs, fs_old);
         load_lanes(hrel, rel_old);
         memcpy(&fn_old, hfn, sizeof fn_old);
+        v4u8 touched;
+        memcpy(&touched, htouching, sizeof touched);
+        const vm had = __builtin_convertvector(touched, vm) != 0;
 
         /* the previous normal from the relative position as in ball_chunk_pass
          * (first: its square root and division overlap the loads below) */
@@ -1031,8 +1049,6 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
             dv[k] = LANES_OF(v, j, D, k) - LANES_OF(v, i, D, k);
         }
         const vd ri = LANES_OF(rad, i, 1, 0), rj = LANES_OF(rad, j, 1, 0);
-        const vm had = {-(int64_t)(touching[cc[0]] != 0), -(int64_t)(touching[cc[1]] != 0),
-                        -(int64_t)(touching[cc[2]] != 0), -(int64_t)(touching[cc[3]] != 0)};
 
         /* 4-1 ... 4-4 */
         /* sums from zero, as dot() (the sign of a zero sum) */
@@ -1102,8 +1118,8 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         const vm active = u > VZERO;
         const vd sim = LANES_OF(im, i, 1, 0) + LANES_OF(im, j, 1, 0);
         vd cn;
-        if (sim[0] == memo_sim && sim[1] == memo_sim && sim[2] == memo_sim && sim[3] == memo_sim &&
-            dash[0] == memo_dash && dash[1] == memo_dash && dash[2] == memo_dash && dash[3] == memo_dash) {
+        const vm other = (sim != memo_sim) | (dash != memo_dash);
+        if (!VANY(other)) {
             cn = VZERO + memo_cn;
         } else {
             cn = VSQRT(dash / sim);
@@ -1305,6 +1321,7 @@ static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
     sx_pairs *p = &m->bw;
     const double dt = motion_dt(m);
     const bool track = m->track_energy;
+    double memo_dash = NAN, memo_im = NAN, memo_cn = 0;
     for (int64_t c = o->w0; c < o->w1; c++) {
         const int64_t i = p->a[c];
         const sx_wall *wl = &m->walls[p->b[c]];
@@ -1372,9 +1389,16 @@ static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
         double fd = fn, dsh[D], F[D];
         bool shear_dashpot = false;
         if (law->beta_n > 0 || law->beta_s > 0) {
-            /* the ball's full mass: c = 2 beta sqrt(m k) */
-            const double cn = law->hertz || law->per_radius ? 2 * law->beta_n * sqrt(kn / B->inv_mass[i])
-                                                            : sqrt(law->dash_n / B->inv_mass[i]);
+            /* the ball's full mass: c = 2 beta sqrt(m k); balls of one size and material share it */
+            double cn;
+            if (law->hertz || law->per_radius) {
+                cn = 2 * law->beta_n * sqrt(kn / B->inv_mass[i]);
+            } else if (law->dash_n == memo_dash && B->inv_mass[i] == memo_im) {
+                cn = memo_cn;
+            } else {
+                cn = sqrt(law->dash_n / B->inv_mass[i]);
+                memo_dash = law->dash_n, memo_im = B->inv_mass[i], memo_cn = cn;
+            }
             const double fdn = -cn * vn;
             fd += fdn;
             double work = fdn * vn;
