@@ -748,6 +748,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 if (!law->hertz && ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
             }
             touching[c] = 0;
+            fn_all[c] = 0; /* its last evaluation: no force */
             continue;
         }
         /* 4-1 ... 4-4 */
@@ -1018,23 +1019,21 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         /* the history as stored, four consecutive pairs by shuffles (a short
          * batch copied to four pairs first) */
         const bool full = nb == LANES;
-        double tail[2 * LANES * D + LANES];
+        double tail[2 * LANES * D];
         uint8_t tail_touching[LANES];
-        const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D, *hfn = fn_all + c0;
+        const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D;
         const uint8_t *htouching = touching + c0;
         if (!full) {
             for (int q = 0; q < LANES; q++) {
                 memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
                 memcpy(tail + (LANES + q) * D, geo_all + cc[q] * D, D * sizeof(double));
-                tail[2 * LANES * D + q] = fn_all[cc[q]];
                 tail_touching[q] = touching[cc[q]];
             }
-            hfs = tail, hrel = tail + LANES * D, hfn = tail + 2 * LANES * D, htouching = tail_touching;
+            hfs = tail, hrel = tail + LANES * D, htouching = tail_touching;
         }
-        vd fs_old[D], rel_old[D], fn_old;
+        vd fs_old[D], rel_old[D];
         load_lanes(hfs, fs_old);
         load_lanes(hrel, rel_old);
-        memcpy(&fn_old, hfn, sizeof fn_old);
         v4u8 touched;
         memcpy(&touched, htouching, sizeof touched);
         const vm had = __builtin_convertvector(touched, vm) != 0;
@@ -1155,23 +1154,22 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
                     o->err_r = ri[q] < rj[q] ? ri[q] : rj[q];
                     return;
                 }
-        /* a pair out of reach this step keeps its history, untouched */
+        /* a pair out of reach this step keeps its history, untouched, and has no force */
         if (full) {
             vd keep[D];
             for (int k = 0; k < D; k++) keep[k] = VSEL(live, g[k], fs_old[k]);
             store_lanes(fs_all + c0 * D, keep);
             for (int k = 0; k < D; k++) keep[k] = VSEL(live, dx[k], rel_old[k]);
             store_lanes(geo_all + c0 * D, keep);
-            const vd fn_new = VSEL(live, fdo, fn_old);
-            memcpy(fn_all + c0, &fn_new, sizeof fn_new);
+            memcpy(fn_all + c0, &fdo, sizeof fdo); /* 0 out of reach, as in ball_chunk_pass */
             for (int q = 0; q < LANES; q++) touching[c0 + q] = (live[q] & active[q]) != 0;
         } else {
             for (int q = 0; q < nb; q++) {
                 const int64_t c = cc[q];
                 touching[c] = (live[q] & active[q]) != 0;
+                fn_all[c] = fdo[q];
                 if (!live[q]) continue;
                 for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], geo_all[c * D + k] = dx[k][q];
-                fn_all[c] = fdo[q];
             }
         }
         for (int q = 0; q < nb; q++) {
