@@ -165,13 +165,13 @@ START_TEST(queries_do_not_perturb)
 }
 END_TEST
 
-/* The step's ball-ball pass has a batched form for the common laws
- * (linear, no shear dashpot, no bonds) and a full one that also tracks
+/* The step's passes have batched forms for the common cases (contacts
+ * with linear laws, no shear dashpot and no bonds; the law of motion of
+ * balls without fixities or damping) and full ones that also track
  * energies: both give the same bits, friction and the normal dashpot
- * included. */
-START_TEST(batched_pass_matches_full_pass)
+ * included, with and without local damping. */
+static void batched_and_full(int dim, double damping)
 {
-    const int dim = _i;
     const int n = steps_for(dim) / 2;
     sx_model *ms[2];
     for (int k = 0; k < 2; k++) {
@@ -179,6 +179,7 @@ START_TEST(batched_pass_matches_full_pass)
         sx_material_def md;
         ck_assert_int_eq(sx_material_get(ms[k], scene_material(ms[k]), &md), SX_OK);
         md.viscous_normal = 0.3;
+        md.damping = damping;
         ck_assert_int_eq(sx_material_set(ms[k], "m", &md, NULL), SX_OK);
         /* a tilted floor, so wall contacts have normals of every component */
         double nrm[3] = {0.4, dim == 3 ? 0.3 : 1, dim == 3 ? 1 : 0};
@@ -206,6 +207,11 @@ START_TEST(batched_pass_matches_full_pass)
     sx_model_destroy(ms[0]);
     sx_model_destroy(ms[1]);
 }
+
+START_TEST(batched_pass_matches_full_pass) { batched_and_full(_i, 0.7); }
+END_TEST
+
+START_TEST(batched_motion_matches_full_motion) { batched_and_full(_i, 0); }
 END_TEST
 
 int main(void)
@@ -219,6 +225,7 @@ int main(void)
     tcase_add_loop_test(tc, split_cycles_auto_timestep, 2, 4);
     tcase_add_loop_test(tc, queries_do_not_perturb, 2, 4);
     tcase_add_loop_test(tc, batched_pass_matches_full_pass, 2, 4);
+    tcase_add_loop_test(tc, batched_motion_matches_full_motion, 2, 4);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -1679,6 +1679,22 @@ static sx_status KERNEL(walls)(sx_model *m)
 /* --------------------------------------------------------- law of motion */
 
 
+/* After a block's law of motion: when its check sum is not finite, the
+ * first ball whose position, velocity or spin is not (-1: none, the sum
+ * overflowed). */
+static void blame_non_finite(const sx_model *m, sx_block *o, double check)
+{
+    const sx_balls *B = &m->balls;
+    o->bad = -1;
+    if (isfinite(check)) return;
+    for (int64_t i = o->b0; i < o->b1 && o->bad < 0; i++) {
+        bool ok = true;
+        for (int k = 0; k < D; k++) ok &= isfinite(B->x[i * D + k]) && isfinite(B->v[i * D + k]);
+        for (int k = 0; k < RD; k++) ok &= isfinite(B->w[i * RD + k]);
+        if (!ok) o->bad = i;
+    }
+}
+
 /* 4-46 ... 4-48: central differences, velocities at half steps, for the
  * balls of one block; partial sums go to the block. With energy tracking,
  * the damping's and applied loads' work use the mean of the old and new
@@ -1753,24 +1769,93 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     o->worst = worst;
     o->damp_work = damp_work;
     o->load_work = load_work;
-    o->bad = -1;
-    if (!isfinite(check)) /* find the first ball to blame */
-        for (int64_t i = o->b0; i < o->b1 && o->bad < 0; i++) {
-            bool ok = true;
-            for (int k = 0; k < D; k++) ok &= isfinite(xa[i * D + k]) && isfinite(va[i * D + k]);
-            for (int k = 0; k < RD; k++) ok &= isfinite(wa[i * RD + k]);
-            if (!ok) o->bad = i;
-        }
+    blame_non_finite(m, o, check);
 }
 
-static void integrate_block(sx_model *m, sx_block *o)
+/* A plain block (no fixities, damping, tracking or pebbles) four balls at
+ * a time: motion_pass's arithmetic in vector lanes (four balls' components
+ * are adjacent in memory, moved by shuffles), the largest displacement per
+ * lane and then over the lanes (a maximum, in any order the same), the
+ * last balls one by one. */
+static inline __attribute__((always_inline)) void motion_lanes(sx_model *m, sx_block *o)
+{
+    sx_balls *B = &m->balls;
+    const double dt = m->dt;
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt; /* as in motion_pass */
+    double *restrict xa = B->x, *restrict va = B->v, *restrict wa = B->w;
+    const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
+    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia;
+    vd worst = VZERO, check = VZERO;
+    int64_t i = o->b0;
+    for (; i + LANES <= o->b1; i += LANES) {
+        vd x[D], v[D], f[D], x0[D], im, ii;
+        load_lanes(xa + i * D, x);
+        load_lanes(va + i * D, v);
+        load_lanes(fa + i * D, f);
+        load_lanes(xb + i * D, x0);
+        memcpy(&im, ima + i, sizeof im);
+        memcpy(&ii, iia + i, sizeof ii);
+        vd disp2 = VZERO;
+        for (int k = 0; k < D; k++) {
+            v[k] += (f[k] * im + m->gravity[k]) * dtv; /* 4-46 with 4-40 */
+            x[k] += v[k] * dt;                         /* 4-48 */
+            const vd u = x[k] - x0[k];
+            disp2 += u * u;
+        }
+        store_lanes(xa + i * D, x);
+        store_lanes(va + i * D, v);
+        check += disp2;
+        worst = VSEL(disp2 > worst, disp2, worst);
+#if D == 3
+        vd w[3], t[3];
+        load_lanes(wa + i * 3, w);
+        load_lanes(ta + i * 3, t);
+        for (int k = 0; k < 3; k++) {
+            w[k] += t[k] * ii * dtv; /* 4-47 */
+            check += 0 * w[k];
+        }
+        store_lanes(wa + i * 3, w);
+#else
+        vd w, t;
+        memcpy(&w, wa + i, sizeof w);
+        memcpy(&t, ta + i, sizeof t);
+        w += t * ii * dtv; /* 4-47 */
+        check += 0 * w;
+        memcpy(wa + i, &w, sizeof w);
+#endif
+    }
+    double most = 0, sum = check[0] + check[1] + check[2] + check[3];
+    for (int q = 0; q < LANES; q++) most = worst[q] > most ? worst[q] : most;
+    for (; i < o->b1; i++) {
+        const double im = ima[i], ii = iia[i];
+        double disp2 = 0;
+        for (int k = 0; k < D; k++) {
+            va[i * D + k] += (fa[i * D + k] * im + m->gravity[k]) * dtv;
+            xa[i * D + k] += va[i * D + k] * dt;
+            const double u = xa[i * D + k] - xb[i * D + k];
+            disp2 += u * u;
+        }
+        sum += disp2;
+        for (int k = 0; k < RD; k++) {
+            wa[i * RD + k] += ta[i * RD + k] * ii * dtv;
+            sum += 0 * wa[i * RD + k];
+        }
+        most = disp2 > most ? disp2 : most;
+    }
+    o->worst = most;
+    o->damp_work = o->load_work = 0;
+    blame_non_finite(m, o, sum);
+}
+
+SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 {
     bool plain = !m->track_energy, undamped = true; /* undamped: no material has local damping */
     for (int k = 0; k < m->nmat; k++) undamped &= m->mats[k].def.damping == 0;
     const sx_balls *B = &m->balls;
     for (int64_t i = o->b0; i < o->b1 && plain; i++)
         plain = !B->fix[i] && (B->alpha ? B->alpha[i] == 0 : undamped || sx__ball_damping(m, i) == 0);
-    if (plain) motion_pass(m, o, true);
+    if (plain && !B->clump) motion_lanes(m, o);
+    else if (plain) motion_pass(m, o, true);
     else motion_pass(m, o, false);
 }
 
