@@ -63,153 +63,196 @@ static inline void moment_of(const double *r, const double *f, double *out)
 
 /* ---------------------------------------------------------- broad phase */
 
-/* A pair's history as saved across a build: shear force (D), the last
- * evaluation's geometry (D), overlap (ball-wall) and normal force. */
-#define REC (2 * D + 2)
+/* History across a build. The old stores stay as they are (grouped by a,
+ * as plan_chunks leaves them) while the build lists its pairs; a new pair
+ * finds its old one among the few pairs of its lower-indexed ball, through
+ * the sort's permutation. Each array of a store is then gathered in turn
+ * into one the size of the new store, so a build needs one array more,
+ * not a copy of every history (the memory of a build is the memory of the
+ * model plus little). The history (shear force, geometry, overlap, normal
+ * force, bond) of a pair whose balls swapped places in the order is
+ * re-expressed for the new orientation, as sx__pair_flip does. */
+typedef struct transfer {
+    bool history;             /* some old pair has a history (touching; else the rest is not needed) */
+    int32_t *order;           /* new index i <- old index order[i] (the sort's permutation) */
+    int64_t nold;             /* balls of the old stores (before the sort) */
+    int32_t *row_bb, *row_bw; /* the old stores' first pair of each old ball (nold + 1) */
+    /* the new pairs as listed: src is the old pair + 1 (negated when the
+     * pair turned round), 0 when it had no history (src NULL: none had) */
+    int32_t *a, *b, *src;
+    int64_t n, cap;
+    uint8_t *seen;            /* per bond slot: found again by the grid */
+} transfer;
 
-typedef struct history {
-    uint64_t *key;   /* 0 = empty slot */
-    int64_t *src;    /* record index of each slot */
-    int64_t cap;
-    double *rec;     /* REC doubles per saved pair */
-    int32_t *bond;   /* bond slot + 1 of each saved pair (0: none) */
-    uint8_t *seen;   /* per bond slot: found again by the grid */
-    int64_t n;
-} history;
-
-static inline uint64_t hash_key(uint64_t k)
+/* First pair of each ball in a store grouped by a, into row (nb + 1). */
+static void rows_of(const sx_pairs *p, int64_t nb, int32_t *row)
 {
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdULL;
-    k ^= k >> 33;
-    return k;
+    memset(row, 0, (size_t)(nb + 1) * sizeof *row);
+    for (int64_t c = 0; c < p->n; c++) row[p->a[c] + 1]++;
+    for (int64_t i = 0; i < nb; i++) row[i + 1] += row[i];
 }
 
-static inline uint64_t bb_key(int64_t ida, int64_t idb)
+static bool transfer_begin(sx_model *m, transfer *tr)
 {
-    return ida < idb ? ((uint64_t)ida << 32) | (uint64_t)idb : ((uint64_t)idb << 32) | (uint64_t)ida;
-}
-
-static inline uint64_t bw_key(int64_t id, int64_t wall)
-{
-    return (1ULL << 63) | ((uint64_t)id << 32) | (uint64_t)wall;
-}
-
-/* Saves pair c of p; sgn re-expresses the vectors (and the bond's) for the
- * key's orientation, lower id -> higher id. */
-static void history_put(sx_model *m, history *h, uint64_t key, const sx_pairs *p, int64_t c, double sgn)
-{
-    int64_t s = (int64_t)(hash_key(key) & (uint64_t)(h->cap - 1));
-    while (h->key[s]) s = (s + 1) & (h->cap - 1);
-    h->key[s] = key;
-    h->src[s] = h->n;
-    double *r = h->rec + h->n * REC;
-    for (int k = 0; k < D; k++) {
-        r[k] = sgn * p->fs[c * D + k];
-        r[D + k] = sgn * p->geo[c * D + k];
-    }
-    r[2 * D] = p->un ? p->un[c] : 0;
-    r[2 * D + 1] = p->fn[c];
-    const int32_t bond = p->bond ? p->bond[c] : 0;
-    if (bond && sgn < 0) sx__bond_flip(m, bond - 1);
-    h->bond[h->n] = bond;
-    h->n++;
-}
-
-static int64_t history_get(const history *h, uint64_t key)
-{
-    if (!h->cap) return -1;
-    int64_t s = (int64_t)(hash_key(key) & (uint64_t)(h->cap - 1));
-    while (h->key[s]) {
-        if (h->key[s] == key) return h->src[s];
-        s = (s + 1) & (h->cap - 1);
-    }
-    return -1;
-}
-
-/* Saves every touching (or bonded) pair's history keyed by stable ids. */
-static bool history_save(sx_model *m, history *h)
-{
-    memset(h, 0, sizeof *h);
-    h->seen = calloc((size_t)(m->bonds.n + 1), 1);
-    if (!h->seen) return false;
-    int64_t live = 0;
-    for (int64_t c = 0; c < m->bb.n; c++) live += m->bb.touching[c];
-    for (int64_t c = 0; c < m->bw.n; c++) live += m->bw.touching[c];
-    if (!live) return true;
-    h->cap = 16;
-    while (h->cap < 2 * live) h->cap *= 2;
-    h->key = calloc((size_t)h->cap, sizeof *h->key);
-    h->src = malloc((size_t)h->cap * sizeof *h->src);
-    h->rec = malloc((size_t)(live * REC) * sizeof(double));
-    h->bond = malloc((size_t)live * sizeof(int32_t));
-    if (!h->key || !h->src || !h->rec || !h->bond) return false;
-    const int32_t *id = m->balls.id;
-    for (int64_t c = 0; c < m->bb.n; c++) {
-        if (!m->bb.touching[c]) continue;
-        const int64_t ia = id[m->bb.a[c]], ib = id[m->bb.b[c]];
-        history_put(m, h, bb_key(ia, ib), &m->bb, c, ia < ib ? 1.0 : -1.0);
-    }
-    for (int64_t c = 0; c < m->bw.n; c++)
-        if (m->bw.touching[c]) history_put(m, h, bw_key(id[m->bw.a[c]], m->bw.b[c]), &m->bw, c, 1.0);
+    memset(tr, 0, sizeof *tr);
+    for (int64_t c = 0; c < m->bb.n && !tr->history; c++) tr->history = m->bb.touching[c];
+    for (int64_t c = 0; c < m->bw.n && !tr->history; c++) tr->history = m->bw.touching[c];
+    if (!tr->history) return true;
+    tr->nold = m->balls.n;
+    const size_t rows = (size_t)tr->nold + 1;
+    tr->row_bb = sx_alloc_resize(&m->alloc, NULL, 0, rows, sizeof *tr->row_bb);
+    tr->row_bw = sx_alloc_resize(&m->alloc, NULL, 0, rows, sizeof *tr->row_bw);
+    tr->seen = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)m->bonds.n + 1, 1);
+    /* a removal may have left the stores out of order */
+    if (!tr->row_bb || !tr->row_bw || !tr->seen || !sx__pairs_sort(m, &m->bb) || !sx__pairs_sort(m, &m->bw))
+        return false;
+    rows_of(&m->bb, tr->nold, tr->row_bb);
+    rows_of(&m->bw, tr->nold, tr->row_bw);
     return true;
 }
 
-static void history_free(history *h)
+static void transfer_end(sx_model *m, transfer *tr)
 {
-    free(h->key);
-    free(h->src);
-    free(h->rec);
-    free(h->bond);
-    free(h->seen);
+    const size_t rows = (size_t)tr->nold + 1;
+    sx_alloc_free(&m->alloc, tr->order, tr->order ? (size_t)m->balls.n : 0, sizeof *tr->order);
+    sx_alloc_free(&m->alloc, tr->row_bb, tr->row_bb ? rows : 0, sizeof *tr->row_bb);
+    sx_alloc_free(&m->alloc, tr->row_bw, tr->row_bw ? rows : 0, sizeof *tr->row_bw);
+    sx_alloc_free(&m->alloc, tr->seen, tr->seen ? (size_t)m->bonds.n + 1 : 0, 1);
+    sx_alloc_free(&m->alloc, tr->a, (size_t)tr->cap, sizeof *tr->a);
+    sx_alloc_free(&m->alloc, tr->b, (size_t)tr->cap, sizeof *tr->b);
+    sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
 }
 
-/* Appends candidate pair (a, b) and restores its history if it had one;
- * sgn is -1 when a has the higher id. */
-static bool pair_push(sx_model *m, sx_pairs *p, int32_t a, int32_t b, const history *h, uint64_t key, double sgn)
+/* Room for cap listed pairs (the list emptied when fresh). */
+static bool transfer_list(sx_model *m, transfer *tr, int64_t cap, bool fresh)
 {
-    if (p->n == p->cap && sx__pairs_reserve(m, p, p->n + 1)) return false;
-    const int64_t c = p->n++;
-    p->a[c] = a;
-    p->b[c] = b;
-    const int64_t s = history_get(h, key);
-    const double *r = s >= 0 ? h->rec + s * REC : NULL;
-    for (int k = 0; k < D; k++) {
-        p->fs[c * D + k] = r ? sgn * r[k] : 0;
-        p->geo[c * D + k] = r ? sgn * r[D + k] : 0;
+    if (fresh) tr->n = 0;
+    if (cap < 16) cap = 16; /* never an empty allocation */
+    if (cap > INT32_MAX) return false;
+    if (cap == tr->cap) return true;
+    int32_t *q[3] = {tr->a, tr->b, tr->src};
+    for (int k = 0; k < (tr->history ? 3 : 2); k++) {
+        int32_t *r = sx_alloc_resize(&m->alloc, q[k], (size_t)tr->cap, (size_t)cap, sizeof *r);
+        if (!r) return false;
+        q[k] = r;
+        if (k == 0) tr->a = r;
+        else if (k == 1) tr->b = r;
+        else tr->src = r;
     }
-    if (p->un) p->un[c] = r ? r[2 * D] : 0;
-    p->fn[c] = r ? r[2 * D + 1] : 0;
-    p->touching[c] = r != NULL;
-    if (p->bond) {
-        const int32_t bond = r ? h->bond[s] : 0;
-        p->bond[c] = bond;
-        if (bond) {
-            h->seen[bond - 1] = 1;
-            if (sgn < 0) sx__bond_flip(m, bond - 1);
+    tr->cap = cap;
+    return true;
+}
+
+/* The old pair of new pair (a, b) in old store p (rows row): old pair + 1,
+ * negated when the pair turned round; 0 without history (not found, or
+ * not touching). A ball-ball pair is kept under its lower old index, a
+ * ball-wall pair (wall) under its ball. */
+static int32_t old_pair(const transfer *tr, const sx_pairs *p, const int32_t *row, int64_t a, int64_t b, bool wall)
+{
+    if (!tr->history) return 0;
+    const int64_t oa = tr->order[a], ob = wall ? b : tr->order[b];
+    const int64_t lo = wall || oa < ob ? oa : ob, hi = wall || oa < ob ? ob : oa;
+    for (int32_t c = row[lo]; c < row[lo + 1]; c++)
+        if (p->b[c] == hi) return p->touching[c] ? (oa == lo ? c + 1 : -(c + 1)) : 0;
+    return 0;
+}
+
+static void transfer_push(transfer *tr, int32_t a, int32_t b, int32_t src)
+{
+    tr->a[tr->n] = a, tr->b[tr->n] = b;
+    if (tr->src) tr->src[tr->n] = src;
+    tr->n++;
+}
+
+/* Replaces *field (old_cap rows of per elements of size bytes) by the
+ * listed pairs' rows, gathered from their old pairs (zero without);
+ * flipped doubles are negated (sign: the vectors of a pair's orientation). */
+static bool gather_field(sx_model *m, void **field, int64_t old_cap, const transfer *tr, int per, size_t size,
+                         bool sign)
+{
+    char *to = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(tr->cap * per), size);
+    if (!to) return false;
+    const char *from = *field;
+    const size_t row = (size_t)per * size;
+    for (int64_t c = 0; c < tr->n && tr->src; c++) {
+        const int32_t s = tr->src[c];
+        if (!s) continue; /* zeros */
+        const int64_t o = s > 0 ? s - 1 : -s - 1;
+        memcpy(to + (size_t)c * row, from + (size_t)o * row, row);
+        if (sign && s < 0)
+            for (int k = 0; k < per; k++) ((double *)(to + (size_t)c * row))[k] *= -1;
+    }
+    sx_alloc_free(&m->alloc, *field, (size_t)(old_cap * per), size);
+    *field = to;
+    return true;
+}
+
+/* The store p becomes the listed pairs, their history carried over. Out of
+ * memory, it is emptied (the history is lost; the next build lists the
+ * pairs again, bonded ones included). */
+static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
+{
+    const int64_t old = p->cap;
+    /* the list's ends become the store's (the old ones are no longer needed) */
+    sx_alloc_free(&m->alloc, p->a, (size_t)old, sizeof *p->a);
+    sx_alloc_free(&m->alloc, p->b, (size_t)old, sizeof *p->b);
+    p->a = tr->a, p->b = tr->b;
+    tr->a = tr->b = NULL;
+    if (p->bond && tr->src) /* a bond's vectors follow its pair's orientation */
+        for (int64_t c = 0; c < tr->n; c++) {
+            const int32_t s = tr->src[c], bond = s ? p->bond[s > 0 ? s - 1 : -s - 1] : 0;
+            if (bond && s < 0) sx__bond_flip(m, bond - 1);
         }
+    struct {
+        void **data;
+        int per;
+        size_t size;
+        bool sign, present;
+    } fields[] = {
+        {(void **)&p->fs, D, sizeof(double), true, true},
+        {(void **)&p->geo, D, sizeof(double), true, true},
+        {(void **)&p->fn, 1, sizeof(double), false, true},
+        {(void **)&p->touching, 1, 1, false, true},
+        {(void **)&p->un, 1, sizeof(double), false, p->walls},
+        {(void **)&p->bond, 1, sizeof(int32_t), false, p->bond != NULL},
+    };
+    const int nf = (int)(sizeof fields / sizeof fields[0]);
+    for (int k = 0; k < nf; k++) {
+        if (!fields[k].present || gather_field(m, fields[k].data, old, tr, fields[k].per, fields[k].size, fields[k].sign))
+            continue;
+        for (int j = 0; j < nf; j++) /* gathered ones at the new size, the others at the old */
+            sx_alloc_free(&m->alloc, *fields[j].data, (size_t)((j < k ? tr->cap : old) * fields[j].per), fields[j].size);
+        sx_alloc_free(&m->alloc, p->a, (size_t)tr->cap, sizeof *p->a);
+        sx_alloc_free(&m->alloc, p->b, (size_t)tr->cap, sizeof *p->b);
+        const bool walls = p->walls;
+        memset(p, 0, sizeof *p);
+        p->walls = walls;
+        return false;
     }
+    p->n = tr->n, p->cap = tr->cap;
+    /* the list starts afresh for the next store */
+    sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
+    tr->src = NULL;
+    tr->n = tr->cap = 0;
     return true;
 }
 
 /* Bonded pairs stay in the store whatever their gap: those the grid did
- * not find again are appended (after the grid's pairs, in slot order; the
- * store grown once to hold them). */
-static bool keep_bonded_pairs(sx_model *m, const history *h)
+ * not find again are listed too (after the grid's pairs, in slot order). */
+static bool keep_bonded_pairs(sx_model *m, transfer *tr)
 {
     const sx_bonds *bs = &m->bonds;
     int64_t lost = 0;
-    for (int64_t s = 0; s < bs->n; s++) lost += bs->kind[s] && !h->seen[s];
-    if (lost && sx__pairs_presize(m, &m->bb, m->bb.n + lost)) return false;
+    for (int64_t s = 0; s < bs->n; s++) lost += bs->kind[s] && !tr->seen[s];
+    if (lost && !transfer_list(m, tr, tr->n + lost, false)) return false;
     for (int64_t s = 0; s < bs->n; s++) {
-        if (!bs->kind[s] || h->seen[s]) continue;
+        if (!bs->kind[s] || tr->seen[s]) continue;
         int32_t a = m->balls.index_of[bs->ida[s]], b = m->balls.index_of[bs->idb[s]];
         if (a > b) {
             const int32_t t = a;
             a = b, b = t;
         }
-        const int64_t ia = m->balls.id[a], ib = m->balls.id[b];
-        if (!pair_push(m, &m->bb, a, b, h, bb_key(ia, ib), ia < ib ? 1.0 : -1.0)) return false;
+        transfer_push(tr, a, b, old_pair(tr, &m->bb, tr->row_bb, a, b, false));
     }
     return true;
 }
@@ -328,16 +371,17 @@ static inline void cell_coords(const sx_grid *g, const double *x, int64_t *c)
     }
 }
 
-/* Sorts balls by cell (counting sort, stable) and fills g->start. */
-static bool sort_balls(sx_model *m)
+/* Sorts balls by cell (counting sort, stable) and fills g->start; the
+ * permutation goes to tr->order. */
+static bool sort_balls(sx_model *m, transfer *tr)
 {
     sx_grid *g = &m->grid;
     sx_balls *b = &m->balls;
     const int64_t n = b->n;
-    int32_t *order = malloc((size_t)(n > 0 ? n : 1) * sizeof *order);
+    int32_t *order = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)n, sizeof *order);
     double *scratch = sx__scratch(m, n * D);
     if (!order || !scratch) {
-        free(order);
+        sx_alloc_free(&m->alloc, order, order ? (size_t)n : 0, sizeof *order);
         return false;
     }
     /* the cell of each ball lives in the scratch until the permutation needs it */
@@ -356,8 +400,9 @@ static bool sort_balls(sx_model *m)
     for (int64_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
     g->start[0] = 0;
     sx__balls_permute(m, order, scratch);
-    free(order);
     sx__scratch_release(m); /* not kept between builds: the pairs come next */
+    if (tr->history) tr->order = order; /* the transfer's */
+    else sx_alloc_free(&m->alloc, order, (size_t)n, sizeof *order);
     return true;
 }
 
@@ -383,28 +428,32 @@ static int half_stencil(int64_t (*off)[3])
     return n;
 }
 
-/* A candidate pair (i, j), i < j: counted when count is given, else stored. */
-static inline bool candidate(sx_model *m, const history *h, int32_t i, int32_t j, int64_t *count)
+/* A candidate pair (i, j), i < j: counted when count is given, else listed
+ * with its old pair (a bond it carries is found again). */
+static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, int64_t *count)
 {
     const int32_t *cl = m->balls.clump; /* clumps: pebbles of one clump never pair (NULL without clumps) */
-    if (cl && cl[i] && cl[i] == cl[j]) return true;
+    if (cl && cl[i] && cl[i] == cl[j]) return;
     if (count) {
         (*count)++;
-        return true;
+        return;
     }
-    const int32_t *id = m->balls.id;
-    return pair_push(m, &m->bb, i, j, h, bb_key(id[i], id[j]), id[i] < id[j] ? 1.0 : -1.0);
+    const int32_t src = old_pair(tr, &m->bb, tr->row_bb, i, j, false);
+    if (src && m->bb.bond) {
+        const int32_t bond = m->bb.bond[src > 0 ? src - 1 : -src - 1];
+        if (bond) tr->seen[bond - 1] = 1;
+    }
+    transfer_push(tr, i, j, src);
 }
 
 /* The grid's candidate pairs in cell order; with count, only counts them
  * (a build counts first, so the store is sized once, without growing). */
-static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
+static void build_ball_pairs(sx_model *m, transfer *tr, int64_t *count)
 {
     const sx_grid *g = &m->grid;
     const sx_balls *b = &m->balls;
     int64_t off[13][3];
     const int nst = half_stencil(off);
-    if (!count) m->bb.n = 0;
     for (int64_t cz = 0; cz < g->nc[2]; cz++)
         for (int64_t cy = 0; cy < g->nc[1]; cy++)
             for (int64_t cx = 0; cx < g->nc[0]; cx++) {
@@ -417,7 +466,7 @@ static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
                         double dx[D];
                         for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                         const double reach = ri + b->rad[j];
-                        if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
+                        if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
                     }
                     for (int s = 0; s < nst; s++) {
                         const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
@@ -427,37 +476,39 @@ static bool build_ball_pairs(sx_model *m, const history *h, int64_t *count)
                             double dx[D];
                             for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
                             const double reach = ri + b->rad[j];
-                            if (dot(dx, dx) < reach * reach && !candidate(m, h, i, j, count)) return false;
+                            if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
                         }
                     }
                 }
             }
-    return true;
 }
 
 /* Ball-wall candidates, ball-major so the contact loop walks balls in
  * order; with count, only counts them (as build_ball_pairs). */
-static bool build_wall_pairs(sx_model *m, const history *h, int64_t *count)
+static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
 {
     const sx_balls *b = &m->balls;
-    sx_pairs *p = &m->bw;
-    if (!count) p->n = 0;
     for (int64_t i = 0; i < b->n; i++)
         for (int64_t w = 0; w < m->nwall; w++) {
             double n[D];
             const double dist = wall_distance(&m->walls[w], b->x + i * D, n);
             if (dist >= b->rad[i] + m->skin) continue;
             if (count) (*count)++;
-            else if (!pair_push(m, p, (int32_t)i, (int32_t)w, h, bw_key(b->id[i], w), 1.0)) return false;
+            else transfer_push(tr, (int32_t)i, (int32_t)w, old_pair(tr, &m->bw, tr->row_bw, i, w, true));
         }
-    return true;
 }
 
-/* Sizes a store for the count of a build's pairs, the history being saved. */
-static bool presize_for(sx_model *m, sx_pairs *p, int64_t count)
+/* The pairs of one store, counted, then listed (and the bonded pairs kept),
+ * then carried over into the store. */
+static bool build_store(sx_model *m, transfer *tr, bool walls)
 {
-    p->n = 0;
-    return !sx__pairs_presize(m, p, count);
+    int64_t count = 0;
+    if (walls) build_wall_pairs(m, tr, &count);
+    else build_ball_pairs(m, tr, &count);
+    if (!transfer_list(m, tr, count, true)) return false;
+    if (walls) build_wall_pairs(m, tr, NULL);
+    else build_ball_pairs(m, tr, NULL);
+    return (walls || keep_bonded_pairs(m, tr)) && transfer_store(m, walls ? &m->bw : &m->bb, tr);
 }
 
 static bool plan_chunks(sx_model *m);
@@ -480,16 +531,13 @@ static bool KERNEL(build)(sx_model *m)
         for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
         m->skin = 0.2 * sum / (double)m->balls.n;
     }
-    history h;
-    /* each pair store sized to its count first, so it holds no more than
-     * its pairs and never grows by half while it is filled */
-    int64_t count = 0, wall_count = 0;
-    bool ok = history_save(m, &h) && grid_setup(m) && sort_balls(m) && build_ball_pairs(m, &h, &count) &&
-              presize_for(m, &m->bb, count) && build_ball_pairs(m, &h, NULL) && keep_bonded_pairs(m, &h) &&
-              build_wall_pairs(m, &h, &wall_count) && presize_for(m, &m->bw, wall_count) &&
-              build_wall_pairs(m, &h, NULL) && plan_chunks(m);
-    history_free(&h);
-    if (!ok) return false;
+    /* each pair store made from its counted pairs, so it holds no more than
+     * them and never grows while it is filled */
+    transfer tr;
+    bool ok = transfer_begin(m, &tr) && grid_setup(m) && sort_balls(m, &tr) && build_store(m, &tr, false) &&
+              build_store(m, &tr, true);
+    transfer_end(m, &tr);
+    if (!ok || !plan_chunks(m)) return false;
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;
