@@ -6,8 +6,14 @@
  * Broad phase: a uniform grid of cells at least one diameter plus the skin
  * wide; balls are sorted by cell at every build (cache locality and a
  * deterministic pair order); a forward half stencil gives each pair once
- * with a < b. History (shear force and previous normal) is carried across
- * builds through a hash keyed by the pair of stable ids.
+ * with a < b. History (shear force and the last evaluation's geometry) is
+ * carried across builds from each new pair's old one, found through the
+ * sort's permutation among the old pairs of its lower ball (transfer).
+ *
+ * Contacts and the law of motion have batched forms for the common cases,
+ * four pairs, walls contacts or balls at a time in vector lanes (GCC
+ * vector extensions), beside the full scalar forms; both give the same
+ * bits (tests/test_determinism.c).
  */
 #include "model_internal.h"
 
