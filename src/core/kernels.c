@@ -11,7 +11,7 @@
  * sort's permutation among the old pairs of its lower ball (transfer).
  *
  * Contacts and the law of motion have batched forms for the common cases,
- * four pairs, walls contacts or balls at a time in vector lanes (GCC
+ * four pairs, wall contacts or balls at a time in vector lanes (GCC
  * vector extensions), beside the full scalar forms; both give the same
  * bits (tests/test_determinism.c).
  */
