@@ -370,13 +370,6 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
     return pairs_resize(m, p, cap);
 }
 
-sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap)
-{
-    if (cap < p->n) cap = p->n;
-    if (cap < 16) cap = 16; /* never an empty allocation */
-    return cap == p->cap ? SX_OK : pairs_resize(m, p, cap);
-}
-
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
 {
     const int d = m->dim;

@@ -279,8 +279,6 @@ sx_status sx__balls_expand(sx_model *m);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
-/* Resizes the store to exactly cap pairs (never below its count). */
-sx_status sx__pairs_presize(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
 /* Bytes of the ball arrays (with the id map and the grid's per-ball cells), of a pair store. */
