@@ -111,7 +111,6 @@ typedef struct sx_pairs {
 typedef struct sx_grid {
     double lo[3], cell;
     int64_t nc[3], ncells, cap_cells;
-    int32_t *head;         /* first ball of each cell (after sorting: start index) */
     int32_t *start;        /* cells' start in sorted order (ncells + 1) */
 } sx_grid;
 
