@@ -222,7 +222,7 @@ end
 --- bonds, porosity, floaters, sigma0, material, ...}.
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
-                                "porosity", "material", "sigma0", "gap", "seed", "path", "log", "max_steps"})
+                                "porosity", "material", "sigma0", "gap", "seed", "path", "log", "max_steps", "clump"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
   local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
@@ -233,14 +233,23 @@ function lab.specimen(opts)
     fail("lab.specimen: shape '%s' is not a %dD shape (valid: %s)", tostring(shape), dim, table.concat(names, ", "))
   end
   local size, cyl_axis, trim = shape_of(merge(opts, {shape = shape}), dim)
+  -- a specimen of clumps: {pebbles = {...} (m:clump_template's form), scale = s | {smin, smax}}
+  local grain = opts.clump
   local radius = opts.radius or {0.8e-3, 1.33e-3}
+  if grain ~= nil then
+    if type(grain) ~= "table" or type(grain.pebbles) ~= "table" or #grain.pebbles < 1 then
+      fail("lab.specimen: clump must be {pebbles = {...}, scale = s | {smin, smax}}")
+    end
+    if opts.radius then fail("lab.specimen: a clump specimen takes scale, not radius") end
+  end
   if type(radius) ~= "table" or #radius ~= 2 or not (radius[1] > 0) or not (radius[2] >= radius[1]) then
     fail("lab.specimen: radius must be {rmin, rmax} with 0 < rmin <= rmax")
   end
   local mat = lab.rock(opts.material)
   local sigma0 = opts.sigma0 or 0.1e6
   positive(sigma0, "sigma0", "specimen")
-  local porosity = opts.porosity or (dim == 3 and 0.42 or 0.18)
+  -- clumps are placed at random (no radius expansion): looser, the servo compacts them
+  local porosity = opts.porosity or (grain and (dim == 3 and 0.68 or 0.5) or (dim == 3 and 0.42 or 0.18))
   local seed = opts.seed or 1
   local path = opts.path or fail("lab.specimen: a path for the specimen file is required")
   local t0 = seixo.clock()
@@ -248,17 +257,35 @@ function lab.specimen(opts)
   local m = seixo.model{dim = dim}
   -- genesis is frictionless (a dense packing); the rock's friction comes back before bonding
   m:material("rock", merge(mat, {friction = 0}))
+  if grain then -- the pebbles' radii, scaled: the sizes the tests and the bond gap use
+    local info = m:clump_template("grain", grain.pebbles)
+    local sc = type(grain.scale) == "table" and grain.scale or {grain.scale or 1, grain.scale or 1}
+    local rlo, rhi = math.huge, 0
+    for _, pb in ipairs(info.pebbles) do
+      local r = pb.radius or pb[dim + 1]
+      rlo, rhi = math.min(rlo, r), math.max(rhi, r)
+    end
+    radius = {rlo * sc[1], rhi * sc[2]}
+  end
   local rmean = 0.5 * (radius[1] + radius[2])
   local kn = ball_kn(mat, rmean, dim)
   local v = make_vessel(m, size, kn, cyl_axis)
-  local n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed}
-  say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps)", n, porosity, m:step())
+  local n
+  if grain then
+    n = m:generate{template = "grain", scale = grain.scale or 1, porosity = porosity, region = v.region, seed = seed}
+    say(opts, "lab.specimen: %d clumps (%d pebbles) placed at random to porosity %.3f", n, m:ball_count(), porosity)
+  else
+    n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed}
+    say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps)", n, porosity, m:step())
+  end
 
   -- the isotropic stress, by servo-controlled walls; a small sigma0 is a
   -- tiny overlap (sigma0 d / kn), which the balls' vibrations disturb by a
   -- few per cent: 2 % and a ratio of 1e-2 are close enough for a seating
   -- stress (a frictionless packing also creeps as the walls close in)
-  local steps, err = servo_vessel(m, v, sigma0, {max_speed = 0.5, max_steps = opts.max_steps or 30000, tol = 0.02,
+  -- (randomly placed clumps start loose: their walls travel further)
+  local steps, err = servo_vessel(m, v, sigma0, {max_speed = grain and 2 or 0.5,
+                                                 max_steps = opts.max_steps or (grain and 300000 or 30000), tol = 0.02,
                                                  ratio = 1e-2})
   say(opts, "lab.specimen: isotropic stress %.3g Pa installed within %.2f %% (%d steps)", sigma0, 100 * err, steps)
 
@@ -281,14 +308,21 @@ function lab.specimen(opts)
   -- out of the vessel: the specimen relaxes and its locked-in stresses fall
   for _, w in ipairs(v.walls) do w:remove() end
   m:solve{ratio = 1e-4, steps = 20000}
-  if trim then
+  if trim then -- balls (clumps: by their centroid) outside the disk go
     local c, r = trim.center, trim.radius
-    local removed = m:remove_balls{where = function(b)
-      local p = b.pos
-      return (p[1] - c[1]) ^ 2 + (p[2] - c[2]) ^ 2 > r * r
-    end}
+    local function outside(p) return (p[1] - c[1]) ^ 2 + (p[2] - c[2]) ^ 2 > r * r end
+    local removed = 0
+    if grain then
+      local out = {}
+      for cl in m:clumps() do if outside(cl.pos) then out[#out + 1] = cl end end
+      for _, cl in ipairs(out) do cl:remove() end
+      removed = #out
+    else
+      removed = m:remove_balls{where = function(b) return outside(b.pos) end}
+    end
     m:solve{ratio = 1e-4, steps = 20000}
-    say(opts, "lab.specimen: trimmed to a disk: %d balls removed, %d left", removed, m:ball_count())
+    say(opts, "lab.specimen: trimmed to a disk: %d %s removed, %d balls left", removed, grain and "clumps" or "balls",
+        m:ball_count())
   end
 
   local elo, ehi = extents(m)
@@ -299,7 +333,7 @@ function lab.specimen(opts)
   local spec = {
     path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
-    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, genesis_steps = m:step(),
+    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, genesis_steps = m:step(), clumps = m:clump_count(),
     genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
     depth = opts.depth, thickness = opts.thickness,
   }
