@@ -214,13 +214,14 @@ end
 -- loose assembly moves at G (sigma - target), G = alpha A / (kn Nc dt) being
 -- made for contacts the packing backs, i.e. by half the overlap sigma0 asks
 -- of its contacts a step (1e-8 m here), while the clumps it pushes fly off
--- undamped (local damping scales forces, and a free body has none): 300,000
--- steps left a 2D specimen of 300 clumps 64 % short of sigma0 and loose. The
--- compaction goes on until the clumps jam: after a stage every wall carries
--- sigma0 or more and still does, with the walls held, once the motion has
--- died out (ratio 1e-2). Before jamming such loads are transients that fade
--- within a few thousand steps as the clumps rearrange. Returns the stages
--- and steps taken, or nil when the clumps fill 95 % of the vessel unjammed.
+-- undamped (local damping scales forces, and a free body has none): after
+-- 300,000 steps a 2D specimen of 300 clumps was loose, its walls 64 % off
+-- sigma0 with one to three contacts each. The compaction goes on until the
+-- clumps jam: after a stage every wall carries sigma0 or more and still
+-- does, with the walls held, once the motion has died out (ratio 1e-2).
+-- Before jamming such loads are transients that fade within a few thousand
+-- steps as the clumps rearrange. Returns the stages and steps taken, or nil
+-- when the clumps fill 95 % of the vessel unjammed.
 local function compact_clumps(m, v, c, sigma0)
   local dim, start, stages, solid = m:dim(), m:step(), 0, 0
   for cl in m:clumps() do solid = solid + cl.volume end
@@ -346,7 +347,8 @@ function lab.specimen(opts)
     say(opts, "lab.specimen: %d clumps (%d pebbles) placed at random to porosity %.3f", n, m:ball_count(), loose)
     local stages, steps = compact_clumps(m, v, centre, sigma0)
     if not stages then
-      fail("lab.specimen: the clumps fill 95 %% of the vessel and do not jam; check the template's pebbles")
+      fail("lab.specimen: the clumps fill 95 %% of the vessel and still do not carry sigma0 = %g Pa at rest; "
+           .. "lower sigma0 or check the template's pebbles", sigma0)
     end
     say(opts, "lab.specimen: compacted until the clumps jam: %d stages of 2 %% (%d steps)", stages, steps)
     -- then the decompression to sigma0 by the servo, still frictionless (a
