@@ -354,7 +354,7 @@ function lab.specimen(opts)
     -- then the decompression to sigma0 by the servo, still frictionless (a
     -- dense packing; P&C). A frictionless packing of clumps does not come to
     -- rest there: held at the volume where the servo brings it, its stress
-    -- falls to 1e-5 sigma0 within 2000 steps as the clumps slide into room,
+    -- falls below 1e-3 sigma0 within 2000 steps as the clumps slide apart,
     -- and under the servo it creeps on (the walls at 0.83 to 0.98 sigma0, a
     -- ratio of 0.04 to 0.13 after 60,000 steps), where disks settle. So this
     -- servo stops within 10 %, and the friction comes back for the last one:
