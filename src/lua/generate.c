@@ -383,6 +383,42 @@ static void grid_add(grid *gr, const double *x, double r)
     gr->head[c] = i;
 }
 
+/* A grid (a Lua userdata on the stack) over the region holding the model's
+ * balls near it, within `reach` of its box, so new balls are also checked
+ * against them; cells fit a new ball of radius rnew against the largest
+ * of those, and room is made for `more` new entries. */
+static grid *grid_of_model(lua_State *L, const sx_model *m, const sx_lua_region *reg, double reach, double rnew,
+                           int64_t more)
+{
+    const int dim = sx_model_dim(m);
+    const int64_t nb = sx_ball_count(m);
+    double rold = 0;
+    int64_t near = 0;
+    grid *gr = NULL;
+    for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+        for (int64_t i = 0; i < nb; i++) {
+            const int64_t id = sx_ball_id_at(m, i);
+            double p[3], rb;
+            sx_ball_get_vec(m, id, SX_BALL_POS, p);
+            sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
+            bool in = true;
+            for (int k = 0; k < dim; k++) in &= p[k] > reg->lo[k] - rb - reach && p[k] < reg->hi[k] + rb + reach;
+            if (!in) continue;
+            if (gr) {
+                grid_add(gr, p, rb);
+            } else {
+                near++;
+                if (rb > rold) rold = rb;
+            }
+        }
+        if (!gr) {
+            gr = lua_newuserdatauv(L, sizeof *gr, 0);
+            grid_init(L, gr, dim, reg->lo, reg->hi, rnew + fmax(rnew, rold), near + more);
+        }
+    }
+    return gr;
+}
+
 /* Calls fn(i, ud) for every ball in the cells around x; stops when fn returns true. */
 static bool grid_near(const grid *gr, const double *x, bool (*fn)(const grid *, int64_t, void *), void *ud)
 {
@@ -516,36 +552,11 @@ static void place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const
                          int64_t n, double *x)
 {
     const sx_lua_region *reg = &g->region;
-    const int dim = g->dim;
     if (n > 0 && !fits(reg, rad[0]))
         luaL_argerror(L, 2, lua_pushfstring(L, "a ball of radius %f m does not fit in the region", rad[0]));
     /* the model's balls near the region take part in the overlap checks */
     const double rnew = n > 0 ? rad[0] : 0;
-    const int64_t nb = sx_ball_count(m);
-    double rold = 0;
-    int64_t near = 0;
-    grid *gr = NULL;
-    for (int pass = 0; pass < 2; pass++) {
-        for (int64_t i = 0; i < nb; i++) {
-            const int64_t id = sx_ball_id_at(m, i);
-            double p[3], rb;
-            sx_ball_get_vec(m, id, SX_BALL_POS, p);
-            sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
-            bool in = true;
-            for (int k = 0; k < dim; k++) in &= p[k] > reg->lo[k] - rb - rnew && p[k] < reg->hi[k] + rb + rnew;
-            if (!in) continue;
-            if (gr) {
-                grid_add(gr, p, rb);
-            } else {
-                near++;
-                if (rb > rold) rold = rb;
-            }
-        }
-        if (!gr) {
-            gr = lua_newuserdatauv(L, sizeof *gr, 0);
-            grid_init(L, gr, dim, reg->lo, reg->hi, rnew + fmax(rnew, rold), near + n);
-        }
-    }
+    grid *gr = grid_of_model(L, m, reg, rnew, rnew, n);
     double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
     if (reg->kind == SX_REGION_CYLINDER) perpendicular(reg->axis, e1, e2);
     for (int64_t i = 0; i < n; i++) {
@@ -802,31 +813,7 @@ static void place_clumps(lua_State *L, const sx_model *m, const gen *g, rng *r, 
                                             s[0] * bound));
     /* the model's balls near the region take part in the overlap checks, as in place_random */
     const double rnew = n > 0 ? s[0] * rpeb : 0, reach = n > 0 ? s[0] * bound : 0;
-    const int64_t nb = sx_ball_count(m);
-    double rold = 0;
-    int64_t near = 0;
-    grid *gr = NULL;
-    for (int pass = 0; pass < 2; pass++) {
-        for (int64_t i = 0; i < nb; i++) {
-            const int64_t id = sx_ball_id_at(m, i);
-            double c[3], rb;
-            sx_ball_get_vec(m, id, SX_BALL_POS, c);
-            sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
-            bool in = true;
-            for (int k = 0; k < dim; k++) in &= c[k] > reg->lo[k] - rb - reach && c[k] < reg->hi[k] + rb + reach;
-            if (!in) continue;
-            if (gr) {
-                grid_add(gr, c, rb);
-            } else {
-                near++;
-                if (rb > rold) rold = rb;
-            }
-        }
-        if (!gr) {
-            gr = lua_newuserdatauv(L, sizeof *gr, 0);
-            grid_init(L, gr, dim, reg->lo, reg->hi, rnew + fmax(rnew, rold), near + n * np);
-        }
-    }
+    grid *gr = grid_of_model(L, m, reg, reach, rnew, n * np);
     double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
     if (reg->kind == SX_REGION_CYLINDER) perpendicular(reg->axis, e1, e2);
     double *xp = lua_newuserdatauv(L, (size_t)np * 3 * sizeof(double), 0);

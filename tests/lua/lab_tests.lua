@@ -1,6 +1,7 @@
 -- The lab-test library (seixo.lab): the Mohr-Coulomb fit against its closed
 -- form, and the whole pipeline on a tiny 2D specimen -- genesis, UCS,
--- biaxial tests, the fit, the files and the quasi-static warnings.
+-- biaxial tests, the fit, the files and the quasi-static warnings -- and on
+-- specimens of clumps.
 local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
 local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
 local lab = require "seixo.lab"
@@ -122,6 +123,63 @@ test("3D: a tiny cylinder through UCS and triaxial tests in a servo-controlled c
   end
   check(s.fit.c > 0 and s.fit.c < math.huge and s.fit.phi > 0 and s.fit.phi < 90,
         string.format("c %g phi %g", s.fit.c, s.fit.phi))
+end)
+
+-- a dimer of overlapping pebbles of radius r, the template of the clump specimens
+local function dimer(dim, r)
+  if dim == 2 then return {{-0.6 * r, 0, r}, {0.6 * r, 0, r}} end
+  return {{-0.6 * r, 0, 0, r}, {0.6 * r, 0, 0, r}}
+end
+
+-- every ball of the specimen's file is a pebble of one of its clumps
+local function all_pebbles(spec)
+  local m = seixo.load(spec.path)
+  eq(m:clump_count(), spec.clumps)
+  local pebbles = 0
+  for cl in m:clumps() do pebbles = pebbles + #cl.pebbles end
+  eq(pebbles, m:ball_count())
+  for b in m:balls() do check(b.clump ~= nil, "ball " .. b.id .. " is not a pebble") end
+  m:close()
+end
+
+test("a specimen of clumps through UCS and biaxial tests", function()
+  local cs = lab.specimen{dim = 2, shape = "rect", width = 0.01, height = 0.02, seed = 4, path = dir .. "/clumps.h5",
+                          clump = {pebbles = dimer(2, 0.5e-3), scale = {0.9, 1.1}}, log = false}
+  check(cs.clumps > 100, cs.clumps)
+  eq(cs.balls, 2 * cs.clumps)
+  all_pebbles(cs)
+  eq(lab.open(cs.path).clumps, cs.clumps)
+  -- a dense, well bonded packing: a jammed one, not the loose random placement
+  check(cs.bonds > 2 * cs.clumps, string.format("%d bonds for %d clumps", cs.bonds, cs.clumps))
+  check(cs.floaters < 0.1 * cs.clumps, cs.floaters)
+  check(cs.porosity > 0.05 and cs.porosity < 0.25, cs.porosity)
+  local prev = 0
+  for _, s3 in ipairs{0, 5e6} do
+    local r = s3 > 0 and lab.triaxial(cs, {confining = s3, log = false}) or lab.ucs(cs, {log = false})
+    check(r.peak > 50e6 and r.peak < 1e9, r.peak) -- a rock's: tens to hundreds of MPa
+    check(r.young > 1e9 and r.young < 1e12, r.young)
+    check(r.cracks.tension + r.cracks.shear > 0, "cracks at the peak")
+    eq(r.stopped, "post_peak")
+    check(r.peak > prev, "strength grows with confinement")
+    prev = r.peak
+  end
+  raises(function() lab.specimen{dim = 2, width = 0.01, height = 0.02, path = "x.h5", clump = {}} end, "clump must be")
+  raises(function()
+    lab.specimen{dim = 2, width = 0.01, height = 0.02, path = "x.h5", radius = {1e-3, 2e-3},
+                 clump = {pebbles = dimer(2, 1e-3)}}
+  end, "takes scale, not radius")
+end)
+
+test("3D: a small cylinder of clumps through a UCS test", function()
+  local cyl = lab.specimen{dim = 3, shape = "cylinder", diameter = 0.01, height = 0.02, seed = 2,
+                           path = dir .. "/clumps3.h5", clump = {pebbles = dimer(3, 0.8e-3), scale = {0.9, 1.1}},
+                           log = false}
+  check(cyl.clumps > 100 and cyl.bonds > 2 * cyl.clumps, string.format("%d clumps, %d bonds", cyl.clumps, cyl.bonds))
+  all_pebbles(cyl)
+  local r = lab.ucs(cyl, {log = false})
+  check(r.peak > 50e6 and r.peak < 1e9 and r.young > 1e9 and r.young < 1e12, string.format("%g, %g", r.peak, r.young))
+  check(r.cracks.tension + r.cracks.shear > 0, "cracks at the peak")
+  eq(r.stopped, "post_peak")
 end)
 
 os.execute("rm -rf '" .. dir .. "'")
