@@ -1022,6 +1022,38 @@ static inline void store_lanes(double *p, const vd *in)
 #endif
 }
 
+/* 4-14 then 4-15 on four lanes, as carry_make and carry_apply: the shear
+ * force g, the stored one where the pair had a contact (had) and none
+ * otherwise, rotated from the previous normal (prev; n for a new contact)
+ * into n, then in 3D about n by half the bodies' summed spin about it
+ * (spin_sum; a wall does not spin, so there its ball's spin alone).
+ * (Arrays and masks by pointer: a vector argument would change the
+ * baseline ABI.) */
+static inline __attribute__((always_inline)) void rotate_shear_lanes(vd *g, const vd *fs_old, const vd *prev,
+                                                                     const vm *had, const vd *n, const vd *spin_sum,
+                                                                     double dt)
+{
+    vd no[D];
+    for (int k = 0; k < D; k++) {
+        g[k] = VSEL(*had, fs_old[k], VZERO);
+        no[k] = VSEL(*had, prev[k], n[k]);
+    }
+#if D == 3
+    const vd c0v = no[1] * n[2] - no[2] * n[1], c1v = no[2] * n[0] - no[0] * n[2], c2v = no[0] * n[1] - no[1] * n[0];
+    vd t0 = c1v * g[2] - c2v * g[1], t1 = c2v * g[0] - c0v * g[2], t2 = c0v * g[1] - c1v * g[0];
+    g[0] += t0, g[1] += t1, g[2] += t2;
+    const vd wbar = 0.5 * (((VZERO + spin_sum[0] * n[0]) + spin_sum[1] * n[1]) + spin_sum[2] * n[2]);
+    const vd r0 = wbar * n[0] * dt, r1 = wbar * n[1] * dt, r2 = wbar * n[2] * dt;
+    t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
+    g[0] += t0, g[1] += t1, g[2] += t2;
+#else
+    (void)spin_sum, (void)dt;
+    const vd cz = no[0] * n[1] - no[1] * n[0], g0 = g[0];
+    g[0] -= cz * g[1];
+    g[1] += cz * g0;
+#endif
+}
+
 /* The batched pass is compiled three times where the compiler can pick at
  * run time (GCC's function multi-versioning on x86-64 GNU/Linux): for
  * x86-64-v4 (AVX-512: the same four lanes, in twice as many registers, so
@@ -1138,25 +1170,13 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) vn += vc[k] * n[k];
         vd vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
-        /* history: none for a new contact */
-        vd g[D], no[D];
-        for (int k = 0; k < D; k++) {
-            g[k] = VSEL(had, fs_old[k], VZERO);
-            no[k] = VSEL(had, rel_old[k] * inv_r, n[k]);
-        }
-        /* 4-14 then 4-15 (carry_make, carry_apply) */
+        /* history: none for a new contact; 4-14 then 4-15 */
+        vd g[D], prev[D];
+        for (int k = 0; k < D; k++) prev[k] = rel_old[k] * inv_r;
 #if D == 3
-        const vd c0v = no[1] * n[2] - no[2] * n[1], c1v = no[2] * n[0] - no[0] * n[2], c2v = no[0] * n[1] - no[1] * n[0];
-        vd t0 = c1v * g[2] - c2v * g[1], t1 = c2v * g[0] - c0v * g[2], t2 = c0v * g[1] - c1v * g[0];
-        g[0] += t0, g[1] += t1, g[2] += t2;
-        const vd wbar = 0.5 * (((VZERO + wsum[0] * n[0]) + wsum[1] * n[1]) + wsum[2] * n[2]);
-        const vd r0 = wbar * n[0] * dt, r1 = wbar * n[1] * dt, r2 = wbar * n[2] * dt;
-        t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
-        g[0] += t0, g[1] += t1, g[2] += t2;
+        rotate_shear_lanes(g, fs_old, prev, &had, n, wsum, dt);
 #else
-        const vd cz = no[0] * n[1] - no[1] * n[0], g0 = g[0];
-        g[0] -= cz * g[1];
-        g[1] += cz * g0;
+        rotate_shear_lanes(g, fs_old, prev, &had, n, NULL, dt);
 #endif
         const vd fn = kn * u; /* 4-6 */
         const vd ksdt = ks * dt;
@@ -1574,24 +1594,12 @@ static inline __attribute__((always_inline)) bool wall_lanes(sx_model *m, sx_blo
     vd vs[D];
     for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
     const vd fn = kn * un; /* 4-6 */
-    vd g[D], no[D];
-    for (int k = 0; k < D; k++) {
-        g[k] = VSEL(had, fs_old[k], VZERO);
-        no[k] = VSEL(had, no_old[k], n[k]);
-    }
-    /* 4-14 then 4-15 (carry_make, carry_apply; the wall does not spin) */
+    /* 4-14 then 4-15 (the wall does not spin) */
+    vd g[D];
 #if D == 3
-    const vd c0v = no[1] * n[2] - no[2] * n[1], c1v = no[2] * n[0] - no[0] * n[2], c2v = no[0] * n[1] - no[1] * n[0];
-    vd t0 = c1v * g[2] - c2v * g[1], t1 = c2v * g[0] - c0v * g[2], t2 = c0v * g[1] - c1v * g[0];
-    g[0] += t0, g[1] += t1, g[2] += t2;
-    const vd wbar = 0.5 * (((VZERO + w[0] * n[0]) + w[1] * n[1]) + w[2] * n[2]);
-    const vd r0 = wbar * n[0] * dt, r1 = wbar * n[1] * dt, r2 = wbar * n[2] * dt;
-    t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
-    g[0] += t0, g[1] += t1, g[2] += t2;
+    rotate_shear_lanes(g, fs_old, no_old, &had, n, w, dt);
 #else
-    const vd cz = no[0] * n[1] - no[1] * n[0], g0 = g[0];
-    g[0] -= cz * g[1];
-    g[1] += cz * g0;
+    rotate_shear_lanes(g, fs_old, no_old, &had, n, NULL, dt);
 #endif
     const vd ksdt = ks * dt;
     for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k];
