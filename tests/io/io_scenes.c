@@ -341,3 +341,44 @@ void io_assert_same_extras(const sx_model *a, const sx_model *b)
         ck_assert_int_eq(na, nb);
     }
 }
+
+static bool first_ball_contact(const sx_contact_info *ci, void *ud)
+{
+    if (ci->is_wall) return true;
+    *(sx_contact_info *)ud = *ci;
+    return false;
+}
+
+void io_first_ball_contact(const sx_model *m, sx_contact_info *ci)
+{
+    memset(ci, 0, sizeof *ci);
+    ci->a = -1;
+    sx_contact_each(m, first_ball_contact, ci);
+    ck_assert_msg(ci->a >= 0, "no ball-ball contact");
+}
+
+static int run_one(const char *name, const TTest *test, bool fork, enum print_output print)
+{
+    Suite *s = suite_create(name);
+    TCase *tc = tcase_create(name);
+    tcase_add_test(tc, test);
+    suite_add_tcase(s, tc);
+    SRunner *r = srunner_create(s);
+    if (!fork) srunner_set_fork_status(r, CK_NOFORK);
+    srunner_run_all(r, print);
+    const int failed = srunner_ntests_failed(r);
+    srunner_free(r);
+    return failed ? 1 : 0;
+}
+
+int io_run_test(const char *name, const TTest *test) { return run_one(name, test, true, CK_NORMAL); }
+
+int io_run_writer(int argc, char **argv, const char *name, const TTest *writer, const char **out_path)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s out.h5\n", argv[0]);
+        return 2;
+    }
+    *out_path = argv[1];
+    return run_one(name, writer, false, CK_SILENT);
+}

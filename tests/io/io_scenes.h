@@ -46,3 +46,12 @@ void io_assert_same_energy(sx_model *a, sx_model *b);
 /// Same crack log, bond and contact counts, walls' definitions, forces and
 /// servo loads (bits).
 void io_assert_same_extras(const sx_model *a, const sx_model *b);
+
+/// The first ball-ball contact of m in the core's order into *ci (asserts one exists).
+void io_first_ball_contact(const sx_model *m, sx_contact_info *ci);
+/// main() of a program of one Check test named name: 0 when it passes.
+int io_run_test(const char *name, const TTest *test);
+/// main() of a sample writer (`prog out.h5`, run once to make a committed
+/// file of an old format): *out_path = argv[1], then the writer test runs
+/// in this process; 2 on a bad command line, 1 when the writer fails.
+int io_run_writer(int argc, char **argv, const char *name, const TTest *writer, const char **out_path);

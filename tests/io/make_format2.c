@@ -99,21 +99,4 @@ START_TEST(make)
 }
 END_TEST
 
-int main(int argc, char **argv)
-{
-    if (argc != 2) {
-        fprintf(stderr, "usage: %s out.h5\n", argv[0]);
-        return 2;
-    }
-    out_path = argv[1];
-    Suite *s = suite_create("make_format2");
-    TCase *tc = tcase_create("make");
-    tcase_add_test(tc, make);
-    suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_set_fork_status(r, CK_NOFORK);
-    srunner_run_all(r, CK_SILENT);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
-}
+int main(int argc, char **argv) { return io_run_writer(argc, argv, "make_format2", make, &out_path); }

@@ -13,13 +13,6 @@
 
 static const char *out_path;
 
-static bool first_ball_contact(const sx_contact_info *ci, void *ud)
-{
-    if (ci->is_wall) return true;
-    *(sx_contact_info *)ud = *ci;
-    return false;
-}
-
 START_TEST(make)
 {
     sx_model *m = scene_model(3, (double[3]){0, 0, -9.81}, 1e-5, 2e5, 0.5, 2500);
@@ -47,8 +40,7 @@ START_TEST(make)
     ck_assert_msg(sx_snapshot_save(m, out_path, &o, err, sizeof err) == SX_OK, "%s", err);
 
     sx_contact_info ci;
-    memset(&ci, 0, sizeof ci);
-    sx_contact_each(m, first_ball_contact, &ci);
+    io_first_ball_contact(m, &ci);
     printf("time %a step %lld balls %lld contacts %lld\n", sx_model_time(m), (long long)sx_model_step_count(m),
            (long long)sx_ball_count(m), (long long)sx_contact_count(m));
     printf("first ball-ball contact %lld-%lld: normal %a %a %a overlap %a shear %a %a %a fn %a\n", (long long)ci.a,
@@ -58,21 +50,4 @@ START_TEST(make)
 }
 END_TEST
 
-int main(int argc, char **argv)
-{
-    if (argc != 2) {
-        fprintf(stderr, "usage: %s out.h5\n", argv[0]);
-        return 2;
-    }
-    out_path = argv[1];
-    Suite *s = suite_create("make_format3");
-    TCase *tc = tcase_create("make");
-    tcase_add_test(tc, make);
-    suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_set_fork_status(r, CK_NOFORK);
-    srunner_run_all(r, CK_SILENT);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
-}
+int main(int argc, char **argv) { return io_run_writer(argc, argv, "make_format3", make, &out_path); }

@@ -82,15 +82,4 @@ START_TEST(format1_loads)
 }
 END_TEST
 
-int main(void)
-{
-    Suite *s = suite_create("io_format1");
-    TCase *tc = tcase_create("format1");
-    tcase_add_test(tc, format1_loads);
-    suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
-}
+int main(void) { return io_run_test("io_format1", format1_loads); }

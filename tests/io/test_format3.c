@@ -12,13 +12,6 @@
 #error "SX_TEST_DATA: the folder of tests/data"
 #endif
 
-static bool first_ball_contact(const sx_contact_info *ci, void *ud)
-{
-    if (ci->is_wall) return true;
-    *(sx_contact_info *)ud = *ci;
-    return false;
-}
-
 START_TEST(format3_loads)
 {
     const char *path = SX_TEST_DATA "/format3.h5";
@@ -38,8 +31,7 @@ START_TEST(format3_loads)
     ck_assert_int_eq(sx_ball_count(m), 36);
     ck_assert_int_eq(sx_contact_count(m), 27);
     sx_contact_info ci;
-    memset(&ci, 0, sizeof ci);
-    sx_contact_each(m, first_ball_contact, &ci);
+    io_first_ball_contact(m, &ci);
     ck_assert(ci.a == 1 && ci.b == 10);
     ck_assert(ci.normal[0] == -0x1.960773b8ebae3p-11 && ci.normal[1] == -0x1.abb2cd776536ep-11 &&
               ci.normal[2] == 0x1.ffffeac5d929p-1);
@@ -57,15 +49,4 @@ START_TEST(format3_loads)
 }
 END_TEST
 
-int main(void)
-{
-    Suite *s = suite_create("io_format3");
-    TCase *tc = tcase_create("format3");
-    tcase_add_test(tc, format3_loads);
-    suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
-}
+int main(void) { return io_run_test("io_format3", format3_loads); }
