@@ -105,7 +105,7 @@ static void qnormalize(double *q)
 }
 
 /* The rotation matrix (row-major) of a unit quaternion. */
-static void qmatrix(const double *q, double *R)
+static inline void qmatrix(const double *q, double *R)
 {
     const double w = q[0], x = q[1], y = q[2], z = q[3];
     R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
@@ -781,11 +781,11 @@ static void momentum_of(const double *R, const double *I, const double *w, doubl
 /* Sets every pebble of clump c from its body: position x + R s b,
  * velocity v + w x r, spin w. Returns the largest squared displacement of
  * a pebble since the last broad-phase build. */
-static double place_pebbles(sx_model *m, int64_t c, const double *R)
+static inline __attribute__((always_inline)) double place_pebbles_dim(sx_model *m, int64_t c, const double *R,
+                                                                      const int d, const int r)
 {
     sx_clumps *C = m->clumps;
     sx_balls *B = &m->balls;
-    const int d = m->dim, r = m->rdim;
     const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
     const double s = C->scale[c], *xc = C->x + c * d, *vc = C->v + c * d, *wc = C->w + c * r;
     const double *body = C->tp_body + t->first * d;
@@ -808,6 +808,11 @@ static double place_pebbles(sx_model *m, int64_t c, const double *R)
         if (disp2 > worst) worst = disp2;
     }
     return worst;
+}
+
+static double place_pebbles(sx_model *m, int64_t c, const double *R)
+{
+    return m->dim == 3 ? place_pebbles_dim(m, c, R, 3, 3) : place_pebbles_dim(m, c, R, 2, 1);
 }
 
 /* Mass and principal moments of clump c from its template, scale and
@@ -1258,30 +1263,38 @@ static inline void sin_cos(double x, double *s, double *c)
  * orientation gains the body-axis rotation (cos phi/2, sin phi/2 e_a) on the
  * right, and L, fixed in space, turns by -phi in body coordinates. R is the
  * rotation of q at the start (the kick's). */
+/* One part of the splitting: the rotation about principal axis a (j, k the
+ * two after it, cyclically) by the share `part` of dt. */
+static inline __attribute__((always_inline)) void rotor_part(double *Lb, double *w, double *v, const double *h, int a,
+                                                             int j, int k, double part)
+{
+    double sh, ch;
+    sin_cos(Lb[a] * h[a] * part, &sh, &ch);
+    const double c = ch * ch - sh * sh, sn = 2 * sh * ch; /* cos phi, sin phi */
+    const double lj = Lb[j], lk = Lb[k];
+    Lb[j] = c * lj + sn * lk;
+    Lb[k] = c * lk - sn * lj;
+    /* q (ch, sh e_a): the Hamilton product with a rotation about one axis */
+    const double w0 = *w, va = v[a], vj = v[j], vk = v[k];
+    *w = w0 * ch - va * sh;
+    v[a] = va * ch + w0 * sh;
+    v[j] = vj * ch + vk * sh;
+    v[k] = vk * ch - vj * sh;
+}
+
 static void free_rotor(double *q, const double *R, const double *L, const double *I, double dt)
 {
-    /* the axis of each sub-rotation, the two after it (cyclically), and its share of dt / 2 */
-    static const int axis[5][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {1, 2, 0}, {0, 1, 2}};
-    static const double part[5] = {0.25, 0.25, 0.5, 0.25, 0.25};
     const double h[3] = {dt / I[0], dt / I[1], dt / I[2]};
     double Lb[3];
     mat_tvec(R, L, Lb);
     double w = q[0], v[3] = {q[1], q[2], q[3]};
-    for (int s = 0; s < 5; s++) {
-        const int a = axis[s][0], j = axis[s][1], k = axis[s][2];
-        double sh, ch;
-        sin_cos(Lb[a] * h[a] * part[s], &sh, &ch);
-        const double c = ch * ch - sh * sh, sn = 2 * sh * ch; /* cos phi, sin phi */
-        const double lj = Lb[j], lk = Lb[k];
-        Lb[j] = c * lj + sn * lk;
-        Lb[k] = c * lk - sn * lj;
-        /* q (ch, sh e_a): the Hamilton product with a rotation about one axis */
-        const double w0 = w, va = v[a], vj = v[j], vk = v[k];
-        w = w0 * ch - va * sh;
-        v[a] = va * ch + w0 * sh;
-        v[j] = vj * ch + vk * sh;
-        v[k] = vk * ch - vj * sh;
-    }
+    /* axes 0, 1, 2, 1, 0 by dt/4, dt/4, dt/2, dt/4, dt/4 (the axes spelled
+     * out so that the parts' arithmetic stays in registers) */
+    rotor_part(Lb, &w, v, h, 0, 1, 2, 0.25);
+    rotor_part(Lb, &w, v, h, 1, 2, 0, 0.25);
+    rotor_part(Lb, &w, v, h, 2, 0, 1, 0.5);
+    rotor_part(Lb, &w, v, h, 1, 2, 0, 0.25);
+    rotor_part(Lb, &w, v, h, 0, 1, 2, 0.25);
     q[0] = w, q[1] = v[0], q[2] = v[1], q[3] = v[2];
     qnormalize(q);
 }
@@ -1305,11 +1318,11 @@ typedef struct clump_block {
     int64_t bad;                        /* first clump with a non-finite state, or -1 */
 } clump_block;
 
-static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
+static inline __attribute__((always_inline)) void step_block_dim(sx_model *m, int64_t c0, int64_t c1, clump_block *o,
+                                                                 const int d, const int r)
 {
     sx_clumps *C = m->clumps;
     sx_balls *B = &m->balls;
-    const int d = m->dim, r = m->rdim;
     const double dt = m->dt;
     /* the kick spans the time between the half-step velocities, as for balls */
     const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
@@ -1387,7 +1400,7 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
                 qmatrix(q, R);
                 spin_of(R, I, L, w);
             }
-            worst = fmax(worst, place_pebbles(m, c, R));
+            worst = fmax(worst, place_pebbles_dim(m, c, R, d, r));
         } else {
             if (!(fix & SX_FIX_WX)) {
                 const double md = sx__damped(T[0], w[0], a), wold = w[0];
@@ -1400,7 +1413,7 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
             C->q[c] += w[0] * dt;
             double R[9];
             body_rotation(m, c, R);
-            worst = fmax(worst, place_pebbles(m, c, R));
+            worst = fmax(worst, place_pebbles_dim(m, c, R, d, r));
         }
         bool ok = isfinite(C->q[c * (d == 3 ? 4 : 1)]);
         for (int k = 0; k < d; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
@@ -1408,6 +1421,13 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
         if (!ok && o->bad < 0) o->bad = c;
     }
     o->worst = worst, o->damp_work = damp_work, o->load_work = load_work;
+}
+
+/* (the dimension a constant in each form, so that the small loops unroll) */
+static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
+{
+    if (m->dim == 3) step_block_dim(m, c0, c1, o, 3, 3);
+    else step_block_dim(m, c0, c1, o, 2, 1);
 }
 
 /* In fixed blocks of clumps whose partial sums are added in block order:
