@@ -8,7 +8,9 @@
 # The X server is started here rather than by xvfb-run -a, whose choice of a
 # free display races with other servers (CI saw "bad X server connection"):
 # with -displayfd the server picks a free display itself and writes its
-# number once it accepts connections.
+# number once it accepts connections; -noreset keeps it from resetting when
+# its last client closes (a client that connects again during a reset is
+# refused: the suite once saw that on all three tries).
 set -eu
 seixo=$1 src=$2 out=$3
 command -v pvbatch > /dev/null 2>&1 || { echo "pvbatch not found: skipped"; exit 77; }
@@ -21,7 +23,7 @@ echo "seixo wrote $1 snapshots of $2 balls, radii $3 .. $4 m"
 
 start_x() {
     rm -f "$dir/display"
-    Xvfb -displayfd 3 -nolisten tcp -screen 0 800x600x24 3> "$dir/display" 2> "$dir/xvfb.log" &
+    Xvfb -displayfd 3 -nolisten tcp -noreset -screen 0 800x600x24 3> "$dir/display" 2> "$dir/xvfb.log" &
     xpid=$!
     tries=0
     while [ ! -s "$dir/display" ]; do
@@ -45,7 +47,9 @@ for attempt in 1 2 3; do
     wait "$xpid" 2> /dev/null || true
     xpid=
     grep -q 'bad X server connection' "$dir/pv.log" || break
-    sleep 1
+    echo "pvbatch could not connect to display $DISPLAY; the server said:"
+    cat "$dir/xvfb.log"
+    sleep 2
 done
 cat "$dir/pv.log"
 grep -q '^paraview_check: OK' "$dir/pv.log"
