@@ -129,6 +129,13 @@ end
 
 -- ---------------------------------------------------------------- vessels
 
+-- The point p moved towards c to f times its distance (an affine scaling about c).
+local function scaled(p, f, c)
+  local q = {}
+  for k = 1, #c do q[k] = c[k] + f * (p[k] - c[k]) end
+  return q
+end
+
 -- A vessel of walls around the box [lo, hi]: six planes (four lines), or
 -- for a cylinder along axis `ax` a cylindrical wall closed by two planes.
 -- vessel.areas() gives the current area (2D: length) each wall loads,
@@ -139,9 +146,7 @@ local function make_vessel(m, lo, hi, kn, cyl_axis)
   local v = {}
   function v.scale(f, c)
     for _, w in ipairs(v.walls) do
-      local p, q = w.point, {}
-      for k = 1, dim do q[k] = c[k] + f * (p[k] - c[k]) end
-      w.point = q
+      w.point = scaled(w.point, f, c)
       if w.kind == "cylinder" then w:set_radius(f * w:radius()) end
     end
   end
@@ -223,7 +228,7 @@ end
 -- steps as the clumps rearrange. Returns the stages and steps taken, or nil
 -- when the clumps fill 95 % of the vessel unjammed.
 local function compact_clumps(m, v, c, sigma0)
-  local dim, start, stages, solid = m:dim(), m:step(), 0, 0
+  local start, stages, solid = m:step(), 0, 0
   for cl in m:clumps() do solid = solid + cl.volume end
   local function loaded()
     local areas = v.areas()
@@ -233,11 +238,7 @@ local function compact_clumps(m, v, c, sigma0)
   while solid / v.volume() < 0.95 do
     stages = stages + 1
     local f = 0.98
-    for cl in m:clumps() do
-      local p, q = cl.pos, {}
-      for k = 1, dim do q[k] = c[k] + f * (p[k] - c[k]) end
-      cl.pos = q
-    end
+    for cl in m:clumps() do cl.pos = scaled(cl.pos, f, c) end
     v.scale(f, c)
     m:cycle(100)
     if loaded() then
