@@ -841,16 +841,24 @@ static void place_clumps(lua_State *L, const sx_model *m, const gen *g, rng *r, 
     }
 }
 
+/* Room for `more` new balls: when they are at least as many as there are,
+ * the store grown once to hold them exactly, not by doubling (which may
+ * leave half of it unused); fewer, and the doubling's amortised growth is
+ * kept. */
+static void reserve_balls(lua_State *L, sx_model *m, int64_t more)
+{
+    if (more >= sx_ball_count(m) && sx_ball_reserve(m, more) != SX_OK)
+        luaL_error(L, "m:generate: %s", sx_lua_core_message(sx_model_error(m)));
+}
+
 /* Adds the clumps; all or none (a failure removes those added). */
 static void add_clumps(lua_State *L, sx_model *m, const gen *g, const double *x, const double *q, const double *s,
                        int64_t n)
 {
     int64_t *ids = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *ids, 0);
-    /* as many new balls as there are: the store grown once, to hold them
-     * exactly, not by doubling (which may leave half of it unused); fewer,
-     * and the doubling's amortised growth is kept */
-    if (n >= sx_ball_count(m) && sx_ball_reserve(m, n) != SX_OK)
-        luaL_error(L, "m:generate: %s", sx_lua_core_message(sx_model_error(m)));
+    sx_clump_props p;
+    sx_lua_check(L, m, sx_clump_template_props(m, g->tpl, &p), "m:generate");
+    reserve_balls(L, m, n * p.count); /* the new balls are the pebbles */
     for (int64_t i = 0; i < n; i++) {
         sx_clump_def d = sx_clump_default_def();
         d.template_index = g->tpl;
@@ -921,11 +929,7 @@ static void push_gravity_guard(lua_State *L, sx_lua_model *ud)
 static int64_t *add_balls(lua_State *L, sx_model *m, const gen *g, const double *x, const double *rad, int64_t n)
 {
     int64_t *ids = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *ids, 0);
-    /* as many new balls as there are: the store grown once, to hold them
-     * exactly, not by doubling (which may leave half of it unused); fewer,
-     * and the doubling's amortised growth is kept */
-    if (n >= sx_ball_count(m) && sx_ball_reserve(m, n) != SX_OK)
-        luaL_error(L, "m:generate: %s", sx_lua_core_message(sx_model_error(m)));
+    reserve_balls(L, m, n);
     for (int64_t i = 0; i < n; i++) {
         sx_ball_def d = sx_ball_default_def();
         memcpy(d.pos, x + 3 * i, sizeof d.pos);
