@@ -356,7 +356,7 @@ static sx_status pairs_resize(sx_model *m, sx_pairs *p, int64_t cap)
     RESIZE(p, geo, d);
     RESIZE(p, touching, 1);
     if (p->bond) RESIZE(p, bond, 1);
-    if (p->walls) RESIZE(p, un, 1);
+    if (p == &m->bw) RESIZE(p, un, 1); /* a ball-ball store derives the overlap */
     RESIZE(p, fn, 1);
     p->cap = cap;
     return SX_OK;
@@ -449,9 +449,7 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
     free_field(m, p->bond, p->bond ? c : 0, sizeof(int32_t));
     free_field(m, p->un, p->un ? c : 0, sizeof(double));
     free_field(m, p->fn, c, sizeof(double));
-    const bool walls = p->walls;
     memset(p, 0, sizeof *p);
-    p->walls = walls;
 }
 
 size_t sx__balls_bytes(const sx_model *m)

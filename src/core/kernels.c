@@ -219,7 +219,7 @@ static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
         {(void **)&p->geo, D, sizeof(double), true, true},
         {(void **)&p->fn, 1, sizeof(double), false, true},
         {(void **)&p->touching, 1, 1, false, true},
-        {(void **)&p->un, 1, sizeof(double), false, p->walls},
+        {(void **)&p->un, 1, sizeof(double), false, p == &m->bw},
         {(void **)&p->bond, 1, sizeof(int32_t), false, p->bond != NULL},
     };
     const int nf = (int)(sizeof fields / sizeof fields[0]);
@@ -230,9 +230,7 @@ static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
             sx_alloc_free(&m->alloc, *fields[j].data, (size_t)((j < k ? tr->cap : old) * fields[j].per), fields[j].size);
         sx_alloc_free(&m->alloc, p->a, (size_t)tr->cap, sizeof *p->a);
         sx_alloc_free(&m->alloc, p->b, (size_t)tr->cap, sizeof *p->b);
-        const bool walls = p->walls;
         memset(p, 0, sizeof *p);
-        p->walls = walls;
         return false;
     }
     p->n = tr->n, p->cap = tr->cap;

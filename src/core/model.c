@@ -68,7 +68,6 @@ sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
     m->build_needed = true;
     m->guard_dirty = true;
     m->threads = 1;
-    m->bw.walls = true;
     return m;
 }
 

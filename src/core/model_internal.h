@@ -93,7 +93,6 @@ typedef struct sx_wall {
  * touching = 0 means no history. */
 typedef struct sx_pairs {
     int64_t n, cap;
-    bool walls;            /* a ball-wall store (it keeps the overlap; a ball-ball one derives it) */
     int32_t *a, *b;
     double *fs;            /* shear force (dim) */
     /* the last evaluation (dim): ball-ball, the relative position x_b - x_a,
@@ -104,7 +103,7 @@ typedef struct sx_pairs {
     uint8_t *touching;     /* history is live (touching, or bonded) */
     int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
     /* the last force evaluation, for queries consistent with the balls' forces */
-    double *un;            /* overlap (ball-wall stores only) */
+    double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
 } sx_pairs;
 

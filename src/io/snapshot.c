@@ -122,9 +122,10 @@ static int pair_fields(const sx_model *m, const sx_pairs *p, field *f, double *o
     f[n++] = F("a", T_I32, p->a, 1, NULL);
     f[n++] = F("b", T_I32, p->b, 1, NULL);
     f[n++] = F("shear_force", T_F64, p->fs, d, "N");
-    if (p->walls || overlap) {
+    const bool walls = p == &m->bw;
+    if (walls || overlap) {
         f[n++] = F("normal", T_F64, p->geo, d, "1");
-        f[n++] = F("overlap", T_F64, p->walls ? p->un : overlap, 1, "m");
+        f[n++] = F("overlap", T_F64, walls ? p->un : overlap, 1, "m");
     } else {
         f[n++] = F("relative_position", T_F64, p->geo, d, "m");
     }
