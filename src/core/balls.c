@@ -504,15 +504,20 @@ static sx_status ensure_applied(sx_model *m)
     return SX_OK;
 }
 
-sx_status sx__balls_expand(sx_model *m)
+sx_status sx__balls_expand_damping(sx_model *m)
 {
     sx_balls *b = &m->balls;
-    const size_t c = (size_t)b->cap;
-    if (!b->alpha) {
-        if (!(b->alpha = sx_alloc_resize(&m->alloc, NULL, 0, c, sizeof *b->alpha))) return SX_ENOMEM;
-        for (int64_t i = 0; i < b->n; i++) b->alpha[i] = m->mats[b->mat[i]].def.damping;
-    }
-    if (!b->group && !(b->group = sx_alloc_resize(&m->alloc, NULL, 0, c, sizeof *b->group))) return SX_ENOMEM;
+    if (b->alpha) return SX_OK;
+    if (!(b->alpha = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)b->cap, sizeof *b->alpha))) return SX_ENOMEM;
+    for (int64_t i = 0; i < b->n; i++) b->alpha[i] = m->mats[b->mat[i]].def.damping;
+    return SX_OK;
+}
+
+sx_status sx__balls_expand_groups(sx_model *m)
+{
+    sx_balls *b = &m->balls;
+    if (!b->group && !(b->group = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)b->cap, sizeof *b->group)))
+        return SX_ENOMEM;
     return SX_OK;
 }
 
@@ -627,7 +632,7 @@ sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double valu
         if (!(value >= 0 && value < 1))
             return sx__fail(m, SX_EINVAL, "ball_set: local damping must be in [0, 1) (got %g)", value);
         if (!b->alpha && value == sx__ball_damping(m, i)) return SX_OK; /* it follows its material already */
-        if (sx__balls_expand(m)) return sx__fail(m, SX_ENOMEM, "ball_set: out of memory");
+        if (sx__balls_expand_damping(m)) return sx__fail(m, SX_ENOMEM, "ball_set: out of memory");
         b->alpha[i] = value;
         return SX_OK;
     case SX_BALL_MASS:
@@ -723,7 +728,7 @@ sx_status sx_ball_set_group(sx_model *m, int64_t id, int32_t group)
     const int64_t i = lookup(m, id, "ball_set_group");
     if (i < 0) return SX_ENOTFOUND;
     if (!m->balls.group && group == 0) return SX_OK;
-    if (sx__balls_expand(m)) return sx__fail(m, SX_ENOMEM, "ball_set_group: out of memory");
+    if (sx__balls_expand_groups(m)) return sx__fail(m, SX_ENOMEM, "ball_set_group: out of memory");
     m->balls.group[i] = group;
     return SX_OK;
 }

@@ -1909,11 +1909,11 @@ static inline __attribute__((always_inline)) void motion_lanes(sx_model *m, sx_b
 
 SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 {
-    bool plain = !m->track_energy, undamped = true; /* undamped: no material has local damping */
-    for (int k = 0; k < m->nmat; k++) undamped &= m->mats[k].def.damping == 0;
     const sx_balls *B = &m->balls;
-    for (int64_t i = o->b0; i < o->b1 && plain; i++)
-        plain = !B->fix[i] && (B->alpha ? B->alpha[i] == 0 : undamped || sx__ball_damping(m, i) == 0);
+    /* undamped: no ball has its own damping and no material has any (no per-ball test needed) */
+    bool plain = !m->track_energy, undamped = !B->alpha;
+    for (int k = 0; k < m->nmat && undamped; k++) undamped = m->mats[k].def.damping == 0;
+    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !B->fix[i] && (undamped || sx__ball_damping(m, i) == 0);
     if (plain && !B->clump) motion_lanes(m, o);
     else if (plain) motion_pass(m, o, true);
     else motion_pass(m, o, false);

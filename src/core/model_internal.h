@@ -58,7 +58,7 @@ typedef struct sx_balls {
     int32_t *id;           /* stable id of each dense index */
     uint16_t *mat;         /* material index */
     uint8_t *fix;          /* SX_FIX_* bits (2D: spin bit stored as SX_FIX_WX) */
-    /* allocated once some ball needs them (sx__balls_expand): local damping,
+    /* allocated once some ball needs them (sx__balls_expand_*): local damping,
      * NULL while every ball has its material's (sx__ball_damping); user
      * group number, NULL while every ball is in none (0) */
     double *alpha;
@@ -270,10 +270,11 @@ void sx__balls_free(sx_model *m);
 /* new index i <- old index order[i]; scratch holds n * dim doubles */
 void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch);
 void sx__ball_update_mass(sx_model *m, int64_t i);
-/* Allocates the per-ball damping (from the materials) and group (0) arrays
- * if absent; SX_ENOMEM. Compact frees each again when it holds only what
- * the materials or the default would (a loaded state, say). */
-sx_status sx__balls_expand(sx_model *m);
+/* Allocate the per-ball damping (filled from the materials) or group (0)
+ * array if absent; SX_ENOMEM. Compact frees each again when it holds only
+ * what the materials or the default would (a loaded state, say). */
+sx_status sx__balls_expand_damping(sx_model *m);
+sx_status sx__balls_expand_groups(sx_model *m);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 void sx__pairs_free(sx_model *m, sx_pairs *p);

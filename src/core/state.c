@@ -58,7 +58,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     /* applied loads live at the balls' capacity: a store that had them keeps one */
     if ((s->balls > 0 || s->applied) && sx__balls_reserve(m, s->balls > 0 ? s->balls : 1)) goto nomem;
     /* the damping and group arrays for the file to fill (sx__state_finish frees them when uniform) */
-    if (b->cap > 0 && sx__balls_expand(m)) goto nomem;
+    if (b->cap > 0 && (sx__balls_expand_damping(m) || sx__balls_expand_groups(m))) goto nomem;
     if (s->applied) {
         if (!alloc_array(m, (void **)&b->fapp, b->cap * d, sizeof(double)) ||
             !alloc_array(m, (void **)&b->tapp, b->cap * r, sizeof(double)))
@@ -162,9 +162,9 @@ static sx_status check_balls(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: ball %lld has material %d, there are %d", (long long)id,
                             (int)b->mat[i], m->nmat);
         if (b->fix[i] & ~valid) return sx__fail(m, SX_EINVAL, "state: ball %lld has invalid fixity bits", (long long)id);
+        const double alpha = sx__ball_damping(m, i);
         if (!(b->rad[i] > 0) || !isfinite(b->rad[i]) || !(b->inv_mass[i] > 0) || !isfinite(b->inv_mass[i]) ||
-            !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) || !(sx__ball_damping(m, i) >= 0) ||
-            !(sx__ball_damping(m, i) < 1))
+            !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) || !(alpha >= 0 && alpha < 1))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a radius, mass, inertia or damping out of range",
                             (long long)id);
         if (!finite_all(b->x + i * d, d) || !finite_all(b->x_build + i * d, d) || !finite_all(b->v + i * d, d) ||
