@@ -136,14 +136,11 @@ static bool transfer_list(sx_model *m, transfer *tr, int64_t cap, bool fresh)
     if (cap < 16) cap = 16; /* never an empty allocation */
     if (cap > INT32_MAX) return false;
     if (cap == tr->cap) return true;
-    int32_t *q[3] = {tr->a, tr->b, tr->src};
+    int32_t **q[3] = {&tr->a, &tr->b, &tr->src};
     for (int k = 0; k < (tr->history ? 3 : 2); k++) {
-        int32_t *r = sx_alloc_resize(&m->alloc, q[k], (size_t)tr->cap, (size_t)cap, sizeof *r);
+        int32_t *r = sx_alloc_resize(&m->alloc, *q[k], (size_t)tr->cap, (size_t)cap, sizeof *r);
         if (!r) return false;
-        q[k] = r;
-        if (k == 0) tr->a = r;
-        else if (k == 1) tr->b = r;
-        else tr->src = r;
+        *q[k] = r;
     }
     tr->cap = cap;
     return true;
