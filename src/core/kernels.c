@@ -1017,16 +1017,17 @@ static inline void store_lanes(double *p, const vd *in)
 #endif
 }
 
-/* 4-14 then 4-15 on four lanes, as carry_make and carry_apply: the shear
- * force g, the stored one where the pair had a contact (had) and none
- * otherwise, rotated from the previous normal (prev; n for a new contact)
- * into n, then in 3D about n by half the bodies' summed spin about it
- * (spin_sum; a wall does not spin, so there its ball's spin alone).
- * (Arrays and masks by pointer: a vector argument would change the
- * baseline ABI.) */
-static inline __attribute__((always_inline)) void rotate_shear_lanes(vd *g, const vd *fs_old, const vd *prev,
-                                                                     const vm *had, const vd *n, const vd *spin_sum,
-                                                                     double dt)
+/* The shear force g of four lanes, as the scalar passes make it: the
+ * stored one where the pair had a contact (had) and none otherwise,
+ * rotated (4-14, as carry_make and carry_apply) from the previous normal
+ * (prev; n for a new contact) into n, then in 3D (4-15) about n by half
+ * the bodies' summed spin about it (spin_sum; a wall does not spin, so
+ * there its ball's spin alone); the increment of the shear velocity vs
+ * (4-18 ... 4-20); the Coulomb limit fmax (4-30/4-31). (Arrays and masks
+ * by pointer: a vector argument would change the baseline ABI.) */
+static inline __attribute__((always_inline)) void shear_lanes(vd *g, const vd *fs_old, const vd *prev, const vm *had,
+                                                              const vd *n, const vd *spin_sum, const vd *vs,
+                                                              const vd *ks, const vd *fmax, double dt)
 {
     vd no[D];
     for (int k = 0; k < D; k++) {
@@ -1042,11 +1043,20 @@ static inline __attribute__((always_inline)) void rotate_shear_lanes(vd *g, cons
     t0 = r1 * g[2] - r2 * g[1], t1 = r2 * g[0] - r0 * g[2], t2 = r0 * g[1] - r1 * g[0];
     g[0] += t0, g[1] += t1, g[2] += t2;
 #else
-    (void)spin_sum, (void)dt;
+    (void)spin_sum;
     const vd cz = no[0] * n[1] - no[1] * n[0], g0 = g[0];
     g[0] -= cz * g[1];
     g[1] += cz * g0;
 #endif
+    const vd ksdt = *ks * dt;
+    for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k];
+    vd f2 = VZERO;
+    for (int k = 0; k < D; k++) f2 += g[k] * g[k];
+    const vm slips = f2 > *fmax * *fmax;
+    if (VANY(slips)) {
+        const vd sc = VSEL(slips, *fmax / VSQRT(f2), VZERO + 1.0);
+        for (int k = 0; k < D; k++) g[k] *= sc;
+    }
 }
 
 /* The batched pass is compiled three times where the compiler can pick at
@@ -1165,26 +1175,16 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) vn += vc[k] * n[k];
         vd vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
-        /* history: none for a new contact; 4-14 then 4-15 */
+        const vd fn = kn * u; /* 4-6 */
+        const vd fmax = mu * VSEL(fn > VZERO, fn, VZERO);
+        /* the shear force (none for a new contact) */
         vd g[D], prev[D];
         for (int k = 0; k < D; k++) prev[k] = rel_old[k] * inv_r;
 #if D == 3
-        rotate_shear_lanes(g, fs_old, prev, &had, n, wsum, dt);
+        shear_lanes(g, fs_old, prev, &had, n, wsum, vs, &ks, &fmax, dt);
 #else
-        rotate_shear_lanes(g, fs_old, prev, &had, n, NULL, dt);
+        shear_lanes(g, fs_old, prev, &had, n, NULL, vs, &ks, &fmax, dt);
 #endif
-        const vd fn = kn * u; /* 4-6 */
-        const vd ksdt = ks * dt;
-        for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
-        /* 4-30/4-31 */
-        const vd fmax = mu * VSEL(fn > VZERO, fn, VZERO);
-        vd f2 = VZERO;
-        for (int k = 0; k < D; k++) f2 += g[k] * g[k];
-        const vm slips = f2 > fmax * fmax;
-        if (VANY(slips)) {
-            const vd sc = VSEL(slips, fmax / VSQRT(f2), VZERO + 1.0);
-            for (int k = 0; k < D; k++) g[k] *= sc;
-        }
         const vm active = u > VZERO;
         const vd sim = LANES_OF(im, i, 1, 0) + LANES_OF(im, j, 1, 0);
         vd cn;
@@ -1588,24 +1588,14 @@ static inline __attribute__((always_inline)) bool wall_lanes(sx_model *m, sx_blo
     for (int k = 0; k < D; k++) vn += vc[k] * n[k];
     vd vs[D];
     for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
-    const vd fn = kn * un; /* 4-6 */
-    /* 4-14 then 4-15 (the wall does not spin) */
+    const vd fn = kn * un, fmax = mu * fn; /* 4-6 */
+    /* the shear force (the wall does not spin) */
     vd g[D];
 #if D == 3
-    rotate_shear_lanes(g, fs_old, no_old, &had, n, w, dt);
+    shear_lanes(g, fs_old, no_old, &had, n, w, vs, &ks, &fmax, dt);
 #else
-    rotate_shear_lanes(g, fs_old, no_old, &had, n, NULL, dt);
+    shear_lanes(g, fs_old, no_old, &had, n, NULL, vs, &ks, &fmax, dt);
 #endif
-    const vd ksdt = ks * dt;
-    for (int k = 0; k < D; k++) g[k] -= ksdt * vs[k];
-    const vd fmax = mu * fn;
-    vd f2 = VZERO;
-    for (int k = 0; k < D; k++) f2 += g[k] * g[k];
-    const vm slips = f2 > fmax * fmax;
-    if (VANY(slips)) {
-        const vd sc = VSEL(slips, fmax / VSQRT(f2), VZERO + 1.0);
-        for (int k = 0; k < D; k++) g[k] *= sc;
-    }
     /* the ball's full mass: c = 2 beta sqrt(m k) */
     vd cn = VZERO + memo->cn;
     const vm other = (im != memo->im) | (dash != memo->dash);
