@@ -342,6 +342,19 @@ void io_assert_same_extras(const sx_model *a, const sx_model *b)
     }
 }
 
+sx_model *io_load_sample(const char *dir, int version, sx_snapshot_info *info)
+{
+    char path[4096], script[64], err[1024];
+    snprintf(path, sizeof path, "%s/format%d.h5", dir, version);
+    snprintf(script, sizeof script, "tests/io/make_format%d.c", version);
+    sx_model *m = sx_snapshot_load(path, 0, info, err, sizeof err);
+    ck_assert_msg(m, "%s", err);
+    ck_assert_int_eq(info->format_version, version);
+    ck_assert_str_eq(info->seixo_version, "0.1.0");
+    ck_assert_str_eq(info->script, script);
+    return m;
+}
+
 static bool first_ball_contact(const sx_contact_info *ci, void *ud)
 {
     if (ci->is_wall) return true;

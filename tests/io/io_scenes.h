@@ -47,6 +47,10 @@ void io_assert_same_energy(sx_model *a, sx_model *b);
 /// servo loads (bits).
 void io_assert_same_extras(const sx_model *a, const sx_model *b);
 
+/// Loads the committed sample dir/formatN.h5 of file format `version`
+/// (asserts success) and checks what its provenance says: that version,
+/// seixo 0.1.0, written by tests/io/make_formatN.c; info is the caller's to free.
+sx_model *io_load_sample(const char *dir, int version, sx_snapshot_info *info);
 /// The first ball-ball contact of m in the core's order into *ci (asserts one exists).
 void io_first_ball_contact(const sx_model *m, sx_contact_info *ci);
 /// main() of a program of one Check test named name: 0 when it passes.

@@ -20,14 +20,8 @@ static bool pb_contacts(const sx_contact_info *ci, void *ud)
 
 START_TEST(format1_loads)
 {
-    const char *path = SX_TEST_DATA "/format1.h5";
-    char err[1024];
     sx_snapshot_info info;
-    sx_model *m = sx_snapshot_load(path, 0, &info, err, sizeof err);
-    ck_assert_msg(m, "%s", err);
-    ck_assert_int_eq(info.format_version, 1);
-    ck_assert_str_eq(info.seixo_version, "0.1.0");
-    ck_assert_str_eq(info.script, "tests/io/make_format1.c");
+    sx_model *m = io_load_sample(SX_TEST_DATA, 1, &info);
 
     /* the values io_make_format1 printed when it wrote the file */
     ck_assert_int_eq(sx_model_dim(m), 2);

@@ -13,14 +13,8 @@
 
 START_TEST(format2_loads)
 {
-    const char *path = SX_TEST_DATA "/format2.h5";
-    char err[1024];
     sx_snapshot_info info;
-    sx_model *m = sx_snapshot_load(path, 0, &info, err, sizeof err);
-    ck_assert_msg(m, "%s", err);
-    ck_assert_int_eq(info.format_version, 2);
-    ck_assert_str_eq(info.seixo_version, "0.1.0");
-    ck_assert_str_eq(info.script, "tests/io/make_format2.c");
+    sx_model *m = io_load_sample(SX_TEST_DATA, 2, &info);
 
     /* the values io_make_format2 printed when it wrote the file */
     ck_assert_int_eq(sx_model_dim(m), 3);

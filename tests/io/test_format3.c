@@ -14,14 +14,8 @@
 
 START_TEST(format3_loads)
 {
-    const char *path = SX_TEST_DATA "/format3.h5";
-    char err[1024];
     sx_snapshot_info info;
-    sx_model *m = sx_snapshot_load(path, 0, &info, err, sizeof err);
-    ck_assert_msg(m, "%s", err);
-    ck_assert_int_eq(info.format_version, 3);
-    ck_assert_str_eq(info.seixo_version, "0.1.0");
-    ck_assert_str_eq(info.script, "tests/io/make_format3.c");
+    sx_model *m = io_load_sample(SX_TEST_DATA, 3, &info);
     sx_snapshot_info_free(&info);
 
     /* the values io_make_format3 printed when it wrote the file */
