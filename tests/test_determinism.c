@@ -201,7 +201,10 @@ static void batched_and_full(int dim, double damping)
     for (int s = 0; s < n; s += 100) {
         ck_assert_cycle(ms[0], 100);
         ck_assert_cycle(ms[1], 100);
+        /* the hash covers the tracked energy terms too: compared without them */
+        sx_model_track_energy(ms[1], false);
         ck_assert_uint_eq(sx_model_state_hash(ms[0]), sx_model_state_hash(ms[1]));
+        sx_model_track_energy(ms[1], true);
     }
     ck_assert(sx_contact_count(ms[0]) > sx_ball_count(ms[0]) / 2);
     sx_model_destroy(ms[0]);

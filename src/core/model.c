@@ -353,19 +353,28 @@ sx_status sx__prepare(sx_model *m)
     return SX_OK;
 }
 
-static sx_status update_timestep(sx_model *m)
+/* The timestep the next step takes: the user's, the automatic one in use,
+ * or, when that is stale or due for a refresh, safety x critical. */
+static sx_status next_timestep(sx_model *m, double *dt)
 {
+    *dt = m->dt;
     if (m->dt_user > 0) {
-        m->dt = m->dt_user;
+        *dt = m->dt_user;
     } else if (m->dt_stale || m->step % DT_REFRESH_STEPS == 0 || !(m->dt > 0)) {
         const double crit = kernels(m)->critical_dt(m);
         if (!isfinite(crit))
             return sx__fail(m, SX_EINVAL,
                             "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
-        m->dt = m->dt_safety * crit;
+        *dt = m->dt_safety * crit;
     }
-    m->dt_stale = false;
     return SX_OK;
+}
+
+static sx_status update_timestep(sx_model *m)
+{
+    const sx_status st = next_timestep(m, &m->dt);
+    if (!st) m->dt_stale = false;
+    return st;
 }
 
 double sx_model_critical_timestep(sx_model *m)
@@ -374,11 +383,14 @@ double sx_model_critical_timestep(sx_model *m)
     return kernels(m)->critical_dt(m);
 }
 
+/* A query: the timestep is computed, not stored, so that asking for it
+ * leaves the state (and its hash) as it was. */
 double sx_model_timestep(sx_model *m)
 {
     if (m->dt_user > 0) return m->dt_user;
-    if (sx__prepare(m) || update_timestep(m)) return NAN;
-    return m->dt;
+    double dt = NAN;
+    if (sx__prepare(m) || next_timestep(m, &dt)) return NAN;
+    return dt;
 }
 
 sx_status sx_model_set_timestep(sx_model *m, double dt)
@@ -640,54 +652,6 @@ uint64_t sx__fnv(uint64_t h, const void *data, size_t n)
 {
     const unsigned char *p = data;
     for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
-    return h;
-}
-
-uint64_t sx_model_state_hash(const sx_model *m)
-{
-    const sx_balls *b = &m->balls;
-    const size_t n = (size_t)b->n, d = (size_t)m->dim, r = (size_t)m->rdim;
-    uint64_t h = 0xcbf29ce484222325ULL;
-    h = sx__fnv(h, &m->time, sizeof m->time);
-    h = sx__fnv(h, &m->step, sizeof m->step);
-    h = sx__fnv(h, &m->dt_prev, sizeof m->dt_prev);
-    h = sx__fnv(h, b->id, n * sizeof *b->id);
-    h = sx__fnv(h, b->x, n * d * sizeof(double));
-    h = sx__fnv(h, b->v, n * d * sizeof(double));
-    h = sx__fnv(h, b->w, n * r * sizeof(double));
-    h = sx__fnv(h, b->f, n * d * sizeof(double));
-    h = sx__fnv(h, b->t, n * r * sizeof(double));
-    h = sx__fnv(h, b->rad, n * sizeof(double));
-    const sx_pairs *ps[2] = {&m->bb, &m->bw};
-    for (int s = 0; s < 2; s++) {
-        const sx_pairs *p = ps[s];
-        for (int64_t c = 0; c < p->n; c++) {
-            if (!p->touching[c]) continue;
-            const int32_t ends[2] = {b->id[p->a[c]], s == 0 ? b->id[p->b[c]] : p->b[c]};
-            h = sx__fnv(h, ends, sizeof ends);
-            h = sx__fnv(h, p->fs + c * (int64_t)d, d * sizeof(double));
-        }
-    }
-    for (int64_t w = 0; w < m->nwall; w++) {
-        const sx_wall *wl = &m->walls[w];
-        h = sx__fnv(h, wl->def.point, sizeof wl->def.point);
-        h = sx__fnv(h, &wl->def.radius, sizeof wl->def.radius);
-        h = sx__fnv(h, wl->force, sizeof wl->force);
-        /* a servo drives its wall: its settings, the loads it read and the
-         * velocities it set are state a continuing run depends on */
-        h = sx__fnv(h, wl->def.vel, sizeof wl->def.vel);
-        h = sx__fnv(h, &wl->def.radial_vel, sizeof wl->def.radial_vel);
-        const uint8_t on = wl->servo_on;
-        h = sx__fnv(h, &on, 1);
-        if (on) {
-            const double servo[4] = {wl->servo.target, wl->servo.area, wl->servo.alpha, wl->servo.max_speed};
-            h = sx__fnv(h, servo, sizeof servo);
-        }
-        h = sx__fnv(h, &wl->load, sizeof wl->load);
-        h = sx__fnv(h, &wl->kn_sum, sizeof wl->kn_sum);
-        h = sx__fnv(h, &wl->contacts, sizeof wl->contacts);
-    }
-    if (m->clumps) h = sx__clumps_hash(m, h);
     return h;
 }
 

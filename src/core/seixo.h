@@ -86,9 +86,10 @@ SX_API void sx_model_interrupt(sx_model *m);
 /// contacts, infinity when forces act but no contact carries any.
 SX_API double sx_model_unbalanced_ratio(const sx_model *m);
 
-/// A 64-bit hash of the full dynamic state (positions, velocities, spins,
-/// forces, contact histories, walls with their motion and servo, time);
-/// equal hashes mean bit-identical states.
+/// A 64-bit hash of everything a restart restores, in a canonical form
+/// (balls by id, contacts in no order, -0 as +0, what the next cycle
+/// derives first as derived; docs/lua-api.md, m:hash(), lists it): equal
+/// hashes mean states that continue bit-identically. Queries leave it as it is.
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
 
 /// Bytes currently allocated by the model.

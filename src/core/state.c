@@ -273,3 +273,220 @@ sx_status sx__state_finish(sx_model *m)
     if (m->balls.n > 0 && !k->plan(m)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
     return SX_OK;
 }
+
+/* ---------------------------------------------------------------- hash
+ *
+ * The state hash covers what a restart restores (see state.h), in a
+ * canonical form, so that equal hashes mean states that continue
+ * bit-identically, and states that differ only in representation hash
+ * alike:
+ *  - balls in id order, not dense order (a broad-phase build re-sorts them);
+ *  - contact histories as per-pair digests summed (order-free, each digest
+ *    mixed before the sum so that no cancellation is cheap), each pair
+ *    oriented from its smaller ball id (a re-sort can flip a pair, which
+ *    negates its vectors, sx__pair_flip);
+ *  - -0 hashed as +0;
+ *  - what the next cycle derives before its first step hashed as derived:
+ *    with a broad-phase build pending, the build positions are the
+ *    positions, the walls have not moved, and the automatic timestep is
+ *    stale; an automatic timestep is hashed only while it is up to date,
+ *    the automatic skin (a fifth of the mean radius at the last build) not. A query that prepares the model (m:timestep(), m:energy(),
+ *    m:contacts()) therefore leaves the hash as it was.
+ * Left out: the thread count (results do not depend on it), the number of
+ * builds (a statistic), caches rebuilt by every cycle (laws, grid,
+ * chunks), the profile. */
+
+typedef struct hasher {
+    uint64_t h;
+} hasher;
+
+static void put(hasher *s, const void *data, size_t n) { s->h = sx__fnv(s->h, data, n); }
+
+static void put_doubles(hasher *s, const double *v, int64_t n, double sign)
+{
+    for (int64_t i = 0; i < n; i++) {
+        const double x = v ? sign * v[i] : 0;
+        const double c = x == 0 ? 0.0 : x; /* -0 as +0 */
+        put(s, &c, sizeof c);
+    }
+}
+
+static void put_double(hasher *s, double v) { put_doubles(s, &v, 1, 1); }
+
+static void put_int(hasher *s, int64_t v) { put(s, &v, sizeof v); }
+
+/* A 64-bit finaliser (splitmix64): digests are mixed before they are summed. */
+static uint64_t mix(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static const uint64_t FNV_BASIS = 0xcbf29ce484222325ULL;
+
+static void hash_scalars(hasher *s, const sx_model *m)
+{
+    put_int(s, m->dim);
+    put_doubles(s, m->gravity, 3, 1);
+    put_double(s, m->dt_user);
+    put_double(s, m->dt_safety);
+    /* an automatic timestep is derived again before the next step when stale */
+    const bool dt_fresh = m->dt_user == 0 && !m->dt_stale && !m->build_needed;
+    put_int(s, dt_fresh);
+    if (dt_fresh) put_double(s, m->dt);
+    put_double(s, m->dt_prev);
+    /* the skin in use is the user's or follows from the radii at each build */
+    put_double(s, m->skin_user);
+    put_double(s, m->time);
+    put_int(s, m->step);
+    put_int(s, m->guard_on);
+    put_int(s, m->guard_dirty);
+    put_double(s, m->guard_e0);
+    put_double(s, m->guard_scale);
+    put_int(s, m->track_energy);
+    put_doubles(s, (const double *)&m->acc, sizeof m->acc / sizeof(double), 1);
+    put_int(s, m->balls.next_id);
+    put_int(s, m->next_wall_id);
+}
+
+static void hash_materials(hasher *s, const sx_model *m)
+{
+    put_int(s, m->nmat);
+    for (int i = 0; i < m->nmat; i++) {
+        const sx_material *t = &m->mats[i];
+        put(s, t->name, strnlen(t->name, sizeof t->name));
+        put_int(s, t->def.model);
+        const double def[] = {t->def.density,  t->def.kn,        t->def.ks,       t->def.modulus,
+                              t->def.stiffness_ratio, t->def.shear_modulus, t->def.poisson, t->def.friction,
+                              t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
+        put_doubles(s, def, sizeof def / sizeof *def, 1);
+        put_doubles(s, (const double *)&t->bpm, sizeof t->bpm / sizeof(double), 1);
+    }
+}
+
+static void hash_balls(hasher *s, const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const int d = m->dim, r = m->rdim;
+    put_int(s, b->n);
+    for (int64_t id = 1; id < b->index_cap && id < b->next_id; id++) {
+        const int64_t i = b->index_of[id];
+        if (i < 0) continue;
+        put_int(s, id);
+        put_doubles(s, b->x + i * d, d, 1);
+        put_doubles(s, (m->build_needed ? b->x : b->x_build) + i * d, d, 1);
+        put_doubles(s, b->v + i * d, d, 1);
+        put_doubles(s, b->w + i * r, r, 1);
+        put_doubles(s, b->f + i * d, d, 1);
+        put_doubles(s, b->t + i * r, r, 1);
+        put_doubles(s, b->fapp ? b->fapp + i * d : NULL, d, 1);
+        put_doubles(s, b->tapp ? b->tapp + i * r : NULL, r, 1);
+        const double scalars[] = {b->rad[i], b->inv_mass[i], b->inv_inertia[i], sx__ball_damping(m, i)};
+        put_doubles(s, scalars, 4, 1);
+        put_int(s, b->mat[i]);
+        put_int(s, b->fix[i]);
+        put_int(s, b->group ? b->group[i] : 0);
+    }
+}
+
+/* The order-free sum of the digests of the pairs with a live history. */
+static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool walls)
+{
+    const int d = m->dim, r = m->rdim;
+    const sx_bonds *k = &m->bonds;
+    uint64_t sum[2] = {0, 0};
+    int64_t live = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        if (!p->touching[c]) continue;
+        int64_t ia = m->balls.id[p->a[c]], ib = walls ? m->walls[p->b[c]].id : m->balls.id[p->b[c]];
+        /* a ball-ball pair from its smaller id: the vectors of b -> a are the negated ones */
+        const double sign = !walls && ia > ib ? -1 : 1;
+        if (sign < 0) {
+            const int64_t t = ia;
+            ia = ib;
+            ib = t;
+        }
+        hasher one = {FNV_BASIS};
+        put_int(&one, ia);
+        put_int(&one, ib);
+        put_doubles(&one, p->fs + c * d, d, sign);
+        put_doubles(&one, p->geo + c * d, d, sign);
+        put_double(&one, p->fn[c]);
+        if (walls) put_double(&one, p->un[c]);
+        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
+        put_int(&one, slot);
+        if (slot >= 0) { /* the bond's vectors follow the pair's orientation (sx__bond_flip) */
+            put_doubles(&one, k->fs + (int64_t)slot * d, d, sign);
+            put_doubles(&one, k->ms + (int64_t)slot * r, r, sign);
+        }
+        sum[0] += mix(one.h);
+        sum[1] += mix(one.h ^ 0x9e3779b97f4a7c15ULL);
+        live++;
+    }
+    put_int(s, live);
+    put(s, sum, sizeof sum);
+}
+
+static void hash_bonds(hasher *s, const sx_model *m)
+{
+    const sx_bonds *k = &m->bonds;
+    put_int(s, k->n);
+    for (int64_t i = 0; i < k->n; i++) { /* slots are never reused: their order is canonical */
+        put_int(s, k->kind[i]);
+        put_int(s, k->ida[i]);
+        put_int(s, k->idb[i]);
+        const double v[] = {k->cb_n[i], k->cb_s[i], k->rbar[i], k->kn[i],
+                            k->ks[i],   k->sigma_c[i], k->tau_c[i], k->fn[i], k->mn[i]};
+        put_doubles(s, v, sizeof v / sizeof *v, 1);
+    }
+    put_int(s, m->cracks.n);
+    for (int64_t i = 0; i < m->cracks.n; i++) {
+        const sx_crack *c = &m->cracks.ev[i];
+        put_int(s, c->step);
+        put_int(s, c->mode);
+        put_int(s, c->kind);
+        put_int(s, c->a);
+        put_int(s, c->b);
+        const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
+        put_doubles(s, v, sizeof v / sizeof *v, 1);
+    }
+}
+
+static void hash_walls(hasher *s, const sx_model *m)
+{
+    put_int(s, m->nwall);
+    for (int64_t i = 0; i < m->nwall; i++) {
+        const sx_wall *w = &m->walls[i];
+        put_int(s, w->id);
+        put_int(s, w->def.kind);
+        put_doubles(s, w->def.point, 3, 1);
+        put_doubles(s, w->def.normal, 3, 1);
+        put_doubles(s, w->def.edge1, 3, 1);
+        put_doubles(s, w->def.edge2, 3, 1);
+        put_doubles(s, w->def.vel, 3, 1);
+        const double def[] = {w->def.radius, w->def.height, w->def.radial_vel, w->def.kn, w->def.ks, w->def.friction};
+        put_doubles(s, def, sizeof def / sizeof *def, 1);
+        put_doubles(s, w->force, 3, 1);
+        put_doubles(s, w->moment, 3, 1);
+        const double last[] = {w->load, w->kn_sum, m->build_needed ? 0 : w->moved};
+        put_doubles(s, last, 3, 1);
+        put_int(s, w->contacts);
+        put_int(s, w->servo_on);
+        if (w->servo_on) put_doubles(s, (const double *)&w->servo, sizeof w->servo / sizeof(double), 1);
+    }
+}
+
+uint64_t sx_model_state_hash(const sx_model *m)
+{
+    hasher s = {FNV_BASIS};
+    hash_scalars(&s, m);
+    hash_materials(&s, m);
+    hash_balls(&s, m);
+    hash_walls(&s, m);
+    hash_pairs(&s, m, &m->bb, false);
+    hash_pairs(&s, m, &m->bw, true);
+    hash_bonds(&s, m);
+    if (m->clumps) s.h = sx__clumps_hash(m, s.h);
+    return s.h;
+}

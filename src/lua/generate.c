@@ -309,6 +309,9 @@ static double *draw_radii(lua_State *L, gen *g, rng *r)
     }
     if (g->has_count && g->has_porosity && g->count > 0) {
         const double k = pow(target / solid, 1.0 / g->dim);
+        if (!(k > 0) || !isfinite(k) || !isfinite(g->rmax * k))
+            luaL_argerror(L, 2, "the radii cannot be scaled to this porosity and count (their volume overflows or "
+                                "vanishes)");
         for (int64_t i = 0; i < g->count; i++) rad[i] *= k;
         g->rmin *= k;
         g->rmax *= k;
@@ -352,6 +355,12 @@ static void grid_init(lua_State *L, grid *gr, int dim, const double *lo, const d
     gr->dim = dim;
     gr->cap = cap;
     const double target = fmax(1024.0, 2.0 * (double)cap);
+    /* no ball to size the cells by (h = 0: nothing placed yet), or radii
+     * that overflow: cells of a target's share of the box, never a size
+     * the loop below cannot grow from */
+    double extent = 0;
+    for (int k = 0; k < dim; k++) extent = fmax(extent, hi[k] - lo[k]);
+    if (!(h > 0) || !isfinite(h)) h = isfinite(extent) && extent > 0 ? extent / target * 4 : 1;
     for (;;) {
         double cells = 1;
         for (int k = 0; k < dim; k++) cells *= floor((hi[k] - lo[k]) / h) + 3;
@@ -1058,7 +1067,7 @@ static int model_generate(lua_State *L)
     m = sx_lua_checkmodel(L, 1);
     const int64_t *ids = add_balls(L, m, &g, x, rad, n);
     sx_lua_record_seed(L, 1, (int64_t)g.seed); /* the balls exist: the files' provenance lists it */
-    if (g.method == M_EXPAND && shrink < 1) {
+    if (g.method == M_EXPAND && shrink < 1 && n > 0) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);
         const int stages = (int)ceil(log(1 / shrink) / log(1.02));

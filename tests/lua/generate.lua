@@ -330,4 +330,33 @@ test("argument errors name the function, the field and the position", function()
   eq(m2:ball_count(), 0)
 end)
 
+-- issue 18: a count of 0 (or -0.0) once sized the placement grid by a NaN
+-- and never returned; radii whose volume overflows are refused
+test("nothing to generate returns at once, in every method, clumps included", function()
+  for _, dim in ipairs({2, 3}) do
+    local z, one = T.zero(dim), dim == 3 and {1, 1, 1} or {1, 1}
+    for _, method in ipairs({"random", "distribute", "expand", "lattice"}) do
+      for _, count in ipairs({0, -0.0}) do
+        local m = seixo.model{dim = dim}
+        m:material("rock")
+        local spec = {count = count, radius = 0.01, method = method, region = {box = {z, one}}}
+        if method == "distribute" or method == "expand" then spec.porosity = 0.5 end
+        local n, porosity = m:generate(spec)
+        eq(n, 0)
+        eq(porosity, 1)
+        m:clump_template("pair", dim == 3 and {{0, 0, 0, 0.01}, {0.01, 0, 0, 0.01}} or {{0, 0, 0.01}, {0.01, 0, 0.01}})
+        if method == "random" then
+          eq(m:generate{template = "pair", count = count, region = {box = {z, one}}}, 0)
+        end
+        eq(m:ball_count(), 0)
+      end
+    end
+    local m = seixo.model{dim = dim}
+    m:material("rock")
+    raises(function() m:generate{count = 3, radius = 1e300, method = "expand", porosity = 0.5, region = {box = {z, one}}} end,
+           HERE, "cannot be scaled")
+    raises(function() m:generate{count = 3, radius = 1e300, region = {box = {z, one}}} end, HERE, "does not fit")
+  end
+end)
+
 T.done()

@@ -1,0 +1,328 @@
+/* The state hash covers what a restart restores, canonically (docs/lua-api.md,
+ * m:hash()): each field a restart restores, written on one of two identical
+ * models, changes the hash, and putting it back restores it; a pair flipped
+ * by a re-sort, a -0 for a +0, a pending build done by a query and a stale
+ * automatic timestep asked for do not change it; a save -> load round trip
+ * keeps it. The fields are poked in the core's own arrays (model_internal.h),
+ * so none is missed through the public API's reach. */
+#include "io_scenes.h"
+
+#include "model_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef enum { F64, I64, I32, U16, U8, BOOL, INT, CHAR } kind;
+
+/* The fields a test has changed, by name: every one must be seen. */
+static const char *seen[256];
+static int nseen;
+
+static void mark(const char *name)
+{
+    for (int i = 0; i < nseen; i++)
+        if (strcmp(seen[i], name) == 0) return;
+    ck_assert_int_lt(nseen, 256);
+    seen[nseen++] = name;
+}
+
+/* Changes the value at p (of a field of b) and back: the hash must follow. */
+static void poke(sx_model *a, sx_model *b, const char *name, void *p, kind k)
+{
+    const uint64_t ha = sx_model_state_hash(a);
+    ck_assert_uint_eq(sx_model_state_hash(b), ha);
+    static const size_t size[] = {8, 8, 4, 2, 1, sizeof(bool), sizeof(int), 1};
+    unsigned char saved[8];
+    memcpy(saved, p, size[k]);
+    switch (k) {
+    case F64: {
+        double *v = p;
+        *v = *v + 1 + fabs(*v);
+        break;
+    }
+    case I64: *(int64_t *)p += 1; break;
+    case I32: *(int32_t *)p += 1; break;
+    case U16: *(uint16_t *)p += 1; break;
+    case U8: *(uint8_t *)p ^= 1; break;
+    case BOOL: *(bool *)p = !*(bool *)p; break;
+    case INT: *(int *)p += 1; break;
+    case CHAR: *(char *)p = *(char *)p == 'x' ? 'y' : 'x'; break;
+    }
+    ck_assert_msg(sx_model_state_hash(b) != ha, "the hash does not cover %s", name);
+    memcpy(p, saved, size[k]);
+    ck_assert_uint_eq(sx_model_state_hash(b), ha);
+    mark(name);
+}
+
+#define POKE(field, k) poke(a, b, #field, &b->field, k)
+
+/* The first pair of store p with a live history, -1 if none. */
+static int64_t live_pair(const sx_pairs *p)
+{
+    for (int64_t c = 0; c < p->n; c++)
+        if (p->touching[c]) return c;
+    return -1;
+}
+
+static void poke_all(sx_model *a, sx_model *b)
+{
+    const int d = b->dim, r = b->rdim;
+    /* the model */
+    POKE(gravity[0], F64);
+    POKE(gravity[d - 1], F64);
+    POKE(dt_user, F64);
+    POKE(dt_safety, F64);
+    if (b->dt_user == 0 && !b->dt_stale && !b->build_needed) POKE(dt, F64);
+    POKE(dt_prev, F64);
+    POKE(skin_user, F64);
+    POKE(time, F64);
+    POKE(step, I64);
+    POKE(guard_on, BOOL);
+    POKE(guard_dirty, BOOL);
+    POKE(guard_e0, F64);
+    POKE(guard_scale, F64);
+    POKE(track_energy, BOOL);
+    POKE(acc.slip, F64);
+    POKE(acc.local_damping, F64);
+    POKE(acc.viscous, F64);
+    POKE(acc.boundary_work, F64);
+    POKE(acc.bond_released, F64);
+    POKE(acc.kinetic, F64);
+    POKE(balls.next_id, I64);
+    POKE(next_wall_id, I64);
+    /* materials */
+    POKE(mats[0].name[0], CHAR);
+    POKE(mats[0].def.model, INT);
+    POKE(mats[0].def.density, F64);
+    POKE(mats[0].def.kn, F64);
+    POKE(mats[0].def.ks, F64);
+    POKE(mats[0].def.modulus, F64);
+    POKE(mats[0].def.stiffness_ratio, F64);
+    POKE(mats[0].def.shear_modulus, F64);
+    POKE(mats[0].def.poisson, F64);
+    POKE(mats[0].def.friction, F64);
+    POKE(mats[0].def.damping, F64);
+    POKE(mats[0].def.viscous_normal, F64);
+    POKE(mats[0].def.viscous_shear, F64);
+    POKE(mats[0].bpm.radius_multiplier, F64);
+    POKE(mats[0].bpm.tensile_strength, F64);
+    POKE(mats[0].bpm.shear_strength_sd, F64);
+    /* a ball in the middle of the dense order, every array */
+    const int64_t i = b->balls.n / 2;
+    POKE(balls.x[i * d + d - 1], F64);
+    if (!b->build_needed) POKE(balls.x_build[i * d], F64);
+    POKE(balls.v[i * d], F64);
+    POKE(balls.w[i * r + r - 1], F64);
+    POKE(balls.f[i * d], F64);
+    POKE(balls.t[i * r], F64);
+    POKE(balls.rad[i], F64);
+    POKE(balls.inv_mass[i], F64);
+    POKE(balls.inv_inertia[i], F64);
+    if (b->nmat > 1) POKE(balls.mat[i], U16); /* a valid material: the damping is read through it */
+    POKE(balls.fix[i], U8);
+    if (b->balls.alpha) POKE(balls.alpha[i], F64);
+    if (b->balls.group) POKE(balls.group[i], I32);
+    if (b->balls.fapp) {
+        POKE(balls.fapp[i * d], F64);
+        POKE(balls.tapp[i * r], F64);
+    }
+    /* walls */
+    for (int64_t w = 0; w < b->nwall; w++) {
+        POKE(walls[w].id, I64);
+        POKE(walls[w].def.kind, INT);
+        POKE(walls[w].def.point[0], F64);
+        POKE(walls[w].def.normal[1], F64);
+        POKE(walls[w].def.edge1[0], F64);
+        POKE(walls[w].def.edge2[1], F64);
+        POKE(walls[w].def.vel[d - 1], F64);
+        POKE(walls[w].def.radius, F64);
+        POKE(walls[w].def.height, F64);
+        POKE(walls[w].def.radial_vel, F64);
+        POKE(walls[w].def.kn, F64);
+        POKE(walls[w].def.ks, F64);
+        POKE(walls[w].def.friction, F64);
+        POKE(walls[w].force[0], F64);
+        POKE(walls[w].moment[2], F64);
+        POKE(walls[w].load, F64);
+        POKE(walls[w].kn_sum, F64);
+        POKE(walls[w].contacts, I64);
+        if (!b->build_needed) POKE(walls[w].moved, F64);
+        POKE(walls[w].servo_on, BOOL);
+        if (b->walls[w].servo_on) {
+            POKE(walls[w].servo.target, F64);
+            POKE(walls[w].servo.area, F64);
+            POKE(walls[w].servo.alpha, F64);
+            POKE(walls[w].servo.max_speed, F64);
+        }
+    }
+    /* contact histories */
+    const int64_t c = live_pair(&b->bb), cw = live_pair(&b->bw);
+    if (c >= 0) {
+        POKE(bb.fs[c * d], F64);
+        POKE(bb.geo[c * d + d - 1], F64);
+        POKE(bb.fn[c], F64);
+        POKE(bb.touching[c], U8);
+        if (b->bb.bond && b->bb.bond[c]) {
+            const int64_t s = b->bb.bond[c] - 1;
+            POKE(bonds.fs[s * d], F64);
+            POKE(bonds.ms[s * r], F64);
+        }
+    }
+    if (cw >= 0) {
+        POKE(bw.fs[cw * d], F64);
+        POKE(bw.geo[cw * d], F64);
+        POKE(bw.fn[cw], F64);
+        POKE(bw.un[cw], F64);
+    }
+    /* bonds, intact or broken, and the crack log */
+    for (int64_t s = 0; s < b->bonds.n; s += b->bonds.n - 1 > 0 ? b->bonds.n - 1 : 1) {
+        POKE(bonds.kind[s], U8);
+        POKE(bonds.ida[s], I32);
+        POKE(bonds.idb[s], I32);
+        POKE(bonds.cb_n[s], F64);
+        POKE(bonds.cb_s[s], F64);
+        POKE(bonds.rbar[s], F64);
+        POKE(bonds.kn[s], F64);
+        POKE(bonds.ks[s], F64);
+        POKE(bonds.sigma_c[s], F64);
+        POKE(bonds.tau_c[s], F64);
+        POKE(bonds.fn[s], F64);
+        POKE(bonds.mn[s], F64);
+    }
+    if (b->cracks.n > 0) {
+        POKE(cracks.ev[0].time, F64);
+        POKE(cracks.ev[0].step, I64);
+        POKE(cracks.ev[0].pos[1], F64);
+        POKE(cracks.ev[0].mode, INT);
+        POKE(cracks.ev[0].kind, INT);
+        POKE(cracks.ev[0].a, I64);
+        POKE(cracks.ev[0].b, I64);
+        POKE(cracks.ev[0].fn, F64);
+        POKE(cracks.ev[0].fs, F64);
+        POKE(cracks.ev[0].mn, F64);
+        POKE(cracks.ev[0].ms, F64);
+    }
+}
+
+typedef sx_model *(*scene_fn)(int dim);
+static sx_model *granular(int dim) { return io_scene_granular(dim, 120); }
+static const scene_fn scenes[] = {granular, io_scene_bonded, io_scene_servo, io_scene_hertz};
+enum { NSCENES = sizeof scenes / sizeof *scenes };
+
+static void cycled_pair(int scene, int dim, sx_model **a, sx_model **b)
+{
+    *a = scenes[scene](dim);
+    *b = scenes[scene](dim);
+    io_cycle(*a, 150);
+    io_cycle(*b, 150);
+}
+
+START_TEST(every_restored_field)
+{
+    nseen = 0;
+    for (int scene = 0; scene < NSCENES; scene++)
+        for (int dim = 2; dim <= 3; dim++) {
+            sx_model *a, *b;
+            cycled_pair(scene, dim, &a, &b);
+            poke_all(a, b);
+            sx_model_destroy(a);
+            sx_model_destroy(b);
+        }
+    /* every field was covered by some scene */
+    static const char *const must[] = {"balls.fapp[i * d]", "balls.group[i]", "balls.alpha[i]", "walls[w].servo.target",
+                                       "bonds.fs[s * d]", "bonds.ms[s * r]", "cracks.ev[0].fs", "bw.un[cw]",
+                                       "bb.fs[c * d]", "dt", "balls.x_build[i * d]", "walls[w].moved"};
+    for (size_t k = 0; k < sizeof must / sizeof *must; k++) {
+        bool found = false;
+        for (int i = 0; i < nseen; i++) found |= strcmp(seen[i], must[k]) == 0;
+        ck_assert_msg(found, "no scene exercises %s", must[k]);
+    }
+}
+END_TEST
+
+/* Representation, not state: none of these changes the hash. */
+START_TEST(canonical)
+{
+    const int dim = _i;
+    for (int scene = 0; scene < NSCENES; scene++) {
+        sx_model *a, *b;
+        cycled_pair(scene, dim, &a, &b);
+        const uint64_t h = sx_model_state_hash(a);
+        /* a pair flipped (the other ball first) and its rows moved */
+        sx_pairs *p = &b->bb;
+        for (int64_t c = 0; c < p->n; c++) sx__pair_flip(b, p, c);
+        ck_assert_uint_eq(sx_model_state_hash(b), h);
+        for (int64_t c = 0; c < p->n; c++) sx__pair_flip(b, p, c);
+        if (p->n >= 2 && p->cap > p->n) {
+            sx__pair_move(b, p, p->n, 0);
+            sx__pair_move(b, p, 0, p->n - 1);
+            sx__pair_move(b, p, p->n - 1, p->n);
+            ck_assert_uint_eq(sx_model_state_hash(b), h);
+        }
+        /* -0 for +0 */
+        const int64_t id = sx_ball_id_at(b, 0);
+        double v[3] = {0, 0, 0}, nv[3] = {-0.0, -0.0, -0.0};
+        ck_assert_int_eq(sx_ball_set_vec(a, id, SX_BALL_VEL, v), SX_OK);
+        ck_assert_int_eq(sx_ball_set_vec(b, id, SX_BALL_VEL, nv), SX_OK);
+        ck_assert_uint_eq(sx_model_state_hash(b), sx_model_state_hash(a));
+        /* queries that prepare the model: a pending build and a stale automatic timestep */
+        ck_assert_int_eq(sx_model_set_timestep(a, 0), SX_OK);
+        ck_assert_int_eq(sx_model_set_timestep(b, 0), SX_OK);
+        double x[3];
+        ck_assert_int_eq(sx_ball_get_vec(a, id, SX_BALL_POS, x), SX_OK);
+        ck_assert_int_eq(sx_ball_set_vec(a, id, SX_BALL_POS, x), SX_OK);
+        ck_assert_int_eq(sx_ball_set_vec(b, id, SX_BALL_POS, x), SX_OK);
+        const uint64_t h2 = sx_model_state_hash(a);
+        ck_assert(b->build_needed && b->dt_stale);
+        ck_assert(isfinite(sx_model_timestep(b)));
+        sx_energy e = sx_model_energy(b);
+        ck_assert(isfinite(e.kinetic));
+        ck_assert(sx_contact_count(b) >= 0);
+        ck_assert(!b->build_needed);
+        ck_assert_uint_eq(sx_model_state_hash(b), h2);
+        /* and the two continue alike */
+        io_cycle(a, 20);
+        io_cycle(b, 20);
+        ck_assert_uint_eq(sx_model_state_hash(b), sx_model_state_hash(a));
+        sx_model_destroy(a);
+        sx_model_destroy(b);
+    }
+}
+END_TEST
+
+/* A restart keeps the hash, however the file's rows come back. */
+START_TEST(restart_keeps_it)
+{
+    const int dim = _i;
+    char path[512];
+    for (int scene = 0; scene < NSCENES; scene++) {
+        sx_model *a = scenes[scene](dim);
+        io_cycle(a, 150);
+        io_save(a, io_path(path, sizeof path, "hash.h5"));
+        sx_model *b = io_load(path, dim);
+        ck_assert_uint_eq(sx_model_state_hash(b), sx_model_state_hash(a));
+        io_cycle(a, 30);
+        io_cycle(b, 30);
+        ck_assert_uint_eq(sx_model_state_hash(b), sx_model_state_hash(a));
+        sx_model_destroy(a);
+        sx_model_destroy(b);
+    }
+    io_rmdir();
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("hash");
+    TCase *t = tcase_create("hash");
+    tcase_set_timeout(t, 600);
+    tcase_add_test(t, every_restored_field);
+    tcase_add_loop_test(t, canonical, 2, 4);
+    tcase_add_loop_test(t, restart_keeps_it, 2, 4);
+    suite_add_tcase(s, t);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    const int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}
