@@ -15,8 +15,8 @@
  * protected call (pmain), every chunk under lua_pcall with a message
  * handler (with a traceback on -t). A SIGINT interrupts a running cycle
  * through the bindings, or else the running Lua code through a hook; either
- * way the error unwinds to the prompt with the models intact. The handler
- * resets itself, so a second SIGINT ends a process that does not respond. */
+ * way the error unwinds to the prompt with the models intact. A second
+ * SIGINT while the first is unanswered ends a process that does not respond. */
 #include <lauxlib.h>
 #include <lua.h>
 #include <lualib.h>
@@ -107,23 +107,52 @@ static int msghandler(lua_State *L)
     return 1;
 }
 
+/* The coroutines resumed now, innermost last: a hook is per thread, so the
+ * one set on the main thread would not stop a loop inside a coroutine.
+ * coroutine.resume and coroutine.wrap are replaced to keep the list. */
+enum { MAX_RESUMED = 256 };
+static lua_State *volatile resumed[MAX_RESUMED];
+static volatile sig_atomic_t nresumed;
+
 /* Raises "interrupted" in Lua code only. At the call or return of a C
  * function it stays armed for the next Lua instruction: raising on entry
  * would skip the function's body, and when that function is a __close
- * (a seixo run giving its model back) the model would stay "cycling". */
+ * (a seixo run giving its model back) the model would stay "cycling".
+ * Armed on every running thread, it fires on each until the main thread's
+ * fires, which answers the Ctrl-C; a hook left on a thread after that is
+ * dropped when it fires. */
 static void stop_hook(lua_State *L, lua_Debug *ar)
 {
+    if (!sx_lua_interrupt_pending()) {
+        lua_sethook(L, NULL, 0, 0);
+        return;
+    }
     if ((ar->event == LUA_HOOKCALL || ar->event == LUA_HOOKRET) && lua_getinfo(L, "S", ar) && ar->what[0] == 'C')
         return;
     lua_sethook(L, NULL, 0, 0);
+    if (L == global_L) sx_lua_interrupt_clear();
     luaL_error(L, "interrupted");
 }
 
+/* The handler stays armed: a script that caught one "interrupted" (pcall)
+ * is stopped by the next Ctrl-C as well. A second Ctrl-C while the first is
+ * still unanswered (code no hook reaches: a finaliser, a long C call) ends
+ * seixo, saying so. */
 static void on_sigint(int sig)
 {
     (void)sig;
-    if (sx_lua_interrupt_all() == 0)
-        lua_sethook(global_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT, 1);
+    if (sx_lua_interrupt_pending()) {
+        static const char msg[] = "\nseixo: interrupted again before the running code stopped; exiting\n";
+        ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
+        (void)w;
+        _exit(130);
+    }
+    if (sx_lua_interrupt_all() == 0) {
+        const int mask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
+        const int n = nresumed;
+        for (int i = 0; i < n && i < MAX_RESUMED; i++) lua_sethook(resumed[i], stop_hook, mask, 1);
+        lua_sethook(global_L, stop_hook, mask, 1);
+    }
 }
 
 static void set_sigint(void (*handler)(int))
@@ -131,9 +160,66 @@ static void set_sigint(void (*handler)(int))
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = handler;
-    sa.sa_flags = SA_RESETHAND;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
+}
+
+/* coroutine.resume, listing the coroutine while it runs (upvalue 1: the
+ * library's resume). */
+static int resume_listed(lua_State *L)
+{
+    lua_State *co = lua_tothread(L, 1);
+    const sig_atomic_t depth = nresumed;
+    if (co && depth < MAX_RESUMED) resumed[depth] = co;
+    nresumed = depth + 1;
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    const int st = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
+    nresumed = depth;
+    if (st != LUA_OK) return lua_error(L);
+    return lua_gettop(L);
+}
+
+/* The function coroutine.wrap returns (upvalue 1: the coroutine, 2: resume_listed). */
+static int wrapped_call(lua_State *L)
+{
+    lua_pushvalue(L, lua_upvalueindex(2));
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_rotate(L, 1, 2);
+    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+    if (!lua_toboolean(L, 1)) {
+        if (lua_type(L, 2) == LUA_TSTRING) { /* as the library's wrap: the caller's position */
+            luaL_where(L, 1);
+            lua_insert(L, 2);
+            lua_concat(L, 2);
+        }
+        lua_settop(L, 2);
+        return lua_error(L);
+    }
+    return lua_gettop(L) - 1;
+}
+
+static int wrap_listed(lua_State *L)
+{
+    luaL_checktype(L, 1, LUA_TFUNCTION);
+    lua_State *co = lua_newthread(L);
+    lua_pushvalue(L, 1);
+    lua_xmove(L, co, 1);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_pushcclosure(L, wrapped_call, 2);
+    return 1;
+}
+
+static void list_coroutines(lua_State *L)
+{
+    lua_getglobal(L, "coroutine");
+    lua_getfield(L, -1, "resume");
+    lua_pushcclosure(L, resume_listed, 1);
+    lua_pushvalue(L, -1);
+    lua_setfield(L, -3, "resume");
+    lua_pushcclosure(L, wrap_listed, 1);
+    lua_setfield(L, -2, "wrap");
+    lua_pop(L, 1);
 }
 
 /* Calls the function below its narg arguments with SIGINT caught. */
@@ -143,11 +229,13 @@ static int docall(lua_State *L, int narg, int nres)
     lua_pushcfunction(L, msghandler);
     lua_insert(L, base);
     global_L = L;
+    sx_lua_interrupt_clear();
     set_sigint(on_sigint);
     const int status = lua_pcall(L, narg, nres, base);
     set_sigint(SIG_DFL);
     /* an interrupt that came when no Lua code was left to stop */
     if (lua_gethook(L) == stop_hook) lua_sethook(L, NULL, 0, 0);
+    sx_lua_interrupt_clear();
     lua_remove(L, base);
     return status;
 }
@@ -561,28 +649,39 @@ static int load_entry(lua_State *L, bool tty)
     return status;
 }
 
-/* Appends the string on the stack top to the string at acc. */
-static void append(lua_State *L, int acc)
+/* A Ctrl-C while C code of the REPL works through a large value: the
+ * hook the handler armed fires in Lua code only. */
+static void check_interrupt(lua_State *L)
 {
-    lua_pushvalue(L, acc);
-    lua_insert(L, -2);
-    lua_concat(L, 2);
-    lua_replace(L, acc);
+    if (!sx_lua_interrupt_pending()) return;
+    lua_sethook(L, NULL, 0, 0);
+    sx_lua_interrupt_clear();
+    luaL_error(L, "interrupted");
+}
+
+/* Moves the string on the stack top into parts[k + 1]; returns k + 1. */
+static lua_Integer add_part(lua_State *L, int parts, lua_Integer k)
+{
+    lua_rawseti(L, parts, ++k);
+    if (k % 1024 == 0) check_interrupt(L);
+    return k;
 }
 
 /* A table shown one level deep, so vectors and energy tables read at a
- * glance: {1, 2, 3}, {kinetic = 0.5, strain = 0}. */
+ * glance: {1, 2, 3}, {kinetic = 0.5, strain = 0}. The pieces are gathered
+ * in a table and joined once: a 50k-sample history prints in linear time. */
 static void push_shallow(lua_State *L, int t)
 {
-    lua_pushliteral(L, "{");
-    const int acc = lua_gettop(L);
+    lua_newtable(L);
+    const int parts = lua_gettop(L);
+    lua_Integer k = 0;
     const lua_Integer n = (lua_Integer)lua_rawlen(L, t);
     const char *sep = "";
     for (lua_Integer i = 1; i <= n; i++, sep = ", ") {
         lua_rawgeti(L, t, i);
         lua_pushfstring(L, "%s%s", sep, luaL_tolstring(L, -1, NULL));
-        append(L, acc);
-        lua_settop(L, acc);
+        k = add_part(L, parts, k);
+        lua_settop(L, parts);
     }
     lua_pushnil(L);
     while (lua_next(L, t)) {
@@ -594,13 +693,21 @@ static void push_shallow(lua_State *L, int t)
                 lua_pushfstring(L, "%s%s = %s", sep, lua_tostring(L, key), value);
             else
                 lua_pushfstring(L, "%s[%s] = %s", sep, luaL_tolstring(L, key, NULL), value);
-            append(L, acc);
+            k = add_part(L, parts, k);
             sep = ", ";
         }
         lua_settop(L, key);
     }
-    lua_pushliteral(L, "}");
-    append(L, acc);
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    luaL_addchar(&b, '{');
+    for (lua_Integer i = 1; i <= k; i++) {
+        lua_rawgeti(L, parts, i);
+        luaL_addvalue(&b);
+    }
+    luaL_addchar(&b, '}');
+    luaL_pushresult(&b);
+    lua_remove(L, parts);
 }
 
 /* Prints its arguments with the global print, tables without __tostring
@@ -742,6 +849,7 @@ static int pmain(lua_State *L)
     lua_settop(L, 0);
     luaL_checkversion(L);
     luaL_openlibs(L);
+    list_coroutines(L);
     sx_lua_open(L);
     global_L = L;
     open_library(L);

@@ -190,8 +190,9 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
 /// Cycles the core n steps in the run, without user callbacks; an interrupt
 /// ("interrupted at step N") or a failure is a Lua error.
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n);
-/// Raises "interrupted at step N" when the run was interrupted: long C work
-/// between cycles calls it so that a Ctrl-C stops it too.
+/// Raises "interrupted at step N" when the run was interrupted, and
+/// "interrupted" when r is NULL and a Ctrl-C is pending: long C work (between
+/// cycles, or outside any run) calls it so that a Ctrl-C stops it too.
 void sx_lua_run_poll(lua_State *L, sx_lua_run *r);
 /// Calls the function below its nargs arguments as a user callback of the
 /// model at `model`: removals are queued while it runs and applied after.

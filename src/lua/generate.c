@@ -569,10 +569,11 @@ static void place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const
     double e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
     if (reg->kind == SX_REGION_CYLINDER) perpendicular(reg->axis, e1, e2);
     for (int64_t i = 0; i < n; i++) {
-        if (run && i % 1024 == 0) sx_lua_run_poll(L, run);
+        if (i % 1024 == 0) sx_lua_run_poll(L, run); /* a Ctrl-C, in a run or not */
         double *xi = x + 3 * i;
         int64_t t = 0;
         for (; t < g->tries; t++) {
+            if (t % 4096 == 4095) sx_lua_run_poll(L, run); /* a region that is full: many tries per ball */
             sample(reg, r, rad[i], e1, e2, xi);
             if (!sx_lua_region_contains(reg, xi, rad[i])) continue;
             probe p = {xi, rad[i]};

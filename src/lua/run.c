@@ -37,7 +37,7 @@
 #include "bindings.h"
 #include "seixo_lua.h"
 
-enum { MAX_RUNS = 16 };  // deeper nested runs are not listed, hence not interruptible
+enum { MAX_RUNS = 16 };  // models cycling inside each other's callbacks, at most
 _Static_assert(ATOMIC_POINTER_LOCK_FREE == 2 && ATOMIC_INT_LOCK_FREE == 2,
                "a signal handler may only touch lock-free atomics");
 
@@ -133,9 +133,16 @@ typedef sx_lua_run run;
 
 static _Atomic(run *) runs[MAX_RUNS];
 static atomic_int nruns;
+/* a Ctrl-C no code has answered yet: long C work outside any run polls it */
+static atomic_int pending;
+
+int sx_lua_interrupt_pending(void) { return atomic_load(&pending); }
+
+void sx_lua_interrupt_clear(void) { atomic_store(&pending, 0); }
 
 int sx_lua_interrupt_all(void)
 {
+    atomic_store(&pending, 1);
     const int n = atomic_load(&nruns);
     for (int i = 0; i < n; i++) {
         run *r = atomic_load(&runs[i]);
@@ -195,27 +202,34 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     ud->running++;
     r->saved_callback = ud->callback;
     r->open = true;
+    /* an unlisted run could not be interrupted: deeper nesting is refused */
     const int slot = atomic_load(&nruns);
-    if (slot < MAX_RUNS) {
-        r->slot = slot;
-        atomic_store(&runs[slot], r);
-        atomic_store(&nruns, slot + 1);
-    }
+    if (slot >= MAX_RUNS)
+        luaL_error(L, "%s: more than %d models cycling inside each other's callbacks", what, MAX_RUNS);
+    r->slot = slot;
+    atomic_store(&runs[slot], r);
+    atomic_store(&nruns, slot + 1);
     return r;
+}
+
+/* The Ctrl-C is answered: by the error raised now. */
+static void interrupted(lua_State *L, sx_lua_run *r)
+{
+    atomic_store(&pending, 0);
+    if (r) luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+    luaL_error(L, "interrupted");
 }
 
 void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 {
-    if (atomic_load(&r->interrupted))
-        luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+    if ((r && atomic_load(&r->interrupted)) || atomic_load(&pending)) interrupted(L, r);
 }
 
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
 {
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle(r->m, n);
-    if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
-        luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+    if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);
     sx_lua_check(L, r->m, st, r->what);
 }
 
@@ -249,8 +263,10 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
     if (ud->callback == 0) sx_lua_apply_removals(L, model);
     if (status != LUA_OK) {
         /* a Ctrl-C that stopped the callback reads like one that stopped the cycle */
-        if (mine && atomic_load(&r->interrupted))
+        if (mine && atomic_load(&r->interrupted)) {
+            atomic_store(&pending, 0);
             luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
+        }
         lua_error(L);
     }
 }

@@ -20,6 +20,14 @@ SX_API void sx_lua_open(lua_State *L);
 /// Lua code itself (the seixo executable sets a hook, as lua.c does).
 SX_API int sx_lua_interrupt_all(void);
 
+/// A Ctrl-C (sx_lua_interrupt_all) that no code has answered yet with an
+/// "interrupted" error; long C work outside the cycles polls it.
+/// Async-signal-safe.
+SX_API int sx_lua_interrupt_pending(void);
+/// Forgets a pending Ctrl-C: the caller answered it (the executable's hook
+/// raised "interrupted"), or no code was left to stop.
+SX_API void sx_lua_interrupt_clear(void);
+
 /// Switches the progress line of long cycles (steps, time, steps/s, ETA on
 /// stderr) on or off for this state; off by default. The executable turns
 /// it on when stderr is a terminal.
