@@ -15,6 +15,7 @@
  * vector extensions), beside the full scalar forms; both give the same
  * bits (tests/test_determinism.c).
  */
+#include "laws/registry.h"
 #include "model_internal.h"
 
 #include <assert.h>
@@ -593,37 +594,19 @@ static inline void carry_apply(const carry *r, double *v)
 #endif
 }
 
-/* Normal and shear stiffness of a contact (4-22/4-23, 4-25/4-26, 4-49/4-50).
+/* Normal and shear stiffness of a contact by its law (laws/registry.h).
  * rbar is 4-27's 2RARB/(RA+RB) (ball-wall: R, 4-28). Returns the normal force. */
 static inline double stiffness(const sx_pair_law *l, double ra, double rb, double rbar, double un, double *kn,
                                double *ks)
 {
-    if (l->hertz) {
-        const double u = un > 0 ? un : 0;
-        *kn = 2 * l->g * sqrt(2 * rbar) / (3 * (1 - l->nu)) * sqrt(u);                  /* 4-25 */
-        const double fn = *kn * u;
-        *ks = 2 * cbrt(l->g * l->g * 3 * (1 - l->nu) * rbar) / (2 - l->nu) * cbrt(fn); /* 4-26 */
-        return fn;
-    }
-    if (l->per_radius) {
-        const double kna = l->ec_a > 0 ? (D == 3 ? 4 * ra * l->ec_a : 2 * l->ec_a) : l->kn_a; /* 4-49 */
-        const double ksa = l->ec_a > 0 ? kna / l->ratio_a : l->ks_a;                          /* 4-50 */
-        const double knb = l->ec_b > 0 ? (D == 3 ? 4 * rb * l->ec_b : 2 * l->ec_b) : l->kn_b;
-        const double ksb = l->ec_b > 0 ? knb / l->ratio_b : l->ks_b;
-        *kn = kna * knb / (kna + knb);
-        *ks = ksa + ksb > 0 ? ksa * ksb / (ksa + ksb) : 0;
-    } else {
-        *kn = l->kn;
-        *ks = l->ks;
-    }
-    return *kn * un; /* 4-6 */
+    return sx__law_force(l, D, ra, rb, rbar, un, kn, ks);
 }
 
-/* Strain energy of a contact spring: linear 1/2 Fn Un, Hertz 2/5 Fn Un, plus
- * the shear spring's 1/2 |Fs|^2 / ks. */
-static inline double contact_strain(bool hertz, double fn, double un, const double *fs, double ks)
+/* Strain energy of a contact spring: its law's factor times Fn Un (linear
+ * 1/2, Hertz 2/5), plus the shear spring's 1/2 |Fs|^2 / ks. */
+static inline double contact_strain(const sx_pair_law *l, double fn, double un, const double *fs, double ks)
 {
-    const double normal = (hertz ? 0.4 : 0.5) * fn * un;
+    const double normal = sx__law(l->law)->strain * fn * un;
     return normal + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
 }
 
@@ -794,7 +777,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
                 double kn, ks;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
-                if (!law->hertz && ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+                if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
             }
             touching[c] = 0;
             fn_all[c] = 0; /* its last evaluation: no force */
@@ -893,7 +876,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 /* viscous dashpots at the critical-damping ratios on the reduced mass
                  * m* = 1 / (1/ma + 1/mb): c = 2 beta sqrt(m* k), a per-law factor when k is */
                 const double sum_im = im[i] + im[j];
-                const double cn = law->hertz || law->per_radius ? 2 * law->beta_n * sqrt(kn / sum_im)
+                const double cn = !law->plain ? 2 * law->beta_n * sqrt(kn / sum_im)
                                                                 : sqrt(law->dash_n / sum_im);
                 const double fdn = -cn * vn;
                 fd += fdn;
@@ -914,7 +897,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (track && touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
                 double kn0, ks0;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn0, &ks0);
-                if (!law->hertz && ks0 > 0) o->slip += 0.5 * dot(fs, fs) / ks0;
+                if (ks0 > 0) o->slip += 0.5 * dot(fs, fs) / ks0;
             }
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
             fn_all[c] = 0;
@@ -1404,7 +1387,7 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     const double dist = wall_distance(wl, xi, n);
     const sx_pair_law *law = &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
     if (dist >= r) {
-        if (p->touching[c] && track && !law->hertz) {
+        if (p->touching[c] && track) { /* a Hertz spring holds nothing at zero overlap: ks = 0 */
             double kn, ks;
             stiffness(law, r, 0, r, 0, &kn, &ks);
             if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
@@ -1463,7 +1446,7 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     if (law->beta_n > 0 || law->beta_s > 0) {
         /* the ball's full mass: c = 2 beta sqrt(m k); balls of one size and material share it */
         double cn;
-        if (law->hertz || law->per_radius) {
+        if (!law->plain) {
             cn = 2 * law->beta_n * sqrt(kn / B->inv_mass[i]);
         } else if (law->dash_n == memo->dash && B->inv_mass[i] == memo->im) {
             cn = memo->cn;
@@ -1651,7 +1634,7 @@ static inline bool plain_wall_contact(const sx_model *m, int64_t c)
 {
     const sx_wall *wl = &m->walls[m->bw.b[c]];
     const sx_pair_law *law = &m->wlaw[m->balls.mat[m->bw.a[c]] * m->nwall + m->bw.b[c]];
-    return (wl->def.kind == SX_WALL_PLANE || wl->def.kind == SX_WALL_LINE) && !law->hertz && !law->per_radius &&
+    return (wl->def.kind == SX_WALL_PLANE || wl->def.kind == SX_WALL_LINE) && law->plain &&
            law->beta_s == 0;
 }
 
@@ -1971,7 +1954,7 @@ static double KERNEL(critical_dt)(sx_model *m)
                 ct[i] += cn + cs, ct[j] += cn + cs;
                 cr[i] += cs * B->rad[i] * B->rad[i], cr[j] += cs * B->rad[j] * B->rad[j];
             }
-            if (law->hertz) kn *= 1.5; /* 4-29 */
+            kn *= sx__law(law->law)->tangent; /* 4-29 */
             ktr = kn + ks;
             krot_i = ks * B->rad[i] * B->rad[i];
             krot_j = ks * B->rad[j] * B->rad[j];
@@ -2005,7 +1988,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             ct[i] += 2 * law.beta_n * sqrt(mass * kn) + cs;
             cr[i] += cs * B->rad[i] * B->rad[i];
         }
-        if (law.hertz) kn *= 1.5;
+        kn *= sx__law(law.law)->tangent;
         kt[i] += kn + ks;
         kr[i] += ks * B->rad[i] * B->rad[i];
     }
@@ -2016,8 +1999,9 @@ static double KERNEL(critical_dt)(sx_model *m)
         const double r = B->rad[i];
         double kn, ks;
         stiffness(self, r, r, r, HERTZ_REFERENCE_OVERLAP * r, &kn, &ks);
-        if (self->hertz) kn *= 1.5;
-        else kn *= 2, ks *= 2; /* undo the series combination with itself */
+        const sx_law *own = sx__law(self->law);
+        kn *= own->tangent;
+        if (own->series) kn *= 2, ks *= 2; /* undo the series combination with itself */
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
         if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
@@ -2090,8 +2074,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
         const double fn = pair_force(m, c, un, &kn, &ks);
-        const bool hertz = m->law[B->mat[i] * m->law_n + B->mat[j]].hertz;
-        e->strain += contact_strain(hertz, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
+        e->strain += contact_strain(&m->law[B->mat[i] * m->law_n + B->mat[j]], fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
     }
@@ -2102,7 +2085,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
-        if (un > 0) e->strain += contact_strain(law.hertz, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
+        if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
     }
 }
 

@@ -163,8 +163,9 @@ typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
     double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
-    bool hertz;             /* Hertz-Mindlin with g, nu (the means, 4-27) */
-    double g, nu;
+    uint8_t law;            /* its number in the registry (laws/registry.h) */
+    bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */
+    double g, nu;           /* Hertz-Mindlin's G and nu (laws/hertz.h) */
     /* BPM modulus mode (4-49/4-50): a side with ec > 0 has kn = 4 R ec (3D)
      * or 2 ec (2D) and ks = kn / ratio, put in series per contact; a side
      * with ec = 0 keeps its kn, ks. */
@@ -304,6 +305,9 @@ void sx__bonds_free(sx_model *m);
 sx_status sx__prepare(sx_model *m);
 /* Law of a ball of material `mat` against a wall (wall stiffness in series). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
+/* NULL when material d's law and its parameters are valid, else why not
+ * (written into why[len]; laws.c). */
+const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
 
