@@ -207,27 +207,16 @@ static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
             const int32_t s = tr->src[c], bond = s ? p->bond[s > 0 ? s - 1 : -s - 1] : 0;
             if (bond && s < 0) sx__bond_flip(m, bond - 1);
         }
-    struct {
-        void **data;
-        int per;
-        size_t size;
-        bool sign, present;
-    } fields[] = {
-        {(void **)&p->fs, D, sizeof(double), true, true},
-        {(void **)&p->geo, D, sizeof(double), true, true},
-        {(void **)&p->fn, 1, sizeof(double), false, true},
-        {(void **)&p->touching, 1, 1, false, true},
-        {(void **)&p->un, 1, sizeof(double), false, p == &m->bw},
-        {(void **)&p->bond, 1, sizeof(int32_t), false, p->bond != NULL},
-    };
-    const int nf = (int)(sizeof fields / sizeof fields[0]);
+    sx_pair_field fields[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, fields);
     for (int k = 0; k < nf; k++) {
-        if (!fields[k].present || gather_field(m, fields[k].data, old, tr, fields[k].per, fields[k].size, fields[k].sign))
-            continue;
-        for (int j = 0; j < nf; j++) /* gathered ones at the new size, the others at the old */
-            sx_alloc_free(&m->alloc, *fields[j].data, (size_t)((j < k ? tr->cap : old) * fields[j].per), fields[j].size);
-        sx_alloc_free(&m->alloc, p->a, (size_t)tr->cap, sizeof *p->a);
-        sx_alloc_free(&m->alloc, p->b, (size_t)tr->cap, sizeof *p->b);
+        const size_t size = sx__pair_size(&fields[k]);
+        if (fields[k].end || gather_field(m, fields[k].data, old, tr, fields[k].per, size, fields[k].sign)) continue;
+        for (int j = 0; j < nf; j++) /* gathered ones (and the ends) at the new size, the others at the old */
+            if (*fields[j].data)
+                sx_alloc_free(&m->alloc, *fields[j].data,
+                              (size_t)((j < k || fields[j].end ? tr->cap : old) * fields[j].per),
+                              sx__pair_size(&fields[j]));
         memset(p, 0, sizeof *p);
         return false;
     }

@@ -107,6 +107,30 @@ typedef struct sx_pairs {
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
 } sx_pairs;
 
+/* The pair store's fields, described once: resizing, moving, flipping,
+ * sorting and freeing a store, its bytes, a build's history transfer and
+ * the files (src/io/snapshot.c) iterate this table (sx__pair_fields); a
+ * law's history fields join it there. */
+typedef enum sx_pair_type { SX_PAIR_I32, SX_PAIR_F64, SX_PAIR_U8 } sx_pair_type;
+typedef struct sx_pair_field {
+    void **data;           /* the array's address in the store */
+    int per;               /* elements per pair */
+    sx_pair_type type;
+    bool sign;             /* a vector of the pair's a -> b orientation: negated when it turns round */
+    bool end;              /* a or b: listed by the broad phase, not carried as history */
+    const char *name;      /* the files' dataset */
+    const char *unit;      /* its unit (NULL: none) */
+} sx_pair_field;
+#define SX_PAIR_FIELDS_MAX 12
+/* The fields store p has (bond slots only once the model has bonds, the
+ * overlap only in the ball-wall store), into f; returns their count. */
+int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f);
+/* Bytes of one element of a field. */
+static inline size_t sx__pair_size(const sx_pair_field *f)
+{
+    return f->type == SX_PAIR_F64 ? sizeof(double) : f->type == SX_PAIR_I32 ? sizeof(int32_t) : 1;
+}
+
 typedef struct sx_grid {
     double lo[3], cell;
     int64_t nc[3], ncells, cap_cells;

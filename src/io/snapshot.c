@@ -110,28 +110,25 @@ static int ball_fields(const sx_model *m, const ball_cols *c, field *f)
     return n;
 }
 
-/* Every array of a pair store (bond slots only when it has them). The
- * last evaluation's geometry: a ball-wall pair's normal and overlap; a
- * ball-ball pair's relative position (format 3), or, reading a file of
- * format 1 or 2, its normal and overlap (into `overlap`, see
- * relative_from_normal). */
+/* Every array of a pair store, from the core's field table (bond slots
+ * only when it has them). The last evaluation's geometry: a ball-wall
+ * pair's normal and overlap; a ball-ball pair's relative position (format
+ * 3), or, reading a file of format 1 or 2, its normal and overlap (into
+ * `overlap`, see relative_from_normal). */
 static int pair_fields(const sx_model *m, const sx_pairs *p, field *f, double *overlap)
 {
-    const int d = m->dim;
+    static const int types[] = {[SX_PAIR_I32] = T_I32, [SX_PAIR_F64] = T_F64, [SX_PAIR_U8] = T_U8};
+    sx_pair_field s[SX_PAIR_FIELDS_MAX];
+    const int ns = sx__pair_fields(m, (sx_pairs *)p, s);
     int n = 0;
-    f[n++] = F("a", T_I32, p->a, 1, NULL);
-    f[n++] = F("b", T_I32, p->b, 1, NULL);
-    f[n++] = F("shear_force", T_F64, p->fs, d, "N");
-    const bool walls = p == &m->bw;
-    if (walls || overlap) {
-        f[n++] = F("normal", T_F64, p->geo, d, "1");
-        f[n++] = F("overlap", T_F64, walls ? p->un : overlap, 1, "m");
-    } else {
-        f[n++] = F("relative_position", T_F64, p->geo, d, "m");
+    for (int k = 0; k < ns; k++) {
+        if (overlap && s[k].data == (void **)&p->geo) {
+            f[n++] = F("normal", T_F64, p->geo, m->dim, "1");
+            f[n++] = F("overlap", T_F64, overlap, 1, "m");
+        } else {
+            f[n++] = F(s[k].name, types[s[k].type], *s[k].data, s[k].per, s[k].unit);
+        }
     }
-    f[n++] = F("touching", T_U8, p->touching, 1, NULL);
-    f[n++] = F("normal_force", T_F64, p->fn, 1, "N");
-    if (p->bond) f[n++] = F("bond", T_I32, p->bond, 1, NULL);
     return n;
 }
 
