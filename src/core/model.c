@@ -278,6 +278,17 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
     return l;
 }
 
+sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb)
+{
+    const sx_material_def *a = &m->mats[ma].def, *b = &m->mats[mb].def;
+    sx_pair_law l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
+                            0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
+    /* a pair of materials of two laws is refused where it may touch (check_models) */
+    l.law = (uint8_t)a->model;
+    sx__law(l.law)->mix(&l, a, b);
+    return l;
+}
+
 static sx_status refresh_laws(sx_model *m)
 {
     const int n = m->nmat;
@@ -290,13 +301,8 @@ static sx_status refresh_laws(sx_model *m)
     bool plain = true;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
-            const sx_material_def *a = &m->mats[i].def, *b = &m->mats[j].def;
             sx_pair_law *l = &m->law[i * n + j];
-            *l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
-                         0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
-            /* a pair of materials of two laws is refused where it may touch (check_models) */
-            l->law = (uint8_t)a->model;
-            sx__law(l->law)->mix(l, a, b);
+            *l = sx__pair_law(m, i, j);
             if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
@@ -709,7 +715,6 @@ int64_t sx_contact_count(const sx_model *m) { return kernels(m)->count_contacts(
 
 bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    if (refresh_laws((sx_model *)m)) return false;
     return kernels(m)->each_contact(m, fn, ud);
 }
 

@@ -327,6 +327,9 @@ void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
+/* Law of a contact of materials ma and mb, from the materials as they are
+ * (the step reads the table m->law, refreshed before each cycle). */
+sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb);
 /* Law of a ball of material `mat` against a wall (wall stiffness in series). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
 /* NULL when material d's law and its parameters are valid, else why not
