@@ -20,10 +20,13 @@
 /* pi to double precision (M_PI is not C11) */
 #define SX_PI 3.14159265358979323846
 
+#define SX_LAW_MAX 16 /* units of the law registry, at most */
+
 typedef struct sx_material {
     char name[64];
     sx_material_def def;
     sx_bpm_def bpm;
+    double derived[SX_LAW_MAX]; /* the registry units' constants of the material (sx__material_derive) */
 } sx_material;
 
 /* Bonds live apart from pairs, so an unbonded scene stores none. A pair
@@ -335,6 +338,8 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
 /* NULL when material d's law and its parameters are valid, else why not
  * (written into why[len]; laws.c). */
 const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
+/* Derives the registry units' constants of material t from its definition (laws.c). */
+void sx__material_derive(sx_material *t);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
 

@@ -140,6 +140,7 @@ static sx_status check_materials(sx_model *m)
         if (sx__law_check(&t->def, why, sizeof why))
             return sx__fail(m, SX_EINVAL, "state: material '%s' (contact model %d): %s", t->name, (int)t->def.model,
                             why);
+        sx__material_derive(t);
         if (!(t->def.density > 0) || !isfinite(t->def.density) || !(t->def.stiffness_ratio > 0))
             return sx__fail(m, SX_EINVAL, "state: material '%s' has a density or stiffness ratio <= 0", t->name);
     }
