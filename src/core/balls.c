@@ -345,19 +345,36 @@ void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
 
+int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
+{
+    const int d = m->dim;
+    const bool walls = p == &m->bw;
+    int n = 0;
+    f[n++] = (sx_pair_field){(void **)&p->a, 1, SX_PAIR_I32, false, true, "a", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->b, 1, SX_PAIR_I32, false, true, "b", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->fs, d, SX_PAIR_F64, true, false, "shear_force", "N"};
+    /* the last evaluation's geometry: a ball-wall pair's normal, a ball-ball pair's relative position */
+    f[n++] = walls ? (sx_pair_field){(void **)&p->geo, d, SX_PAIR_F64, true, false, "normal", "1"}
+                   : (sx_pair_field){(void **)&p->geo, d, SX_PAIR_F64, true, false, "relative_position", "m"};
+    if (walls) f[n++] = (sx_pair_field){(void **)&p->un, 1, SX_PAIR_F64, false, false, "overlap", "m"};
+    f[n++] = (sx_pair_field){(void **)&p->touching, 1, SX_PAIR_U8, false, false, "touching", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->fn, 1, SX_PAIR_F64, false, false, "normal_force", "N"};
+    if (p->bond) f[n++] = (sx_pair_field){(void **)&p->bond, 1, SX_PAIR_I32, false, false, "bond", NULL};
+    return n;
+}
+
 /* Resizes every array of the pair store to exactly cap pairs. */
 static sx_status pairs_resize(sx_model *m, sx_pairs *p, int64_t cap)
 {
     if (cap > INT32_MAX) return SX_ENOMEM;
-    const int d = m->dim;
-    RESIZE(p, a, 1);
-    RESIZE(p, b, 1);
-    RESIZE(p, fs, d);
-    RESIZE(p, geo, d);
-    RESIZE(p, touching, 1);
-    if (p->bond) RESIZE(p, bond, 1);
-    if (p == &m->bw) RESIZE(p, un, 1); /* a ball-ball store derives the overlap */
-    RESIZE(p, fn, 1);
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    for (int k = 0; k < nf; k++) {
+        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(p->cap * f[k].per), (size_t)(cap * f[k].per),
+                                  sx__pair_size(&f[k]));
+        if (!q) return SX_ENOMEM;
+        *f[k].data = q;
+    }
     p->cap = cap;
     return SX_OK;
 }
@@ -372,27 +389,24 @@ sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap)
 
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from)
 {
-    const int d = m->dim;
-    p->a[to] = p->a[from];
-    p->b[to] = p->b[from];
-    memmove(p->fs + to * d, p->fs + from * d, (size_t)d * sizeof(double));
-    memmove(p->geo + to * d, p->geo + from * d, (size_t)d * sizeof(double));
-    p->touching[to] = p->touching[from];
-    if (p->un) p->un[to] = p->un[from];
-    p->fn[to] = p->fn[from];
-    if (p->bond) p->bond[to] = p->bond[from];
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    for (int k = 0; k < nf; k++) {
+        const size_t row = (size_t)f[k].per * sx__pair_size(&f[k]);
+        char *data = *f[k].data;
+        memmove(data + (size_t)to * row, data + (size_t)from * row, row);
+    }
 }
 
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k)
 {
-    const int d = m->dim;
     const int32_t a = p->a[k];
     p->a[k] = p->b[k];
     p->b[k] = a;
-    for (int j = 0; j < d; j++) {
-        p->fs[k * d + j] = -p->fs[k * d + j];
-        p->geo[k * d + j] = -p->geo[k * d + j]; /* the relative position and the normal alike */
-    }
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    for (int q = 0; q < nf; q++) /* the shear force, the relative position and the normal alike */
+        for (int j = 0; f[q].sign && j < f[q].per; j++) ((double *)*f[q].data)[k * f[q].per + j] *= -1;
     if (p->bond && p->bond[k]) sx__bond_flip(m, p->bond[k] - 1);
 }
 
@@ -402,11 +416,10 @@ bool sx__pairs_sort(sx_model *m, sx_pairs *p)
     while (c < p->n && p->a[c - 1] <= p->a[c]) c++;
     if (c >= p->n) return true;
     const int64_t n = p->n, nb = m->balls.n;
-    const int d = m->dim;
     /* counting sort: pos[c] is the new place of pair c */
     int32_t *pos = malloc((size_t)n * sizeof *pos);
     int64_t *count = calloc((size_t)nb + 1, sizeof *count);
-    void *tmp = malloc((size_t)(n * d) * sizeof(double));
+    void *tmp = malloc((size_t)(n * m->dim) * sizeof(double)); /* the widest field */
     if (!pos || !count || !tmp) {
         free(pos);
         free(count);
@@ -416,22 +429,14 @@ bool sx__pairs_sort(sx_model *m, sx_pairs *p)
     for (c = 0; c < n; c++) count[p->a[c] + 1]++;
     for (int64_t i = 0; i < nb; i++) count[i + 1] += count[i];
     for (c = 0; c < n; c++) pos[c] = (int32_t)count[p->a[c]]++;
-#define SCATTER(field, per, type)                                                                  \
-    do {                                                                                           \
-        type *q = tmp;                                                                             \
-        for (int64_t e = 0; e < n; e++)                                                            \
-            for (int k = 0; k < (per); k++) q[(int64_t)pos[e] * (per) + k] = p->field[e * (per) + k]; \
-        memcpy(p->field, q, (size_t)(n * (per)) * sizeof(type));                                   \
-    } while (0)
-    SCATTER(a, 1, int32_t);
-    SCATTER(b, 1, int32_t);
-    SCATTER(fs, d, double);
-    SCATTER(geo, d, double);
-    SCATTER(touching, 1, uint8_t);
-    if (p->un) SCATTER(un, 1, double);
-    SCATTER(fn, 1, double);
-    if (p->bond) SCATTER(bond, 1, int32_t);
-#undef SCATTER
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    for (int k = 0; k < nf; k++) {
+        const size_t row = (size_t)f[k].per * sx__pair_size(&f[k]);
+        char *data = *f[k].data, *q = tmp;
+        for (int64_t e = 0; e < n; e++) memcpy(q + (size_t)pos[e] * row, data + (size_t)e * row, row);
+        memcpy(data, q, (size_t)n * row);
+    }
     free(pos);
     free(count);
     free(tmp);
@@ -440,15 +445,10 @@ bool sx__pairs_sort(sx_model *m, sx_pairs *p)
 
 void sx__pairs_free(sx_model *m, sx_pairs *p)
 {
-    const int64_t c = p->cap, d = m->dim;
-    free_field(m, p->a, c, sizeof(int32_t));
-    free_field(m, p->b, c, sizeof(int32_t));
-    free_field(m, p->fs, c * d, sizeof(double));
-    free_field(m, p->geo, c * d, sizeof(double));
-    free_field(m, p->touching, c, sizeof(uint8_t));
-    free_field(m, p->bond, p->bond ? c : 0, sizeof(int32_t));
-    free_field(m, p->un, p->un ? c : 0, sizeof(double));
-    free_field(m, p->fn, c, sizeof(double));
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    for (int k = 0; k < nf; k++)
+        free_field(m, *f[k].data, *f[k].data ? p->cap * f[k].per : 0, sx__pair_size(&f[k]));
     memset(p, 0, sizeof *p);
 }
 
@@ -466,10 +466,10 @@ size_t sx__balls_bytes(const sx_model *m)
 
 size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p)
 {
-    const size_t d = (size_t)m->dim;
-    size_t per = 2 * sizeof(int32_t) + (2 * d + 1) * sizeof(double) + sizeof(uint8_t);
-    if (p->bond) per += sizeof(int32_t);
-    if (p->un) per += sizeof(double);
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, (sx_pairs *)p, f);
+    size_t per = 0;
+    for (int k = 0; k < nf; k++) per += (size_t)f[k].per * sx__pair_size(&f[k]);
     return (size_t)p->cap * per;
 }
 

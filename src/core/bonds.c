@@ -2,6 +2,7 @@
  * installation from the bonded-particle micro-parameters (4.4), and the
  * crack log of broken bonds. The bond forces themselves are computed with
  * the contact in kernels.c. */
+#include "laws/law.h"
 #include "model_internal.h"
 
 #include <math.h>
@@ -196,17 +197,18 @@ static bool pair_selected(const sx_bond_def *def, int a, int b)
     return f < 0 || a == f || b == f;
 }
 
-/* Whether bonds of def's kind can join materials ma and mb: not Hertz (the
- * seed, 4.3.3), and every parameter the bond needs is positive once the
+/* Whether bonds of def's kind can join materials ma and mb: their law takes
+ * bonds (not Hertz: the seed, 4.3.3), and every parameter the bond needs is positive once the
  * materials' values fill what the call leaves at 0. Checked for every
  * candidate pair before any bond is installed, so a refused call changes nothing. */
 static sx_status check_pair(sx_model *m, const sx_bond_def *def, int ma, int mb)
 {
-    if (m->law[ma * m->law_n + mb].hertz)
+    const int law = m->law[ma * m->law_n + mb].law;
+    if (!sx__law(law)->bonds)
         return sx__fail(m, SX_EINVAL,
-                        "bond: materials '%s' and '%s' use the Hertz-Mindlin model, which is not to be combined "
+                        "bond: materials '%s' and '%s' use the %s model (%s), which is not to be combined "
                         "with bonds (seed 4.3.3); use the linear model for bonded materials",
-                        m->mats[ma].name, m->mats[mb].name);
+                        m->mats[ma].name, m->mats[mb].name, sx_law_name(law), sx_law_summary(law));
     const sx_bpm_def *pa = &m->mats[ma].bpm, *pb = &m->mats[mb].bpm;
     if (def->kind == SX_BOND_CONTACT) {
         if (!(param(def->normal_strength, pa->normal_strength, pb->normal_strength) > 0) ||

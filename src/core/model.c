@@ -3,6 +3,7 @@
  *     broad phase (when needed) -> timestep (auto) -> contact forces
  *     -> law of motion -> walls -> time, guard
  * with the dimension-specific stages in kernels.c. */
+#include "laws/law.h"
 #include "model_internal.h"
 
 #include <math.h>
@@ -213,13 +214,9 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     CHECK(d->viscous_shear >= 0, "viscous_shear must be >= 0", d->viscous_shear);
     CHECK(d->modulus >= 0, "modulus must be >= 0 Pa (0: use kn, ks)", d->modulus);
     CHECK(d->stiffness_ratio > 0, "stiffness_ratio (kn/ks) must be > 0", d->stiffness_ratio);
-    if (d->model != SX_MODEL_LINEAR && d->model != SX_MODEL_HERTZ)
-        return sx__fail(m, SX_EINVAL, "material '%s': model must be linear or hertz", name);
-    if (d->model == SX_MODEL_HERTZ) {
-        CHECK(d->shear_modulus > 0, "the Hertz shear modulus must be > 0 Pa", d->shear_modulus);
-        CHECK(d->poisson >= 0 && d->poisson < 0.5, "the Hertz Poisson's ratio must be in [0, 0.5)", d->poisson);
-    }
 #undef CHECK
+    char why[256];
+    if (sx__law_check(d, why, sizeof why)) return sx__fail(m, SX_EINVAL, "material '%s': %s", name, why);
     int i = sx_material_find(m, name);
     if (i < 0) {
         if (m->nmat >= UINT16_MAX) return sx__fail(m, SX_EINVAL, "material: too many materials");
@@ -236,6 +233,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     const bool density_changed = m->mats[i].def.density != d->density;
     const bool damping_changed = m->mats[i].def.damping != d->damping;
     m->mats[i].def = *d;
+    sx__material_derive(&m->mats[i]);
     for (int64_t b = 0; b < m->balls.n; b++) {
         if (m->balls.mat[b] != i) continue;
         if (density_changed) sx__ball_update_mass(m, b);
@@ -270,15 +268,27 @@ static sx_pair_law combine(const sx_material_def *a, double kn, double ks, doubl
     return l;
 }
 
-/* A ball against a wall: the wall's springs in series; Hertz uses the
- * ball's own G and nu (4-28). */
+/* A ball against a wall: the wall's springs in series; the ball's law
+ * completes it from the ball's material alone. */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
 {
     const sx_material_def *a = &m->mats[mat].def;
     sx_pair_law l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
-    l.hertz = a->model == SX_MODEL_HERTZ;
-    l.g = a->shear_modulus;
-    l.nu = a->poisson;
+    l.law = (uint8_t)a->model;
+    sx__law(l.law)->mix(&l, &m->mats[mat], NULL, l.law);
+    sx__law_parts_mix(&l, &m->mats[mat], NULL);
+    return l;
+}
+
+sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb)
+{
+    const sx_material_def *a = &m->mats[ma].def, *b = &m->mats[mb].def;
+    sx_pair_law l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
+                            0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
+    /* a pair of materials of two laws is refused where it may touch (check_models) */
+    l.law = (uint8_t)a->model;
+    sx__law(l.law)->mix(&l, &m->mats[ma], &m->mats[mb], l.law);
+    sx__law_parts_mix(&l, &m->mats[ma], &m->mats[mb]);
     return l;
 }
 
@@ -294,49 +304,45 @@ static sx_status refresh_laws(sx_model *m)
     bool plain = true;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
-            const sx_material_def *a = &m->mats[i].def, *b = &m->mats[j].def;
             sx_pair_law *l = &m->law[i * n + j];
-            *l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
-                         0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
-            /* 4-27: a Hertz pair uses the means of G and nu */
-            l->hertz = a->model == SX_MODEL_HERTZ && b->model == SX_MODEL_HERTZ;
-            l->g = 0.5 * (a->shear_modulus + b->shear_modulus);
-            l->nu = 0.5 * (a->poisson + b->poisson);
-            if (l->hertz || l->per_radius || l->beta_s > 0) plain = false;
+            *l = sx__pair_law(m, i, j);
+            if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
     return SX_OK;
 }
 
-/* Pairs mixing a Hertz material with a linear one are refused where balls
- * of both exist (the model of such a contact would be ambiguous). */
+/* Pairs mixing materials of two laws are refused where balls of both
+ * exist (the law of such a contact would be ambiguous), and so are bonds
+ * between materials of a law that takes none. */
 static sx_status check_models(sx_model *m)
 {
-    bool used_hertz = false, used_linear = false;
-    int hertz = -1, linear = -1;
-    for (int64_t i = 0; i < m->balls.n; i++) {
+    int first = -1, other = -1;
+    for (int64_t i = 0; i < m->balls.n && other < 0; i++) {
         const int k = m->balls.mat[i];
-        if (m->mats[k].def.model == SX_MODEL_HERTZ) used_hertz = true, hertz = k;
-        else used_linear = true, linear = k;
+        if (first < 0) first = k;
+        else if (m->mats[k].def.model != m->mats[first].def.model) other = k;
     }
-    if (used_hertz && used_linear)
+    if (other >= 0)
         return sx__fail(m, SX_EINVAL,
-                        "contact model: balls of material '%s' (hertz) and '%s' (linear) may touch; "
-                        "a contact between Hertz and linear materials is not defined: use one model for both",
-                        m->mats[hertz].name, m->mats[linear].name);
-    /* a material switched to Hertz (or a ball moved onto one) after bonds
-     * were installed: the seed's rule holds whenever it is cycled */
-    if (!used_hertz) return SX_OK;
+                        "contact model: balls of material '%s' (%s) and '%s' (%s) may touch; "
+                        "a contact between materials of two laws is not defined: use one model for both",
+                        m->mats[first].name, sx_law_name(m->mats[first].def.model), m->mats[other].name,
+                        sx_law_name(m->mats[other].def.model));
+    /* a material switched to a law without bonds (or a ball moved onto one)
+     * after bonds were installed: the rule holds whenever it is cycled */
+    if (first < 0 || sx__law(m->mats[first].def.model)->bonds) return SX_OK;
     const sx_bonds *b = &m->bonds;
     for (int64_t s = 0; s < b->n; s++) {
         if (!b->kind[s]) continue;
         const int ka = m->balls.mat[m->balls.index_of[b->ida[s]]], kb = m->balls.mat[m->balls.index_of[b->idb[s]]];
-        if (m->mats[ka].def.model == SX_MODEL_HERTZ || m->mats[kb].def.model == SX_MODEL_HERTZ)
+        const int bad = sx__law(m->mats[ka].def.model)->bonds ? kb : ka;
+        if (!sx__law(m->mats[bad].def.model)->bonds)
             return sx__fail(m, SX_EINVAL,
-                            "contact model: balls %lld and %lld are bonded but material '%s' uses the Hertz-Mindlin "
-                            "model, which is not to be combined with bonds (seed 4.3.3); use the linear model",
-                            (long long)b->ida[s], (long long)b->idb[s],
-                            m->mats[m->mats[ka].def.model == SX_MODEL_HERTZ ? ka : kb].name);
+                            "contact model: balls %lld and %lld are bonded but material '%s' uses the %s model "
+                            "(%s), which is not to be combined with bonds (seed 4.3.3); use the linear model",
+                            (long long)b->ida[s], (long long)b->idb[s], m->mats[bad].name,
+                            sx_law_name(m->mats[bad].def.model), sx_law_summary(m->mats[bad].def.model));
     }
     return SX_OK;
 }
@@ -676,7 +682,6 @@ int64_t sx_contact_count(const sx_model *m) { return kernels(m)->count_contacts(
 
 bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    if (refresh_laws((sx_model *)m)) return false;
     return kernels(m)->each_contact(m, fn, ud);
 }
 

@@ -20,10 +20,13 @@
 /* pi to double precision (M_PI is not C11) */
 #define SX_PI 3.14159265358979323846
 
+#define SX_LAW_MAX 16 /* units of the law registry, at most */
+
 typedef struct sx_material {
     char name[64];
     sx_material_def def;
     sx_bpm_def bpm;
+    double derived[SX_LAW_MAX]; /* the registry units' constants of the material (sx__material_derive) */
 } sx_material;
 
 /* Bonds live apart from pairs, so an unbonded scene stores none. A pair
@@ -107,6 +110,30 @@ typedef struct sx_pairs {
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
 } sx_pairs;
 
+/* The pair store's fields, described once: resizing, moving, flipping,
+ * sorting and freeing a store, its bytes, a build's history transfer and
+ * the files (src/io/snapshot.c) iterate this table (sx__pair_fields); a
+ * law's history fields join it there. */
+typedef enum sx_pair_type { SX_PAIR_I32, SX_PAIR_F64, SX_PAIR_U8 } sx_pair_type;
+typedef struct sx_pair_field {
+    void **data;           /* the array's address in the store */
+    int per;               /* elements per pair */
+    sx_pair_type type;
+    bool sign;             /* a vector of the pair's a -> b orientation: negated when it turns round */
+    bool end;              /* a or b: listed by the broad phase, not carried as history */
+    const char *name;      /* the files' dataset */
+    const char *unit;      /* its unit (NULL: none) */
+} sx_pair_field;
+#define SX_PAIR_FIELDS_MAX 12
+/* The fields store p has (bond slots only once the model has bonds, the
+ * overlap only in the ball-wall store), into f; returns their count. */
+int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f);
+/* Bytes of one element of a field. */
+static inline size_t sx__pair_size(const sx_pair_field *f)
+{
+    return f->type == SX_PAIR_F64 ? sizeof(double) : f->type == SX_PAIR_I32 ? sizeof(int32_t) : 1;
+}
+
 typedef struct sx_grid {
     double lo[3], cell;
     int64_t nc[3], ncells, cap_cells;
@@ -163,8 +190,9 @@ typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
     double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
-    bool hertz;             /* Hertz-Mindlin with g, nu (the means, 4-27) */
-    double g, nu;
+    uint8_t law;            /* its number in the registry (laws/registry.h) */
+    bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */
+    double g, nu;           /* Hertz-Mindlin's G and nu (laws/hertz.h) */
     /* BPM modulus mode (4-49/4-50): a side with ec > 0 has kn = 4 R ec (3D)
      * or 2 ec (2D) and ks = kn / ratio, put in series per contact; a side
      * with ec = 0 keeps its kn, ks. */
@@ -302,8 +330,16 @@ void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
+/* Law of a contact of materials ma and mb, from the materials as they are
+ * (the step reads the table m->law, refreshed before each cycle). */
+sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb);
 /* Law of a ball of material `mat` against a wall (wall stiffness in series). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
+/* NULL when material d's law and its parameters are valid, else why not
+ * (written into why[len]; laws.c). */
+const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
+/* Derives the registry units' constants of material t from its definition (laws.c). */
+void sx__material_derive(sx_material *t);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
 

@@ -155,8 +155,8 @@ typedef enum sx_contact_model {
 } sx_contact_model;
 
 typedef struct sx_material_def {
-    sx_contact_model model; ///< a ball-ball pair uses Hertz only if both materials are Hertz;
-                            ///< mixing Hertz with linear is refused when cycling
+    sx_contact_model model; ///< the contact law, a registry number (sx_law_find); two materials in
+                            ///< contact must use the same law (refused when cycling otherwise)
     double density;         ///< kg/m^3 (> 0)
     double kn;              ///< N/m, normal stiffness of the ball (springs in series, 4-22)
     double ks;              ///< N/m, shear stiffness of the ball (4-23)
@@ -169,7 +169,26 @@ typedef struct sx_material_def {
     double damping;         ///< local (non-viscous) damping coefficient alpha in [0, 1)
     double viscous_normal;  ///< normal critical-damping ratio of the contact dashpot, >= 0
     double viscous_shear;   ///< shear critical-damping ratio of the contact dashpot, >= 0
+    double restitution;     ///< coefficient of restitution e in (0, 1] of a normal impact: the normal
+                            ///< dashpot's ratio is derived from it for the law (0: viscous_normal gives it)
 } sx_material_def;
+
+/// The units of the contact-law registry (src/core/laws/registry.h), numbered in its order:
+/// the normal laws a material's `model` names (SX_MODEL_LINEAR, SX_MODEL_HERTZ are 0 and 1;
+/// sx_law_is_model), then the parts every contact runs beside its law, switched on by their
+/// parameters (restitution, ...). Their count, the name and a one-line summary of unit `law`
+/// (NULL out of range), the number of a name (-1: none).
+SX_API int sx_law_count(void);
+SX_API bool sx_law_is_model(int law);
+SX_API const char *sx_law_name(int law);
+SX_API const char *sx_law_summary(int law);
+SX_API int sx_law_find(const char *name);
+/// The material parameters a unit reads (beside the common ones of sx_material_def): their
+/// count, the k-th one's key (its unit into *unit if not NULL; NULL out of range), and its
+/// field in a definition (NULL out of range).
+SX_API int sx_law_param_count(int law);
+SX_API const char *sx_law_param_name(int law, int k, const char **unit);
+SX_API double *sx_law_param_value(sx_material_def *d, int law, int k);
 
 /// Linear, density 2650, kn = ks = 1e8, friction 0.5, no damping, stiffness_ratio 1,
 /// Hertz G = 29 GPa, nu = 0.15 (used only when model is Hertz).

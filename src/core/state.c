@@ -136,9 +136,11 @@ static sx_status check_materials(sx_model *m)
         for (int j = 0; j < i; j++)
             if (strcmp(m->mats[j].name, t->name) == 0)
                 return sx__fail(m, SX_EINVAL, "state: material '%s' appears twice", t->name);
-        if (t->def.model != SX_MODEL_LINEAR && t->def.model != SX_MODEL_HERTZ)
-            return sx__fail(m, SX_EINVAL, "state: material '%s' has an unknown contact model %d", t->name,
-                            (int)t->def.model);
+        char why[256];
+        if (sx__law_check(&t->def, why, sizeof why))
+            return sx__fail(m, SX_EINVAL, "state: material '%s' (contact model %d): %s", t->name, (int)t->def.model,
+                            why);
+        sx__material_derive(t);
         if (!(t->def.density > 0) || !isfinite(t->def.density) || !(t->def.stiffness_ratio > 0))
             return sx__fail(m, SX_EINVAL, "state: material '%s' has a density or stiffness ratio <= 0", t->name);
     }

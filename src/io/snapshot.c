@@ -110,28 +110,25 @@ static int ball_fields(const sx_model *m, const ball_cols *c, field *f)
     return n;
 }
 
-/* Every array of a pair store (bond slots only when it has them). The
- * last evaluation's geometry: a ball-wall pair's normal and overlap; a
- * ball-ball pair's relative position (format 3), or, reading a file of
- * format 1 or 2, its normal and overlap (into `overlap`, see
- * relative_from_normal). */
+/* Every array of a pair store, from the core's field table (bond slots
+ * only when it has them). The last evaluation's geometry: a ball-wall
+ * pair's normal and overlap; a ball-ball pair's relative position (format
+ * 3), or, reading a file of format 1 or 2, its normal and overlap (into
+ * `overlap`, see relative_from_normal). */
 static int pair_fields(const sx_model *m, const sx_pairs *p, field *f, double *overlap)
 {
-    const int d = m->dim;
+    static const int types[] = {[SX_PAIR_I32] = T_I32, [SX_PAIR_F64] = T_F64, [SX_PAIR_U8] = T_U8};
+    sx_pair_field s[SX_PAIR_FIELDS_MAX];
+    const int ns = sx__pair_fields(m, (sx_pairs *)p, s);
     int n = 0;
-    f[n++] = F("a", T_I32, p->a, 1, NULL);
-    f[n++] = F("b", T_I32, p->b, 1, NULL);
-    f[n++] = F("shear_force", T_F64, p->fs, d, "N");
-    const bool walls = p == &m->bw;
-    if (walls || overlap) {
-        f[n++] = F("normal", T_F64, p->geo, d, "1");
-        f[n++] = F("overlap", T_F64, walls ? p->un : overlap, 1, "m");
-    } else {
-        f[n++] = F("relative_position", T_F64, p->geo, d, "m");
+    for (int k = 0; k < ns; k++) {
+        if (overlap && s[k].data == (void **)&p->geo) {
+            f[n++] = F("normal", T_F64, p->geo, m->dim, "1");
+            f[n++] = F("overlap", T_F64, overlap, 1, "m");
+        } else {
+            f[n++] = F(s[k].name, types[s[k].type], *s[k].data, s[k].per, s[k].unit);
+        }
     }
-    f[n++] = F("touching", T_U8, p->touching, 1, NULL);
-    f[n++] = F("normal_force", T_F64, p->fn, 1, "N");
-    if (p->bond) f[n++] = F("bond", T_I32, p->bond, 1, NULL);
     return n;
 }
 
@@ -260,31 +257,61 @@ static void read_scalars(sx_h5 *h, hid_t g, sx_model *m)
 
 /* ----------------------------------------------------------- materials */
 
-static const char *const model_names[] = {"linear", "hertz"};
-static const int model_values[] = {SX_MODEL_LINEAR, SX_MODEL_HERTZ};
+/* The contact laws' names and numbers, from the registry (the file's enum). */
+enum { MAX_LAWS = 32 };
+static hid_t law_enum(hid_t base)
+{
+    const char *names[MAX_LAWS];
+    int values[MAX_LAWS];
+    int n = 0;
+    while (n < MAX_LAWS && sx_law_is_model(n)) names[n] = sx_law_name(n), values[n] = n, n++;
+    return sx_h5_enum(base, names, values, n);
+}
 
-/* A material's numbers: its definition, then its BPM parameters. */
-#define MAT_NUMBERS 22
-static const char *const mat_names[MAT_NUMBERS] = {
-    "density", "kn", "ks", "modulus", "stiffness_ratio", "shear_modulus", "poisson", "friction", "damping",
+/* A material's numbers: its definition, its BPM parameters, then every
+ * law's parameters (each once, from the registry). */
+#define MAT_FIXED 20
+#define MAT_MAX (MAT_FIXED + 32)
+static const char *const mat_fixed_names[MAT_FIXED] = {
+    "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping",
     "viscous_normal", "viscous_shear",
     "bond_radius_multiplier", "bond_modulus", "bond_stiffness_ratio", "bond_tensile_strength",
     "bond_tensile_strength_sd", "bond_cohesion", "bond_cohesion_sd", "bond_normal_strength",
     "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd"};
-static const char *const mat_units[MAT_NUMBERS] = {
-    "kg/m^3", "N/m", "N/m", "Pa", "1", "Pa", "1", "1", "1", "1", "1",
+static const char *const mat_fixed_units[MAT_FIXED] = {
+    "kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1",
     "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N"};
 
-static double *mat_number(sx_material *t, int k)
+typedef struct mat_column {
+    const char *name, *unit;
+    int law, k; /* a law's parameter k, or law -1: fixed number k */
+} mat_column;
+
+static int mat_columns(mat_column *c)
 {
+    int n = 0;
+    for (int k = 0; k < MAT_FIXED; k++) c[n++] = (mat_column){mat_fixed_names[k], mat_fixed_units[k], -1, k};
+    for (int law = 0; law < sx_law_count(); law++)
+        for (int k = 0; k < sx_law_param_count(law) && n < MAT_MAX; k++) {
+            const char *unit, *name = sx_law_param_name(law, k, &unit);
+            bool seen = false;
+            for (int j = MAT_FIXED; j < n && !seen; j++) seen = strcmp(c[j].name, name) == 0;
+            if (!seen) c[n++] = (mat_column){name, unit, law, k};
+        }
+    return n;
+}
+
+static double *mat_number(sx_material *t, const mat_column *c)
+{
+    if (c->law >= 0) return sx_law_param_value(&t->def, c->law, c->k);
     sx_material_def *d = &t->def;
     sx_bpm_def *b = &t->bpm;
-    double *p[MAT_NUMBERS] = {&d->density, &d->kn, &d->ks, &d->modulus, &d->stiffness_ratio, &d->shear_modulus,
-                              &d->poisson, &d->friction, &d->damping, &d->viscous_normal, &d->viscous_shear,
-                              &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
-                              &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
-    return p[k];
+    double *p[MAT_FIXED] = {&d->density, &d->kn, &d->ks, &d->modulus, &d->stiffness_ratio, &d->friction,
+                            &d->damping, &d->viscous_normal, &d->viscous_shear,
+                            &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
+                            &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
+                            &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+    return p[c->k];
 }
 
 static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
@@ -294,8 +321,8 @@ static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
     char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
     int *model = calloc((size_t)n + 1, sizeof *model);
     double *col = calloc((size_t)n + 1, sizeof *col);
-    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, model_names, model_values, 2);
-    hid_t file = sx_h5_enum(H5T_STD_U8LE, model_names, model_values, 2);
+    hid_t mem = law_enum(H5T_NATIVE_INT);
+    hid_t file = law_enum(H5T_STD_U8LE);
     if (!names || !model || !col || mem < 0 || file < 0) {
         sx_h5_fail(h, "out of memory");
     } else {
@@ -305,9 +332,11 @@ static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
         }
         sx_io_write_strings(h, g, "name", names, sizeof m->mats[0].name, n);
         sx_h5_write(h, g, "model", mem, file, model, n, 1, NULL);
-        for (int k = 0; k < MAT_NUMBERS; k++) {
-            for (int i = 0; i < n; i++) col[i] = *mat_number(&m->mats[i], k);
-            sx_h5_write(h, g, mat_names[k], H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, col, n, 1, mat_units[k]);
+        mat_column c[MAT_MAX];
+        const int nc = mat_columns(c);
+        for (int k = 0; k < nc; k++) {
+            for (int i = 0; i < n; i++) col[i] = *mat_number(&m->mats[i], &c[k]);
+            sx_h5_write(h, g, c[k].name, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, col, n, 1, c[k].unit);
         }
     }
     sx_h5_close(mem);
@@ -324,7 +353,7 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
     char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
     int *model = calloc((size_t)n + 1, sizeof *model);
     double *col = calloc((size_t)n + 1, sizeof *col);
-    hid_t mem = sx_h5_enum(H5T_NATIVE_INT, model_names, model_values, 2);
+    hid_t mem = law_enum(H5T_NATIVE_INT);
     if (!names || !model || !col || mem < 0) {
         sx_h5_fail(h, "out of memory");
     } else if (sx_io_read_strings(h, g, "/materials", "name", names, sizeof m->mats[0].name, n) &&
@@ -333,9 +362,17 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
             memcpy(m->mats[i].name, names + (size_t)i * sizeof m->mats[0].name, sizeof m->mats[0].name);
             m->mats[i].def.model = (sx_contact_model)model[i];
         }
-        for (int k = 0; k < MAT_NUMBERS && !h->failed; k++)
-            if (sx_h5_read(h, g, "/materials", mat_names[k], H5T_NATIVE_DOUBLE, col, n, 1, true))
-                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], k) = col[i];
+        mat_column c[MAT_MAX];
+        const int nc = mat_columns(c);
+        /* a law's parameter a file predates takes its default (the law is newer than the file) */
+        sx_material def = {.def = sx_material_default_def()};
+        for (int k = 0; k < nc && !h->failed; k++) {
+            const bool newer = c[k].law >= 0 && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
+            if (newer)
+                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = *mat_number(&def, &c[k]);
+            else if (sx_h5_read(h, g, "/materials", c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))
+                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = col[i];
+        }
     }
     sx_h5_close(mem);
     free(names);

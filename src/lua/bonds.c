@@ -4,8 +4,8 @@
  *   m:cracks()                                     the crack log, a table of events
  *   m:crack_count([mode])                          broken bonds (all, "tension", "shear")
  *   m:track_energy(on)                             accumulate dissipation and work
- * and the material keys model/shear_modulus/poisson/modulus/stiffness_ratio
- * and the `bond` sub-table read by m:material. */
+ * and the material keys model (a law of the registry), its laws' parameters,
+ * modulus/stiffness_ratio and the `bond` sub-table read by m:material. */
 #include "bindings.h"
 
 #include <string.h>
@@ -28,17 +28,41 @@ static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
     for (int k = 0; bpm_keys[k]; k++) sx_lua_optnumfield(L, arg, bpm_keys[k], bpm_field(b, k));
 }
 
+int sx_lua_law_keys(const char **keys, int n, int cap)
+{
+    for (int law = 0; law < sx_law_count(); law++)
+        for (int k = 0; k < sx_law_param_count(law); k++) {
+            const char *key = sx_law_param_name(law, k, NULL);
+            bool seen = false;
+            for (int j = 0; j < n && !seen; j++) seen = strcmp(keys[j], key) == 0;
+            if (!seen && n < cap) keys[n++] = key;
+        }
+    return n;
+}
+
 void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm)
 {
-    static const char *const models[] = {"linear", "hertz", NULL};
     const char *model = sx_lua_optstrfield(L, arg, "model");
     if (model) {
-        const int k = sx_lua_find(model, models);
-        if (k < 0) luaL_argerror(L, arg, lua_pushfstring(L, "field 'model': 'linear' or 'hertz' expected, got '%s'", model));
-        d->model = k == 1 ? SX_MODEL_HERTZ : SX_MODEL_LINEAR;
+        const int k = sx_law_find(model);
+        if (!sx_law_is_model(k)) {
+            luaL_Buffer b;
+            luaL_buffinit(L, &b);
+            for (int i = 0; sx_law_is_model(i); i++) {
+                if (i) luaL_addstring(&b, ", ");
+                lua_pushfstring(L, "'%s'", sx_law_name(i));
+                luaL_addvalue(&b);
+            }
+            luaL_pushresult(&b);
+            luaL_argerror(L, arg,
+                          lua_pushfstring(L, "field 'model': one of %s expected, got '%s'", lua_tostring(L, -1), model));
+        }
+        d->model = (sx_contact_model)k;
     }
-    sx_lua_optnumfield(L, arg, "shear_modulus", &d->shear_modulus);
-    sx_lua_optnumfield(L, arg, "poisson", &d->poisson);
+    /* every law's parameters: a material may be switched to another law later */
+    for (int law = 0; law < sx_law_count(); law++)
+        for (int k = 0; k < sx_law_param_count(law); k++)
+            sx_lua_optnumfield(L, arg, sx_law_param_name(law, k, NULL), sx_law_param_value(d, law, k));
     sx_lua_optnumfield(L, arg, "modulus", &d->modulus);
     sx_lua_optnumfield(L, arg, "stiffness_ratio", &d->stiffness_ratio);
     *has_bpm = false;

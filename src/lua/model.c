@@ -231,10 +231,10 @@ static int model_summary(lua_State *L)
 
 static int model_material(lua_State *L)
 {
-    static const char *const keys[] = {"kn",      "ks",             "friction",      "density",
-                                       "damping", "viscous_normal", "viscous_shear", "model",
-                                       "shear_modulus", "poisson", "modulus", "stiffness_ratio",
-                                       "bond",    NULL};
+    const char *keys[48] = {"kn",      "ks",             "friction",      "density", "damping",
+                            "viscous_normal", "viscous_shear", "model", "modulus", "stiffness_ratio",
+                            "bond"};
+    keys[sx_lua_law_keys(keys, 11, 47)] = NULL; /* and the laws' parameters */
     sx_model *m = sx_lua_checkmodel(L, 1);
     const char *name = luaL_checkstring(L, 2);
     sx_material_def d = sx_material_default_def();
@@ -275,7 +275,7 @@ static int model_materials(lua_State *L)
         sx_material_def d;
         sx_lua_check(L, m, sx_material_get(m, i, &d), "m:materials");
         lua_createtable(L, 0, 12);
-        lua_pushstring(L, d.model == SX_MODEL_HERTZ ? "hertz" : "linear");
+        lua_pushstring(L, sx_law_name(d.model));
         lua_setfield(L, -2, "model");
         setnum(L, "density", d.density);
         setnum(L, "kn", d.kn);
@@ -286,8 +286,9 @@ static int model_materials(lua_State *L)
         setnum(L, "viscous_shear", d.viscous_shear);
         setnum(L, "modulus", d.modulus);
         setnum(L, "stiffness_ratio", d.stiffness_ratio);
-        setnum(L, "shear_modulus", d.shear_modulus);
-        setnum(L, "poisson", d.poisson);
+        for (int law = 0; law < sx_law_count(); law++)
+            for (int k = 0; k < sx_law_param_count(law); k++)
+                setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(&d, law, k));
         lua_setfield(L, -2, sx_material_name(m, i));
     }
     return 1;

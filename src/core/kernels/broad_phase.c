@@ -1,0 +1,471 @@
+/* Stage: the broad phase (entry point KERNEL(build)). Part of the
+ * per-dimension unit kernels.c, which includes it; not compiled alone. */
+
+/* ---------------------------------------------------------- broad phase */
+
+/* History across a build. The old stores stay as they are (grouped by a,
+ * as plan_chunks leaves them) while the build lists its pairs; a new pair
+ * finds its old one among the few pairs of its lower-indexed ball, through
+ * the sort's permutation. Each array of a store is then gathered in turn
+ * into one the size of the new store, so a build needs one array more,
+ * not a copy of every history (the memory of a build is the memory of the
+ * model plus little). The history (shear force, geometry, overlap, normal
+ * force, bond) of a pair whose balls swapped places in the order is
+ * re-expressed for the new orientation, as sx__pair_flip does. */
+typedef struct transfer {
+    bool history;             /* some old pair has a history (touching; else the rest is not needed) */
+    int32_t *order;           /* new index i <- old index order[i] (the sort's permutation) */
+    int64_t nold;             /* balls of the old stores (before the sort) */
+    int32_t *row_bb, *row_bw; /* the old stores' first pair of each old ball (nold + 1) */
+    /* the new pairs as listed: src is the old pair + 1 (negated when the
+     * pair turned round), 0 when it had no history (src NULL: none had) */
+    int32_t *a, *b, *src;
+    int64_t n, cap;
+    uint8_t *seen;            /* per bond slot: found again by the grid */
+} transfer;
+
+/* First pair of each ball in a store grouped by a, into row (nb + 1). */
+static void rows_of(const sx_pairs *p, int64_t nb, int32_t *row)
+{
+    memset(row, 0, (size_t)(nb + 1) * sizeof *row);
+    for (int64_t c = 0; c < p->n; c++) row[p->a[c] + 1]++;
+    for (int64_t i = 0; i < nb; i++) row[i + 1] += row[i];
+}
+
+static bool transfer_begin(sx_model *m, transfer *tr)
+{
+    memset(tr, 0, sizeof *tr);
+    for (int64_t c = 0; c < m->bb.n && !tr->history; c++) tr->history = m->bb.touching[c];
+    for (int64_t c = 0; c < m->bw.n && !tr->history; c++) tr->history = m->bw.touching[c];
+    if (!tr->history) return true;
+    tr->nold = m->balls.n;
+    const size_t rows = (size_t)tr->nold + 1;
+    tr->row_bb = sx_alloc_resize(&m->alloc, NULL, 0, rows, sizeof *tr->row_bb);
+    tr->row_bw = sx_alloc_resize(&m->alloc, NULL, 0, rows, sizeof *tr->row_bw);
+    tr->seen = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)m->bonds.n + 1, 1);
+    /* a removal may have left the stores out of order */
+    if (!tr->row_bb || !tr->row_bw || !tr->seen || !sx__pairs_sort(m, &m->bb) || !sx__pairs_sort(m, &m->bw))
+        return false;
+    rows_of(&m->bb, tr->nold, tr->row_bb);
+    rows_of(&m->bw, tr->nold, tr->row_bw);
+    return true;
+}
+
+static void transfer_end(sx_model *m, transfer *tr)
+{
+    const size_t rows = (size_t)tr->nold + 1;
+    sx_alloc_free(&m->alloc, tr->order, tr->order ? (size_t)m->balls.n : 0, sizeof *tr->order);
+    sx_alloc_free(&m->alloc, tr->row_bb, tr->row_bb ? rows : 0, sizeof *tr->row_bb);
+    sx_alloc_free(&m->alloc, tr->row_bw, tr->row_bw ? rows : 0, sizeof *tr->row_bw);
+    sx_alloc_free(&m->alloc, tr->seen, tr->seen ? (size_t)m->bonds.n + 1 : 0, 1);
+    sx_alloc_free(&m->alloc, tr->a, (size_t)tr->cap, sizeof *tr->a);
+    sx_alloc_free(&m->alloc, tr->b, (size_t)tr->cap, sizeof *tr->b);
+    sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
+}
+
+/* Room for cap listed pairs (the list emptied when fresh). */
+static bool transfer_list(sx_model *m, transfer *tr, int64_t cap, bool fresh)
+{
+    if (fresh) tr->n = 0;
+    if (cap < 16) cap = 16; /* never an empty allocation */
+    if (cap > INT32_MAX) return false;
+    if (cap == tr->cap) return true;
+    int32_t **q[3] = {&tr->a, &tr->b, &tr->src};
+    for (int k = 0; k < (tr->history ? 3 : 2); k++) {
+        int32_t *r = sx_alloc_resize(&m->alloc, *q[k], (size_t)tr->cap, (size_t)cap, sizeof *r);
+        if (!r) return false;
+        *q[k] = r;
+    }
+    tr->cap = cap;
+    return true;
+}
+
+/* The old pair of new pair (a, b) in old store p (rows row): old pair + 1,
+ * negated when the pair turned round; 0 without history (not found, or
+ * not touching). A ball-ball pair is kept under its lower old index, a
+ * ball-wall pair (wall) under its ball. */
+static int32_t old_pair(const transfer *tr, const sx_pairs *p, const int32_t *row, int64_t a, int64_t b, bool wall)
+{
+    if (!tr->history) return 0;
+    const int64_t oa = tr->order[a], ob = wall ? b : tr->order[b];
+    const int64_t lo = wall || oa < ob ? oa : ob, hi = wall || oa < ob ? ob : oa;
+    for (int32_t c = row[lo]; c < row[lo + 1]; c++)
+        if (p->b[c] == hi) return p->touching[c] ? (oa == lo ? c + 1 : -(c + 1)) : 0;
+    return 0;
+}
+
+static void transfer_push(transfer *tr, int32_t a, int32_t b, int32_t src)
+{
+    tr->a[tr->n] = a, tr->b[tr->n] = b;
+    if (tr->src) tr->src[tr->n] = src;
+    tr->n++;
+}
+
+/* Replaces *field (old_cap rows of per elements of size bytes) by the
+ * listed pairs' rows, gathered from their old pairs (zero without);
+ * flipped doubles are negated (sign: the vectors of a pair's orientation). */
+static bool gather_field(sx_model *m, void **field, int64_t old_cap, const transfer *tr, int per, size_t size,
+                         bool sign)
+{
+    char *to = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(tr->cap * per), size);
+    if (!to) return false;
+    const char *from = *field;
+    const size_t row = (size_t)per * size;
+    for (int64_t c = 0; c < tr->n && tr->src; c++) {
+        const int32_t s = tr->src[c];
+        if (!s) continue; /* zeros */
+        const int64_t o = s > 0 ? s - 1 : -s - 1;
+        memcpy(to + (size_t)c * row, from + (size_t)o * row, row);
+        if (sign && s < 0)
+            for (int k = 0; k < per; k++) ((double *)(to + (size_t)c * row))[k] *= -1;
+    }
+    sx_alloc_free(&m->alloc, *field, (size_t)(old_cap * per), size);
+    *field = to;
+    return true;
+}
+
+/* The store p becomes the listed pairs, their history carried over. Out of
+ * memory, it is emptied (the history is lost; the next build lists the
+ * pairs again, bonded ones included). */
+static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
+{
+    const int64_t old = p->cap;
+    /* the list's ends become the store's (the old ones are no longer needed) */
+    sx_alloc_free(&m->alloc, p->a, (size_t)old, sizeof *p->a);
+    sx_alloc_free(&m->alloc, p->b, (size_t)old, sizeof *p->b);
+    p->a = tr->a, p->b = tr->b;
+    tr->a = tr->b = NULL;
+    if (p->bond && tr->src) /* a bond's vectors follow its pair's orientation */
+        for (int64_t c = 0; c < tr->n; c++) {
+            const int32_t s = tr->src[c], bond = s ? p->bond[s > 0 ? s - 1 : -s - 1] : 0;
+            if (bond && s < 0) sx__bond_flip(m, bond - 1);
+        }
+    sx_pair_field fields[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, fields);
+    for (int k = 0; k < nf; k++) {
+        const size_t size = sx__pair_size(&fields[k]);
+        if (fields[k].end || gather_field(m, fields[k].data, old, tr, fields[k].per, size, fields[k].sign)) continue;
+        for (int j = 0; j < nf; j++) /* gathered ones (and the ends) at the new size, the others at the old */
+            if (*fields[j].data)
+                sx_alloc_free(&m->alloc, *fields[j].data,
+                              (size_t)((j < k || fields[j].end ? tr->cap : old) * fields[j].per),
+                              sx__pair_size(&fields[j]));
+        memset(p, 0, sizeof *p);
+        return false;
+    }
+    p->n = tr->n, p->cap = tr->cap;
+    /* the list starts afresh for the next store */
+    sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
+    tr->src = NULL;
+    tr->n = tr->cap = 0;
+    return true;
+}
+
+/* Bonded pairs stay in the store whatever their gap: those the grid did
+ * not find again are listed too (after the grid's pairs, in slot order). */
+static bool keep_bonded_pairs(sx_model *m, transfer *tr)
+{
+    const sx_bonds *bs = &m->bonds;
+    int64_t lost = 0;
+    for (int64_t s = 0; s < bs->n; s++) lost += bs->kind[s] && !tr->seen[s];
+    if (lost && !transfer_list(m, tr, tr->n + lost, false)) return false;
+    for (int64_t s = 0; s < bs->n; s++) {
+        if (!bs->kind[s] || tr->seen[s]) continue;
+        int32_t a = m->balls.index_of[bs->ida[s]], b = m->balls.index_of[bs->idb[s]];
+        if (a > b) {
+            const int32_t t = a;
+            a = b, b = t;
+        }
+        transfer_push(tr, a, b, old_pair(tr, &m->bb, tr->row_bb, a, b, false));
+    }
+    return true;
+}
+
+/* Distance from ball centre x to wall w: fills the unit normal from the wall
+ * to the ball and returns the (signed, for planes) distance. Infinite walls
+ * inline, the others in finite_wall_distance. */
+static double finite_wall_distance(const sx_wall *w, const double *x, double *n);
+
+static inline double wall_distance(const sx_wall *w, const double *x, double *n)
+{
+    const sx_wall_def *d = &w->def;
+    if (d->kind == SX_WALL_PLANE || d->kind == SX_WALL_LINE) {
+        double r[D];
+        for (int k = 0; k < D; k++) r[k] = x[k] - d->point[k];
+        for (int k = 0; k < D; k++) n[k] = d->normal[k];
+        return dot(r, d->normal);
+    }
+    return finite_wall_distance(w, x, n);
+}
+
+static double finite_wall_distance(const sx_wall *w, const double *x, double *n)
+{
+    const sx_wall_def *d = &w->def;
+    double r[D];
+    for (int k = 0; k < D; k++) r[k] = x[k] - d->point[k];
+    double q[D];
+#if D == 3
+    if (d->kind == SX_WALL_CYLINDER) { /* balls inside; n points from the surface towards the axis */
+        const double axial = dot(r, d->normal);
+        if (d->height > 0 && (axial < 0 || axial > d->height)) { /* beyond its open ends */
+            for (int k = 0; k < D; k++) n[k] = d->normal[k];
+            return INFINITY;
+        }
+        for (int k = 0; k < D; k++) q[k] = r[k] - axial * d->normal[k];
+        const double rho = sqrt(dot(q, q));
+        if (rho > 0) {
+            for (int k = 0; k < D; k++) n[k] = -q[k] / rho;
+        } else { /* on the axis: any radial direction */
+            const double e[3] = {fabs(d->normal[0]) < 0.9 ? 1.0 : 0.0, fabs(d->normal[0]) < 0.9 ? 0.0 : 1.0, 0};
+            double t[3];
+            spin_cross(d->normal, e, t);
+            const double tn = sqrt(dot(t, t));
+            for (int k = 0; k < D; k++) n[k] = t[k] / tn;
+        }
+        return d->radius - rho;
+    }
+    double s = dot(r, w->u), t = dot(r, w->v);
+    s = s < 0 ? 0 : s > w->len_u ? w->len_u : s;
+    t = t < 0 ? 0 : t > w->len_v ? w->len_v : t;
+    for (int k = 0; k < D; k++) q[k] = r[k] - s * w->u[k] - t * w->v[k];
+#else
+    double s = dot(r, d->edge1) / (w->seg_len * w->seg_len);
+    s = s < 0 ? 0 : s > 1 ? 1 : s;
+    for (int k = 0; k < D; k++) q[k] = r[k] - s * d->edge1[k];
+#endif
+    const double dist = sqrt(dot(q, q));
+    if (dist > 0) {
+        for (int k = 0; k < D; k++) n[k] = q[k] / dist;
+    } else { /* centre exactly on the wall: push along its normal */
+        for (int k = 0; k < D; k++) n[k] = d->normal[k];
+    }
+    return dist;
+}
+
+/* Grid over the balls' bounding box; cells at least a diameter plus the
+ * skin wide, widened if a sparse scene would need more cells than ~2 per ball. */
+static bool grid_setup(sx_model *m)
+{
+    sx_grid *g = &m->grid;
+    const sx_balls *b = &m->balls;
+    double lo[D], hi[D], rmax = 0;
+    for (int k = 0; k < D; k++) lo[k] = hi[k] = b->x[k];
+    for (int64_t i = 0; i < b->n; i++) {
+        for (int k = 0; k < D; k++) {
+            const double v = b->x[i * D + k];
+            if (v < lo[k]) lo[k] = v;
+            if (v > hi[k]) hi[k] = v;
+        }
+        if (b->rad[i] > rmax) rmax = b->rad[i];
+    }
+    /* a scene spread wider than a double can hold (e.g. balls at +-1e300)
+     * has an infinite extent: take the largest finite one, so the cells
+     * widen until they fit (at worst one cell, still correct) */
+    double extent[D];
+    for (int k = 0; k < D; k++) extent[k] = isfinite(hi[k] - lo[k]) ? hi[k] - lo[k] : DBL_MAX;
+    double cell = 2 * rmax + m->skin;
+    const double limit = 2.0 * (double)b->n + 64;
+    for (;;) {
+        double cells = 1;
+        for (int k = 0; k < D; k++) cells *= floor(extent[k] / cell) + 1;
+        if (cells <= limit) break;
+        cell *= 1.5;
+    }
+    g->cell = cell;
+    g->ncells = 1;
+    for (int k = 0; k < 3; k++) {
+        g->lo[k] = k < D ? lo[k] : 0;
+        g->nc[k] = k < D ? (int64_t)floor(extent[k] / cell) + 1 : 1;
+        g->ncells *= g->nc[k];
+    }
+    if (g->ncells + 1 > g->cap_cells) {
+        int32_t *q = sx_alloc_resize(&m->alloc, g->start, (size_t)g->cap_cells, (size_t)(g->ncells + 1), sizeof *q);
+        if (!q) return false;
+        g->start = q;
+        g->cap_cells = g->ncells + 1;
+    }
+    return true;
+}
+
+static inline void cell_coords(const sx_grid *g, const double *x, int64_t *c)
+{
+    for (int k = 0; k < D; k++) {
+        const double q = (x[k] - g->lo[k]) / g->cell; /* NaN when both are infinite: cell 0 */
+        c[k] = q >= (double)g->nc[k] ? g->nc[k] - 1 : q >= 0 ? (int64_t)q : 0;
+    }
+}
+
+/* Sorts balls by cell (counting sort, stable) and fills g->start; the
+ * permutation goes to tr->order. */
+static bool sort_balls(sx_model *m, transfer *tr)
+{
+    sx_grid *g = &m->grid;
+    sx_balls *b = &m->balls;
+    const int64_t n = b->n;
+    int32_t *order = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)n, sizeof *order);
+    double *scratch = sx__scratch(m, n * D);
+    if (!order || !scratch) {
+        sx_alloc_free(&m->alloc, order, order ? (size_t)n : 0, sizeof *order);
+        return false;
+    }
+    /* the cell of each ball lives in the scratch until the permutation needs it */
+    int32_t *cell_of = (int32_t *)scratch;
+    memset(g->start, 0, (size_t)(g->ncells + 1) * sizeof *g->start);
+    for (int64_t i = 0; i < n; i++) {
+        int64_t c[3] = {0, 0, 0};
+        cell_coords(g, b->x + i * D, c);
+        const int64_t cell = c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]);
+        cell_of[i] = (int32_t)cell;
+        g->start[cell + 1]++;
+    }
+    for (int64_t c = 0; c < g->ncells; c++) g->start[c + 1] += g->start[c];
+    for (int64_t i = 0; i < n; i++) order[g->start[cell_of[i]]++] = (int32_t)i;
+    /* start[c] now holds the end of cell c: shift back to starts */
+    for (int64_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    sx__balls_permute(m, order, scratch);
+    sx__scratch_release(m); /* not kept between builds: the pairs come next */
+    if (tr->history) tr->order = order; /* the transfer's */
+    else sx_alloc_free(&m->alloc, order, (size_t)n, sizeof *order);
+    return true;
+}
+
+/* The forward half of the neighbour stencil: offsets whose linear cell
+ * index is greater, so every pair of cells is visited once. */
+static int half_stencil(int64_t (*off)[3])
+{
+    int n = 0;
+#if D == 3
+    for (int z = 0; z <= 1; z++)
+        for (int y = -1; y <= 1; y++)
+            for (int x = -1; x <= 1; x++) {
+                if (z == 0 && (y < 0 || (y == 0 && x <= 0))) continue;
+                off[n][0] = x, off[n][1] = y, off[n][2] = z, n++;
+            }
+#else
+    for (int y = 0; y <= 1; y++)
+        for (int x = -1; x <= 1; x++) {
+            if (y == 0 && x <= 0) continue;
+            off[n][0] = x, off[n][1] = y, off[n][2] = 0, n++;
+        }
+#endif
+    return n;
+}
+
+/* A candidate pair (i, j), i < j: counted when count is given, else listed
+ * with its old pair (a bond it carries is found again). */
+static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, int64_t *count)
+{
+    const int32_t *cl = m->balls.clump; /* clumps: pebbles of one clump never pair (NULL without clumps) */
+    if (cl && cl[i] && cl[i] == cl[j]) return;
+    if (count) {
+        (*count)++;
+        return;
+    }
+    const int32_t src = old_pair(tr, &m->bb, tr->row_bb, i, j, false);
+    if (src && m->bb.bond) {
+        const int32_t bond = m->bb.bond[src > 0 ? src - 1 : -src - 1];
+        if (bond) tr->seen[bond - 1] = 1;
+    }
+    transfer_push(tr, i, j, src);
+}
+
+/* The grid's candidate pairs in cell order; with count, only counts them
+ * (a build counts first, so the store is sized once, without growing). */
+static void build_ball_pairs(sx_model *m, transfer *tr, int64_t *count)
+{
+    const sx_grid *g = &m->grid;
+    const sx_balls *b = &m->balls;
+    int64_t off[13][3];
+    const int nst = half_stencil(off);
+    for (int64_t cz = 0; cz < g->nc[2]; cz++)
+        for (int64_t cy = 0; cy < g->nc[1]; cy++)
+            for (int64_t cx = 0; cx < g->nc[0]; cx++) {
+                const int64_t cell = cx + g->nc[0] * (cy + g->nc[1] * cz);
+                for (int32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
+                    const double *xi = b->x + (int64_t)i * D;
+                    const double ri = b->rad[i] + m->skin;
+                    /* own cell: later balls only */
+                    for (int32_t j = i + 1; j < g->start[cell + 1]; j++) {
+                        double dx[D];
+                        for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
+                        const double reach = ri + b->rad[j];
+                        if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
+                    }
+                    for (int s = 0; s < nst; s++) {
+                        const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
+                        if (nx < 0 || nx >= g->nc[0] || ny < 0 || ny >= g->nc[1] || nz >= g->nc[2]) continue;
+                        const int64_t nc = nx + g->nc[0] * (ny + g->nc[1] * nz);
+                        for (int32_t j = g->start[nc]; j < g->start[nc + 1]; j++) {
+                            double dx[D];
+                            for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
+                            const double reach = ri + b->rad[j];
+                            if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
+                        }
+                    }
+                }
+            }
+}
+
+/* Ball-wall candidates, ball-major so the contact loop walks balls in
+ * order; with count, only counts them (as build_ball_pairs). */
+static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
+{
+    const sx_balls *b = &m->balls;
+    for (int64_t i = 0; i < b->n; i++)
+        for (int64_t w = 0; w < m->nwall; w++) {
+            double n[D];
+            const double dist = wall_distance(&m->walls[w], b->x + i * D, n);
+            if (dist >= b->rad[i] + m->skin) continue;
+            if (count) (*count)++;
+            else transfer_push(tr, (int32_t)i, (int32_t)w, old_pair(tr, &m->bw, tr->row_bw, i, w, true));
+        }
+}
+
+/* The pairs of one store, counted, then listed (and the bonded pairs kept),
+ * then carried over into the store. */
+static bool build_store(sx_model *m, transfer *tr, bool walls)
+{
+    int64_t count = 0;
+    if (walls) build_wall_pairs(m, tr, &count);
+    else build_ball_pairs(m, tr, &count);
+    if (!transfer_list(m, tr, count, true)) return false;
+    if (walls) build_wall_pairs(m, tr, NULL);
+    else build_ball_pairs(m, tr, NULL);
+    return (walls || keep_bonded_pairs(m, tr)) && transfer_store(m, walls ? &m->bw : &m->bb, tr);
+}
+
+static bool plan_chunks(sx_model *m);
+
+static bool KERNEL(build)(sx_model *m)
+{
+    if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
+        m->bb.n = m->bw.n = 0;
+        m->nchunk = m->nblock = 0;
+        m->builds++;
+        m->build_needed = false;
+        m->dt_stale = true;
+        return true;
+    }
+    /* the automatic skin: a fifth of the mean radius */
+    if (m->skin_user > 0) {
+        m->skin = m->skin_user;
+    } else {
+        double sum = 0;
+        for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
+        m->skin = 0.2 * sum / (double)m->balls.n;
+    }
+    /* each pair store made from its counted pairs, so it holds no more than
+     * them and never grows while it is filled */
+    transfer tr;
+    bool ok = transfer_begin(m, &tr) && grid_setup(m) && sort_balls(m, &tr) && build_store(m, &tr, false) &&
+              build_store(m, &tr, true);
+    transfer_end(m, &tr);
+    if (!ok || !plan_chunks(m)) return false;
+    memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
+    for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
+    m->builds++;
+    m->build_needed = false;
+    m->dt_stale = true; /* new contacts: a new automatic timestep, wherever the build happens */
+    return true;
+}

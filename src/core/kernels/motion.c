@@ -1,0 +1,211 @@
+/* Stage: the law of motion (entry point KERNEL(integrate)). Part of the
+ * per-dimension unit kernels.c, which includes it; not compiled alone. */
+
+/* --------------------------------------------------------- law of motion */
+
+
+/* After a block's law of motion: when its check sum is not finite, the
+ * first ball whose position, velocity or spin is not (-1: none, the sum
+ * overflowed). */
+static void blame_non_finite(const sx_model *m, sx_block *o, double check)
+{
+    const sx_balls *B = &m->balls;
+    o->bad = -1;
+    if (isfinite(check)) return;
+    for (int64_t i = o->b0; i < o->b1 && o->bad < 0; i++) {
+        bool ok = true;
+        for (int k = 0; k < D; k++) ok &= isfinite(B->x[i * D + k]) && isfinite(B->v[i * D + k]);
+        for (int k = 0; k < RD; k++) ok &= isfinite(B->w[i * RD + k]);
+        if (!ok) o->bad = i;
+    }
+}
+
+/* 4-46 ... 4-48: central differences, velocities at half steps, for the
+ * balls of one block; partial sums go to the block. With energy tracking,
+ * the damping's and applied loads' work use the mean of the old and new
+ * velocities. A free, undamped component takes v += (F/m + g) dt, the
+ * same lines in both instances: `plain` (a constant at each call site)
+ * compiles a block without fixities, damping or tracking alone. */
+static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_block *o, const bool plain)
+{
+    sx_balls *B = &m->balls;
+    const double dt = m->dt;
+    /* the kick spans the time between the half-step velocities, t_{n+1/2} - t_{n-1/2} */
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
+    const double g[D] = {m->gravity[0], m->gravity[1]
+#if D == 3
+                         , m->gravity[2]
+#endif
+    };
+    const bool track = !plain && m->track_energy;
+    double *restrict xa = B->x, *restrict va = B->v, *restrict wa = B->w;
+    const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
+    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia;
+    const uint8_t *restrict fixa = B->fix;
+    const int32_t *cl = B->clump;
+    double worst = 0, damp_work = 0, load_work = 0;
+    /* the displacements' squares (a non-finite velocity makes its position
+     * so) and 0 x every spin: not finite once some value is not (or once
+     * the squares overflow; the search below tells) */
+    double check = 0;
+    for (int64_t i = o->b0; i < o->b1; i++) {
+        if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
+        const unsigned fix = plain ? 0 : fixa[i];
+        const double a = plain ? 0 : sx__ball_damping(m, i), im = ima[i], ii = iia[i];
+        double *v = va + i * D, *x = xa + i * D;
+        const double *f = fa + i * D;
+        double disp2 = 0;
+        for (int k = 0; k < D; k++) {
+            if (!(fix & (SX_FIX_VX << k))) {
+                const double vold = v[k];
+                if (a == 0) {
+                    v[k] += (f[k] * im + g[k]) * dtv; /* 4-46 with 4-40 */
+                } else {
+                    const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
+                    const double fd = sx__damped(force, v[k], a);
+                    v[k] += fd * im * dtv; /* 4-46 */
+                    if (track) damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
+                }
+                if (track && B->fapp) load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
+            }
+            x[k] += v[k] * dt; /* 4-48 */
+            const double u = x[k] - xb[i * D + k];
+            disp2 += u * u;
+        }
+        check += disp2;
+        double *w = wa + i * RD;
+        const double *t = ta + i * RD;
+        for (int k = 0; k < RD; k++) {
+            if (!(fix & (SX_FIX_WX << k))) {
+                const double wold = w[k];
+                if (a == 0) {
+                    w[k] += t[k] * ii * dtv; /* 4-47 */
+                } else {
+                    const double md = sx__damped(t[k], w[k], a);
+                    w[k] += md * ii * dtv;
+                    if (track) damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
+                }
+                if (track && B->tapp) load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
+            }
+            check += 0 * w[k];
+        }
+        worst = disp2 > worst ? disp2 : worst;
+    }
+    o->worst = worst;
+    o->damp_work = damp_work;
+    o->load_work = load_work;
+    blame_non_finite(m, o, check);
+}
+
+/* A plain block (no fixities, damping, tracking or pebbles) four balls at
+ * a time: motion_pass's arithmetic in vector lanes (four balls' components
+ * are adjacent in memory, moved by shuffles), the largest displacement per
+ * lane and then over the lanes (a maximum, in any order the same), the
+ * last balls one by one. */
+static inline __attribute__((always_inline)) void motion_lanes(sx_model *m, sx_block *o)
+{
+    sx_balls *B = &m->balls;
+    const double dt = m->dt;
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt; /* as in motion_pass */
+    double *restrict xa = B->x, *restrict va = B->v, *restrict wa = B->w;
+    const double *restrict fa = B->f, *restrict ta = B->t, *restrict xb = B->x_build;
+    const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia;
+    vd worst = VZERO, check = VZERO;
+    int64_t i = o->b0;
+    for (; i + LANES <= o->b1; i += LANES) {
+        vd x[D], v[D], f[D], x0[D], im, ii;
+        load_lanes(xa + i * D, x);
+        load_lanes(va + i * D, v);
+        load_lanes(fa + i * D, f);
+        load_lanes(xb + i * D, x0);
+        memcpy(&im, ima + i, sizeof im);
+        memcpy(&ii, iia + i, sizeof ii);
+        vd disp2 = VZERO;
+        for (int k = 0; k < D; k++) {
+            v[k] += (f[k] * im + m->gravity[k]) * dtv; /* 4-46 with 4-40 */
+            x[k] += v[k] * dt;                         /* 4-48 */
+            const vd u = x[k] - x0[k];
+            disp2 += u * u;
+        }
+        store_lanes(xa + i * D, x);
+        store_lanes(va + i * D, v);
+        check += disp2;
+        worst = VSEL(disp2 > worst, disp2, worst);
+#if D == 3
+        vd w[3], t[3];
+        load_lanes(wa + i * 3, w);
+        load_lanes(ta + i * 3, t);
+        for (int k = 0; k < 3; k++) {
+            w[k] += t[k] * ii * dtv; /* 4-47 */
+            check += 0 * w[k];
+        }
+        store_lanes(wa + i * 3, w);
+#else
+        vd w, t;
+        memcpy(&w, wa + i, sizeof w);
+        memcpy(&t, ta + i, sizeof t);
+        w += t * ii * dtv; /* 4-47 */
+        check += 0 * w;
+        memcpy(wa + i, &w, sizeof w);
+#endif
+    }
+    double most = 0, sum = check[0] + check[1] + check[2] + check[3];
+    for (int q = 0; q < LANES; q++) most = worst[q] > most ? worst[q] : most;
+    for (; i < o->b1; i++) {
+        const double im = ima[i], ii = iia[i];
+        double disp2 = 0;
+        for (int k = 0; k < D; k++) {
+            va[i * D + k] += (fa[i * D + k] * im + m->gravity[k]) * dtv;
+            xa[i * D + k] += va[i * D + k] * dt;
+            const double u = xa[i * D + k] - xb[i * D + k];
+            disp2 += u * u;
+        }
+        sum += disp2;
+        for (int k = 0; k < RD; k++) {
+            wa[i * RD + k] += ta[i * RD + k] * ii * dtv;
+            sum += 0 * wa[i * RD + k];
+        }
+        most = disp2 > most ? disp2 : most;
+    }
+    o->worst = most;
+    o->damp_work = o->load_work = 0;
+    blame_non_finite(m, o, sum);
+}
+
+SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
+{
+    const sx_balls *B = &m->balls;
+    /* undamped: no ball has its own damping and no material has any (no per-ball test needed) */
+    bool plain = !m->track_energy, undamped = !B->alpha;
+    for (int k = 0; k < m->nmat && undamped; k++) undamped = m->mats[k].def.damping == 0;
+    for (int64_t i = o->b0; i < o->b1 && plain; i++) plain = !B->fix[i] && (undamped || sx__ball_damping(m, i) == 0);
+    if (plain && !B->clump) motion_lanes(m, o);
+    else if (plain) motion_pass(m, o, true);
+    else motion_pass(m, o, false);
+}
+
+/* The law of motion in fixed blocks of balls whose partial sums are added
+ * in block order (the same bits for any thread count). Returns the largest
+ * displacement since the last build in *max_disp. */
+static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
+{
+    const int64_t nb = m->nblock;
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
+    for (int64_t b = 0; b < nb; b++) integrate_block(m, &m->blocks[b]);
+    double worst = 0;
+    for (int64_t b = 0; b < nb; b++) {
+        const sx_block *o = &m->blocks[b];
+        if (o->bad >= 0)
+            return sx__fail(m, SX_EUNSTABLE,
+                            "unstable at step %lld: ball %lld has a non-finite position, velocity or spin; "
+                            "the timestep %g s is likely too large (critical estimate %g s)",
+                            (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(critical_dt)(m));
+        if (o->worst > worst) worst = o->worst;
+        if (m->track_energy) {
+            m->acc.local_damping -= o->damp_work;
+            m->acc.boundary_work += o->load_work;
+        }
+    }
+    *max_disp = sqrt(worst);
+    return SX_OK;
+}

@@ -1,0 +1,703 @@
+/* Stage: the ball-ball contacts (entry point KERNEL(contacts); the
+ * chunk plan KERNEL(plan)). Part of the per-dimension unit kernels.c,
+ * which includes it; not compiled alone. */
+
+/* ------------------------------------------------------- contact forces */
+
+/* The rotation carried by a contact from one step to the next: into the new
+ * contact plane (4-13/4-14, c = n_old x n) and about the normal by the mean
+ * spin of the two entities (4-8/4-9/4-15). Applied to the shear force and to
+ * the parallel bond's shear force and bending moment. */
+typedef struct carry {
+    double c[D == 3 ? 3 : 1];
+    double wdt[D == 3 ? 3 : 1];
+} carry;
+
+static inline void carry_make(carry *r, const double *nold, const double *n, const double *wa, const double *wb,
+                              double dt)
+{
+#if D == 3
+    r->c[0] = nold[1] * n[2] - nold[2] * n[1];
+    r->c[1] = nold[2] * n[0] - nold[0] * n[2];
+    r->c[2] = nold[0] * n[1] - nold[1] * n[0];
+    /* 4-9: the mean spin projected on the normal (a wall does not spin) */
+    double ws[3];
+    for (int k = 0; k < 3; k++) ws[k] = wa ? wa[k] + wb[k] : wb[k];
+    const double wbar = 0.5 * dot(ws, n);
+    for (int k = 0; k < 3; k++) r->wdt[k] = wbar * n[k] * dt;
+#else
+    /* in 2D c is along z, and the spins are normal to n, so 4-15 is the identity */
+    (void)wa, (void)wb, (void)dt;
+    r->c[0] = nold[0] * n[1] - nold[1] * n[0];
+    r->wdt[0] = 0;
+#endif
+}
+
+static inline void carry_apply(const carry *r, double *v)
+{
+#if D == 3
+    double t[3];
+    spin_cross(r->c, v, t); /* 4-14: F + c x F */
+    for (int k = 0; k < 3; k++) v[k] += t[k];
+    spin_cross(r->wdt, v, t); /* 4-15: F + (w dt) x F */
+    for (int k = 0; k < 3; k++) v[k] += t[k];
+#else
+    const double v0 = v[0];
+    v[0] -= r->c[0] * v[1];
+    v[1] += r->c[0] * v0;
+#endif
+}
+
+/* Normal and shear stiffness of a contact by its law (laws/registry.h).
+ * rbar is 4-27's 2RARB/(RA+RB) (ball-wall: R, 4-28). Returns the normal force. */
+static inline double stiffness(const sx_pair_law *l, double ra, double rb, double rbar, double un, double *kn,
+                               double *ks)
+{
+    return sx__law_force(l, D, ra, rb, rbar, un, kn, ks);
+}
+
+/* Strain energy of a contact spring: its law's factor times Fn Un (linear
+ * 1/2, Hertz 2/5), plus the shear spring's 1/2 |Fs|^2 / ks. */
+static inline double contact_strain(const sx_pair_law *l, double fn, double un, const double *fs, double ks)
+{
+    const double normal = sx__law(l->law)->strain * fn * un;
+    return normal + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+}
+
+/* Section of a parallel bond: area, moment of inertia, polar moment (4-35;
+ * 2D: a beam of unit thickness, A = 2R, I = 2/3 R^3, no twist). */
+static inline void pb_section(double r, double *area, double *inertia, double *polar)
+{
+#if D == 3
+    *area = SX_PI * r * r;
+    *inertia = 0.25 * SX_PI * r * r * r * r;
+    *polar = 0.5 * SX_PI * r * r * r * r;
+#else
+    *area = 2 * r;
+    *inertia = 2.0 / 3.0 * r * r * r;
+    *polar = 0;
+#endif
+}
+
+static double pb_strain(const sx_bonds *b, int64_t s)
+{
+    double area, inertia, polar;
+    pb_section(b->rbar[s], &area, &inertia, &polar);
+    const double *fs = b->fs + s * D, *ms = b->ms + s * RD;
+    double e = 0.5 * b->fn[s] * b->fn[s] / (b->kn[s] * area) + 0.5 * dot(fs, fs) / (b->ks[s] * area);
+    double m2 = 0;
+    for (int k = 0; k < RD; k++) m2 += ms[k] * ms[k];
+    e += 0.5 * m2 / (b->kn[s] * inertia);
+    if (D == 3) e += 0.5 * b->mn[s] * b->mn[s] / (b->ks[s] * polar);
+    return e;
+}
+
+static double KERNEL(critical_dt)(sx_model *m);
+
+/* 4-16 ... 4-20: the velocity v_{n-1/2} moved the entities from x_{n-1} to
+ * x_n during the previous step, so displacement increments use its length. */
+static inline double motion_dt(const sx_model *m) { return m->dt_prev > 0 ? m->dt_prev : m->dt; }
+
+static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64_t idb, double un, double r)
+{
+    return sx__fail(m, SX_EUNSTABLE,
+                    "unstable at step %lld: %s %lld and %lld overlap by %g m, more than the radius %g m; "
+                    "the timestep %g s is too large for the contact stiffness (critical estimate %g s): "
+                    "lower the timestep or use the automatic one",
+                    (long long)m->step, what, (long long)ida, (long long)idb, un, r, m->dt,
+                    KERNEL(critical_dt)(m));
+}
+
+static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int64_t i,
+                      int64_t j, double fn, double fs, double mn, double ms)
+{
+    sx_crack c;
+    memset(&c, 0, sizeof c);
+    c.time = m->time;
+    c.step = m->step;
+    for (int k = 0; k < D; k++) c.pos[k] = xc[k];
+    c.mode = mode;
+    c.kind = kind;
+    c.a = m->balls.id[i];
+    c.b = m->balls.id[j];
+    c.fn = fn, c.fs = fs, c.mn = mn, c.ms = ms;
+    /* kept with the chunk, merged into the model's log in chunk order */
+    if (o->ncracks == o->capcracks) {
+        const int64_t cap = o->capcracks ? 2 * o->capcracks : 16;
+        sx_crack *q = realloc(o->cracks, (size_t)cap * sizeof *q);
+        if (!q) return; /* out of memory: the event is dropped, the bond still breaks */
+        o->cracks = q;
+        o->capcracks = cap;
+    }
+    o->cracks[o->ncracks++] = c;
+}
+
+/* The parallel bond of pair (i, j), 4-32 ... 4-39: carried with the contact,
+ * incremented from the relative motion, checked against its strengths.
+ * Adds its force to F (on j) and its moment to mb (on j). Returns false
+ * when it broke. */
+static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *n, double vn, const double *vs,
+                          const double *dtheta, const double *xc, int64_t i, int64_t j, double *F, double *mb)
+{
+    sx_bonds *b = &m->bonds;
+    const double dt = motion_dt(m), rbar = b->rbar[s];
+    double area, inertia, polar;
+    pb_section(rbar, &area, &inertia, &polar);
+    double *fs = b->fs + s * D, *ms = b->ms + s * RD;
+    carry_apply(rot, fs);
+#if D == 3
+    carry_apply(rot, ms);
+#endif
+    b->fn[s] += b->kn[s] * area * (-vn * dt); /* 4-33, compression positive */
+    for (int k = 0; k < D; k++) fs[k] -= b->ks[s] * area * vs[k] * dt; /* 4-33 with dUs (seed typo corrected) */
+#if D == 3
+    const double twist = dot(dtheta, n);
+    b->mn[s] -= b->ks[s] * polar * twist; /* 4-34 */
+    for (int k = 0; k < 3; k++) ms[k] -= b->kn[s] * inertia * (dtheta[k] - twist * n[k]);
+#else
+    (void)polar;
+    ms[0] -= b->kn[s] * inertia * dtheta[0];
+#endif
+    double ms2 = 0;
+    for (int k = 0; k < RD; k++) ms2 += ms[k] * ms[k];
+    const double msn = sqrt(ms2), fsn = sqrt(dot(fs, fs)), mnn = fabs(b->mn[s]);
+    /* 4-38 as corrected: magnitudes, the twist only in 3D */
+    const double sigma = -b->fn[s] / area + msn * rbar / inertia;
+    const double tau = fsn / area + (D == 3 ? mnn * rbar / polar : 0);
+    if (sigma >= b->sigma_c[s] || tau >= b->tau_c[s]) {
+        const bool tension = sigma / b->sigma_c[s] >= tau / b->tau_c[s];
+        log_crack(m, o, xc, tension ? SX_CRACK_TENSION : SX_CRACK_SHEAR, SX_BOND_PARALLEL, i, j, b->fn[s], fsn, mnn,
+                  msn);
+        if (m->track_energy) o->released += pb_strain(b, s);
+        return false;
+    }
+    for (int k = 0; k < D; k++) F[k] += b->fn[s] * n[k] + fs[k]; /* 4-32 */
+#if D == 3
+    for (int k = 0; k < 3; k++) mb[k] += b->mn[s] * n[k] + ms[k];
+#else
+    mb[0] += ms[0];
+#endif
+    return true;
+}
+
+/* A chunk's results start empty; the balls it clears start from their
+ * applied loads (or nothing). */
+static void chunk_start(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    const size_t nf = (size_t)((o->clear_hi - o->clear_lo) * D), nt = (size_t)((o->clear_hi - o->clear_lo) * RD);
+    if (B->fapp) {
+        memcpy(B->f + o->clear_lo * D, B->fapp + o->clear_lo * D, nf * sizeof(double));
+        memcpy(B->t + o->clear_lo * RD, B->tapp + o->clear_lo * RD, nt * sizeof(double));
+    } else {
+        memset(B->f + o->clear_lo * D, 0, nf * sizeof(double));
+        memset(B->t + o->clear_lo * RD, 0, nt * sizeof(double));
+    }
+    o->slip = o->viscous = o->released = 0;
+    o->lost_bonds = 0;
+    o->ncracks = 0;
+    o->st = SX_OK;
+}
+
+/* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
+ * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
+ * a; energies, cracks and errors go to the chunk. */
+static void ball_chunk_pass(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
+    const double *restrict im = B->inv_mass;
+    const uint16_t *restrict mat = B->mat;
+    const int32_t *restrict pa = p->a, *restrict pb = p->b;
+    const int32_t *restrict bond = p->bond;
+    double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
+    uint8_t *restrict touching = p->touching;
+    double *restrict f = B->f, *restrict t = B->t;
+    const sx_pair_law *laws = m->law;
+    chunk_start(m, o);
+    const double dt = motion_dt(m);
+    const int nlaw = m->law_n;
+    const bool track = m->track_energy;
+    for (int64_t c = o->first; c < o->last; c++) {
+        const int64_t i = pa[c], j = pb[c];
+        const int32_t slot = bond ? bond[c] - 1 : -1;
+        double dx[D];
+        for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
+        const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
+        const sx_pair_law *law = &laws[mat[i] * nlaw + mat[j]];
+        double *restrict fs = fs_all + c * D, *restrict rel = geo_all + c * D;
+        if (d2 >= rsum * rsum && slot < 0) {
+            if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
+                double kn, ks;
+                stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
+                if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+            }
+            touching[c] = 0;
+            fn_all[c] = 0; /* its last evaluation: no force */
+            continue;
+        }
+        /* 4-1 ... 4-4 */
+        const double d = sqrt(d2), inv_d = 1.0 / d;
+        double n[D];
+        for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
+        const double un = rsum - d;
+        const double rmin = ri < rj ? ri : rj;
+        if (un > rmin) {
+            o->st = SX_EUNSTABLE;
+            o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un, o->err_r = rmin;
+            return;
+        }
+        const double la = ri - 0.5 * un, lb = rj - 0.5 * un;
+        /* 4-16 with the arms la n from a and -lb n from b: the contact-point
+         * velocity of b relative to a is vb - va - (la wa + lb wb) x n */
+        const double *wi = w + i * RD, *wj = w + j * RD;
+        double ws[RD], wn[D], vc[D];
+        for (int k = 0; k < RD; k++) ws[k] = la * wi[k] + lb * wj[k];
+        spin_cross(ws, n, wn);
+        for (int k = 0; k < D; k++) vc[k] = (v[j * D + k] - v[i * D + k]) - wn[k];
+        const double vn = dot(vc, n);
+        double vs[D];
+        for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k]; /* 4-17 */
+
+        /* the previous normal, from the last evaluation's relative position as n
+         * was computed from dx (the same bits); none for a new contact */
+        double nold[D];
+        if (touching[c]) {
+            const double inv_r = 1.0 / sqrt(dot(rel, rel));
+            for (int k = 0; k < D; k++) nold[k] = rel[k] * inv_r;
+        } else {
+            for (int k = 0; k < D; k++) fs[k] = 0, nold[k] = n[k];
+        }
+        carry rot;
+        carry_make(&rot, nold, n, wi, wj, dt);
+        unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+        const unsigned bonds_before = bonds;
+        double xc[D]; /* the contact point (4-4), for the crack log */
+        if (slot >= 0)
+            for (int k = 0; k < D; k++) xc[k] = x[i * D + k] + la * n[k];
+
+        double kn, ks, fn = 0, F[D], mb[RD];
+        bool bond_moment = false;
+        const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
+        bool slip = false;
+        if (active) {
+            fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
+            carry_apply(&rot, fs);
+            double f0[D]; /* the shear force before this step's increment, for the slip energy */
+            for (int k = 0; k < D; k++) f0[k] = fs[k];
+            const double ksdt = ks * dt;
+            for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+            if (bonds & SX_BOND_CONTACT) {
+                const double fsn = sqrt(dot(fs, fs));
+                if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
+                    log_crack(m, o, xc, SX_CRACK_TENSION, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * fsn * fsn / ks : 0);
+                    bonds &= ~(unsigned)SX_BOND_CONTACT;
+                    fn = 0;
+                    for (int k = 0; k < D; k++) fs[k] = 0;
+                } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
+                    log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    bonds &= ~(unsigned)SX_BOND_CONTACT;
+                }
+            }
+            if (!(bonds & SX_BOND_CONTACT)) {
+                if (un <= 0) { /* unbonded and open: no contact force */
+                    /* a contact bond that failed in shear while in tension releases both springs */
+                    if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+                    fn = 0;
+                    for (int k = 0; k < D; k++) fs[k] = 0;
+                }
+                /* 4-30/4-31: Coulomb slip with the smaller friction */
+                const double fmax = law->mu * (fn > 0 ? fn : 0);
+                const double f2 = dot(fs, fs);
+                if (f2 > fmax * fmax) {
+                    const double sc = fmax / sqrt(f2);
+                    /* slip work: the mean of the shear force before and after the step along the
+                     * slip displacement (trial - final force) / ks */
+                    if (track && ks > 0) {
+                        double e = 0;
+                        for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
+                        o->slip += 0.5 * e / ks;
+                    }
+                    for (int k = 0; k < D; k++) fs[k] *= sc;
+                    slip = true;
+                }
+            }
+            double fd = fn, dsh[D];
+            bool shear_dashpot = false;
+            if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
+                /* viscous dashpots at the critical-damping ratios on the reduced mass
+                 * m* = 1 / (1/ma + 1/mb): c = 2 beta sqrt(m* k), a per-law factor when k is */
+                const double sum_im = im[i] + im[j];
+                const double cn = !law->plain ? 2 * law->beta_n * sqrt(kn / sum_im)
+                                                                : sqrt(law->dash_n / sum_im);
+                const double fdn = -cn * vn;
+                fd += fdn;
+                double work = fdn * vn;
+                if (!slip && law->beta_s > 0) {
+                    const double cs = 2 * law->beta_s * sqrt(ks / sum_im);
+                    for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
+                    work += dot(dsh, vs);
+                    shear_dashpot = true;
+                }
+                if (track) o->viscous -= work * dt;
+            }
+            for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k]; /* 4-5 */
+            if (shear_dashpot)
+                for (int k = 0; k < D; k++) F[k] += dsh[k];
+            fn_all[c] = fd;
+        } else {
+            if (track && touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
+                double kn0, ks0;
+                stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn0, &ks0);
+                if (ks0 > 0) o->slip += 0.5 * dot(fs, fs) / ks0;
+            }
+            for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
+            fn_all[c] = 0;
+        }
+        if (bonds & SX_BOND_PARALLEL) {
+            double dtheta[RD];
+            for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
+            for (int k = 0; k < RD; k++) mb[k] = 0;
+            if (parallel_bond(m, o, slot, &rot, n, vn, vs, dtheta, xc, i, j, F, mb)) bond_moment = true;
+            else bonds &= ~(unsigned)SX_BOND_PARALLEL;
+        }
+        if (bonds != bonds_before) { /* only this pair touches its bond slot */
+            m->bonds.kind[slot] = (uint8_t)bonds;
+            if (!bonds) {
+                p->bond[c] = 0;
+                o->lost_bonds++;
+            }
+        }
+        for (int k = 0; k < D; k++) rel[k] = dx[k];
+        touching[c] = active || bonds;
+        /* 4-21 and 4-39: both arms lie along n, so both moments are multiples of n x F */
+        double nf[RD];
+        moment_of(n, F, nf);
+        double *fi = f + i * D, *ti = t + i * RD, *fj = f + j * D, *tj = t + j * RD;
+        for (int k = 0; k < D; k++) {
+            fi[k] -= F[k];
+            fj[k] += F[k];
+        }
+        for (int k = 0; k < RD; k++) {
+            double ma = la * nf[k], mj = -lb * nf[k];
+            if (bond_moment) ma += mb[k], mj += mb[k];
+            ti[k] -= ma;
+            tj[k] += mj;
+        }
+    }
+}
+
+/* The common case (linear laws without a shear dashpot, no bonds, no
+ * energy tracking) of ball_chunk_pass, four pairs at a time: each pair's
+ * inputs are loaded straight into one lane of vector registers, every
+ * formula runs on the four lanes at once (branches become selects: a pair
+ * out of contact or not slipping takes the same lanes, and multiplying by
+ * a scale of exactly 1 changes nothing), and the results are scattered
+ * in pair order. Each lane does the scalar pass's arithmetic in its
+ * order, so both give the same bits. */
+#include "lanes.h"
+
+SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
+{
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
+    const double *restrict im = B->inv_mass;
+    const uint16_t *restrict mat = B->mat;
+    const int32_t *restrict pa = p->a, *restrict pb = p->b;
+    double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
+    uint8_t *restrict touching = p->touching;
+    double *restrict f = B->f, *restrict t = B->t;
+    const sx_pair_law *laws = m->law;
+    const int nlaw = m->law_n;
+    chunk_start(m, o);
+    const double dt = motion_dt(m);
+    /* the law's parameters per lane; with one material, the same in every lane */
+    vd kn = VZERO + laws->kn, ks = VZERO + laws->ks, mu = VZERO + laws->mu, dash = VZERO + laws->dash_n,
+       bn = VZERO + laws->beta_n;
+    /* the dashpot's sqrt(dash / (1/ma + 1/mb)) of the last lanes that needed one:
+     * balls of one size and material share it */
+    double memo_dash = NAN, memo_sim = NAN, memo_cn = 0;
+
+    for (int64_t c0 = o->first; c0 < o->last; c0 += LANES) {
+        const int nb = o->last - c0 < LANES ? (int)(o->last - c0) : LANES;
+        int64_t cc[LANES], i[LANES], j[LANES]; /* lanes past nb repeat the first pair */
+        for (int q = 0; q < LANES; q++) {
+            cc[q] = c0 + (q < nb ? q : 0);
+            i[q] = pa[cc[q]], j[q] = pb[cc[q]];
+        }
+        if (nlaw > 1)
+            for (int q = 0; q < LANES; q++) {
+                const sx_pair_law *law = &laws[mat[i[q]] * nlaw + mat[j[q]]];
+                kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
+            }
+        /* the history as stored, four consecutive pairs by shuffles (a short
+         * batch copied to four pairs first) */
+        const bool full = nb == LANES;
+        double tail[2 * LANES * D];
+        uint8_t tail_touching[LANES];
+        const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D;
+        const uint8_t *htouching = touching + c0;
+        if (!full) {
+            for (int q = 0; q < LANES; q++) {
+                memcpy(tail + q * D, fs_all + cc[q] * D, D * sizeof(double));
+                memcpy(tail + (LANES + q) * D, geo_all + cc[q] * D, D * sizeof(double));
+                tail_touching[q] = touching[cc[q]];
+            }
+            hfs = tail, hrel = tail + LANES * D, htouching = tail_touching;
+        }
+        vd fs_old[D], rel_old[D];
+        load_lanes(hfs, fs_old);
+        load_lanes(hrel, rel_old);
+        v4u8 touched;
+        memcpy(&touched, htouching, sizeof touched);
+        const vm had = __builtin_convertvector(touched, vm) != 0;
+
+        /* the previous normal from the relative position as in ball_chunk_pass
+         * (first: its square root and division overlap the loads below) */
+        vd rr = VZERO;
+        for (int k = 0; k < D; k++) rr += rel_old[k] * rel_old[k];
+        const vd inv_r = 1.0 / VSQRT(rr);
+
+        vd dx[D], dv[D];
+        for (int k = 0; k < D; k++) {
+            dx[k] = LANES_OF(x, j, D, k) - LANES_OF(x, i, D, k);
+            dv[k] = LANES_OF(v, j, D, k) - LANES_OF(v, i, D, k);
+        }
+        const vd ri = LANES_OF(rad, i, 1, 0), rj = LANES_OF(rad, j, 1, 0);
+
+        /* 4-1 ... 4-4 */
+        /* sums from zero, as dot() (the sign of a zero sum) */
+        vd d2 = VZERO;
+        for (int k = 0; k < D; k++) d2 += dx[k] * dx[k];
+        const vd d = VSQRT(d2), inv_d = 1.0 / d;
+        vd n[D];
+        for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
+        const vd rsum = ri + rj, u = rsum - d;
+        const vd la = ri - 0.5 * u, lb = rj - 0.5 * u;
+        /* 4-16, 4-17 as in ball_chunk_pass */
+        vd ws[RD], vc[D];
+#if D == 3
+        vd wsum[3]; /* for 4-15 */
+#endif
+        for (int k = 0; k < RD; k++) {
+            const vd wa = LANES_OF(w, i, RD, k), wb = LANES_OF(w, j, RD, k);
+            ws[k] = la * wa + lb * wb;
+#if D == 3
+            wsum[k] = wa + wb;
+#endif
+        }
+#if D == 3
+        vc[0] = dv[0] - (ws[1] * n[2] - ws[2] * n[1]);
+        vc[1] = dv[1] - (ws[2] * n[0] - ws[0] * n[2]);
+        vc[2] = dv[2] - (ws[0] * n[1] - ws[1] * n[0]);
+#else
+        vc[0] = dv[0] - -ws[0] * n[1];
+        vc[1] = dv[1] - ws[0] * n[0];
+#endif
+        vd vn = VZERO;
+        for (int k = 0; k < D; k++) vn += vc[k] * n[k];
+        vd vs[D];
+        for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
+        const vd fn = kn * u; /* 4-6 */
+        const vd fmax = mu * VSEL(fn > VZERO, fn, VZERO);
+        /* the shear force (none for a new contact) */
+        vd g[D], prev[D];
+        for (int k = 0; k < D; k++) prev[k] = rel_old[k] * inv_r;
+#if D == 3
+        shear_lanes(g, fs_old, prev, &had, n, wsum, vs, &ks, &fmax, dt);
+#else
+        shear_lanes(g, fs_old, prev, &had, n, NULL, vs, &ks, &fmax, dt);
+#endif
+        const vm active = u > VZERO;
+        const vd sim = LANES_OF(im, i, 1, 0) + LANES_OF(im, j, 1, 0);
+        vd cn;
+        const vm other = (sim != memo_sim) | (dash != memo_dash);
+        if (!VANY(other)) {
+            cn = VZERO + memo_cn;
+        } else {
+            cn = VSQRT(dash / sim);
+            memo_sim = sim[0], memo_dash = dash[0], memo_cn = cn[0];
+        }
+        const vd fd = VSEL(active & (bn > VZERO), fn + -cn * vn, fn);
+        vd F[D];
+        for (int k = 0; k < D; k++) {
+            F[k] = VSEL(active, fd * n[k] + g[k], VZERO); /* 4-5 */
+            g[k] = VSEL(active, g[k], VZERO);
+        }
+        /* 4-21: both arms lie along n */
+        vd nf[RD];
+#if D == 3
+        nf[0] = n[1] * F[2] - n[2] * F[1];
+        nf[1] = n[2] * F[0] - n[0] * F[2];
+        nf[2] = n[0] * F[1] - n[1] * F[0];
+#else
+        nf[0] = n[0] * F[1] - n[1] * F[0];
+#endif
+        vd ma[RD], mj[RD];
+        for (int k = 0; k < RD; k++) ma[k] = la * nf[k], mj[k] = -lb * nf[k];
+        const vd fdo = VSEL(active, fd, VZERO);
+        const vm live = d2 < rsum * rsum;
+        const vm bad = live & (u > VSEL(ri < rj, ri, rj));
+        if (VANY(bad))
+            for (int q = 0; q < nb; q++)
+                if (bad[q]) {
+                    o->st = SX_EUNSTABLE;
+                    o->err_a = B->id[i[q]], o->err_b = B->id[j[q]], o->err_un = u[q];
+                    o->err_r = ri[q] < rj[q] ? ri[q] : rj[q];
+                    return;
+                }
+        /* a pair out of reach this step keeps its history, untouched, and has no force */
+        if (full) {
+            vd keep[D];
+            for (int k = 0; k < D; k++) keep[k] = VSEL(live, g[k], fs_old[k]);
+            store_lanes(fs_all + c0 * D, keep);
+            for (int k = 0; k < D; k++) keep[k] = VSEL(live, dx[k], rel_old[k]);
+            store_lanes(geo_all + c0 * D, keep);
+            memcpy(fn_all + c0, &fdo, sizeof fdo); /* 0 out of reach, as in ball_chunk_pass */
+            for (int q = 0; q < LANES; q++) touching[c0 + q] = (live[q] & active[q]) != 0;
+        } else {
+            for (int q = 0; q < nb; q++) {
+                const int64_t c = cc[q];
+                touching[c] = (live[q] & active[q]) != 0;
+                fn_all[c] = fdo[q];
+                if (!live[q]) continue;
+                for (int k = 0; k < D; k++) fs_all[c * D + k] = g[k][q], geo_all[c * D + k] = dx[k][q];
+            }
+        }
+        for (int q = 0; q < nb; q++) {
+            if (!live[q]) continue;
+            double *fi = f + i[q] * D, *ti = t + i[q] * RD, *fj = f + j[q] * D, *tj = t + j[q] * RD;
+            for (int k = 0; k < D; k++) {
+                fi[k] -= F[k][q];
+                fj[k] += F[k][q];
+            }
+            for (int k = 0; k < RD; k++) {
+                ti[k] -= ma[k][q];
+                tj[k] += mj[k][q];
+            }
+        }
+    }
+}
+
+static void ball_chunk(sx_model *m, sx_chunk *o)
+{
+    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_batched(m, o);
+    else ball_chunk_pass(m, o);
+}
+
+/* Chunks of the ball-ball pass and blocks of the per-ball passes, planned
+ * after each build (and on a restore) from the stores alone. A power of
+ * two of chunks (so that each phase splits evenly over 2, 4, ... threads)
+ * of at least CHUNK_PAIRS pairs, at most MAX_CHUNKS; MAX_CHUNKS / 2 bounds
+ * the useful thread count of that pass, MOTION_BLOCKS that of the per-ball
+ * passes. */
+enum { CHUNK_PAIRS = 1024, MAX_CHUNKS = 16, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
+
+/* First index c of sorted a[0..n) with a[c] >= key. */
+static int64_t lower_bound(const int32_t *a, int64_t n, int64_t key)
+{
+    int64_t lo = 0, hi = n;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+static bool plan_chunks(sx_model *m)
+{
+    /* ownership needs the pairs grouped by a: bonded pairs appended by a
+     * build, or a store patched by a removal, are put in order (stably, so
+     * each ball's contacts keep their order) */
+    if (!sx__pairs_sort(m, &m->bb) || !sx__pairs_sort(m, &m->bw)) return false;
+    const sx_pairs *p = &m->bb;
+    const int64_t n = m->balls.n;
+    int64_t k = 1;
+    while (2 * k <= MAX_CHUNKS && 2 * k * CHUNK_PAIRS <= p->n) k *= 2;
+    if (k > m->cap_chunk) {
+        sx_chunk *q = sx_alloc_resize(&m->alloc, m->chunks, (size_t)m->cap_chunk, (size_t)k, sizeof *q);
+        if (!q) return false;
+        m->chunks = q;
+        m->cap_chunk = k;
+    }
+    m->nchunk = k;
+    /* chunk c starts at the ball of pair p->n c / k, and at least where the
+     * chunk two before it reaches (its largest b), so that a chunk's b's
+     * fall in its own range or the next one's */
+    int64_t lo[MAX_CHUNKS + 1];
+    for (int64_t c = 0; c < k; c++) {
+        const int64_t q = p->n * c / k;
+        lo[c] = c == 0 ? 0 : q < p->n ? p->a[q] : n;
+    }
+    lo[k] = n;
+    for (int64_t c = 0; c < k; c++) {
+        if (c > 0 && lo[c] < lo[c - 1]) lo[c] = lo[c - 1];
+        sx_chunk *o = &m->chunks[c];
+        o->own_lo = lo[c];
+        o->first = lower_bound(p->a, p->n, lo[c]);
+        if (c >= 2) { /* chunk c - 2 is complete once chunk c - 1 starts */
+            const sx_chunk *e = &m->chunks[c - 2];
+            int64_t reach = lo[c - 1];
+            for (int64_t q = e->first; q < m->chunks[c - 1].first; q++)
+                if (p->b[q] + 1 > reach) reach = p->b[q] + 1;
+            if (reach > lo[c]) {
+                lo[c] = reach;
+                o->own_lo = reach;
+                o->first = lower_bound(p->a, p->n, reach);
+            }
+        }
+    }
+    for (int64_t c = 0; c < k; c++) {
+        sx_chunk *o = &m->chunks[c];
+        o->own_hi = c + 1 < k ? m->chunks[c + 1].own_lo : n;
+        o->last = c + 1 < k ? m->chunks[c + 1].first : p->n;
+        /* the first phase clears the forces of every ball before either phase adds to them */
+        o->clear_lo = c % 2 == 0 ? o->own_lo : 0;
+        o->clear_hi = c % 2 == 0 ? (c + 2 < k ? m->chunks[c + 2].own_lo : n) : 0;
+        for (int64_t q = o->first; q < o->last; q++) /* what the two phases rely on */
+            assert(p->a[q] >= o->own_lo && p->a[q] < o->own_hi && (c + 2 >= k || p->b[q] < m->chunks[c + 2].own_lo));
+    }
+    /* blocks of at least MOTION_MIN balls, at most MOTION_BLOCKS of them */
+    if (!m->blocks) {
+        m->blocks = sx_alloc_resize(&m->alloc, NULL, 0, MOTION_BLOCKS, sizeof *m->blocks);
+        if (!m->blocks) return false;
+    }
+    int64_t nb = (n + MOTION_MIN - 1) / MOTION_MIN;
+    if (nb > MOTION_BLOCKS) nb = MOTION_BLOCKS;
+    const int64_t size = nb ? (n + nb - 1) / nb : 0;
+    m->nblock = nb;
+    for (int64_t b = 0; b < nb; b++) {
+        sx_block *o = &m->blocks[b];
+        o->b0 = b * size;
+        o->b1 = (b + 1) * size < n ? (b + 1) * size : n;
+        o->w0 = lower_bound(m->bw.a, m->bw.n, o->b0);
+        o->w1 = lower_bound(m->bw.a, m->bw.n, o->b1);
+    }
+    return true;
+}
+
+/* Runs the even chunks, then the odd ones (each phase in parallel), then
+ * merges energies, cracks and errors in chunk order. */
+static sx_status KERNEL(contacts)(sx_model *m)
+{
+    const int64_t nchunk = m->nchunk;
+#pragma omp parallel num_threads(m->threads) if (nchunk > 2)
+    for (int64_t phase = 0; phase < 2; phase++) {
+#pragma omp for schedule(static)
+        for (int64_t c = phase; c < nchunk; c += 2) ball_chunk(m, &m->chunks[c]);
+    }
+    for (int64_t c = 0; c < nchunk; c++) {
+        sx_chunk *o = &m->chunks[c];
+        if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+        m->acc.slip += o->slip;
+        m->acc.viscous += o->viscous;
+        m->acc.bond_released += o->released;
+        m->bonds.intact -= o->lost_bonds;
+        for (int64_t e = 0; e < o->ncracks; e++) sx__crack_log(m, &o->cracks[e]);
+    }
+    return SX_OK;
+}

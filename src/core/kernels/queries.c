@@ -1,0 +1,138 @@
+/* Queries: energies and the contact list (entry points KERNEL(energy),
+ * KERNEL(each_contact), KERNEL(count_contacts)); they read the model and
+ * change nothing: a pair's law is mixed from the materials as they are
+ * (sx__pair_law), not read from the step's table, which may be stale. Part of the per-dimension unit kernels.c, which includes
+ * it; not compiled alone. */
+
+/* Geometry of a stored ball-ball pair: overlap and unit normal. */
+static double pair_geometry(const sx_model *m, int64_t i, int64_t j, double *n)
+{
+    const sx_balls *B = &m->balls;
+    for (int k = 0; k < D; k++) n[k] = B->x[j * D + k] - B->x[i * D + k];
+    const double d = sqrt(dot(n, n));
+    for (int k = 0; k < D; k++) n[k] = d > 0 ? n[k] / d : 0;
+    return B->rad[i] + B->rad[j] - d;
+}
+
+/* Normal force and stiffnesses of a stored ball-ball pair from its geometry. */
+static double pair_force(const sx_model *m, int64_t c, double un, double *kn, double *ks)
+{
+    const sx_balls *B = &m->balls;
+    const int64_t i = m->bb.a[c], j = m->bb.b[c];
+    const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
+    const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+    const bool active = un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT));
+    const double rsum = B->rad[i] + B->rad[j];
+    const double fn = stiffness(&law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, kn, ks);
+    return active ? fn : 0;
+}
+
+static void KERNEL(energy)(const sx_model *m, sx_energy *e)
+{
+    const sx_balls *B = &m->balls;
+    *e = m->acc;
+    e->kinetic = e->gravitational = e->strain = e->bond_strain = 0;
+    for (int64_t i = 0; i < B->n; i++) {
+        if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once, below */
+        const double *v = B->v + i * D, *w = B->w + i * RD;
+        double ww = 0;
+        for (int k = 0; k < RD; k++) ww += w[k] * w[k];
+        e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
+        e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
+    }
+    if (m->clumps) sx__clumps_energy(m, e);
+    /* every overlap stores normal strain, even one no step has seen yet;
+     * the shear spring only once the contact has history */
+    const double zero[D] = {0};
+    for (int64_t c = 0; c < m->bb.n; c++) {
+        double n[D], kn, ks;
+        const int64_t i = m->bb.a[c], j = m->bb.b[c];
+        const double un = pair_geometry(m, i, j, n);
+        const double fn = pair_force(m, c, un, &kn, &ks);
+        const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
+        e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
+        const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
+    }
+    for (int64_t c = 0; c < m->bw.n; c++) {
+        double n[D], kn, ks;
+        const int64_t i = m->bw.a[c];
+        const sx_wall *wl = &m->walls[m->bw.b[c]];
+        const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
+        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
+        const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
+        if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
+    }
+}
+
+/* Contacts are reported as the last force evaluation left them (the forces
+ * the balls felt): normal, overlap (a ball-ball one from the evaluation's
+ * centre distance and the current radii), normal force (with its dashpot),
+ * the elastic shear force and the bonds; the point is placed from ball a's
+ * current centre. */
+static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall,
+                   bool (*fn)(const sx_contact_info *, void *), void *ud)
+{
+    const sx_balls *B = &m->balls;
+    const int64_t i = p->a[c];
+    double n[D], un;
+    if (is_wall) {
+        for (int k = 0; k < D; k++) n[k] = p->geo[c * D + k];
+        un = p->un[c];
+    } else { /* the normal and overlap of the relative position, as the step computed them */
+        const double *rel = p->geo + c * D, d = sqrt(dot(rel, rel)), inv_d = 1.0 / d;
+        for (int k = 0; k < D; k++) n[k] = rel[k] * inv_d;
+        un = B->rad[i] + B->rad[p->b[c]] - d;
+    }
+    sx_contact_info ci;
+    memset(&ci, 0, sizeof ci);
+    const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])
+                                    : sx__pair_law(m, B->mat[i], B->mat[p->b[c]]);
+    const double rj = is_wall ? B->rad[i] : B->rad[p->b[c]];
+    stiffness(&law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
+    /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
+    const double arm = is_wall ? -(B->rad[i] - 0.5 * un) : B->rad[i] - 0.5 * un;
+    for (int k = 0; k < D; k++) {
+        ci.normal[k] = n[k];
+        ci.point[k] = B->x[i * D + k] + arm * n[k];
+        ci.shear[k] = p->fs[c * D + k];
+    }
+    ci.overlap = un;
+    ci.fn = p->fn[c];
+    ci.a = B->id[i];
+    ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
+    ci.is_wall = is_wall;
+    const int32_t slot = !is_wall && p->bond ? p->bond[c] - 1 : -1;
+    if (slot >= 0) {
+        const sx_bonds *b = &m->bonds;
+        ci.bond = b->kind[slot];
+        if (b->kind[slot] & SX_BOND_PARALLEL) {
+            ci.pb_fn = b->fn[slot];
+            ci.pb_radius = b->rbar[slot];
+            for (int k = 0; k < D; k++) ci.pb_fs[k] = b->fs[slot * D + k];
+#if D == 3
+            for (int k = 0; k < 3; k++) ci.pb_moment[k] = b->mn[slot] * n[k] + b->ms[slot * 3 + k];
+#else
+            ci.pb_moment[0] = b->ms[slot];
+#endif
+        }
+    }
+    return fn(&ci, ud);
+}
+
+static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
+{
+    for (int64_t c = 0; c < m->bb.n; c++)
+        if (m->bb.touching[c] && !report(m, &m->bb, c, false, fn, ud)) return false;
+    for (int64_t c = 0; c < m->bw.n; c++)
+        if (m->bw.touching[c] && !report(m, &m->bw, c, true, fn, ud)) return false;
+    return true;
+}
+
+static int64_t KERNEL(count_contacts)(const sx_model *m)
+{
+    int64_t n = 0;
+    for (int64_t c = 0; c < m->bb.n; c++) n += m->bb.touching[c];
+    for (int64_t c = 0; c < m->bw.n; c++) n += m->bw.touching[c];
+    return n;
+}

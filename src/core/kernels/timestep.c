@@ -1,0 +1,114 @@
+/* Stage: the critical timestep (entry point KERNEL(critical_dt)). Part of
+ * the per-dimension unit kernels.c, which includes it; not compiled alone. */
+
+/* -------------------------------------------------------------- timestep */
+
+/* Hertz has no stiffness at zero overlap: a free Hertz ball is rated at the
+ * tangent stiffness of this overlap, a fraction of its radius. */
+#define HERTZ_REFERENCE_OVERLAP 0.01
+
+/* PFC-style estimate: for each ball sqrt(m / k_tran) with k_tran the sum of
+ * its contacts' (tangent) normal and shear stiffnesses, bonds included, and
+ * sqrt(I / k_rot) with k_rot = sum ks l^2 plus the bonds' rotational
+ * stiffness. A ball is never rated below its own stiffness (as if touching
+ * one entity like itself), so the first impact is already resolved and the
+ * timestep does not jump as contacts form. */
+static double KERNEL(critical_dt)(sx_model *m)
+{
+    sx_balls *B = &m->balls;
+    const int64_t n = B->n;
+    if (n == 0) return INFINITY;
+    double *kt = sx__scratch(m, 4 * n);
+    if (!kt) return INFINITY;
+    double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
+    memset(kt, 0, (size_t)(4 * n) * sizeof(double));
+    const sx_pairs *p = &m->bb;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int64_t i = p->a[c], j = p->b[c];
+        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
+        double dx[D];
+        for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
+        const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
+        const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
+        double ktr = 0, krot_i = 0, krot_j = 0;
+        if (un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT))) {
+            double kn, ks;
+            stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
+            if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
+                const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
+                const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
+                ct[i] += cn + cs, ct[j] += cn + cs;
+                cr[i] += cs * B->rad[i] * B->rad[i], cr[j] += cs * B->rad[j] * B->rad[j];
+            }
+            kn *= sx__law(law->law)->tangent; /* 4-29 */
+            ktr = kn + ks;
+            krot_i = ks * B->rad[i] * B->rad[i];
+            krot_j = ks * B->rad[j] * B->rad[j];
+        }
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) {
+            const sx_bonds *b = &m->bonds;
+            double area, inertia, polar;
+            pb_section(b->rbar[slot], &area, &inertia, &polar);
+            ktr += (b->kn[slot] + b->ks[slot]) * area;
+            const double krb = b->kn[slot] * inertia + b->ks[slot] * polar;
+            krot_i += krb + b->ks[slot] * area * B->rad[i] * B->rad[i];
+            krot_j += krb + b->ks[slot] * area * B->rad[j] * B->rad[j];
+        }
+        kt[i] += ktr;
+        kt[j] += ktr;
+        kr[i] += krot_i;
+        kr[j] += krot_j;
+    }
+    p = &m->bw;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int64_t i = p->a[c];
+        double nrm[D];
+        const double un = B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
+        if (un <= 0) continue;
+        const sx_pair_law law = sx__wall_law(m, B->mat[i], &m->walls[p->b[c]]);
+        double kn, ks;
+        stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
+        if (law.beta_n > 0 || law.beta_s > 0) {
+            const double mass = 1.0 / B->inv_mass[i];
+            const double cs = 2 * law.beta_s * sqrt(mass * ks);
+            ct[i] += 2 * law.beta_n * sqrt(mass * kn) + cs;
+            cr[i] += cs * B->rad[i] * B->rad[i];
+        }
+        kn *= sx__law(law.law)->tangent;
+        kt[i] += kn + ks;
+        kr[i] += ks * B->rad[i] * B->rad[i];
+    }
+    double best = INFINITY;
+    for (int64_t i = 0; i < n; i++) {
+        /* the ball's own rating: a contact with an entity of its own stiffness */
+        const sx_pair_law *self = &m->law[B->mat[i] * m->law_n + B->mat[i]];
+        const double r = B->rad[i];
+        double kn, ks;
+        stiffness(self, r, r, r, HERTZ_REFERENCE_OVERLAP * r, &kn, &ks);
+        const sx_law *own = sx__law(self->law);
+        kn *= own->tangent;
+        if (own->series) kn *= 2, ks *= 2; /* undo the series combination with itself */
+        const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
+        const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
+        if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
+            kt[i] = ktr, kr[i] = krot;
+            continue;
+        }
+        /* Contact dashpots lower the stable timestep of the central differences: for
+         * m x'' + c x' + k x = 0 with x' taken at the half step, stability needs
+         * (w dt)^2 + 4 z (w dt) < 4, i.e. dt < (2/w)(sqrt(1 + z^2) - z), z = c / (2 sqrt(k m));
+         * local damping scales a decelerating force by up to (1 + alpha), so z is scaled too. */
+        const double amp = 1 + sx__ball_damping(m, i);
+        const double zt = amp * ct[i] / (2 * sqrt(ktr / B->inv_mass[i]));
+        const double dtt = sqrt(1.0 / (B->inv_mass[i] * ktr)) * (sqrt(1 + zt * zt) - zt);
+        if (dtt < best) best = dtt;
+        if (krot > 0) {
+            const double zr = amp * cr[i] / (2 * sqrt(krot / B->inv_inertia[i]));
+            const double dtr = sqrt(1.0 / (B->inv_inertia[i] * krot)) * (sqrt(1 + zr * zr) - zr);
+            if (dtr < best) best = dtr;
+        }
+    }
+    if (m->clumps) best = fmin(best, sx__clumps_critical_dt(m, kt, kr, ct, cr)); /* reads the sums above */
+    sx__scratch_release(m);
+    return best;
+}

@@ -1,0 +1,349 @@
+/* Stage: the ball-wall contacts (entry point KERNEL(walls)). Part of the
+ * per-dimension unit kernels.c, which includes it; not compiled alone. */
+
+/* The wall pass of one block: the block's ball-wall contacts, after the
+ * ball-ball pass. The wall is entity A (phi1 of 4-10), the ball B; n
+ * points from the wall to the ball. Wall resultants go to the block's
+ * partial sums acc (one per wall). */
+
+/* The dashpot factor of the last contact that needed one (balls of one
+ * size and material share it). */
+typedef struct dash_memo {
+    double dash, im, cn;
+} dash_memo;
+
+/* One ball-wall contact c, every law and wall kind; false on an overlap error. */
+static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c, dash_memo *memo)
+{
+    sx_balls *B = &m->balls;
+    double *restrict f = B->f, *restrict t = B->t;
+    sx_pairs *p = &m->bw;
+    const double dt = motion_dt(m);
+    const bool track = m->track_energy;
+    const int64_t i = p->a[c];
+    const sx_wall *wl = &m->walls[p->b[c]];
+    sx_wall_acc *wa = &acc[p->b[c]];
+    const double *xi = B->x + i * D, r = B->rad[i];
+    double *fs = p->fs + c * D;
+    double n[D];
+    const double dist = wall_distance(wl, xi, n);
+    const sx_pair_law *law = &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
+    if (dist >= r) {
+        if (p->touching[c] && track) { /* a Hertz spring holds nothing at zero overlap: ks = 0 */
+            double kn, ks;
+            stiffness(law, r, 0, r, 0, &kn, &ks);
+            if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+        }
+        p->touching[c] = 0;
+        return true;
+    }
+    const double un = r - dist; /* 4-3 */
+    if (un > r) {
+        o->st = SX_EUNSTABLE;
+        o->err_ball = B->id[i], o->err_wall = wl->id, o->err_un = un, o->err_r = r;
+        return false;
+    }
+    const double lb = r - 0.5 * un;
+    double xc[D];
+    for (int k = 0; k < D; k++) xc[k] = xi[k] - lb * n[k]; /* 4-4 */
+    /* the contact point's velocity: the ball's, with its arm -lb n, less the
+     * wall's surface velocity (its translation, and a cylinder's radial
+     * motion along -n) */
+    double wn[D], vc[D];
+    spin_cross(B->w + i * RD, n, wn);
+    for (int k = 0; k < D; k++)
+        vc[k] = (B->v[i * D + k] - lb * wn[k]) - (wl->def.vel[k] - wl->def.radial_vel * n[k]);
+    const double vn = dot(vc, n);
+    double vs[D];
+    for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
+
+    double kn, ks;
+    const double fn = stiffness(law, r, 0, r, un, &kn, &ks);
+    if (!p->touching[c])
+        for (int k = 0; k < D; k++) fs[k] = 0, p->geo[c * D + k] = n[k];
+    carry rot;
+    carry_make(&rot, p->geo + c * D, n, NULL, B->w + i * RD, dt);
+    carry_apply(&rot, fs);
+    double f0[D];
+    for (int k = 0; k < D; k++) f0[k] = fs[k];
+    const double ksdt = ks * dt;
+    for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k];
+    const double fmax = law->mu * fn, f2 = dot(fs, fs);
+    bool slip = false;
+    if (f2 > fmax * fmax) {
+        const double sc = fmax / sqrt(f2);
+        if (track && ks > 0) { /* as for ball-ball contacts */
+            double e = 0;
+            for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
+            o->slip += 0.5 * e / ks;
+        }
+        for (int k = 0; k < D; k++) fs[k] *= sc;
+        slip = true;
+    }
+    for (int k = 0; k < D; k++) p->geo[c * D + k] = n[k];
+    p->touching[c] = 1;
+
+    double fd = fn, dsh[D], F[D];
+    bool shear_dashpot = false;
+    if (law->beta_n > 0 || law->beta_s > 0) {
+        /* the ball's full mass: c = 2 beta sqrt(m k); balls of one size and material share it */
+        double cn;
+        if (!law->plain) {
+            cn = 2 * law->beta_n * sqrt(kn / B->inv_mass[i]);
+        } else if (law->dash_n == memo->dash && B->inv_mass[i] == memo->im) {
+            cn = memo->cn;
+        } else {
+            cn = sqrt(law->dash_n / B->inv_mass[i]);
+            memo->dash = law->dash_n, memo->im = B->inv_mass[i], memo->cn = cn;
+        }
+        const double fdn = -cn * vn;
+        fd += fdn;
+        double work = fdn * vn;
+        if (!slip && law->beta_s > 0) {
+            const double cs = 2 * law->beta_s * sqrt(ks / B->inv_mass[i]);
+            for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
+            work += dot(dsh, vs);
+            shear_dashpot = true;
+        }
+        if (track) o->viscous -= work * dt;
+    }
+    for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k];
+    if (shear_dashpot)
+        for (int k = 0; k < D; k++) F[k] += dsh[k];
+    p->un[c] = un;
+    p->fn[c] = fd;
+    wa->load += fd;
+    wa->kn_sum += kn;
+    wa->contacts++;
+    /* 4-21: the ball's arm is -lb n */
+    double nf[RD], mw[RD], arm[D];
+    moment_of(n, F, nf);
+    for (int k = 0; k < D; k++) {
+        f[i * D + k] += F[k];
+        wa->force[k] -= F[k];
+        arm[k] = xc[k] - wl->def.point[k];
+    }
+#if D == 3
+    if (wl->def.kind == SX_WALL_RECT)
+        for (int k = 0; k < D; k++) arm[k] -= 0.5 * (wl->def.edge1[k] + wl->def.edge2[k]);
+#endif
+    moment_of(arm, F, mw);
+    for (int k = 0; k < RD; k++) {
+        t[i * RD + k] -= lb * nf[k];
+        wa->moment[k] -= mw[k];
+    }
+    return true;
+}
+
+/* Four ball-wall contacts [c0, c0 + 4) at once where each is plain (an
+ * infinite wall, a linear law without a shear dashpot, no energy
+ * tracking): wall_contact's arithmetic in vector lanes, as
+ * ball_chunk_batched does it for ball-ball pairs, then the results in
+ * contact order; the same bits. false on an overlap error. */
+/* GCC 12 takes a vector built from four scalars straight into an array
+ * element for a read of the element's old value (-Wmaybe-uninitialized);
+ * every element here is written before it is read. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+static inline __attribute__((always_inline)) bool wall_lanes(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, dash_memo *memo)
+{
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bw;
+    const double dt = motion_dt(m);
+    int64_t i[LANES];
+    const sx_wall *wl[LANES];
+    const sx_pair_law *law[LANES];
+    for (int q = 0; q < LANES; q++) {
+        i[q] = p->a[c0 + q];
+        wl[q] = &m->walls[p->b[c0 + q]];
+        law[q] = &m->wlaw[B->mat[i[q]] * m->nwall + p->b[c0 + q]];
+    }
+#define WALL_LANES(field) ((vd){wl[0]->def.field, wl[1]->def.field, wl[2]->def.field, wl[3]->def.field})
+#define LAW_LANES(field) ((vd){law[0]->field, law[1]->field, law[2]->field, law[3]->field})
+    vd x[D], v[D], pt[D], n[D], vel[D];
+    for (int k = 0; k < D; k++) {
+        x[k] = LANES_OF(B->x, i, D, k);
+        v[k] = LANES_OF(B->v, i, D, k);
+        pt[k] = WALL_LANES(point[k]);
+        n[k] = WALL_LANES(normal[k]);
+        vel[k] = WALL_LANES(vel[k]);
+    }
+    const vd rvel = WALL_LANES(radial_vel);
+    const vd rad = LANES_OF(B->rad, i, 1, 0), im = LANES_OF(B->inv_mass, i, 1, 0);
+    const vd kn = LAW_LANES(kn), ks = LAW_LANES(ks), mu = LAW_LANES(mu), dash = LAW_LANES(dash_n),
+             bn = LAW_LANES(beta_n);
+#undef WALL_LANES
+#undef LAW_LANES
+    vd fs_old[D], no_old[D];
+    load_lanes(p->fs + c0 * D, fs_old);
+    load_lanes(p->geo + c0 * D, no_old);
+    v4u8 touched;
+    memcpy(&touched, p->touching + c0, sizeof touched);
+    const vm had = __builtin_convertvector(touched, vm) != 0;
+
+    /* the distance from an infinite wall (sums from zero, as dot()) */
+    vd dist = VZERO;
+    for (int k = 0; k < D; k++) dist += (x[k] - pt[k]) * n[k];
+    const vm live = dist < rad;
+    const vd un = rad - dist; /* 4-3 */
+    const vm bad = live & (un > rad);
+    if (VANY(bad))
+        for (int q = 0; q < LANES; q++)
+            if (bad[q]) {
+                o->st = SX_EUNSTABLE;
+                o->err_ball = B->id[i[q]], o->err_wall = wl[q]->id, o->err_un = un[q], o->err_r = rad[q];
+                return false;
+            }
+    const vd lb = rad - 0.5 * un;
+    vd xc[D], wn[D], vc[D];
+    for (int k = 0; k < D; k++) xc[k] = x[k] - lb * n[k]; /* 4-4 */
+#if D == 3
+    vd w[3];
+    for (int k = 0; k < 3; k++) w[k] = LANES_OF(B->w, i, 3, k);
+    wn[0] = w[1] * n[2] - w[2] * n[1];
+    wn[1] = w[2] * n[0] - w[0] * n[2];
+    wn[2] = w[0] * n[1] - w[1] * n[0];
+#else
+    const vd w0 = LANES_OF(B->w, i, 1, 0);
+    wn[0] = -w0 * n[1];
+    wn[1] = w0 * n[0];
+#endif
+    for (int k = 0; k < D; k++) vc[k] = (v[k] - lb * wn[k]) - (vel[k] - rvel * n[k]);
+    vd vn = VZERO;
+    for (int k = 0; k < D; k++) vn += vc[k] * n[k];
+    vd vs[D];
+    for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
+    const vd fn = kn * un, fmax = mu * fn; /* 4-6 */
+    /* the shear force (the wall does not spin) */
+    vd g[D];
+#if D == 3
+    shear_lanes(g, fs_old, no_old, &had, n, w, vs, &ks, &fmax, dt);
+#else
+    shear_lanes(g, fs_old, no_old, &had, n, NULL, vs, &ks, &fmax, dt);
+#endif
+    /* the ball's full mass: c = 2 beta sqrt(m k) */
+    vd cn = VZERO + memo->cn;
+    const vm other = (im != memo->im) | (dash != memo->dash);
+    if (VANY(other)) {
+        cn = VSQRT(dash / im);
+        memo->dash = dash[0], memo->im = im[0], memo->cn = cn[0];
+    }
+    const vd fd = VSEL(bn > VZERO, fn + -cn * vn, fn);
+    vd F[D], nf[RD], mw[RD], arm[D];
+    for (int k = 0; k < D; k++) {
+        F[k] = fd * n[k] + g[k];
+        arm[k] = xc[k] - pt[k];
+    }
+    /* 4-21: the ball's arm is -lb n */
+#if D == 3
+    nf[0] = n[1] * F[2] - n[2] * F[1], nf[1] = n[2] * F[0] - n[0] * F[2], nf[2] = n[0] * F[1] - n[1] * F[0];
+    mw[0] = arm[1] * F[2] - arm[2] * F[1], mw[1] = arm[2] * F[0] - arm[0] * F[2], mw[2] = arm[0] * F[1] - arm[1] * F[0];
+#else
+    nf[0] = n[0] * F[1] - n[1] * F[0];
+    mw[0] = arm[0] * F[1] - arm[1] * F[0];
+#endif
+    double *restrict f = B->f, *restrict t = B->t;
+    for (int q = 0; q < LANES; q++) {
+        const int64_t c = c0 + q;
+        if (!live[q]) {
+            p->touching[c] = 0;
+            continue;
+        }
+        sx_wall_acc *wa = &acc[p->b[c]];
+        for (int k = 0; k < D; k++) p->fs[c * D + k] = g[k][q], p->geo[c * D + k] = n[k][q];
+        p->touching[c] = 1;
+        p->un[c] = un[q];
+        p->fn[c] = fd[q];
+        wa->load += fd[q];
+        wa->kn_sum += kn[q];
+        wa->contacts++;
+        for (int k = 0; k < D; k++) {
+            f[i[q] * D + k] += F[k][q];
+            wa->force[k] -= F[k][q];
+        }
+        for (int k = 0; k < RD; k++) {
+            t[i[q] * RD + k] -= lb[q] * nf[k][q];
+            wa->moment[k] -= mw[k][q];
+        }
+    }
+    return true;
+}
+
+#pragma GCC diagnostic pop
+
+/* A contact wall_lanes takes. */
+static inline bool plain_wall_contact(const sx_model *m, int64_t c)
+{
+    const sx_wall *wl = &m->walls[m->bw.b[c]];
+    const sx_pair_law *law = &m->wlaw[m->balls.mat[m->bw.a[c]] * m->nwall + m->bw.b[c]];
+    return (wl->def.kind == SX_WALL_PLANE || wl->def.kind == SX_WALL_LINE) && law->plain &&
+           law->beta_s == 0;
+}
+
+SX_VECTOR_CLONES static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *acc)
+{
+    if (m->nwall) memset(acc, 0, (size_t)m->nwall * sizeof *acc);
+    o->slip = o->viscous = 0;
+    o->st = SX_OK;
+    dash_memo memo = {NAN, NAN, 0};
+    for (int64_t c = o->w0; c < o->w1;) {
+        bool lanes = !m->track_energy && c + LANES <= o->w1;
+        for (int q = 0; q < LANES && lanes; q++) lanes = plain_wall_contact(m, c + q);
+        if (lanes) {
+            if (!wall_lanes(m, o, acc, c, &memo)) return;
+            c += LANES;
+        } else {
+            if (!wall_contact(m, o, acc, c, &memo)) return;
+            c++;
+        }
+    }
+}
+
+/* The wall pass over all blocks (in parallel), then the walls' resultants,
+ * energies and errors summed in block order. */
+static sx_status KERNEL(walls)(sx_model *m)
+{
+    const int64_t nw = m->nwall, nb = m->nblock;
+    /* the laws of each material against each wall, for this step */
+    if (m->nmat * nw > m->cap_wlaw) {
+        sx_pair_law *q = sx_alloc_resize(&m->alloc, m->wlaw, (size_t)m->cap_wlaw, (size_t)(m->nmat * nw), sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+        m->wlaw = q;
+        m->cap_wlaw = m->nmat * nw;
+    }
+    for (int a = 0; a < m->nmat; a++)
+        for (int64_t w = 0; w < nw; w++) m->wlaw[a * nw + w] = sx__wall_law(m, a, &m->walls[w]);
+    if (nb * nw > m->cap_wall_acc) {
+        sx_wall_acc *q = sx_alloc_resize(&m->alloc, m->wall_acc, (size_t)m->cap_wall_acc, (size_t)(nb * nw), sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+        m->wall_acc = q;
+        m->cap_wall_acc = nb * nw;
+    }
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
+    for (int64_t b = 0; b < nb; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
+    for (int64_t w = 0; w < nw; w++) {
+        sx_wall *wl = &m->walls[w];
+        memset(wl->force, 0, sizeof wl->force);
+        memset(wl->moment, 0, sizeof wl->moment);
+        wl->load = wl->kn_sum = 0;
+        wl->contacts = 0;
+    }
+    for (int64_t b = 0; b < nb; b++) {
+        const sx_block *o = &m->blocks[b];
+        if (o->st) return overlap_error(m, "ball and wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
+        m->acc.slip += o->slip;
+        m->acc.viscous += o->viscous;
+        for (int64_t w = 0; w < nw; w++) {
+            const sx_wall_acc *a = &m->wall_acc[b * nw + w];
+            sx_wall *wl = &m->walls[w];
+            for (int k = 0; k < 3; k++) wl->force[k] += a->force[k], wl->moment[k] += a->moment[k];
+            wl->load += a->load;
+            wl->kn_sum += a->kn_sum;
+            wl->contacts += a->contacts;
+        }
+    }
+    if (m->track_energy) /* boundary work of the moving walls over this step */
+        for (int64_t w = 0; w < nw; w++)
+            m->acc.boundary_work -= (dot(m->walls[w].force, m->walls[w].def.vel) + m->walls[w].def.radial_vel * m->walls[w].load) * m->dt;
+    return SX_OK;
+}
