@@ -6,7 +6,8 @@
  * table of user values per ball, dropped when the ball is removed. */
 #include "bindings.h"
 
-const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras"};
+static const char *const ball_shown[] = {"pos", "radius", "vel", "material", "group", NULL};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras", ball_shown};
 #define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */

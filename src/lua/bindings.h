@@ -64,6 +64,8 @@ typedef struct sx_lua_model {
     int callback;  ///< depth of user callbacks being run (removals are queued while > 0)
 } sx_lua_model;
 
+/// seixo.models() -> {model, ...}: the open models, in order of creation.
+int sx_lua_models(lua_State *L);
 /// seixo.model{...}: the constructor.
 int sx_lua_model_new(lua_State *L);
 /// Creates the model class with the methods of every array in `sets`
@@ -282,6 +284,7 @@ typedef struct sx_lua_kind {
     const char *name;                           ///< its name in messages, "ball"
     bool (*exists)(const sx_model *, int64_t);  ///< whether an id is live
     const char *extras;                         ///< the model state's table of user extras, by id
+    const char *const *shown;                   ///< the fields print(x) shows (NULL-terminated)
 } sx_lua_kind;
 
 /// Pushes a handle for the object `id` of the model userdata at `model`.
@@ -293,7 +296,8 @@ sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_
 /// id, at idx into *id: returns NULL, or pushes and returns what is wrong (a
 /// handle of another model is refused, not read as a plain id).
 const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id);
-/// __tostring of a handle: "seixo.ball 7", with "(removed)" or "(model closed)".
+/// __tostring of a handle: "seixo.ball 7 {pos = {0, 0, 0.1}, radius = 0.001, ...}"
+/// (the kind's shown fields), or "seixo.ball 7 (removed)" / "(model closed)".
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.
 int sx_lua_handle_eq(lua_State *L);

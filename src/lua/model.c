@@ -55,6 +55,50 @@ int sx_lua_material_arg(lua_State *L, const sx_model *m, int arg, const char *ke
     return 0;
 }
 
+/* The models of the session, for seixo.models(): a table with weak values
+ * in the registry, keyed by creation number, so listing never keeps a
+ * model alive. */
+static const char models_key[] = "seixo.models";
+
+static void push_model_list(lua_State *L)
+{
+    if (luaL_getsubtable(L, LUA_REGISTRYINDEX, models_key)) return;
+    lua_createtable(L, 0, 1);
+    lua_pushliteral(L, "v");
+    lua_setfield(L, -2, "__mode");
+    lua_setmetatable(L, -2);
+}
+
+static void list_model(lua_State *L, int model)
+{
+    push_model_list(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    const lua_Integer n = lua_tointeger(L, -1) + 1;
+    lua_pop(L, 1);
+    lua_pushinteger(L, n);
+    lua_setfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    lua_pushvalue(L, model);
+    lua_rawseti(L, -2, n);
+    lua_pop(L, 1);
+}
+
+int sx_lua_models(lua_State *L)
+{
+    push_model_list(L);
+    const int list = lua_gettop(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    const lua_Integer made = lua_tointeger(L, -1);
+    lua_newtable(L);
+    lua_Integer k = 0;
+    for (lua_Integer i = 1; i <= made; i++) {
+        if (lua_rawgeti(L, list, i) == LUA_TUSERDATA && sx_lua_tomodel(L, -1))
+            lua_rawseti(L, -2, ++k);
+        else
+            lua_pop(L, 1);
+    }
+    return 1;
+}
+
 int sx_lua_model_new(lua_State *L)
 {
     static const char *const keys[] = {"dim", "gravity", "timestep", "timestep_safety", "skin", NULL};
@@ -79,6 +123,7 @@ int sx_lua_model_new(lua_State *L)
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
+    list_model(L, lua_gettop(L));
     /* the executable's --threads N (seixo.threads); results do not depend on it */
     if (lua_getglobal(L, "seixo") == LUA_TTABLE) {
         lua_getfield(L, -1, "threads");

@@ -37,7 +37,8 @@ static const struct shape {
     [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
 };
 
-const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras"};
+static const char *const wall_shown[] = {"kind", "point", "normal", "vel", "force", NULL};
+const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras", wall_shown};
 #define wall_kind sx_lua_wall_kind
 
 /* The wall of the handle at index 1: live, in an open model. */

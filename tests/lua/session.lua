@@ -1,0 +1,151 @@
+-- A new user's first session: the REPL and -i keep a chunk's top-level
+-- locals, seixo.models() lists the open models, objects print what they
+-- are, tables print readably, a typo is answered with the name meant,
+-- help() covers seixo.lab, a callback's error names the callback and the
+-- step, and progress written to a log is plain lines.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, raises = T.test, T.check, T.eq, T.raises
+local HERE = debug.getinfo(1, "S").short_src
+
+local function tmpfile(text)
+  local path = os.tmpname()
+  local f = assert(io.open(path, "w"))
+  f:write(text)
+  f:close()
+  return path
+end
+
+test("-i: the script's top-level locals are globals of the session", function()
+  local script = tmpfile([[
+local m = seixo.model{dim = 2}
+local n = 42
+m:material("a")
+local function helper() local hidden = 1 return hidden end
+helper()
+]])
+  local status, out = T.run("-i " .. T.quote(script), "print(n, m:dim(), type(helper), hidden)\n")
+  os.remove(script)
+  eq(status, 0, out)
+  eq(out, "42\t2\tfunction\tnil\n")
+  -- without -i nothing is copied: the script's locals stay local
+  status, out = T.run("-e " .. T.quote("local z = 1") .. " -e 'print(z)'")
+  eq(out, "nil\n")
+end)
+
+test("the REPL keeps a line's locals for the next lines", function()
+  local status, out = T.run("-i", "local m = seixo.model{dim = 2}\nlocal a, b = 1, 2\nprint(m:dim(), a + b)\n")
+  eq(status, 0, out)
+  eq(out, "2\t3\n")
+  -- a line that fails keeps nothing
+  status, out = T.run("-i", "local q = 5; error('no')\nprint(q)\n")
+  check(out:find("no\nnil\n", 1, true), out)
+end)
+
+test("seixo.models() lists the open models in order", function()
+  local before = #seixo.models()
+  local a = seixo.model{dim = 2}
+  local b = seixo.model{dim = 3}
+  local list = seixo.models()
+  eq(#list, before + 2)
+  check(rawequal(list[#list - 1], a) and rawequal(list[#list], b))
+  a:close()
+  list = seixo.models()
+  eq(#list, before + 1)
+  check(rawequal(list[#list], b))
+  b:close()
+end)
+
+test("objects print what they are", function()
+  local m = seixo.model{dim = 3}
+  m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  local b = m:ball{pos = {0, 0, 0.5e-3}, radius = 1e-3, group = "top"}
+  eq(tostring(b), "seixo.ball 1 {pos = {0, 0, 0.0005}, radius = 0.001, vel = {0, 0, 0}, material = glass, group = top}")
+  local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  eq(tostring(w), "seixo.wall 1 {kind = plane, point = {0, 0, 0}, normal = {0, 0, 1}, vel = {0, 0, 0}, force = {0, 0, 0}}")
+  m:cycle(1)
+  for c in m:contacts() do check(tostring(c):find("^seixo.contact ball 1 %- wall 1 %(fn [%d.e-]+ N")) end
+  m:clump_template("pair", {{-1e-3, 0, 0, 1e-3}, {1e-3, 0, 0, 1e-3}})
+  local cl = m:clump{template = "pair", pos = {0, 0, 0.01}}
+  check(tostring(cl):find("^seixo.clump 1 {pos = {0, 0, 0.01}, mass = [%d.e-]+, vel = {0, 0, 0}, template = pair}$"), tostring(cl))
+  b:remove()
+  eq(tostring(b), "seixo.ball 1 (removed)")
+  m:close()
+  eq(tostring(w), "seixo.wall 1 (model closed)")
+end)
+
+test("the REPL prints tables of tables one entry a line, long arrays cut", function()
+  local status, out = T.run("-i", [[
+m = seixo.model{dim = 2, timestep = 1e-3}
+m:material("a", {density = 2000})
+m:materials()
+m:history("t", "time")
+m:cycle(20)
+m:history("t").steps
+]])
+  eq(status, 0, out)
+  check(out:find('{\n  a = {\n    damping = 0.0,\n    density = 2000.0,', 1, true), out)
+  check(out:find("{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, ... (20 entries)}", 1, true), out)
+end)
+
+test("a typo is answered with the name meant", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  local b = m:ball{pos = {0, 0}, radius = 1}
+  raises(function() return m:slove() end, "model has no field 'slove' (did you mean 'solve'?)")
+  raises(function() return b.radisu end, "ball has no field 'radisu' (did you mean 'radius'?)", "(fields: id, pos")
+  raises(function() b.raduis = 2 end, "ball has no writable field 'raduis' (did you mean 'radius'?)")
+  local err = raises(function() return m:frobnicate() end, "model has no field 'frobnicate'", 'help("model")')
+  check(not err:find("did you mean", 1, true), err)
+  m:close()
+end)
+
+test("help covers seixo.lab", function()
+  local H = require("seixo.help")
+  local lab = require("seixo.lab")
+  local text = H.text(lab)
+  for _, name in ipairs{"triaxial", "ucs", "brazilian", "specimen", "series", "mohr_coulomb"} do
+    check(text:find("  " .. name .. " ", 1, true), text)
+  end
+  check(H.text(lab.ucs):find("^lab.ucs%(spec"), H.text(lab.ucs))
+  check(H.text("lab"):find("seixo.lab", 1, true))
+end)
+
+test("an error in a callback names the callback's file:line and the step", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  m:ball{pos = {0, 0}, radius = 1}
+  local line = debug.getinfo(1, "l").currentline + 1
+  m:on("cycle", function(mm) if mm:step() == 7 then error("boom") end end)
+  raises(function() m:cycle(10) end,
+         string.format("the callback defined at %s:%d failed at step 7: %s:%d: boom", HERE, line, HERE, line))
+  eq(m:step(), 7)
+  -- a history function too
+  local m2 = seixo.model{dim = 2, timestep = 1e-3}
+  m2:material("a")
+  line = debug.getinfo(1, "l").currentline + 1
+  m2:history("bad", function() return nil + 1 end)
+  raises(function() m2:cycle(1) end, string.format("the callback defined at %s:%d failed at step 1", HERE, line))
+  m:close()
+  m2:close()
+end)
+
+test("progress to a log: plain lines, no carriage return nor escape code", function()
+  local slow = [[
+    local m = seixo.model{dim = 2, timestep = 1e-4}
+    m:material("a")
+    m:ball{pos = {0, 0}, radius = 1}
+    m:on("cycle", function() local t = os.clock() while os.clock() - t < 0.01 do end end)
+    print(seixo.progress("log", 0.2))
+    m:solve{steps = 60}]]
+  local status, out = T.run("-e " .. T.quote(slow))
+  eq(status, 0, out)
+  check(out:find("^log\n"), out)  -- the executable's default when stderr is not a terminal
+  local lines = 0
+  for line in out:gmatch("seixo: m:solve: step %d+ of 60[^\n]*ETA %d+ s\n") do lines = lines + 1 end
+  check(lines >= 2, out)
+  check(not out:find("[\r\27]"), out)
+  raises(function() seixo.progress("yes") end, "boolean or 'log' expected")
+  raises(function() seixo.progress("log", -1) end, "seconds between log lines")
+end)
+
+T.done()
