@@ -227,6 +227,8 @@ local entries = {
   ["lab.series"] = {"lab.series(spec, {confining = {sigma3, ...}, out =, ...}) -> results",
     "A UCS and triaxial tests at each sigma3 [Pa], the Mohr-Coulomb fit of their peaks and the plots (out: a file prefix)."},
   ["lab.write_csv"] = {"lab.write_csv(path, header, rows)", "Writes rows (arrays of numbers) under a header to a CSV file, atomically."},
+  ["plot.live"] = {"plot.live(m, names[, {every = 1000, terminal =, output =, title =, x = 'step' | 'time', log =}]) -> plot",
+    "A gnuplot plot of histories of m, redrawn every `every` steps while m cycles (p:draw() now, p:close() stops it); the run's bits do not change."},
   ["lab.have_gnuplot"] = {"lab.have_gnuplot() -> bool", "Whether gnuplot can be run (the plots are skipped, with a note, if not)."},
 }
 H.entries = entries
@@ -264,7 +266,7 @@ local function name_of_function(fn)
       if f == fn then return "seixo." .. name end
     end
   end
-  for prefix, module in pairs{util = "seixo.util", lab = "seixo.lab"} do
+  for prefix, module in pairs{util = "seixo.util", lab = "seixo.lab", plot = "seixo.plot"} do
     for name, f in pairs(package.loaded[module] or {}) do
       if f == fn then return prefix .. "." .. name end
     end
@@ -326,7 +328,7 @@ seixo: a DEM simulator driven from Lua.
   print(m)
 help(m) lists the model's methods, help(b) a ball's fields, help("solve") one entry;
 help("util") the vector helpers of require "seixo.util", help("lab") the laboratory tests
-of require "seixo.lab". Top-level locals of a line, or of a script run with -i, stay
+of require "seixo.lab", help("plot") live plots of histories. Top-level locals of a line, or of a script run with -i, stay
 defined for the next lines; seixo.models() lists the open models.
 The full reference: docs/lua-api.md.]]
 
@@ -340,6 +342,7 @@ function H.text(x)
   if x == package.loaded.seixo then return listing("seixo:", members("seixo.")) end
   if x == package.loaded["seixo.util"] then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
   if x == package.loaded["seixo.lab"] then return listing("seixo.lab (require \"seixo.lab\"):", members("lab.")) end
+  if x == package.loaded["seixo.plot"] then return listing("seixo.plot (require \"seixo.plot\"):", members("plot.")) end
   local kind = class_of(x)
   if kind then return object_text(kind) end
   if type(x) ~= "string" then return "no help for a " .. type(x) .. "; try help()" end
@@ -348,6 +351,7 @@ function H.text(x)
   if x == "seixo" then return listing("seixo:", members("seixo.")) end
   if x == "util" then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
   if x == "lab" then return listing("seixo.lab (require \"seixo.lab\"):", members("lab.")) end
+  if x == "plot" then return listing("seixo.plot (require \"seixo.plot\"):", members("plot.")) end
   -- a bare name: every entry it ends
   local found = {}
   for name in pairs(entries) do

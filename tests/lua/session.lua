@@ -148,4 +148,37 @@ test("progress to a log: plain lines, no carriage return nor escape code", funct
   raises(function() seixo.progress("log", -1) end, "seconds between log lines")
 end)
 
+test("a live plot of histories is redrawn while the model cycles, and changes no bit", function()
+  local plot = require("seixo.plot")
+  local function run(with_plot, out)
+    local m = seixo.model{dim = 2, gravity = {0, -9.81}}
+    m:material("a", {density = 2000, kn = 1e6, ks = 1e6, damping = 0.7})
+    m:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
+    m:ball{pos = {0, 0.01}, radius = 0.005}
+    m:history("kinetic energy", "kinetic", {every = 10})
+    local p
+    if with_plot then p = plot.live(m, "kinetic energy", {every = 100, terminal = "dumb", output = out}) end
+    m:cycle(500)
+    local hash = m:hash()
+    if p then
+      eq(p.draws, 6)  -- at once, then at steps 100, ..., 500
+      check(tostring(p):find("seixo.plot of kinetic energy (6 draws)", 1, true), tostring(p))
+      p:close()
+      check(tostring(p):find("closed", 1, true))
+      raises(function() p:draw() end, "the plot has been closed")
+    end
+    m:cycle(100)  -- no refresh once closed
+    m:close()
+    return hash
+  end
+  local out = os.tmpname()
+  local with = run(true, out)
+  eq(with, run(false))
+  local text = assert(io.open(out)):read("a")
+  os.remove(out)
+  check(text:find("kinetic energy", 1, true) and text:find("step", 1, true), text)
+  raises(function() plot.live(seixo.model{dim = 2}, "nope") end, "no history named 'nope'")
+  raises(function() plot.live(seixo.model{dim = 2}, {}) end, "names of histories expected")
+end)
+
 T.done()
