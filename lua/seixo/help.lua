@@ -11,8 +11,8 @@ local H = {}
 -- name -> {signature, text}; units in brackets
 local entries = {
   -- the module
-  ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0}",
-    "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic."},
+  ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0, overlap_limit = 0.5}",
+    "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic; overlap_limit: the largest overlap a ball may be placed with, a fraction of its radius."},
   ["seixo.version"] = {"seixo.version", "The version string."},
   ["seixo.models"] = {"seixo.models() -> {model, ...}", "The open models, in the order they were made (a model no longer referenced may be collected)."},
   ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",

@@ -59,9 +59,11 @@ void sx_lua_io_register(lua_State *L);
 
 /// The model userdata. Its uservalue is the state table (sx_lua_state).
 typedef struct sx_lua_model {
-    sx_model *m;   ///< NULL once closed
-    int running;   ///< inside m:cycle / m:solve / a relaxation of m:generate
-    int callback;  ///< depth of user callbacks being run (removals are queued while > 0)
+    sx_model *m;           ///< NULL once closed
+    int running;           ///< inside m:cycle / m:solve / a relaxation of m:generate
+    int callback;          ///< depth of user callbacks being run (removals are queued while > 0)
+    double overlap_limit;  ///< seixo.model{overlap_limit}: the largest overlap placed, a fraction of the radius
+    bool unchecked;        ///< a ball or wall was added since the last placement check (geometry.c)
 } sx_lua_model;
 
 /// seixo.models() -> {model, ...}: the open models, in order of creation.
@@ -178,6 +180,20 @@ bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f
 /// Collects the ids of the balls that pass into a Lua-owned array pushed on
 /// the stack; returns it, its length in *n.
 int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
+
+/* ------------------------------------------------------ geometry.c */
+
+/// m:ball: a new ball at x of radius r behind a plane or line wall of the
+/// model userdata at `model`, or overlapping one beyond the limit, is an error.
+void sx_lua_check_ball_walls(lua_State *L, int model, const sx_model *m, const double *x, double r);
+/// After the first step since balls or walls were added: an overlap of the
+/// last step's contacts (of the balls as placed, when that step `failed`)
+/// beyond the limit is an error (of the Lua call `what`) naming the two
+/// entities. Clears ud->unchecked.
+void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
+/// Warns on stderr (once per model and `what`) when v != 0 lies outside
+/// [lo, hi] in magnitude, naming the unit expected.
+void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit);
 
 /* ----------------------------------------------------------- run.c */
 

@@ -101,8 +101,9 @@ int sx_lua_models(lua_State *L)
 
 int sx_lua_model_new(lua_State *L)
 {
-    static const char *const keys[] = {"dim", "gravity", "timestep", "timestep_safety", "skin", NULL};
+    static const char *const keys[] = {"dim", "gravity", "timestep", "timestep_safety", "skin", "overlap_limit", NULL};
     sx_model_def d = sx_model_default_def();
+    double overlap_limit = 0.5;
     if (!lua_isnoneornil(L, 1)) {
         sx_lua_checkkeys(L, 1, keys);
         double dim = d.dim;
@@ -113,10 +114,12 @@ int sx_lua_model_new(lua_State *L)
         sx_lua_optnumfield(L, 1, "timestep", &d.timestep);
         sx_lua_optnumfield(L, 1, "timestep_safety", &d.timestep_safety);
         sx_lua_optnumfield(L, 1, "skin", &d.skin);
+        sx_lua_optrangefield(L, 1, "overlap_limit", 0, 1, &overlap_limit);
     }
     /* the userdata first: if Lua runs out of memory, no model leaks */
     sx_lua_model *u = lua_newuserdatauv(L, sizeof *u, 1);
     memset(u, 0, sizeof *u);
+    u->overlap_limit = overlap_limit;
     luaL_setmetatable(L, SX_LUA_MODEL);
     lua_newtable(L);
     lua_setiuservalue(L, -2, 1);
@@ -296,6 +299,9 @@ static int model_material(lua_State *L)
         sx_lua_optnumfield(L, 3, "viscous_normal", &d.viscous_normal);
         sx_lua_optnumfield(L, 3, "viscous_shear", &d.viscous_shear);
         sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
+        sx_lua_check_range(L, 1, "density", d.density, 100, 3e4, "kg/m^3");
+        sx_lua_check_range(L, 1, "modulus", d.modulus, 1e5, 1e12, "Pa");
+        sx_lua_check_range(L, 1, "shear_modulus", d.shear_modulus, 1e5, 1e12, "Pa");
     }
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");

@@ -241,6 +241,8 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
     const sx_status st = sx_model_cycle(r->m, n);
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted)))
         luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
+    /* the first step since balls or walls were placed (run_model takes it alone) */
+    if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
     sx_lua_check(L, r->m, st, r->what);
 }
 
@@ -504,6 +506,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (k < n) n = k;
         }
         if (p->mode && p->chunk < n) n = p->chunk;
+        if (r->ud->unchecked) n = 1;  // a placement check follows the first step
         sx_lua_run_cycle(L, r, n);
         double fraction = -1;
         int64_t total = 0;

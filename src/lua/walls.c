@@ -266,6 +266,7 @@ static int model_wall(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
+    sx_lua_modelud(L, 1)->unchecked = true;  // a wall placed over balls is named after the next step
     const char *name = sx_lua_optstrfield(L, 2, "kind");
     if (!name) return luaL_argerror(L, 2, "field 'kind' is required");
     const int kind = sx_lua_find(name, kind_names);

@@ -181,4 +181,74 @@ test("a live plot of histories is redrawn while the model cycles, and changes no
   raises(function() plot.live(seixo.model{dim = 2}, {}) end, "names of histories expected")
 end)
 
+test("a ball placed behind a wall or overlapping one is an error naming the wall", function()
+  local m = seixo.model{dim = 3}
+  m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  raises(function() m:ball{pos = {0, 0, -1e-3}, radius = 1e-3} end, "m:ball: the ball of radius 0.001 m lies behind wall 1")
+  raises(function() m:ball{pos = {0, 0, 0.2e-3}, radius = 1e-3} end,
+         "would overlap wall 1 by 0.0008 m, 80% of its radius (more than the 50% of seixo.model{overlap_limit})")
+  eq(m:ball_count(), 0)
+  m:ball{pos = {0, 0, 0.6e-3}, radius = 1e-3}  -- 40%: accepted
+  -- the limit is the model's
+  local loose = seixo.model{dim = 3, overlap_limit = 0.9}
+  loose:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  loose:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  loose:ball{pos = {0, 0, 0.2e-3}, radius = 1e-3}
+  raises(function() seixo.model{overlap_limit = 2} end, "overlap_limit", "[0.0, 1.0]")
+  m:close()
+  loose:close()
+end)
+
+test("balls placed overlapping are named at the first step, not blamed on the timestep", function()
+  local function two(dx, opts)
+    local m = seixo.model(opts or {dim = 3})
+    m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+    m:ball{pos = {0, 0, 0}, radius = 1e-3}
+    m:ball{pos = {dx, 0, 0}, radius = 1e-3}
+    return m
+  end
+  -- 60 %: the step succeeds, its contacts show the overlap
+  local m = two(1.4e-3)
+  raises(function() m:cycle(10) end, "m:cycle: balls 1 and 2 overlap by 0.0006 m, 60% of the smaller radius 0.001 m",
+         "the timestep is not the cause")
+  eq(m:step(), 1)
+  -- 180 %: the first step fails as unstable; the placement is still what is named
+  m = two(0.2e-3)
+  local err = raises(function() m:solve{steps = 10} end, "m:solve: balls 1 and 2 overlap by 0.0018 m, 180%")
+  check(not err:find("lower the timestep", 1, true), err)
+  -- 40 %, or a looser limit: no error, and the same bits as with no check
+  m = two(1.6e-3)
+  m:cycle(50)
+  local h = m:hash()
+  m = two(1.6e-3, {dim = 3, overlap_limit = 1})
+  m:cycle(50)
+  eq(m:hash(), h)
+  -- a wall added over a placed ball
+  m = seixo.model{dim = 2}
+  m:material("a", {density = 2650, kn = 1e6, ks = 1e6})
+  m:ball{pos = {0, 0.5e-3}, radius = 1e-3}
+  m:wall{kind = "box", min = {-0.01, 1e-3}, max = {0.01, 0.02}}
+  raises(function() m:cycle(10) end, "ball 1 overlaps wall 3 by 0.0015 m, 150% of its radius 0.001 m (its centre is behind the wall)")
+end)
+
+test("values outside a material's physical range warn once, with the unit expected", function()
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 3}
+m:material("glass", {density = 2.5, kn = 1e5, ks = 1e5})
+m:material("glass2", {density = 2.6})
+m:material("rock", {modulus = 40, stiffness_ratio = 2})
+m:material("fine", {density = 2650, modulus = 40e9})
+w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+w:servo{target = 10, area = 1}
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("seixo: warning: (command line):2: density 2.5 is outside the range of rocks and grains, 100 ... 30000 kg/m^3 (seixo's unit is kg/m^3)", 1, true), out)
+  local _, count = out:gsub("density", "")
+  eq(count, 1, "once per model")
+  check(out:find("(command line):4: modulus 40 is outside the range of rocks and grains, 100000 ... 1e+12 Pa", 1, true), out)
+  check(out:find("(command line):7: servo target stress 10 is outside the range of rocks and grains, 1000 ... 1e+10 Pa (seixo's unit is Pa)", 1, true), out)
+  check(out:find("done\n$"), out)
+end)
+
 T.done()
