@@ -22,6 +22,7 @@
 -- the axial strain plus (dim - 1) lateral strains. In 2D (disks of unit
 -- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
 
+local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
 local lab = {}
 
 local pi = math.pi

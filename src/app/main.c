@@ -744,7 +744,7 @@ static bool has_library(const char *dir)
 
 /* The directory of the pure-Lua library: $SEIXO_LUA_PATH, else lua/ beside
  * the executable's directory (a build directory in the source tree) or the
- * installed share/seixo/lua, else the source tree the executable was built
+ * installed share/lua/5.4 (where a stock Lua finds it too), else the source tree the executable was built
  * from. Pushes it, or nil when none has a seixo/ directory. */
 static void push_library_dir(lua_State *L)
 {
@@ -759,7 +759,7 @@ static void push_library_dir(lua_State *L)
         exe[n] = 0;
         char *slash = strrchr(exe, '/');
         if (slash) *slash = 0;
-        const char *const rel[] = {"/../lua", "/../share/seixo/lua"};
+        const char *const rel[] = {"/../lua", "/../share/lua/5.4"};
         for (size_t i = 0; i < sizeof rel / sizeof *rel; i++) {
             const char *dir = lua_pushfstring(L, "%s%s", exe, rel[i]);
             if (has_library(dir)) return;
