@@ -11,11 +11,12 @@ local H = {}
 -- name -> {signature, text}; units in brackets
 local entries = {
   -- the module
-  ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0}",
-    "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic."},
+  ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0, overlap_limit = 0.5}",
+    "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic; overlap_limit: the largest overlap a ball may be placed with, a fraction of its radius."},
   ["seixo.version"] = {"seixo.version", "The version string."},
-  ["seixo.progress"] = {"seixo.progress([on]) -> was_on",
-    "The progress line of long cycles on stderr (steps, time, steps/s, ETA); on by default when stderr is a terminal."},
+  ["seixo.models"] = {"seixo.models() -> {model, ...}", "The open models, in the order they were made (a model no longer referenced may be collected)."},
+  ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",
+    "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},
   ["seixo.clock"] = {"seixo.clock() -> seconds", "Wall-clock seconds from a monotonic clock: the difference of two readings times a run."},
   ["seixo.threads"] = {"seixo.threads", "OpenMP threads for the step of each new model: --threads N (default 1); results do not depend on it."},
   ["help"] = {"help([x])", "Help on x: a function, an object (model, ball, wall, contact), or a name such as \"cycle\" or \"ball.pos\"."},
@@ -208,9 +209,27 @@ local entries = {
   ["util.dist"] = {"util.dist(a, b)", "|a - b|"},
   ["util.normalize"] = {"util.normalize(a)", "a / |a|"},
   ["util.lerp"] = {"util.lerp(a, b, t)", "a + t (b - a)"},
-  ["util.show"] = {"util.show(v[, depth]) -> text", "A readable text of any value, tables in full."},
+  ["util.show"] = {"util.show(v[, depth[, limit]]) -> text", "A readable text of any value: tables to depth levels (4), each cut after limit entries (none); the REPL prints tables with it."},
   ["util.print"] = {"util.print(...)", "Prints values with util.show."},
   ["util.read_csv"] = {"util.read_csv(path) -> {header, columns, rows}", "Reads a CSV written by m:history_csv."},
+
+  -- seixo.lab (lua/seixo/lab.lua)
+  ["lab.rock"] = {"lab.rock([over]) -> material", "Bonded-particle micro-parameters of a granite-like rock (Potyondy & Cundall 2004, seed 4.4), with the fields of over replacing the defaults."},
+  ["lab.specimen"] = {"lab.specimen{dim =, shape = 'cylinder' | 'prism' | 'disk', diameter =, height =, path =, material =, ...} -> spec",
+    "Material genesis of a bonded specimen (radius expansion, servo to an isotropic stress, bonds, relaxation, trimming), saved to path [m, Pa]."},
+  ["lab.open"] = {"lab.open(path) -> spec", "The specimen saved at path by lab.specimen."},
+  ["lab.triaxial"] = {"lab.triaxial(spec, {confining =, rate =, out =, ...}) -> result",
+    "A triaxial test at confining = sigma3 [Pa] held by servo-controlled walls (0: unconfined); returns peak [Pa], E [Pa], nu, cracks, curves."},
+  ["lab.ucs"] = {"lab.ucs(spec[, opts]) -> result", "The unconfined compression test (lab.triaxial without confinement)."},
+  ["lab.brazilian"] = {"lab.brazilian(spec[, opts]) -> result", "The Brazilian test of a disk: two platens close; sigma_t = 2 F / (pi D t) [Pa]."},
+  ["lab.mohr_coulomb"] = {"lab.mohr_coulomb({{sigma3, sigma1}, ...}) -> {c =, phi =, N =, intercept =, r2 =, rms =, points =}",
+    "The Mohr-Coulomb fit of failure states [Pa]; phi in degrees."},
+  ["lab.series"] = {"lab.series(spec, {confining = {sigma3, ...}, out =, ...}) -> results",
+    "A UCS and triaxial tests at each sigma3 [Pa], the Mohr-Coulomb fit of their peaks and the plots (out: a file prefix)."},
+  ["lab.write_csv"] = {"lab.write_csv(path, header, rows)", "Writes rows (arrays of numbers) under a header to a CSV file, atomically."},
+  ["plot.live"] = {"plot.live(m, names[, {every = 1000, terminal =, output =, title =, x = 'step' | 'time', log =}]) -> plot",
+    "A gnuplot plot of histories of m, redrawn every `every` steps while m cycles (p:draw() now, p:close() stops it); the run's bits do not change."},
+  ["lab.have_gnuplot"] = {"lab.have_gnuplot() -> bool", "Whether gnuplot can be run (the plots are skipped, with a note, if not)."},
 }
 H.entries = entries
 
@@ -247,10 +266,9 @@ local function name_of_function(fn)
       if f == fn then return "seixo." .. name end
     end
   end
-  local util = package.loaded["seixo.util"]
-  if util then
-    for name, f in pairs(util) do
-      if f == fn then return "util." .. name end
+  for prefix, module in pairs{util = "seixo.util", lab = "seixo.lab", plot = "seixo.plot"} do
+    for name, f in pairs(package.loaded[module] or {}) do
+      if f == fn then return prefix .. "." .. name end
     end
   end
   if fn == rawget(_G, "help") then return "help" end
@@ -309,7 +327,10 @@ seixo: a DEM simulator driven from Lua.
   m:solve{ratio = 1e-4}
   print(m)
 help(m) lists the model's methods, help(b) a ball's fields, help("solve") one entry;
-help("util") the vector helpers of require "seixo.util". The full reference: docs/lua-api.md.]]
+help("util") the vector helpers of require "seixo.util", help("lab") the laboratory tests
+of require "seixo.lab", help("plot") live plots of histories. Top-level locals of a line, or of a script run with -i, stay
+defined for the next lines; seixo.models() lists the open models.
+The full reference: docs/lua-api.md.]]
 
 --- The help text of x (see the top of this file).
 function H.text(x)
@@ -320,6 +341,8 @@ function H.text(x)
   end
   if x == package.loaded.seixo then return listing("seixo:", members("seixo.")) end
   if x == package.loaded["seixo.util"] then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
+  if x == package.loaded["seixo.lab"] then return listing("seixo.lab (require \"seixo.lab\"):", members("lab.")) end
+  if x == package.loaded["seixo.plot"] then return listing("seixo.plot (require \"seixo.plot\"):", members("plot.")) end
   local kind = class_of(x)
   if kind then return object_text(kind) end
   if type(x) ~= "string" then return "no help for a " .. type(x) .. "; try help()" end
@@ -327,6 +350,8 @@ function H.text(x)
   if classes[x] then return object_text(x) end
   if x == "seixo" then return listing("seixo:", members("seixo.")) end
   if x == "util" then return listing("seixo.util (require \"seixo.util\"):", members("util.")) end
+  if x == "lab" then return listing("seixo.lab (require \"seixo.lab\"):", members("lab.")) end
+  if x == "plot" then return listing("seixo.plot (require \"seixo.plot\"):", members("plot.")) end
   -- a bare name: every entry it ends
   local found = {}
   for name in pairs(entries) do

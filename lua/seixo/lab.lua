@@ -22,6 +22,7 @@
 -- the axial strain plus (dim - 1) lateral strains. In 2D (disks of unit
 -- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
 
+local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
 local lab = {}
 
 local pi = math.pi
@@ -562,12 +563,15 @@ local function drive(top, bottom, dim, speed)
 end
 
 -- A test's end: with opts.out, its history as CSV, the model with the
--- result (history included) as HDF5, and its figures.
+-- result (history included) as HDF5, the final state as a series with its
+-- .xmf for ParaView (out_view.h5, out_view.xmf: balls, walls, cracks), and
+-- its figures.
 local function finish(m, r, opts, plot)
   if opts.out then
     lab.write_csv(opts.out .. ".csv", r.columns, r.rows)
     m:vars().lab_result = copy(r)
     m:save(opts.out .. ".h5")
+    m:output{path = opts.out .. "_view.h5", fields = {"all"}}:close()
     if opts.plot ~= false then plot(r, opts.out) end
   end
   m:close()

@@ -138,7 +138,7 @@ local function sorted_keys(t)
   return keys
 end
 
-local function show(v, depth, indent, seen)
+local function show(v, depth, indent, seen, limit)
   if type(v) == "string" then return string.format("%q", v) end
   if type(v) ~= "table" then
     local ok, text = pcall(tostring, v)
@@ -153,29 +153,36 @@ local function show(v, depth, indent, seen)
   if depth <= 0 then return "{...}" end
   seen[v] = true
   local parts = {}
+  local count
   if is_array(v) then
-    for i = 1, rawlen(v) do parts[i] = show(rawget(v, i), depth - 1, indent, seen) end
+    count = rawlen(v)
+    for i = 1, math.min(count, limit) do parts[i] = show(rawget(v, i), depth - 1, indent + 1, seen, limit) end
   else
-    for _, k in ipairs(sorted_keys(v)) do
-      parts[#parts + 1] = key_text(k) .. " = " .. show(rawget(v, k), depth - 1, indent, seen)
+    local keys = sorted_keys(v)
+    count = #keys
+    for i = 1, math.min(count, limit) do
+      local k = keys[i]
+      parts[i] = key_text(k) .. " = " .. show(rawget(v, k), depth - 1, indent + 1, seen, limit)
     end
   end
+  if count > limit then parts[#parts + 1] = "... (" .. count .. " entries)" end
   seen[v] = nil
   local flat = "{" .. table.concat(parts, ", ") .. "}"
   if #flat <= 78 or #parts == 0 then return flat end
   local pad = string.rep("  ", indent + 1)
-  for i = 1, #parts do
-    parts[i] = pad .. parts[i]:gsub("\n", "\n  ")
-  end
+  for i = 1, #parts do parts[i] = pad .. parts[i] end
   return "{\n" .. table.concat(parts, ",\n") .. "\n" .. string.rep("  ", indent) .. "}"
 end
 
---- A readable text of any value: tables in full (keys sorted, cycles marked), to `depth` levels (default 4).
-function util.show(v, depth)
-  if depth ~= nil and math.type(depth) ~= "integer" then
-    error("bad argument 'depth' to 'util.show' (integer expected, got " .. type(depth) .. ")", 2)
+--- A readable text of any value: tables (keys sorted, cycles marked) to `depth` levels (default 4),
+--- each cut after `limit` entries (default: none) with "... (n entries)".
+function util.show(v, depth, limit)
+  for name, x in pairs{depth = depth, limit = limit} do
+    if math.type(x) ~= "integer" then
+      error("bad argument '" .. name .. "' to 'util.show' (integer expected, got " .. type(x) .. ")", 2)
+    end
   end
-  return show(v, depth or 4, 0, {})
+  return show(v, depth or 4, 0, {}, limit or math.maxinteger)
 end
 
 --- Prints each argument with util.show, separated by tabs.

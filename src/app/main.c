@@ -9,7 +9,8 @@
  * each statement is appended whole as it is entered),
  * and tab completion that walks the Lua value before the cursor (globals,
  * table keys, the methods and fields of seixo objects). A long cycle shows
- * a progress line on stderr when stderr is a terminal.
+ * a progress line on stderr when stderr is a terminal, and a plain line every
+ * 10 s when it is a file or a pipe (a log).
  *
  * Modelled on the reference interpreter lua.c: everything runs inside one
  * protected call (pmain), every chunk under lua_pcall with a message
@@ -240,6 +241,39 @@ static int docall(lua_State *L, int narg, int nres)
     return status;
 }
 
+/* ----- a chunk's top-level locals outlive it in an interactive session
+ *
+ * Every example writes `local m = seixo.model{...}`; typed at the prompt, or
+ * in a script run with -i, that local dies with its chunk and the next line
+ * finds a nil global. A return hook copies the chunk's top-level locals into
+ * globals as the chunk returns (a chunk's final return still sees them), so
+ * the session goes on with them. Only the main function of the chunk named
+ * keep_source counts: functions it calls, and modules it requires, return
+ * untouched. A chunk that fails keeps nothing. */
+static const char *keep_source;  // "=stdin" at the prompt, "@path" for a script
+
+static void keep_locals_hook(lua_State *L, lua_Debug *ar)
+{
+    if (!lua_getinfo(L, "S", ar) || strcmp(ar->what, "main") != 0 || strcmp(ar->source, keep_source) != 0) return;
+    const char *name;
+    for (int i = 1; (name = lua_getlocal(L, ar, i)) != NULL; i++) {
+        if (name[0] == '(')  // the compiler's temporaries
+            lua_pop(L, 1);
+        else
+            lua_setglobal(L, name);
+    }
+}
+
+/* docall for a chunk whose top-level locals become globals when it returns. */
+static int docall_keeping_locals(lua_State *L, int narg, int nres, const char *source)
+{
+    keep_source = source;
+    lua_sethook(L, keep_locals_hook, LUA_MASKRET, 0);
+    const int status = docall(L, narg, nres);
+    if (lua_gethook(L) == keep_locals_hook) lua_sethook(L, NULL, 0, 0);
+    return status;
+}
+
 static int run_chunk(lua_State *L, const char *code)
 {
     int status = luaL_loadbuffer(L, code, strlen(code), "=(command line)");
@@ -247,8 +281,9 @@ static int run_chunk(lua_State *L, const char *code)
     return report(L, status);
 }
 
-/* The script's arguments go to `...` as well as to the global `arg`. */
-static int run_script(lua_State *L, char **argv, int script, int argc)
+/* The script's arguments go to `...` as well as to the global `arg`; with
+ * -i (keep), its top-level locals become globals for the session. */
+static int run_script(lua_State *L, char **argv, int script, int argc, bool keep)
 {
     const char *fname = strcmp(argv[script], "-") == 0 ? NULL : argv[script];
     int status = luaL_loadfile(L, fname);
@@ -256,7 +291,17 @@ static int run_script(lua_State *L, char **argv, int script, int argc)
         const int n = argc - script - 1;
         luaL_checkstack(L, n, "too many arguments to the script");
         for (int i = script + 1; i < argc; i++) lua_pushstring(L, argv[i]);
-        status = docall(L, n, 0);
+        if (keep) {
+            lua_Debug ar;
+            lua_pushvalue(L, -n - 1);
+            lua_getinfo(L, ">S", &ar);
+            lua_pushstring(L, ar.source);  // the chunk's name, kept on the stack under the call
+            lua_insert(L, -n - 2);
+            status = docall_keeping_locals(L, n, 0, lua_tostring(L, -n - 2));
+            lua_remove(L, status == LUA_OK ? -1 : -2);
+        } else {
+            status = docall(L, n, 0);
+        }
     }
     return report(L, status);
 }
@@ -710,8 +755,27 @@ static void push_shallow(lua_State *L, int t)
     lua_remove(L, parts);
 }
 
+/* Pushes the text of the table at t: seixo.util.show's (keys sorted, nested
+ * tables in full, long arrays cut), or the one-level form when the Lua
+ * library is not found. */
+static void push_table(lua_State *L, int t)
+{
+    lua_getglobal(L, "require");
+    lua_pushliteral(L, "seixo.util");
+    if (lua_pcall(L, 1, 1, 0) != LUA_OK || lua_getfield(L, -1, "show") != LUA_TFUNCTION) {
+        lua_settop(L, lua_gettop(L) - 2);
+        push_shallow(L, t);
+        return;
+    }
+    lua_remove(L, -2);
+    lua_pushvalue(L, t);
+    lua_pushinteger(L, 3);   // levels
+    lua_pushinteger(L, 12);  // entries of a table shown before "..."
+    lua_call(L, 3, 1);
+}
+
 /* Prints its arguments with the global print, tables without __tostring
- * shown shallowly. */
+ * shown by push_table. */
 static int show(lua_State *L)
 {
     const int n = lua_gettop(L);
@@ -722,7 +786,7 @@ static int show(lua_State *L)
             lua_pop(L, 1);
             continue;
         }
-        push_shallow(L, i);
+        push_table(L, i);
         lua_replace(L, i);
     }
     lua_getglobal(L, "print");
@@ -747,7 +811,7 @@ static void repl(lua_State *L)
 #endif
     int status;
     while ((status = load_entry(L, tty)) != -1) {
-        if (status == LUA_OK) status = docall(L, 0, LUA_MULTRET);
+        if (status == LUA_OK) status = docall_keeping_locals(L, 0, LUA_MULTRET, "=stdin");
         if (status == LUA_OK && lua_gettop(L) > 0) {
             lua_pushcfunction(L, show);
             lua_insert(L, 1);
@@ -787,7 +851,7 @@ static bool has_library(const char *dir)
 
 /* The directory of the pure-Lua library: $SEIXO_LUA_PATH, else lua/ beside
  * the executable's directory (a build directory in the source tree) or the
- * installed share/seixo/lua, else the source tree the executable was built
+ * installed share/lua/5.4 (where a stock Lua finds it too), else the source tree the executable was built
  * from. Pushes it, or nil when none has a seixo/ directory. */
 static void push_library_dir(lua_State *L)
 {
@@ -802,7 +866,7 @@ static void push_library_dir(lua_State *L)
         exe[n] = 0;
         char *slash = strrchr(exe, '/');
         if (slash) *slash = 0;
-        const char *const rel[] = {"/../lua", "/../share/seixo/lua"};
+        const char *const rel[] = {"/../lua", "/../share/lua/5.4"};
         for (size_t i = 0; i < sizeof rel / sizeof *rel; i++) {
             const char *dir = lua_pushfstring(L, "%s%s", exe, rel[i]);
             if (has_library(dir)) return;
@@ -853,7 +917,7 @@ static int pmain(lua_State *L)
     sx_lua_open(L);
     global_L = L;
     open_library(L);
-    sx_lua_set_progress(L, isatty(STDERR_FILENO));
+    sx_lua_set_progress(L, isatty(STDERR_FILENO) ? SX_PROGRESS_TERMINAL : SX_PROGRESS_LOG);
     sx_lua_set_profile(L, o->profile);
     lua_getglobal(L, "seixo");
     lua_pushinteger(L, o->threads > 0 ? o->threads : 1);
@@ -861,7 +925,7 @@ static int pmain(lua_State *L)
     lua_pop(L, 1);
     create_arg_table(L, argv, argc, o->script);
     bool ok = run_chunks(L, argv, o->script);
-    if (ok && o->script < argc) ok = run_script(L, argv, o->script, argc) == LUA_OK;
+    if (ok && o->script < argc) ok = run_script(L, argv, o->script, argc, o->interactive) == LUA_OK;
     if (ok && (o->interactive || (o->script == argc && !o->has_chunks))) repl(L);
     lua_pushboolean(L, ok);
     return 1;

@@ -7,7 +7,9 @@
  * centres (connectivity into the balls' points), ball-wall contacts as
  * lines from the centre to the contact point, and walls as quadrilaterals
  * (3D) or segments (2D); an infinite wall is drawn across the balls'
- * bounding box.
+ * bounding box; the crack log so far (with the bonds) as points, so a
+ * viewer draws the crack map of each snapshot. Every block is named in the
+ * XDMF (balls, contacts, wall_contacts, bonds, cracks, walls).
  *
  * Histories grow beside the snapshots: /histories/<name> holds extendable
  * datasets (history.c) to which each write appends the samples of steps
@@ -125,7 +127,7 @@ static void put(buf *b, const char *fmt, ...)
 /* What the XDMF needs to know of a snapshot (stored as its attributes). */
 typedef struct snap {
     double time;
-    int64_t step, balls, contacts, wall_contacts, bonds, walls;
+    int64_t step, balls, contacts, wall_contacts, bonds, walls, cracks;
     int64_t wall_cells, wall_points; /* a cylinder is drawn with many cells */
     unsigned fields;
     int dim;
@@ -244,6 +246,16 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "shear_force", "bonds/shear_force", s->bonds, 3, "Float", 8, true);
         attribute(b, base, k, "moment", "bonds/moment", s->bonds, 3, "Float", 8, true);
         attribute(b, base, k, "radius", "bonds/radius", s->bonds, 1, "Float", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_BONDS) && s->cracks > 0) {  // the crack map: every bond broken so far, a point each
+        put(b, "    <Grid Name=\"cracks\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "cracks/connectivity", s->cracks, 1, "Polyvertex");
+        geometry(b, base, k, "cracks/position", s->cracks);
+        attribute(b, base, k, "mode", "cracks/mode", s->cracks, 1, "Int", 8, false);
+        attribute(b, base, k, "kind", "cracks/kind", s->cracks, 1, "Int", 8, false);
+        attribute(b, base, k, "time", "cracks/time", s->cracks, 1, "Float", 8, false);
+        attribute(b, base, k, "step", "cracks/step", s->cracks, 1, "Int", 8, false);
         put(b, "    </Grid>\n");
     }
     if ((f & SX_OUT_WALLS) && s->wall_cells > 0) {
@@ -585,6 +597,39 @@ done:
     free(ids);
 }
 
+/* The crack log so far as points (the bonds' field brings it): position,
+ * mode (1 tension, 2 shear), kind (of bond), time and step of each break. */
+enum { CR_D = 7 };
+
+static void write_cracks(sx_h5 *h, hid_t snapg, const sx_model *m, snap *s)
+{
+    cells c = {.per_i = 1, .per_d = CR_D};
+    for (int64_t i = 0; i < m->cracks.n; i++) {
+        const sx_crack *e = &m->cracks.ev[i];
+        const int32_t conn[1] = {(int32_t)i};
+        double *d = cells_push(&c, conn);
+        if (!d) {
+            sx_h5_fail(h, "out of memory");
+            break;
+        }
+        for (int k = 0; k < 3; k++) d[k] = k < m->dim ? e->pos[k] : 0;
+        d[3] = e->mode, d[4] = e->kind, d[5] = e->time, d[6] = (double)e->step;
+    }
+    if (!h->failed) {
+        s->cracks = c.n;
+        hid_t g = sx_h5_group(h, snapg, "cracks");
+        write_cells(h, g, &c);
+        write_col(h, g, "position", &c, 0, 3, "m", false);
+        write_col(h, g, "mode", &c, 3, 1, NULL, true);
+        write_col(h, g, "kind", &c, 4, 1, NULL, true);
+        write_col(h, g, "time", &c, 5, 1, "s", false);
+        write_col(h, g, "step", &c, 6, 1, NULL, true);
+        sx_h5_close(g);
+    }
+    free(c.conn);
+    free(c.d);
+}
+
 static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f, snap *s)
 {
     memset(s, 0, sizeof *s);
@@ -640,6 +685,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
         }
         free(g.bb.conn), free(g.bb.d), free(g.bw.conn), free(g.bw.d), free(g.bd.conn), free(g.bd.d);
     }
+    if ((f & SX_OUT_BONDS) && m->cracks.n > 0) write_cracks(h, snapg, m, s);
     if (f & SX_OUT_WALLS) {
         s->walls = m->nwall;
         write_walls(h, snapg, m, s);
@@ -652,6 +698,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     sx_h5_attr_int(h, snapg, "wall_contacts", s->wall_contacts);
     sx_h5_attr_int(h, snapg, "bonds", s->bonds);
     sx_h5_attr_int(h, snapg, "walls", s->walls);
+    sx_h5_attr_int(h, snapg, "cracks", s->cracks);
     sx_h5_attr_int(h, snapg, "wall_cells", s->wall_cells);
     sx_h5_attr_int(h, snapg, "wall_points", s->wall_points);
     sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
@@ -710,6 +757,7 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     s->wall_points = s->walls * (dim == 3 ? 4 : 2);
     sx_h5_get_i64(h, g, name, "wall_cells", &s->wall_cells, 1, false);
     sx_h5_get_i64(h, g, name, "wall_points", &s->wall_points, 1, false);
+    sx_h5_get_i64(h, g, name, "cracks", &s->cracks, 1, false); /* absent before crack maps */
     sx_h5_close(g);
     return !h->failed;
 }

@@ -6,7 +6,8 @@
  * table of user values per ball, dropped when the ball is removed. */
 #include "bindings.h"
 
-const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras"};
+static const char *const ball_shown[] = {"pos", "radius", "vel", "material", "group", NULL};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras", ball_shown};
 #define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */
@@ -342,7 +343,9 @@ static int add_ball(lua_State *L, sx_model *m)
     const char *group = sx_lua_optstrfield(L, 2, "group");
     const int32_t g = group ? sx_lua_group_id(L, 1, group, true) : 0;
     int64_t id;
+    if (d.radius > 0) sx_lua_check_ball_walls(L, 1, m, d.pos, d.radius);
     sx_lua_check(L, m, sx_ball_add(m, &d, &id), "m:ball");
+    sx_lua_modelud(L, 1)->unchecked = true;
     if (g) sx_lua_check(L, m, sx_ball_set_group(m, id, g), "m:ball");
     sx_lua_pushhandle(L, 1, &ball_kind, id);
     return 1;

@@ -59,11 +59,15 @@ void sx_lua_io_register(lua_State *L);
 
 /// The model userdata. Its uservalue is the state table (sx_lua_state).
 typedef struct sx_lua_model {
-    sx_model *m;   ///< NULL once closed
-    int running;   ///< inside m:cycle / m:solve / a relaxation of m:generate
-    int callback;  ///< depth of user callbacks being run (removals are queued while > 0)
+    sx_model *m;           ///< NULL once closed
+    int running;           ///< inside m:cycle / m:solve / a relaxation of m:generate
+    int callback;          ///< depth of user callbacks being run (removals are queued while > 0)
+    double overlap_limit;  ///< seixo.model{overlap_limit}: the largest overlap placed, a fraction of the radius
+    bool unchecked;        ///< a ball or wall was added since the last placement check (geometry.c)
 } sx_lua_model;
 
+/// seixo.models() -> {model, ...}: the open models, in order of creation.
+int sx_lua_models(lua_State *L);
 /// seixo.model{...}: the constructor.
 int sx_lua_model_new(lua_State *L);
 /// Creates the model class with the methods of every array in `sets`
@@ -180,6 +184,20 @@ bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f
 /// the stack; returns it, its length in *n.
 int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
 
+/* ------------------------------------------------------ geometry.c */
+
+/// m:ball: a new ball at x of radius r behind a plane or line wall of the
+/// model userdata at `model`, or overlapping one beyond the limit, is an error.
+void sx_lua_check_ball_walls(lua_State *L, int model, const sx_model *m, const double *x, double r);
+/// After the first step since balls or walls were added: an overlap of the
+/// last step's contacts (of the balls as placed, when that step `failed`)
+/// beyond the limit is an error (of the Lua call `what`) naming the two
+/// entities. Clears ud->unchecked.
+void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
+/// Warns on stderr (once per model and `what`) when v != 0 lies outside
+/// [lo, hi] in magnitude, naming the unit expected.
+void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit);
+
 /* ----------------------------------------------------------- run.c */
 
 /// A run of a model: while its record is open the model counts as cycling
@@ -286,6 +304,7 @@ typedef struct sx_lua_kind {
     const char *name;                           ///< its name in messages, "ball"
     bool (*exists)(const sx_model *, int64_t);  ///< whether an id is live
     const char *extras;                         ///< the model state's table of user extras, by id
+    const char *const *shown;                   ///< the fields print(x) shows (NULL-terminated)
 } sx_lua_kind;
 
 /// Pushes a handle for the object `id` of the model userdata at `model`.
@@ -297,7 +316,8 @@ sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_
 /// id, at idx into *id: returns NULL, or pushes and returns what is wrong (a
 /// handle of another model is refused, not read as a plain id).
 const char *sx_lua_toid(lua_State *L, int idx, int model, const sx_lua_kind *k, int64_t *id);
-/// __tostring of a handle: "seixo.ball 7", with "(removed)" or "(model closed)".
+/// __tostring of a handle: "seixo.ball 7 {pos = {0, 0, 0.1}, radius = 0.001, ...}"
+/// (the kind's shown fields), or "seixo.ball 7 (removed)" / "(model closed)".
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k);
 /// __eq of handles: the same class, model and id.
 int sx_lua_handle_eq(lua_State *L);

@@ -16,7 +16,8 @@
 
 #include "bindings.h"
 
-const sx_lua_kind sx_lua_clump_kind = {"seixo.clump", "clump", sx_clump_exists, NULL}; /* no user extras */
+static const char *const clump_shown[] = {"pos", "mass", "vel", "template", NULL};
+const sx_lua_kind sx_lua_clump_kind = {"seixo.clump", "clump", sx_clump_exists, NULL, clump_shown}; /* no user extras */
 #define clump_kind sx_lua_clump_kind
 
 static sx_model *check_clump(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &clump_kind, id); }

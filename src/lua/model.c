@@ -55,10 +55,55 @@ int sx_lua_material_arg(lua_State *L, const sx_model *m, int arg, const char *ke
     return 0;
 }
 
+/* The models of the session, for seixo.models(): a table with weak values
+ * in the registry, keyed by creation number, so listing never keeps a
+ * model alive. */
+static const char models_key[] = "seixo.models";
+
+static void push_model_list(lua_State *L)
+{
+    if (luaL_getsubtable(L, LUA_REGISTRYINDEX, models_key)) return;
+    lua_createtable(L, 0, 1);
+    lua_pushliteral(L, "v");
+    lua_setfield(L, -2, "__mode");
+    lua_setmetatable(L, -2);
+}
+
+static void list_model(lua_State *L, int model)
+{
+    push_model_list(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    const lua_Integer n = lua_tointeger(L, -1) + 1;
+    lua_pop(L, 1);
+    lua_pushinteger(L, n);
+    lua_setfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    lua_pushvalue(L, model);
+    lua_rawseti(L, -2, n);
+    lua_pop(L, 1);
+}
+
+int sx_lua_models(lua_State *L)
+{
+    push_model_list(L);
+    const int list = lua_gettop(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    const lua_Integer made = lua_tointeger(L, -1);
+    lua_newtable(L);
+    lua_Integer k = 0;
+    for (lua_Integer i = 1; i <= made; i++) {
+        if (lua_rawgeti(L, list, i) == LUA_TUSERDATA && sx_lua_tomodel(L, -1))
+            lua_rawseti(L, -2, ++k);
+        else
+            lua_pop(L, 1);
+    }
+    return 1;
+}
+
 int sx_lua_model_new(lua_State *L)
 {
-    static const char *const keys[] = {"dim", "gravity", "timestep", "timestep_safety", "skin", NULL};
+    static const char *const keys[] = {"dim", "gravity", "timestep", "timestep_safety", "skin", "overlap_limit", NULL};
     sx_model_def d = sx_model_default_def();
+    double overlap_limit = 0.5;
     if (!lua_isnoneornil(L, 1)) {
         sx_lua_checkkeys(L, 1, keys);
         double dim = d.dim;
@@ -69,16 +114,19 @@ int sx_lua_model_new(lua_State *L)
         sx_lua_optnumfield(L, 1, "timestep", &d.timestep);
         sx_lua_optnumfield(L, 1, "timestep_safety", &d.timestep_safety);
         sx_lua_optnumfield(L, 1, "skin", &d.skin);
+        sx_lua_optrangefield(L, 1, "overlap_limit", 0, 1, &overlap_limit);
     }
     /* the userdata first: if Lua runs out of memory, no model leaks */
     sx_lua_model *u = lua_newuserdatauv(L, sizeof *u, 1);
     memset(u, 0, sizeof *u);
+    u->overlap_limit = overlap_limit;
     luaL_setmetatable(L, SX_LUA_MODEL);
     lua_newtable(L);
     lua_setiuservalue(L, -2, 1);
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
+    list_model(L, lua_gettop(L));
     /* the executable's --threads N (seixo.threads); results do not depend on it */
     if (lua_getglobal(L, "seixo") == LUA_TTABLE) {
         lua_getfield(L, -1, "threads");
@@ -251,6 +299,9 @@ static int model_material(lua_State *L)
         sx_lua_optnumfield(L, 3, "viscous_normal", &d.viscous_normal);
         sx_lua_optnumfield(L, 3, "viscous_shear", &d.viscous_shear);
         sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
+        sx_lua_check_range(L, 1, "density", d.density, 100, 3e4, "kg/m^3");
+        sx_lua_check_range(L, 1, "modulus", d.modulus, 1e5, 1e12, "Pa");
+        sx_lua_check_range(L, 1, "shear_modulus", d.shear_modulus, 1e5, 1e12, "Pa");
     }
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");

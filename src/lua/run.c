@@ -43,20 +43,29 @@ _Static_assert(ATOMIC_POINTER_LOCK_FREE == 2 && ATOMIC_INT_LOCK_FREE == 2,
 
 /* ------------------------------------------------------------ progress */
 
-static const char progress_key[] = "seixo.progress";
+static const char progress_key[] = "seixo.progress", progress_every_key[] = "seixo.progress_every";
 
 void sx_lua_set_progress(lua_State *L, int on)
 {
-    lua_pushboolean(L, on);
+    if (on == SX_PROGRESS_LOG)
+        lua_pushliteral(L, "log");
+    else
+        lua_pushboolean(L, on);
     lua_setfield(L, LUA_REGISTRYINDEX, progress_key);
 }
 
-static bool progress_on(lua_State *L)
+int sx_lua_progress_mode(lua_State *L)
 {
-    lua_getfield(L, LUA_REGISTRYINDEX, progress_key);
-    const bool on = lua_toboolean(L, -1);
+    const int t = lua_getfield(L, LUA_REGISTRYINDEX, progress_key);
+    const int mode = t == LUA_TSTRING ? SX_PROGRESS_LOG : lua_toboolean(L, -1) ? SX_PROGRESS_TERMINAL : SX_PROGRESS_OFF;
     lua_pop(L, 1);
-    return on;
+    return mode;
+}
+
+void sx_lua_set_progress_every(lua_State *L, double seconds)
+{
+    lua_pushnumber(L, seconds);
+    lua_setfield(L, LUA_REGISTRYINDEX, progress_every_key);
 }
 
 static double now(void)
@@ -66,22 +75,35 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250 };
+/* On a terminal a line rewritten in place, after a second; in a log a line
+ * every `every` seconds (10 by default), for runs that last that long. */
+enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250, PROGRESS_LOG_EVERY_S = 10 };
 
 typedef struct progress {
-    bool on, shown;
+    int mode;              // SX_PROGRESS_*
+    bool shown;
     double start, last;    // wall-clock s
+    double delay, every;   // s before the first line, s between lines
     int64_t step0;         // model step at the start
     int64_t chunk;         // steps per chunk, adapted to about 0.1 s
+    const char *what;      // the call, which a log line names
 } progress;
 
-static void progress_start(lua_State *L, progress *p, const sx_model *m)
+static void progress_start(lua_State *L, progress *p, const sx_model *m, const char *what)
 {
-    p->on = progress_on(L);
+    p->mode = sx_lua_progress_mode(L);
     p->shown = false;
     p->start = p->last = now();
     p->step0 = sx_model_step_count(m);
     p->chunk = 16;
+    p->what = what;
+    p->delay = PROGRESS_DELAY_MS * 1e-3;
+    p->every = PROGRESS_EVERY_MS * 1e-3;
+    if (p->mode == SX_PROGRESS_LOG) {
+        lua_getfield(L, LUA_REGISTRYINDEX, progress_every_key);
+        p->delay = p->every = lua_isnumber(L, -1) ? lua_tonumber(L, -1) : PROGRESS_LOG_EVERY_S;
+        lua_pop(L, 1);
+    }
 }
 
 /* One status line on stderr: steps, time, speed, and the ETA when `fraction` (of the run done) is known. */
@@ -93,7 +115,7 @@ static void progress_show(progress *p, const sx_model *m, int64_t total, double 
     /* aim the next chunk at 0.1 s of cycling */
     const double want = rate * 0.1;
     p->chunk = want < 1 ? 1 : want > 1e9 ? 1000000000 : (int64_t)want;
-    if (!p->on || t - p->start < PROGRESS_DELAY_MS * 1e-3 || t - p->last < PROGRESS_EVERY_MS * 1e-3) return;
+    if (!p->mode || t - p->start < p->delay || t - p->last < p->every) return;
     p->last = t;
     p->shown = true;
     char line[256];
@@ -106,13 +128,16 @@ static void progress_show(progress *p, const sx_model *m, int64_t total, double 
     if (target > 0) k += snprintf(line + k, sizeof line - (size_t)k, "  ratio %.3g -> %.3g", ratio, target);
     if (fraction > 0 && fraction <= 1)
         snprintf(line + k, sizeof line - (size_t)k, "  ETA %.0f s", (t - p->start) * (1 - fraction) / fraction);
-    fprintf(stderr, "\r%s\033[K", line);
+    if (p->mode == SX_PROGRESS_LOG)  // a plain line a log keeps: no carriage return, no escape code
+        fprintf(stderr, "seixo: %s: %s\n", p->what, line);
+    else
+        fprintf(stderr, "\r%s\033[K", line);
     fflush(stderr);
 }
 
 static void progress_end(progress *p)
 {
-    if (!p->shown) return;
+    if (!p->shown || p->mode != SX_PROGRESS_TERMINAL) return;
     fputs("\r\033[K", stderr);
     fflush(stderr);
     p->shown = false;
@@ -230,6 +255,8 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle(r->m, n);
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);
+    /* the first step since balls or walls were placed (run_model takes it alone) */
+    if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
     sx_lua_check(L, r->m, st, r->what);
 }
 
@@ -240,11 +267,17 @@ enum { POINT_AFTER, POINT_BEFORE };
 
 /* Calls the function below its nargs arguments on behalf of the user, as a
  * callback of the model at `model`: removals are queued meanwhile and
- * applied after; a SIGINT stops the Lua code (see sx_lua_interrupt_all). */
+ * applied after; a SIGINT stops the Lua code (see sx_lua_interrupt_all).
+ * An error says it came from a callback, where that function is defined
+ * and at which step: the error's own position may be in a helper far from
+ * the m:on or m:history that registered it. */
 void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
 {
     model = lua_absindex(L, model);
     sx_lua_model *ud = sx_lua_modelud(L, model);
+    lua_Debug fn;
+    lua_pushvalue(L, -nargs - 1);
+    lua_getinfo(L, ">S", &fn);
     run *r = innermost();
     const bool mine = r && r->ud == ud;
     ud->callback++;
@@ -266,6 +299,13 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
         if (mine && atomic_load(&r->interrupted)) {
             atomic_store(&pending, 0);
             luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
+        }
+        if (lua_type(L, -1) == LUA_TSTRING && ud->m) {
+            if (fn.what[0] == 'C')
+                luaL_error(L, "a callback (a C function) failed at step %I: %s", (lua_Integer)sx_model_step_count(ud->m),
+                           lua_tostring(L, -1));
+            luaL_error(L, "the callback defined at %s:%d failed at step %I: %s", fn.short_src, fn.linedefined,
+                       (lua_Integer)sx_model_step_count(ud->m), lua_tostring(L, -1));
         }
         lua_error(L);
     }
@@ -441,7 +481,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     const int64_t start = sx_model_step_count(m);
     const double t0 = sx_model_time(m);
     progress *p = &r->progress;
-    progress_start(L, p, m);
+    progress_start(L, p, m, what);
     *ratio = NAN;
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {
@@ -481,7 +521,8 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = steps_to_time(m, lim->time, taken);
             if (k < n) n = k;
         }
-        if (p->on && p->chunk < n) n = p->chunk;
+        if (p->mode && p->chunk < n) n = p->chunk;
+        if (r->ud->unchecked) n = 1;  // a placement check follows the first step
         sx_lua_run_cycle(L, r, n);
         double fraction = -1;
         int64_t total = 0;

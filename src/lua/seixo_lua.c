@@ -6,6 +6,7 @@
 
 #include "bindings.h"
 
+#include <string.h>
 #include <time.h>
 
 static const luaL_Reg *const model_methods[] = {
@@ -15,16 +16,31 @@ static const luaL_Reg *const model_methods[] = {
     sx_lua_lab_methods,      sx_lua_clumps_methods, NULL,
 };
 
-/* seixo.progress([on]): the progress line of long cycles; returns the previous setting. */
+/* seixo.progress([mode[, every]]): the progress display of long cycles
+ * (false, true: a terminal line, "log": plain lines every `every` s);
+ * returns the previous mode. */
 static int seixo_progress(lua_State *L)
 {
-    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.progress");
-    const int was = lua_toboolean(L, -1);
+    const int was = sx_lua_progress_mode(L);
     if (!lua_isnone(L, 1)) {
-        luaL_checktype(L, 1, LUA_TBOOLEAN);
-        sx_lua_set_progress(L, lua_toboolean(L, 1));
+        int mode;
+        if (lua_type(L, 1) == LUA_TBOOLEAN)
+            mode = lua_toboolean(L, 1) ? SX_PROGRESS_TERMINAL : SX_PROGRESS_OFF;
+        else if (lua_type(L, 1) == LUA_TSTRING && strcmp(lua_tostring(L, 1), "log") == 0)
+            mode = SX_PROGRESS_LOG;
+        else
+            return luaL_argerror(L, 1, lua_pushfstring(L, "boolean or 'log' expected, got %s", luaL_typename(L, 1)));
+        if (!lua_isnoneornil(L, 2)) {
+            const double every = luaL_checknumber(L, 2);
+            luaL_argcheck(L, every >= 0 && every < 1e9, 2, "seconds between log lines, >= 0 expected");
+            sx_lua_set_progress_every(L, every);
+        }
+        sx_lua_set_progress(L, mode);
     }
-    lua_pushboolean(L, was);
+    if (was == SX_PROGRESS_LOG)
+        lua_pushliteral(L, "log");
+    else
+        lua_pushboolean(L, was);
     return 1;
 }
 
@@ -42,6 +58,7 @@ int luaopen_seixo(lua_State *L)
 {
     static const luaL_Reg functions[] = {
         {"model", sx_lua_model_new},
+        {"models", sx_lua_models},
         {"progress", seixo_progress},
         {"clock", seixo_clock},
         {NULL, NULL},

@@ -28,10 +28,18 @@ SX_API int sx_lua_interrupt_pending(void);
 /// raised "interrupted"), or no code was left to stop.
 SX_API void sx_lua_interrupt_clear(void);
 
-/// Switches the progress line of long cycles (steps, time, steps/s, ETA on
-/// stderr) on or off for this state; off by default. The executable turns
-/// it on when stderr is a terminal.
+/// The progress display of long cycles (steps, time, steps/s, ETA on stderr).
+enum {
+    SX_PROGRESS_OFF = 0,       ///< nothing (the default of a state)
+    SX_PROGRESS_TERMINAL = 1,  ///< one line rewritten in place (the executable's, stderr a terminal)
+    SX_PROGRESS_LOG = 2,       ///< a plain line every few seconds (the executable's, stderr a file or pipe)
+};
+/// Sets this state's progress display to one of SX_PROGRESS_*.
 SX_API void sx_lua_set_progress(lua_State *L, int on);
+/// This state's progress display, one of SX_PROGRESS_*.
+SX_API int sx_lua_progress_mode(lua_State *L);
+/// Seconds between the lines of SX_PROGRESS_LOG (default 10).
+SX_API void sx_lua_set_progress_every(lua_State *L, double seconds);
 
 /// Switches the end-of-model profile on or off for this state (off by
 /// default): a model that has cycled prints its m:profile() table on

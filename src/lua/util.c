@@ -13,6 +13,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* The core names its own functions ("ball_set: radius must be ..."), which
@@ -238,13 +239,59 @@ const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key)
 
 /* ------------------------------------------------------------- classes */
 
+/* The edit distance of a and b: insertions, deletions, substitutions and
+ * swaps of two neighbours (the commonest typo: slove for solve), over the
+ * first 32 characters, enough to tell a typo from another name. */
+static int edit_distance(const char *a, const char *b)
+{
+    enum { N = 32 };
+    int d[N + 1][N + 1];
+    const int la = (int)strnlen(a, N), lb = (int)strnlen(b, N);
+    for (int i = 0; i <= la; i++) d[i][0] = i;
+    for (int j = 0; j <= lb; j++) d[0][j] = j;
+    for (int i = 1; i <= la; i++)
+        for (int j = 1; j <= lb; j++) {
+            int v = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < v) v = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < v) v = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < v)
+                v = d[i - 2][j - 2] + 1;
+            d[i][j] = v;
+        }
+    return d[la][lb];
+}
+
+/* The string key of the tables at upvalues 1 and 2 closest to `key`, or
+ * NULL when none is near enough to be a typo of it (at most a third of its
+ * letters wrong, at least one allowed). */
+static const char *nearest_name(lua_State *L, const char *key)
+{
+    const char *best = NULL;
+    int best_d = (int)strlen(key) / 3 > 1 ? (int)strlen(key) / 3 : 1;
+    for (int u = 1; u <= 2; u++) {
+        lua_pushnil(L);
+        while (lua_next(L, lua_upvalueindex(u))) {
+            lua_pop(L, 1);
+            const char *name = lua_tostring(L, -1);
+            const int d = edit_distance(key, name);
+            if (d < best_d || (d == best_d && !best)) {
+                best = name;  // kept alive by the class's table
+                best_d = d;
+            }
+        }
+    }
+    return best;
+}
+
 static int no_field(lua_State *L, const char *what)
 {
     const char *kind = lua_tostring(L, lua_upvalueindex(3));
     const char *names = lua_tostring(L, lua_upvalueindex(4));
+    const char *near = lua_type(L, 2) == LUA_TSTRING ? nearest_name(L, lua_tostring(L, 2)) : NULL;
     const char *key = push_key(L, 2);
-    if (!*names) return luaL_error(L, "%s has no %s %s", kind, what, key);
-    return luaL_error(L, "%s has no %s %s (%ss: %s)", kind, what, key, what, names);
+    const char *hint = near ? lua_pushfstring(L, " (did you mean '%s'?)", near) : "";
+    if (!*names) return luaL_error(L, "%s has no %s %s%s; help(\"%s\") lists what it has", kind, what, key, hint, kind);
+    return luaL_error(L, "%s has no %s %s%s (%ss: %s)", kind, what, key, hint, what, names);
 }
 
 /* upvalues: methods, getters, kind, the readable field names */
@@ -354,12 +401,63 @@ sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_
     return m;
 }
 
+/* Pushes a shown value as text: numbers in %.6g, arrays of numbers as {a, b, c}. */
+static void push_shown(lua_State *L, int v)
+{
+    char num[40];
+    if (lua_type(L, v) == LUA_TNUMBER && !lua_isinteger(L, v)) {
+        snprintf(num, sizeof num, "%.6g", lua_tonumber(L, v));
+        lua_pushstring(L, num);
+    } else if (lua_type(L, v) == LUA_TTABLE) {
+        lua_pushliteral(L, "{");
+        lua_Integer i = 1;
+        for (; lua_rawgeti(L, v, i) == LUA_TNUMBER; i++) {
+            snprintf(num, sizeof num, "%s%.6g", i > 1 ? ", " : "", lua_tonumber(L, -1));
+            lua_pop(L, 1);
+            lua_pushstring(L, num);
+        }
+        lua_pop(L, 1);
+        lua_pushliteral(L, "}");
+        lua_concat(L, (int)i + 1);
+    } else {
+        luaL_tolstring(L, v, NULL);
+    }
+}
+
+/* A live object shows the kind's fields, read through the class's own
+ * getters (what b.pos gives, formatted): "seixo.ball 7 {pos = {...}, ...}". */
 int sx_lua_handle_tostring(lua_State *L, const sx_lua_kind *k)
 {
     int64_t id;
+    lua_settop(L, 1);
     const sx_model *m = tohandle(L, 1, k, &id);
-    const char *state = !m ? " (model closed)" : k->exists(m, id) ? "" : " (removed)";
-    lua_pushfstring(L, "%s %I%s", k->tname, (lua_Integer)id, state);
+    if (!m || !k->exists(m, id)) {
+        lua_pushfstring(L, "%s %I%s", k->tname, (lua_Integer)id, m ? " (removed)" : " (model closed)");
+        return 1;
+    }
+    luaL_getmetafield(L, 1, "__getters");  // index 2
+    lua_pushfstring(L, "%s %I {", k->tname, (lua_Integer)id);  // index 3, the text so far
+    int shown = 0;
+    for (int i = 0; k->shown && k->shown[i]; i++) {
+        lua_getfield(L, 2, k->shown[i]);
+        const lua_CFunction get = lua_tocfunction(L, -1);
+        lua_pop(L, 1);
+        if (!get) continue;
+        lua_pushcfunction(L, get);
+        lua_pushvalue(L, 1);
+        lua_pushstring(L, k->shown[i]);
+        lua_call(L, 2, 1);
+        if (!lua_isnil(L, 4)) {
+            lua_pushfstring(L, "%s%s = ", shown++ ? ", " : "", k->shown[i]);
+            push_shown(L, 4);
+            lua_remove(L, 4);
+            lua_concat(L, 3);
+        } else {
+            lua_pop(L, 1);
+        }
+    }
+    lua_pushliteral(L, "}");
+    lua_concat(L, 2);
     return 1;
 }
 

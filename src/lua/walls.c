@@ -37,7 +37,8 @@ static const struct shape {
     [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
 };
 
-const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras"};
+static const char *const wall_shown[] = {"kind", "point", "normal", "vel", "force", NULL};
+const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras", wall_shown};
 #define wall_kind sx_lua_wall_kind
 
 /* The wall of the handle at index 1: live, in an open model. */
@@ -265,6 +266,7 @@ static int model_wall(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
+    sx_lua_modelud(L, 1)->unchecked = true;  // a wall placed over balls is named after the next step
     const char *name = sx_lua_optstrfield(L, 2, "kind");
     if (!name) return luaL_argerror(L, 2, "field 'kind' is required");
     const int kind = sx_lua_find(name, kind_names);

@@ -23,6 +23,8 @@ local function defined()
   end
   for name in pairs(seixo) do names["seixo." .. name] = true end
   for name in pairs(util) do names["util." .. name] = true end
+  for name in pairs(require("seixo.lab")) do names["lab." .. name] = true end
+  for name in pairs(require("seixo.plot")) do names["plot." .. name] = true end
   names.help = true
   return names
 end
@@ -33,7 +35,7 @@ local doc = assert(io.open(T.root .. "docs/lua-api.md")):read("a")
 local function doc_form(name)
   local kind, sep, member = name:match("^(%w+)([:%.])([%w_]+)$")
   if not kind then return name .. "(" end
-  if kind == "seixo" or kind == "util" then return name end
+  if kind == "seixo" or kind == "util" or kind == "lab" or kind == "plot" then return name end
   return letter[kind] .. sep .. member
 end
 

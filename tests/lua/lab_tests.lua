@@ -67,6 +67,10 @@ test("UCS and biaxial tests give finite peaks, moduli and a Mohr-Coulomb envelop
   -- and the snapshot carries the results
   local m = seixo.load(dir .. "/series_ucs.h5")
   near(m:vars().lab_result.peak, s.tests[1].peak, 1e-12)
+  -- and the final state is a series ParaView opens: its .xmf names the .h5 beside it and draws the crack map
+  local xmf = assert(io.open(dir .. "/series_ucs_view.xmf")):read("a")
+  check(xmf:find(">series_ucs_view.h5:/snapshots/000000/balls/position<", 1, true), xmf:sub(1, 400))
+  check(xmf:find('<Grid Name="cracks"', 1, true) and xmf:find('<Grid Name="balls"', 1, true), "named blocks")
   m:close()
   if lab.have_gnuplot() then
     for _, f in ipairs{"stress", "volumetric", "cracks", "mohr"} do

@@ -67,11 +67,15 @@ test("show prints any value readably", function()
   check(text:find("\n  field1 = 1,", 1, true), text)
   -- objects print as themselves; metamethods are never run
   local m = T.model(2)
-  check(util.show({m:ball{pos = {0, 0}, radius = 1}}):find("{seixo.ball 1}", 1, true))
+  check(util.show({m:ball{pos = {0, 0}, radius = 1}}):find("{seixo.ball 1 {pos = {0, 0}, radius = 1,", 1, true))
   local trap = setmetatable({1}, {__index = function() error("no") end, __len = function() error("no") end,
                                   __pairs = function() error("no") end})
   eq(util.show(trap), "{1}")
   raises(function() util.show({}, 1.5) end, HERE, "integer expected")
+  -- a limit cuts each table, saying how long it was
+  eq(util.show({1, 2, 3, 4, 5}, 4, 3), "{1, 2, 3, ... (5 entries)}")
+  eq(util.show({a = 1, b = 2, c = {1, 2, 3}}, 4, 2), "{a = 1, b = 2, ... (3 entries)}")
+  raises(function() util.show({}, 2, "x") end, HERE, "'limit'", "integer expected")
 end)
 
 test("read_csv reads what history_csv writes", function()

@@ -1,0 +1,254 @@
+-- A new user's first session: the REPL and -i keep a chunk's top-level
+-- locals, seixo.models() lists the open models, objects print what they
+-- are, tables print readably, a typo is answered with the name meant,
+-- help() covers seixo.lab, a callback's error names the callback and the
+-- step, and progress written to a log is plain lines.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, raises = T.test, T.check, T.eq, T.raises
+local HERE = debug.getinfo(1, "S").short_src
+
+local function tmpfile(text)
+  local path = os.tmpname()
+  local f = assert(io.open(path, "w"))
+  f:write(text)
+  f:close()
+  return path
+end
+
+test("-i: the script's top-level locals are globals of the session", function()
+  local script = tmpfile([[
+local m = seixo.model{dim = 2}
+local n = 42
+m:material("a")
+local function helper() local hidden = 1 return hidden end
+helper()
+]])
+  local status, out = T.run("-i " .. T.quote(script), "print(n, m:dim(), type(helper), hidden)\n")
+  os.remove(script)
+  eq(status, 0, out)
+  eq(out, "42\t2\tfunction\tnil\n")
+  -- without -i nothing is copied: the script's locals stay local
+  status, out = T.run("-e " .. T.quote("local z = 1") .. " -e 'print(z)'")
+  eq(out, "nil\n")
+end)
+
+test("the REPL keeps a line's locals for the next lines", function()
+  local status, out = T.run("-i", "local m = seixo.model{dim = 2}\nlocal a, b = 1, 2\nprint(m:dim(), a + b)\n")
+  eq(status, 0, out)
+  eq(out, "2\t3\n")
+  -- a line that fails keeps nothing
+  status, out = T.run("-i", "local q = 5; error('no')\nprint(q)\n")
+  check(out:find("no\nnil\n", 1, true), out)
+end)
+
+test("seixo.models() lists the open models in order", function()
+  local before = #seixo.models()
+  local a = seixo.model{dim = 2}
+  local b = seixo.model{dim = 3}
+  local list = seixo.models()
+  eq(#list, before + 2)
+  check(rawequal(list[#list - 1], a) and rawequal(list[#list], b))
+  a:close()
+  list = seixo.models()
+  eq(#list, before + 1)
+  check(rawequal(list[#list], b))
+  b:close()
+end)
+
+test("objects print what they are", function()
+  local m = seixo.model{dim = 3}
+  m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  local b = m:ball{pos = {0, 0, 0.5e-3}, radius = 1e-3, group = "top"}
+  eq(tostring(b), "seixo.ball 1 {pos = {0, 0, 0.0005}, radius = 0.001, vel = {0, 0, 0}, material = glass, group = top}")
+  local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  eq(tostring(w), "seixo.wall 1 {kind = plane, point = {0, 0, 0}, normal = {0, 0, 1}, vel = {0, 0, 0}, force = {0, 0, 0}}")
+  m:cycle(1)
+  for c in m:contacts() do check(tostring(c):find("^seixo.contact ball 1 %- wall 1 %(fn [%d.e-]+ N")) end
+  m:clump_template("pair", {{-1e-3, 0, 0, 1e-3}, {1e-3, 0, 0, 1e-3}})
+  local cl = m:clump{template = "pair", pos = {0, 0, 0.01}}
+  check(tostring(cl):find("^seixo.clump 1 {pos = {0, 0, 0.01}, mass = [%d.e-]+, vel = {0, 0, 0}, template = pair}$"), tostring(cl))
+  b:remove()
+  eq(tostring(b), "seixo.ball 1 (removed)")
+  m:close()
+  eq(tostring(w), "seixo.wall 1 (model closed)")
+end)
+
+test("the REPL prints tables of tables one entry a line, long arrays cut", function()
+  local status, out = T.run("-i", [[
+m = seixo.model{dim = 2, timestep = 1e-3}
+m:material("a", {density = 2000})
+m:materials()
+m:history("t", "time")
+m:cycle(20)
+m:history("t").steps
+]])
+  eq(status, 0, out)
+  check(out:find('{\n  a = {\n    damping = 0.0,\n    density = 2000.0,', 1, true), out)
+  check(out:find("{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, ... (20 entries)}", 1, true), out)
+end)
+
+test("a typo is answered with the name meant", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  local b = m:ball{pos = {0, 0}, radius = 1}
+  raises(function() return m:slove() end, "model has no field 'slove' (did you mean 'solve'?)")
+  raises(function() return b.radisu end, "ball has no field 'radisu' (did you mean 'radius'?)", "(fields: id, pos")
+  raises(function() b.raduis = 2 end, "ball has no writable field 'raduis' (did you mean 'radius'?)")
+  local err = raises(function() return m:frobnicate() end, "model has no field 'frobnicate'", 'help("model")')
+  check(not err:find("did you mean", 1, true), err)
+  m:close()
+end)
+
+test("help covers seixo.lab", function()
+  local H = require("seixo.help")
+  local lab = require("seixo.lab")
+  local text = H.text(lab)
+  for _, name in ipairs{"triaxial", "ucs", "brazilian", "specimen", "series", "mohr_coulomb"} do
+    check(text:find("  " .. name .. " ", 1, true), text)
+  end
+  check(H.text(lab.ucs):find("^lab.ucs%(spec"), H.text(lab.ucs))
+  check(H.text("lab"):find("seixo.lab", 1, true))
+end)
+
+test("an error in a callback names the callback's file:line and the step", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  m:ball{pos = {0, 0}, radius = 1}
+  local line = debug.getinfo(1, "l").currentline + 1
+  m:on("cycle", function(mm) if mm:step() == 7 then error("boom") end end)
+  raises(function() m:cycle(10) end,
+         string.format("the callback defined at %s:%d failed at step 7: %s:%d: boom", HERE, line, HERE, line))
+  eq(m:step(), 7)
+  -- a history function too
+  local m2 = seixo.model{dim = 2, timestep = 1e-3}
+  m2:material("a")
+  line = debug.getinfo(1, "l").currentline + 1
+  m2:history("bad", function() return nil + 1 end)
+  raises(function() m2:cycle(1) end, string.format("the callback defined at %s:%d failed at step 1", HERE, line))
+  m:close()
+  m2:close()
+end)
+
+test("progress to a log: plain lines, no carriage return nor escape code", function()
+  local slow = [[
+    local m = seixo.model{dim = 2, timestep = 1e-4}
+    m:material("a")
+    m:ball{pos = {0, 0}, radius = 1}
+    m:on("cycle", function() local t = os.clock() while os.clock() - t < 0.01 do end end)
+    print(seixo.progress("log", 0.2))
+    m:solve{steps = 60}]]
+  local status, out = T.run("-e " .. T.quote(slow))
+  eq(status, 0, out)
+  check(out:find("^log\n"), out)  -- the executable's default when stderr is not a terminal
+  local lines = 0
+  for line in out:gmatch("seixo: m:solve: step %d+ of 60[^\n]*ETA %d+ s\n") do lines = lines + 1 end
+  check(lines >= 2, out)
+  check(not out:find("[\r\27]"), out)
+  raises(function() seixo.progress("yes") end, "boolean or 'log' expected")
+  raises(function() seixo.progress("log", -1) end, "seconds between log lines")
+end)
+
+test("a live plot of histories is redrawn while the model cycles, and changes no bit", function()
+  local plot = require("seixo.plot")
+  local function run(with_plot, out)
+    local m = seixo.model{dim = 2, gravity = {0, -9.81}}
+    m:material("a", {density = 2000, kn = 1e6, ks = 1e6, damping = 0.7})
+    m:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
+    m:ball{pos = {0, 0.01}, radius = 0.005}
+    m:history("kinetic energy", "kinetic", {every = 10})
+    local p
+    if with_plot then p = plot.live(m, "kinetic energy", {every = 100, terminal = "dumb", output = out}) end
+    m:cycle(500)
+    local hash = m:hash()
+    if p then
+      eq(p.draws, 6)  -- at once, then at steps 100, ..., 500
+      check(tostring(p):find("seixo.plot of kinetic energy (6 draws)", 1, true), tostring(p))
+      p:close()
+      check(tostring(p):find("closed", 1, true))
+      raises(function() p:draw() end, "the plot has been closed")
+    end
+    m:cycle(100)  -- no refresh once closed
+    m:close()
+    return hash
+  end
+  local out = os.tmpname()
+  local with = run(true, out)
+  eq(with, run(false))
+  local text = assert(io.open(out)):read("a")
+  os.remove(out)
+  check(text:find("kinetic energy", 1, true) and text:find("step", 1, true), text)
+  raises(function() plot.live(seixo.model{dim = 2}, "nope") end, "no history named 'nope'")
+  raises(function() plot.live(seixo.model{dim = 2}, {}) end, "names of histories expected")
+end)
+
+test("a ball placed behind a wall or overlapping one is an error naming the wall", function()
+  local m = seixo.model{dim = 3}
+  m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  raises(function() m:ball{pos = {0, 0, -1e-3}, radius = 1e-3} end, "m:ball: the ball of radius 0.001 m lies behind wall 1")
+  raises(function() m:ball{pos = {0, 0, 0.2e-3}, radius = 1e-3} end,
+         "would overlap wall 1 by 0.0008 m, 80% of its radius (more than the 50% of seixo.model{overlap_limit})")
+  eq(m:ball_count(), 0)
+  m:ball{pos = {0, 0, 0.6e-3}, radius = 1e-3}  -- 40%: accepted
+  -- the limit is the model's
+  local loose = seixo.model{dim = 3, overlap_limit = 0.9}
+  loose:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+  loose:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  loose:ball{pos = {0, 0, 0.2e-3}, radius = 1e-3}
+  raises(function() seixo.model{overlap_limit = 2} end, "overlap_limit", "[0.0, 1.0]")
+  m:close()
+  loose:close()
+end)
+
+test("balls placed overlapping are named at the first step, not blamed on the timestep", function()
+  local function two(dx, opts)
+    local m = seixo.model(opts or {dim = 3})
+    m:material("glass", {density = 2500, kn = 1e5, ks = 1e5})
+    m:ball{pos = {0, 0, 0}, radius = 1e-3}
+    m:ball{pos = {dx, 0, 0}, radius = 1e-3}
+    return m
+  end
+  -- 60 %: the step succeeds, its contacts show the overlap
+  local m = two(1.4e-3)
+  raises(function() m:cycle(10) end, "m:cycle: balls 1 and 2 overlap by 0.0006 m, 60% of the smaller radius 0.001 m",
+         "the timestep is not the cause")
+  eq(m:step(), 1)
+  -- 180 %: the first step fails as unstable; the placement is still what is named
+  m = two(0.2e-3)
+  local err = raises(function() m:solve{steps = 10} end, "m:solve: balls 1 and 2 overlap by 0.0018 m, 180%")
+  check(not err:find("lower the timestep", 1, true), err)
+  -- 40 %, or a looser limit: no error, and the same bits as with no check
+  m = two(1.6e-3)
+  m:cycle(50)
+  local h = m:hash()
+  m = two(1.6e-3, {dim = 3, overlap_limit = 1})
+  m:cycle(50)
+  eq(m:hash(), h)
+  -- a wall added over a placed ball
+  m = seixo.model{dim = 2}
+  m:material("a", {density = 2650, kn = 1e6, ks = 1e6})
+  m:ball{pos = {0, 0.5e-3}, radius = 1e-3}
+  m:wall{kind = "box", min = {-0.01, 1e-3}, max = {0.01, 0.02}}
+  raises(function() m:cycle(10) end, "ball 1 overlaps wall 3 by 0.0015 m, 150% of its radius 0.001 m (its centre is behind the wall)")
+end)
+
+test("values outside a material's physical range warn once, with the unit expected", function()
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 3}
+m:material("glass", {density = 2.5, kn = 1e5, ks = 1e5})
+m:material("glass2", {density = 2.6})
+m:material("rock", {modulus = 40, stiffness_ratio = 2})
+m:material("fine", {density = 2650, modulus = 40e9})
+w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+w:servo{target = 10, area = 1}
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("seixo: warning: (command line):2: density 2.5 is outside the range of rocks and grains, 100 ... 30000 kg/m^3 (seixo's unit is kg/m^3)", 1, true), out)
+  local _, count = out:gsub("density", "")
+  eq(count, 1, "once per model")
+  check(out:find("(command line):4: modulus 40 is outside the range of rocks and grains, 100000 ... 1e+12 Pa", 1, true), out)
+  check(out:find("(command line):7: servo target stress 10 is outside the range of rocks and grains, 1000 ... 1e+10 Pa (seixo's unit is Pa)", 1, true), out)
+  check(out:find("done\n$"), out)
+end)
+
+T.done()
