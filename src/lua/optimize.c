@@ -31,6 +31,16 @@ typedef struct objective {
     double value;
 } objective;
 
+/* An error at the position of seixo.optimize's caller (level 2: level 1 is
+ * seixo.optimize itself, which called this function through lua_pcall). */
+static int bad_value(lua_State *L, const char *what)
+{
+    luaL_where(L, 2);
+    lua_pushfstring(L, "seixo.optimize: f returned %s, not a number", what);
+    lua_concat(L, 2);
+    return lua_error(L);
+}
+
 /* Runs f(x) in protected mode: the arguments are the objective (a light
  * userdata) and f. */
 static int call_objective(lua_State *L)
@@ -44,8 +54,8 @@ static int call_objective(lua_State *L)
     lua_call(L, 1, 1);  // f(x), f at 2
     int isnum = 0;
     const double v = lua_tonumberx(L, -1, &isnum);
-    if (!isnum) return luaL_error(L, "seixo.optimize: f returned %s, not a number", luaL_typename(L, -1));
-    if (isnan(v)) return luaL_error(L, "seixo.optimize: f returned nan (give failed points a finite penalty)");
+    if (!isnum) return bad_value(L, luaL_typename(L, -1));
+    if (isnan(v)) return bad_value(L, "nan (give failed points a finite penalty)");
     o->value = v;
     return 0;
 }
@@ -142,7 +152,7 @@ static int seixo_optimize(lua_State *L)
     const int which = luaL_checkoption(L, -1, "bobyqa", names);
     lua_pop(L, 1);
     const double maxeval = opt_number(L, "maxeval", 200);
-    if (!(maxeval >= 1 && maxeval <= 1e9)) return luaL_error(L, "seixo.optimize: maxeval must be from 1 to 1e9");
+    if (!(maxeval >= 1 && maxeval <= 1e6)) return luaL_error(L, "seixo.optimize: maxeval must be from 1 to 1e6");
     const double xtol = opt_number(L, "xtol", 1e-4), ftol = opt_number(L, "ftol", 0);
     if (!(xtol >= 0) || !(ftol >= 0)) return luaL_error(L, "seixo.optimize: xtol and ftol must be >= 0");
     const double stopval = opt_number(L, "stopval", -HUGE_VAL);

@@ -5,7 +5,7 @@
  *   seixo.executable()   the path of the running program (to start workers)
  *   seixo.rank(), seixo.ranks()   this process's MPI rank and the number of
  *                        ranks: 0 and 1 unless started under mpirun
- *   seixo.send(rank, text), seixo.receive() -> text, rank   MPI messages
+ *   seixo.send(rank, text), seixo.receive([wait]) -> text, rank   MPI messages
  *
  * MPI is optional (meson finds it or not: SX_HAVE_MPI). A program started
  * by mpirun has OMPI_COMM_WORLD_SIZE (Open MPI) or PMI_SIZE (MPICH, Slurm)
@@ -104,12 +104,14 @@ static int seixo_send(lua_State *L)
     return 0;
 }
 
-/* Waits for the next message from any rank. The wait polls every
+/* The next message from any rank; with wait = false, nil when none has
+ * come. The wait polls every
  * millisecond instead of blocking in MPI_Recv: Open MPI's blocking receive
  * spins on a core, which a rank waiting for a long evaluation would take
  * from the ranks doing the work. */
 static int seixo_receive(lua_State *L)
 {
+    const bool wait = lua_isnoneornil(L, 1) || lua_toboolean(L, 1);
     check_ranks(L, "receive");
 #ifdef SX_HAVE_MPI
     MPI_Status st;
@@ -117,6 +119,7 @@ static int seixo_receive(lua_State *L)
     for (;;) {
         MPI_Iprobe(MPI_ANY_SOURCE, MESSAGE_TAG, MPI_COMM_WORLD, &ready, &st);
         if (ready) break;
+        if (!wait) return 0;
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
@@ -129,6 +132,7 @@ static int seixo_receive(lua_State *L)
     lua_pushinteger(L, st.MPI_SOURCE);
     return 2;
 #else
+    (void)wait;
     return 0;
 #endif
 }
