@@ -11,8 +11,9 @@
 -- strengths (UCS, BTS, c) in proportion to the bond strengths, and nu with
 -- the stiffness ratios (kn/ks and the bond's) by a law that is not a power:
 -- its local exponent comes from a second candidate, perturbed, evaluated
--- beside the first (the pilot). Each free parameter is then scaled to its
--- target (x = x0 (target / achieved)^(1/exponent)), a few times, and NLopt's
+-- beside the first (the pilot), and again between guesses. Each free
+-- parameter is then scaled to its target (x = x0 (target /
+-- achieved)^(1/exponent), a factor of 2 at most), a few times, and NLopt's
 -- BOBYQA polishes the result in log-scaled parameters against normalised
 -- targets (sum of squared relative errors).
 --
@@ -679,13 +680,12 @@ local function calibrate(lab, helpers, opts)
     end
   end
   local cands, perturbed = {o.x0}, {}
-  for i, k in pairs(roles) do
+  for i in pairs(roles) do
     if not o.groups[i].exponent then
       local x = copy(o.x0)
-      local up = o.x0[i] * 1.5 <= o.upper[i]
-      x[i] = clamp(i, up and o.x0[i] * 1.5 or o.x0[i] / 1.5)
+      local up = o.x0[i] * 2 <= o.upper[i]
+      x[i] = clamp(i, up and o.x0[i] * 2 or o.x0[i] / 2)
       if x[i] ~= o.x0[i] then cands[#cands + 1], perturbed[i] = x, #cands + 1 end
-      assert(k)
     end
   end
   local first = evaluate(cands)
@@ -703,7 +703,10 @@ local function calibrate(lab, helpers, opts)
     end
   end
 
-  -- 2. scaling: each parameter with a role times (target / achieved)^(1/exponent)
+  -- 2. scaling: each parameter with a role times (target / achieved)^(1/exponent),
+  -- by a factor of 2 at most (a trust region: a measured exponent can be far
+  -- off); an exponent that was measured is measured again between each guess
+  -- and the candidate it came from (a secant in log-log space)
   local start = best
   for _ = 1, o.guesses do
     if start.objective <= stop or not start.ok then break end
@@ -711,12 +714,21 @@ local function calibrate(lab, helpers, opts)
     for i, k in pairs(roles) do
       local a = start.achieved[k]
       if exponents[i] and a and a.mean > 0 and o.targets[k] > 0 and k ~= "curve" then
-        x[i] = clamp(i, start.x[i] * (o.targets[k] / a.mean) ^ (1 / exponents[i]))
+        local f = math.min(2, math.max(0.5, (o.targets[k] / a.mean) ^ (1 / exponents[i])))
+        x[i] = clamp(i, start.x[i] * f)
         moved = moved or x[i] ~= start.x[i]
       end
     end
     if not moved then break end
     local c = evaluate({x})[1]
+    for i, k in pairs(roles) do
+      local a, b = start.achieved[k], c.achieved[k]
+      if not o.groups[i].exponent and a and b and a.mean > 0 and b.mean > 0
+         and math.abs(math.log(c.x[i] / start.x[i])) > 0.05 then
+        local e = math.log(b.mean / a.mean) / math.log(c.x[i] / start.x[i])
+        if math.abs(e) > 0.05 then exponents[i] = e end
+      end
+    end
     if c.objective >= start.objective then break end
     start = c
   end
