@@ -9,9 +9,9 @@
 --   scripts/run examples/calibrate.lua [out_dir] [maxeval] [seeds] [width_m]
 local lab = require "seixo.lab"
 local out = arg and arg[1] or "lab-results-calibrate"
-local maxeval = tonumber(arg and arg[2]) or 20
+local maxeval = tonumber(arg and arg[2]) or 16
 local seeds = tonumber(arg and arg[3]) or 2
-local width = tonumber(arg and arg[4]) or 0.025
+local width = tonumber(arg and arg[4]) or 0.03
 if seixo.rank() == 0 then os.execute("mkdir -p '" .. out .. "'") end
 
 local t0 = seixo.clock()
@@ -19,7 +19,7 @@ local r = lab.calibrate{
   targets = {E = 69e9, nu = 0.26, UCS = 200e6},
   parameters = {modulus = {20e9, 200e9}, stiffness_ratio = {1, 5}, strength = {50e6, 600e6}},
   specimen = {dim = 2, width = width, height = 2 * width},
-  seeds = seeds, maxeval = maxeval, tolerance = 0.03,
+  seeds = seeds, maxeval = maxeval, tolerance = 0.05,
   out = out .. "/calibration",
 }
 if seixo.rank() == 0 then

@@ -57,12 +57,7 @@ local function fail(fmt, ...)
   error(string.format("lab.calibrate: " .. fmt, ...), level)
 end
 
-local function copy(t)
-  if type(t) ~= "table" then return t end
-  local r = {}
-  for k, v in pairs(t) do r[k] = copy(v) end
-  return r
-end
+local copy -- lab.lua's deep copy, given at install
 
 -- ------------------------------------------------------- the parameters
 
@@ -709,7 +704,7 @@ local function calibrate(lab, helpers, opts)
   -- and the candidate it came from (a secant in log-log space)
   local start = best
   for _ = 1, o.guesses do
-    if start.objective <= stop or not start.ok then break end
+    if start.objective <= stop or not start.ok or #history >= o.maxeval then break end
     local x, moved = copy(start.x), false
     for i, k in pairs(roles) do
       local a = start.achieved[k]
@@ -770,9 +765,11 @@ local function calibrate(lab, helpers, opts)
   return result
 end
 
---- Installs lab.calibrate; lab.lua hands over its gnuplot runner and its
---- atomic file writer (the figures and files of the lab look the same).
+--- Installs lab.calibrate; lab.lua hands over its gnuplot runner, its
+--- atomic file writer (the figures and files of the lab look the same) and
+--- its deep copy.
 function M.install(lab, helpers)
+  copy = helpers.copy
   lab.calibrate = function(opts) return calibrate(lab, helpers, opts) end
 end
 

@@ -1070,5 +1070,5 @@ set yrange [0:%.6g]
 end
 
 -- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures and atomic writes
-require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file})
+require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file, copy = copy})
 return lab

@@ -199,15 +199,40 @@ test("a tiny 2D specimen: the modulus that gives a known E is recovered", functi
   local path = os.tmpname()
   local spec = lab.specimen{dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}, seed = 1, path = path,
                             log = false, material = lab.rock{modulus = 40e9, bond = {modulus = 40e9}}}
-  local E = lab.ucs(spec, {log = false}).young
+  local known = lab.ucs(spec, {log = false})
   os.remove(path)
+  -- the measured curve: ten points of the known test's rise to its peak
+  local curve, peak = {strain = {}, stress = {}}, 1
+  for i, row in ipairs(known.rows) do if row[8] > known.rows[peak][8] then peak = i end end
+  for k = 1, 10 do
+    local row = known.rows[math.max(1, math.floor(peak * k / 10))]
+    curve.strain[k], curve.stress[k] = row[3], row[8]
+  end
   local lines = {}
-  local r = lab.calibrate{targets = {E = E}, parameters = {modulus = {10e9, 200e9, 80e9}}, specimen = recipe,
+  local r = lab.calibrate{targets = {E = known.young, curve = curve}, parameters = {modulus = {10e9, 200e9, 80e9}},
+                          specimen = recipe,
                           seeds = {1}, workers = 1, tolerance = 5e-3, maxeval = 8, log = fresh("calibrate_2d.csv"),
                           out = "calibrate_2d", plot = false, print = function(s) lines[#lines + 1] = s end}
-  near(r.parameters.modulus, 40e9, 0.02)
+  near(r.parameters.modulus, 40e9, 0.02, table.concat(lines, "\n"))
   check(r.evaluations <= 5, table.concat(lines, "\n"))
   check(r.achieved.nu and r.achieved.UCS, "every macro-property of the test is reported")
+  -- the curve's misfit: 80 GPa (the start) is far off, the result close
+  check(r.history[1].achieved.curve.mean > 0.2, "misfit at the start " .. r.history[1].achieved.curve.mean)
+  check(r.achieved.curve.mean < 0.05, "misfit at the end " .. r.achieved.curve.mean)
+end)
+
+test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for their targets", function()
+  local r = lab.calibrate{targets = {BTS = 20e6, c = 30e6, phi = 30}, parameters = {strength = {50e6, 400e6}},
+                          specimen = {dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}},
+                          brazilian = {diameter = 0.012}, confining = {0, 5e6}, seeds = {1}, workers = 1, maxeval = 1,
+                          log = fresh("calibrate_2d_strengths.csv"), out = "calibrate_2d_strengths", plot = false,
+                          print = false}
+  eq(r.evaluations, 1)
+  for _, k in ipairs({"BTS", "c", "phi", "UCS", "E"}) do
+    local a = r.achieved[k]
+    check(a and a.n == 1 and a.mean > 0 and a.mean < math.huge, k)
+  end
+  check(r.achieved.BTS.mean < r.achieved.UCS.mean, "tensile strength below the UCS")
 end)
 
 test("bad options are clear errors at the caller", function()
