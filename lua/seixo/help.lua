@@ -19,6 +19,14 @@ local entries = {
     "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},
   ["seixo.clock"] = {"seixo.clock() -> seconds", "Wall-clock seconds from a monotonic clock: the difference of two readings times a run."},
   ["seixo.threads"] = {"seixo.threads", "OpenMP threads for the step of each new model: --threads N (default 1); results do not depend on it."},
+  ["seixo.optimize"] = {"seixo.optimize(f, {x0 =, lower =, upper =, algorithm = 'bobyqa', maxeval = 200, xtol = 1e-4, ftol = 0, stopval =, step =, seed = 1}) -> x, fmin, {evaluations =, status =}",
+    "Minimises f(x) (x an array, f a number) within bounds by an NLopt derivative-free local algorithm: 'bobyqa', 'neldermead', 'sbplx' or 'cobyla'. xtol, ftol relative; an error in f stops the search and is raised."},
+  ["seixo.cores"] = {"seixo.cores() -> n", "The processors online (lab.calibrate's default number of worker processes)."},
+  ["seixo.executable"] = {"seixo.executable() -> path", "The path of the running seixo program, to start worker processes."},
+  ["seixo.rank"] = {"seixo.rank() -> r", "This process's MPI rank: 0 unless started by mpirun (and seixo built with MPI)."},
+  ["seixo.ranks"] = {"seixo.ranks() -> n", "The number of MPI ranks: 1 unless started by mpirun -np N."},
+  ["seixo.send"] = {"seixo.send(rank, text)", "Sends a string to another MPI rank (under mpirun only)."},
+  ["seixo.receive"] = {"seixo.receive([wait = true]) -> text, rank", "The next string sent by any MPI rank and its sender; with wait = false, nil when none has come."},
   ["help"] = {"help([x])", "Help on x: a function, an object (model, ball, wall, contact), or a name such as \"cycle\" or \"ball.pos\"."},
 
   -- model: set-up

@@ -1073,4 +1073,6 @@ set yrange [0:%.6g]
                           {key = "c", path = out .. "_cracks.png"}, {key = "m", path = out .. "_mohr.png"}})
 end
 
+-- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures and atomic writes
+require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file, copy = copy})
 return lab

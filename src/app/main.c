@@ -984,14 +984,16 @@ static enum parsed parse(int argc, char **argv, options *o)
 int main(int argc, char **argv)
 {
     options o = {0};
+    sx_lua_parallel_start(&argc, &argv);  // MPI_Init under mpirun, before anything reads argv
     switch (parse(argc, argv, &o)) {
-    case DONE: return EXIT_SUCCESS;
-    case BAD: return EXIT_FAILURE;
+    case DONE: sx_lua_parallel_stop(1); return EXIT_SUCCESS;
+    case BAD: sx_lua_parallel_stop(0); return EXIT_FAILURE;
     case RUN: break;
     }
     lua_State *L = luaL_newstate();
     if (!L) {
         message("cannot create the Lua state: not enough memory");
+        sx_lua_parallel_stop(0);
         return EXIT_FAILURE;
     }
     lua_pushcfunction(L, pmain);
@@ -1002,5 +1004,6 @@ int main(int argc, char **argv)
     const bool ok = status == LUA_OK && lua_toboolean(L, -1);
     report(L, status);
     lua_close(L);
+    sx_lua_parallel_stop(ok);
     return ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }

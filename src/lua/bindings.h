@@ -44,6 +44,10 @@ void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
 extern const luaL_Reg sx_lua_clumps_methods[];    ///< clumps.c: clump_template(s), clump, clumps, clump_count
 
+/* Functions of the seixo table beside the loader's own. */
+extern const luaL_Reg sx_lua_optimize_functions[];  ///< optimize.c: seixo.optimize
+extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, executable, rank, ranks, send, receive
+
 /* Classes other than the model's; each leaves nothing on the stack. */
 void sx_lua_balls_register(lua_State *L);
 void sx_lua_walls_register(lua_State *L);

@@ -70,6 +70,8 @@ int luaopen_seixo(lua_State *L)
     sx_lua_contacts_register(L);
     sx_lua_clumps_register(L);
     luaL_newlib(L, functions);
+    luaL_setfuncs(L, sx_lua_optimize_functions, 0); /* optimize.c: seixo.optimize (NLopt) */
+    luaL_setfuncs(L, sx_lua_parallel_functions, 0); /* parallel.c: cores, executable, MPI ranks and messages */
     sx_lua_io_register(L); /* io.c: m:save, m:vars, m:output, seixo.load, seixo.xdmf */
     lua_pushliteral(L, SX_VERSION);
     lua_setfield(L, -2, "version");

@@ -45,3 +45,12 @@ SX_API void sx_lua_set_progress_every(lua_State *L, double seconds);
 /// default): a model that has cycled prints its m:profile() table on
 /// stderr when it is closed or collected. The executable's --profile.
 SX_API void sx_lua_set_profile(lua_State *L, int on);
+
+/// Starts MPI when the program was launched by mpirun (Open MPI's or a
+/// PMI launcher's environment) and seixo was built with MPI; else nothing.
+/// Call it first thing in main; seixo.rank() and seixo.ranks() tell the rest.
+SX_API void sx_lua_parallel_start(int *argc, char ***argv);
+
+/// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
+/// when ok is 0 and other ranks exist (they would wait for this one forever).
+SX_API void sx_lua_parallel_stop(int ok);

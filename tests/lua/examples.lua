@@ -85,4 +85,19 @@ test("clump_triaxial: a 2D specimen of clumps through a UCS and a biaxial test",
   check(out:find("Mohr-Coulomb: c = ", 1, true), out)
 end)
 
+test("calibrate: two candidates of a tiny 2D specimen in worker processes, the table and the plot", function()
+  local dir = os.tmpname()
+  os.remove(dir)
+  local status, out = example("calibrate.lua", T.quote(dir) .. " 2 1 0.012")
+  local plot = io.open(dir .. "/calibration_convergence.png", "rb")
+  local log = require("seixo.util").read_csv(dir .. "/calibration.csv")
+  os.execute("rm -rf " .. T.quote(dir))
+  eq(status, 0, out)
+  check(out:find("calibrate #2: modulus 6.2e+10, stiffness_ratio 5,", 1, true), out) -- the pilot's twin: kn/ks x 2
+  check(out:find("calibrate: 2 evaluations of 1 seeds in", 1, true), out)
+  check(out:find("micro-parameters:", 1, true) and out:find("material: modulus", 1, true), out)
+  eq(log.rows, 2, "two runs logged")
+  if require("seixo.lab").have_gnuplot() then check(plot, "the convergence plot") end
+end)
+
 T.done()

@@ -1,0 +1,776 @@
+-- seixo.calibrate: lab.calibrate, the search for the micro-parameters of a
+-- bonded-particle material that reproduce a rock's macro-properties (seed
+-- 4.4: no formula links the two, so the lab tests are run until they agree).
+--   local r = lab.calibrate{targets = {E = 69e9, nu = 0.26, UCS = 200e6},
+--                           parameters = {modulus = {20e9, 150e9}, stiffness_ratio = {1, 5},
+--                                         strength = {50e6, 500e6}},
+--                           specimen = {dim = 2, width = 0.025, height = 0.05}, seeds = 2}
+--
+-- How it converges in few evaluations: the BPM's known scalings. E grows in
+-- proportion to the moduli at fixed ratios (Ec with the bond's), the
+-- strengths (UCS, BTS, c) in proportion to the bond strengths, and nu with
+-- the stiffness ratios (kn/ks and the bond's) by a law that is not a power:
+-- its local exponent comes from a second candidate, perturbed, evaluated
+-- beside the first (the pilot), and again between guesses. Each free
+-- parameter is then scaled to its target (x = x0 (target /
+-- achieved)^(1/exponent), a factor of 2 at most), a few times, and NLopt's
+-- BOBYQA polishes the result in log-scaled parameters against normalised
+-- targets (sum of squared relative errors).
+--
+-- Noise: every candidate is tested on the same few specimens (seeds), so the
+-- objective is the same function of the parameters at every call (common
+-- random numbers), and each macro-property is reported as mean and scatter.
+--
+-- Parallel: the runs of a batch (candidates x seeds) go to separate
+-- processes, the running script started again by seixo.executable() with
+-- SEIXO_CALIBRATE_JOB naming a job file; that process runs the script up to
+-- this call, which runs the one job, writes its result and exits. Under
+-- mpirun every rank runs the script too: rank 0 searches and the others
+-- wait here for jobs (seixo.send/receive), and all return the same result.
+-- Hence the rule for a script: what comes before lab.calibrate must be cheap
+-- and the same on every run.
+--
+-- Robust: a run that raises an error, goes unstable (a result that is not a
+-- finite number) or stops before its peak is recorded as failed; a
+-- candidate without a successful run costs a penalty and the search goes
+-- on. Every run is logged (a CSV rewritten atomically, one row per run),
+-- and a calibration started again reads its log first: the search is
+-- deterministic, so it passes through the same candidates, finds their runs
+-- in the log and only runs what the log lacks.
+
+local util = require("seixo.util")
+
+local M = {}
+
+local macros = {"E", "nu", "UCS", "BTS", "c", "phi", "curve"}
+local is_macro = {}
+for _, k in ipairs(macros) do is_macro[k] = true end
+-- how each macro-property is shown: a divisor and a unit
+local units = {E = {1e9, "GPa"}, UCS = {1e6, "MPa"}, BTS = {1e6, "MPa"}, c = {1e6, "MPa"}, nu = {1, ""},
+               phi = {1, "deg"}, curve = {1, "(rms misfit)"}}
+
+-- An error at the first caller outside this file: the user's script.
+local here = debug.getinfo(1, "S").source
+local function fail(fmt, ...)
+  local level = 2
+  while debug.getinfo(level, "S") and debug.getinfo(level, "S").source == here do level = level + 1 end
+  error(string.format("lab.calibrate: " .. fmt, ...), level)
+end
+
+local copy -- lab.lua's deep copy, given at install
+
+-- ------------------------------------------------------- the parameters
+
+-- A free parameter's effect on the material: named groups keep the BPM's
+-- ratios (the bond's modulus with the balls', cohesion with tensile
+-- strength, each standard deviation with its mean); any other name is a
+-- dotted path into the material ("bond.radius_multiplier", "damping").
+-- role: the targets it scales, first choice first; exponent: the power law
+-- of that scaling when known (nil: measured by the pilot).
+local function scale_fields(t, f, keys)
+  for _, k in ipairs(keys) do if t[k] then t[k] = t[k] * f end end
+end
+
+local groups = {
+  modulus = {role = {"E"}, exponent = 1, get = function(m) return m.modulus end,
+             set = function(m, v) local f = v / m.modulus; m.modulus = v; scale_fields(m.bond, f, {"modulus"}) end},
+  stiffness_ratio = {role = {"nu"}, get = function(m) return m.stiffness_ratio end,
+                     set = function(m, v)
+                       local f = v / m.stiffness_ratio
+                       m.stiffness_ratio = v
+                       scale_fields(m.bond, f, {"stiffness_ratio"})
+                     end},
+  strength = {role = {"UCS", "BTS", "c"}, exponent = 1, get = function(m) return m.bond.tensile_strength end,
+              set = function(m, v)
+                scale_fields(m.bond, v / m.bond.tensile_strength,
+                             {"tensile_strength", "tensile_strength_sd", "cohesion", "cohesion_sd"})
+              end},
+  tensile_strength = {role = {"BTS"}, exponent = 1, get = function(m) return m.bond.tensile_strength end,
+                      set = function(m, v)
+                        scale_fields(m.bond, v / m.bond.tensile_strength, {"tensile_strength", "tensile_strength_sd"})
+                      end},
+  cohesion = {role = {"c", "UCS"}, exponent = 1, get = function(m) return m.bond.cohesion end,
+              set = function(m, v) scale_fields(m.bond, v / m.bond.cohesion, {"cohesion", "cohesion_sd"}) end},
+  friction = {role = {"phi"}, get = function(m) return m.friction end, set = function(m, v) m.friction = v end},
+}
+
+-- The group of a parameter name: a named one, or a path into the material.
+local function group_of(name, material)
+  if groups[name] then return groups[name] end
+  local keys = {}
+  for k in name:gmatch("[^.]+") do keys[#keys + 1] = k end
+  local function parent(m)
+    for i = 1, #keys - 1 do m = type(m) == "table" and m[keys[i]] or nil end
+    return type(m) == "table" and m or nil
+  end
+  local p = parent(material)
+  if not p or type(p[keys[#keys]]) ~= "number" then
+    local named = {}
+    for k in pairs(groups) do named[#named + 1] = k end
+    table.sort(named)
+    fail("parameter '%s' is neither %s nor a number of the material", name, table.concat(named, ", "))
+  end
+  return {role = {}, get = function(m) return parent(m)[keys[#keys]] end,
+          set = function(m, v) parent(m)[keys[#keys]] = v end}
+end
+
+-- Ten significant digits: the value a run is made with is the value the log
+-- keeps, so a run read back from the log is the same run.
+local function quantize(v) return tonumber(string.format("%.10g", v)) end
+
+-- --------------------------------------------------- messages and files
+
+-- Tables of numbers, strings and booleans to text and back, for job files,
+-- result files and MPI messages; numbers in hexadecimal, exactly.
+local function serialize(v)
+  local t = type(v)
+  if t == "number" then
+    if v ~= v then return "(0/0)" end
+    if v == math.huge then return "math.huge" end
+    if v == -math.huge then return "(-math.huge)" end
+    return math.type(v) == "integer" and string.format("%d", v) or string.format("%a", v)
+  elseif t == "string" then
+    return string.format("%q", v)
+  elseif t == "boolean" then
+    return tostring(v)
+  elseif t == "table" then
+    local parts = {}
+    for k, x in pairs(v) do parts[#parts + 1] = "[" .. serialize(k) .. "]=" .. serialize(x) end
+    return "{" .. table.concat(parts, ",") .. "}"
+  end
+  error("lab.calibrate: a " .. t .. " cannot pass between processes", 2)
+end
+
+local function deserialize(text)
+  local chunk = load("return " .. text, "=message", "t", {math = math})
+  return chunk and chunk() or nil
+end
+
+local function read_all(path)
+  local f = io.open(path, "r")
+  if not f then return nil end
+  local text = f:read("a")
+  f:close()
+  return text
+end
+
+local function quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
+
+-- ------------------------------------------------------ the evaluation
+
+-- The stress of a measured curve's point against the simulated curve
+-- (axial strain, deviator): the relative rms misfit, over the peak of the
+-- measured curve. Past the end of the simulation the last stress counts.
+local function curve_misfit(curve, rows)
+  local peak, sum = 0, 0
+  for _, s in ipairs(curve.stress) do peak = math.max(peak, math.abs(s)) end
+  for i, e in ipairs(curve.strain) do
+    local sim = rows[#rows][8]
+    for j = 2, #rows do
+      if rows[j][3] >= e then
+        local a, b = rows[j - 1], rows[j]
+        local t = b[3] > a[3] and (e - a[3]) / (b[3] - a[3]) or 1
+        sim = a[8] + t * (b[8] - a[8])
+        break
+      end
+    end
+    sum = sum + ((sim - curve.stress[i]) / peak) ^ 2
+  end
+  return math.sqrt(sum / #curve.strain)
+end
+
+-- The lab's own evaluation: a specimen made with the material and seed,
+-- its UCS test (or, for c and phi, the series), and for BTS a disk and its
+-- Brazilian test.
+local function lab_evaluate(lab, o, material, seed)
+  local t = o.targets
+  local base = os.tmpname()
+  local files = {base}
+  local function cleanup() for _, f in ipairs(files) do os.remove(f) end end
+  local ok, out = pcall(function()
+    local recipe = copy(o.specimen)
+    recipe.material, recipe.seed, recipe.log = material, seed, false
+    recipe.path = base .. ".h5"
+    files[#files + 1] = recipe.path
+    local values = {}
+    local function peaked(r, what)
+      if r.stopped ~= "post_peak" then error(string.format("%s stopped on %s before its peak", what, r.stopped), 0) end
+      return r
+    end
+    if t.E or t.nu or t.UCS or t.curve or t.c or t.phi then
+      local spec = lab.specimen(recipe)
+      local test = copy(o.test or {})
+      test.log = false
+      local r
+      if t.c or t.phi then
+        test.confining = o.confining
+        local s = lab.series(spec, test)
+        for i, x in ipairs(s.tests) do
+          peaked(x, string.format("the test at confining %g Pa", o.confining[i]))
+          if x.confining == 0 then r = x end
+        end
+        values.c, values.phi = s.fit.c, s.fit.phi
+      else
+        r = peaked(lab.ucs(spec, test), "the UCS test")
+      end
+      if r then
+        values.E, values.nu, values.UCS = r.young, r.poisson, r.peak
+        if t.curve then values.curve = curve_misfit(t.curve, r.rows) end
+      end
+    end
+    if t.BTS then
+      local disk = copy(recipe)
+      for k, v in pairs(o.brazilian or {}) do disk[k] = v end
+      disk.shape = o.specimen.dim == 3 and "disc" or "disk"
+      disk.path = base .. "_disk.h5"
+      files[#files + 1] = disk.path
+      local b = lab.brazilian(lab.specimen(disk), {log = false})
+      values.BTS = peaked(b, "the Brazilian test").tensile_strength
+    end
+    return values
+  end)
+  cleanup()
+  if not ok then error(out, 0) end
+  return out
+end
+
+-- One run, protected: {status = 1, values = {...}} or {status = 0, error = why}.
+local function run_job(o, x, seed)
+  local t0 = seixo.clock()
+  local ok, values = pcall(o.evaluate, o.material_of(x), seed)
+  if ok and type(values) ~= "table" then ok, values = false, "evaluate returned " .. type(values) end
+  if ok then
+    for _, k in ipairs(o.target_names) do
+      local v = values[k]
+      if type(v) ~= "number" or v ~= v or v == math.huge or v == -math.huge then
+        ok, values = false, string.format("unstable: %s = %s", k, tostring(v))
+        break
+      end
+    end
+  end
+  local rec = {status = ok and 1 or 0, time = seixo.clock() - t0}
+  if ok then
+    rec.values = {}
+    for k, v in pairs(values) do if is_macro[k] and type(v) == "number" then rec.values[k] = quantize(v) end end
+  else
+    rec.error = tostring(values)
+  end
+  return rec
+end
+
+-- ------------------------------------------------------ running batches
+
+-- The script's command line, to start it again as a worker (nil when there
+-- is no script file: an -e chunk, the standard input or the REPL).
+local function script_command()
+  if type(arg) ~= "table" or not arg[0] or arg[0] == "-" then return nil end
+  local lo = 0
+  while arg[lo - 1] do lo = lo - 1 end
+  local parts = {quote(seixo.executable())}
+  for i = lo + 1, #arg do parts[#parts + 1] = quote(arg[i]) end
+  return table.concat(parts, " ")
+end
+
+-- Runs jobs {x =, seed =} in processes, `workers` at a time; each writes
+-- its record to a file. A process that dies without writing one is a
+-- failed run.
+local function run_processes(o, jobs, record)
+  local command = script_command()
+  local running, next_job = {}, 1
+  local function start(i)
+    local stem = string.format("%s.job%d", o.log, i)
+    o.write_file(stem .. ".lua", serialize({log = o.log, x = jobs[i].x, seed = jobs[i].seed, result = stem .. ".out"}))
+    local h = io.popen(string.format("SEIXO_CALIBRATE_JOB=%s %s > %s 2>&1", quote(stem .. ".lua"), command,
+                                     quote(stem .. ".txt")))
+    running[#running + 1] = {i = i, h = h, stem = stem}
+  end
+  while next_job <= #jobs or #running > 0 do
+    while #running < o.workers and next_job <= #jobs do
+      start(next_job)
+      next_job = next_job + 1
+    end
+    local w = table.remove(running, 1)
+    local _, _, code = w.h:close()
+    local rec = deserialize(read_all(w.stem .. ".out") or "")
+    if type(rec) ~= "table" then
+      local tail = (read_all(w.stem .. ".txt") or ""):sub(-300):gsub("%s+$", "")
+      rec = {status = 0, time = 0, error = string.format("the worker exited with code %s: %s", tostring(code), tail)}
+    end
+    for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(w.stem .. ext) end
+    record(w.i, rec)
+  end
+end
+
+-- Runs jobs over the MPI ranks: rank 0 hands each idle rank a job, runs
+-- one itself while any is left, and collects the records as they come.
+local function run_ranks(o, jobs, record)
+  local idle, out, next_job = {}, 0, 1
+  for r = 1, seixo.ranks() - 1 do idle[#idle + 1] = r end
+  local function collect(wait)
+    local text, from = seixo.receive(wait)
+    if not text then return false end
+    local msg = deserialize(text)
+    record(msg.i, msg.rec)
+    idle[#idle + 1], out = from, out - 1
+    return true
+  end
+  while next_job <= #jobs or out > 0 do
+    while collect(false) do end
+    while #idle > 0 and next_job <= #jobs do
+      seixo.send(table.remove(idle, 1), serialize({i = next_job, x = jobs[next_job].x, seed = jobs[next_job].seed}))
+      next_job, out = next_job + 1, out + 1
+    end
+    if next_job <= #jobs then
+      record(next_job, run_job(o, jobs[next_job].x, jobs[next_job].seed))
+      next_job = next_job + 1
+    elseif out > 0 then
+      collect(true)
+    end
+  end
+end
+
+-- A rank other than 0: runs the jobs rank 0 sends until it sends the result.
+local function serve_rank(o)
+  while true do
+    local msg = deserialize((seixo.receive(true)))
+    if msg.done then return msg.done end
+    seixo.send(0, serialize({i = msg.i, rec = run_job(o, msg.x, msg.seed)}))
+  end
+end
+
+-- ------------------------------------------------------------------ log
+
+local function key_of(x, seed)
+  local parts = {}
+  for i, v in ipairs(x) do parts[i] = string.format("%.10g", v) end
+  parts[#parts + 1] = tostring(seed)
+  return table.concat(parts, " ")
+end
+
+local function log_header(o)
+  local h = {"candidate", "seed", "status", "time"}
+  for _, n in ipairs(o.names) do h[#h + 1] = n end
+  for _, k in ipairs(macros) do h[#h + 1] = k end
+  return h
+end
+
+-- The runs of an earlier start of this calibration: key -> record.
+local function read_log(o)
+  local cache, rows = {}, {}
+  if not io.open(o.log, "r") then return cache, rows end
+  local csv = util.read_csv(o.log)
+  local header = log_header(o)
+  if table.concat(csv.header, ",") ~= table.concat(header, ",") then
+    fail("the log %s has the columns %s, not this calibration's %s; remove it or name another log", o.log,
+         table.concat(csv.header, ","), table.concat(header, ","))
+  end
+  for i = 1, csv.rows do
+    local x = {}
+    for j, n in ipairs(o.names) do x[j] = csv.columns[n][i] end
+    local rec = {status = csv.columns.status[i], time = csv.columns.time[i], values = {}, logged = true}
+    for _, k in ipairs(macros) do rec.values[k] = csv.columns[k][i] end
+    if rec.status ~= 1 then rec.values, rec.error = nil, "failed (in the log)" end
+    local row = {}
+    for j, h in ipairs(header) do row[j] = csv.columns[h][i] end
+    rows[#rows + 1] = row
+    cache[key_of(x, csv.columns.seed[i])] = rec
+  end
+  return cache, rows
+end
+
+-- ------------------------------------------------------------- summary
+
+local function mean_sd(list)
+  local n, s = #list, 0
+  for _, v in ipairs(list) do s = s + v end
+  local mean, ss = s / n, 0
+  for _, v in ipairs(list) do ss = ss + (v - mean) ^ 2 end
+  return mean, n > 1 and math.sqrt(ss / (n - 1)) or 0
+end
+
+-- A candidate from its runs: every macro-property's mean, scatter and
+-- count, and the objective: the weighted sum of squared relative errors of
+-- the means (a curve's misfit is already relative), or the penalty when a
+-- target has no successful run.
+local function summarize(o, x, recs)
+  local lists, failed = {}, 0
+  for _, rec in ipairs(recs) do
+    if rec.status == 1 then
+      for k, v in pairs(rec.values) do lists[k] = lists[k] or {}; table.insert(lists[k], v) end
+    else
+      failed = failed + 1
+    end
+  end
+  local c = {x = x, achieved = {}, failed = failed, runs = #recs}
+  for k, l in pairs(lists) do
+    local mean, sd = mean_sd(l)
+    c.achieved[k] = {mean = mean, sd = sd, n = #l}
+  end
+  local f = 0
+  for _, k in ipairs(o.target_names) do
+    local a = c.achieved[k]
+    if not a then f = nil; break end
+    local err = k == "curve" and a.mean or (a.mean - o.targets[k]) / math.abs(o.targets[k])
+    f = f + (o.weights[k] or 1) * err * err
+  end
+  c.objective = f and quantize(f) or o.penalty
+  c.ok = f ~= nil
+  return c
+end
+
+local function show(k, v)
+  local u = units[k]
+  return string.format("%.4g%s", v / u[1], u[2] ~= "" and " " .. u[2] or "")
+end
+
+local function progress(o, c, cached, seconds)
+  local parts = {}
+  for i, n in ipairs(o.names) do parts[#parts + 1] = string.format("%s %.4g", n, c.x[i]) end
+  local got = {}
+  for _, k in ipairs(o.target_names) do
+    local a = c.achieved[k]
+    if a then
+      local err = k == "curve" and "" or string.format(" (%+.1f %%)", 100 * (a.mean / o.targets[k] - 1))
+      got[#got + 1] = string.format("%s %s ± %s%s", k, show(k, a.mean), show(k, a.sd), err)
+    else
+      got[#got + 1] = k .. " failed"
+    end
+  end
+  o.print(string.format("calibrate #%d: %s | %s | objective %.3g (%d runs, %d failed, %s)", c.index,
+                        table.concat(parts, ", "), table.concat(got, ", "), c.objective, c.runs, c.failed,
+                        cached and "from the log" or string.format("%.1f s", seconds)))
+end
+
+-- --------------------------------------------------------- the figures
+
+local function write_convergence(o, history)
+  local header = {"evaluation", "objective"}
+  for _, k in ipairs(o.target_names) do header[#header + 1] = k end
+  local rows = {}
+  for i, c in ipairs(history) do
+    local row = {i, c.objective}
+    for j, k in ipairs(o.target_names) do
+      local a = c.achieved[k]
+      -- achieved over target (a curve: its misfit, whose target is 0)
+      row[j + 2] = a and (k == "curve" and a.mean or a.mean / o.targets[k]) or nil
+    end
+    rows[i] = row
+  end
+  o.lab.write_csv(o.out .. "_convergence.csv", header, rows)
+  if o.plot == false then return end
+  local lines = {}
+  for j, k in ipairs(o.target_names) do
+    lines[#lines + 1] = string.format("'%s' using 1:%d with linespoints lw 2 title '%s%s'", o.out .. "_convergence.csv",
+                                      j + 2, k, k == "curve" and " misfit" or " / target")
+  end
+  lines[#lines + 1] = string.format("'%s' using 1:2 axes x1y2 with linespoints dt 2 title 'objective'",
+                                    o.out .. "_convergence.csv")
+  local script = string.format([[
+set terminal pngcairo size 900,600 font ',11'
+set datafile separator ','
+set grid
+set output '@p@'
+set title 'calibration: achieved / target against evaluations'
+set xlabel 'evaluation (candidate)'
+set ylabel 'achieved / target'
+set y2label 'objective'
+set logscale y2
+set y2tics
+set key outside bottom center horizontal
+plot 1 lc rgb 'black' notitle, %s
+]], table.concat(lines, ", "))
+  o.gnuplot(script, {{key = "p", path = o.out .. "_convergence.png"}})
+end
+
+local function final_table(o, best)
+  local lines = {string.format("%-8s %14s %28s %9s", "target", "wanted", "achieved (mean ± scatter, n)", "error")}
+  for _, k in ipairs(o.target_names) do
+    local a = best.achieved[k]
+    local wanted = k == "curve" and "0" or show(k, o.targets[k])
+    local got = a and string.format("%s ± %s (%d)", show(k, a.mean), show(k, a.sd), a.n) or "failed"
+    local err = (a and k ~= "curve") and string.format("%+.1f %%", 100 * (a.mean / o.targets[k] - 1)) or ""
+    lines[#lines + 1] = string.format("%-8s %14s %28s %9s", k, wanted, got, err)
+  end
+  for k, a in pairs(best.achieved) do
+    if not o.targets[k] then
+      lines[#lines + 1] = string.format("%-8s %14s %28s", k, "-", string.format("%s ± %s (%d)", show(k, a.mean),
+                                                                                 show(k, a.sd), a.n))
+    end
+  end
+  lines[#lines + 1] = "micro-parameters:"
+  for i, n in ipairs(o.names) do lines[#lines + 1] = string.format("  %-18s %.6g", n, best.x[i]) end
+  return table.concat(lines, "\n")
+end
+
+-- -------------------------------------------------------------- options
+
+local option_keys = {"targets", "weights", "parameters", "material", "specimen", "test", "confining", "brazilian",
+                     "seeds", "workers", "maxeval", "xtol", "tolerance", "algorithm", "guesses", "penalty", "log",
+                     "out", "plot", "print", "evaluate"}
+
+local function check_options(lab, opts)
+  if type(opts) ~= "table" then fail("a table of options expected, got %s", type(opts)) end
+  local allowed = {}
+  for _, k in ipairs(option_keys) do allowed[k] = true end
+  for k in pairs(opts) do
+    if not allowed[k] then fail("unknown option '%s' (valid: %s)", tostring(k), table.concat(option_keys, ", ")) end
+  end
+  local o = {lab = lab, weights = opts.weights or {}, targets = {}, target_names = {}}
+  if type(opts.targets) ~= "table" then fail("targets = {E =, nu =, UCS =, BTS =, c =, phi =, curve =} expected") end
+  for _, k in ipairs(macros) do
+    local v = opts.targets[k]
+    if v ~= nil then
+      if k == "curve" then
+        if type(v) ~= "table" or type(v.strain) ~= "table" or type(v.stress) ~= "table" or #v.strain < 2
+           or #v.strain ~= #v.stress then
+          fail("targets.curve = {strain = {...}, stress = {...}} (axial strain, deviator [Pa]) of equal lengths >= 2")
+        end
+      elseif type(v) ~= "number" or v ~= v or v == 0 or math.abs(v) == math.huge then
+        fail("targets.%s must be a finite non-zero number (got %s)", k, tostring(v))
+      end
+      o.targets[k] = v
+      o.target_names[#o.target_names + 1] = k
+    end
+  end
+  for k in pairs(opts.targets) do
+    if not is_macro[k] then fail("unknown target '%s' (valid: %s)", tostring(k), table.concat(macros, ", ")) end
+  end
+  if #o.target_names == 0 then fail("no target given") end
+  if (o.targets.c or o.targets.phi) and not opts.evaluate
+     and (type(opts.confining) ~= "table" or #opts.confining < 2) then
+    fail("targets c and phi need a series: confining = {0, sigma3, ...}")
+  end
+  o.confining = opts.confining
+  o.material = lab.rock(opts.material)
+  if type(opts.parameters) ~= "table" or next(opts.parameters) == nil then
+    fail("parameters = {name = {lower, upper}, ...} expected (names: modulus, stiffness_ratio, strength, ...)")
+  end
+  o.names, o.lower, o.upper, o.x0, o.groups = {}, {}, {}, {}, {}
+  for name in pairs(opts.parameters) do o.names[#o.names + 1] = name end
+  table.sort(o.names)
+  for i, name in ipairs(o.names) do
+    local b = opts.parameters[name]
+    local g = group_of(name, o.material)
+    if type(b) ~= "table" or type(b[1]) ~= "number" or type(b[2]) ~= "number" or not (b[1] < b[2]) then
+      fail("parameters.%s must be {lower, upper} with lower < upper", name)
+    end
+    o.groups[i], o.lower[i], o.upper[i] = g, b[1], b[2]
+    o.x0[i] = quantize(math.min(b[2], math.max(b[1], b[3] or g.get(o.material))))
+  end
+  function o.material_of(x)
+    local m = copy(o.material)
+    for i, g in ipairs(o.groups) do g.set(m, x[i]) end
+    return m
+  end
+  if opts.evaluate ~= nil and type(opts.evaluate) ~= "function" then fail("evaluate must be a function") end
+  if not opts.evaluate and type(opts.specimen) ~= "table" then
+    fail("specimen = {dim =, width =, height =, ...} (lab.specimen's options) expected")
+  end
+  o.specimen, o.test, o.brazilian = opts.specimen, opts.test, opts.brazilian
+  o.evaluate = opts.evaluate or function(material, seed) return lab_evaluate(lab, o, material, seed) end
+  local seeds = opts.seeds or 3
+  if type(seeds) == "number" then
+    if seeds < 1 or seeds ~= math.floor(seeds) then fail("seeds must be a count >= 1 or a list") end
+    o.seeds = {}
+    for i = 1, seeds do o.seeds[i] = i end
+  elseif type(seeds) == "table" and #seeds > 0 then
+    o.seeds = seeds
+  else
+    fail("seeds must be a count >= 1 or a list of seeds")
+  end
+  o.workers = opts.workers or seixo.cores()
+  if type(o.workers) ~= "number" or o.workers < 1 then fail("workers must be >= 1") end
+  o.maxeval = opts.maxeval or 40
+  o.xtol = opts.xtol or 1e-3
+  o.tolerance = opts.tolerance or 0.02
+  o.guesses = opts.guesses or 3
+  o.penalty = opts.penalty or 10
+  o.algorithm = opts.algorithm or "bobyqa"
+  o.out = opts.out or "calibration"
+  o.log = opts.log or (o.out .. ".csv")
+  o.plot = opts.plot
+  o.print = opts.print == false and function() end or opts.print or print
+  return o
+end
+
+-- -------------------------------------------------------------- search
+
+local function calibrate(lab, helpers, opts)
+  local o = check_options(lab, opts)
+  o.gnuplot, o.write_file = helpers.gnuplot, helpers.write_file
+  if seixo.rank() > 0 then return serve_rank(o) end
+
+  -- a worker process started for one run of this calibration
+  local job_file = os.getenv("SEIXO_CALIBRATE_JOB")
+  local job = job_file and deserialize(read_all(job_file) or "") or nil
+  if job and job.log == o.log then
+    o.write_file(job.result, serialize(run_job(o, job.x, job.seed)))
+    os.exit(0, true)
+  end
+  -- (a worker for a later calibration of the script replays this one from its log)
+  local replay = job ~= nil
+  local mode = seixo.ranks() > 1 and "ranks" or (o.workers > 1 and script_command() and "processes" or "serial")
+  if mode == "serial" then o.workers = 1 end
+
+  local cache, log_rows = read_log(o)
+  local history, best = {}, nil
+  local t_start = seixo.clock()
+
+  -- Evaluates the candidates (arrays of quantized values): their runs not
+  -- in the log go out in one batch; returns their summaries.
+  local function evaluate(cands)
+    local jobs = {}
+    for _, x in ipairs(cands) do
+      for _, seed in ipairs(o.seeds) do
+        if not cache[key_of(x, seed)] then jobs[#jobs + 1] = {x = x, seed = seed} end
+      end
+    end
+    local t0 = seixo.clock()
+    if #jobs > 0 and replay then
+      fail("this worker replays the calibration logged in %s, which is not finished", o.log)
+    end
+    local function record(i, rec)
+      local j = jobs[i]
+      cache[key_of(j.x, j.seed)] = rec
+      local row = {#history + 1, j.seed, rec.status, rec.time}
+      for _, v in ipairs(j.x) do row[#row + 1] = v end
+      for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
+      log_rows[#log_rows + 1] = row
+      lab.write_csv(o.log, log_header(o), log_rows)
+      if rec.status ~= 1 then o.print(string.format("calibrate: run failed (seed %s): %s", tostring(j.seed), rec.error)) end
+    end
+    if mode == "ranks" then
+      run_ranks(o, jobs, record)
+    elseif mode == "processes" then
+      run_processes(o, jobs, record)
+    else
+      for i, j in ipairs(jobs) do record(i, run_job(o, j.x, j.seed)) end
+    end
+    local out = {}
+    for _, x in ipairs(cands) do
+      local recs = {}
+      for _, seed in ipairs(o.seeds) do recs[#recs + 1] = cache[key_of(x, seed)] end
+      local c = summarize(o, x, recs)
+      history[#history + 1] = c
+      c.index = #history
+      if not best or c.objective < best.objective then best = c end
+      progress(o, c, #jobs == 0, seixo.clock() - t0)
+      out[#out + 1] = c
+    end
+    if not replay then write_convergence(o, history) end
+    return out
+  end
+
+  local function clamp(i, v) return quantize(math.min(o.upper[i], math.max(o.lower[i], v))) end
+  local stop = o.tolerance ^ 2  -- every relative error within the tolerance, at most
+
+  -- 1. the pilot, with a perturbed candidate for each scaling whose exponent is unknown
+  local roles, claimed = {}, {}
+  for i, g in ipairs(o.groups) do
+    for _, k in ipairs(g.role) do
+      if o.targets[k] and not claimed[k] then
+        roles[i], claimed[k] = k, true
+        break
+      end
+    end
+  end
+  local cands, perturbed = {o.x0}, {}
+  for i in pairs(roles) do
+    if not o.groups[i].exponent then
+      local x = copy(o.x0)
+      local up = o.x0[i] * 2 <= o.upper[i]
+      x[i] = clamp(i, up and o.x0[i] * 2 or o.x0[i] / 2)
+      if x[i] ~= o.x0[i] then cands[#cands + 1], perturbed[i] = x, #cands + 1 end
+    end
+  end
+  local first = evaluate(cands)
+  local pilot = first[1]
+  local exponents = {}
+  for i, k in pairs(roles) do
+    if o.groups[i].exponent then
+      exponents[i] = o.groups[i].exponent
+    elseif perturbed[i] then
+      local p, q = pilot.achieved[k], first[perturbed[i]].achieved[k]
+      if p and q and p.mean > 0 and q.mean > 0 then
+        local e = math.log(q.mean / p.mean) / math.log(cands[perturbed[i]][i] / o.x0[i])
+        if math.abs(e) > 0.05 then exponents[i] = e end
+      end
+    end
+  end
+
+  -- 2. scaling: each parameter with a role times (target / achieved)^(1/exponent),
+  -- by a factor of 2 at most (a trust region: a measured exponent can be far
+  -- off); an exponent that was measured is measured again between each guess
+  -- and the candidate it came from (a secant in log-log space)
+  local start = best
+  for _ = 1, o.guesses do
+    if start.objective <= stop or not start.ok or #history >= o.maxeval then break end
+    local x, moved = copy(start.x), false
+    for i, k in pairs(roles) do
+      local a = start.achieved[k]
+      if exponents[i] and a and a.mean > 0 and o.targets[k] > 0 and k ~= "curve" then
+        local f = math.min(2, math.max(0.5, (o.targets[k] / a.mean) ^ (1 / exponents[i])))
+        x[i] = clamp(i, start.x[i] * f)
+        moved = moved or x[i] ~= start.x[i]
+      end
+    end
+    if not moved then break end
+    local c = evaluate({x})[1]
+    for i, k in pairs(roles) do
+      local a, b = start.achieved[k], c.achieved[k]
+      if not o.groups[i].exponent and a and b and a.mean > 0 and b.mean > 0
+         and math.abs(math.log(c.x[i] / start.x[i])) > 0.05 then
+        local e = math.log(b.mean / a.mean) / math.log(c.x[i] / start.x[i])
+        if math.abs(e) > 0.05 then exponents[i] = e end
+      end
+    end
+    if c.objective >= start.objective then break end
+    start = c
+  end
+
+  -- 3. NLopt from the best so far, in parameters scaled to [0, 1] (log-scaled when positive)
+  local function to_unit(i, v)
+    if o.lower[i] > 0 then return math.log(v / o.lower[i]) / math.log(o.upper[i] / o.lower[i]) end
+    return (v - o.lower[i]) / (o.upper[i] - o.lower[i])
+  end
+  local function from_unit(i, u)
+    if o.lower[i] > 0 then return o.lower[i] * (o.upper[i] / o.lower[i]) ^ u end
+    return o.lower[i] + u * (o.upper[i] - o.lower[i])
+  end
+  local left = o.maxeval - #history
+  local status = best.objective <= stop and "tolerance" or "maxeval"
+  if left > 0 and best.objective > stop then
+    local u0, lo, hi = {}, {}, {}
+    for i in ipairs(o.names) do u0[i], lo[i], hi[i] = to_unit(i, best.x[i]), 0, 1 end
+    local _, _, info = seixo.optimize(function(u)
+      local x = {}
+      for i in ipairs(o.names) do x[i] = clamp(i, from_unit(i, u[i])) end
+      return evaluate({x})[1].objective
+    end, {x0 = u0, lower = lo, upper = hi, algorithm = o.algorithm, maxeval = left, xtol = o.xtol, stopval = stop,
+          step = (function() local s = {} for i in ipairs(o.names) do s[i] = 0.05 end return s end)()})
+    status = info.status == "stopval" and "tolerance" or info.status
+  end
+
+  local result = {parameters = {}, material = o.material_of(best.x), achieved = best.achieved,
+                  objective = best.objective, evaluations = #history, status = status, log = o.log,
+                  wall_time = seixo.clock() - t_start, history = {}}
+  for i, n in ipairs(o.names) do result.parameters[n] = best.x[i] end
+  for i, c in ipairs(history) do result.history[i] = {objective = c.objective, achieved = c.achieved} end
+  result.table = final_table(o, best)
+  if not replay then
+    o.print(string.format("calibrate: %s after %d evaluations (%.1f s); best:\n%s", status, #history,
+                          result.wall_time, result.table))
+  end
+  for r = 1, seixo.ranks() - 1 do seixo.send(r, serialize({done = result})) end
+  return result
+end
+
+--- Installs lab.calibrate; lab.lua hands over its gnuplot runner, its
+--- atomic file writer (the figures and files of the lab look the same) and
+--- its deep copy.
+function M.install(lab, helpers)
+  copy = helpers.copy
+  lab.calibrate = function(opts) return calibrate(lab, helpers, opts) end
+end
+
+return M

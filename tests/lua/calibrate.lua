@@ -1,0 +1,252 @@
+-- lab.calibrate and seixo.optimize: the optimiser recovers known
+-- parameters of a cheap synthetic material and of a tiny 2D specimen; runs
+-- spread over worker processes; a killed calibration resumes from its log
+-- without repeating a run; a failing run is recorded and the search goes on.
+--
+-- lab.calibrate with workers > 1 starts this script again in each worker
+-- process (SEIXO_CALIBRATE_JOB set), which runs it up to the calibration it
+-- serves: hence the calibrations that use processes come first, and the
+-- logs are removed only by the parent.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near = T.test, T.check, T.eq, T.near
+local lab = require("seixo.lab")
+local util = require("seixo.util")
+
+local worker = os.getenv("SEIXO_CALIBRATE_JOB") ~= nil
+local function fresh(path)
+  if not worker then os.remove(path) end
+  return path
+end
+
+-- The synthetic material: E with the modulus (and a little with the
+-- stiffness ratio), nu with the stiffness ratio (not a power law), UCS with
+-- the bond strength; each seed scatters them by a few per cent about the
+-- law, with a mean of zero over the seeds 1, 2, 3.
+local calls = 0
+local function synthetic(material, seed)
+  calls = calls + 1
+  local s = seed - 2
+  local kr = material.stiffness_ratio
+  return {E = 1.1 * material.modulus * (1 + 0.1 / kr) * (1 + 0.02 * s),
+          nu = (0.5 - 0.6 / (kr + 1)) * (1 - 0.03 * s),
+          UCS = 1.3 * material.bond.tensile_strength * (1 + 0.04 * s)}
+end
+-- the targets of the known parameters modulus 50 GPa, stiffness ratio 2, strength 120 MPa
+local known = {modulus = 50e9, stiffness_ratio = 2, strength = 120e6}
+local targets = {E = 1.1 * 50e9 * 1.05, nu = 0.5 - 0.6 / 3, UCS = 1.3 * 120e6}
+local bounds = {modulus = {10e9, 200e9}, stiffness_ratio = {1, 6}, strength = {30e6, 600e6}}
+
+local function recovered(r, rel)
+  for k, v in pairs(known) do near(r.parameters[k], v, rel) end
+  near(r.material.bond.tensile_strength, known.strength, rel)
+  -- the ratios of the BPM stay: the bond's modulus with the balls', cohesion with tensile strength
+  near(r.material.bond.modulus, r.material.modulus, 1e-12)
+  near(r.material.bond.cohesion, r.material.bond.tensile_strength, 1e-12)
+end
+
+test("seixo.optimize: BOBYQA and Nelder-Mead find a bounded minimum; f's error comes through", function()
+  for _, alg in ipairs({"bobyqa", "neldermead", "sbplx"}) do
+    local x, f, info = seixo.optimize(function(x) return (x[1] - 1.5) ^ 2 + 10 * (x[2] + 0.25) ^ 2 end,
+                                      {x0 = {0, 0}, lower = {-2, -2}, upper = {2, 2}, algorithm = alg, maxeval = 500,
+                                       xtol = 1e-10})
+    near(x[1], 1.5, 1e-4)
+    near(x[2], -0.25, 1e-4)
+    check(f < 1e-8 and info.evaluations <= 500, alg)
+  end
+  -- the minimum outside the box: the bound
+  local x = seixo.optimize(function(x) return (x[1] - 5) ^ 2 end, {x0 = {0}, lower = {-1}, upper = {1}})
+  near(x[1], 1, 1e-9)
+  local n = 0
+  T.raises(function() seixo.optimize(function(x) n = n + 1; if n == 3 then error("boom") end return x[1] ^ 2 end,
+                                     {x0 = {0.5}, lower = {-1}, upper = {1}}) end, "boom")
+  eq(n, 3, "f is not called after its error")
+  T.raises(function() seixo.optimize(function() return 0 / 0 end, {x0 = {0}, lower = {-1}, upper = {1}}) end,
+           "f returned nan")
+  T.raises(function() seixo.optimize(function() return 1 end, {x0 = {3}, lower = {-1}, upper = {1}}) end,
+           "outside its bounds")
+  T.raises(function() seixo.optimize(function() return 1 end, {x0 = {0}, lower = {1}, upper = {-1}}) end,
+           "must be below")
+end)
+
+test("synthetic material over 2 worker processes: the known parameters, every run in the log", function()
+  local log = fresh("calibrate_processes.csv")
+  local r = lab.calibrate{targets = targets, parameters = bounds, evaluate = synthetic, seeds = 3, workers = 2,
+                          tolerance = 1e-3, maxeval = 60, log = log, out = "calibrate_processes", plot = false,
+                          print = false}
+  recovered(r, 1e-2)
+  eq(calls, 0, "every run was made in a worker process")
+  local csv = util.read_csv(log)
+  -- one row per run: each distinct candidate once per seed (a candidate met again comes from the log)
+  local distinct = {}
+  for i = 1, csv.rows do
+    eq(csv.columns.status[i], 1)
+    local key = string.format("%.10g %.10g %.10g", csv.columns.modulus[i], csv.columns.stiffness_ratio[i],
+                              csv.columns.strength[i])
+    distinct[key] = (distinct[key] or 0) + 1
+  end
+  for key, n in pairs(distinct) do eq(n, 3, key) end
+  check(csv.rows <= 3 * r.evaluations)
+  -- the scatter over the seeds: E's law scatters by 2 % per seed (sd 2 % of the mean)
+  near(r.achieved.E.sd / r.achieved.E.mean, 0.02, 1e-2)
+  eq(r.achieved.E.n, 3)
+end)
+
+if worker then return end -- the worker processes stop here: what follows runs in-process
+
+test("synthetic material: few evaluations thanks to the scalings; the table and the figure", function()
+  calls = 0
+  local lines = {}
+  local r = lab.calibrate{targets = targets, parameters = bounds, evaluate = synthetic, seeds = 3, workers = 1,
+                          tolerance = 1e-2, maxeval = 60, log = fresh("calibrate_serial.csv"), out = "calibrate_serial",
+                          print = function(s) lines[#lines + 1] = s end}
+  recovered(r, 2e-2)
+  -- the pilot, its perturbed twin (nu's exponent) and the scaled guesses reach 1 %
+  check(r.evaluations <= 6, "evaluations: " .. r.evaluations)
+  eq(calls, 3 * r.evaluations)
+  check(r.status == "tolerance", r.status)
+  local text = table.concat(lines, "\n")
+  check(text:find("calibrate #1:", 1, true) and text:find("micro-parameters:", 1, true), text)
+  check(r.table:find("E%s+57.75 GPa"), r.table)
+  local conv = util.read_csv("calibrate_serial_convergence.csv")
+  eq(conv.rows, r.evaluations)
+  if lab.have_gnuplot() then check(io.open("calibrate_serial_convergence.png", "rb"), "the convergence plot") end
+end)
+
+test("a failing run is recorded and skipped; a candidate with no run left costs the penalty", function()
+  local failures = 0
+  local failing = function(material, seed)
+    if seed == 2 and failures < 3 then failures = failures + 1; error("the specimen went unstable") end
+    if material.modulus > 150e9 then return {E = 0 / 0, nu = 0.3, UCS = 1e8} end -- not finite: failed
+    return synthetic(material, seed)
+  end
+  local log = fresh("calibrate_failing.csv")
+  local lines = {}
+  local r = lab.calibrate{targets = targets, parameters = bounds, evaluate = failing, seeds = 3, workers = 1,
+                          tolerance = 1e-3, maxeval = 60, log = log, out = "calibrate_failing", plot = false,
+                          print = function(s) lines[#lines + 1] = s end}
+  local csv = util.read_csv(log)
+  local failed = 0
+  for i = 1, csv.rows do if csv.columns.status[i] == 0 then failed = failed + 1 end end
+  check(failed >= 3, "failed runs in the log: " .. failed)
+  check(table.concat(lines, "\n"):find("the specimen went unstable", 1, true), "the failure is reported")
+  recovered(r, 2e-2)
+  -- all seeds failing: the penalty
+  local p = lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = function() error("no") end,
+                          seeds = 2, workers = 1, maxeval = 4, log = fresh("calibrate_penalty.csv"),
+                          out = "calibrate_penalty", plot = false, print = false, penalty = 7}
+  eq(p.objective, 7)
+  eq(p.evaluations, 4)
+end)
+
+test("a calibration killed in the middle resumes from its log without repeating a run", function()
+  local log = fresh("calibrate_resume.csv")
+  local script = os.tmpname()
+  local f = assert(io.open(script, "w"))
+  f:write(string.format([[
+local lab = require("seixo.lab")
+local kill_at, n = tonumber(os.getenv("KILL_AT")), 0
+local function synthetic(material, seed)
+  n = n + 1
+  if n == kill_at then os.exit(9) end -- a hard stop in the middle of a run
+  local h = io.open(%q, "a")
+  h:write(material.modulus, " ", material.stiffness_ratio, " ", material.bond.tensile_strength, " ", seed, "\n")
+  h:close()
+  local kr = material.stiffness_ratio
+  return {E = 1.1 * material.modulus * (1 + 0.1 / kr) * (1 + 0.02 * (seed - 2)), nu = 0.5 - 0.6 / (kr + 1),
+          UCS = 1.3 * material.bond.tensile_strength}
+end
+local r = lab.calibrate{targets = {E = %.17g, nu = 0.3, UCS = 156e6}, parameters = {modulus = {10e9, 200e9},
+  stiffness_ratio = {1, 6}, strength = {30e6, 600e6}}, evaluate = synthetic, seeds = 2, workers = 1,
+  tolerance = 1e-3, maxeval = 40, log = %q, out = %q, plot = false}
+print(string.format("RESULT %%.10g %%.10g %%.10g %%d", r.parameters.modulus, r.parameters.stiffness_ratio,
+                    r.parameters.strength, r.evaluations))
+]], log .. ".runs", 1.1 * 50e9 * 1.05, log, log:gsub("%.csv$", "")))
+  f:close()
+  os.remove(log .. ".runs")
+  local status, out = T.run("'" .. script .. "'", nil)
+  eq(status, 0, out)
+  local whole = out:match("RESULT ([^\n]+)")
+  local runs = 0
+  for _ in io.lines(log .. ".runs") do runs = runs + 1 end
+  -- again, killed at the 9th run, then resumed
+  os.remove(log)
+  os.remove(log .. ".runs")
+  local p = io.popen("KILL_AT=9 timeout 120 " .. T.quote(T.seixo) .. " " .. T.quote(script) .. " 2>&1")
+  local killed_out = p:read("a")
+  local _, _, code = p:close()
+  eq(code, 9, killed_out)
+  local before = 0
+  for _ in io.lines(log .. ".runs") do before = before + 1 end
+  eq(before, 8, "runs before the kill")
+  eq(util.read_csv(log).rows, 8, "the log holds every finished run")
+  status, out = T.run("'" .. script .. "'")
+  eq(status, 0, out)
+  eq(out:match("RESULT ([^\n]+)"), whole, "the resumed calibration ends where the whole one did")
+  local total, seen, repeated = 0, {}, 0
+  for line in io.lines(log .. ".runs") do
+    total = total + 1
+    if seen[line] then repeated = repeated + 1 end
+    seen[line] = true
+  end
+  eq(total, runs, "the two parts made as many runs as the whole calibration")
+  eq(repeated, 0, "no run repeated")
+  check(out:find("from the log", 1, true), out)
+  os.remove(script)
+end)
+
+test("a tiny 2D specimen: the modulus that gives a known E is recovered", function()
+  local recipe = {dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}}
+  local path = os.tmpname()
+  local spec = lab.specimen{dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}, seed = 1, path = path,
+                            log = false, material = lab.rock{modulus = 40e9, bond = {modulus = 40e9}}}
+  local known = lab.ucs(spec, {log = false})
+  os.remove(path)
+  -- the measured curve: ten points of the known test's rise to its peak
+  local curve, peak = {strain = {}, stress = {}}, 1
+  for i, row in ipairs(known.rows) do if row[8] > known.rows[peak][8] then peak = i end end
+  for k = 1, 10 do
+    local row = known.rows[math.max(1, math.floor(peak * k / 10))]
+    curve.strain[k], curve.stress[k] = row[3], row[8]
+  end
+  local lines = {}
+  local r = lab.calibrate{targets = {E = known.young, curve = curve}, parameters = {modulus = {10e9, 200e9, 80e9}},
+                          specimen = recipe,
+                          seeds = {1}, workers = 1, tolerance = 5e-3, maxeval = 8, log = fresh("calibrate_2d.csv"),
+                          out = "calibrate_2d", plot = false, print = function(s) lines[#lines + 1] = s end}
+  near(r.parameters.modulus, 40e9, 0.02, table.concat(lines, "\n"))
+  check(r.evaluations <= 5, table.concat(lines, "\n"))
+  check(r.achieved.nu and r.achieved.UCS, "every macro-property of the test is reported")
+  -- the curve's misfit: 80 GPa (the start) is far off, the result close
+  check(r.history[1].achieved.curve.mean > 0.2, "misfit at the start " .. r.history[1].achieved.curve.mean)
+  check(r.achieved.curve.mean < 0.05, "misfit at the end " .. r.achieved.curve.mean)
+end)
+
+test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for their targets", function()
+  local r = lab.calibrate{targets = {BTS = 20e6, c = 30e6, phi = 30}, parameters = {strength = {50e6, 400e6}},
+                          specimen = {dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}},
+                          brazilian = {diameter = 0.012}, confining = {0, 5e6}, seeds = {1}, workers = 1, maxeval = 1,
+                          log = fresh("calibrate_2d_strengths.csv"), out = "calibrate_2d_strengths", plot = false,
+                          print = false}
+  eq(r.evaluations, 1)
+  for _, k in ipairs({"BTS", "c", "phi", "UCS", "E"}) do
+    local a = r.achieved[k]
+    check(a and a.n == 1 and a.mean > 0 and a.mean < math.huge, k)
+  end
+  check(r.achieved.BTS.mean < r.achieved.UCS.mean, "tensile strength below the UCS")
+end)
+
+test("bad options are clear errors at the caller", function()
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {2e9, 1e9}}, evaluate = synthetic} end,
+           "parameters.modulus must be {lower, upper}")
+  T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
+           "unknown target 'G'")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {nothing = {1, 2}}, evaluate = synthetic} end,
+           "parameter 'nothing'")
+  T.raises(function() lab.calibrate{targets = {c = 1e6}, parameters = {cohesion = {1e6, 2e6}}, specimen = {}} end,
+           "confining")
+  local err = T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}} end,
+                       "specimen =")
+  check(err:find("calibrate.lua:%d+:"), "the position is the caller's: " .. err)
+end)
+
+T.done()
