@@ -39,11 +39,17 @@ sx_model_def sx_model_default_def(void)
     return d;
 }
 
+/* A user timestep: 0 (automatic), or from 1e-15 s (below, a step no
+ * longer advances the time of a long run; a denormal is no timestep) to
+ * 1 s (a DEM timestep is orders of magnitude below: a larger one is a
+ * mistake of units). */
+static bool timestep_ok(double dt) { return dt == 0 || (dt >= 1e-15 && dt <= 1); }
+
 sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
 {
     const char *why = NULL;
     if (def->dim != 2 && def->dim != 3) why = "dim must be 2 or 3";
-    else if (!(def->timestep >= 0) || !isfinite(def->timestep)) why = "timestep must be >= 0 (0 = automatic)";
+    else if (!timestep_ok(def->timestep)) why = "timestep must be 0 (automatic) or in [1e-15, 1] s";
     else if (!(def->timestep_safety > 0 && def->timestep_safety <= 1)) why = "timestep_safety must be in (0, 1]";
     else if (!(def->skin >= 0) || !isfinite(def->skin)) why = "skin must be >= 0 (0 = automatic)";
     for (int k = 0; k < 3 && !why; k++)
@@ -197,13 +203,12 @@ sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out)
     return SX_OK;
 }
 
-sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *d, int *out)
+/* The first rule a material definition breaks (its value in *bad), or
+ * NULL: for sx_material_set and for a loaded state alike. */
+const char *sx__material_invalid(const sx_material_def *d, double *bad)
 {
-    if (m->locked) return sx__fail(m, SX_ELOCKED, "material: the model is stepping");
-    if (!name || !*name || strlen(name) >= sizeof m->mats[0].name)
-        return sx__fail(m, SX_EINVAL, "material: the name must have 1 to %zu characters", sizeof m->mats[0].name - 1);
 #define CHECK(cond, what, val) \
-    if (!(cond) || !isfinite(val)) return sx__fail(m, SX_EINVAL, "material '%s': %s (got %g)", name, what, val)
+    if (!(cond) || !isfinite(val)) return *bad = (val), (what)
     CHECK(d->density > 0, "density must be > 0 kg/m^3", d->density);
     CHECK(d->kn > 0, "kn must be > 0 N/m", d->kn);
     CHECK(d->ks >= 0, "ks must be >= 0 N/m", d->ks);
@@ -213,13 +218,24 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     CHECK(d->viscous_shear >= 0, "viscous_shear must be >= 0", d->viscous_shear);
     CHECK(d->modulus >= 0, "modulus must be >= 0 Pa (0: use kn, ks)", d->modulus);
     CHECK(d->stiffness_ratio > 0, "stiffness_ratio (kn/ks) must be > 0", d->stiffness_ratio);
-    if (d->model != SX_MODEL_LINEAR && d->model != SX_MODEL_HERTZ)
-        return sx__fail(m, SX_EINVAL, "material '%s': model must be linear or hertz", name);
-    if (d->model == SX_MODEL_HERTZ) {
-        CHECK(d->shear_modulus > 0, "the Hertz shear modulus must be > 0 Pa", d->shear_modulus);
-        CHECK(d->poisson >= 0 && d->poisson < 0.5, "the Hertz Poisson's ratio must be in [0, 0.5)", d->poisson);
-    }
+    /* kept (and saved) by a linear material too: finite there as well */
+    CHECK(d->shear_modulus >= 0, "shear_modulus must be >= 0 Pa", d->shear_modulus);
+    CHECK(d->poisson >= 0 && d->poisson < 0.5, "Poisson's ratio must be in [0, 0.5)", d->poisson);
+    *bad = (double)d->model;
+    if (d->model != SX_MODEL_LINEAR && d->model != SX_MODEL_HERTZ) return "model must be linear or hertz";
+    if (d->model == SX_MODEL_HERTZ) CHECK(d->shear_modulus > 0, "the Hertz shear modulus must be > 0 Pa", d->shear_modulus);
 #undef CHECK
+    return NULL;
+}
+
+sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *d, int *out)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "material: the model is stepping");
+    if (!name || !*name || strlen(name) >= sizeof m->mats[0].name)
+        return sx__fail(m, SX_EINVAL, "material: the name must have 1 to %zu characters", sizeof m->mats[0].name - 1);
+    double bad = 0;
+    const char *why = sx__material_invalid(d, &bad);
+    if (why) return sx__fail(m, SX_EINVAL, "material '%s': %s (got %g)", name, why, bad);
     int i = sx_material_find(m, name);
     if (i < 0) {
         if (m->nmat >= UINT16_MAX) return sx__fail(m, SX_EINVAL, "material: too many materials");
@@ -395,8 +411,9 @@ double sx_model_timestep(sx_model *m)
 
 sx_status sx_model_set_timestep(sx_model *m, double dt)
 {
-    if (!(dt >= 0) || !isfinite(dt))
-        return sx__fail(m, SX_EINVAL, "set_timestep: the timestep must be > 0 s, or 0 for automatic (got %g)", dt);
+    if (!timestep_ok(dt))
+        return sx__fail(m, SX_EINVAL, "set_timestep: the timestep must be in [1e-15, 1] s, or 0 for automatic (got %g)",
+                        dt);
     m->dt_user = dt;
     m->dt_stale = true;
     return SX_OK;

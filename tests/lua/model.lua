@@ -223,8 +223,28 @@ test("--threads is accepted and recorded", function()
   local status, out = T.run("--threads 3 -e 'print(seixo.threads)'")
   eq(status, 0, out)
   eq(out, "3\n")
-  status, out = T.run("-e 'print(seixo.threads)'")
+  status, out = T.run("-e 'print(seixo.threads)'", nil, "-u OMP_NUM_THREADS")
   eq(out, "1\n")
+  -- OMP_NUM_THREADS is read when --threads is not given; a bad one is an error, not 1 thread
+  status, out = T.run("-e 'print(seixo.threads)'", nil, "OMP_NUM_THREADS=2")
+  eq(out, "2\n")
+  status, out = T.run("--threads 3 -e 'print(seixo.threads)'", nil, "OMP_NUM_THREADS=2")
+  eq(out, "3\n")
+  for _, bad in ipairs({"x", "0", "2000", "1e300"}) do
+    status, out = T.run("-e 'print(1)'", nil, "OMP_NUM_THREADS=" .. bad)
+    eq(status, 1)
+    check(out:find("OMP_NUM_THREADS='" .. bad .. "' is not a whole number", 1, true), out)
+  end
+  -- seixo.threads set by a script: a thread count, or seixo.model says so
+  for _, bad in ipairs({"x", 0 / 0, 0, 2000, 1e300, 1.5}) do
+    seixo.threads = bad
+    raises(function() seixo.model{dim = 2} end, HERE, "seixo.threads must be a whole number from 1 to 1024")
+  end
+  seixo.threads = 2
+  seixo.model{dim = 2}:close()
+  seixo.threads = nil
+  seixo.model{dim = 2}:close()
+  seixo.threads = 1
   status, out = T.run("--threads 0 -e 'print(1)'")
   eq(status, 1)
   check(out:find("'--threads' needs a whole number", 1, true), out)
