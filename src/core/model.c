@@ -5,6 +5,7 @@
  * with the dimension-specific stages in kernels.c. */
 #include "model_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -359,11 +360,43 @@ static sx_status check_models(sx_model *m)
 
 /* ------------------------------------------------------------- timestep */
 
+/* A user's skin so wide that nearly every pair of balls is a candidate
+ * (skin = 1e3 m, or m:bond's gap over a large assembly) would build for
+ * minutes, uninterruptibly, and exhaust memory: refused before the build,
+ * from the pairs a uniform spread of the balls over their bounding box
+ * would give (cubes of the reach's width: an overestimate). */
+static sx_status check_skin(sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    if (m->skin_user <= 0 || b->n < 2) return SX_OK;
+    const int d = m->dim;
+    double lo[3], hi[3], rmax = 0;
+    for (int k = 0; k < d; k++) lo[k] = hi[k] = b->x[k];
+    for (int64_t i = 0; i < b->n; i++) {
+        for (int k = 0; k < d; k++) {
+            lo[k] = fmin(lo[k], b->x[i * d + k]);
+            hi[k] = fmax(hi[k], b->x[i * d + k]);
+        }
+        rmax = fmax(rmax, b->rad[i]);
+    }
+    const double reach = 2 * rmax + m->skin_user;
+    double share = 1;
+    for (int k = 0; k < d; k++) share *= fmin(1, 2 * reach / fmax(hi[k] - lo[k], DBL_MIN));
+    const double pairs = 0.5 * (double)b->n * (double)(b->n - 1) * share, most = 200.0 * (double)b->n + 1e6;
+    if (pairs > most)
+        return sx__fail(m, SX_EINVAL,
+                        "broad phase: a skin of %g m makes about %.3g candidate pairs of %lld balls (more than %.3g): "
+                        "lower the skin (m:bond's gap widens it)",
+                        m->skin_user, pairs, (long long)b->n, most);
+    return SX_OK;
+}
+
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
 sx_status sx__prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (!st) st = check_models(m);
+    if (!st && m->build_needed) st = check_skin(m);
     if (st) return st;
     if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;

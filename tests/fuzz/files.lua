@@ -126,8 +126,12 @@ end
 local function load(p, dim) local m = seixo.load(p, {dim = dim}) return m end
 local function cycle(m, n) m:cycle(n) end
 local function xdmf(p) seixo.xdmf(p) end
+-- a small model continues the damaged series (its histories are read back)
 local function append(p, dim)
-  local m = scene(dim)
+  local m = seixo.model{dim = dim, timestep = 1e-5}
+  m:material("rock")
+  m:ball{pos = V(dim, 0, 0, 0), radius = 0.01}
+  m:history("ke", "kinetic")
   local o = m:output{path = p, every = 10, append = true}
   m:cycle(25)
   o:close()

@@ -322,4 +322,23 @@ test("m:memory reports bytes per ball and per contact", function()
   check(r.peak >= r.total)
 end)
 
+-- issue 18: a skin (or a bond gap) that makes every pair a candidate is
+-- refused before the broad phase runs for minutes beyond Ctrl-C's reach
+test("a skin wider than the assembly is refused, quickly", function()
+  local t0 = seixo.clock()
+  local region = {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}}
+  local m = seixo.model{dim = 3, skin = 1e3}
+  m:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
+  eq(m:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}, 8000)
+  raises(function() m:cycle(1) end, HERE, "a skin of 1000 m makes about", "lower the skin")
+  local m2 = seixo.model{dim = 3}
+  m2:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
+  m2:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}
+  raises(function() m2:bond{kind = "contact", gap = 1} end, HERE, "a skin of 1 m")
+  eq(m2:bond_count(), 0)
+  check(m2:bond{kind = "contact", gap = 1e-4} > 20000)
+  m2:cycle(1)
+  check(seixo.clock() - t0 < 60, seixo.clock() - t0)
+end)
+
 T.done()
