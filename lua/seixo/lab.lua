@@ -51,6 +51,22 @@ local function positive(v, what, fn)
   return v
 end
 
+-- a specimen of lab.specimen or lab.open: its file and dimension at least
+local function check_spec(spec, fn)
+  if type(spec) ~= "table" or type(spec.path) ~= "string" or (spec.dim ~= 2 and spec.dim ~= 3) then
+    error(string.format("lab.%s: a specimen (from lab.specimen or lab.open) expected, got %s", fn,
+                        type(spec) == "table" and "a table without its path or dim" or type(spec)), 3)
+  end
+end
+
+-- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
+local function steps(v, what, fn)
+  if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
+    error(string.format("lab.%s: %s must be a whole number of steps >= 1 (got %s)", fn, what, tostring(v)), 3)
+  end
+  return math.tointeger(v)
+end
+
 local function copy(t)
   if type(t) ~= "table" then return t end
   local r = {}
@@ -115,6 +131,7 @@ end
 --- Bonded-particle micro-parameters (4-49 ... 4-53) of a granite-like rock,
 --- after Potyondy & Cundall (2004, Lac du Bonnet granite), with overrides.
 function lab.rock(over)
+  if over ~= nil and type(over) ~= "table" then error("lab.rock: a table of overrides expected, got " .. type(over), 2) end
   return merge({
     density = 2630, modulus = 62e9, stiffness_ratio = 2.5, friction = 0.5, damping = 0.7,
     bond = {radius_multiplier = 1, modulus = 62e9, stiffness_ratio = 2.5,
@@ -586,6 +603,7 @@ local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_s
 
 -- A triaxial (confining > 0) or unconfined compression test.
 local function compression(spec, opts, fn)
+  check_spec(spec, fn)
   check_keys(opts, fn, test_keys)
   local dim, ax = spec.dim, axis_of(spec.dim)
   if spec.shape == "disc" or spec.shape == "disk" then
@@ -606,7 +624,8 @@ local function compression(spec, opts, fn)
   local max_strain = positive(opts.max_strain or 0.02, "max_strain", fn)
   local post_peak = opts.post_peak or 0.7
   if not (post_peak > 0 and post_peak < 1) then fail("lab.%s: post_peak must be in (0, 1)", fn) end
-  local every = opts.every or 100
+  local every = steps(opts.every or 100, "every", fn)
+  if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", fn) end
   local t0 = seixo.clock()
 
   local m, lo, hi, centre, bottom, top = open_test(spec)
@@ -840,6 +859,7 @@ end
 --- y): two platens close at a constant speed; sigma_t = 2 F / (pi D t).
 function lab.brazilian(spec, opts)
   opts = opts or {}
+  check_spec(spec, "brazilian")
   check_keys(opts, "brazilian", {"strain_rate", "post_peak", "every", "out", "plot", "log", "max_steps", "max_strain"})
   local dim, ax = spec.dim, axis_of(spec.dim)
   if spec.shape ~= "disc" and spec.shape ~= "disk" then
@@ -847,7 +867,8 @@ function lab.brazilian(spec, opts)
   end
   if opts.strain_rate ~= nil then positive(opts.strain_rate, "strain_rate", "brazilian") end
   local post_peak = opts.post_peak or 0.5
-  local every = opts.every or 100
+  local every = steps(opts.every or 100, "every", "brazilian")
+  if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", "brazilian") end
   local t0 = seixo.clock()
   local m, lo, hi, _, bottom, top = open_test(spec)
   local rate = opts.strain_rate or default_rate(m)
@@ -926,6 +947,7 @@ end
 --- the Mohr-Coulomb fit of their peaks, and the plots. opts as for
 --- lab.triaxial, with confining = {sigma3, ...}; opts.out is a prefix.
 function lab.series(spec, opts)
+  check_spec(spec, "series")
   opts = copy(opts or {})
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
@@ -1075,4 +1097,28 @@ end
 
 -- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures and atomic writes
 require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file, copy = copy})
+
+-- Errors point at the caller's line, not into this file: what fails inside
+-- an exported function is raised again from its caller's position (the
+-- helpers above raise at a fixed level, which is the caller's only for
+-- some call paths). One wrapper here keeps every function honest.
+local function at_caller(f)
+  return function(...)
+    local r = table.pack(pcall(f, ...))
+    if r[1] then return table.unpack(r, 2, r.n) end
+    local e = r[2]
+    if type(e) ~= "string" then error(e, 0) end
+    local caller = debug.getinfo(2, "Sl")
+    local here = caller and caller.currentline > 0 and (caller.short_src .. ":" .. caller.currentline .. ": ")
+    if here and e:sub(1, #here) == here then error(e, 0) end -- already the caller's
+    local inner = e:match("^[^\n]-lab%.lua:%d+: (.*)$")
+    if inner then error(inner, 2) end
+    if e:match("^[^\n:]+:%d+: ") then error(e, 0) end -- another file's (a user's callback)
+    error(e, 2) -- no position (a helper's level fell on a tail call)
+  end
+end
+for name, f in pairs(lab) do
+  if type(f) == "function" then lab[name] = at_caller(f) end
+end
+
 return lab

@@ -52,6 +52,14 @@ typedef struct options {
 
 enum { MAX_THREADS = 1024 };  // as many as sx_model_set_threads takes (model.c)
 
+/* A thread count 1..MAX_THREADS written in v; 0 when v is none. */
+static long thread_count(const char *v)
+{
+    char *end = NULL;
+    const long t = v ? strtol(v, &end, 10) : 0;
+    return v && *v && !*end && t >= 1 && t <= MAX_THREADS ? t : 0;
+}
+
 static void usage(FILE *out)
 {
     fprintf(out,
@@ -955,9 +963,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             show_traceback = true;
         } else if (strcmp(a, "--threads") == 0 || strncmp(a, "--threads=", 10) == 0) {
             const char *v = a[9] == '=' ? a + 10 : (++i < argc ? argv[i] : NULL);
-            char *end = NULL;
-            const long t = v ? strtol(v, &end, 10) : 0;
-            if (!v || !*v || *end || t < 1 || t > MAX_THREADS) {
+            const long t = thread_count(v);
+            if (!t) {
                 fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d; seixo --help for usage\n", progname,
                         MAX_THREADS);
                 return BAD;
@@ -978,6 +985,16 @@ static enum parsed parse(int argc, char **argv, options *o)
         }
     }
     o->script = i < argc ? i : argc;
+    /* without --threads, OMP_NUM_THREADS as any OpenMP program reads it;
+     * a value that is no thread count is an error, not a silent 1 */
+    const char *env = getenv("OMP_NUM_THREADS");
+    if (!o->threads && env && *env) {
+        o->threads = thread_count(env);
+        if (!o->threads) {
+            fprintf(stderr, "%s: OMP_NUM_THREADS='%s' is not a whole number from 1 to %d\n", progname, env, MAX_THREADS);
+            return BAD;
+        }
+    }
     return RUN;
 }
 

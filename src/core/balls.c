@@ -101,6 +101,17 @@ void sx__balls_free(sx_model *m)
 }
 
 /* 4-43 and its 2D analogue: sphere I = 2/5 m R^2, disk of unit thickness I = 1/2 m R^2. */
+/* A radius the ball's mass and inertia can follow: both positive and
+ * finite (1e300 m would make them infinite, 1e-200 m zero). */
+static bool radius_ok(const sx_model *m, double r, int mat)
+{
+    if (!(r > 0) || !isfinite(r)) return false;
+    const double rho = m->mats[mat].def.density;
+    const double mass = (m->dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r) * rho;
+    const double inertia = mass * r * r;
+    return mass > 0 && isfinite(mass) && inertia > 0 && isfinite(inertia) && isfinite(1 / inertia);
+}
+
 void sx__ball_update_mass(sx_model *m, int64_t i)
 {
     sx_balls *b = &m->balls;
@@ -163,6 +174,8 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     if (def->material < 0 || def->material >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "ball_add: no material with index %d (define one with material first)",
                         def->material);
+    if (!radius_ok(m, def->radius, def->material))
+        return sx__fail(m, SX_EINVAL, "ball_add: a radius of %g m gives a mass or inertia of 0 or infinity", def->radius);
     const int d = m->dim, r = m->rdim;
     if (!finite_vec(def->pos, d) || !finite_vec(def->vel, d) || !finite_vec(def->spin, r))
         return sx__fail(m, SX_EINVAL, "ball_add: position, velocity and spin must be finite");
@@ -623,6 +636,8 @@ sx_status sx_ball_set(sx_model *m, int64_t id, sx_ball_scalar which, double valu
     case SX_BALL_RADIUS:
         if (!(value > 0) || !isfinite(value))
             return sx__fail(m, SX_EINVAL, "ball_set: radius must be a positive finite number (got %g)", value);
+        if (!radius_ok(m, value, b->mat[i]))
+            return sx__fail(m, SX_EINVAL, "ball_set: a radius of %g m gives a mass or inertia of 0 or infinity", value);
         b->rad[i] = value;
         sx__ball_update_mass(m, i);
         m->build_needed = true;

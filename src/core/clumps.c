@@ -513,7 +513,8 @@ static double props_difference(int d, double v1, const double *c1, const double 
     return e;
 }
 
-enum { LINES_3D = 512, LINES_2D = 65536, LINES_MIN = 16 };
+/* at most 16 times the default's work in 3D (lines^2), 16 times its lines in 2D */
+enum { LINES_3D = 512, LINES_2D = 65536, LINES_MIN = 16, LINES_MAX_3D = 2048, LINES_MAX_2D = 1 << 20 };
 /* The midpoint rule's error across the lines fluctuates with how the grid
  * meets the lenses' rims, so the spread of two coarser grids (half the
  * lines, two offsets) is an estimate, not a bound: it is taken 4 times,
@@ -636,9 +637,12 @@ sx_status sx_clump_template_add(sx_model *m, const char *name, const sx_clump_te
     if (def->count < 1 || def->count > 1000000 || !def->pos || !def->radius)
         return sx__fail(m, SX_EINVAL, "clump_template '%s': 1 to 1000000 pebbles expected (got %lld)", name,
                         (long long)def->count);
-    if (def->lines != 0 && (def->lines < LINES_MIN || def->lines > 1 << 20))
-        return sx__fail(m, SX_EINVAL, "clump_template '%s': lines must be 0 (default) or in %d..%d (got %lld)", name,
-                        LINES_MIN, 1 << 20, (long long)def->lines);
+    /* 3D integrates over lines x lines lines: 2^20 of them per axis would
+     * take days, and nothing (not even a Ctrl-C) could stop it */
+    const int64_t max_lines = m->dim == 3 ? LINES_MAX_3D : LINES_MAX_2D;
+    if (def->lines != 0 && (def->lines < LINES_MIN || def->lines > max_lines))
+        return sx__fail(m, SX_EINVAL, "clump_template '%s': lines must be 0 (default) or in %d..%lld (got %lld)", name,
+                        LINES_MIN, (long long)max_lines, (long long)def->lines);
     const int d = m->dim;
     for (int64_t i = 0; i < def->count; i++) {
         bool ok = def->radius[i] > 0 && isfinite(def->radius[i]);

@@ -6,6 +6,7 @@
 #include "laws/law.h"
 #include "model_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -40,11 +41,17 @@ sx_model_def sx_model_default_def(void)
     return d;
 }
 
+/* A user timestep: 0 (automatic), or from 1e-15 s (below, a step no
+ * longer advances the time of a long run; a denormal is no timestep) to
+ * 1 s (a DEM timestep is orders of magnitude below: a larger one is a
+ * mistake of units). */
+static bool timestep_ok(double dt) { return dt == 0 || (dt >= 1e-15 && dt <= 1); }
+
 sx_model *sx_model_create(const sx_model_def *def, char *err, size_t errlen)
 {
     const char *why = NULL;
     if (def->dim != 2 && def->dim != 3) why = "dim must be 2 or 3";
-    else if (!(def->timestep >= 0) || !isfinite(def->timestep)) why = "timestep must be >= 0 (0 = automatic)";
+    else if (!timestep_ok(def->timestep)) why = "timestep must be 0 (automatic) or in [1e-15, 1] s";
     else if (!(def->timestep_safety > 0 && def->timestep_safety <= 1)) why = "timestep_safety must be in (0, 1]";
     else if (!(def->skin >= 0) || !isfinite(def->skin)) why = "skin must be >= 0 (0 = automatic)";
     for (int k = 0; k < 3 && !why; k++)
@@ -198,13 +205,13 @@ sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out)
     return SX_OK;
 }
 
-sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *d, int *out)
+/* The first rule a material definition breaks, written into why, or NULL:
+ * for sx_material_set and for a loaded state alike. The rules of every
+ * material come first, then its law's parameters (laws.c). */
+const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len)
 {
-    if (m->locked) return sx__fail(m, SX_ELOCKED, "material: the model is stepping");
-    if (!name || !*name || strlen(name) >= sizeof m->mats[0].name)
-        return sx__fail(m, SX_EINVAL, "material: the name must have 1 to %zu characters", sizeof m->mats[0].name - 1);
 #define CHECK(cond, what, val) \
-    if (!(cond) || !isfinite(val)) return sx__fail(m, SX_EINVAL, "material '%s': %s (got %g)", name, what, val)
+    if (!(cond) || !isfinite(val)) return snprintf(why, len, "%s (got %g)", what, (double)(val)), why
     CHECK(d->density > 0, "density must be > 0 kg/m^3", d->density);
     CHECK(d->kn > 0, "kn must be > 0 N/m", d->kn);
     CHECK(d->ks >= 0, "ks must be >= 0 N/m", d->ks);
@@ -214,9 +221,20 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     CHECK(d->viscous_shear >= 0, "viscous_shear must be >= 0", d->viscous_shear);
     CHECK(d->modulus >= 0, "modulus must be >= 0 Pa (0: use kn, ks)", d->modulus);
     CHECK(d->stiffness_ratio > 0, "stiffness_ratio (kn/ks) must be > 0", d->stiffness_ratio);
+    /* kept (and saved) by a linear material too: finite there as well */
+    CHECK(d->shear_modulus >= 0, "shear_modulus must be >= 0 Pa", d->shear_modulus);
+    CHECK(d->poisson >= 0 && d->poisson < 0.5, "Poisson's ratio must be in [0, 0.5)", d->poisson);
 #undef CHECK
+    return sx__law_check(d, why, len);
+}
+
+sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *d, int *out)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "material: the model is stepping");
+    if (!name || !*name || strlen(name) >= sizeof m->mats[0].name)
+        return sx__fail(m, SX_EINVAL, "material: the name must have 1 to %zu characters", sizeof m->mats[0].name - 1);
     char why[256];
-    if (sx__law_check(d, why, sizeof why)) return sx__fail(m, SX_EINVAL, "material '%s': %s", name, why);
+    if (sx__material_invalid(d, why, sizeof why)) return sx__fail(m, SX_EINVAL, "material '%s': %s", name, why);
     int i = sx_material_find(m, name);
     if (i < 0) {
         if (m->nmat >= UINT16_MAX) return sx__fail(m, SX_EINVAL, "material: too many materials");
@@ -349,11 +367,43 @@ static sx_status check_models(sx_model *m)
 
 /* ------------------------------------------------------------- timestep */
 
+/* A user's skin so wide that nearly every pair of balls is a candidate
+ * (skin = 1e3 m, or m:bond's gap over a large assembly) would build for
+ * minutes, uninterruptibly, and exhaust memory: refused before the build,
+ * from the pairs a uniform spread of the balls over their bounding box
+ * would give (cubes of the reach's width: an overestimate). */
+static sx_status check_skin(sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    if (m->skin_user <= 0 || b->n < 2) return SX_OK;
+    const int d = m->dim;
+    double lo[3], hi[3], rmax = 0;
+    for (int k = 0; k < d; k++) lo[k] = hi[k] = b->x[k];
+    for (int64_t i = 0; i < b->n; i++) {
+        for (int k = 0; k < d; k++) {
+            lo[k] = fmin(lo[k], b->x[i * d + k]);
+            hi[k] = fmax(hi[k], b->x[i * d + k]);
+        }
+        rmax = fmax(rmax, b->rad[i]);
+    }
+    const double reach = 2 * rmax + m->skin_user;
+    double share = 1;
+    for (int k = 0; k < d; k++) share *= fmin(1, 2 * reach / fmax(hi[k] - lo[k], DBL_MIN));
+    const double pairs = 0.5 * (double)b->n * (double)(b->n - 1) * share, most = 200.0 * (double)b->n + 1e6;
+    if (pairs > most)
+        return sx__fail(m, SX_EINVAL,
+                        "broad phase: a skin of %g m makes about %.3g candidate pairs of %lld balls (more than %.3g): "
+                        "lower the skin (m:bond's gap widens it)",
+                        m->skin_user, pairs, (long long)b->n, most);
+    return SX_OK;
+}
+
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
 sx_status sx__prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (!st) st = check_models(m);
+    if (!st && m->build_needed) st = check_skin(m);
     if (st) return st;
     if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;
@@ -401,8 +451,9 @@ double sx_model_timestep(sx_model *m)
 
 sx_status sx_model_set_timestep(sx_model *m, double dt)
 {
-    if (!(dt >= 0) || !isfinite(dt))
-        return sx__fail(m, SX_EINVAL, "set_timestep: the timestep must be > 0 s, or 0 for automatic (got %g)", dt);
+    if (!timestep_ok(dt))
+        return sx__fail(m, SX_EINVAL, "set_timestep: the timestep must be in [1e-15, 1] s, or 0 for automatic (got %g)",
+                        dt);
     m->dt_user = dt;
     m->dt_stale = true;
     return SX_OK;

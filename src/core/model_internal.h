@@ -273,6 +273,9 @@ static inline double sx__damped(double force, double vel, double alpha)
     return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
 }
 
+/* The first rule d breaks (its value in *bad), or NULL (model.c). */
+const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len);
+
 /* error helper: formats into m->err and returns status */
 sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

@@ -136,13 +136,16 @@ static sx_status check_materials(sx_model *m)
         for (int j = 0; j < i; j++)
             if (strcmp(m->mats[j].name, t->name) == 0)
                 return sx__fail(m, SX_EINVAL, "state: material '%s' appears twice", t->name);
+        /* the rules of sx_material_set: a NaN stiffness would be blamed on the timestep at the first cycle */
         char why[256];
-        if (sx__law_check(&t->def, why, sizeof why))
-            return sx__fail(m, SX_EINVAL, "state: material '%s' (contact model %d): %s", t->name, (int)t->def.model,
-                            why);
+        if (sx__material_invalid(&t->def, why, sizeof why))
+            return sx__fail(m, SX_EINVAL, "state: material '%s': %s", t->name, why);
+        const double *bpm = (const double *)&t->bpm;
+        for (size_t k = 0; k < sizeof t->bpm / sizeof(double); k++)
+            if (!(bpm[k] >= 0) || !isfinite(bpm[k]))
+                return sx__fail(m, SX_EINVAL, "state: material '%s' has a bond parameter that is negative or not "
+                                              "finite (%g)", t->name, bpm[k]);
         sx__material_derive(t);
-        if (!(t->def.density > 0) || !isfinite(t->def.density) || !(t->def.stiffness_ratio > 0))
-            return sx__fail(m, SX_EINVAL, "state: material '%s' has a density or stiffness ratio <= 0", t->name);
     }
     return SX_OK;
 }
@@ -173,6 +176,10 @@ static sx_status check_balls(sx_model *m)
             !finite_all(b->w + i * r, r))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a non-finite position, velocity or spin",
                             (long long)id);
+        if (!finite_all(b->f + i * d, d) || !finite_all(b->t + i * r, r) ||
+            (b->fapp && (!finite_all(b->fapp + i * d, d) || !finite_all(b->tapp + i * r, r))))
+            return sx__fail(m, SX_EINVAL, "state: ball %lld has a non-finite force, moment or applied load",
+                            (long long)id);
     }
     return SX_OK;
 }
@@ -190,8 +197,19 @@ static sx_status check_walls(sx_model *m)
                             (long long)m->next_wall_id);
         for (int64_t j = 0; j < i; j++)
             if (m->walls[j].id == w->id) return sx__fail(m, SX_EINVAL, "state: wall id %lld appears twice", (long long)w->id);
-        if (!finite_all(w->def.point, 3) || !finite_all(w->def.normal, 3) || !finite_all(w->def.vel, 3))
-            return sx__fail(m, SX_EINVAL, "state: wall %lld has a non-finite point, normal or velocity", (long long)w->id);
+        if (!finite_all(w->def.point, 3) || !finite_all(w->def.normal, 3) || !finite_all(w->def.vel, 3) ||
+            !finite_all(w->def.edge1, 3) || !finite_all(w->def.edge2, 3) || !finite_all(w->force, 3) ||
+            !finite_all(w->moment, 3))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has a non-finite point, normal, edge, velocity, force or "
+                                          "moment", (long long)w->id);
+        /* a unit normal (walls are stored normalised) */
+        const double *nv = w->def.normal;
+        if (!(fabs(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2] - 1) < 1e-6))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has a normal of length other than 1", (long long)w->id);
+        if (!(w->def.kn > 0) || !isfinite(w->def.kn) || !(w->def.ks >= 0) || !isfinite(w->def.ks) ||
+            !(w->def.friction >= 0) || !isfinite(w->def.friction) || !(w->moved >= 0) || !isfinite(w->moved))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has a stiffness, friction or move out of range",
+                            (long long)w->id);
         if ((k == SX_WALL_RECT && !(w->len_u > 0 && w->len_v > 0)) || (k == SX_WALL_SEGMENT && !(w->seg_len > 0)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a zero extent", (long long)w->id);
         if (k == SX_WALL_CYLINDER &&
@@ -209,11 +227,22 @@ static sx_status check_walls(sx_model *m)
     return SX_OK;
 }
 
+/* The history of pair c of store p is finite (a NaN shear force or
+ * relative position would spread through the step unseen). */
+static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
+{
+    const int d = m->dim;
+    return finite_all(p->fs + c * d, d) && finite_all(p->geo + c * d, d) && isfinite(p->fn[c]) &&
+           (!p->un || isfinite(p->un[c]));
+}
+
 static sx_status check_pairs(sx_model *m)
 {
     const int64_t n = m->balls.n;
     const sx_pairs *p = &m->bb;
     for (int64_t c = 0; c < p->n; c++) {
+        if (!pair_finite(m, p, c))
+            return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a non-finite history", (long long)c);
         if (p->a[c] < 0 || p->a[c] >= p->b[c] || p->b[c] >= n)
             return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld refers to balls %d, %d of %lld", (long long)c,
                             p->a[c], p->b[c], (long long)n);
@@ -238,6 +267,8 @@ static sx_status check_pairs(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld refers to ball %d of %lld, wall %d of %lld",
                             (long long)c, p->a[c], (long long)n, p->b[c], (long long)m->nwall);
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld has a bad touching flag", (long long)c);
+        if (!pair_finite(m, p, c))
+            return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld has a non-finite history", (long long)c);
     }
     return SX_OK;
 }
@@ -254,8 +285,20 @@ static sx_status check_bonds(sx_model *m)
         if (sx__ball_index(m, k->ida[s]) < 0 || sx__ball_index(m, k->idb[s]) < 0 || k->ida[s] == k->idb[s])
             return sx__fail(m, SX_EINVAL, "state: intact bond %lld joins balls %d and %d, which do not exist",
                             (long long)s, k->ida[s], k->idb[s]);
-        if ((k->kind[s] & SX_BOND_PARALLEL) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0))
-            return sx__fail(m, SX_EINVAL, "state: parallel bond %lld has a radius or stiffness <= 0", (long long)s);
+        if ((k->kind[s] & SX_BOND_PARALLEL) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0 &&
+                                                 isfinite(k->rbar[s]) && isfinite(k->kn[s]) && isfinite(k->ks[s])))
+            return sx__fail(m, SX_EINVAL, "state: parallel bond %lld has a radius or stiffness <= 0 or not finite",
+                            (long long)s);
+        /* NaN or infinite strengths never break, zero or negative ones break at once (m:bond refuses both) */
+        if ((k->kind[s] & SX_BOND_PARALLEL) &&
+            !(k->sigma_c[s] > 0 && isfinite(k->sigma_c[s]) && k->tau_c[s] > 0 && isfinite(k->tau_c[s])))
+            return sx__fail(m, SX_EINVAL, "state: parallel bond %lld has a strength <= 0 or not finite", (long long)s);
+        if ((k->kind[s] & SX_BOND_CONTACT) && !(k->cb_n[s] > 0 && isfinite(k->cb_n[s]) && k->cb_s[s] > 0 &&
+                                                isfinite(k->cb_s[s])))
+            return sx__fail(m, SX_EINVAL, "state: contact bond %lld has a strength <= 0 or not finite", (long long)s);
+        if (!isfinite(k->fn[s]) || !finite_all(k->fs + s * m->dim, m->dim) || !isfinite(k->mn[s]) ||
+            !finite_all(k->ms + s * m->rdim, m->rdim))
+            return sx__fail(m, SX_EINVAL, "state: bond %lld has a non-finite force or moment", (long long)s);
         k->intact++;
     }
     return SX_OK;

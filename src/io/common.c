@@ -51,6 +51,11 @@ hid_t sx_io_open(sx_h5 *h, const char *path, bool rdwr, const char *kind, int wa
         sx_h5_fail(h, "is a folder, not a file");
         return -1;
     }
+    /* a FIFO or a device would block the read (or never end): files only */
+    if (!S_ISREG(st.st_mode)) {
+        sx_h5_fail(h, "is not a regular file (a pipe, socket or device)");
+        return -1;
+    }
     const htri_t is = H5Fis_hdf5(path);
     if (is <= 0) {
         H5Eclear2(H5E_DEFAULT);
@@ -70,7 +75,12 @@ hid_t sx_io_open(sx_h5 *h, const char *path, bool rdwr, const char *kind, int wa
     if (f < 0) return -1;
     char fmt[32], k[32];
     int64_t ver = 0, d = 0;
-    if (!sx_h5_get_str(f, "format", fmt, sizeof fmt) || strcmp(fmt, "seixo") != 0) {
+    if (sx_h5_attr_is_vlen(f, "format") || sx_h5_attr_is_vlen(f, "kind")) {
+        /* rewritten by h5py: said as it is, not as a missing attribute */
+        sx_h5_fail(h, "its '%s' attribute is a variable-length string (as h5py writes one by default); seixo reads "
+                      "fixed-length strings: write it as one (h5py: numpy.bytes_)",
+                   sx_h5_attr_is_vlen(f, "format") ? "format" : "kind");
+    } else if (!sx_h5_get_str(f, "format", fmt, sizeof fmt) || strcmp(fmt, "seixo") != 0) {
         sx_h5_fail(h, "an HDF5 file, but not a seixo file (its root has no 'format' attribute \"seixo\")");
     } else if (!sx_h5_get_i64(h, f, "/", "format_version", &ver, 1, true)) {
         /* failed */

@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,11 +70,24 @@ bool sx_h5_fail(sx_h5 *h, const char *fmt, ...)
     return false;
 }
 
-/* The innermost message of HDF5's error stack: the most specific one. */
+/* The innermost message of HDF5's error stack: the most specific one, on
+ * one line. A failed write's says "file write failed: time = <ctime text
+ * with its newline>, filename = ..., errno = 28, error message = 'No space
+ * left on device', ...": then the system's message alone is kept. */
 static herr_t innermost(unsigned n, const H5E_error2_t *e, void *ud)
 {
     char *out = ud;
-    if (n == 0 && e->desc && *e->desc) snprintf(out, 256, "%s", e->desc);
+    if (n != 0 || !e->desc || !*e->desc) return 0;
+    const char *sys = strstr(e->desc, "error message = '");
+    if (sys) {
+        sys += strlen("error message = '");
+        const char *end = strchr(sys, '\'');
+        snprintf(out, 256, "%.*s", (int)(end ? end - sys : (ptrdiff_t)strlen(sys)), sys);
+    } else {
+        snprintf(out, 256, "%s", e->desc);
+    }
+    for (char *c = out; *c; c++)
+        if (*c == '\n' || *c == '\r' || *c == '\t') *c = ' ';
     return 0;
 }
 
@@ -368,6 +382,16 @@ bool sx_h5_get_str(hid_t obj, const char *name, char *out, size_t len)
     sx_h5_close(t);
     sx_h5_close(a);
     return ok;
+}
+
+bool sx_h5_attr_is_vlen(hid_t obj, const char *name)
+{
+    if (H5Aexists(obj, name) <= 0) return false;
+    hid_t a = H5Aopen(obj, name, H5P_DEFAULT), t = a >= 0 ? H5Aget_type(a) : -1;
+    const bool vlen = t >= 0 && H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) > 0;
+    sx_h5_close(t);
+    sx_h5_close(a);
+    return vlen;
 }
 
 /* ------------------------------------------------------------ datasets */

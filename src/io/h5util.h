@@ -83,6 +83,9 @@ size_t sx_h5_attr_len(hid_t obj, const char *name);
 /// Reads a string attribute into out (truncated to len - 1); false without
 /// failing when absent or not a string.
 bool sx_h5_get_str(hid_t obj, const char *name, char *out, size_t len);
+/// The attribute `name` of obj exists as a variable-length string (as
+/// h5py writes strings by default), which sx_h5_get_str does not read.
+bool sx_h5_attr_is_vlen(hid_t obj, const char *name);
 
 /* ------------------------------------------------------------ datasets */
 

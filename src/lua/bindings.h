@@ -231,7 +231,8 @@ int64_t sx_lua_history_next(lua_State *L, int model, int64_t s);
 
 struct sx_io_history;
 /// Pushes a userdata that holds the histories of the model at `model` as
-/// C arrays for the I/O layer (freed when it is collected or closed) and
+/// C arrays for the I/O layer, to be closed (freed when the calling C
+/// function returns or raises; the caller must not pop it before) and
 /// returns them, *n of them: all, or those named in the array at `names`
 /// (0: all); with `passed` (the index of a table name -> step, 0: none)
 /// only the samples of later steps.

@@ -491,6 +491,10 @@ struct sx_io_history *sx_lua_histories_push(lua_State *L, int model, int names, 
         lua_setfield(L, -2, "__close");
     }
     lua_setmetatable(L, -2);
+    /* freed when the calling C function returns or raises, never by a
+     * finaliser alone: one made while lua_close runs the finalisers (an
+     * output left open at the end of a script) would never run */
+    lua_toclose(L, -1);
     const int top = lua_gettop(L);
     sx_lua_state(L, model, "histories");
     const lua_Integer count = (lua_Integer)lua_rawlen(L, names ? names : top + 1);

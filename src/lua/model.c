@@ -126,15 +126,18 @@ int sx_lua_model_new(lua_State *L)
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
-    list_model(L, lua_gettop(L));
+    const int self = lua_gettop(L);
+    list_model(L, self);
     /* the executable's --threads N (seixo.threads); results do not depend on it */
-    if (lua_getglobal(L, "seixo") == LUA_TTABLE) {
-        lua_getfield(L, -1, "threads");
-        const lua_Integer t = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : 0;
-        if (t >= 1 && t <= 1024) sx_model_set_threads(u->m, (int)t);
-        lua_pop(L, 1);
+    if (lua_getglobal(L, "seixo") == LUA_TTABLE && lua_getfield(L, -1, "threads") != LUA_TNIL) {
+        int isint = 0;
+        const lua_Integer t = lua_tointegerx(L, -1, &isint);
+        if (!isint || t < 1 || t > 1024)
+            return luaL_error(L, "seixo.model: seixo.threads must be a whole number from 1 to 1024 (got %s)",
+                              luaL_tolstring(L, -1, NULL));
+        sx_model_set_threads(u->m, (int)t);
     }
-    lua_pop(L, 1);
+    lua_settop(L, self);
     return 1;
 }
 

@@ -52,6 +52,8 @@ test("a template from a table, and its properties", function()
   raises(function() m:clump_template("x", {{0, 0, 0}}) end, HERE, "pebble 1")
   raises(function() m:clump_template("x", {}) end, HERE, "1 to 1000000 pebbles")
   raises(function() m:clump_template("x", {{0, 0, 0, 1}}, {lines = 3}) end, HERE, "lines")
+  -- issue 18: 1e6 x 1e6 lines would integrate for days, uninterruptibly
+  raises(function() m:clump_template("x", {{0, 0, 0, 1}, {0.5, 0, 0, 1}}, {lines = 1000000}) end, HERE, "in 16..2048")
   raises(function() m:clump_template("x", 42) end, HERE, "table of pebbles or file name")
 end)
 

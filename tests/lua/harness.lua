@@ -70,9 +70,10 @@ local function quote(s) return "'" .. s:gsub("'", "'\\''") .. "'" end
 T.quote = quote
 
 -- Runs the seixo executable (under a time limit) with a shell argument
--- string; returns the exit status and the output (stdout and stderr).
-function T.run(args, input)
-  local cmd = "timeout 120 " .. quote(T.seixo) .. " " .. args .. " 2>&1"
+-- string (and `env` arguments before it, "-u VAR" or "VAR=value");
+-- returns the exit status and the output (stdout and stderr).
+function T.run(args, input, env)
+  local cmd = "timeout 120 env " .. (env or "") .. " " .. quote(T.seixo) .. " " .. args .. " 2>&1"
   if input then cmd = "printf '%s' " .. quote(input) .. " | " .. cmd end
   local p = io.popen(cmd)
   local out = p:read("a")

@@ -47,5 +47,29 @@ do
   check("radius required", not ok and tostring(err):find("radius"), err)
 end
 
+do
+  -- issue 18: errors raised inside seixo.lab point at the caller's line,
+  -- and a test that would cycle nothing forever (every = 0) is refused
+  local lab = require("seixo.lab")
+  local here = "lab.lua:" .. (debug.getinfo(1, "l").currentline + 2) .. ": "
+  local cases = {
+    {"ucs every = 0", function() lab.ucs({dim = 2, shape = "rect"}, {every = 0}) end, "every must be a whole number"},
+    {"ucs every = NaN", function() lab.ucs({dim = 2, shape = "rect"}, {every = 0 / 0}) end, "every must be"},
+    {"ucs max_steps = 0.5", function() lab.ucs({dim = 2, shape = "rect"}, {max_steps = 0.5}) end, "max_steps must be"},
+    {"brazilian every = 0", function() lab.brazilian({dim = 2, shape = "disk"}, {every = 0}) end, "every must be"},
+    {"triaxial unknown option", function() lab.triaxial({dim = 2, shape = "rect"}, {bogus = 1}) end, "unknown option"},
+    {"mohr_coulomb", function() lab.mohr_coulomb(5) end, "two failure states"},
+    {"a number for a specimen", function() lab.ucs(5) end, "attempt to index"},
+  }
+  for i, c in ipairs(cases) do
+    local ok, err = pcall(c[2])
+    -- every case's function is on its own line of the table above
+    local line = tonumber(here:match(":(%d+): ")) + i - 1
+    local at = "lab.lua:" .. line .. ": "
+    check(c[1], not ok and tostring(err):find(at, 1, true) and tostring(err):find(c[3], 1, true)
+          and not tostring(err):find("seixo/lab.lua", 1, true), err)
+  end
+end
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

@@ -223,8 +223,28 @@ test("--threads is accepted and recorded", function()
   local status, out = T.run("--threads 3 -e 'print(seixo.threads)'")
   eq(status, 0, out)
   eq(out, "3\n")
-  status, out = T.run("-e 'print(seixo.threads)'")
+  status, out = T.run("-e 'print(seixo.threads)'", nil, "-u OMP_NUM_THREADS")
   eq(out, "1\n")
+  -- OMP_NUM_THREADS is read when --threads is not given; a bad one is an error, not 1 thread
+  status, out = T.run("-e 'print(seixo.threads)'", nil, "OMP_NUM_THREADS=2")
+  eq(out, "2\n")
+  status, out = T.run("--threads 3 -e 'print(seixo.threads)'", nil, "OMP_NUM_THREADS=2")
+  eq(out, "3\n")
+  for _, bad in ipairs({"x", "0", "2000", "1e300"}) do
+    status, out = T.run("-e 'print(1)'", nil, "OMP_NUM_THREADS=" .. bad)
+    eq(status, 1)
+    check(out:find("OMP_NUM_THREADS='" .. bad .. "' is not a whole number", 1, true), out)
+  end
+  -- seixo.threads set by a script: a thread count, or seixo.model says so
+  for _, bad in ipairs({"x", 0 / 0, 0, 2000, 1e300, 1.5}) do
+    seixo.threads = bad
+    raises(function() seixo.model{dim = 2} end, HERE, "seixo.threads must be a whole number from 1 to 1024")
+  end
+  seixo.threads = 2
+  seixo.model{dim = 2}:close()
+  seixo.threads = nil
+  seixo.model{dim = 2}:close()
+  seixo.threads = 1
   status, out = T.run("--threads 0 -e 'print(1)'")
   eq(status, 1)
   check(out:find("'--threads' needs a whole number", 1, true), out)
@@ -300,6 +320,25 @@ test("m:memory reports bytes per ball and per contact", function()
   near(r.per_ball, r.balls / 5, 1e-12)
   near(r.per_contact, r.contacts / r.contact_count, 1e-12)
   check(r.peak >= r.total)
+end)
+
+-- issue 18: a skin (or a bond gap) that makes every pair a candidate is
+-- refused before the broad phase runs for minutes beyond Ctrl-C's reach
+test("a skin wider than the assembly is refused, quickly", function()
+  local t0 = seixo.clock()
+  local region = {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}}
+  local m = seixo.model{dim = 3, skin = 1e3}
+  m:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
+  eq(m:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}, 8000)
+  raises(function() m:cycle(1) end, HERE, "a skin of 1000 m makes about", "lower the skin")
+  local m2 = seixo.model{dim = 3}
+  m2:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
+  m2:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}
+  raises(function() m2:bond{kind = "contact", gap = 1} end, HERE, "a skin of 1 m")
+  eq(m2:bond_count(), 0)
+  check(m2:bond{kind = "contact", gap = 1e-4} > 20000)
+  m2:cycle(1)
+  check(seixo.clock() - t0 < 60, seixo.clock() - t0)
 end)
 
 T.done()
