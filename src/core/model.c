@@ -309,6 +309,9 @@ static sx_status refresh_laws(sx_model *m)
             if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
+    for (int i = 0; i < n; i++) /* a law's history joins the pair stores once a material uses it */
+        if (m->mats[i].def.rolling_friction > 0 && sx__pairs_expand_rolling(m))
+            return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     return SX_OK;
 }
 

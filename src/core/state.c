@@ -18,6 +18,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->bb = m->bb.n;
     out->bw = m->bw.n;
     out->bb_bonds = m->bb.bond != NULL;
+    out->rolling = m->bb.mr != NULL;
     out->bonds = m->bonds.n;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
@@ -73,6 +74,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (sx__pairs_reserve(m, &m->bb, s->bb_bonds && s->bb == 0 ? 1 : s->bb)) goto nomem;
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
     if (sx__pairs_reserve(m, &m->bw, s->bw)) goto nomem;
+    if (s->rolling && sx__pairs_expand_rolling(m)) goto nomem;
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 
