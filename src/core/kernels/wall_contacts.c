@@ -69,6 +69,13 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     for (int k = 0; k < D; k++) f0[k] = fs[k];
     const double ksdt = ks * dt;
     for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k];
+    double *us = law->total_shear ? p->us + c * D : NULL; /* Mindlin's total form (laws/total_shear.h) */
+    if (us) {
+        if (!p->touching[c])
+            for (int k = 0; k < D; k++) us[k] = 0;
+        carry_apply(&rot, us);
+        sx_law_total_shear_force(D, us, fs, vs, ks, dt);
+    }
     const double fmax = law->mu * fn, f2 = dot(fs, fs);
     bool slip = false;
     if (f2 > fmax * fmax) {
@@ -79,6 +86,7 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
             o->slip += 0.5 * e / ks;
         }
         for (int k = 0; k < D; k++) fs[k] *= sc;
+        if (us) sx_law_total_shear_slip(D, us, sc);
         slip = true;
     }
     double mroll[RD] = {0};
