@@ -320,20 +320,9 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 }
                 /* 4-30/4-31: Coulomb slip with the smaller friction */
                 const double fmax = law->mu * (fn > 0 ? fn : 0);
-                const double f2 = dot(fs, fs);
-                if (f2 > fmax * fmax) {
-                    const double sc = fmax / sqrt(f2);
-                    /* slip work: the mean of the shear force before and after the step along the
-                     * slip displacement (trial - final force) / ks */
-                    if (track && ks > 0) {
-                        double e = 0;
-                        for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                        o->slip += 0.5 * e / ks;
-                    }
-                    for (int k = 0; k < D; k++) fs[k] *= sc;
-                    if (us) sx_law_total_shear_slip(D, us, sc);
-                    slip = true;
-                }
+                double sc;
+                slip = sx__law_cap(D, fs, f0, dot(fs, fs), fmax, ks, track ? &o->slip : NULL, &sc);
+                if (slip && us) sx_law_total_shear_slip(D, us, sc);
             }
             if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h) */
                 double *mr = p->mr + c * RD, dtheta[RD];
