@@ -8,9 +8,11 @@
 #include "hertz.h"
 #include "linear.h"
 #include "restitution.h"
+#include "rolling.h"
+#include "total_shear.h"
 
 #define SX_LAWS(X) X(linear) X(hertz)
-#define SX_PARTS(X) X(restitution)
+#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear)
 
 #define SX_LAW_ID(name) SX_LAW_ID_##name
 #define SX_LAW_ENUM_(name) SX_LAW_ID(name),
