@@ -14,6 +14,8 @@ local entries = {
   ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0, overlap_limit = 0.5}",
     "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic; overlap_limit: the largest overlap a ball may be placed with, a fraction of its radius."},
   ["seixo.version"] = {"seixo.version", "The version string."},
+  ["seixo.vec"] = {"seixo.vec(x, y[, z]) | seixo.vec{x, y[, z]} -> vector",
+    "A vector with arithmetic (v + w, v - w, -v, v * s, s * v, v / s, v == w), fields x, y, z and methods dot, cross, norm, unit, copy; accepted wherever {x, y, z} is, and what b.pos, b.vel, w.force, ... return."},
   ["seixo.models"] = {"seixo.models() -> {model, ...}", "The open models, in the order they were made (a model no longer referenced may be collected)."},
   ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",
     "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},

@@ -262,8 +262,12 @@ void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, cons
 /// Reads the value at idx as n numbers (n <= 4) into out; returns NULL, or
 /// pushes and returns a message saying what is wrong.
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
-/// Pushes n components of v (a number when n == 1).
+/// Pushes n components of v (a number when n == 1, else a seixo.vec).
 void sx_lua_pushvec(lua_State *L, const double *v, int n);
+/// vec.c: pushes a seixo.vec of n (1 to 4) components.
+void sx_lua_pushnewvec(lua_State *L, const double *v, int n);
+/// vec.c: creates the seixo.vec class and adds seixo.vec to the module table on the stack top.
+void sx_lua_vec_register(lua_State *L);
 /// A value assigned to the field `field` of an object of `kind`: n numbers,
 /// or an error naming both ("ball field 'vel': ...").
 void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field);

@@ -71,6 +71,7 @@ int luaopen_seixo(lua_State *L)
     sx_lua_clumps_register(L);
     luaL_newlib(L, functions);
     sx_lua_io_register(L); /* io.c: m:save, m:vars, m:output, seixo.load, seixo.xdmf */
+    sx_lua_vec_register(L); /* vec.c: seixo.vec, the class of every vector returned */
     lua_pushliteral(L, SX_VERSION);
     lua_setfield(L, -2, "version");
     return 1;

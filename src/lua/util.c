@@ -135,15 +135,10 @@ const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
 
 void sx_lua_pushvec(lua_State *L, const double *v, int n)
 {
-    if (n == 1) {
+    if (n == 1)
         lua_pushnumber(L, v[0]);
-        return;
-    }
-    lua_createtable(L, n, 0);
-    for (int k = 0; k < n; k++) {
-        lua_pushnumber(L, v[k]);
-        lua_rawseti(L, -2, k + 1);
-    }
+    else
+        sx_lua_pushnewvec(L, v, n);
 }
 
 void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field)

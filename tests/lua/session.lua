@@ -251,4 +251,37 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API", function()
+  local v, w = seixo.vec(1, 2, 3), seixo.vec{0, 1, 0}
+  eq(tostring(v + w), "{1.0, 3.0, 3.0}")
+  eq(tostring(v - w), "{1.0, 1.0, 3.0}")
+  eq(tostring(-v), "{-1.0, -2.0, -3.0}")
+  eq(tostring(v * 2), "{2.0, 4.0, 6.0}")
+  eq(tostring(2 * v), "{2.0, 4.0, 6.0}")
+  eq(tostring(v / 2), "{0.5, 1.0, 1.5}")
+  check(v == seixo.vec(1, 2, 3) and v ~= w)
+  eq(v:dot(w), 2.0)
+  eq(tostring(v:cross(w)), "{-3.0, 0.0, 1.0}")
+  eq(seixo.vec(3, 4):norm(), 5.0)
+  eq(seixo.vec(1, 0):cross(seixo.vec(0, 1)), 1.0)
+  eq(tostring(seixo.vec(0, 3, 4):unit()), "{0.0, 0.6, 0.8}")
+  eq(v.x + v.y + v.z, 6.0)
+  eq(#v, 3)
+  raises(function() return v + seixo.vec(1, 2) end, "the two vectors differ in length")
+  raises(function() return v * w end, "a vector times a number expected")
+  raises(function() return seixo.vec(0, 0):unit() end, "the zero vector has no direction")
+  raises(function() return v.w end, "vector has no field 'w'")
+  local m = seixo.model{dim = 3, gravity = {0, 0, -10}}
+  m:material("a")
+  local b = m:ball{pos = seixo.vec(0, 0, 1), radius = 0.1, vel = v}
+  eq(getmetatable(b.pos), getmetatable(v))
+  b.pos = b.pos + b.vel * 0.5
+  eq(tostring(b.pos), "{0.5, 1.0, 2.5}")
+  eq(tostring(m:gravity()), "{0.0, 0.0, -10.0}")
+  local copy = b.pos
+  copy[1] = 5
+  eq(b.pos.x, 0.5, "a returned vector is a copy")
+  m:close()
+end)
+
 T.done()
