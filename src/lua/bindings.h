@@ -181,6 +181,17 @@ bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f
 /// the stack; returns it, its length in *n.
 int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
 
+/* -------------------------------------------------------- events.c */
+
+/// Whether `name` is an event of m:on ("bond_break", "contact_create", ...).
+bool sx_lua_is_event(const char *name);
+/// m:on(event, fn[, opts]) for the model at 1 with the handler's id: pushes the id.
+int sx_lua_events_add(lua_State *L, lua_Integer id);
+/// Whether the model at `model` has handlers that need the run to go step by step.
+bool sx_lua_events_per_step(lua_State *L, int model);
+/// Delivers the events of the steps since the last delivery to their handlers.
+void sx_lua_events_deliver(lua_State *L, int model);
+
 /* ------------------------------------------------------ geometry.c */
 
 /// m:ball: a new ball at x of radius r behind a plane or line wall of the
