@@ -325,6 +325,13 @@ static int ball_remove(lua_State *L)
     return 0;
 }
 
+static int get_disp(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    return sx_lua_ball_disp(L, m, id);
+}
+
 static int ball_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &ball_kind); }
 
 /* ------------------------------------------------------- model methods */
@@ -431,6 +438,7 @@ void sx_lua_balls_register(lua_State *L)
         {"group", get_group},
         {"extra", get_extra},
         {"clump", get_clump},
+        {"disp", get_disp},
         {NULL, NULL},
     };
     static const luaL_Reg setters[] = {

@@ -485,6 +485,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     const double t0 = sx_model_time(m);
     progress *p = &r->progress;
     progress_start(L, p, m, what);
+    sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
     *ratio = NAN;
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {

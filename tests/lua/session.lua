@@ -284,4 +284,27 @@ test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API",
   m:close()
 end)
 
+test("b.disp: the displacement since m:reset_disp, for balls added later since their first cycle", function()
+  local m = seixo.model{dim = 2, timestep = 1e-3}
+  m:material("a")
+  local b = m:ball{pos = {0, 0}, radius = 0.1, vel = {1, 0}}
+  raises(function() return b.disp end, "ball field 'disp': no reference position yet; m:reset_disp() starts")
+  m:cycle(10)
+  eq(m:reset_disp(), 1)
+  eq(tostring(b.disp), "{0.0, 0.0}")
+  m:cycle(100)
+  T.near(b.disp.x, 0.1, 1e-12)
+  local c = m:ball{pos = {5, 5}, radius = 0.1, vel = {0, 2}}
+  eq(tostring(c.disp), "{0.0, 0.0}")  -- measured from the next cycle on
+  m:cycle(100)
+  T.near(b.disp.x, 0.2, 1e-12)
+  T.near(c.disp.y, 0.2, 1e-12)
+  -- a filter resets some balls only
+  eq(m:reset_disp{where = function(x) return x.id == 1 end}, 1)
+  eq(b.disp.x, 0.0)
+  T.near(c.disp.y, 0.2, 1e-12)
+  check(tostring(b):find("seixo.ball 1", 1, true))
+  m:close()
+end)
+
 T.done()
