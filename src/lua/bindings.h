@@ -284,6 +284,8 @@ void sx_lua_pushvec(lua_State *L, const double *v, int n);
 void sx_lua_pushnewvec(lua_State *L, const double *v, int n);
 /// vec.c: creates the seixo.vec class and adds seixo.vec to the module table on the stack top.
 void sx_lua_vec_register(lua_State *L);
+/// Sets field k of the table on the stack top to the number v.
+void sx_lua_setnum(lua_State *L, const char *k, double v);
 /// A value assigned to the field `field` of an object of `kind`: n numbers,
 /// or an error naming both ("ball field 'vel': ...").
 void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field);

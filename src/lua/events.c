@@ -197,12 +197,6 @@ static void setint(lua_State *L, const char *k, int64_t v)
     lua_setfield(L, -2, k);
 }
 
-static void setnum(lua_State *L, const char *k, double v)
-{
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-}
-
 static void setball(lua_State *L, int model, const char *k, int64_t id, bool wall)
 {
     sx_lua_pushhandle(L, model, wall ? &sx_lua_wall_kind : &sx_lua_ball_kind, id);
@@ -229,9 +223,9 @@ static void deliver_bonds(lua_State *L, int model, int handlers, int state, cons
         lua_setfield(L, -2, "mode");
         lua_pushstring(L, c.kind == SX_BOND_PARALLEL ? "parallel" : "contact");
         lua_setfield(L, -2, "bond");
-        setnum(L, "fn", c.fn);
-        setnum(L, "fs", c.fs);
-        setnum(L, "time", c.time);
+        sx_lua_setnum(L, "fn", c.fn);
+        sx_lua_setnum(L, "fs", c.fs);
+        sx_lua_setnum(L, "time", c.time);
         setint(L, "step", c.step);
         dispatch(L, model, handlers, EV_BOND, lua_gettop(L));
         lua_pop(L, 1);
@@ -246,8 +240,8 @@ static void pair_event(lua_State *L, int model, int handlers, int kind, const pa
     lua_pushboolean(L, p->wall);
     lua_setfield(L, -2, "wall");
     if (kind == EV_CREATE) {
-        setnum(L, "fn", p->fn);
-        setnum(L, "overlap", p->overlap);
+        sx_lua_setnum(L, "fn", p->fn);
+        sx_lua_setnum(L, "overlap", p->overlap);
     }
     setint(L, "step", step);
     dispatch(L, model, handlers, kind, lua_gettop(L));

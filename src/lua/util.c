@@ -147,6 +147,12 @@ void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *ki
     if (err) luaL_error(L, "%s field '%s': %s", kind, field, err);
 }
 
+void sx_lua_setnum(lua_State *L, const char *k, double v)
+{
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+}
+
 /* ----------------------------------------------------- property tables */
 
 static int rawfield(lua_State *L, int arg, const char *key)

@@ -5,17 +5,7 @@ local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "har
 local test, check, eq, raises = T.test, T.check, T.eq, T.raises
 
 -- two bonded rows of balls pulled apart: every bond between the rows breaks
-local function rows()
-  local m = seixo.model{dim = 3}
-  m:material("rock", {kn = 1e6, ks = 1e6, friction = 0.5, density = 2600})
-  for i = 0, 9 do
-    for j = 0, 1 do m:ball{pos = {0.002 * i, 0.002 * j, 0}, radius = 0.001} end
-  end
-  m:bond{kind = "parallel", gap = 1e-4, radius_multiplier = 0.5, modulus = 1e7, stiffness_ratio = 2,
-         tensile_strength = 1e4, cohesion = 1e4}
-  for b in m:balls() do b.vel = {0, b.pos[2] > 0.001 and 0.5 or -0.5, 0} end
-  return m
-end
+local rows = dofile(T.root .. "tests/io/bonded_rows.lua")
 
 -- balls dropped into a box: contacts made and lost as they bounce
 local function pile()
