@@ -67,7 +67,7 @@ local entries = {
     "Wall-clock time per stage of the step (broad phase, ball contacts, wall contacts, integration, callbacks, other) since the model was created or reset; prints the table unless print = false."},
 
   -- model: groups and bulk operations
-  ["model:group"] = {"m:group(name, filter | fn) -> n", "Puts the selected balls (filter {group, region, where} or a predicate fn(ball)) in the group; returns how many."},
+  ["model:group"] = {"m:group(name, filter | fn[, slot]) -> n", "Puts the selected balls (filter {group, slot, region, where} or a predicate fn(ball)) in the group, in group slot `slot` (1 to 8, default 1: b.group); returns how many. A filter's group matches any slot, or the filter's slot."},
   ["model:groups"] = {"m:groups() -> {name = count}", "Every group and its number of balls."},
   ["model:set"] = {"m:set{group =, region =, where =, vel =, spin =, applied_force =, applied_moment =, radius =, damping =, material =, fix =} -> n",
     "Sets fields of the selected balls at once (in C); returns how many."},
@@ -117,6 +117,8 @@ local entries = {
 
   -- ball
   ["ball:remove"] = {"b:remove()", "Removes the ball (queued while a callback runs)."},
+  ["ball:set_group"] = {"b:set_group(name | nil, slot)", "Puts the ball in a group in one of its 8 group slots (PFC's slots; slot 1 is b.group)."},
+  ["ball.groups"] = {"b.groups", "The ball's groups by slot: {[slot] = name} (read-only; slot 1 is b.group)."},
   ["ball:set_extra"] = {"b:set_extra(key, value)", "Stores a user value with the ball (same as b.extra[key] = value)."},
   ["ball:get_extra"] = {"b:get_extra(key[, default]) -> value", "A user value stored with the ball."},
   ["ball.id"] = {"b.id", "The ball's stable id (read-only)."},

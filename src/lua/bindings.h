@@ -139,6 +139,13 @@ void sx_lua_clump_set_group(lua_State *L, sx_model *m, int64_t id, int32_t group
 int32_t sx_lua_group_id(lua_State *L, int model, const char *name, bool create);
 /// Pushes the name of group number g (nil for 0).
 void sx_lua_push_group_name(lua_State *L, int model, int32_t g);
+/// Group slots of a ball, PFC's: slot 1 is the core's group (b.group), slots
+/// 2 .. SX_LUA_SLOTS live in the model's Lua state.
+enum { SX_LUA_SLOTS = 8 };
+/// The group number of ball id in slot (1 .. SX_LUA_SLOTS) of the model userdata at `model`.
+int32_t sx_lua_slot_group(lua_State *L, int model, const sx_model *m, int64_t id, int slot);
+/// Puts ball id in group g (0: none) in slot; an error of `what` when the core refuses.
+void sx_lua_set_slot_group(lua_State *L, int model, sx_model *m, int64_t id, int slot, int32_t g, const char *what);
 
 /* ----------------------------------------------------------- region.c */
 
@@ -169,6 +176,7 @@ bool sx_lua_region_contains(const sx_lua_region *g, const double *x, double r);
 /// and a Lua predicate `where`, all optional.
 typedef struct sx_lua_filter {
     int32_t group;       ///< 0: any
+    int slot;            ///< the group slot the group is looked for in; 0: any (groups.c)
     bool has_region;
     sx_lua_region region;
     int where;           ///< stack index of the predicate, 0 for none

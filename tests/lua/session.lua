@@ -307,4 +307,33 @@ test("b.disp: the displacement since m:reset_disp, for balls added later since t
   m:close()
 end)
 
+test("group slots: a ball in several groups, filters by any slot or one", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  for i = 1, 6 do m:ball{pos = {i, 0}, radius = 0.1} end
+  eq(m:group("left", {where = function(b) return b.pos.x < 3.5 end}), 3)       -- slot 1: b.group
+  eq(m:group("even", function(b) return b.id % 2 == 0 end, 2), 3)              -- slot 2
+  local b = m:ball(2)
+  eq(b.group, "left")
+  eq(b.groups[1], "left")
+  eq(b.groups[2], "even")
+  b:set_group("special", 5)
+  eq(b.groups[5], "special")
+  eq(m:count{group = "even"}, 3)
+  eq(m:count{group = "even", slot = 1}, 0)
+  eq(m:count{group = "even", slot = 2}, 3)
+  eq(m:count{group = "left", region = {box = {{1.5, -1}, {7, 1}}}}, 2)
+  local g = m:groups()
+  eq(g.left, 3)
+  eq(g.even, 3)
+  eq(g.special, 1)
+  b:set_group(nil, 2)
+  eq(b.groups[2], nil)
+  eq(m:count{group = "even"}, 2)
+  raises(function() m:group("x", {}, 9) end, "a group slot from 1 to 8 expected")
+  raises(function() m:count{group = "left", slot = 0} end, "a group slot from 1 to 8 expected")
+  raises(function() b:set_group("x", 9) end, "a group slot from 1 to 8 expected")
+  m:close()
+end)
+
 T.done()
