@@ -77,7 +77,7 @@ static void push_pairs(lua_State *L, const sx_model *m)
         free(s.p);
         luaL_error(L, "event callbacks: out of memory");
     }
-    qsort(s.p, (size_t)s.n, sizeof *s.p, pair_cmp);
+    if (s.n > 1) qsort(s.p, (size_t)s.n, sizeof *s.p, pair_cmp);
     pair *u = lua_newuserdatauv(L, (size_t)s.n * sizeof *u, 0);
     if (s.n) memcpy(u, s.p, (size_t)s.n * sizeof *u);
     free(s.p);
