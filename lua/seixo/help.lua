@@ -14,6 +14,8 @@ local entries = {
   ["seixo.model"] = {"seixo.model{dim = 3, gravity = {0, 0, 0}, timestep = 0, timestep_safety = 0.8, skin = 0, overlap_limit = 0.5}",
     "A new model. dim 2 (disks of unit thickness) or 3 (spheres); gravity [m/s^2]; timestep [s], 0 = automatic; skin [m] of the broad phase, 0 = automatic; overlap_limit: the largest overlap a ball may be placed with, a fraction of its radius."},
   ["seixo.version"] = {"seixo.version", "The version string."},
+  ["seixo.vec"] = {"seixo.vec(x, y[, z]) | seixo.vec{x, y[, z]} -> vector",
+    "A vector with arithmetic (v + w, v - w, -v, v * s, s * v, v / s, v == w), fields x, y, z and methods dot, cross, norm, unit, copy; accepted wherever {x, y, z} is, and what b.pos, b.vel, w.force, ... return."},
   ["seixo.models"] = {"seixo.models() -> {model, ...}", "The open models, in the order they were made (a model no longer referenced may be collected)."},
   ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",
     "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},
@@ -51,8 +53,8 @@ local entries = {
   ["model:solve"] = {"m:solve{ratio =, steps =, time =, every = 100} -> reason, ratio, steps",
     "Cycles until the mean unbalanced-force ratio <= ratio (checked every `every` steps), or `steps` steps, or `time` [s] of model time; reason is 'ratio', 'steps' or 'time'. With no limit: ratio = 1e-5."},
   ["model:on"] = {"m:on(point, fn[, {every = N}]) -> id",
-    "Calls fn(m) at step boundaries s with s % N == 0: point 'after' (alias 'cycle') once step s is taken, 'before' before step s + 1."},
-  ["model:off"] = {"m:off(id) -> removed", "Removes a callback added by m:on."},
+    "Calls fn(m) at step boundaries s with s % N == 0: point 'after' (alias 'cycle') once step s is taken, 'before' before step s + 1. Events: m:on('bond_break' | 'contact_create' | 'contact_delete' | 'ball_leave_region', fn(m, e)[, {region =}]) after the step they happen in."},
+  ["model:off"] = {"m:off(id) -> removed", "Removes a callback or an event handler added by m:on."},
   ["model:dim"] = {"m:dim() -> 2 | 3", "The model's dimension."},
   ["model:time"] = {"m:time() -> t", "Model time [s]."},
   ["model:step"] = {"m:step() -> n", "Steps taken."},
@@ -73,7 +75,7 @@ local entries = {
     "Wall-clock time per stage of the step (broad phase, ball contacts, wall contacts, integration, callbacks, other) since the model was created or reset; prints the table unless print = false."},
 
   -- model: groups and bulk operations
-  ["model:group"] = {"m:group(name, filter | fn) -> n", "Puts the selected balls (filter {group, region, where} or a predicate fn(ball)) in the group; returns how many."},
+  ["model:group"] = {"m:group(name, filter | fn[, slot]) -> n", "Puts the selected balls (filter {group, slot, region, where} or a predicate fn(ball)) in the group, in group slot `slot` (1 to 8, default 1: b.group); returns how many. A filter's group matches any slot, or the filter's slot."},
   ["model:groups"] = {"m:groups() -> {name = count}", "Every group and its number of balls."},
   ["model:set"] = {"m:set{group =, region =, where =, vel =, spin =, applied_force =, applied_moment =, radius =, damping =, material =, fix =} -> n",
     "Sets fields of the selected balls at once (in C); returns how many."},
@@ -123,10 +125,14 @@ local entries = {
 
   -- ball
   ["ball:remove"] = {"b:remove()", "Removes the ball (queued while a callback runs)."},
+  ["ball:set_group"] = {"b:set_group(name | nil, slot)", "Puts the ball in a group in one of its 8 group slots (PFC's slots; slot 1 is b.group)."},
+  ["ball.groups"] = {"b.groups", "The ball's groups by slot: {[slot] = name} (read-only; slot 1 is b.group)."},
   ["ball:set_extra"] = {"b:set_extra(key, value)", "Stores a user value with the ball (same as b.extra[key] = value)."},
   ["ball:get_extra"] = {"b:get_extra(key[, default]) -> value", "A user value stored with the ball."},
   ["ball.id"] = {"b.id", "The ball's stable id (read-only)."},
   ["ball.pos"] = {"b.pos", "Position [m]."},
+  ["ball.disp"] = {"b.disp", "Displacement since m:reset_disp() [m] (read-only); a ball added later is measured from its first cycle."},
+  ["model:reset_disp"] = {"m:reset_disp([filter]) -> n", "Makes the selected balls' (all: every ball's) positions the reference of b.disp; returns how many."},
   ["ball.vel"] = {"b.vel", "Velocity [m/s]."},
   ["ball.spin"] = {"b.spin", "Angular velocity [rad/s] (2D: a number, about z)."},
   ["ball.force"] = {"b.force", "Contact plus applied force of the last step [N] (read-only)."},

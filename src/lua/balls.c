@@ -236,6 +236,38 @@ static int set_group(lua_State *L)
     return 0;
 }
 
+/* b.groups: {[slot] = name} of the slots that hold a group */
+static int get_groups(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    lua_getiuservalue(L, 1, 1);
+    const int model = lua_gettop(L);
+    lua_newtable(L);
+    for (int k = 1; k <= SX_LUA_SLOTS; k++) {
+        const int32_t g = sx_lua_slot_group(L, model, m, id, k);
+        if (!g) continue;
+        sx_lua_push_group_name(L, model, g);
+        lua_rawseti(L, -2, k);
+    }
+    return 1;
+}
+
+/* b:set_group(name | nil, slot): PFC's group slots (slot 1 is b.group) */
+static int ball_set_group(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_ball(L, &id);
+    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TSTRING) return luaL_typeerror(L, 2, "group name or nil");
+    const lua_Integer slot = luaL_checkinteger(L, 3);
+    luaL_argcheck(L, slot >= 1 && slot <= SX_LUA_SLOTS, 3, "a group slot from 1 to 8 expected");
+    lua_getiuservalue(L, 1, 1);
+    const int model = lua_gettop(L);
+    const int32_t g = lua_isnil(L, 2) ? 0 : sx_lua_group_id(L, model, lua_tostring(L, 2), true);
+    sx_lua_set_slot_group(L, model, m, id, (int)slot, g, "b:set_group");
+    return 0;
+}
+
 static int get_extra(lua_State *L) { return sx_lua_extra_table(L, &ball_kind); }
 static int set_extra_table(lua_State *L) { return sx_lua_set_extra_table(L, &ball_kind); }
 static int ball_set_extra(lua_State *L) { return sx_lua_set_extra(L, &ball_kind); }
@@ -325,6 +357,13 @@ static int ball_remove(lua_State *L)
     return 0;
 }
 
+static int get_disp(lua_State *L)
+{
+    int64_t id;
+    const sx_model *m = check_ball(L, &id);
+    return sx_lua_ball_disp(L, m, id);
+}
+
 static int ball_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &ball_kind); }
 
 /* ------------------------------------------------------- model methods */
@@ -411,6 +450,7 @@ void sx_lua_balls_register(lua_State *L)
         {"remove", ball_remove},
         {"set_extra", ball_set_extra},
         {"get_extra", ball_get_extra},
+        {"set_group", ball_set_group},
         {NULL, NULL},
     };
     static const luaL_Reg getters[] = {
@@ -429,8 +469,10 @@ void sx_lua_balls_register(lua_State *L)
         {"fix", get_fix},
         {"damping", get_damping},
         {"group", get_group},
+        {"groups", get_groups},
         {"extra", get_extra},
         {"clump", get_clump},
+        {"disp", get_disp},
         {NULL, NULL},
     };
     static const luaL_Reg setters[] = {

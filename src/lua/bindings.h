@@ -43,6 +43,11 @@ extern const luaL_Reg sx_lua_lab_methods[];       ///< lab.c: measure
 void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
 extern const luaL_Reg sx_lua_clumps_methods[];    ///< clumps.c: clump_template(s), clump, clumps, clump_count
+extern const luaL_Reg sx_lua_disp_methods[];      ///< disp.c: reset_disp
+/// disp.c: records a reference position for each ball that has none, once m:reset_disp made the table.
+void sx_lua_disp_fill(lua_State *L, int model);
+/// disp.c: pushes b.disp of ball id, the handle at index 1 (an error before any m:reset_disp).
+int sx_lua_ball_disp(lua_State *L, const sx_model *m, int64_t id);
 
 /* Functions of the seixo table beside the loader's own. */
 extern const luaL_Reg sx_lua_optimize_functions[];  ///< optimize.c: seixo.optimize
@@ -141,6 +146,13 @@ void sx_lua_clump_set_group(lua_State *L, sx_model *m, int64_t id, int32_t group
 int32_t sx_lua_group_id(lua_State *L, int model, const char *name, bool create);
 /// Pushes the name of group number g (nil for 0).
 void sx_lua_push_group_name(lua_State *L, int model, int32_t g);
+/// Group slots of a ball, PFC's: slot 1 is the core's group (b.group), slots
+/// 2 .. SX_LUA_SLOTS live in the model's Lua state.
+enum { SX_LUA_SLOTS = 8 };
+/// The group number of ball id in slot (1 .. SX_LUA_SLOTS) of the model userdata at `model`.
+int32_t sx_lua_slot_group(lua_State *L, int model, const sx_model *m, int64_t id, int slot);
+/// Puts ball id in group g (0: none) in slot; an error of `what` when the core refuses.
+void sx_lua_set_slot_group(lua_State *L, int model, sx_model *m, int64_t id, int slot, int32_t g, const char *what);
 
 /* ----------------------------------------------------------- region.c */
 
@@ -171,6 +183,7 @@ bool sx_lua_region_contains(const sx_lua_region *g, const double *x, double r);
 /// and a Lua predicate `where`, all optional.
 typedef struct sx_lua_filter {
     int32_t group;       ///< 0: any
+    int slot;            ///< the group slot the group is looked for in; 0: any (groups.c)
     bool has_region;
     sx_lua_region region;
     int where;           ///< stack index of the predicate, 0 for none
@@ -187,6 +200,17 @@ bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f
 /// Collects the ids of the balls that pass into a Lua-owned array pushed on
 /// the stack; returns it, its length in *n.
 int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
+
+/* -------------------------------------------------------- events.c */
+
+/// Whether `name` is an event of m:on ("bond_break", "contact_create", ...).
+bool sx_lua_is_event(const char *name);
+/// m:on(event, fn[, opts]) for the model at 1 with the handler's id: pushes the id.
+int sx_lua_events_add(lua_State *L, lua_Integer id);
+/// Whether the model at `model` has handlers that need the run to go step by step.
+bool sx_lua_events_per_step(lua_State *L, int model);
+/// Delivers the events of the steps since the last delivery to their handlers.
+void sx_lua_events_deliver(lua_State *L, int model);
 
 /* ------------------------------------------------------ geometry.c */
 
@@ -271,8 +295,14 @@ void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, cons
 /// Reads the value at idx as n numbers (n <= 4) into out; returns NULL, or
 /// pushes and returns a message saying what is wrong.
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
-/// Pushes n components of v (a number when n == 1).
+/// Pushes n components of v (a number when n == 1, else a seixo.vec).
 void sx_lua_pushvec(lua_State *L, const double *v, int n);
+/// vec.c: pushes a seixo.vec of n (1 to 4) components.
+void sx_lua_pushnewvec(lua_State *L, const double *v, int n);
+/// vec.c: creates the seixo.vec class and adds seixo.vec to the module table on the stack top.
+void sx_lua_vec_register(lua_State *L);
+/// Sets field k of the table on the stack top to the number v.
+void sx_lua_setnum(lua_State *L, const char *k, double v);
 /// A value assigned to the field `field` of an object of `kind`: n numbers,
 /// or an error naming both ("ball field 'vel': ...").
 void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field);

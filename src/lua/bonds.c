@@ -152,12 +152,6 @@ static int model_bond_count(lua_State *L)
     return 1;
 }
 
-static void setnum(lua_State *L, const char *k, double v)
-{
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-}
-
 static int model_cracks(lua_State *L)
 {
     const sx_model *m = sx_lua_checkmodel(L, 1);
@@ -167,7 +161,7 @@ static int model_cracks(lua_State *L)
         sx_crack c;
         sx_lua_check(L, m, sx_crack_get(m, i, &c), "m:cracks");
         lua_createtable(L, 0, 11);
-        setnum(L, "time", c.time);
+        sx_lua_setnum(L, "time", c.time);
         lua_pushinteger(L, (lua_Integer)c.step);
         lua_setfield(L, -2, "step");
         sx_lua_pushvec(L, c.pos, sx_model_dim(m));
@@ -180,10 +174,10 @@ static int model_cracks(lua_State *L)
         lua_setfield(L, -2, "a");
         lua_pushinteger(L, (lua_Integer)c.b);
         lua_setfield(L, -2, "b");
-        setnum(L, "fn", c.fn);
-        setnum(L, "fs", c.fs);
-        setnum(L, "mn", c.mn);
-        setnum(L, "ms", c.ms);
+        sx_lua_setnum(L, "fn", c.fn);
+        sx_lua_setnum(L, "fs", c.fs);
+        sx_lua_setnum(L, "mn", c.mn);
+        sx_lua_setnum(L, "ms", c.ms);
         lua_rawseti(L, -2, (lua_Integer)(i + 1));
     }
     return 1;

@@ -12,7 +12,14 @@
  *
  * The core stores a group number per ball (0: none); names live in the
  * model's state: `groups` maps a name to its number, `group_names` the
- * number back to its name. */
+ * number back to its name.
+ *
+ * A ball has SX_LUA_SLOTS group slots, as in PFC: slot 1 is the core's
+ * group (b.group, the output files' group); slots 2 and up are tables of
+ * the model's state (`slot2`, ...: ball id -> group number), made when a
+ * group is first put in them, so a model that uses one slot pays nothing.
+ * A filter's group matches a ball that has it in any slot, or in the slot
+ * given by the filter's `slot`. Slots 2 and up are not saved by m:save. */
 #include <math.h>
 #include <string.h>
 
@@ -59,7 +66,52 @@ void sx_lua_push_group_name(lua_State *L, int model, int32_t g)
 
 /* ------------------------------------------------------------ filters */
 
-const char *const sx_lua_filter_keys[] = {"group", "region", "where", NULL};
+/* ---------------------------------------------------------------- slots */
+
+static const char *const slot_names[] = {NULL, NULL, "slot2", "slot3", "slot4", "slot5", "slot6", "slot7", "slot8"};
+_Static_assert(sizeof slot_names / sizeof *slot_names == SX_LUA_SLOTS + 1, "a table name per slot");
+
+int32_t sx_lua_slot_group(lua_State *L, int model, const sx_model *m, int64_t id, int slot)
+{
+    int32_t g = 0;
+    if (slot == 1) {
+        sx_ball_group(m, id, &g);
+        return g;
+    }
+    lua_getiuservalue(L, model, 1);
+    if (lua_getfield(L, -1, slot_names[slot]) == LUA_TTABLE) {
+        lua_rawgeti(L, -1, (lua_Integer)id);
+        g = (int32_t)lua_tointeger(L, -1);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+    return g;
+}
+
+void sx_lua_set_slot_group(lua_State *L, int model, sx_model *m, int64_t id, int slot, int32_t g, const char *what)
+{
+    if (slot == 1) {
+        sx_lua_check(L, m, sx_ball_set_group(m, id, g), what);
+        return;
+    }
+    sx_lua_state(L, model, slot_names[slot]);
+    if (g) lua_pushinteger(L, g);
+    else lua_pushnil(L);
+    lua_rawseti(L, -2, (lua_Integer)id);
+    lua_pop(L, 1);
+}
+
+/* A slot number at idx (nil: `dflt`), an argument error on arg otherwise. */
+static int check_slot(lua_State *L, int idx, int arg, int dflt)
+{
+    if (lua_isnoneornil(L, idx)) return dflt;
+    const lua_Integer k = lua_isinteger(L, idx) ? lua_tointeger(L, idx) : 0;
+    if (k < 1 || k > SX_LUA_SLOTS)
+        luaL_argerror(L, arg, lua_pushfstring(L, "a group slot from 1 to %d expected", SX_LUA_SLOTS));
+    return (int)k;
+}
+
+const char *const sx_lua_filter_keys[] = {"group", "slot", "region", "where", NULL};
 
 /* The group named by the string at idx; an unknown name is an error that lists the groups. */
 static int32_t existing_group(lua_State *L, int model, int arg, int idx)
@@ -94,6 +146,9 @@ void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f)
     const int dim = sx_model_dim(sx_lua_checkmodel(L, model));
     if (lua_getfield(L, arg, "group") != LUA_TNIL) f->group = existing_group(L, f->model, arg, lua_gettop(L));
     lua_pop(L, 1);
+    lua_getfield(L, arg, "slot");
+    f->slot = check_slot(L, lua_gettop(L), arg, 0);
+    lua_pop(L, 1);
     if (lua_getfield(L, arg, "region") != LUA_TNIL) {
         const int top = lua_gettop(L);
         sx_lua_region_read(L, top, dim, arg, "region", &f->region);
@@ -115,8 +170,10 @@ void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f)
 bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t id)
 {
     if (f->group) {
-        int32_t g;
-        if (sx_ball_group(m, id, &g) != SX_OK || g != f->group) return false;
+        bool in = false;
+        for (int k = f->slot ? f->slot : 1; !in && k <= (f->slot ? f->slot : SX_LUA_SLOTS); k++)
+            in = sx_lua_slot_group(L, f->model, m, id, k) == f->group;
+        if (!in) return false;
     }
     if (f->has_region) {
         double x[3];
@@ -160,12 +217,13 @@ static int64_t *select_balls(lua_State *L, int arg, int64_t *n)
 
 /* ---------------------------------------------------- group, groups, count */
 
-/* m:group(name, selector): selector a filter table or a predicate. */
+/* m:group(name, selector[, slot]): selector a filter table or a predicate. */
 static int model_group(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
     const char *name = luaL_checkstring(L, 2);
     luaL_argcheck(L, *name, 2, "a group name must not be empty");
+    const int slot = check_slot(L, 4, 4, 1);
     if (lua_isfunction(L, 3)) {
         lua_createtable(L, 0, 1);
         lua_pushvalue(L, 3);
@@ -183,7 +241,7 @@ static int model_group(lua_State *L)
     int64_t done = 0;
     for (int64_t i = 0; i < n; i++)
         if (sx_ball_exists(m, ids[i])) {
-            sx_lua_check(L, m, sx_ball_set_group(m, ids[i], g), "m:group");
+            sx_lua_set_slot_group(L, 1, m, ids[i], slot, g, "m:group");
             done++;
         }
     lua_pushinteger(L, (lua_Integer)done);
@@ -198,10 +256,17 @@ static int model_groups(lua_State *L)
     const lua_Integer ng = (lua_Integer)lua_rawlen(L, names);
     lua_Integer *counts = lua_newuserdatauv(L, (size_t)(ng + 1) * sizeof *counts, 0);
     memset(counts, 0, (size_t)(ng + 1) * sizeof *counts);
+    /* a ball counts once in each group it is in, whatever the slots */
+    int32_t *seen = lua_newuserdatauv(L, SX_LUA_SLOTS * sizeof *seen, 0);
     const int64_t n = sx_ball_count(m);
     for (int64_t i = 0; i < n; i++) {
-        int32_t g;
-        if (sx_ball_group(m, sx_ball_id_at(m, i), &g) == SX_OK && g > 0 && g <= ng) counts[g]++;
+        const int64_t id = sx_ball_id_at(m, i);
+        for (int k = 1; k <= SX_LUA_SLOTS; k++) {
+            const int32_t g = seen[k - 1] = sx_lua_slot_group(L, 1, m, id, k);
+            bool again = false;
+            for (int j = 1; j < k; j++) again |= seen[j - 1] == g;
+            if (g > 0 && g <= ng && !again) counts[g]++;
+        }
     }
     lua_createtable(L, 0, (int)ng);
     for (lua_Integer g = 1; g <= ng; g++) {

@@ -313,12 +313,6 @@ static int model_material(lua_State *L)
     return 1;  // the name: materials are referred to by name everywhere
 }
 
-static void setnum(lua_State *L, const char *k, double v)
-{
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-}
-
 /* m:materials(): name -> its properties, as m:material takes them. */
 static int model_materials(lua_State *L)
 {
@@ -331,18 +325,18 @@ static int model_materials(lua_State *L)
         lua_createtable(L, 0, 12);
         lua_pushstring(L, sx_law_name(d.model));
         lua_setfield(L, -2, "model");
-        setnum(L, "density", d.density);
-        setnum(L, "kn", d.kn);
-        setnum(L, "ks", d.ks);
-        setnum(L, "friction", d.friction);
-        setnum(L, "damping", d.damping);
-        setnum(L, "viscous_normal", d.viscous_normal);
-        setnum(L, "viscous_shear", d.viscous_shear);
-        setnum(L, "modulus", d.modulus);
-        setnum(L, "stiffness_ratio", d.stiffness_ratio);
+        sx_lua_setnum(L, "density", d.density);
+        sx_lua_setnum(L, "kn", d.kn);
+        sx_lua_setnum(L, "ks", d.ks);
+        sx_lua_setnum(L, "friction", d.friction);
+        sx_lua_setnum(L, "damping", d.damping);
+        sx_lua_setnum(L, "viscous_normal", d.viscous_normal);
+        sx_lua_setnum(L, "viscous_shear", d.viscous_shear);
+        sx_lua_setnum(L, "modulus", d.modulus);
+        sx_lua_setnum(L, "stiffness_ratio", d.stiffness_ratio);
         for (int law = 0; law < sx_law_count(); law++)
             for (int k = 0; k < sx_law_param_count(law); k++)
-                setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(&d, law, k));
+                sx_lua_setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(&d, law, k));
         lua_setfield(L, -2, sx_material_name(m, i));
     }
     return 1;

@@ -8,6 +8,9 @@
  * model's absolute step count, so m:cycle(100) twice does exactly what
  * m:cycle(200) does, callbacks and histories included.
  *
+ * Event handlers (m:on("bond_break", fn), ...) are in events.c; their
+ * events are delivered after each chunk, before the callbacks.
+ *
  * A callback with every = N runs at the step boundaries s with s % N == 0:
  * "after" (alias "cycle") once the step s is taken, "before" when the step
  * s + 1 is about to be taken. At one boundary the "after" callbacks run
@@ -364,11 +367,25 @@ static int64_t next_event(lua_State *L, int model, int64_t s)
     return next;
 }
 
-/* m:on(point, fn[, {every = N}]) -> id */
+/* The next id of a callback or an event handler of the model at 1. */
+static lua_Integer next_id(lua_State *L)
+{
+    sx_lua_state(L, 1, "next_callback");
+    lua_rawgeti(L, -1, 1);
+    const lua_Integer id = lua_tointeger(L, -1) + 1;
+    lua_pop(L, 1);
+    lua_pushinteger(L, id);
+    lua_rawseti(L, -2, 1);
+    lua_pop(L, 1);
+    return id;
+}
+
+/* m:on(point, fn[, {every = N}]) -> id; m:on(event, fn[, {region =}]) -> id (events.c) */
 static int model_on(lua_State *L)
 {
     static const char *const keys[] = {"every", NULL};
     sx_lua_checkmodel(L, 1);
+    if (lua_type(L, 2) == LUA_TSTRING && sx_lua_is_event(lua_tostring(L, 2))) return sx_lua_events_add(L, next_id(L));
     const int point = luaL_checkoption(L, 2, NULL, point_names);
     luaL_checktype(L, 3, LUA_TFUNCTION);
     int64_t every = 1;
@@ -376,12 +393,7 @@ static int model_on(lua_State *L)
         sx_lua_checkkeys(L, 4, keys);
         sx_lua_optintfield(L, 4, "every", 1, INT64_MAX / 2, &every);
     }
-    sx_lua_state(L, 1, "next_callback");
-    lua_rawgeti(L, -1, 1);
-    const lua_Integer id = lua_tointeger(L, -1) + 1;
-    lua_pop(L, 1);
-    lua_pushinteger(L, id);
-    lua_rawseti(L, -2, 1);
+    const lua_Integer id = next_id(L);
     sx_lua_state(L, 1, "callbacks");
     lua_createtable(L, 0, 5);
     lua_pushinteger(L, id);
@@ -397,12 +409,10 @@ static int model_on(lua_State *L)
     return 1;
 }
 
-/* m:off(id): removes a callback; true if there was one. */
-static int model_off(lua_State *L)
+/* Removes entry `id` from the model's list `list`; whether there was one. */
+static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
 {
-    sx_lua_checkmodel(L, 1);
-    const lua_Integer id = luaL_checkinteger(L, 2);
-    sx_lua_state(L, 1, "callbacks");
+    sx_lua_state(L, 1, list);
     const int t = lua_gettop(L);
     const lua_Integer n = (lua_Integer)lua_rawlen(L, t);
     for (lua_Integer i = 1; i <= n; i++) {
@@ -423,10 +433,19 @@ static int model_off(lua_State *L)
         }
         lua_pushnil(L);
         lua_rawseti(L, t, n);
-        lua_pushboolean(L, 1);
-        return 1;
+        lua_settop(L, t - 1);
+        return true;
     }
-    lua_pushboolean(L, 0);
+    lua_settop(L, t - 1);
+    return false;
+}
+
+/* m:off(id): removes a callback or an event handler; true if there was one. */
+static int model_off(lua_State *L)
+{
+    sx_lua_checkmodel(L, 1);
+    const lua_Integer id = luaL_checkinteger(L, 2);
+    lua_pushboolean(L, remove_entry(L, "callbacks", id) || remove_entry(L, "events", id));
     return 1;
 }
 
@@ -482,6 +501,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     const double t0 = sx_model_time(m);
     progress *p = &r->progress;
     progress_start(L, p, m, what);
+    sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
     *ratio = NAN;
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {
@@ -522,8 +542,10 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (k < n) n = k;
         }
         if (p->mode && p->chunk < n) n = p->chunk;
-        if (r->ud->unchecked) n = 1;  // a placement check follows the first step
+        /* a placement check follows the first step; contact and region events are per step */
+        if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         sx_lua_run_cycle(L, r, n);
+        sx_lua_events_deliver(L, 1);
         double fraction = -1;
         int64_t total = 0;
         if (lim->steps < INT64_MAX) {

@@ -13,7 +13,7 @@ static const luaL_Reg *const model_methods[] = {
     sx_lua_model_methods,    sx_lua_run_methods,     sx_lua_balls_methods,
     sx_lua_walls_methods,    sx_lua_contacts_methods, sx_lua_groups_methods,
     sx_lua_history_methods,  sx_lua_generate_methods, sx_lua_bonds_methods,
-    sx_lua_lab_methods,      sx_lua_clumps_methods, NULL,
+    sx_lua_lab_methods,      sx_lua_clumps_methods,   sx_lua_disp_methods, NULL,
 };
 
 /* seixo.progress([mode[, every]]): the progress display of long cycles
@@ -73,6 +73,7 @@ int luaopen_seixo(lua_State *L)
     luaL_setfuncs(L, sx_lua_optimize_functions, 0); /* optimize.c: seixo.optimize (NLopt) */
     luaL_setfuncs(L, sx_lua_parallel_functions, 0); /* parallel.c: cores, executable, MPI ranks and messages */
     sx_lua_io_register(L); /* io.c: m:save, m:vars, m:output, seixo.load, seixo.xdmf */
+    sx_lua_vec_register(L); /* vec.c: seixo.vec, the class of every vector returned */
     lua_pushliteral(L, SX_VERSION);
     lua_setfield(L, -2, "version");
     return 1;

@@ -135,21 +135,22 @@ const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
 
 void sx_lua_pushvec(lua_State *L, const double *v, int n)
 {
-    if (n == 1) {
+    if (n == 1)
         lua_pushnumber(L, v[0]);
-        return;
-    }
-    lua_createtable(L, n, 0);
-    for (int k = 0; k < n; k++) {
-        lua_pushnumber(L, v[k]);
-        lua_rawseti(L, -2, k + 1);
-    }
+    else
+        sx_lua_pushnewvec(L, v, n);
 }
 
 void sx_lua_checkvalue(lua_State *L, int idx, int n, double *out, const char *kind, const char *field)
 {
     const char *err = sx_lua_tovec(L, idx, n, out);
     if (err) luaL_error(L, "%s field '%s': %s", kind, field, err);
+}
+
+void sx_lua_setnum(lua_State *L, const char *k, double v)
+{
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
 }
 
 /* ----------------------------------------------------- property tables */

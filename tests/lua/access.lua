@@ -140,7 +140,7 @@ test("groups by name, region and predicate", function()
   eq(m:count{group = "odd"}, 3)
   eq(m:count(), 10)
   raises(function() m:count{group = "tpo"} end, HERE, "field 'group'", "no group named 'tpo'", "groups: first, low, odd, top")
-  raises(function() m:group("x", {regoin = {}}) end, HERE, "unknown key 'regoin'", "group, region, where")
+  raises(function() m:group("x", {regoin = {}}) end, HERE, "unknown key 'regoin'", "group, slot, region, where")
   raises(function() m:group("x") end, HERE, "filter table or predicate function")
   raises(function() m:group("", {}) end, HERE, "empty")
   -- a ball added with a group

@@ -251,4 +251,89 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API", function()
+  local v, w = seixo.vec(1, 2, 3), seixo.vec{0, 1, 0}
+  eq(tostring(v + w), "{1.0, 3.0, 3.0}")
+  eq(tostring(v - w), "{1.0, 1.0, 3.0}")
+  eq(tostring(-v), "{-1.0, -2.0, -3.0}")
+  eq(tostring(v * 2), "{2.0, 4.0, 6.0}")
+  eq(tostring(2 * v), "{2.0, 4.0, 6.0}")
+  eq(tostring(v / 2), "{0.5, 1.0, 1.5}")
+  check(v == seixo.vec(1, 2, 3) and v ~= w)
+  eq(v:dot(w), 2.0)
+  eq(tostring(v:cross(w)), "{-3.0, 0.0, 1.0}")
+  eq(seixo.vec(3, 4):norm(), 5.0)
+  eq(seixo.vec(1, 0):cross(seixo.vec(0, 1)), 1.0)
+  eq(tostring(seixo.vec(0, 3, 4):unit()), "{0.0, 0.6, 0.8}")
+  eq(v.x + v.y + v.z, 6.0)
+  eq(#v, 3)
+  raises(function() return v + seixo.vec(1, 2) end, "the two vectors differ in length")
+  raises(function() return v * w end, "a vector times a number expected")
+  raises(function() return seixo.vec(0, 0):unit() end, "the zero vector has no direction")
+  raises(function() return v.w end, "vector has no field 'w'")
+  local m = seixo.model{dim = 3, gravity = {0, 0, -10}}
+  m:material("a")
+  local b = m:ball{pos = seixo.vec(0, 0, 1), radius = 0.1, vel = v}
+  eq(getmetatable(b.pos), getmetatable(v))
+  b.pos = b.pos + b.vel * 0.5
+  eq(tostring(b.pos), "{0.5, 1.0, 2.5}")
+  eq(tostring(m:gravity()), "{0.0, 0.0, -10.0}")
+  local copy = b.pos
+  copy[1] = 5
+  eq(b.pos.x, 0.5, "a returned vector is a copy")
+  m:close()
+end)
+
+test("b.disp: the displacement since m:reset_disp, for balls added later since their first cycle", function()
+  local m = seixo.model{dim = 2, timestep = 1e-3}
+  m:material("a")
+  local b = m:ball{pos = {0, 0}, radius = 0.1, vel = {1, 0}}
+  raises(function() return b.disp end, "ball field 'disp': no reference position yet; m:reset_disp() starts")
+  m:cycle(10)
+  eq(m:reset_disp(), 1)
+  eq(tostring(b.disp), "{0.0, 0.0}")
+  m:cycle(100)
+  T.near(b.disp.x, 0.1, 1e-12)
+  local c = m:ball{pos = {5, 5}, radius = 0.1, vel = {0, 2}}
+  eq(tostring(c.disp), "{0.0, 0.0}")  -- measured from the next cycle on
+  m:cycle(100)
+  T.near(b.disp.x, 0.2, 1e-12)
+  T.near(c.disp.y, 0.2, 1e-12)
+  -- a filter resets some balls only
+  eq(m:reset_disp{where = function(x) return x.id == 1 end}, 1)
+  eq(b.disp.x, 0.0)
+  T.near(c.disp.y, 0.2, 1e-12)
+  check(tostring(b):find("seixo.ball 1", 1, true))
+  m:close()
+end)
+
+test("group slots: a ball in several groups, filters by any slot or one", function()
+  local m = seixo.model{dim = 2}
+  m:material("a")
+  for i = 1, 6 do m:ball{pos = {i, 0}, radius = 0.1} end
+  eq(m:group("left", {where = function(b) return b.pos.x < 3.5 end}), 3)       -- slot 1: b.group
+  eq(m:group("even", function(b) return b.id % 2 == 0 end, 2), 3)              -- slot 2
+  local b = m:ball(2)
+  eq(b.group, "left")
+  eq(b.groups[1], "left")
+  eq(b.groups[2], "even")
+  b:set_group("special", 5)
+  eq(b.groups[5], "special")
+  eq(m:count{group = "even"}, 3)
+  eq(m:count{group = "even", slot = 1}, 0)
+  eq(m:count{group = "even", slot = 2}, 3)
+  eq(m:count{group = "left", region = {box = {{1.5, -1}, {7, 1}}}}, 2)
+  local g = m:groups()
+  eq(g.left, 3)
+  eq(g.even, 3)
+  eq(g.special, 1)
+  b:set_group(nil, 2)
+  eq(b.groups[2], nil)
+  eq(m:count{group = "even"}, 2)
+  raises(function() m:group("x", {}, 9) end, "a group slot from 1 to 8 expected")
+  raises(function() m:count{group = "left", slot = 0} end, "a group slot from 1 to 8 expected")
+  raises(function() b:set_group("x", 9) end, "a group slot from 1 to 8 expected")
+  m:close()
+end)
+
 T.done()
