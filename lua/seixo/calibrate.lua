@@ -357,7 +357,9 @@ end
 -- The runs of an earlier start of this calibration: key -> record.
 local function read_log(o)
   local cache, rows = {}, {}
-  if not io.open(o.log, "r") then return cache, rows end
+  local f = io.open(o.log, "r")
+  if not f then return cache, rows end
+  f:close()
   local csv = util.read_csv(o.log)
   local header = log_header(o)
   if table.concat(csv.header, ",") ~= table.concat(header, ",") then
@@ -367,7 +369,7 @@ local function read_log(o)
   for i = 1, csv.rows do
     local x = {}
     for j, n in ipairs(o.names) do x[j] = csv.columns[n][i] end
-    local rec = {status = csv.columns.status[i], time = csv.columns.time[i], values = {}, logged = true}
+    local rec = {status = csv.columns.status[i], time = csv.columns.time[i], values = {}}
     for _, k in ipairs(macros) do rec.values[k] = csv.columns[k][i] end
     if rec.status ~= 1 then rec.values, rec.error = nil, "failed (in the log)" end
     local row = {}
@@ -622,9 +624,9 @@ local function calibrate(lab, helpers, opts)
   -- in the log go out in one batch; returns their summaries.
   local function evaluate(cands)
     local jobs = {}
-    for _, x in ipairs(cands) do
+    for ci, x in ipairs(cands) do
       for _, seed in ipairs(o.seeds) do
-        if not cache[key_of(x, seed)] then jobs[#jobs + 1] = {x = x, seed = seed} end
+        if not cache[key_of(x, seed)] then jobs[#jobs + 1] = {x = x, seed = seed, candidate = #history + ci} end
       end
     end
     local t0 = seixo.clock()
@@ -634,7 +636,7 @@ local function calibrate(lab, helpers, opts)
     local function record(i, rec)
       local j = jobs[i]
       cache[key_of(j.x, j.seed)] = rec
-      local row = {#history + 1, j.seed, rec.status, rec.time}
+      local row = {j.candidate, j.seed, rec.status, rec.time}
       for _, v in ipairs(j.x) do row[#row + 1] = v end
       for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
       log_rows[#log_rows + 1] = row

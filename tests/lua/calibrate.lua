@@ -85,6 +85,9 @@ test("synthetic material over 2 worker processes: the known parameters, every ru
     distinct[key] = (distinct[key] or 0) + 1
   end
   for key, n in pairs(distinct) do eq(n, 3, key) end
+  -- the pilot's batch: the pilot (candidate 1) and its twin (candidate 2, kn/ks x 2)
+  eq(csv.columns.candidate[4], 2)
+  eq(csv.columns.stiffness_ratio[4], 5)
   check(csv.rows <= 3 * r.evaluations)
   -- the scatter over the seeds: E's law scatters by 2 % per seed (sd 2 % of the mean)
   near(r.achieved.E.sd / r.achieved.E.mean, 0.02, 1e-2)
