@@ -19,14 +19,15 @@
 #include <time.h>
 #include <unistd.h>
 
+static int world_rank = 0, world_size = 1;
+
 #ifdef SX_HAVE_MPI
 #include <mpi.h>
-#endif
 
-static int world_rank = 0, world_size = 1;
 static bool mpi_started;
 
 enum { MESSAGE_TAG = 7 };
+#endif
 
 void sx_lua_parallel_start(int *argc, char ***argv)
 {
