@@ -243,7 +243,7 @@ local function run_job(o, x, seed)
     for _, k in ipairs(o.target_names) do
       local v = values[k]
       if type(v) ~= "number" or v ~= v or v == math.huge or v == -math.huge then
-        ok, values = false, string.format("unstable: %s = %s", k, tostring(v))
+        ok, values = false, string.format("%s is %s: not measured, or the run went unstable", k, tostring(v))
         break
       end
     end
