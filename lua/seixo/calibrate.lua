@@ -47,7 +47,7 @@ local is_macro = {}
 for _, k in ipairs(macros) do is_macro[k] = true end
 -- how each macro-property is shown: a divisor and a unit
 local units = {E = {1e9, "GPa"}, UCS = {1e6, "MPa"}, BTS = {1e6, "MPa"}, c = {1e6, "MPa"}, nu = {1, ""},
-               phi = {1, "deg"}, curve = {1, "(rms misfit)"}}
+               phi = {1, "deg"}, curve = {1, ""}}
 
 -- An error at the first caller outside this file: the user's script.
 local here = debug.getinfo(1, "S").source
@@ -243,7 +243,7 @@ local function run_job(o, x, seed)
     for _, k in ipairs(o.target_names) do
       local v = values[k]
       if type(v) ~= "number" or v ~= v or v == math.huge or v == -math.huge then
-        ok, values = false, string.format("unstable: %s = %s", k, tostring(v))
+        ok, values = false, string.format("%s is %s: not measured, or the run went unstable", k, tostring(v))
         break
       end
     end
@@ -357,7 +357,9 @@ end
 -- The runs of an earlier start of this calibration: key -> record.
 local function read_log(o)
   local cache, rows = {}, {}
-  if not io.open(o.log, "r") then return cache, rows end
+  local f = io.open(o.log, "r")
+  if not f then return cache, rows end
+  f:close()
   local csv = util.read_csv(o.log)
   local header = log_header(o)
   if table.concat(csv.header, ",") ~= table.concat(header, ",") then
@@ -367,7 +369,7 @@ local function read_log(o)
   for i = 1, csv.rows do
     local x = {}
     for j, n in ipairs(o.names) do x[j] = csv.columns[n][i] end
-    local rec = {status = csv.columns.status[i], time = csv.columns.time[i], values = {}, logged = true}
+    local rec = {status = csv.columns.status[i], time = csv.columns.time[i], values = {}}
     for _, k in ipairs(macros) do rec.values[k] = csv.columns[k][i] end
     if rec.status ~= 1 then rec.values, rec.error = nil, "failed (in the log)" end
     local row = {}
@@ -406,15 +408,17 @@ local function summarize(o, x, recs)
     local mean, sd = mean_sd(l)
     c.achieved[k] = {mean = mean, sd = sd, n = #l}
   end
-  local f = 0
+  local f, within = 0, true
   for _, k in ipairs(o.target_names) do
     local a = c.achieved[k]
     if not a then f = nil; break end
     local err = k == "curve" and a.mean or (a.mean - o.targets[k]) / math.abs(o.targets[k])
     f = f + (o.weights[k] or 1) * err * err
+    within = within and math.abs(err) <= o.tolerance
   end
   c.objective = f and quantize(f) or o.penalty
   c.ok = f ~= nil
+  c.within = c.ok and within -- every target within the tolerance: done
   return c
 end
 
@@ -620,9 +624,9 @@ local function calibrate(lab, helpers, opts)
   -- in the log go out in one batch; returns their summaries.
   local function evaluate(cands)
     local jobs = {}
-    for _, x in ipairs(cands) do
+    for ci, x in ipairs(cands) do
       for _, seed in ipairs(o.seeds) do
-        if not cache[key_of(x, seed)] then jobs[#jobs + 1] = {x = x, seed = seed} end
+        if not cache[key_of(x, seed)] then jobs[#jobs + 1] = {x = x, seed = seed, candidate = #history + ci} end
       end
     end
     local t0 = seixo.clock()
@@ -632,7 +636,7 @@ local function calibrate(lab, helpers, opts)
     local function record(i, rec)
       local j = jobs[i]
       cache[key_of(j.x, j.seed)] = rec
-      local row = {#history + 1, j.seed, rec.status, rec.time}
+      local row = {j.candidate, j.seed, rec.status, rec.time}
       for _, v in ipairs(j.x) do row[#row + 1] = v end
       for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
       log_rows[#log_rows + 1] = row
@@ -653,7 +657,9 @@ local function calibrate(lab, helpers, opts)
       local c = summarize(o, x, recs)
       history[#history + 1] = c
       c.index = #history
-      if not best or c.objective < best.objective then best = c end
+      if not best or (c.within and not best.within) or (c.within == best.within and c.objective < best.objective) then
+        best = c
+      end
       progress(o, c, #jobs == 0, seixo.clock() - t0)
       out[#out + 1] = c
     end
@@ -662,7 +668,6 @@ local function calibrate(lab, helpers, opts)
   end
 
   local function clamp(i, v) return quantize(math.min(o.upper[i], math.max(o.lower[i], v))) end
-  local stop = o.tolerance ^ 2  -- every relative error within the tolerance, at most
 
   -- 1. the pilot, with a perturbed candidate for each scaling whose exponent is unknown
   local roles, claimed = {}, {}
@@ -704,7 +709,7 @@ local function calibrate(lab, helpers, opts)
   -- and the candidate it came from (a secant in log-log space)
   local start = best
   for _ = 1, o.guesses do
-    if start.objective <= stop or not start.ok or #history >= o.maxeval then break end
+    if start.within or not start.ok or #history >= o.maxeval then break end
     local x, moved = copy(start.x), false
     for i, k in pairs(roles) do
       local a = start.achieved[k]
@@ -738,18 +743,24 @@ local function calibrate(lab, helpers, opts)
     return o.lower[i] + u * (o.upper[i] - o.lower[i])
   end
   local left = o.maxeval - #history
-  local status = best.objective <= stop and "tolerance" or "maxeval"
-  if left > 0 and best.objective > stop then
-    local u0, lo, hi = {}, {}, {}
-    for i in ipairs(o.names) do u0[i], lo[i], hi[i] = to_unit(i, best.x[i]), 0, 1 end
-    local _, _, info = seixo.optimize(function(u)
+  local status = "maxeval"
+  if left > 0 and not best.within then
+    local u0, lo, hi, step = {}, {}, {}, {}
+    for i in ipairs(o.names) do u0[i], lo[i], hi[i], step[i] = to_unit(i, best.x[i]), 0, 1, 0.05 end
+    -- a candidate with every target within the tolerance ends the search:
+    -- its value as an error, which seixo.optimize raises unchanged
+    local done = {}
+    local ok, err, _, info = pcall(seixo.optimize, function(u)
       local x = {}
       for i in ipairs(o.names) do x[i] = clamp(i, from_unit(i, u[i])) end
-      return evaluate({x})[1].objective
-    end, {x0 = u0, lower = lo, upper = hi, algorithm = o.algorithm, maxeval = left, xtol = o.xtol, stopval = stop,
-          step = (function() local s = {} for i in ipairs(o.names) do s[i] = 0.05 end return s end)()})
-    status = info.status == "stopval" and "tolerance" or info.status
+      local c = evaluate({x})[1]
+      if c.within then error(done) end
+      return c.objective
+    end, {x0 = u0, lower = lo, upper = hi, algorithm = o.algorithm, maxeval = left, xtol = o.xtol, step = step})
+    if not ok and err ~= done then error(err, 0) end
+    if ok then status = info.status end
   end
+  if best.within then status = "tolerance" end
 
   local result = {parameters = {}, material = o.material_of(best.x), achieved = best.achieved,
                   objective = best.objective, evaluations = #history, status = status, log = o.log,

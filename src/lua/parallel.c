@@ -9,8 +9,9 @@
  *
  * MPI is optional (meson finds it or not: SX_HAVE_MPI). A program started
  * by mpirun has OMPI_COMM_WORLD_SIZE (Open MPI) or PMI_SIZE (MPICH, Slurm)
- * in its environment; only then does sx_lua_parallel_start call MPI_Init,
- * so a plain `seixo script.lua` never starts MPI. */
+ * in its environment; only then, and for two ranks or more, does
+ * sx_lua_parallel_start call MPI_Init, so a plain `seixo script.lua` never
+ * starts MPI. */
 #include "bindings.h"
 #include "seixo_lua.h"
 
@@ -19,19 +20,24 @@
 #include <time.h>
 #include <unistd.h>
 
+static int world_rank = 0, world_size = 1;
+
 #ifdef SX_HAVE_MPI
 #include <mpi.h>
-#endif
 
-static int world_rank = 0, world_size = 1;
 static bool mpi_started;
 
 enum { MESSAGE_TAG = 7 };
+#endif
 
 void sx_lua_parallel_start(int *argc, char ***argv)
 {
 #ifdef SX_HAVE_MPI
-    if (!getenv("OMPI_COMM_WORLD_SIZE") && !getenv("PMI_SIZE")) return;
+    /* one rank is a plain process (mpirun -np 1): its worker processes,
+     * which inherit this environment, must not start MPI either */
+    const char *size = getenv("OMPI_COMM_WORLD_SIZE");
+    if (!size) size = getenv("PMI_SIZE");
+    if (!size || atoi(size) < 2) return;
     if (MPI_Init(argc, argv) != MPI_SUCCESS) return;
     mpi_started = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);

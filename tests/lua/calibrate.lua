@@ -85,6 +85,9 @@ test("synthetic material over 2 worker processes: the known parameters, every ru
     distinct[key] = (distinct[key] or 0) + 1
   end
   for key, n in pairs(distinct) do eq(n, 3, key) end
+  -- the pilot's batch: the pilot (candidate 1) and its twin (candidate 2, kn/ks x 2)
+  eq(csv.columns.candidate[4], 2)
+  eq(csv.columns.stiffness_ratio[4], 5)
   check(csv.rows <= 3 * r.evaluations)
   -- the scatter over the seeds: E's law scatters by 2 % per seed (sd 2 % of the mean)
   near(r.achieved.E.sd / r.achieved.E.mean, 0.02, 1e-2)
@@ -201,24 +204,28 @@ test("a tiny 2D specimen: the modulus that gives a known E is recovered", functi
                             log = false, material = lab.rock{modulus = 40e9, bond = {modulus = 40e9}}}
   local known = lab.ucs(spec, {log = false})
   os.remove(path)
-  -- the measured curve: ten points of the known test's rise to its peak
-  local curve, peak = {strain = {}, stress = {}}, 1
+  -- the measured curve: ten points of the known test's rise to 60 % of its
+  -- peak (nearer the peak, where the cracks come, the curve of a packing
+  -- made with 40.01 GPa is another curve: the genesis depends on the
+  -- modulus, chaotically)
+  local curve, peak, last = {strain = {}, stress = {}}, 1, 1
   for i, row in ipairs(known.rows) do if row[8] > known.rows[peak][8] then peak = i end end
+  for i = 1, peak do if known.rows[i][8] <= 0.6 * known.rows[peak][8] then last = i end end
   for k = 1, 10 do
-    local row = known.rows[math.max(1, math.floor(peak * k / 10))]
+    local row = known.rows[math.max(1, math.floor(last * k / 10))]
     curve.strain[k], curve.stress[k] = row[3], row[8]
   end
   local lines = {}
   local r = lab.calibrate{targets = {E = known.young, curve = curve}, parameters = {modulus = {10e9, 200e9, 80e9}},
                           specimen = recipe,
-                          seeds = {1}, workers = 1, tolerance = 5e-3, maxeval = 8, log = fresh("calibrate_2d.csv"),
+                          seeds = {1}, workers = 1, tolerance = 1e-2, maxeval = 8, log = fresh("calibrate_2d.csv"),
                           out = "calibrate_2d", plot = false, print = function(s) lines[#lines + 1] = s end}
-  near(r.parameters.modulus, 40e9, 0.02, table.concat(lines, "\n"))
-  check(r.evaluations <= 5, table.concat(lines, "\n"))
+  check(math.abs(r.parameters.modulus / 40e9 - 1) < 0.02, table.concat(lines, "\n"))
+  check(r.evaluations <= 3, table.concat(lines, "\n"))
   check(r.achieved.nu and r.achieved.UCS, "every macro-property of the test is reported")
   -- the curve's misfit: 80 GPa (the start) is far off, the result close
   check(r.history[1].achieved.curve.mean > 0.2, "misfit at the start " .. r.history[1].achieved.curve.mean)
-  check(r.achieved.curve.mean < 0.05, "misfit at the end " .. r.achieved.curve.mean)
+  check(r.achieved.curve.mean < 0.01, "misfit at the end " .. r.achieved.curve.mean)
 end)
 
 test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for their targets", function()
