@@ -6,8 +6,10 @@
 --
 -- Specimen genesis follows Potyondy & Cundall (2004, "material genesis"):
 -- a polydisperse assembly is made by radius expansion in a vessel of walls,
--- frictionless; the walls are servo-controlled to a small isotropic stress;
--- friction is restored and parallel bonds installed between the touching
+-- frictionless, to a porosity below the jammed one; the radii are scaled
+-- down until the walls carry a small isotropic stress (with the rock's
+-- friction for the last part); the floaters are moved and grown until each
+-- has three neighbours; parallel bonds are installed between the touching
 -- balls (the BPM micro-parameters of the material, seed 4.4); the vessel is
 -- removed and the specimen relaxes, which reduces the locked-in stresses;
 -- the specimen is trimmed to its shape (a cylinder, a prism, a disk) and
