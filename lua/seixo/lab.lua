@@ -672,7 +672,7 @@ function lab.specimen(opts)
       steps, sigma, ok = install_sigma0(m, v, sigma0, {tol = tol, max_steps = max_steps})
       local found, left, passes, growth = eliminate_floaters(m, v, nf, gap, 10)
       say(opts, "lab.specimen: round %d: sigma0 by radius scaling: %.4g Pa (%d steps), porosity %.4f; floaters "
-          .. "(fewer than %d contacts): %d found, %d left after %d passes (largest growth %.1f %%)", round, sigma, steps,
+          .. "(fewer than %d neighbours): %d found, %d left after %d passes (largest growth %.1f %%)", round, sigma, steps,
           1 - m:sum("volume") / v.volume(), nf, found, left, passes, 100 * growth)
       gen.floaters_found = gen.floaters_found + found
       gen.floater_passes = gen.floater_passes + passes
@@ -698,7 +698,7 @@ function lab.specimen(opts)
   gen.coordination = 2 * loaded / n
 
   local bonds = m:bond{kind = "parallel", gap = gap, seed = seed}
-  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, coordination %.3f", bonds,
+  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per ball %.3f", bonds,
       2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
 
   -- out of the vessel: the specimen relaxes and its locked-in stresses fall
