@@ -698,8 +698,8 @@ function lab.specimen(opts)
   gen.coordination = 2 * loaded / n
 
   local bonds = m:bond{kind = "parallel", gap = gap, seed = seed}
-  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per ball %.3f", bonds,
-      2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
+  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
+      .. "ball %.3f", bonds, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
 
   -- out of the vessel: the specimen relaxes and its locked-in stresses fall
   for _, w in ipairs(v.walls) do w:remove() end
