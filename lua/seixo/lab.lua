@@ -538,8 +538,8 @@ end
 --- bonds, porosity, floaters, sigma0, material, ...}.
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
-                                "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "seed", "path", "log",
-                                "max_steps", "clump"})
+                                "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "seed", "path",
+                                "log", "max_steps", "clump"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
   local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
@@ -672,8 +672,8 @@ function lab.specimen(opts)
       steps, sigma, ok = install_sigma0(m, v, sigma0, {tol = tol, max_steps = max_steps})
       local found, left, passes, growth = eliminate_floaters(m, v, nf, gap, 10)
       say(opts, "lab.specimen: round %d: sigma0 by radius scaling: %.4g Pa (%d steps), porosity %.4f; floaters "
-          .. "(fewer than %d neighbours): %d found, %d left after %d passes (largest growth %.1f %%)", round, sigma, steps,
-          1 - m:sum("volume") / v.volume(), nf, found, left, passes, 100 * growth)
+          .. "(fewer than %d neighbours): %d found, %d left after %d passes (largest growth %.1f %%)", round, sigma,
+          steps, 1 - m:sum("volume") / v.volume(), nf, found, left, passes, 100 * growth)
       gen.floaters_found = gen.floaters_found + found
       gen.floater_passes = gen.floater_passes + passes
       gen.floater_growth = math.max(gen.floater_growth, growth)
@@ -737,7 +737,8 @@ function lab.specimen(opts)
   local margin, rmax = 2 * m:max("radius"), m:max("radius")
   local core
   if trim then
-    core = {disk = {center = {0.5 * (elo[1] + ehi[1]), 0.5 * (elo[2] + ehi[2])}, radius = 0.5 * (ehi[1] - elo[1]) - margin}}
+    core = {disk = {center = {0.5 * (elo[1] + ehi[1]), 0.5 * (elo[2] + ehi[2])},
+                    radius = 0.5 * (ehi[1] - elo[1]) - margin}}
   else
     local clo, chi = {}, {}
     for k = 1, dim do
