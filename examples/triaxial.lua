@@ -32,8 +32,8 @@ print("")
 print(string.format("specimen: %d balls, %d parallel bonds, porosity %.3f, %.0f mm x %.0f mm", spec.balls, spec.bonds,
                     spec.porosity, diameter * 1e3, 2 * diameter * 1e3))
 print(string.format("genesis: sigma0 %.4g MPa, %d floaters eliminated (%d left), core porosity %.3f, coordination "
-                    .. "%.2f, locked-in stress %.3g MPa", g.sigma / 1e6, g.floaters_found, spec.floaters, g.core_porosity,
-                    g.core_coordination, g.locked_in / 1e6))
+                    .. "%.2f, locked-in stress %.3g MPa", g.sigma / 1e6, g.floaters_found, spec.floaters,
+                    g.core_porosity, g.core_coordination, g.locked_in / 1e6))
 print(string.format("%-10s %12s %12s %10s %8s %16s", "test", "sigma3 MPa", "peak MPa", "E GPa", "nu", "cracks t/s"))
 for _, r in ipairs(series.tests) do
   print(string.format("%-10s %12.3g %12.4g %10.4g %8.3f %10d / %-5d", r.kind, r.confining / 1e6, r.peak / 1e6,

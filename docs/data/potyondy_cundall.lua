@@ -14,7 +14,8 @@ local tag = string.format("%s_d%d_r%g_s%d_%s", csv:gsub("%.csv$", ""), dim, rmin
 local t0 = seixo.clock()
 local spec, r, values
 if kind == "bts" then
-  spec = dim == 2 and lab.specimen{dim = 2, shape = "disk", diameter = w, radius = radius, seed = seed, path = tag .. ".h5"}
+  spec = dim == 2 and lab.specimen{dim = 2, shape = "disk", diameter = w, radius = radius, seed = seed,
+                                   path = tag .. ".h5"}
     or lab.specimen{dim = 3, shape = "disc", diameter = w, thickness = w / 2, radius = radius, seed = seed,
                     path = tag .. ".h5"}
   r = lab.brazilian(spec, {out = tag, plot = false})
@@ -29,8 +30,8 @@ else
 end
 local g = spec.genesis
 local header = {"dim", "rmin", "seed", "test", "balls", "across", "young", "poisson", "ucs", "tensile_strength",
-                "core_porosity", "core_coordination", "floaters_found", "floaters", "sigma0_ratio", "locked_in", "steps",
-                "seconds"}
+                "core_porosity", "core_coordination", "floaters_found", "floaters", "sigma0_ratio", "locked_in",
+                "steps", "seconds"}
 local row = {dim, rmin, seed, kind, spec.balls, w / (radius[1] + radius[2]), values.young or "", values.poisson or "",
              values.ucs or "", values.tensile_strength or "", g.core_porosity, g.core_coordination, g.floaters_found,
              spec.floaters, g.sigma / spec.sigma0, g.locked_in, spec.genesis_steps + r.steps, seixo.clock() - t0}
