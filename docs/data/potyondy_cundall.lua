@@ -30,11 +30,12 @@ else
 end
 local g = spec.genesis
 local header = {"dim", "rmin", "seed", "test", "balls", "across", "young", "poisson", "ucs", "tensile_strength",
-                "core_porosity", "core_coordination", "floaters_found", "floaters", "sigma0_ratio", "locked_in",
-                "steps", "seconds"}
+                "core_porosity", "core_coordination", "locked_in", "sigma0_ratio", "peak_strain", "test_steps",
+                "genesis_seconds", "test_seconds"}
 local row = {dim, rmin, seed, kind, spec.balls, w / (radius[1] + radius[2]), values.young or "", values.poisson or "",
-             values.ucs or "", values.tensile_strength or "", g.core_porosity, g.core_coordination, g.floaters_found,
-             spec.floaters, g.sigma / spec.sigma0, g.locked_in, spec.genesis_steps + r.steps, seixo.clock() - t0}
+             values.ucs or "", values.tensile_strength or "", g.core_porosity, g.core_coordination, g.locked_in,
+             g.sigma / spec.sigma0, r.peak_strain or "", r.steps, spec.genesis_time,
+             seixo.clock() - t0 - spec.genesis_time}
 local f = io.open(csv, "r")
 local new = f == nil
 if f then f:close() end
