@@ -247,6 +247,14 @@ local function servo_vessel(m, v, target, opts)
   return m:step() - start, worst
 end
 
+-- The volume of the bodies: the balls', or the clumps' own (their pebbles overlap).
+local function solid_volume(m, clumps)
+  if not clumps then return m:sum("volume") end
+  local solid = 0
+  for cl in m:clumps() do solid = solid + cl.volume end
+  return solid
+end
+
 -- Clumps cannot grow as balls do in radius expansion; its geometric
 -- equivalent is to shrink the vessel and the clumps' centroids together (an
 -- affine compaction about the vessel's centre c), by stages of 2 % of the
@@ -264,8 +272,7 @@ end
 -- steps as the clumps rearrange. Returns the stages and steps taken, or nil
 -- when the clumps fill 95 % of the vessel unjammed.
 local function compact_clumps(m, v, c, sigma0)
-  local start, stages, solid = m:step(), 0, 0
-  for cl in m:clumps() do solid = solid + cl.volume end
+  local start, stages, solid = m:step(), 0, solid_volume(m, true)
   local function loaded()
     local areas = v.areas()
     for i, w in ipairs(v.walls) do if w:load() / areas[i] < sigma0 then return false end end
@@ -470,8 +477,9 @@ local function fit_in_cage(p, r, near, vessel)
   return x, best
 end
 
--- P&C's step 3: a floater, a ball with fewer than nf contacts carrying a
--- force, carries nothing and bonds to little. Each one is moved and grown
+-- P&C's step 3: a floater, a ball with fewer than nf neighbours (within
+-- the bond gap, see neighbour_counts), carries nothing and bonds to
+-- little. Each one is moved and grown
 -- to the largest ball its cage of neighbours holds, plus the mean overlap
 -- of the loaded contacts (so its new contacts carry about the stress of the
 -- others): that ball touches dim + 1 neighbours (or walls). Growing it in
@@ -506,6 +514,7 @@ local function eliminate_floaters(m, v, nf, gap, max_passes)
 end
 
 -- --------------------------------------------------------------- specimens
+
 
 local shapes = {
   [3] = {cylinder = true, prism = true, disc = true},
@@ -693,7 +702,7 @@ function lab.specimen(opts)
     for _, w in ipairs(gen.warnings) do say(opts, "lab.specimen: warning: %s", w) end
   end
   gen.sigma = v.stress()
-  gen.vessel_porosity = 1 - (grain and 0 or m:sum("volume")) / v.volume()
+  gen.vessel_porosity = 1 - solid_volume(m, grain) / v.volume()
   local _, loaded = loaded_contacts(m)
   gen.coordination = 2 * loaded / n
 
@@ -729,8 +738,7 @@ function lab.specimen(opts)
   local volume = 1
   for k = 1, dim do volume = volume * (ehi[k] - elo[k]) end
   if shape == "cylinder" or shape == "disc" or shape == "disk" then volume = volume * pi / 4 end
-  local solid = 0 -- a clump's own volume: its pebbles overlap
-  if grain then for cl in m:clumps() do solid = solid + cl.volume end else solid = m:sum("volume") end
+  local solid = solid_volume(m, grain)
   -- the locked-in stress and the bulk porosity, in the core of the
   -- specimen: its box (for a cylinder or a disc the box inscribed in its
   -- section; for a 2D disk a disk) less two largest radii from every side
