@@ -27,9 +27,13 @@ local ucs = series.tests[1]
 local slow = lab.ucs(spec, {strain_rate = ucs.strain_rate / 2, out = out .. "/ucs_half_rate", plot = false})
 
 local fit = series.fit
+local g = spec.genesis
 print("")
 print(string.format("specimen: %d balls, %d parallel bonds, porosity %.3f, %.0f mm x %.0f mm", spec.balls, spec.bonds,
                     spec.porosity, diameter * 1e3, 2 * diameter * 1e3))
+print(string.format("genesis: sigma0 %.4g MPa, %d floaters eliminated (%d left), core porosity %.3f, coordination "
+                    .. "%.2f, locked-in stress %.3g MPa", g.sigma / 1e6, g.floaters_found, spec.floaters,
+                    g.core_porosity, g.core_coordination, g.locked_in / 1e6))
 print(string.format("%-10s %12s %12s %10s %8s %16s", "test", "sigma3 MPa", "peak MPa", "E GPa", "nu", "cracks t/s"))
 for _, r in ipairs(series.tests) do
   print(string.format("%-10s %12.3g %12.4g %10.4g %8.3f %10d / %-5d", r.kind, r.confining / 1e6, r.peak / 1e6,
@@ -42,4 +46,13 @@ local change = math.abs(slow.peak / ucs.peak - 1)
 print(string.format("quasi-static: UCS %.4g MPa at %.3g/s and %.4g MPa at %.3g/s: %.2f %% apart (tolerance %.0f %%) -- %s",
                     ucs.peak / 1e6, ucs.strain_rate, slow.peak / 1e6, slow.strain_rate, 100 * change, 100 * tolerance,
                     change <= tolerance and "quasi-static" or "TOO FAST: lower the strain rate"))
+-- Lac du Bonnet granite as Potyondy & Cundall (2004) give it, the values
+-- their PFC2D and PFC3D materials of these micro-parameters were calibrated
+-- to (docs/potyondy-cundall.md)
+local reference = {{"E GPa", 69, ucs.young / 1e9}, {"nu", 0.26, ucs.poisson}, {"UCS MPa", 200, ucs.peak / 1e6}}
+local gaps = {}
+for _, q in ipairs(reference) do
+  gaps[#gaps + 1] = string.format("%s %.4g (%+.0f %%)", q[1], q[3], 100 * (q[3] / q[2] - 1))
+end
+print(string.format("against Potyondy & Cundall (2004), E 69 GPa, nu 0.26, UCS 200 MPa: %s", table.concat(gaps, ", ")))
 print(string.format("figures: %s/series_{stress,volumetric,cracks,mohr}.png; run time %.0f s", out, seixo.clock() - t0))

@@ -6,8 +6,10 @@
 --
 -- Specimen genesis follows Potyondy & Cundall (2004, "material genesis"):
 -- a polydisperse assembly is made by radius expansion in a vessel of walls,
--- frictionless; the walls are servo-controlled to a small isotropic stress;
--- friction is restored and parallel bonds installed between the touching
+-- frictionless, to a porosity below the jammed one; the radii are scaled
+-- down until the walls carry a small isotropic stress (with the rock's
+-- friction for the last part); the floaters are moved and grown until each
+-- has three neighbours; parallel bonds are installed between the touching
 -- balls (the BPM micro-parameters of the material, seed 4.4); the vessel is
 -- removed and the specimen relaxes, which reduces the locked-in stresses;
 -- the specimen is trimmed to its shape (a cylinder, a prism, a disk) and
@@ -168,6 +170,40 @@ local function make_vessel(m, lo, hi, kn, cyl_axis)
       if w.kind == "cylinder" then w:set_radius(f * w:radius()) end
     end
   end
+  -- the distances from x to the walls, each {gap, unit normal into the vessel}
+  function v.gaps(x)
+    local w, list = v.walls, {}
+    if not cyl_axis then
+      for k = 1, dim do
+        local e = {}
+        for j = 1, dim do e[j] = j == k and 1 or 0 end
+        list[#list + 1] = {x[k] - w[2 * k - 1].point[k], e}
+        list[#list + 1] = {w[2 * k].point[k] - x[k], {-e[1], -e[2], e[3] and -e[3]}}
+      end
+      return list
+    end
+    local ax, c = cyl_axis, w[1].point
+    local u, d2 = {}, 0
+    for k = 1, 3 do u[k] = k == ax and 0 or c[k] - x[k]; d2 = d2 + u[k] * u[k] end
+    local d = math.sqrt(d2)
+    if d > 0 then for k = 1, 3 do u[k] = u[k] / d end end
+    local e = {0, 0, 0}
+    e[ax] = 1
+    list[1] = {w[1]:radius() - d, u}
+    list[2] = {x[ax] - w[2].point[ax], e}
+    list[3] = {w[3].point[ax] - x[ax], {-e[1], -e[2], -e[3]}}
+    return list
+  end
+  -- the mean direct stress on the walls (compression positive): for a
+  -- box the mean over its walls, for a cylinder (2 sigma_r + sigma_z) / 3
+  function v.stress()
+    local areas, s, wsum = v.areas(), 0, 0
+    for i, w in ipairs(v.walls) do
+      local weight = cyl_axis and (i == 1 and 2 or 0.5) or 1
+      s, wsum = s + weight * w:load() / areas[i], wsum + weight
+    end
+    return s / wsum
+  end
   function v.volume()
     local a = v.areas()
     if cyl_axis then return a[2] * (v.walls[3].point[cyl_axis] - v.walls[2].point[cyl_axis]) end
@@ -229,6 +265,14 @@ local function servo_vessel(m, v, target, opts)
   return m:step() - start, worst
 end
 
+-- The volume of the bodies: the balls', or the clumps' own (their pebbles overlap).
+local function solid_volume(m, clumps)
+  if not clumps then return m:sum("volume") end
+  local solid = 0
+  for cl in m:clumps() do solid = solid + cl.volume end
+  return solid
+end
+
 -- Clumps cannot grow as balls do in radius expansion; its geometric
 -- equivalent is to shrink the vessel and the clumps' centroids together (an
 -- affine compaction about the vessel's centre c), by stages of 2 % of the
@@ -246,8 +290,7 @@ end
 -- steps as the clumps rearrange. Returns the stages and steps taken, or nil
 -- when the clumps fill 95 % of the vessel unjammed.
 local function compact_clumps(m, v, c, sigma0)
-  local start, stages, solid = m:step(), 0, 0
-  for cl in m:clumps() do solid = solid + cl.volume end
+  local start, stages, solid = m:step(), 0, solid_volume(m, true)
   local function loaded()
     local areas = v.areas()
     for i, w in ipairs(v.walls) do if w:load() / areas[i] < sigma0 then return false end end
@@ -269,7 +312,227 @@ local function compact_clumps(m, v, c, sigma0)
   end
 end
 
+-- Potyondy & Cundall's (2004) genesis of a specimen of balls, after the
+-- compaction by radius expansion (their step 1) to a porosity below the one
+-- the packing jams at, so that it starts above sigma0 everywhere: step 2
+-- installs sigma0 by scaling every radius by one factor, the vessel held
+-- still, and step 3 grows the floaters until each has the contacts it needs.
+
+-- The mean overlap of the ball-ball contacts that carry a force, and their number.
+local function loaded_contacts(m)
+  local overlap, k = 0, 0
+  for c in m:contacts{kind = "ball-ball"} do
+    if c.fn > 0 then overlap, k = overlap + c.overlap, k + 1 end
+  end
+  return k > 0 and overlap / k or 0, k
+end
+
+-- P&C's step 2: sigma0, the mean direct stress on the walls, by scaling
+-- every radius by one factor 1 + eps a stage, the walls held still (the
+-- vessel keeps its size, so the specimen keeps the size asked for). eps
+-- comes from the packing's stiffness against a uniform growth of the radii,
+-- d sigma / d eps = sum over contacts of kn d^2 / (dim V) (each overlap grows
+-- by d eps, its force by kn d eps, 4-6, and sigma = sum F d / (dim V)),
+-- times a gain: near sigma0 a packing rearranges rather than compresses and
+-- is softer than that, so the gain doubles while the error keeps its sign
+-- and falls by less than a tenth a stage, and halves (to 1 at least) when
+-- it changes sign. A stage cycles 400 steps and then averages the stress
+-- over 4 x 100 more: with 200-step stages and no wait, a frictional 2D
+-- packing of 4,055 balls swung between 0.5 and 1.35 sigma0 for 30,000
+-- steps (its response lags the radii); so it converges within 2 % in 3 to
+-- 8 stages. eps is at most 0.5 %; a packing without contacts grows by
+-- 0.2 %. Done when two stages in a row are within `tol` of sigma0. Returns
+-- the steps, the stress and whether it converged.
+local function install_sigma0(m, v, sigma0, opts)
+  local dim, start, sigma, gain, last, within = m:dim(), m:step(), 0, 1, nil, 0
+  while m:step() - start < opts.max_steps do
+    sigma = 0
+    m:cycle(400)
+    for _ = 1, 4 do
+      m:cycle(100)
+      sigma = sigma + v.stress() / 4
+    end
+    local err = sigma0 - sigma
+    within = math.abs(err) < opts.tol * sigma0 and within + 1 or 0
+    if within >= 2 then return m:step() - start, sigma, true end
+    if last and err * last < 0 then gain = math.max(1, gain / 2)
+    elseif last and math.abs(err) > 0.9 * math.abs(last) then gain = 2 * gain end
+    last = err
+    local stiff = 0
+    for c in m:contacts{kind = "ball-ball"} do
+      if c.overlap > 0 then
+        local d = c.a.radius + c.b.radius - c.overlap
+        stiff = stiff + c.kn * d * d
+      end
+    end
+    stiff = stiff / (dim * v.volume())
+    local eps = stiff > 0 and gain * err / stiff or 0.002
+    eps = math.max(-0.005, math.min(0.005, eps))
+    for b in m:balls() do b.radius = b.radius * (1 + eps) end
+  end
+  return m:step() - start, sigma, false
+end
+
+-- The balls of m in a cell grid of cells of size h: near(p) lists the
+-- entries {ball, pos, radius} in the 3^dim cells about p (every ball whose
+-- centre is within h of p).
+local function ball_grid(m, h)
+  local dim, cells = m:dim(), {}
+  local function key(p, off)
+    local k = 0
+    for j = 1, dim do k = k * 1048576 + (math.floor(p[j] / h) + (off and off[j] or 0)) % 1048576 end
+    return k
+  end
+  for b in m:balls() do
+    local p = b.pos
+    local k = key(p)
+    local cell = cells[k]
+    if not cell then cell = {}; cells[k] = cell end
+    cell[#cell + 1] = {ball = b, pos = p, radius = b.radius}
+  end
+  local offsets = {}
+  for i = 0, 3 ^ dim - 1 do
+    local off, q = {}, i
+    for j = 1, dim do off[j] = q % 3 - 1; q = q // 3 end
+    offsets[#offsets + 1] = off
+  end
+  return function(p)
+    local list = {}
+    for _, off in ipairs(offsets) do
+      for _, e in ipairs(cells[key(p, off)] or {}) do list[#list + 1] = e end
+    end
+    return list
+  end
+end
+
+-- How many neighbours each ball has (by id): the balls and walls of the
+-- vessel v within `gap` of its surface, the pairs that bonds will join. At
+-- sigma0 a contact's overlap is about 1e-6 of a radius, less than the
+-- balls' vibrations, so the contacts that carry a force at a given step
+-- flicker; the bond gap does not.
+local function neighbour_counts(m, v, gap)
+  local near, counts = ball_grid(m, 2 * m:max("radius") + gap), {}
+  for b in m:balls() do
+    local p, r, n = b.pos, b.radius, 0
+    for _, e in ipairs(near(p)) do
+      if e.ball ~= b then
+        local d2 = 0
+        for j = 1, #p do d2 = d2 + (e.pos[j] - p[j]) ^ 2 end
+        if math.sqrt(d2) - r - e.radius < gap then n = n + 1 end
+      end
+    end
+    for _, w in ipairs(v.gaps(p)) do if w[1] - r < gap then n = n + 1 end end
+    counts[b.id] = n
+  end
+  return counts
+end
+
+-- The point of the convex hull of the vectors us nearest the origin
+-- (Gilbert's algorithm: the steepest ascent of min_j u_j . d is along it,
+-- and it is 0 where no direction increases every u_j . d).
+local function min_norm(us, dim)
+  local z = copy(us[1])
+  for _ = 1, 100 do
+    local best, v = math.huge, nil
+    for _, u in ipairs(us) do
+      local d = 0
+      for j = 1, dim do d = d + z[j] * u[j] end
+      if d < best then best, v = d, u end
+    end
+    local zz, dz = 0, 0
+    for j = 1, dim do zz, dz = zz + z[j] * z[j], dz + (z[j] - v[j]) ^ 2 end
+    if zz - best < 1e-12 or dz == 0 then break end
+    local t = math.min(1, (zz - best) / dz)
+    for j = 1, dim do z[j] = z[j] + t * (v[j] - z[j]) end
+  end
+  return z
+end
+
+-- The largest ball that fits in the cage of a floater: the centre x that
+-- maximises the room min_j (|x - c_j| - r_j) among the balls `near` (and
+-- the vessel's walls, vessel.gaps), by steepest ascent of that minimum
+-- from p, with steps from r / 4 halving to 1e-7 r. Returns x and the room.
+local function fit_in_cage(p, r, near, vessel)
+  local dim = #p
+  local function constraints(x)
+    local list = vessel.gaps(x)
+    for _, e in ipairs(near) do
+      local u, d2 = {}, 0
+      for j = 1, dim do u[j] = x[j] - e.pos[j]; d2 = d2 + u[j] * u[j] end
+      local d = math.sqrt(d2)
+      if d > 0 then
+        for j = 1, dim do u[j] = u[j] / d end
+        list[#list + 1] = {d - e.radius, u}
+      end
+    end
+    return list
+  end
+  local function room(list)
+    local g = math.huge
+    for _, c in ipairs(list) do g = math.min(g, c[1]) end
+    return g
+  end
+  local x, step = copy(p), 0.25 * r
+  local list = constraints(x)
+  local best = room(list)
+  while step > 1e-7 * r do
+    local active = {}
+    for _, c in ipairs(list) do if c[1] <= best + step then active[#active + 1] = c[2] end end
+    local d = min_norm(active, dim)
+    local n = 0
+    for j = 1, dim do n = n + d[j] * d[j] end
+    n = math.sqrt(n)
+    local moved = false
+    if n > 1e-9 then
+      local y = {}
+      for j = 1, dim do y[j] = x[j] + step * d[j] / n end
+      local ylist = constraints(y)
+      local g = room(ylist)
+      if g > best then x, list, best, moved = y, ylist, g, true end
+    end
+    if not moved then step = 0.5 * step end
+  end
+  return x, best
+end
+
+-- P&C's step 3: a floater, a ball with fewer than nf neighbours (within
+-- the bond gap, see neighbour_counts), carries nothing and bonds to
+-- little. Each one is moved and grown
+-- to the largest ball its cage of neighbours holds, plus the mean overlap
+-- of the loaded contacts (so its new contacts carry about the stress of the
+-- others): that ball touches dim + 1 neighbours (or walls). Growing it in
+-- place instead, to reach its third neighbour, wedged it between the nearer
+-- ones: 2D, 408 balls, the stress rose to 1.5e8 Pa, 1,500 sigma0, and the
+-- specimen burst its bonds when the vessel went. The packing then cycles
+-- 100 steps and the floaters are counted again, by passes, at most
+-- max_passes. Returns the floaters found, those left, the passes and the
+-- largest relative growth of a radius.
+local function eliminate_floaters(m, v, nf, gap, max_passes)
+  local found, left, passes, growth = nil, 0, 0, 0
+  for pass = 1, max_passes + 1 do
+    local counts, overlap = neighbour_counts(m, v, gap), loaded_contacts(m)
+    local floaters = {}
+    for b in m:balls() do if (counts[b.id] or 0) < nf then floaters[#floaters + 1] = b end end
+    found, left = found or #floaters, #floaters
+    if left == 0 or pass > max_passes then break end
+    passes = pass
+    local near = ball_grid(m, 4 * m:max("radius"))
+    for _, f in ipairs(floaters) do
+      local p, r = f.pos, f.radius
+      local cage = {}
+      for _, e in ipairs(near(p)) do if e.ball ~= f then cage[#cage + 1] = e end end
+      local x, room = fit_in_cage(p, r, cage, v)
+      f.pos, f.radius, f.vel = x, room + overlap, #x == 3 and {0, 0, 0} or {0, 0}
+      growth = math.max(growth, (room + overlap) / r - 1)
+      for _, e in ipairs(near(p)) do if e.ball == f then e.pos, e.radius = x, room + overlap end end
+    end
+    m:cycle(100)
+  end
+  return found, left, passes, growth
+end
+
 -- --------------------------------------------------------------- specimens
+
 
 local shapes = {
   [3] = {cylinder = true, prism = true, disc = true},
@@ -302,7 +565,8 @@ end
 --- bonds, porosity, floaters, sigma0, material, ...}.
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
-                                "porosity", "material", "sigma0", "gap", "seed", "path", "log", "max_steps", "clump"})
+                                "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "seed", "path",
+                                "log", "max_steps", "clump"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
   local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
@@ -329,7 +593,7 @@ function lab.specimen(opts)
   local sigma0 = opts.sigma0 or 0.1e6
   positive(sigma0, "sigma0", "specimen")
   -- clumps: the porosity at which the vessel has its nominal size (see below)
-  local porosity = opts.porosity or (grain and (dim == 3 and 0.35 or 0.14) or (dim == 3 and 0.42 or 0.18))
+  local porosity = opts.porosity or (dim == 3 and 0.35 or (grain and 0.14 or 0.16))
   local seed = opts.seed or 1
   local path = opts.path or fail("lab.specimen: a path for the specimen file is required")
   local t0 = seixo.clock()
@@ -384,36 +648,85 @@ function lab.specimen(opts)
     say(opts, "lab.specimen: unloaded to about %.3g Pa, frictionless (%d steps)", sigma0, steps)
     m:material("rock", mat)
   else
-    n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed}
-    say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps)", n, porosity, m:step())
+    n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed,
+                   relax = false}
+    say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps), mean wall stress %.3g Pa", n,
+        porosity, m:step(), v.stress())
   end
 
-  -- the isotropic stress, by servo-controlled walls; a small sigma0 is a
-  -- tiny overlap (sigma0 d / kn), which the balls' vibrations disturb by a
-  -- few per cent: 2 % and a ratio of 1e-2 are close enough for a seating
-  -- stress (a frictionless packing also creeps as the walls close in)
-  local steps, err = servo_vessel(m, v, sigma0, {max_speed = 0.5, max_steps = opts.max_steps or 30000, tol = 0.02,
-                                                 ratio = 1e-2})
-  say(opts, "lab.specimen: isotropic stress %.3g Pa installed within %.2f %% (%d steps)", sigma0, 100 * err, steps)
-
-  -- floaters: bodies (balls, clumps) with fewer than dim contacts carry nothing
-  local function body(b) return grain and b.clump.id or b.id end
-  local contacts = {}
-  for c in m:contacts{kind = "ball-ball"} do
-    if c.fn > 0 then
-      local a, b = body(c.a), body(c.b)
-      contacts[a] = (contacts[a] or 0) + 1
-      contacts[b] = (contacts[b] or 0) + 1
-    end
-  end
-  local floaters = 0
-  for b in (grain and m:clumps() or m:balls()) do if (contacts[b.id] or 0) < dim then floaters = floaters + 1 end end
-
-  if not grain then m:material("rock", mat) end
   local gap = opts.gap or 1e-3 * radius[1]
+  local gen = {floaters_found = 0, floater_passes = 0, floater_growth = 0, warnings = {}}
+  local floaters
+  if grain then
+    -- the isotropic stress, by servo-controlled walls; a small sigma0 is a
+    -- tiny overlap (sigma0 d / kn), which the clumps' vibrations disturb by
+    -- a few per cent: 2 % and a ratio of 1e-2 are close enough for a
+    -- seating stress
+    local steps, err = servo_vessel(m, v, sigma0, {max_speed = 0.5, max_steps = opts.max_steps or 30000, tol = 0.02,
+                                                   ratio = 1e-2})
+    say(opts, "lab.specimen: isotropic stress %.3g Pa installed within %.2f %% (%d steps)", sigma0, 100 * err, steps)
+    -- floaters: clumps with fewer than dim contacts carry nothing
+    local contacts = {}
+    for c in m:contacts{kind = "ball-ball"} do
+      if c.fn > 0 then
+        local a, b = c.a.clump.id, c.b.clump.id
+        contacts[a], contacts[b] = (contacts[a] or 0) + 1, (contacts[b] or 0) + 1
+      end
+    end
+    floaters = 0
+    for cl in m:clumps() do if (contacts[cl.id] or 0) < dim then floaters = floaters + 1 end end
+    gen.floaters_found = floaters
+  else
+    -- sigma0 and the floaters, P&C's steps 2 and 3 (see install_sigma0 and
+    -- eliminate_floaters), by rounds: a floater's new contacts load its
+    -- neighbours a little, the next round's sigma0 unloads them, which may
+    -- leave a ball with too few again (1 or 2 of 4,055 in 2D). The
+    -- frictionless unloading stops at 10 sigma0 (within 50 %): a
+    -- frictionless packing at sigma0 sits within sigma0 / E, about 2e-6, of
+    -- the packing fraction at which it jams, and that fraction drifts by
+    -- more as the balls creep, so its stress wanders by tens of per cent and
+    -- never settles (2D, 408 balls: between 0.67 and 1.1 sigma0 for 25,000
+    -- steps, the ratio at 0.03 to 0.1; 4,075 balls: 0.64 sigma0 after
+    -- 30,000). The rock's friction then freezes the packing, 10 sigma0 being
+    -- an overlap of 1e-5 of a radius: unloading to sigma0 changes the
+    -- packing no more than that.
+    local tol, nf, max_steps = opts.sigma0_tol or 0.02, opts.floater_contacts or 3, opts.max_steps or 30000
+    local steps, sigma = install_sigma0(m, v, 10 * sigma0, {tol = 0.5, max_steps = max_steps})
+    say(opts, "lab.specimen: frictionless, radii scaled to a wall stress of %.4g Pa (%d steps)", sigma, steps)
+    m:material("rock", mat)
+    local ok
+    for round = 1, 3 do
+      steps, sigma, ok = install_sigma0(m, v, sigma0, {tol = tol, max_steps = max_steps})
+      local found, left, passes, growth = eliminate_floaters(m, v, nf, gap, 10)
+      say(opts, "lab.specimen: round %d: sigma0 by radius scaling: %.4g Pa (%d steps), porosity %.4f; floaters "
+          .. "(fewer than %d neighbours): %d found, %d left after %d passes (largest growth %.1f %%)", round, sigma,
+          steps, 1 - m:sum("volume") / v.volume(), nf, found, left, passes, 100 * growth)
+      gen.floaters_found = gen.floaters_found + found
+      gen.floater_passes = gen.floater_passes + passes
+      gen.floater_growth = math.max(gen.floater_growth, growth)
+      if found == 0 then break end
+    end
+    if not ok then
+      gen.warnings[#gen.warnings + 1] = string.format("sigma0 = %.4g Pa missed: %.4g Pa (%.1f %%, tolerance %g %%) "
+        .. "after %d steps; raise max_steps", sigma0, sigma, 100 * (sigma / sigma0 - 1), 100 * tol, steps)
+    end
+    local counts = neighbour_counts(m, v, gap)
+    floaters = 0
+    for b in m:balls() do if (counts[b.id] or 0) < nf then floaters = floaters + 1 end end
+    if floaters > 0 then
+      gen.warnings[#gen.warnings + 1] = string.format("%d floaters left (fewer than %d neighbours within the bond "
+        .. "gap)", floaters, nf)
+    end
+    for _, w in ipairs(gen.warnings) do say(opts, "lab.specimen: warning: %s", w) end
+  end
+  gen.sigma = v.stress()
+  gen.vessel_porosity = 1 - solid_volume(m, grain) / v.volume()
+  local _, loaded = loaded_contacts(m)
+  gen.coordination = 2 * loaded / n
+
   local bonds = m:bond{kind = "parallel", gap = gap, seed = seed}
-  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters", bonds, 2 * bonds / n,
-      grain and "clump" or "ball", floaters)
+  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
+      .. "ball %.3f", bonds, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
 
   -- out of the vessel: the specimen relaxes and its locked-in stresses fall
   for _, w in ipairs(v.walls) do w:remove() end
@@ -443,11 +756,36 @@ function lab.specimen(opts)
   local volume = 1
   for k = 1, dim do volume = volume * (ehi[k] - elo[k]) end
   if shape == "cylinder" or shape == "disc" or shape == "disk" then volume = volume * pi / 4 end
-  local solid = 0 -- a clump's own volume: its pebbles overlap
-  if grain then for cl in m:clumps() do solid = solid + cl.volume end else solid = m:sum("volume") end
+  local solid = solid_volume(m, grain)
+  -- the locked-in stress and the bulk porosity, in the core of the
+  -- specimen: its box (for a cylinder or a disc the box inscribed in its
+  -- section; for a 2D disk a disk) less two largest radii from every side
+  local margin, rmax = 2 * m:max("radius"), m:max("radius")
+  local core
+  if trim then
+    core = {disk = {center = {0.5 * (elo[1] + ehi[1]), 0.5 * (elo[2] + ehi[2])},
+                    radius = 0.5 * (ehi[1] - elo[1]) - margin}}
+  else
+    local clo, chi = {}, {}
+    for k = 1, dim do
+      local half = 0.5 * (ehi[k] - elo[k])
+      if cyl_axis and k ~= cyl_axis then half = half / math.sqrt(2) end
+      local mid = 0.5 * (elo[k] + ehi[k])
+      clo[k], chi[k] = mid - half + margin, mid + half - margin
+    end
+    core = {box = {clo, chi}}
+  end
+  local inside = m:measure(core)
+  local mean = 0
+  for k = 1, dim do mean = mean + inside.stress[k][k] / dim end
+  gen.locked_in, gen.locked_in_stress, gen.core_porosity = mean, inside.stress, inside.porosity
+  gen.core_coordination = inside.coordination
+  say(opts, "lab.specimen: locked-in mean stress %.4g Pa in the core (%d balls), its porosity %.4f, coordination %.3f",
+      mean, inside.balls, inside.porosity, inside.coordination)
   local spec = {
     path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
+    genesis = gen, rmax = rmax,
     sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, genesis_steps = m:step(), clumps = m:clump_count(),
     clump = copy(grain),
     genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
