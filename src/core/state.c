@@ -19,6 +19,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->bw = m->bw.n;
     out->bb_bonds = m->bb.bond != NULL;
     out->bonds = m->bonds.n;
+    out->fj_elements = m->fjel.n;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
     out->materials = m->nmat;
@@ -44,7 +45,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (!empty(m)) return sx__fail(m, SX_EINVAL, "state: the model to restore into must be new and empty");
     if (s->balls < 0 || s->next_ball_id < 1 || s->balls > s->next_ball_id - 1 || s->next_ball_id >= INT32_MAX ||
         s->bb < 0 || s->bb > INT32_MAX || s->bw < 0 || s->bw > INT32_MAX || s->bonds < 0 ||
-        s->bonds > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
+        s->bonds > INT32_MAX - 1 || s->fj_elements < 0 || s->fj_elements > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
         s->materials > UINT16_MAX)
         return sx__fail(m, SX_EINVAL,
                         "state: sizes out of range (%lld balls, next id %lld, %lld + %lld pairs, %lld bonds, "
@@ -86,9 +87,23 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
         !alloc_array(m, (void **)&k->sigma_c, nb, sizeof(double)) ||
         !alloc_array(m, (void **)&k->tau_c, nb, sizeof(double)) || !alloc_array(m, (void **)&k->fn, nb, sizeof(double)) ||
         !alloc_array(m, (void **)&k->fs, nb * d, sizeof(double)) || !alloc_array(m, (void **)&k->mn, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->ms, nb * r, sizeof(double)))
+        !alloc_array(m, (void **)&k->ms, nb * r, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_first, nb, sizeof(int32_t)) || !alloc_array(m, (void **)&k->fj_nr, nb, 1) ||
+        !alloc_array(m, (void **)&k->fj_na, nb, 1) || !alloc_array(m, (void **)&k->fj_mu, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_tanphi, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_d0, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_rot, nb * (d - 1), sizeof(double)) ||
+        (d == 3 && !alloc_array(m, (void **)&k->fj_axis, nb * 3, sizeof(double))))
         goto nomem;
     k->n = k->cap = nb;
+    sx_fjels *e = &m->fjel;
+    const int64_t ne = s->fj_elements;
+    if (!alloc_array(m, (void **)&e->state, ne, 1) || !alloc_array(m, (void **)&e->sigma_c, ne, sizeof(double)) ||
+        !alloc_array(m, (void **)&e->coh, ne, sizeof(double)) || !alloc_array(m, (void **)&e->gap0, ne, sizeof(double)) ||
+        !alloc_array(m, (void **)&e->fs, ne * (d - 1), sizeof(double)) ||
+        !alloc_array(m, (void **)&e->fn, ne, sizeof(double)))
+        goto nomem;
+    e->n = e->cap = ne;
     if (!alloc_array(m, (void **)&m->cracks.ev, s->cracks, sizeof(sx_crack))) goto nomem;
     m->cracks.n = m->cracks.cap = s->cracks;
 
@@ -246,17 +261,28 @@ static sx_status check_bonds(sx_model *m)
     sx_bonds *k = &m->bonds;
     k->intact = 0;
     for (int64_t s = 0; s < k->n; s++) {
-        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL))
+        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has an unknown kind %d", (long long)s, k->kind[s]);
         if (!k->kind[s]) continue; /* broken: its balls may be gone */
         if (!m->bb.bond) return sx__fail(m, SX_EINVAL, "state: intact bonds but no bond slots in the pair store");
         if (sx__ball_index(m, k->ida[s]) < 0 || sx__ball_index(m, k->idb[s]) < 0 || k->ida[s] == k->idb[s])
             return sx__fail(m, SX_EINVAL, "state: intact bond %lld joins balls %d and %d, which do not exist",
                             (long long)s, k->ida[s], k->idb[s]);
-        if ((k->kind[s] & SX_BOND_PARALLEL) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0))
-            return sx__fail(m, SX_EINVAL, "state: parallel bond %lld has a radius or stiffness <= 0", (long long)s);
+        if ((k->kind[s] & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0))
+            return sx__fail(m, SX_EINVAL, "state: bond %lld has a radius or stiffness <= 0", (long long)s);
+        if (k->kind[s] & SX_BOND_FLATJOINT) {
+            const int64_t nel = (int64_t)k->fj_nr[s] * k->fj_na[s];
+            if (k->kind[s] != SX_BOND_FLATJOINT || nel < 1 || (m->dim == 2 && k->fj_na[s] != 1) || k->fj_first[s] < 0 ||
+                k->fj_first[s] + nel > m->fjel.n)
+                return sx__fail(m, SX_EINVAL, "state: flat joint %lld has bad elements (%d x %d from %d of %lld)",
+                                (long long)s, k->fj_nr[s], k->fj_na[s], k->fj_first[s], (long long)m->fjel.n);
+        }
         k->intact++;
     }
+    for (int64_t e = 0; e < m->fjel.n; e++)
+        if (m->fjel.state[e] > SX_FJ_SHEAR)
+            return sx__fail(m, SX_EINVAL, "state: flat-joint element %lld has an unknown state %d", (long long)e,
+                            m->fjel.state[e]);
     return SX_OK;
 }
 

@@ -37,6 +37,7 @@ typedef struct sx_state_sizes {
     int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
     bool bb_bonds;        ///< the ball-ball store carries bond slots
     int64_t bonds;        ///< bond slots (intact or broken)
+    int64_t fj_elements;  ///< flat-joint elements
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;
     int materials;
