@@ -1,7 +1,8 @@
-/* Bonds (contact and parallel, seed 4.3.5 and 4-32 ... 4-39), their
- * installation from the bonded-particle micro-parameters (4.4), and the
- * crack log of broken bonds. The bond forces themselves are computed with
- * the contact in kernels.c. */
+/* Bonds (contact and parallel, seed 4.3.5 and 4-32 ... 4-39, and the flat
+ * joint, laws/flatjoint.h), their installation from the bonded-particle
+ * micro-parameters (4.4), and the crack log of broken bonds. The bond
+ * forces themselves are computed with the contact in kernels.c. */
+#include "laws/flatjoint.h"
 #include "laws/law.h"
 #include "model_internal.h"
 
@@ -50,10 +51,48 @@ static sx_status bonds_reserve(sx_model *m, int64_t cap)
     GROW(fs, d);
     GROW(mn, 1);
     GROW(ms, r);
+    GROW(fj_first, 1);
+    GROW(fj_nr, 1);
+    GROW(fj_na, 1);
+    GROW(fj_mu, 1);
+    GROW(fj_tanphi, 1);
+    GROW(fj_d0, 1);
+    GROW(fj_rot, d - 1);
+    if (d == 3) GROW(fj_axis, 3);
+    b->cap = cap;
+    return SX_OK;
+}
+
+/* Room for cap flat-joint elements. */
+static sx_status fjels_reserve(sx_model *m, int64_t cap)
+{
+    sx_fjels *b = &m->fjel;
+    if (cap <= b->cap) return SX_OK;
+    if (cap < 2 * b->cap) cap = 2 * b->cap;
+    if (cap < 256) cap = 256;
+    if (cap > INT32_MAX - 1) return SX_ENOMEM;
+    GROW(state, 1);
+    GROW(sigma_c, 1);
+    GROW(coh, 1);
+    GROW(gap0, 1);
+    GROW(fs, m->dim - 1);
+    GROW(fn, 1);
     b->cap = cap;
     return SX_OK;
 }
 #undef GROW
+
+static void fjels_free(sx_model *m)
+{
+    sx_fjels *e = &m->fjel;
+    const size_t c = (size_t)e->cap;
+    sx_alloc *a = &m->alloc;
+    sx_alloc_free(a, e->state, c, 1);
+    double *arrays[] = {e->sigma_c, e->coh, e->gap0, e->fn};
+    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) sx_alloc_free(a, arrays[k], c, sizeof(double));
+    sx_alloc_free(a, e->fs, c * (size_t)(m->dim - 1), sizeof(double));
+    memset(e, 0, sizeof *e);
+}
 
 void sx__bonds_free(sx_model *m)
 {
@@ -67,7 +106,15 @@ void sx__bonds_free(sx_model *m)
     for (size_t k = 0; k < sizeof scalars / sizeof *scalars; k++) sx_alloc_free(a, scalars[k], c, sizeof(double));
     sx_alloc_free(a, b->fs, c * d, sizeof(double));
     sx_alloc_free(a, b->ms, c * r, sizeof(double));
+    sx_alloc_free(a, b->fj_first, c, sizeof(int32_t));
+    sx_alloc_free(a, b->fj_nr, c, 1);
+    sx_alloc_free(a, b->fj_na, c, 1);
+    double *fj[] = {b->fj_mu, b->fj_tanphi, b->fj_d0};
+    for (size_t k = 0; k < sizeof fj / sizeof *fj; k++) sx_alloc_free(a, fj[k], c, sizeof(double));
+    sx_alloc_free(a, b->fj_rot, c * (d - 1), sizeof(double));
+    if (d == 3) sx_alloc_free(a, b->fj_axis, c * 3, sizeof(double));
     memset(b, 0, sizeof *b);
+    fjels_free(m);
     sx_alloc_free(a, m->cracks.ev, (size_t)m->cracks.cap, sizeof *m->cracks.ev);
     memset(&m->cracks, 0, sizeof m->cracks);
 }
@@ -136,7 +183,22 @@ static sx_status check_bpm(sx_model *m, const char *who, const double *v, const 
 
 static const char *const bpm_names[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
                                         "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
-                                        "normal_strength_sd", "shear_strength", "shear_strength_sd"};
+                                        "normal_strength_sd", "shear_strength", "shear_strength_sd",
+                                        "friction_angle", "friction", "elements", "sectors",
+                                        "unbonded_fraction", "initial_gap"};
+
+/* The flat joint's parameters beyond being >= 0: an angle below 90 deg, a
+ * fraction, whole element counts a joint's uint8 holds. */
+static sx_status check_fj(sx_model *m, const char *who, double phi, double elements, double sectors, double fraction)
+{
+    if (!(phi < 90)) return sx__fail(m, SX_EINVAL, "%s: friction_angle must be in [0, 90) degrees (got %g)", who, phi);
+    if (!(fraction <= 1))
+        return sx__fail(m, SX_EINVAL, "%s: unbonded_fraction must be in [0, 1] (got %g)", who, fraction);
+    if (!(elements <= 64) || elements != floor(elements) || !(sectors <= 64) || sectors != floor(sectors))
+        return sx__fail(m, SX_EINVAL, "%s: elements and sectors must be whole numbers <= 64 (got %g, %g)", who,
+                        elements, sectors);
+    return SX_OK;
+}
 
 sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def)
 {
@@ -144,8 +206,11 @@ sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def)
         return sx__fail(m, SX_ENOTFOUND, "material_set_bpm: no material with index %d", material);
     const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
                         def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
-                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd};
+                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd,
+                        def->friction_angle, def->friction, def->elements, def->sectors,
+                        def->unbonded_fraction, def->initial_gap};
     sx_status st = check_bpm(m, "material_set_bpm", v, bpm_names, (int)(sizeof v / sizeof *v));
+    if (!st) st = check_fj(m, "material_set_bpm", def->friction_angle, def->elements, def->sectors, def->unbonded_fraction);
     if (st) return st;
     m->mats[material].bpm = *def;
     return SX_OK;
@@ -219,16 +284,17 @@ static sx_status check_pair(sx_model *m, const sx_bond_def *def, int ma, int mb)
                             m->mats[ma].name, m->mats[mb].name);
         return SX_OK;
     }
+    const char *what = def->kind == SX_BOND_FLATJOINT ? "flat joint" : "parallel bond";
     if (!(param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier) > 0) ||
         !(param(def->modulus, pa->modulus, pb->modulus) > 0) ||
         !(param(def->stiffness_ratio, pa->stiffness_ratio, pb->stiffness_ratio) > 0) ||
         !(param(def->tensile_strength, pa->tensile_strength, pb->tensile_strength) > 0) ||
         !(param(def->cohesion, pa->cohesion, pb->cohesion) > 0))
         return sx__fail(m, SX_EINVAL,
-                        "bond: a parallel bond between '%s' and '%s' needs radius_multiplier, modulus, "
+                        "bond: a %s between '%s' and '%s' needs radius_multiplier, modulus, "
                         "stiffness_ratio, tensile_strength and cohesion > 0 (from the call or the materials' bond "
                         "parameters)",
-                        m->mats[ma].name, m->mats[mb].name);
+                        what, m->mats[ma].name, m->mats[mb].name);
     return SX_OK;
 }
 
@@ -248,17 +314,85 @@ static double pair_gap(const sx_model *m, int64_t c, double *n)
     return dist - B->rad[i] - B->rad[j];
 }
 
+/* A value of the def, or the mean of the materials', or the default. */
+static double param_or(double given, double a, double b, double fallback)
+{
+    const double v = param(given, a, b);
+    return v > 0 ? v : fallback;
+}
+
+/* The flat joint of bond slot s on pair c (normal n from a to b, the
+ * joint's orientation): its face (laws/flatjoint.h) from the pair's
+ * current geometry, stress free, and its elements' states and strengths
+ * drawn from rng in element order. */
+static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t s, int64_t c, const double *n,
+                                    uint64_t *rng)
+{
+    const int d = m->dim;
+    sx_balls *B = &m->balls;
+    sx_pairs *p = &m->bb;
+    const int64_t i = p->a[c], j = p->b[c];
+    const sx_bpm_def *pa = &m->mats[B->mat[i]].bpm, *pb = &m->mats[B->mat[j]].bpm;
+    const int nr = (int)param_or(def->elements, pa->elements, pb->elements, d == 2 ? 4 : 2);
+    const int na = d == 2 ? 1 : (int)param_or(def->sectors, pa->sectors, pb->sectors, 4);
+    sx_fjels *E = &m->fjel;
+    if (E->n + nr * na > INT32_MAX - 1 || fjels_reserve(m, E->n + nr * na))
+        return sx__fail(m, SX_ENOMEM, "bond: out of memory");
+    sx_bonds *b = &m->bonds;
+    const double ri = B->rad[i], rj = B->rad[j];
+    b->rbar[s] = param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier) * (ri < rj ? ri : rj);
+    b->kn[s] = param(def->modulus, pa->modulus, pb->modulus) / (ri + rj);          /* 4-51 */
+    b->ks[s] = b->kn[s] / param(def->stiffness_ratio, pa->stiffness_ratio, pb->stiffness_ratio); /* 4-52 */
+    b->fj_mu[s] = param(def->friction, pa->friction, pb->friction);
+    b->fj_tanphi[s] = tan(param(def->friction_angle, pa->friction_angle, pb->friction_angle) * SX_PI / 180);
+    b->fj_first[s] = (int32_t)E->n;
+    b->fj_nr[s] = (uint8_t)nr;
+    b->fj_na[s] = (uint8_t)na;
+    double dist = 0;
+    for (int k = 0; k < d; k++) dist += (B->x[j * d + k] - B->x[i * d + k]) * (B->x[j * d + k] - B->x[i * d + k]);
+    b->fj_d0[s] = sqrt(dist);
+    for (int k = 0; k < d - 1; k++) b->fj_rot[s * (d - 1) + k] = 0;
+    if (d == 3) { /* t1: the world axis least along n, made normal to n */
+        int least = 0;
+        for (int k = 1; k < 3; k++)
+            if (fabs(n[k]) < fabs(n[least])) least = k;
+        double *t = b->fj_axis + s * 3;
+        for (int k = 0; k < 3; k++) t[k] = (k == least) - n[least] * n[k];
+        const double len = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        for (int k = 0; k < 3; k++) t[k] /= len;
+    }
+    const double fraction = param(def->unbonded_fraction, pa->unbonded_fraction, pb->unbonded_fraction);
+    const double gap0 = param(def->initial_gap, pa->initial_gap, pb->initial_gap);
+    for (int e = 0; e < nr * na; e++) {
+        const int64_t x = E->n++;
+        const bool bonded = !(fraction > 0 && uniform01(rng) < fraction);
+        E->state[x] = (uint8_t)(bonded ? SX_FJ_BONDED : SX_FJ_UNBONDED);
+        E->gap0[x] = bonded ? 0 : gap0;
+        E->sigma_c[x] = draw_strength(rng, param(def->tensile_strength, pa->tensile_strength, pb->tensile_strength),
+                                      param(def->tensile_strength_sd, pa->tensile_strength_sd, pb->tensile_strength_sd));
+        E->coh[x] = draw_strength(rng, param(def->cohesion, pa->cohesion, pb->cohesion),
+                                  param(def->cohesion_sd, pa->cohesion_sd, pb->cohesion_sd));
+        E->fn[x] = 0;
+        for (int k = 0; k < d - 1; k++) E->fs[x * (d - 1) + k] = 0;
+    }
+    for (int k = 0; k < d; k++) p->fs[c * d + k] = 0; /* the joint replaces the contact and its shear spring */
+    return SX_OK;
+}
+
 sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
 {
     if (m->locked) return sx__fail(m, SX_ELOCKED, "bond: the model is stepping");
-    if (def->kind != SX_BOND_CONTACT && def->kind != SX_BOND_PARALLEL)
-        return sx__fail(m, SX_EINVAL, "bond: kind must be contact or parallel");
+    if (def->kind != SX_BOND_CONTACT && def->kind != SX_BOND_PARALLEL && def->kind != SX_BOND_FLATJOINT)
+        return sx__fail(m, SX_EINVAL, "bond: kind must be contact, parallel or flatjoint");
     if (!(def->gap >= 0) || !isfinite(def->gap))
         return sx__fail(m, SX_EINVAL, "bond: gap must be >= 0 m (got %g)", def->gap);
     const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
                         def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
-                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd};
+                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd,
+                        def->friction_angle, def->friction, def->elements, def->sectors,
+                        def->unbonded_fraction, def->initial_gap};
     sx_status st = check_bpm(m, "bond", v, bpm_names, (int)(sizeof v / sizeof *v));
+    if (!st) st = check_fj(m, "bond", def->friction_angle, def->elements, def->sectors, def->unbonded_fraction);
     if (st) return st;
     if (def->material_a >= m->nmat || def->material_b >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "bond: no material with index %d",
@@ -280,7 +414,15 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
     for (int64_t c = 0; c < p->n; c++) {
         const int ma = B->mat[p->a[c]], mb = B->mat[p->b[c]];
         double n[3];
-        if (pair_selected(def, ma, mb) && pair_gap(m, c, n) < def->gap && (st = check_pair(m, def, ma, mb))) return st;
+        if (!pair_selected(def, ma, mb) || pair_gap(m, c, n) >= def->gap) continue;
+        if ((st = check_pair(m, def, ma, mb))) return st;
+        /* a flat joint is its pair's contact: it takes no other bond */
+        const unsigned has = p->bond[c] > 0 ? m->bonds.kind[p->bond[c] - 1] : 0;
+        if (has && (has & SX_BOND_FLATJOINT) != (def->kind & SX_BOND_FLATJOINT))
+            return sx__fail(m, SX_EINVAL,
+                            "bond: balls %d and %d already have a %s; a flat joint replaces the contact and is not "
+                            "combined with other bonds",
+                            B->id[p->a[c]], B->id[p->b[c]], has & SX_BOND_FLATJOINT ? "flat joint" : "bond");
     }
     uint64_t rng = def->seed;
     int64_t installed = 0;
@@ -311,6 +453,9 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
                                           param(def->normal_strength_sd, pa->normal_strength_sd, pb->normal_strength_sd));
             b->cb_s[slot] = draw_strength(&rng, param(def->shear_strength, pa->shear_strength, pb->shear_strength),
                                           param(def->shear_strength_sd, pa->shear_strength_sd, pb->shear_strength_sd));
+        } else if (def->kind == SX_BOND_FLATJOINT) {
+            if ((st = install_flat_joint(m, def, slot, c, n, &rng))) return st;
+            b = &m->bonds;
         } else {
             const double lambda = param(def->radius_multiplier, pa->radius_multiplier, pb->radius_multiplier);
             const double ec = param(def->modulus, pa->modulus, pb->modulus);
@@ -337,5 +482,83 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
     }
     m->dt_stale = true;
     if (count) *count = installed;
+    return SX_OK;
+}
+
+/* --------------------------------------------------------- flat joints */
+
+/* The flat-joint slot joining balls a and b (either order) and its pair,
+ * or -1. */
+static int32_t flat_joint_of(const sx_model *m, int64_t a, int64_t b, int64_t *pair)
+{
+    const sx_pairs *p = &m->bb;
+    for (int64_t c = 0; p->bond && c < p->n; c++) {
+        const int32_t s = p->bond[c] - 1;
+        if (s < 0 || !(m->bonds.kind[s] & SX_BOND_FLATJOINT)) continue;
+        const int32_t ia = m->bonds.ida[s], ib = m->bonds.idb[s];
+        if ((ia == a && ib == b) || (ia == b && ib == a)) {
+            *pair = c;
+            return s;
+        }
+    }
+    return -1;
+}
+
+int sx_flatjoint_get(const sx_model *m, int64_t a, int64_t b, int e, sx_fj_element *out)
+{
+    int64_t c;
+    const int32_t s = flat_joint_of(m, a, b, &c);
+    if (s < 0) return 0;
+    const sx_bonds *k = &m->bonds;
+    const int d = m->dim, nel = k->fj_nr[s] * k->fj_na[s];
+    if (!out || e < 0 || e >= nel) return nel;
+    /* the joint's normal and axes at the last evaluation (geo: x_b - x_a of the pair) */
+    const double *rel = m->bb.geo + c * d;
+    const double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + (d == 3 ? rel[2] * rel[2] : 0));
+    const double sg = m->balls.id[m->bb.a[c]] == k->ida[s] ? 1 : -1;
+    double n[3] = {0, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0};
+    for (int q = 0; q < d; q++) n[q] = sg * rel[q] / dist;
+    if (d == 3) {
+        for (int q = 0; q < 3; q++) t1[q] = k->fj_axis[s * 3 + q];
+        t2[0] = n[1] * t1[2] - n[2] * t1[1], t2[1] = n[2] * t1[0] - n[0] * t1[2], t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    } else {
+        t1[0] = -n[1], t1[1] = n[0];
+    }
+    const double ay = d == 3 ? -k->fj_rot[s * 2 + 1] : -k->fj_rot[s], az = d == 3 ? k->fj_rot[s * 2] : 0;
+    sx_law_fj_geom g;
+    sx_law_fj_element(d, k->rbar[s], k->fj_nr[s], k->fj_na[s], e, &g);
+    const sx_fjels *E = &m->fjel;
+    const int64_t x = k->fj_first[s] + e;
+    const int64_t ia = sx__ball_index(m, k->ida[s]);
+    memset(out, 0, sizeof *out);
+    out->state = (sx_fj_state)E->state[x];
+    out->area = g.area;
+    /* the contact point of 4-4 from a's current centre, then the element's offset */
+    const double ra = m->balls.rad[ia], rb = m->balls.rad[sx__ball_index(m, k->idb[s])];
+    const double arm = ra - 0.5 * (ra + rb - dist);
+    for (int q = 0; q < d; q++) out->centroid[q] = m->balls.x[ia * d + q] + arm * n[q] + g.y * t1[q] + g.z * t2[q];
+    out->gap = E->gap0[x] + (dist - k->fj_d0[s]) + ay * g.y + az * g.z;
+    out->fn = E->fn[x];
+    double f2 = 0;
+    for (int q = 0; q < d - 1; q++) f2 += E->fs[x * (d - 1) + q] * E->fs[x * (d - 1) + q];
+    out->fs = sqrt(f2);
+    out->tensile_strength = E->sigma_c[x];
+    out->cohesion = E->coh[x];
+    return nel;
+}
+
+sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "flatjoint_unbond: the model is stepping");
+    int64_t c;
+    const int32_t s = flat_joint_of(m, a, b, &c);
+    if (s < 0)
+        return sx__fail(m, SX_ENOTFOUND, "flatjoint_unbond: no flat joint between balls %lld and %lld", (long long)a,
+                        (long long)b);
+    const int nel = m->bonds.fj_nr[s] * m->bonds.fj_na[s];
+    if (e < 0 || e >= nel)
+        return sx__fail(m, SX_EINVAL, "flatjoint_unbond: element %d out of range (the joint has %d)", e, nel);
+    uint8_t *st = &m->fjel.state[m->bonds.fj_first[s] + e];
+    if (*st == SX_FJ_BONDED) *st = SX_FJ_UNBONDED;
     return SX_OK;
 }

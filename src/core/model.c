@@ -116,8 +116,11 @@ sx_memory sx_model_memory(const sx_model *m)
     r.balls = sx__balls_bytes(m);
     r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw);
     const sx_bonds *k = &m->bonds;
-    const size_t per_bond = 1 + 2 * sizeof(int32_t) + (9 + (size_t)m->dim + (size_t)m->rdim) * sizeof(double);
-    r.bonds = (size_t)k->cap * per_bond + (size_t)m->cracks.cap * sizeof(sx_crack);
+    const size_t d = (size_t)m->dim;
+    const size_t per_bond = 3 + 3 * sizeof(int32_t) +
+                            (12 + d + (size_t)m->rdim + (d - 1) + (d == 3 ? 3 : 0)) * sizeof(double);
+    const size_t per_element = 1 + (4 + (d - 1)) * sizeof(double);
+    r.bonds = (size_t)k->cap * per_bond + (size_t)m->fjel.cap * per_element + (size_t)m->cracks.cap * sizeof(sx_crack);
     r.work = r.total - r.balls - r.contacts - r.bonds;
     r.ball_count = m->balls.n;
     r.pair_count = m->bb.n + m->bw.n;

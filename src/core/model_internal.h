@@ -44,7 +44,27 @@ typedef struct sx_bonds {
     double *fs;             /* shear force (dim) */
     double *mn;             /* twisting moment about n (3D only; scalar) */
     double *ms;             /* bending moment (3D: vector, 2D: scalar) */
+    /* flat joint (laws/flatjoint.h), in the orientation ida -> idb as
+     * installed (the pair may turn round; the joint does not): its face
+     * radius, kn, ks are rbar, kn, ks above, and fn, fs, mn, ms its last
+     * resultants on the pair's b (as the parallel bond's) */
+    int32_t *fj_first;      /* its first element in m->fjel */
+    uint8_t *fj_nr, *fj_na; /* rings (2D: elements) and sectors (3D; 2D: 1) */
+    double *fj_mu, *fj_tanphi; /* friction of unbonded elements; tan phi-bar of bonded ones */
+    double *fj_d0;          /* centre distance at installation */
+    double *fj_rot;         /* relative bend rotation in the face's axes (3D: 2; 2D: 1) */
+    double *fj_axis;        /* 3D: the face's first in-plane axis t1 (3), carried with the contact */
 } sx_bonds;
+
+/* Flat-joint elements: each joint owns fj_nr x fj_na consecutive ones. */
+typedef struct sx_fjels {
+    int64_t n, cap;
+    uint8_t *state;         /* sx_fj_state */
+    double *sigma_c, *coh;  /* Pa, drawn per element */
+    double *gap0;           /* m, gap at installation (unbonded elements; 0 when bonded) */
+    double *fs;             /* shear force in the face's axes (3D: 2; 2D: 1) */
+    double *fn;             /* last normal force, compression positive */
+} sx_fjels;
 
 typedef struct sx_cracks {
     int64_t n, cap;
@@ -251,6 +271,7 @@ struct sx_model {
     int64_t builds;         /* number of broad-phase builds so far */
 
     sx_bonds bonds;
+    sx_fjels fjel;
     sx_cracks cracks;
     bool track_energy;
     sx_energy acc;          /* accumulated energy terms (slip, damping, work, ...) */

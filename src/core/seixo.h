@@ -388,6 +388,7 @@ SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info 
 typedef enum sx_bond_kind {
     SX_BOND_CONTACT = 1,   ///< contact bond: normal and shear strengths as forces (4.3.5)
     SX_BOND_PARALLEL = 2,  ///< parallel bond: a cement disk/beam (4-32 ... 4-39)
+    SX_BOND_FLATJOINT = 4, ///< flat joint (Potyondy 2012): a face of bonded/unbonded elements; replaces the contact law
 } sx_bond_kind;
 
 /// Bond installation, like PFC's: every ball-ball pair closer than `gap`
@@ -407,6 +408,14 @@ typedef struct sx_bond_def {
     double stiffness_ratio;     ///< kn-bar / ks-bar (4-52)
     double tensile_strength, tensile_strength_sd; ///< Pa, sigma-bar_c (mean, std)
     double cohesion, cohesion_sd;                 ///< Pa, tau-bar_c (mean, std)
+    /* flat joint: the parallel bond's radius_multiplier, modulus, stiffness_ratio,
+     * tensile_strength and cohesion (drawn per element) and these */
+    double friction_angle;      ///< degrees, phi-bar of a bonded element's shear strength c - sigma tan(phi)
+    double friction;            ///< mu of an unbonded or broken element
+    double elements;            ///< 2D: elements along the face; 3D: rings (0: 4 in 2D, 2 in 3D)
+    double sectors;             ///< 3D: sectors of each ring (0: 4)
+    double unbonded_fraction;   ///< probability that an element starts unbonded, in [0, 1]
+    double initial_gap;         ///< m, >= 0: the gap of the elements that start unbonded
 } sx_bond_def;
 
 /// Zero everywhere (take the materials' values), kind parallel, gap 0, seed 1, any materials.
@@ -423,6 +432,8 @@ typedef struct sx_bpm_def {
     double radius_multiplier, modulus, stiffness_ratio;
     double tensile_strength, tensile_strength_sd, cohesion, cohesion_sd;
     double normal_strength, normal_strength_sd, shear_strength, shear_strength_sd;
+    /* flat joint (see sx_bond_def) */
+    double friction_angle, friction, elements, sectors, unbonded_fraction, initial_gap;
 } sx_bpm_def;
 SX_API sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def);
 SX_API sx_status sx_material_get_bpm(const sx_model *m, int material, sx_bpm_def *out);
@@ -441,9 +452,38 @@ typedef struct sx_crack {
     double fs;            ///< N, shear force magnitude at failure
     double mn;            ///< N m, twisting moment magnitude at failure (parallel bond, 3D)
     double ms;            ///< N m, bending moment magnitude at failure (parallel bond)
+    int element;          ///< the flat joint's element that broke (-1: not a flat joint)
 } sx_crack;
 
 SX_API int64_t sx_crack_count(const sx_model *m);
+
+/// State of a flat-joint element.
+typedef enum sx_fj_state {
+    SX_FJ_UNBONDED = 0,   ///< installed unbonded: compression and friction only
+    SX_FJ_BONDED = 1,
+    SX_FJ_TENSION = 2,    ///< broken in tension, now unbonded
+    SX_FJ_SHEAR = 3,      ///< broken in shear, now unbonded
+} sx_fj_state;
+
+/// A flat-joint element as the last force evaluation left it, in the
+/// joint's a -> b orientation (a, b as installed: sx_flatjoint_get).
+typedef struct sx_fj_element {
+    sx_fj_state state;
+    double area;          ///< m^2 (2D: m, unit thickness)
+    double centroid[3];   ///< m, its centroid (world)
+    double gap;           ///< m, at its centroid (< 0: closed)
+    double fn;            ///< N, normal force (compression positive)
+    double fs;            ///< N, shear force magnitude
+    double tensile_strength, cohesion; ///< Pa, as drawn
+} sx_fj_element;
+
+/// The flat joint between balls a and b: its element count (0 when there
+/// is none) and, when out is given, element e.
+SX_API int sx_flatjoint_get(const sx_model *m, int64_t a, int64_t b, int e, sx_fj_element *out);
+/// Makes element e of the flat joint between a and b unbonded (a slit, as
+/// PFC's `flatjoint unbond element e`): it keeps its gap and shear force
+/// and from now on carries compression and friction only; no crack.
+SX_API sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e);
 SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
 
 /* ---------------------------------------------------------- measurement */

@@ -22,6 +22,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->rolling = m->bb.mr != NULL;
     out->total_shear = m->bb.us != NULL;
     out->bonds = m->bonds.n;
+    out->fj_elements = m->fjel.n;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
     out->materials = m->nmat;
@@ -47,7 +48,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (!empty(m)) return sx__fail(m, SX_EINVAL, "state: the model to restore into must be new and empty");
     if (s->balls < 0 || s->next_ball_id < 1 || s->balls > s->next_ball_id - 1 || s->next_ball_id >= INT32_MAX ||
         s->bb < 0 || s->bb > INT32_MAX || s->bw < 0 || s->bw > INT32_MAX || s->bonds < 0 ||
-        s->bonds > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
+        s->bonds > INT32_MAX - 1 || s->fj_elements < 0 || s->fj_elements > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
         s->materials > UINT16_MAX)
         return sx__fail(m, SX_EINVAL,
                         "state: sizes out of range (%lld balls, next id %lld, %lld + %lld pairs, %lld bonds, "
@@ -91,9 +92,23 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
         !alloc_array(m, (void **)&k->sigma_c, nb, sizeof(double)) ||
         !alloc_array(m, (void **)&k->tau_c, nb, sizeof(double)) || !alloc_array(m, (void **)&k->fn, nb, sizeof(double)) ||
         !alloc_array(m, (void **)&k->fs, nb * d, sizeof(double)) || !alloc_array(m, (void **)&k->mn, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->ms, nb * r, sizeof(double)))
+        !alloc_array(m, (void **)&k->ms, nb * r, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_first, nb, sizeof(int32_t)) || !alloc_array(m, (void **)&k->fj_nr, nb, 1) ||
+        !alloc_array(m, (void **)&k->fj_na, nb, 1) || !alloc_array(m, (void **)&k->fj_mu, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_tanphi, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_d0, nb, sizeof(double)) ||
+        !alloc_array(m, (void **)&k->fj_rot, nb * (d - 1), sizeof(double)) ||
+        (d == 3 && !alloc_array(m, (void **)&k->fj_axis, nb * 3, sizeof(double))))
         goto nomem;
     k->n = k->cap = nb;
+    sx_fjels *e = &m->fjel;
+    const int64_t ne = s->fj_elements;
+    if (!alloc_array(m, (void **)&e->state, ne, 1) || !alloc_array(m, (void **)&e->sigma_c, ne, sizeof(double)) ||
+        !alloc_array(m, (void **)&e->coh, ne, sizeof(double)) || !alloc_array(m, (void **)&e->gap0, ne, sizeof(double)) ||
+        !alloc_array(m, (void **)&e->fs, ne * (d - 1), sizeof(double)) ||
+        !alloc_array(m, (void **)&e->fn, ne, sizeof(double)))
+        goto nomem;
+    e->n = e->cap = ne;
     if (!alloc_array(m, (void **)&m->cracks.ev, s->cracks, sizeof(sx_crack))) goto nomem;
     m->cracks.n = m->cracks.cap = s->cracks;
 
@@ -283,16 +298,16 @@ static sx_status check_bonds(sx_model *m)
     sx_bonds *k = &m->bonds;
     k->intact = 0;
     for (int64_t s = 0; s < k->n; s++) {
-        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL))
+        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has an unknown kind %d", (long long)s, k->kind[s]);
         if (!k->kind[s]) continue; /* broken: its balls may be gone */
         if (!m->bb.bond) return sx__fail(m, SX_EINVAL, "state: intact bonds but no bond slots in the pair store");
         if (sx__ball_index(m, k->ida[s]) < 0 || sx__ball_index(m, k->idb[s]) < 0 || k->ida[s] == k->idb[s])
             return sx__fail(m, SX_EINVAL, "state: intact bond %lld joins balls %d and %d, which do not exist",
                             (long long)s, k->ida[s], k->idb[s]);
-        if ((k->kind[s] & SX_BOND_PARALLEL) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0 &&
+        if ((k->kind[s] & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) && !(k->rbar[s] > 0 && k->kn[s] > 0 && k->ks[s] > 0 &&
                                                  isfinite(k->rbar[s]) && isfinite(k->kn[s]) && isfinite(k->ks[s])))
-            return sx__fail(m, SX_EINVAL, "state: parallel bond %lld has a radius or stiffness <= 0 or not finite",
+            return sx__fail(m, SX_EINVAL, "state: bond %lld has a radius or stiffness <= 0 or not finite",
                             (long long)s);
         /* NaN or infinite strengths never break, zero or negative ones break at once (m:bond refuses both) */
         if ((k->kind[s] & SX_BOND_PARALLEL) &&
@@ -304,8 +319,19 @@ static sx_status check_bonds(sx_model *m)
         if (!isfinite(k->fn[s]) || !finite_all(k->fs + s * m->dim, m->dim) || !isfinite(k->mn[s]) ||
             !finite_all(k->ms + s * m->rdim, m->rdim))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has a non-finite force or moment", (long long)s);
+        if (k->kind[s] & SX_BOND_FLATJOINT) {
+            const int64_t nel = (int64_t)k->fj_nr[s] * k->fj_na[s];
+            if (k->kind[s] != SX_BOND_FLATJOINT || nel < 1 || (m->dim == 2 && k->fj_na[s] != 1) || k->fj_first[s] < 0 ||
+                k->fj_first[s] + nel > m->fjel.n)
+                return sx__fail(m, SX_EINVAL, "state: flat joint %lld has bad elements (%d x %d from %d of %lld)",
+                                (long long)s, k->fj_nr[s], k->fj_na[s], k->fj_first[s], (long long)m->fjel.n);
+        }
         k->intact++;
     }
+    for (int64_t e = 0; e < m->fjel.n; e++)
+        if (m->fjel.state[e] > SX_FJ_SHEAR)
+            return sx__fail(m, SX_EINVAL, "state: flat-joint element %lld has an unknown state %d", (long long)e,
+                            m->fjel.state[e]);
     return SX_OK;
 }
 
@@ -440,11 +466,15 @@ static void hash_balls(hasher *s, const sx_model *m)
     }
 }
 
-/* The order-free sum of the digests of the pairs with a live history. */
+/* The order-free sum of the digests of the pairs with a live history:
+ * every field of the store's schema (sx__pair_fields: a law's history
+ * fields join it there), its vectors from the pair's smaller id. */
 static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool walls)
 {
     const int d = m->dim, r = m->rdim;
     const sx_bonds *k = &m->bonds;
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, (sx_pairs *)p, f);
     uint64_t sum[2] = {0, 0};
     int64_t live = 0;
     for (int64_t c = 0; c < p->n; c++) {
@@ -460,10 +490,17 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
         hasher one = {FNV_BASIS};
         put_int(&one, ia);
         put_int(&one, ib);
-        put_doubles(&one, p->fs + c * d, d, sign);
-        put_doubles(&one, p->geo + c * d, d, sign);
-        put_double(&one, p->fn[c]);
-        if (walls) put_double(&one, p->un[c]);
+        for (int j = 0; j < nf; j++) {
+            /* the ends are the ids above; the bond slot below, present or not */
+            if (f[j].end || f[j].data == (void **)&p->bond) continue;
+            const int64_t at = c * f[j].per;
+            if (f[j].type == SX_PAIR_F64)
+                put_doubles(&one, (const double *)*f[j].data + at, f[j].per, f[j].sign ? sign : 1);
+            else
+                for (int e = 0; e < f[j].per; e++)
+                    put_int(&one, f[j].type == SX_PAIR_I32 ? ((const int32_t *)*f[j].data)[at + e]
+                                                           : ((const uint8_t *)*f[j].data)[at + e]);
+        }
         const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
         put_int(&one, slot);
         if (slot >= 0) { /* the bond's vectors follow the pair's orientation (sx__bond_flip) */
@@ -481,6 +518,7 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
 static void hash_bonds(hasher *s, const sx_model *m)
 {
     const sx_bonds *k = &m->bonds;
+    const int d = m->dim;
     put_int(s, k->n);
     for (int64_t i = 0; i < k->n; i++) { /* slots are never reused: their order is canonical */
         put_int(s, k->kind[i]);
@@ -489,6 +527,27 @@ static void hash_bonds(hasher *s, const sx_model *m)
         const double v[] = {k->cb_n[i], k->cb_s[i], k->rbar[i], k->kn[i],
                             k->ks[i],   k->sigma_c[i], k->tau_c[i], k->fn[i], k->mn[i]};
         put_doubles(s, v, sizeof v / sizeof *v, 1);
+    }
+    if (m->fjel.n > 0) { /* flat joints (laws/flatjoint.h): each joint's face and its elements */
+        const int t = d - 1;
+        for (int64_t i = 0; i < k->n; i++) {
+            if (!(k->kind[i] & SX_BOND_FLATJOINT)) continue;
+            put_int(s, k->fj_first[i]);
+            put_int(s, k->fj_nr[i]);
+            put_int(s, k->fj_na[i]);
+            const double v[] = {k->fj_mu[i], k->fj_tanphi[i], k->fj_d0[i]};
+            put_doubles(s, v, 3, 1);
+            put_doubles(s, k->fj_rot + i * t, t, 1);
+            if (d == 3) put_doubles(s, k->fj_axis + i * 3, 3, 1);
+        }
+        const sx_fjels *e = &m->fjel;
+        put_int(s, e->n);
+        for (int64_t i = 0; i < e->n; i++) {
+            put_int(s, e->state[i]);
+            const double v[] = {e->sigma_c[i], e->coh[i], e->gap0[i], e->fn[i]};
+            put_doubles(s, v, 4, 1);
+            put_doubles(s, e->fs + i * t, t, 1);
+        }
     }
     put_int(s, m->cracks.n);
     for (int64_t i = 0; i < m->cracks.n; i++) {

@@ -154,6 +154,38 @@ static int bond_fields(const sx_model *m, field *f)
     return n;
 }
 
+/* The flat joints' per-bond arrays (/flatjoints, one row per bond slot)
+ * and their elements (/flatjoints/elements), written when the model has
+ * flat-joint elements. */
+static int flatjoint_fields(const sx_model *m, field *f)
+{
+    const sx_bonds *b = &m->bonds;
+    const int d = m->dim;
+    int n = 0;
+    f[n++] = F("first_element", T_I32, b->fj_first, 1, NULL);
+    f[n++] = F("rings", T_U8, b->fj_nr, 1, NULL);
+    f[n++] = F("sectors", T_U8, b->fj_na, 1, NULL);
+    f[n++] = F("friction", T_F64, b->fj_mu, 1, "1");
+    f[n++] = F("tan_friction_angle", T_F64, b->fj_tanphi, 1, "1");
+    f[n++] = F("distance0", T_F64, b->fj_d0, 1, "m");
+    f[n++] = F("bend_rotation", T_F64, b->fj_rot, d - 1, "rad");
+    if (d == 3) f[n++] = F("axis", T_F64, b->fj_axis, 3, "1");
+    return n;
+}
+
+static int fj_element_fields(const sx_model *m, field *f)
+{
+    const sx_fjels *e = &m->fjel;
+    int n = 0;
+    f[n++] = F("state", T_U8, e->state, 1, NULL);
+    f[n++] = F("tensile_strength", T_F64, e->sigma_c, 1, "Pa");
+    f[n++] = F("cohesion", T_F64, e->coh, 1, "Pa");
+    f[n++] = F("gap0", T_F64, e->gap0, 1, "m");
+    f[n++] = F("shear_force", T_F64, e->fs, m->dim - 1, "N");
+    f[n++] = F("normal_force", T_F64, e->fn, 1, "N");
+    return n;
+}
+
 enum { MAX_FIELDS = 24 };
 
 static bool write_fields(sx_h5 *h, hid_t g, const field *f, int nf, int64_t rows)
@@ -564,13 +596,13 @@ static void load_walls(sx_h5 *h, hid_t g, sx_model *m, int version)
 
 static const char *const mode_names[] = {"tension", "shear"};
 static const int mode_values[] = {SX_CRACK_TENSION, SX_CRACK_SHEAR};
-static const char *const bond_kind_names[] = {"contact", "parallel"};
-static const int bond_kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL};
+static const char *const bond_kind_names[] = {"contact", "parallel", "flatjoint"};
+static const int bond_kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX_BOND_FLATJOINT};
 
 typedef struct crack_cols {
     double *time, *pos, *fn, *fs, *mn, *ms;
     int64_t *step, *a, *b;
-    int *mode, *kind;
+    int *mode, *kind, *element;
 } crack_cols;
 
 static bool crack_cols_alloc(crack_cols *c, int64_t n)
@@ -587,12 +619,14 @@ static bool crack_cols_alloc(crack_cols *c, int64_t n)
     c->b = calloc(k, sizeof(int64_t));
     c->mode = calloc(k, sizeof(int));
     c->kind = calloc(k, sizeof(int));
-    return c->time && c->pos && c->fn && c->fs && c->mn && c->ms && c->step && c->a && c->b && c->mode && c->kind;
+    c->element = calloc(k, sizeof(int));
+    return c->time && c->pos && c->fn && c->fs && c->mn && c->ms && c->step && c->a && c->b && c->mode && c->kind &&
+           c->element;
 }
 
 static void crack_cols_free(crack_cols *c)
 {
-    void *p[] = {c->time, c->pos, c->fn, c->fs, c->mn, c->ms, c->step, c->a, c->b, c->mode, c->kind};
+    void *p[] = {c->time, c->pos, c->fn, c->fs, c->mn, c->ms, c->step, c->a, c->b, c->mode, c->kind, c->element};
     for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
 }
 
@@ -604,8 +638,10 @@ static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
     crack_cols c;
     hid_t mm = sx_h5_enum(H5T_NATIVE_INT, mode_names, mode_values, 2);
     hid_t mf = sx_h5_enum(H5T_STD_U8LE, mode_names, mode_values, 2);
-    hid_t km = sx_h5_enum(H5T_NATIVE_INT, bond_kind_names, bond_kind_values, 2);
-    hid_t kf = sx_h5_enum(H5T_STD_U8LE, bond_kind_names, bond_kind_values, 2);
+    /* the flat joint's kind and the element column only in files of models with flat joints */
+    const bool fj = write ? m->fjel.n > 0 : H5Lexists(g, "element", H5P_DEFAULT) > 0;
+    hid_t km = sx_h5_enum(H5T_NATIVE_INT, bond_kind_names, bond_kind_values, fj ? 3 : 2);
+    hid_t kf = sx_h5_enum(H5T_STD_U8LE, bond_kind_names, bond_kind_values, fj ? 3 : 2);
     if (!crack_cols_alloc(&c, n) || mm < 0 || mf < 0 || km < 0 || kf < 0) {
         sx_h5_fail(h, "out of memory");
         goto done;
@@ -615,7 +651,7 @@ static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
             const sx_crack *e = &m->cracks.ev[i];
             c.time[i] = e->time, c.step[i] = e->step, c.a[i] = e->a, c.b[i] = e->b;
             c.fn[i] = e->fn, c.fs[i] = e->fs, c.mn[i] = e->mn, c.ms[i] = e->ms;
-            c.mode[i] = (int)e->mode, c.kind[i] = (int)e->kind;
+            c.mode[i] = (int)e->mode, c.kind[i] = (int)e->kind, c.element[i] = e->element;
             for (int k = 0; k < d; k++) c.pos[i * d + k] = e->pos[k];
         }
     struct {
@@ -636,8 +672,10 @@ static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
         {"shear_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.fs, 1, "N"},
         {"twist_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.mn, 1, "N m"},
         {"bending_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.ms, 1, "N m"},
+        {"element", H5T_NATIVE_INT, H5T_STD_I32LE, c.element, 1, NULL},
     };
-    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) {
+    const size_t ncols = sizeof cols / sizeof *cols - (fj ? 0 : 1);
+    for (size_t k = 0; k < ncols; k++) {
         if (write) sx_h5_write(h, g, cols[k].name, cols[k].mem, cols[k].file, cols[k].data, n, cols[k].per, cols[k].units);
         else sx_h5_read(h, g, "/cracks", cols[k].name, cols[k].mem, cols[k].data, n, cols[k].per, true);
     }
@@ -648,6 +686,7 @@ static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
             e->time = c.time[i], e->step = c.step[i], e->a = c.a[i], e->b = c.b[i];
             e->fn = c.fn[i], e->fs = c.fs[i], e->mn = c.mn[i], e->ms = c.ms[i];
             e->mode = (sx_crack_mode)c.mode[i], e->kind = (sx_bond_kind)c.kind[i];
+            e->element = fj ? c.element[i] : -1;
             for (int k = 0; k < d; k++) e->pos[k] = c.pos[i * d + k];
         }
 done:
@@ -906,6 +945,16 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     write_fields(h, g, fl, bond_fields(m, fl), m->bonds.n);
     sx_h5_close(g);
 
+    if (m->fjel.n > 0) {
+        g = sx_h5_group(h, f, "flatjoints");
+        write_fields(h, g, fl, flatjoint_fields(m, fl), m->bonds.n);
+        hid_t e = sx_h5_group(h, g, "elements");
+        sx_h5_attr_int(h, e, "count", m->fjel.n);
+        write_fields(h, e, fl, fj_element_fields(m, fl), m->fjel.n);
+        sx_h5_close(e);
+        sx_h5_close(g);
+    }
+
     g = sx_h5_group(h, f, "cracks");
     sx_h5_attr_int(h, g, "count", m->cracks.n);
     crack_io(h, g, m, true);
@@ -977,6 +1026,11 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     g = sx_h5_open_group(h, f, "/bonds", true);
     s->bonds = sx_h5_rows(h, g, "/bonds", "kind", 1, true);
     sx_h5_close(g);
+    if (H5Lexists(f, "/flatjoints", H5P_DEFAULT) > 0) {
+        g = sx_h5_open_group(h, f, "/flatjoints/elements", true);
+        s->fj_elements = sx_h5_rows(h, g, "/flatjoints/elements", "state", 1, true);
+        sx_h5_close(g);
+    }
     g = sx_h5_open_group(h, f, "/cracks", true);
     s->cracks = sx_h5_rows(h, g, "/cracks", "time", 1, true);
     sx_h5_close(g);
@@ -1108,6 +1162,10 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         free(overlap);
         load_group(&h, f, "/contacts/ball_wall", fl, pair_fields(m, &m->bw, fl, NULL), m->bw.n);
         load_group(&h, f, "/bonds", fl, bond_fields(m, fl), m->bonds.n);
+        if (m->fjel.n > 0) {
+            load_group(&h, f, "/flatjoints", fl, flatjoint_fields(m, fl), m->bonds.n);
+            load_group(&h, f, "/flatjoints/elements", fl, fj_element_fields(m, fl), m->fjel.n);
+        }
         g = sx_h5_open_group(&h, f, "/cracks", true);
         if (g >= 0) crack_io(&h, g, m, false);
         sx_h5_close(g);

@@ -3,6 +3,7 @@
  *   m:bond_count()                                 intact bonds
  *   m:cracks()                                     the crack log, a table of events
  *   m:crack_count([mode])                          broken bonds (all, "tension", "shear")
+ *   m:flatjoint(a, b), m:flatjoint_unbond(a, b, e) a flat joint's elements; make one a slit
  *   m:track_energy(on)                             accumulate dissipation and work
  * and the material keys model (a law of the registry), its laws' parameters,
  * modulus/stiffness_ratio and the `bond` sub-table read by m:material. */
@@ -12,15 +13,29 @@
 
 static const char *const bpm_keys[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
                                        "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
-                                       "normal_strength_sd", "shear_strength", "shear_strength_sd", NULL};
+                                       "normal_strength_sd", "shear_strength", "shear_strength_sd",
+                                       "friction_angle", "friction", "elements", "sectors", "unbonded_fraction",
+                                       "initial_gap", NULL};
 
 /* The bpm fields in bpm_keys order, so one loop reads them all. */
 static double *bpm_field(sx_bpm_def *b, int k)
 {
     double *const fields[] = {&b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
                               &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd,
+                              &b->friction_angle, &b->friction, &b->elements, &b->sectors, &b->unbonded_fraction,
+                              &b->initial_gap};
     return fields[k];
+}
+
+static const char *const kind_names[] = {"contact", "parallel", "flatjoint", NULL};
+static const sx_bond_kind kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX_BOND_FLATJOINT};
+
+static const char *kind_name(sx_bond_kind k)
+{
+    for (int i = 0; kind_names[i]; i++)
+        if (kind_values[i] == k) return kind_names[i];
+    return "?";
 }
 
 static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
@@ -89,17 +104,19 @@ static int model_bond(lua_State *L)
     static const char *const keys[] = {"kind", "gap", "seed", "materials", "radius_multiplier", "modulus",
                                        "stiffness_ratio", "tensile_strength", "tensile_strength_sd", "cohesion",
                                        "cohesion_sd", "normal_strength", "normal_strength_sd", "shear_strength",
-                                       "shear_strength_sd", NULL};
-    static const char *const kinds[] = {"contact", "parallel", NULL};
+                                       "shear_strength_sd", "friction_angle", "friction", "elements", "sectors",
+                                       "unbonded_fraction", "initial_gap", NULL};
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
     sx_bond_def d = sx_bond_default_def();
     const char *kind = sx_lua_optstrfield(L, 2, "kind");
     if (kind) {
-        const int k = sx_lua_find(kind, kinds);
-        if (k < 0) luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': 'contact' or 'parallel' expected, got '%s'", kind));
-        d.kind = k == 0 ? SX_BOND_CONTACT : SX_BOND_PARALLEL;
+        const int k = sx_lua_find(kind, kind_names);
+        if (k < 0)
+            luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': 'contact', 'parallel' or 'flatjoint' expected, got '%s'",
+                                                kind));
+        d.kind = kind_values[k];
     }
     sx_lua_optnumfield(L, 2, "gap", &d.gap);
     double seed = 1;
@@ -139,6 +156,12 @@ static int model_bond(lua_State *L)
     d.normal_strength_sd = b.normal_strength_sd;
     d.shear_strength = b.shear_strength;
     d.shear_strength_sd = b.shear_strength_sd;
+    d.friction_angle = b.friction_angle;
+    d.friction = b.friction;
+    d.elements = b.elements;
+    d.sectors = b.sectors;
+    d.unbonded_fraction = b.unbonded_fraction;
+    d.initial_gap = b.initial_gap;
     int64_t count = 0;
     sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
     sx_lua_record_seed(L, 1, (int64_t)d.seed); /* the strengths drawn from it: the files' provenance lists it */
@@ -168,8 +191,12 @@ static int model_cracks(lua_State *L)
         lua_setfield(L, -2, "pos");
         lua_pushstring(L, c.mode == SX_CRACK_TENSION ? "tension" : "shear");
         lua_setfield(L, -2, "mode");
-        lua_pushstring(L, c.kind == SX_BOND_CONTACT ? "contact" : "parallel");
+        lua_pushstring(L, kind_name(c.kind));
         lua_setfield(L, -2, "kind");
+        if (c.element >= 0) { /* a flat joint's element, numbered from 1 as Lua does */
+            lua_pushinteger(L, c.element + 1);
+            lua_setfield(L, -2, "element");
+        }
         lua_pushinteger(L, (lua_Integer)c.a);
         lua_setfield(L, -2, "a");
         lua_pushinteger(L, (lua_Integer)c.b);
@@ -203,6 +230,49 @@ static int model_crack_count(lua_State *L)
     return 1;
 }
 
+/* m:flatjoint(a, b): the elements of the flat joint between balls a and b
+ * (nil when there is none), each {state=, area=, centroid=, gap=, fn=, fs=,
+ * tensile_strength=, cohesion=}, numbered from 1. */
+static int model_flatjoint(lua_State *L)
+{
+    static const char *const states[] = {"unbonded", "bonded", "tension", "shear"};
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const lua_Integer a = luaL_checkinteger(L, 2), b = luaL_checkinteger(L, 3);
+    const int n = sx_flatjoint_get(m, a, b, -1, NULL);
+    if (n == 0) {
+        lua_pushnil(L);
+        return 1;
+    }
+    lua_createtable(L, n, 0);
+    for (int e = 0; e < n; e++) {
+        sx_fj_element el;
+        sx_flatjoint_get(m, a, b, e, &el);
+        lua_createtable(L, 0, 8);
+        lua_pushstring(L, states[el.state]);
+        lua_setfield(L, -2, "state");
+        sx_lua_setnum(L, "area", el.area);
+        sx_lua_pushvec(L, el.centroid, sx_model_dim(m));
+        lua_setfield(L, -2, "centroid");
+        sx_lua_setnum(L, "gap", el.gap);
+        sx_lua_setnum(L, "fn", el.fn);
+        sx_lua_setnum(L, "fs", el.fs);
+        sx_lua_setnum(L, "tensile_strength", el.tensile_strength);
+        sx_lua_setnum(L, "cohesion", el.cohesion);
+        lua_rawseti(L, -2, e + 1);
+    }
+    return 1;
+}
+
+/* m:flatjoint_unbond(a, b, e): element e (from 1) of the joint becomes a slit. */
+static int model_flatjoint_unbond(lua_State *L)
+{
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    const lua_Integer a = luaL_checkinteger(L, 2), b = luaL_checkinteger(L, 3), e = luaL_checkinteger(L, 4);
+    luaL_argcheck(L, e >= 1 && e <= 64 * 64, 4, "element number out of range");
+    sx_lua_check(L, m, sx_flatjoint_unbond(m, a, b, (int)e - 1), "m:flatjoint_unbond");
+    return 0;
+}
+
 static int model_track_energy(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
@@ -217,5 +287,7 @@ const luaL_Reg sx_lua_bonds_methods[] = {
     {"cracks", model_cracks},
     {"crack_count", model_crack_count},
     {"track_energy", model_track_energy},
+    {"flatjoint", model_flatjoint},
+    {"flatjoint_unbond", model_flatjoint_unbond},
     {NULL, NULL},
 };

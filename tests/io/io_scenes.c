@@ -67,7 +67,9 @@ sx_model *io_scene_granular(int dim, int nballs)
     return m;
 }
 
-sx_model *io_scene_bonded(int dim)
+/* The bonded lattice of io_scene_bonded, with parallel and contact bonds,
+ * or flat joints (a fifth of their elements slit and gapped). */
+static sx_model *bonded_lattice(int dim, bool flat)
 {
     sx_model *m = scene_model(dim, NULL, 0, 1e7, 0.5, 2600);
     sx_material_def md;
@@ -103,10 +105,19 @@ sx_model *io_scene_bonded(int dim)
     bd.gap = 0.5 * r;
     bd.seed = 99;
     int64_t count = 0;
+    if (flat) {
+        bd.kind = SX_BOND_FLATJOINT;
+        bd.friction_angle = 20;
+        bd.friction = 0.4;
+        bd.unbonded_fraction = 0.2;
+        bd.initial_gap = 1e-6;
+        bd.elements = dim == 3 ? 2 : 3;
+        bd.sectors = 3;
+    }
     ck_assert_msg(sx_bond_install(m, &bd, &count) == SX_OK, "%s", sx_model_error(m));
     ck_assert(count > 0);
     bd.kind = SX_BOND_CONTACT;
-    ck_assert_msg(sx_bond_install(m, &bd, &count) == SX_OK, "%s", sx_model_error(m));
+    if (!flat) ck_assert_msg(sx_bond_install(m, &bd, &count) == SX_OK, "%s", sx_model_error(m));
     /* the last axis: bottom layer held, top layer pulled */
     const int axis = dim - 1;
     for (int q = 0; q < n; q++) {
@@ -131,6 +142,10 @@ sx_model *io_scene_bonded(int dim)
     free(ids);
     return m;
 }
+
+sx_model *io_scene_bonded(int dim) { return bonded_lattice(dim, false); }
+
+sx_model *io_scene_flatjoint(int dim) { return bonded_lattice(dim, true); }
 
 sx_model *io_scene_hertz(int dim)
 {

@@ -20,6 +20,8 @@ sx_model *io_scene_granular(int dim, int nballs);
 /// A bonded lattice (parallel and contact bonds) pulled apart by its top
 /// layer while a wall presses on its side: bonds break, cracks are logged.
 sx_model *io_scene_bonded(int dim);
+/// The same lattice joined by flat joints (a fifth of their elements slit and gapped).
+sx_model *io_scene_flatjoint(int dim);
 /// Hertz-Mindlin balls dropped on a floor with a fixed user timestep.
 sx_model *io_scene_hertz(int dim);
 /// A specimen squeezed by servo-controlled walls: 3D, a cylinder of finite

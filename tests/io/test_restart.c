@@ -80,6 +80,28 @@ START_TEST(bonded_restart)
 }
 END_TEST
 
+/* Flat joints: their elements' states, shear forces and the faces' axes
+ * and bend rotations (/flatjoints) continue bit for bit. */
+START_TEST(flatjoint_restart)
+{
+    const int dim = _i;
+    const int n = dim == 3 ? 150 : 250;
+    sx_model *m = io_scene_flatjoint(dim);
+    io_cycle(m, n);
+    const int64_t cracks1 = sx_crack_count(m);
+    io_cycle(m, n);
+    printf("%dD flat-jointed: %lld cracks at %d steps, %lld at %d\n", dim, (long long)cracks1, n,
+           (long long)sx_crack_count(m), 2 * n);
+    ck_assert(cracks1 > 0 && sx_crack_count(m) > cracks1);
+    sx_crack c;
+    ck_assert_int_eq(sx_crack_get(m, 0, &c), SX_OK);
+    ck_assert(c.kind == SX_BOND_FLATJOINT && c.element >= 0);
+    sx_model_destroy(m);
+    restart(io_scene_flatjoint, dim, n, false);
+    restart(io_scene_flatjoint, dim, 1, true);
+}
+END_TEST
+
 START_TEST(hertz_restart)
 {
     restart(io_scene_hertz, _i, 500, false);
@@ -312,6 +334,7 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, granular_restart, 2, 4);
     tcase_add_loop_test(tc, bonded_restart, 2, 4);
+    tcase_add_loop_test(tc, flatjoint_restart, 2, 4);
     tcase_add_loop_test(tc, hertz_restart, 2, 4);
     tcase_add_loop_test(tc, servo_restart, 2, 4);
     tcase_add_loop_test(tc, resave, 2, 4);

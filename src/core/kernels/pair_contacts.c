@@ -92,6 +92,61 @@ static double pb_strain(const sx_bonds *b, int64_t s)
     return e;
 }
 
+/* The flat joint of bond s (laws/flatjoint.h): its face axes t1, t2 for
+ * the joint's normal n (3D: t1 as carried; 2D: n turned by +90 deg, t2 = z). */
+static inline void fj_axes(const sx_bonds *b, int32_t s, const double *n, double *t1, double *t2)
+{
+#if D == 3
+    for (int k = 0; k < 3; k++) t1[k] = b->fj_axis[s * 3 + k];
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+#else
+    (void)b, (void)s;
+    t1[0] = -n[1], t1[1] = n[0];
+    t2[0] = t2[1] = 0;
+#endif
+}
+
+/* The gap gradient (ay, az) = (-theta2, theta1) of flat joint s's bend rotation. */
+static inline void fj_gradient(const sx_bonds *b, int32_t s, double *ay, double *az)
+{
+#if D == 3
+    *ay = -b->fj_rot[s * 2 + 1], *az = b->fj_rot[s * 2];
+#else
+    *ay = -b->fj_rot[s], *az = 0;
+#endif
+}
+
+/* Shear spring energy of a flat-joint element: |Fs|^2 / (2 ks A). */
+static inline double fj_shear_energy(const double *fs, double ks, double area)
+{
+    double f2 = 0;
+    for (int k = 0; k < D - 1; k++) f2 += fs[k] * fs[k];
+    return 0.5 * f2 / (ks * area);
+}
+
+/* Strain energy of flat joint s at centre distance d (its last evaluation's). */
+static double fj_strain(const sx_model *m, int32_t s, double d)
+{
+    const sx_bonds *b = &m->bonds;
+    const sx_fjels *E = &m->fjel;
+    double ay, az;
+    fj_gradient(b, s, &ay, &az);
+    const double delta = d - b->fj_d0[s];
+    const int nel = b->fj_nr[s] * b->fj_na[s];
+    double e = 0;
+    for (int el = 0; el < nel; el++) {
+        const int64_t x = b->fj_first[s] + el;
+        sx_law_fj_geom g;
+        sx_law_fj_element(D, b->rbar[s], b->fj_nr[s], b->fj_na[s], el, &g);
+        const double gc = E->gap0[x] + delta + ay * g.y + az * g.z;
+        e += sx_law_fj_load_of(D, &g, E->state[x] == SX_FJ_BONDED, b->kn[s], gc, ay, az).energy;
+        e += fj_shear_energy(E->fs + x * (D - 1), b->ks[s], g.area);
+    }
+    return e;
+}
+
 static double KERNEL(critical_dt)(sx_model *m);
 
 /* 4-16 ... 4-20: the velocity v_{n-1/2} moved the entities from x_{n-1} to
@@ -108,8 +163,8 @@ static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64
                     KERNEL(critical_dt)(m));
 }
 
-static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int64_t i,
-                      int64_t j, double fn, double fs, double mn, double ms)
+static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int element,
+                      int64_t i, int64_t j, double fn, double fs, double mn, double ms)
 {
     sx_crack c;
     memset(&c, 0, sizeof c);
@@ -121,6 +176,7 @@ static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode 
     c.a = m->balls.id[i];
     c.b = m->balls.id[j];
     c.fn = fn, c.fs = fs, c.mn = mn, c.ms = ms;
+    c.element = element;
     /* kept with the chunk, merged into the model's log in chunk order */
     if (o->ncracks == o->capcracks) {
         const int64_t cap = o->capcracks ? 2 * o->capcracks : 16;
@@ -166,7 +222,7 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     const double tau = fsn / area + (D == 3 ? mnn * rbar / polar : 0);
     if (sigma >= b->sigma_c[s] || tau >= b->tau_c[s]) {
         const bool tension = sigma / b->sigma_c[s] >= tau / b->tau_c[s];
-        log_crack(m, o, xc, tension ? SX_CRACK_TENSION : SX_CRACK_SHEAR, SX_BOND_PARALLEL, i, j, b->fn[s], fsn, mnn,
+        log_crack(m, o, xc, tension ? SX_CRACK_TENSION : SX_CRACK_SHEAR, SX_BOND_PARALLEL, -1, i, j, b->fn[s], fsn, mnn,
                   msn);
         if (m->track_energy) o->released += pb_strain(b, s);
         return false;
@@ -178,6 +234,135 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     mb[0] += ms[0];
 #endif
     return true;
+}
+
+/* The flat joint of pair (i, j) in place of its contact law (laws/flatjoint.h):
+ * its axes carried, its bend rotation and its elements' shear forces
+ * incremented, each element loaded from the gap field and checked against
+ * its strengths (a break goes to the crack log with its element), friction
+ * capping the unbonded ones. The face is evaluated in the joint's own
+ * orientation (as installed); its resultants are turned to the pair's:
+ * the force on j added to F, its moment about the contact point to mb, and
+ * both kept in the bond's fn, fs, mn, ms (as the parallel bond's). Returns
+ * false when the joint is gone: no element bonded and none in contact. */
+static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *np, double d,
+                       const double *vsp, const double *dthp, const double *xc, int64_t i, int64_t j, double *F,
+                       double *mb)
+{
+    sx_bonds *b = &m->bonds;
+    sx_fjels *E = &m->fjel;
+    const double sg = m->balls.id[i] == b->ida[s] ? 1 : -1; /* the pair's orientation against the joint's */
+    const double dt = motion_dt(m), kn = b->kn[s], ks = b->ks[s], r = b->rbar[s];
+    const bool track = m->track_energy;
+    double n[D], vs[D], dth[RD], t1[D], t2[D];
+    for (int k = 0; k < D; k++) n[k] = sg * np[k], vs[k] = sg * vsp[k];
+    for (int k = 0; k < RD; k++) dth[k] = sg * dthp[k];
+#if D == 3
+    /* t1 turns with the contact (4-14/4-15), then is made normal to n again */
+    double *axis = b->fj_axis + s * 3;
+    carry_apply(rot, axis);
+    const double an = dot(axis, n);
+    for (int k = 0; k < 3; k++) axis[k] -= an * n[k];
+    const double inv = 1.0 / sqrt(dot(axis, axis));
+    for (int k = 0; k < 3; k++) axis[k] *= inv;
+    fj_axes(b, s, n, t1, t2);
+    b->fj_rot[s * 2] += dot(dth, t1);
+    b->fj_rot[s * 2 + 1] += dot(dth, t2);
+    const double twist = dot(dth, n);
+    const double dus[2] = {dot(vs, t1) * dt, dot(vs, t2) * dt};
+#else
+    (void)rot;
+    fj_axes(b, s, n, t1, t2);
+    b->fj_rot[s] += dth[0];
+    const double twist = 0, dus[1] = {dot(vs, t1) * dt};
+#endif
+    double ay, az;
+    fj_gradient(b, s, &ay, &az);
+    const double delta = d - b->fj_d0[s], tanphi = b->fj_tanphi[s], mu = b->fj_mu[s];
+    const int nr = b->fj_nr[s], na = b->fj_na[s];
+    double fn_sum = 0, fs_sum[2] = {0, 0}, m1 = 0, m2 = 0, mt = 0;
+    bool alive = false;
+    for (int el = 0; el < nr * na; el++) {
+        const int64_t x = b->fj_first[s] + el;
+        sx_law_fj_geom g;
+        sx_law_fj_element(D, r, nr, na, el, &g);
+        double *fs = E->fs + x * (D - 1);
+        /* the shear displacement of the element's centroid: the contact point's
+         * (4-17 ... 4-20) plus the twist's dtheta_n n x re = (-z, y) dtheta_n */
+        const double ksa = ks * g.area;
+        double f0[2]; /* before the increment, for the slip work */
+        for (int k = 0; k < D - 1; k++) f0[k] = fs[k];
+        fs[0] -= ksa * (dus[0] - twist * g.z);
+        if (D == 3) fs[D - 2] -= ksa * (dus[D - 2] + twist * g.y);
+        const double gc = E->gap0[x] + delta + ay * g.y + az * g.z;
+        bool bonded = E->state[x] == SX_FJ_BONDED;
+        sx_law_fj_load l = sx_law_fj_load_of(D, &g, bonded, kn, gc, ay, az);
+        double fsn = 0;
+        for (int k = 0; k < D - 1; k++) fsn += fs[k] * fs[k];
+        fsn = sqrt(fsn);
+        double released = 0;
+        if (bonded) {
+            const double sigma = -l.fn / g.area, tau = fsn / g.area;
+            const int mode = sigma >= E->sigma_c[x]                    ? SX_CRACK_TENSION
+                             : tau >= E->coh[x] - sigma * tanphi ? SX_CRACK_SHEAR
+                                                                          : 0;
+            if (mode) {
+                double pos[D];
+                for (int k = 0; k < D; k++) pos[k] = xc[k] + g.y * t1[k] + (D == 3 ? g.z * t2[k] : 0);
+                log_crack(m, o, pos, (sx_crack_mode)mode, SX_BOND_FLATJOINT, el, i, j, l.fn, fsn, 0, 0);
+                E->state[x] = (uint8_t)(mode == SX_CRACK_TENSION ? SX_FJ_TENSION : SX_FJ_SHEAR);
+                released = l.energy + fj_shear_energy(fs, ks, g.area);
+                l = sx_law_fj_contact(D, &g, kn, gc, ay, az);
+                bonded = false;
+            }
+        }
+        if (!bonded) { /* compression and Coulomb friction only */
+            const double fmax = mu * (l.fn > 0 ? l.fn : 0);
+            if (fsn > fmax) {
+                const double sc = fmax / fsn;
+                /* slip work, as the contact's: the mean shear force along the
+                 * slip (trial - final) / (ks A); a break's drop is released */
+                if (track && !released) {
+                    double e = 0;
+                    for (int k = 0; k < D - 1; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
+                    o->slip += 0.5 * e / ksa;
+                }
+                for (int k = 0; k < D - 1; k++) fs[k] *= sc;
+            }
+            if (released) released -= l.energy + fj_shear_energy(fs, ks, g.area);
+        }
+        if (track) o->released += released;
+        E->fn[x] = l.fn;
+        alive = alive || bonded || l.fn > 0;
+        /* the element's moment about the contact point: re x (Fn n + Fs) + its own */
+        fn_sum += l.fn;
+        fs_sum[0] += fs[0];
+        m1 += l.m1 + l.fn * g.z;
+        m2 += l.m2 - l.fn * g.y;
+#if D == 3
+        fs_sum[1] += fs[1];
+        mt += g.y * fs[1] - g.z * fs[0];
+#endif
+    }
+    /* resultants, turned to the pair's orientation (sg) */
+    double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
+    b->fn[s] = fn_sum;
+    b->mn[s] = D == 3 ? mt : 0; /* sg mt n_joint = mt n */
+    for (int k = 0; k < D; k++) {
+        bfs[k] = sg * (fs_sum[0] * t1[k] + (D == 3 ? fs_sum[1] * t2[k] : 0));
+        F[k] += fn_sum * np[k] + bfs[k];
+    }
+#if D == 3
+    for (int k = 0; k < 3; k++) {
+        bms[k] = sg * (m1 * t1[k] + m2 * t2[k]);
+        mb[k] += b->mn[s] * np[k] + bms[k];
+    }
+#else
+    (void)m1, (void)mt;
+    bms[0] = sg * m2;
+    mb[0] += bms[0];
+#endif
+    return alive;
 }
 
 /* A chunk's results start empty; the balls it clears start from their
@@ -280,7 +465,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 
         double kn, ks, fn = 0, F[D], mb[RD], mroll[RD] = {0};
         bool bond_moment = false;
-        const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
+        /* a contact bond carries tension; a flat joint replaces the contact law */
+        const bool active = !(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT));
         bool slip = false;
         if (active) {
             fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
@@ -299,14 +485,14 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (bonds & SX_BOND_CONTACT) {
                 const double fsn = sqrt(dot(fs, fs));
                 if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
-                    log_crack(m, o, xc, SX_CRACK_TENSION, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    log_crack(m, o, xc, SX_CRACK_TENSION, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
                     if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * fsn * fsn / ks : 0);
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                     if (us) sx_law_total_shear_slip(D, us, 0);
                 } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
-                    log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
+                    log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
                 }
             }
@@ -374,6 +560,12 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             for (int k = 0; k < RD; k++) mb[k] = 0;
             if (parallel_bond(m, o, slot, &rot, n, vn, vs, dtheta, xc, i, j, F, mb)) bond_moment = true;
             else bonds &= ~(unsigned)SX_BOND_PARALLEL;
+        }
+        if (bonds & SX_BOND_FLATJOINT) {
+            double dtheta[RD];
+            for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt, mb[k] = 0;
+            bond_moment = true;
+            if (!flat_joint(m, o, slot, &rot, n, d, vs, dtheta, xc, i, j, F, mb)) bonds &= ~(unsigned)SX_BOND_FLATJOINT;
         }
         if (bonds != bonds_before) { /* only this pair touches its bond slot */
             m->bonds.kind[slot] = (uint8_t)bonds;

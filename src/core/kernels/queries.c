@@ -21,7 +21,8 @@ static double pair_force(const sx_model *m, int64_t c, double un, double *kn, do
     const int64_t i = m->bb.a[c], j = m->bb.b[c];
     const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
     const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
-    const bool active = un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT));
+    const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+    const bool active = !(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT));
     const double rsum = B->rad[i] + B->rad[j];
     const double fn = stiffness(&law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, kn, ks);
     return active ? fn : 0;
@@ -60,6 +61,8 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
+            e->bond_strain += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
     }
     for (int64_t c = 0; c < m->bw.n; c++) {
         double n[D], kn, ks;
@@ -114,7 +117,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     if (slot >= 0) {
         const sx_bonds *b = &m->bonds;
         ci.bond = b->kind[slot];
-        if (b->kind[slot] & SX_BOND_PARALLEL) {
+        if (b->kind[slot] & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) { /* a flat joint's resultants alike */
             ci.pb_fn = b->fn[slot];
             ci.pb_radius = b->rbar[slot];
             for (int k = 0; k < D; k++) ci.pb_fs[k] = b->fs[slot * D + k];

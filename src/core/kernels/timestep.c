@@ -31,7 +31,8 @@ static double KERNEL(critical_dt)(sx_model *m)
         const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
         const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
         double ktr = 0, krot_i = 0, krot_j = 0;
-        if (un > 0 || (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_CONTACT))) {
+        const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+        if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
             double kn, ks;
             stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
             if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
@@ -49,7 +50,7 @@ static double KERNEL(critical_dt)(sx_model *m)
                 krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
             }
         }
-        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) {
+        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) { /* a flat joint's face: the section of 4-35 */
             const sx_bonds *b = &m->bonds;
             double area, inertia, polar;
             pb_section(b->rbar[slot], &area, &inertia, &polar);

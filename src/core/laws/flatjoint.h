@@ -1,0 +1,194 @@
+/* The flat joint (Potyondy 2012; PFC's `flatjoint`): the interface of two
+ * balls is a notional flat face centred at the contact point, normal to
+ * the centre line, of radius R = lambda min(RA, RB) (4-53's multiplier) --
+ * a segment of length 2R and unit thickness in 2D, a disk in 3D -- cut into
+ * elements: 2D, Nr equal segments; 3D, Nr equal rings of Na equal sectors.
+ * The flat joint replaces the contact law of its pair (it is the contact).
+ *
+ * Kinematics, in the face's axes (t1, t2, n): 3D, t1 is carried with the
+ * contact (4-13 ... 4-15) and t2 = n x t1; 2D, t1 = n turned by +90 deg and
+ * t2 = z, so 2D is 3D with z = 0. A point r = y t1 + z t2 of the face opens
+ * by the gap
+ *     g(r) = g0 + delta - theta2 y + theta1 z,
+ * delta = d - d0 the change of the centre distance since installation,
+ * (theta1, theta2) the relative bend rotation of b from a (the increments
+ * (wb - wa) dt projected on t1, t2), g0 an unbonded element's initial gap
+ * (0 for bonded ones: every element starts stress free).
+ *
+ * Element e (area Ae, centroid re, central second moments Jyy, Jyz, Jzz)
+ * carries, on b:
+ *   normal stress  sigma(r) = -kn g(r) where bonded, or where g < 0
+ *                  (unbonded: compression only), so
+ *                  Fn_e = integral of sigma, the element's moment about its
+ *                  centroid integral of (r - re) x n sigma (exact for a
+ *                  bonded element and, in 2D, over an unbonded one's closed
+ *                  part; an unbonded 3D element by Gauss points, 2 x 2 in
+ *                  each of 4 x 4 sub-sectors);
+ *   shear force    incremental, Fs_e -= ks Ae (dUs + dtheta_n n x re),
+ *                  dUs the contact point's shear displacement (4-17 ...
+ *                  4-20) and dtheta_n the relative twist increment (3D), so
+ *                  the face resists twist through its elements' shear.
+ * A bonded element breaks
+ *   in tension    when sigma-bar = -Fn_e / Ae >= sigma_c (its centroid's
+ *                 tensile stress),
+ *   in shear      when tau = |Fs_e| / Ae >= c - sigma-bar tan(phi),
+ * and is from then on unbonded, with the gap it has: compression only, and
+ * Coulomb friction |Fs_e| <= mu Fn_e. The face's force on b is
+ * sum (Fn_e n + Fs_e), its moment about the contact point
+ * sum (re x (Fn_e n + Fs_e) + M_e); on a the opposite (4-39).
+ *
+ * Energy: the strain energy is (1/2) kn integral of g^2 over the loaded
+ * parts plus |Fs_e|^2 / (2 ks Ae); a break releases the element's energy
+ * before it minus after it (bond_released); friction's work goes to slip.
+ */
+#pragma once
+
+#include <math.h>
+#include <stdbool.h>
+
+#define SX_FJ_PI 3.14159265358979323846
+#define SX_FJ_SUB 4 /* sub-sectors per direction of an unbonded 3D element */
+
+/* An element's (or sub-sector's) area, centroid and central second moments
+ * in the face's axes (2D: y along the face, z = 0). */
+typedef struct sx_law_fj_geom {
+    double area, y, z, jyy, jyz, jzz;
+    double r0, r1, a0, a1; /* 3D: rings [r0, r1], angles [a0, a1]; 2D: the segment [r0, r1] along y */
+} sx_law_fj_geom;
+
+/* The annular sector r0 <= r <= r1, a0 <= alpha <= a1 (y = r cos alpha). */
+static inline void sx_law_fj_sector(double r0, double r1, double a0, double a1, sx_law_fj_geom *g)
+{
+    const double da = a1 - a0, q2 = (r1 * r1 - r0 * r0) / 2, q3 = (r1 * r1 * r1 - r0 * r0 * r0) / 3;
+    const double q4 = (r1 * r1 * r1 * r1 - r0 * r0 * r0 * r0) / 4;
+    const double s0 = sin(a0), s1 = sin(a1), c0 = cos(a0), c1 = cos(a1);
+    g->area = q2 * da;
+    g->y = q3 * (s1 - s0) / g->area;
+    g->z = q3 * (c0 - c1) / g->area;
+    const double s2 = (sin(2 * a1) - sin(2 * a0)) / 4;
+    g->jyy = q4 * (da / 2 + s2) - g->area * g->y * g->y;
+    g->jzz = q4 * (da / 2 - s2) - g->area * g->z * g->z;
+    g->jyz = q4 * (s1 * s1 - s0 * s0) / 2 - g->area * g->y * g->z;
+    g->r0 = r0, g->r1 = r1, g->a0 = a0, g->a1 = a1;
+}
+
+/* The segment [s0, s1] of unit thickness (2D). */
+static inline void sx_law_fj_segment(double s0, double s1, sx_law_fj_geom *g)
+{
+    const double len = s1 - s0;
+    g->area = len;
+    g->y = 0.5 * (s0 + s1);
+    g->z = 0;
+    g->jyy = len * len * len / 12;
+    g->jyz = g->jzz = 0;
+    g->r0 = s0, g->r1 = s1, g->a0 = g->a1 = 0;
+}
+
+/* Element e of a face of radius r: 2D, segment e of nr along [-r, r];
+ * 3D, ring e / na (from the centre) and sector e % na (from t1 towards t2). */
+static inline void sx_law_fj_element(int dim, double r, int nr, int na, int e, sx_law_fj_geom *g)
+{
+    if (dim == 2) {
+        sx_law_fj_segment(-r + 2 * r * e / nr, -r + 2 * r * (e + 1) / nr, g);
+    } else {
+        const int ring = e / na, sector = e % na;
+        sx_law_fj_sector(r * ring / nr, r * (ring + 1) / nr, 2 * SX_FJ_PI * sector / na,
+                     2 * SX_FJ_PI * (sector + 1) / na, g);
+    }
+}
+
+/* What a region carries: normal force (compression positive), moment about
+ * its centroid (m1 along t1, m2 along t2; 2D: m2 is the moment about z),
+ * and its normal springs' strain energy. */
+typedef struct sx_law_fj_load {
+    double fn, m1, m2, energy;
+} sx_law_fj_load;
+
+/* A wholly loaded region (bonded, or closed everywhere) with gap gc at its
+ * centroid and gap gradient (ay, az) = (-theta2, theta1). */
+static inline sx_law_fj_load sx_law_fj_whole(const sx_law_fj_geom *g, double kn, double gc, double ay, double az)
+{
+    sx_law_fj_load l;
+    l.fn = -kn * g->area * gc;
+    l.m1 = -kn * (ay * g->jyz + az * g->jzz);
+    l.m2 = kn * (ay * g->jyy + az * g->jyz);
+    l.energy = 0.5 * kn * (g->area * gc * gc + ay * ay * g->jyy + 2 * ay * az * g->jyz + az * az * g->jzz);
+    return l;
+}
+
+/* The range [lo, hi] of a.(r - centroid) over a region. */
+static inline void sx_law_fj_range(int dim, const sx_law_fj_geom *g, double ay, double az, double *lo, double *hi)
+{
+    if (dim == 2) {
+        const double u = ay * (g->r0 - g->y), v = ay * (g->r1 - g->y);
+        *lo = fmin(u, v), *hi = fmax(u, v);
+        return;
+    }
+    /* a linear function on an annular sector peaks at a corner or where an
+     * arc is parallel to the gradient's normal */
+    const double rr[2] = {g->r0, g->r1};
+    double al[4] = {g->a0, g->a1, atan2(az, ay), atan2(az, ay) + SX_FJ_PI};
+    int na = 2;
+    for (int k = 2; k < 4; k++) {
+        double a = al[k];
+        while (a < g->a0) a += 2 * SX_FJ_PI;
+        while (a > g->a1) a -= 2 * SX_FJ_PI;
+        if (a >= g->a0 && a <= g->a1) al[na++] = a;
+    }
+    *lo = INFINITY, *hi = -INFINITY;
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < na; k++) {
+            const double f = ay * (rr[i] * cos(al[k]) - g->y) + az * (rr[i] * sin(al[k]) - g->z);
+            *lo = fmin(*lo, f), *hi = fmax(*hi, f);
+        }
+}
+
+/* An unbonded region: compression only, where g < 0. */
+static inline sx_law_fj_load sx_law_fj_contact(int dim, const sx_law_fj_geom *g, double kn, double gc, double ay, double az)
+{
+    sx_law_fj_load l = {0, 0, 0, 0};
+    double lo, hi;
+    sx_law_fj_range(dim, g, ay, az, &lo, &hi);
+    if (gc + lo >= 0) return l;
+    if (dim == 2) {
+        if (gc + hi <= 0) return sx_law_fj_whole(g, kn, gc, ay, az);
+        /* exactly over the closed part [p, q] of the segment (centroid at 0) */
+        const double h = 0.5 * g->area, root = -gc / ay;
+        const double p = ay > 0 ? -h : root, q = ay > 0 ? root : h;
+        const double d1 = q - p, d2 = (q * q - p * p) / 2, d3 = (q * q * q - p * p * p) / 3;
+        l.fn = -kn * (gc * d1 + ay * d2);
+        l.m2 = kn * (gc * d2 + ay * d3);
+        l.energy = 0.5 * kn * (gc * gc * d1 + 2 * gc * ay * d2 + ay * ay * d3);
+        return l;
+    }
+    /* 3D: Gauss points, 2 x 2 in each of SUB x SUB sub-sectors (exact in r
+     * for the integrands here, r^3 at most; smooth in alpha), each a
+     * compression-only spring: the forces are the exact derivatives of the
+     * energy summed, so an unbonded element conserves energy as it opens
+     * and closes (a closed element by this rule differs from the exact one
+     * only by the rule's error in alpha) */
+    static const double gp[2] = {-0.57735026918962576, 0.57735026918962576};
+    const double dr = (g->r1 - g->r0) / SX_FJ_SUB, da = (g->a1 - g->a0) / SX_FJ_SUB;
+    for (int i = 0; i < SX_FJ_SUB; i++)
+        for (int k = 0; k < SX_FJ_SUB; k++)
+            for (int u = 0; u < 2; u++)
+                for (int v = 0; v < 2; v++) {
+                    const double r = g->r0 + dr * (i + 0.5 + 0.5 * gp[u]), a = g->a0 + da * (k + 0.5 + 0.5 * gp[v]);
+                    const double dy = r * cos(a) - g->y, dz = r * sin(a) - g->z, gq = gc + ay * dy + az * dz;
+                    if (gq >= 0) continue;
+                    const double w = 0.25 * dr * da * r, f = -kn * w * gq;
+                    /* moved to the element's centroid: + (dy t1 + dz t2) x n f */
+                    l.fn += f;
+                    l.m1 += f * dz;
+                    l.m2 -= f * dy;
+                    l.energy += 0.5 * kn * w * gq * gq;
+                }
+    return l;
+}
+
+/* The normal load of element e: bonded, or compression only. */
+static inline sx_law_fj_load sx_law_fj_load_of(int dim, const sx_law_fj_geom *g, bool bonded, double kn, double gc, double ay,
+                                       double az)
+{
+    return bonded ? sx_law_fj_whole(g, kn, gc, ay, az) : sx_law_fj_contact(dim, g, kn, gc, ay, az);
+}

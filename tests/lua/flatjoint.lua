@@ -1,0 +1,104 @@
+-- Lua-level checks of the flat joint: m:bond{kind = "flatjoint"} with the
+-- parameters from the material's bond table, the per-element draws from the
+-- recorded seed, m:flatjoint and m:flatjoint_unbond, the crack log's
+-- elements and clear errors.
+local passed, failed = 0, 0
+local function check(name, ok, msg)
+  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(msg)) end
+end
+
+-- two balls joined by a flat joint whose parameters come from the material
+local function pair(dim, bond, over)
+  local m = seixo.model{dim = dim}
+  local mat = {density = 1000, damping = 0.3, kn = 1e9, ks = 1e9, friction = 0.5,
+               bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                       tensile_strength_sd = 2e5, cohesion = 2e6, cohesion_sd = 4e5, friction_angle = 30,
+                       friction = 0.6, elements = 4, sectors = 3}}
+  for k, v in pairs(over or {}) do mat.bond[k] = v end
+  m:material("r", mat)
+  local a = m:ball{pos = dim == 3 and {0, 0, 0} or {0, 0}, radius = 1}
+  local b = m:ball{pos = dim == 3 and {2, 0, 0} or {2, 0}, radius = 1}
+  local n = m:bond(bond or {kind = "flatjoint", gap = 1e-6, seed = 5})
+  return m, a, b, n
+end
+
+for _, dim in ipairs{2, 3} do
+  local m, a, b, n = pair(dim)
+  check(dim .. "D one joint", n == 1 and m:bond_count() == 1, n)
+  local els = m:flatjoint(a.id, b.id)
+  check(dim .. "D elements from the material", els and #els == (dim == 3 and 12 or 4), els and #els)
+  local same, spread = true, false
+  local m2, a2, b2 = pair(dim)
+  local els2 = m2:flatjoint(a2.id, b2.id)
+  for k, e in ipairs(els) do
+    same = same and e.tensile_strength == els2[k].tensile_strength and e.cohesion == els2[k].cohesion
+    spread = spread or e.tensile_strength ~= els[1].tensile_strength
+    check(dim .. "D element bonded", e.state == "bonded", e.state)
+  end
+  check(dim .. "D draws repeat from the seed", same, "")
+  check(dim .. "D draws spread (sd > 0)", spread, "")
+  local area = 0
+  for _, e in ipairs(els) do area = area + e.area end
+  local want = dim == 3 and math.pi or 2
+  check(dim .. "D elements tile the face", math.abs(area - want) < 1e-12 * want, area)
+  m:flatjoint_unbond(a.id, b.id, 1)
+  check(dim .. "D slit", m:flatjoint(a.id, b.id)[1].state == "unbonded", m:flatjoint(a.id, b.id)[1].state)
+  local ok, err = pcall(m.flatjoint_unbond, m, a.id, b.id, 99)
+  check(dim .. "D bad element named", not ok and tostring(err):find("element"), err)
+  check(dim .. "D no joint elsewhere", m:flatjoint(a.id, 77) == nil, "")
+  m:close()
+  m2:close()
+end
+
+do -- bad parameters are named
+  local ok, err = pcall(pair, 2, nil, {friction_angle = 95})
+  check("friction_angle range", not ok and tostring(err):find("friction_angle"), err)
+  ok, err = pcall(pair, 2, nil, {elements = 2.5})
+  check("whole elements", not ok and tostring(err):find("elements"), err)
+  ok, err = pcall(pair, 2, {kind = "flatjoint", gap = 1e-6, unbonded_fraction = 2})
+  check("fraction range", not ok and tostring(err):find("unbonded_fraction"), err)
+  ok, err = pcall(pair, 2, {kind = "glue", gap = 1e-6})
+  check("kind named", not ok and tostring(err):find("flatjoint"), err)
+  local m = pair(2)
+  ok, err = pcall(m.bond, m, {kind = "parallel", gap = 1e-6})
+  check("no parallel bond on a flat joint", not ok and tostring(err):find("flat joint"), err)
+end
+
+-- Partial breakage: B is pressed on A and bent by a moment ramped up beyond
+-- the outer elements' strength, so some elements break (in the crack log with
+-- their element), slit elements close, and the face holds on in compression.
+-- The work of the loads closes with the stored, dissipated and released
+-- energies within 1 % (tests/bpm/energy.c has the specimens' balance).
+for _, dim in ipairs{2, 3} do
+  local m, a, b = pair(dim, {kind = "flatjoint", gap = 1e-6, seed = 3, unbonded_fraction = 0.25})
+  a.fix = "all"
+  m:track_energy(true)
+  local mz = dim == 3 and 1.8e6 or 1.5e6
+  for k = 1, 100 do
+    b.applied_force = dim == 3 and {-1e6 * k / 100, 0, 0} or {-1e6 * k / 100, 0}
+    b.applied_moment = dim == 3 and {0, mz * k / 100, 0} or mz * k / 100
+    m:cycle(100)
+  end
+  m:cycle(5000)
+  local els = m:flatjoint(a.id, b.id)
+  check(dim .. "D the joint holds on", els ~= nil and m:bond_count() == 1, m:bond_count())
+  local broken, logged = 0, 0
+  for _, e in ipairs(els or {}) do if e.state == "tension" or e.state == "shear" then broken = broken + 1 end end
+  for _, c in ipairs(m:cracks()) do
+    local e = els and c.element and els[c.element]
+    if c.kind == "flatjoint" and e and e.state == c.mode then logged = logged + 1 end
+  end
+  check(dim .. "D some elements broke, not all", broken > 0 and broken < #(els or {}), broken)
+  check(dim .. "D each break logged with its element and mode", logged == broken and m:crack_count() == broken,
+        logged .. " of " .. broken)
+  local e = m:energy()
+  check(dim .. "D breaks release energy", e.bond_released > 0, e.bond_released)
+  local balance = e.boundary_work - (e.kinetic + e.strain + e.bond_strain + e.slip + e.local_damping + e.viscous
+                                     + e.bond_released)
+  print(string.format("%dD: %d of %d elements broke; work %.5g J, released %.4g J, balance %.2e of the work", dim,
+                      broken, #(els or {}), e.boundary_work, e.bond_released, balance / e.boundary_work))
+  check(dim .. "D energy closes within 1 %", math.abs(balance) < 0.01 * e.boundary_work, balance)
+end
+
+print(string.format("flatjoint: %d passed, %d failed", passed, failed))
+if failed > 0 then os.exit(1) end
