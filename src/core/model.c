@@ -81,6 +81,7 @@ void sx_model_destroy(sx_model *m)
     sx__walls_free(m);
     sx__bonds_free(m);
     sx__clumps_free(m);
+    sx__cell_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
@@ -106,7 +107,7 @@ sx_memory sx_model_memory(const sx_model *m)
     r.total = m->alloc.bytes;
     r.peak = m->alloc.peak;
     r.balls = sx__balls_bytes(m);
-    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw);
+    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw) + sx__cell_bytes(m);
     const sx_bonds *k = &m->bonds;
     const size_t per_bond = 1 + 2 * sizeof(int32_t) + (9 + (size_t)m->dim + (size_t)m->rdim) * sizeof(double);
     r.bonds = (size_t)k->cap * per_bond + (size_t)m->cracks.cap * sizeof(sx_crack);
@@ -352,6 +353,7 @@ sx_status sx__prepare(sx_model *m)
     sx_status st = refresh_laws(m);
     if (!st) st = check_models(m);
     if (st) return st;
+    if (m->build_needed && m->cell && (st = sx__cell_check(m))) return st;
     if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;
 }
@@ -529,6 +531,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
             break;
         }
         if (m->build_needed) {
+            if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
             const bool ok = k->build(m);
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (!ok) {
@@ -553,6 +556,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         sx__walls_servo(m);
         move_walls(m, &max_wall);
+        if (m->cell) sx__cell_step(m); /* periodic space: the cell deforms */
         m->time += m->dt;
         m->dt_prev = m->dt;
         m->step++;
@@ -561,6 +565,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         /* Verlet criterion: two balls may close the gap by twice the largest
          * displacement, a ball and a wall by both of their displacements. */
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
+        /* a ghost moves with its owner and with the cell vectors that shift it */
+        if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
         if (m->step % GUARD_STEPS == 0) st = guard_check(m);
         other += now() - t;
         if (st) break;
@@ -691,6 +697,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
         h = sx__fnv(h, &wl->contacts, sizeof wl->contacts);
     }
     if (m->clumps) h = sx__clumps_hash(m, h);
+    if (m->cell) h = sx__cell_hash(m, h);
     return h;
 }
 
