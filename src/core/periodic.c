@@ -39,6 +39,8 @@ static bool component_in(int c, int dim)
 /* ------------------------------------------------------------ the cell */
 
 static void drop_ghost_pairs(sx_model *m);
+static double set_rates(sx_model *m, const double g[3][3]);
+static void gradient(const sx_model *m, const double stress[3][3], const double *stiff, double g[3][3]);
 
 sx_status sx_model_set_periodic(sx_model *m, const sx_periodic_def *def)
 {
@@ -221,7 +223,11 @@ sx_status sx_cell_set_control(sx_model *m, const sx_cell_control *ctl)
     }
     m->cell->ctl = *ctl;
     m->cell->controlled = on;
-    if (!on) memset(m->cell->hdot, 0, sizeof m->cell->hdot);
+    /* the rates hold from the next step on, so the images move with the
+     * cell in its first contact pass already (a servo starts at rest) */
+    double g[3][3];
+    gradient(m, NULL, NULL, g);
+    set_rates(m, g);
     m->guard_dirty = true;
     return SX_OK;
 }
@@ -245,31 +251,12 @@ sx_status sx_cell_stress(const sx_model *m, double stress[3][3], double *volume)
     return SX_OK;
 }
 
-void sx__cell_step(sx_model *m)
+/* The cell vectors' rate H' = G H, G the velocity gradient (upper
+ * triangular); returns how far an image may move in a step. */
+static double set_rates(sx_model *m, const double g[3][3])
 {
     sx_cell *c = m->cell;
-    if (!c->controlled) return;
     const int d = m->dim;
-    double g[3][3] = {{0}}; /* the velocity gradient of the cell */
-    bool servo = false;
-    for (int k = 0; k < SX_CELL_COMPONENTS; k++) servo |= c->ctl.mode[k] == SX_CELL_STRESS;
-    double stress[3][3], stiff[SX_CELL_COMPONENTS];
-    if (servo) kernels_of(m)->cell_stress(m, stress, stiff);
-    for (int k = 0; k < SX_CELL_COMPONENTS; k++) {
-        int i, j;
-        component_axes(k, &i, &j);
-        if (c->ctl.mode[k] == SX_CELL_RATE) {
-            g[i][j] = c->ctl.rate[k];
-        } else if (c->ctl.mode[k] == SX_CELL_STRESS) {
-            /* PFC's servo: the error over the stress per unit strain, a fraction alpha of it per step;
-             * without contacts (K = 0) the cell closes (or opens) at the bound */
-            const double err = stress[i][j] - c->ctl.target[k], lim = c->ctl.max_rate;
-            double rate = stiff[k] > 0 ? c->ctl.alpha * err / (stiff[k] * m->dt) : (err > 0 ? lim : -lim);
-            if (err == 0) rate = 0;
-            g[i][j] = rate > lim ? lim : rate < -lim ? -lim : rate;
-        }
-    }
-    /* H' = G H, column by column; H moves by H' dt */
     double moved = 0;
     for (int k = 0; k < d; k++) {
         double s = 0;
@@ -281,9 +268,44 @@ void sx__cell_step(sx_model *m)
         }
         moved += sqrt(s) * m->dt; /* an image shifted by several cell vectors moves by at most their sum */
     }
-    for (int k = 0; k < d; k++)
-        for (int i = 0; i < d; i++) c->h[k][i] += c->hdot[k][i] * m->dt;
-    c->moved += moved;
+    return moved;
+}
+
+/* The velocity gradient the control asks for: its rates, and the servo's
+ * from the stress of the last step (stress, stiff; NULL before any). */
+static void gradient(const sx_model *m, const double stress[3][3], const double *stiff, double g[3][3])
+{
+    const sx_cell_control *ctl = &m->cell->ctl;
+    memset(g, 0, 9 * sizeof(double));
+    for (int k = 0; k < SX_CELL_COMPONENTS; k++) {
+        int i, j;
+        component_axes(k, &i, &j);
+        if (ctl->mode[k] == SX_CELL_RATE) {
+            g[i][j] = ctl->rate[k];
+        } else if (ctl->mode[k] == SX_CELL_STRESS && stress) {
+            /* PFC's servo: the error over the stress per unit strain, a fraction alpha of it per step;
+             * without contacts (K = 0) the cell closes (or opens) at the bound */
+            const double err = stress[i][j] - ctl->target[k], lim = ctl->max_rate;
+            double rate = stiff[k] > 0 ? ctl->alpha * err / (stiff[k] * m->dt) : (err > 0 ? lim : -lim);
+            if (err == 0) rate = 0;
+            g[i][j] = rate > lim ? lim : rate < -lim ? -lim : rate;
+        }
+    }
+}
+
+void sx__cell_step(sx_model *m)
+{
+    sx_cell *c = m->cell;
+    if (!c->controlled) return;
+    bool servo = false;
+    for (int k = 0; k < SX_CELL_COMPONENTS; k++) servo |= c->ctl.mode[k] == SX_CELL_STRESS;
+    double stress[3][3], stiff[SX_CELL_COMPONENTS], g[3][3];
+    if (servo) kernels_of(m)->cell_stress(m, stress, stiff);
+    gradient(m, servo ? stress : NULL, stiff, g);
+    c->moved += set_rates(m, g);
+    /* the cell moves by H' dt, as the balls did (leapfrog: H' at the half step) */
+    for (int k = 0; k < m->dim; k++)
+        for (int i = 0; i < m->dim; i++) c->h[k][i] += c->hdot[k][i] * m->dt;
 }
 
 /* ------------------------------------------------------- ghost bookkeeping */
