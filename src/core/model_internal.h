@@ -401,6 +401,11 @@ size_t sx__cell_bytes(const sx_model *m);
 /* Room for n ghosts in the table and in the ball slots past base; SX_ENOMEM. */
 sx_status sx__cell_reserve(sx_model *m, int64_t base, int64_t n);
 void sx__cell_free(sx_model *m);
+/* A restore (the I/O layer): the cell as saved (its scalars; n ghosts),
+ * room for the ghosts made, then, once their table is filled,
+ * sx__cell_finish checks it and fills the ghosts' ball slots. */
+sx_status sx__cell_restore(sx_model *m, const sx_cell *saved);
+sx_status sx__cell_finish(sx_model *m);
 
 /* Clumps (clumps.c): the hooks of the other stages, all no-ops while
  * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */

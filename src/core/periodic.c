@@ -16,6 +16,7 @@
 #include "model_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* kernels of the model's dimension (model.c has its own copy of this) */
@@ -200,27 +201,35 @@ sx_cell_control sx_cell_default_control(void)
     return c;
 }
 
-sx_status sx_cell_set_control(sx_model *m, const sx_cell_control *ctl)
+/* Why a control cannot drive m's cell (written into why), or NULL. */
+static const char *control_problem(const sx_model *m, const sx_cell_control *ctl, bool *on, char *why, size_t len)
 {
-    const sx_cell *c = m->cell;
-    for (int k = 0; k < m->dim; k++)
-        if (!c || !c->axis[k])
-            return sx__fail(m, SX_EINVAL, "cell_control: the space must be periodic on every axis (set_periodic first)");
-    if (!(ctl->alpha > 0 && ctl->alpha <= 1))
-        return sx__fail(m, SX_EINVAL, "cell_control: alpha must be in (0, 1] (got %g)", ctl->alpha);
-    if (!(ctl->max_rate > 0) || !isfinite(ctl->max_rate))
-        return sx__fail(m, SX_EINVAL, "cell_control: max_rate must be > 0 1/s (got %g)", ctl->max_rate);
-    bool on = false;
+    *on = false;
     for (int k = 0; k < SX_CELL_COMPONENTS; k++) {
         const sx_cell_mode mode = ctl->mode[k];
         if (mode != SX_CELL_FIXED && mode != SX_CELL_RATE && mode != SX_CELL_STRESS)
-            return sx__fail(m, SX_EINVAL, "cell_control: unknown mode %d", (int)mode);
+            return snprintf(why, len, "unknown mode %d", (int)mode), why;
         if (mode != SX_CELL_FIXED && !component_in(k, m->dim))
-            return sx__fail(m, SX_EINVAL, "cell_control: a 2D cell has no component %d (xx, yy, xy only)", k);
+            return snprintf(why, len, "a 2D cell has no component %d (xx, yy, xy only)", k), why;
         if (!isfinite(ctl->rate[k]) || !isfinite(ctl->target[k]))
-            return sx__fail(m, SX_EINVAL, "cell_control: rates and targets must be finite");
-        on |= mode != SX_CELL_FIXED;
+            return snprintf(why, len, "rates and targets must be finite"), why;
+        *on |= mode != SX_CELL_FIXED;
     }
+    for (int k = 0; k < m->dim && *on; k++)
+        if (!m->cell || !m->cell->axis[k])
+            return snprintf(why, len, "the space must be periodic on every axis (set_periodic first)"), why;
+    if (!(ctl->alpha > 0 && ctl->alpha <= 1)) return snprintf(why, len, "alpha must be in (0, 1] (got %g)", ctl->alpha), why;
+    if (!(ctl->max_rate > 0) || !isfinite(ctl->max_rate))
+        return snprintf(why, len, "max_rate must be > 0 1/s (got %g)", ctl->max_rate), why;
+    return NULL;
+}
+
+sx_status sx_cell_set_control(sx_model *m, const sx_cell_control *ctl)
+{
+    char why[160];
+    bool on;
+    if (control_problem(m, ctl, &on, why, sizeof why)) return sx__fail(m, SX_EINVAL, "cell_control: %s", why);
+    if (!m->cell) return sx__fail(m, SX_EINVAL, "cell_control: the space is not periodic (set_periodic first)");
     m->cell->ctl = *ctl;
     m->cell->controlled = on;
     /* the rates hold from the next step on, so the images move with the
@@ -383,6 +392,59 @@ static void drop_ghost_pairs(sx_model *m)
         sx__pair_move(m, p, k++, q);
     }
     p->n = k;
+}
+
+sx_status sx__cell_restore(sx_model *m, const sx_cell *saved)
+{
+    if (!m->cell) {
+        m->cell = sx_alloc_resize(&m->alloc, NULL, 0, 1, sizeof *m->cell);
+        if (!m->cell) return sx__fail(m, SX_ENOMEM, "state: out of memory");
+        memset(m->cell, 0, sizeof *m->cell);
+    }
+    sx_cell *c = m->cell;
+    const int64_t cap = c->cap;
+    int32_t *owner = c->owner;
+    int8_t *image = c->image;
+    *c = *saved;
+    c->cap = cap, c->owner = owner, c->image = image;
+    c->base = m->balls.n;
+    if (c->n < 0 || c->n > INT32_MAX - m->balls.n)
+        return sx__fail(m, SX_EINVAL, "state: %lld ghosts", (long long)c->n);
+    return sx__cell_reserve(m, c->base, c->n) ? sx__fail(m, SX_ENOMEM, "state: out of memory for the ghosts")
+                                               : SX_OK;
+}
+
+sx_status sx__cell_finish(sx_model *m)
+{
+    sx_cell *c = m->cell;
+    const int d = m->dim;
+    bool any = false;
+    for (int k = 0; k < 3; k++) {
+        if (!c->axis[k]) continue;
+        any = true;
+        if (k >= d || !(c->h[k][k] > 0) || !isfinite(c->h[k][k]) || !isfinite(c->lo[k]))
+            return sx__fail(m, SX_EINVAL, "state: the periodic cell's axis %c is out of range", "xyz"[k]);
+    }
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++)
+            if (!isfinite(c->h[k][i]) || !isfinite(c->hdot[k][i]) || (i > k && c->h[k][i] != 0))
+                return sx__fail(m, SX_EINVAL, "state: the periodic cell's vectors are not upper triangular and finite");
+    if (!any) return sx__fail(m, SX_EINVAL, "state: a periodic cell without a periodic axis");
+    char why[160];
+    if (control_problem(m, &c->ctl, &c->controlled, why, sizeof why))
+        return sx__fail(m, SX_EINVAL, "state: the cell's control: %s", why);
+    for (int64_t g = 0; g < c->n; g++) {
+        if (c->owner[g] < 0 || c->owner[g] >= m->balls.n)
+            return sx__fail(m, SX_EINVAL, "state: ghost %lld images ball %d of %lld", (long long)g, c->owner[g],
+                            (long long)m->balls.n);
+        for (int k = 0; k < 3; k++) {
+            const int s = c->image[g * 3 + k];
+            if (s < -1 || s > 1 || (s && !c->axis[k]))
+                return sx__fail(m, SX_EINVAL, "state: ghost %lld has a bad image", (long long)g);
+        }
+    }
+    kernels_of(m)->ghosts_refresh(m, true);
+    return SX_OK;
 }
 
 uint64_t sx__cell_hash(const sx_model *m, uint64_t h)

@@ -210,10 +210,10 @@ static sx_status check_walls(sx_model *m)
 
 static sx_status check_pairs(sx_model *m)
 {
-    const int64_t n = m->balls.n;
+    const int64_t n = m->balls.n, ends = n + (m->cell ? m->cell->n : 0); /* b may be a ghost */
     const sx_pairs *p = &m->bb;
     for (int64_t c = 0; c < p->n; c++) {
-        if (p->a[c] < 0 || p->a[c] >= p->b[c] || p->b[c] >= n)
+        if (p->a[c] < 0 || p->a[c] >= n || p->a[c] >= p->b[c] || p->b[c] >= ends)
             return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld refers to balls %d, %d of %lld", (long long)c,
                             p->a[c], p->b[c], (long long)n);
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a bad touching flag", (long long)c);
@@ -264,7 +264,8 @@ sx_status sx__state_finish(sx_model *m)
 {
     sx_status st;
     if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
-        (st = check_pairs(m)) || (st = check_bonds(m)) || (st = sx__clumps_finish(m)))
+        (m->cell && (st = sx__cell_finish(m))) || (st = check_pairs(m)) || (st = check_bonds(m)) ||
+        (st = sx__clumps_finish(m)))
         return st;
     sx__balls_compact(m);
     /* the ball-ball pass's chunks follow from the pair store alone: planned

@@ -223,4 +223,30 @@ T.test("1 and 2 threads: the same bits in a periodic cell (3D, servo)", function
   T.check(m1:contact_count() > 0, "the cell is in contact")
 end)
 
+T.test("a periodic cell restarts bit-for-bit: servo, sheared and tilted cell, bonds through the boundary (2D, 3D)", function()
+  for _, dim in ipairs({2, 3}) do
+    local m = servo(dim, 1)
+    m:cycle(dim == 3 and 3000 or 20000)
+    T.check(m:contact_count() > 0, "in contact")
+    -- a bond through the boundary, a shear on the cell
+    T.check(m:bond{gap = 1e-4, kind = "parallel"} > 0, "bonds installed")
+    local c = m:cell_control()
+    c.xy = {rate = 0.5}
+    m:cell_control(c)
+    m:cycle(300)
+    local through = 0
+    for ct in m:contacts() do if ct.bond and (ct.shift[1] ~= 0 or ct.shift[2] ~= 0) then through = through + 1 end end
+    T.check(through > 0, "a bond through the boundary")
+    local path = "periodic_restart_" .. dim .. ".h5"
+    m:save(path)
+    local r = seixo.load(path)
+    T.eq(r:hash(), m:hash(), "the state as saved")
+    T.eq(r:periodic().tilt.xy, m:periodic().tilt.xy)
+    m:cycle(500)
+    r:cycle(500)
+    T.eq(r:hash(), m:hash(), "500 steps later")
+    os.remove(path)
+  end
+end)
+
 T.done()
