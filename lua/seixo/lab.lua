@@ -1069,4 +1069,7 @@ set yrange [0:%.6g]
                           {key = "c", path = out .. "_cracks.png"}, {key = "m", path = out .. "_mohr.png"}})
 end
 
+-- periodic cells, without walls (lua/seixo/periodic.lua)
+lab.periodic = require "seixo.periodic"
+
 return lab

@@ -409,6 +409,7 @@ static bool unforced(const sx_model *m)
             if (m->walls[w].def.vel[k] != 0) return false;
     }
     if (m->balls.fapp) return false;
+    if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
     for (int64_t i = 0; i < m->balls.n; i++)
         if (m->balls.fix[i]) return false;
     if (m->clumps && sx__clumps_forced(m)) return false;
