@@ -296,4 +296,41 @@ for _, dim in ipairs({2, 3}) do
   end)
 end
 
+-- Balls added and removed while two balls touch through the boundary:
+-- the ghosts' slots move with the ball count, and the pair keeps its
+-- history, as in a model where nothing else happened.
+T.test("adding and removing balls keeps the contacts through the boundary", function()
+  local function run(others)
+    local m = seixo.model{dim = 2, timestep = 1e-5}
+    material(m)
+    m:periodic{min = {0, 0}, max = {1, 1}}
+    local a = m:ball{pos = {0.0149, 0.5}, radius = 0.02, vel = {0.01, 0.02}}
+    local b = m:ball{pos = {0.975, 0.501}, radius = 0.02, vel = {0, -0.02}, spin = 3}
+    T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1)
+    m:cycle(100)
+    if others then
+      local c = m:ball{pos = {0.5, 0.5}, radius = 0.02}
+      local d = m:ball{pos = {0.5, 0.015}, radius = 0.02}
+      local e = m:ball{pos = {0.5, 0.98}, radius = 0.02} -- d and e touch through the boundary too
+      T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1, "d and e bonded")
+      m:cycle(100)
+      c:remove()
+      d:remove()
+      m:cycle(50)
+      e:remove()
+      m:cycle(50)
+    else
+      m:cycle(200)
+    end
+    local cs = m:contacts()()
+    return {a.pos, a.vel, a.spin, b.pos, b.vel, b.spin, a.force, cs.fs, cs.shift}, m
+  end
+  local x, mx = run(true)
+  local y = run(false)
+  for q = 1, #y do same_bits(x[q], y[q], "field " .. q) end
+  T.eq(mx:ball_count(), 2)
+  T.eq(mx:bond_count(), 1, "d-e's bond went with d")
+  T.check(x[9][1] ~= 0, "the pair acts through the boundary")
+end)
+
 T.done()
