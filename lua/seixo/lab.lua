@@ -537,6 +537,7 @@ end
 -- centre, and the platens -- frictionless planes (lines) touching its ends
 -- along the loading axis.
 local function open_test(spec)
+  if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
   local dim, ax = spec.dim, axis_of(spec.dim)
   local m = seixo.load(spec.path)
   local lo, hi = extents(m)

@@ -129,7 +129,7 @@ function periodic.specimen(opts)
   local spec = {path = path, dim = dim, size = cell.size, radius = radius, balls = m:ball_count(),
                 bonds = m:bond_count(), porosity = 1 - m:sum("volume") / volume, sigma0 = sigma0, material = mat,
                 seed = seed, genesis_steps = m:step(), genesis_time = seixo.clock() - t0, periodic = true}
-  m:vars().periodic_specimen = spec
+  m:vars().lab_specimen = spec -- lab.open's key: a specimen of either kind
   m:save(path)
   say(opts, "periodic.specimen: %d balls, %d bonds, porosity %.3f, saved to %s (%.1f s)", spec.balls, spec.bonds,
       spec.porosity, path, spec.genesis_time)
@@ -137,15 +137,8 @@ function periodic.specimen(opts)
   return spec
 end
 
---- The periodic specimen saved at path.
-function periodic.open(path)
-  local m = seixo.load(path)
-  local spec = m:vars().periodic_specimen
-  m:close()
-  if type(spec) ~= "table" then error("periodic.open: " .. path .. " holds no periodic specimen", 2) end
-  spec.path = path
-  return spec
-end
+--- The periodic specimen saved at path (lab.open reads either kind).
+function periodic.open(path) return require("seixo.lab").open(path) end
 
 local function open_test(spec, fn)
   if type(spec) ~= "table" or not spec.periodic then fail("periodic.%s: a periodic specimen expected", fn) end
