@@ -84,13 +84,15 @@ sx_status sx_model_set_periodic(sx_model *m, const sx_periodic_def *def)
     }
     sx_cell *c = m->cell;
     memset(c->h, 0, sizeof c->h);
-    memset(c->hdot, 0, sizeof c->hdot);
     for (int k = 0; k < 3; k++) {
         c->axis[k] = k < d && def->axis[k];
         c->lo[k] = c->axis[k] ? def->lo[k] : 0;
         c->h[k][k] = c->axis[k] ? def->len[k] : 1;
     }
     c->h[1][0] = def->tilt[0], c->h[2][0] = def->tilt[1], c->h[2][1] = def->tilt[2];
+    double g[3][3]; /* a control's rates hold for the new cell vectors */
+    gradient(m, NULL, NULL, g);
+    set_rates(m, g);
     m->build_needed = true; /* balls wrapped, ghosts made at the next build */
     m->guard_dirty = true;
     return SX_OK;
