@@ -9,6 +9,10 @@
 -- carries no wall effect (no wall-ball contacts, no looser packing along
 -- walls), so its modulus and peak are those of the material's interior.
 --   scripts/run examples/periodic_triaxial.lua [out_dir] [confining_Pa] [strain_rate]
+-- Measured (defaults, 1270 balls each): walled 2156 bonds, peak 150.3 MPa at
+-- 0.0026, E 59.0 GPa, nu 0.337; periodic 2027 bonds, peak 129.1 MPa at
+-- 0.0026, E 51.4 GPa, nu 0.360 (ratios 0.86 and 0.87): the periodic cell,
+-- bonded from a packing without walls, has 6 % fewer bonds per ball.
 local lab = require "seixo.lab"
 local out = arg and arg[1] or "periodic-results"
 local confining = tonumber(arg and arg[2]) or 5e6
