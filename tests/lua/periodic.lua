@@ -333,4 +333,31 @@ T.test("adding and removing balls keeps the contacts through the boundary", func
   T.check(x[9][1] ~= 0, "the pair acts through the boundary")
 end)
 
+T.test("bad periodic input is a clear error", function()
+  local m = seixo.model{dim = 2}
+  material(m)
+  local function refuses(fn, text)
+    local ok, err = pcall(fn)
+    T.check(not ok and tostring(err):find(text, 1, true), "expected '" .. text .. "', got " .. tostring(err))
+  end
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 0}} end, "axis y needs a finite corner lo and a length > 0 m")
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 1}, axes = "xz"} end, "letters of 'xy' expected")
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 1}, axes = "x", tilt = {xy = 0.1}} end,
+          "a tilt xy couples two periodic axes")
+  refuses(function() m:cell_control{xx = {rate = 1}} end, "the space must be periodic on every axis")
+  m:periodic{min = {0, 0}, max = {1, 1}, axes = "x"}
+  refuses(function() m:cell_control{xx = {rate = 1}} end, "the space must be periodic on every axis")
+  refuses(function() m:cell_stress() end, "periodic on every axis")
+  m:periodic{min = {0, 0}, max = {1, 1}}
+  refuses(function() m:cell_control{xx = {rate = 1, stress = 2}} end, "give either rate (1/s) or stress (Pa)")
+  refuses(function() m:cell_control{zz = {rate = 1}} end, "a 2D cell has xx, yy and xy only")
+  refuses(function() m:cell_control{xx = {rate = 1}, alpha = 2} end, "alpha must be in (0, 1]")
+  -- balls too large for the cell: the first cycle says what size it needs
+  m:ball{pos = {0.5, 0.5}, radius = 0.3}
+  refuses(function() m:cycle(1) end, "less than twice the contact reach")
+  m:periodic(false)
+  m:cycle(1)
+  T.eq(m:periodic(), nil)
+end)
+
 T.done()
