@@ -113,6 +113,14 @@ local entries = {
   ["output:count"] = {"o:count() -> n", "Snapshots written."},
   ["output:path"] = {"o:path() -> path", "The series' file."},
 
+  -- periodic space (src/lua/periodic.c)
+  ["model:periodic"] = {"m:periodic{min =, max =, axes = \"xyz\", tilt = {xy =, xz =, yz =}}; m:periodic(false); m:periodic() -> {min =, max =, size =, axes =, tilt =} | nil",
+    "Makes space periodic on the given axes (a ball leaving one face comes back at the other; balls touch the images across the faces); tilt [m] shears the cell into a parallelepiped; false: open space again; no argument: the cell now."},
+  ["model:cell_control"] = {"m:cell_control{xx = {rate =} | {stress =}, yy =, zz =, xy =, xz =, yz =, alpha = 0.5, max_rate = 1}; m:cell_control() -> table",
+    "Drives the periodic cell (every axis periodic): per component a strain rate [1/s] or a servo on the cell's stress [Pa], compression positive; no argument: the control now."},
+  ["model:cell_stress"] = {"m:cell_stress() -> stress, volume",
+    "The periodic cell's average stress tensor [Pa] (compression positive, Love-Weber over every contact, through the boundary) and its volume [m^3]."},
+
   -- laboratory tests (src/lua/lab.c)
   ["model:measure"] = {"m:measure(region) -> {stress =, fabric =, porosity =, coordination =, balls =, contacts =, volume =, solid =}",
     "Measures in a box, sphere (3D) or disk (2D) region: the average stress tensor [Pa] (compression positive), the fabric tensor, porosity, coordination number."},
@@ -212,6 +220,7 @@ local entries = {
   ["contact.pb_fs"] = {"c.pb_fs", "Parallel-bond shear force on b [N]."},
   ["contact.pb_moment"] = {"c.pb_moment", "Parallel-bond moment on b [N m]."},
   ["contact.pb_radius"] = {"c.pb_radius", "Parallel-bond radius [m]."},
+  ["contact.shift"] = {"c.shift", "Periodic space: the period [m] b is seen through (its image at b.pos + shift touches a); zeros inside the cell."},
 
   -- seixo.util
   ["util.add"] = {"util.add(a, b)", "a + b"},

@@ -893,6 +893,7 @@ end
 -- centre, and the platens -- frictionless planes (lines) touching its ends
 -- along the loading axis.
 local function open_test(spec)
+  if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
   local dim, ax = spec.dim, axis_of(spec.dim)
   local m = seixo.load(spec.path)
   local lo, hi = extents(m)
@@ -1435,6 +1436,9 @@ end
 
 -- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures and atomic writes
 require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file, copy = copy})
+
+-- periodic cells, without walls (lua/seixo/periodic.lua)
+lab.periodic = require "seixo.periodic"
 
 -- Errors point at the caller's line, not into this file: what fails inside
 -- an exported function is raised again from its caller's position (the

@@ -182,8 +182,10 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
     sx_balls *b = &m->balls;
     if (b->next_id < 1) b->next_id = 1;
     if (b->next_id >= INT32_MAX) return sx__fail(m, SX_ENOMEM, "ball_add: ball ids exhausted");
-    if (sx__balls_reserve(m, b->n + 1) || grow_index(m, b->next_id + 1))
+    const int64_t ghosts = m->cell ? m->cell->n : 0; /* periodic space: the ghosts' slots follow the balls */
+    if (sx__balls_reserve(m, b->n + 1 + ghosts) || grow_index(m, b->next_id + 1))
         return sx__fail(m, SX_ENOMEM, "ball_add: out of memory at %lld balls", (long long)b->n);
+    if (m->cell) sx__cell_ghosts_move(m, b->n + 1, true);
     const int64_t i = b->n++;
     const int64_t id = b->next_id++;
     for (int k = 0; k < d; k++) {
@@ -290,7 +292,9 @@ sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n)
     }
     if (n == 0) return SX_OK;
     /* remap: old dense index -> new one, -1 for a removed ball */
-    int32_t *remap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)nb, sizeof *remap);
+    /* periodic space: the ghosts' slots (past the balls) are renamed too */
+    const int64_t nr = nb + (m->cell ? m->cell->n : 0);
+    int32_t *remap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)nr, sizeof *remap);
     if (!remap) return sx__fail(m, SX_ENOMEM, "ball_remove: out of memory for %lld balls", (long long)nb);
     for (int64_t i = 0; i < nb; i++) remap[i] = (int32_t)i;
     int64_t gone = 0;
@@ -309,13 +313,15 @@ sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n)
         while (remap[from] < 0) from++;
         remap[from++] = (int32_t)i;
     }
+    if (m->cell) sx__cell_ghosts_remap(m, remap, keep);
     patch_pairs_after_remove(m, remap);
     for (int64_t i = 0; i < nb; i++)
         if (remap[i] < 0) b->index_of[b->id[i]] = -1;
     for (int64_t i = keep; i < nb; i++)
         if (remap[i] >= 0) move_ball(m, remap[i], i);
     b->n = keep;
-    sx_alloc_free(&m->alloc, remap, (size_t)nb, sizeof *remap);
+    if (m->cell) sx__cell_ghosts_move(m, keep, false);
+    sx_alloc_free(&m->alloc, remap, (size_t)nr, sizeof *remap);
     m->build_needed = true;
     m->dt_stale = true;
     return SX_OK;

@@ -43,6 +43,7 @@
 
 #include "kernels/broad_phase.c"
 #include "kernels/pair_contacts.c"
+#include "kernels/ghosts.c"
 #include "kernels/wall_contacts.c"
 #include "kernels/motion.c"
 #include "kernels/timestep.c"
@@ -58,4 +59,6 @@ const sx_kernels KERNEL(sx_kernels) = {
     .each_contact = KERNEL(each_contact),
     .count_contacts = KERNEL(count_contacts),
     .plan = plan_chunks,
+    .ghosts_refresh = KERNEL(ghosts_refresh),
+    .cell_stress = KERNEL(cell_stress),
 };

@@ -80,7 +80,12 @@ static bool visit(const sx_contact_info *ci, void *ud)
     double fa[3];
     for (int k = 0; k < 3; k++) fa[k] = -f[k];
     if (in_a) add_stress(c->out, dim, fa, ci->point, arm_origin(m, ia, ba));
-    if (in_b) add_stress(c->out, dim, f, ci->point, arm_origin(m, ib, bb));
+    if (in_b) { /* periodic space: b's arm from its image that touches a */
+        const double *o = arm_origin(m, ib, bb);
+        double ob[3];
+        for (int k = 0; k < dim; k++) ob[k] = o[k] + ci->shift[k];
+        add_stress(c->out, dim, f, ci->point, ob);
+    }
     c->out->contacts += in_a + in_b; /* contact ends inside: twice the contacts for the coordination */
     for (int i = 0; i < dim; i++)
         for (int j = 0; j < dim; j++) c->out->fabric[i][j] += ci->normal[i] * ci->normal[j];

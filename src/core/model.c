@@ -89,6 +89,7 @@ void sx_model_destroy(sx_model *m)
     sx__walls_free(m);
     sx__bonds_free(m);
     sx__clumps_free(m);
+    sx__cell_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
@@ -114,7 +115,7 @@ sx_memory sx_model_memory(const sx_model *m)
     r.total = m->alloc.bytes;
     r.peak = m->alloc.peak;
     r.balls = sx__balls_bytes(m);
-    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw);
+    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw) + sx__cell_bytes(m);
     const sx_bonds *k = &m->bonds;
     const size_t d = (size_t)m->dim;
     const size_t per_bond = 3 + 3 * sizeof(int32_t) +
@@ -415,6 +416,7 @@ sx_status sx__prepare(sx_model *m)
     if (!st) st = check_models(m);
     if (!st && m->build_needed) st = check_skin(m);
     if (st) return st;
+    if (m->build_needed && m->cell && (st = sx__cell_check(m))) return st;
     if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
     return SX_OK;
 }
@@ -483,6 +485,7 @@ static bool unforced(const sx_model *m)
             if (m->walls[w].def.vel[k] != 0) return false;
     }
     if (m->balls.fapp) return false;
+    if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
     for (int64_t i = 0; i < m->balls.n; i++)
         if (m->balls.fix[i]) return false;
     if (m->clumps && sx__clumps_forced(m)) return false;
@@ -605,6 +608,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
             break;
         }
         if (m->build_needed) {
+            if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
             const bool ok = k->build(m);
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (!ok) {
@@ -629,6 +633,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         sx__walls_servo(m);
         move_walls(m, &max_wall);
+        if (m->cell) sx__cell_step(m); /* periodic space: the cell deforms */
         m->time += m->dt;
         m->dt_prev = m->dt;
         m->step++;
@@ -637,6 +642,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         /* Verlet criterion: two balls may close the gap by twice the largest
          * displacement, a ball and a wall by both of their displacements. */
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
+        /* a ghost moves with its owner and with the cell vectors that shift it */
+        if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
         if (m->step % GUARD_STEPS == 0) st = guard_check(m);
         other += now() - t;
         if (st) break;

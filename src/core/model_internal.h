@@ -226,6 +226,32 @@ typedef struct sx_pair_law {
     double kn_a, ks_a, ec_a, ratio_a, kn_b, ks_b, ec_b, ratio_b;
 } sx_pair_law;
 
+/* Periodic space (periodic.c; kernels/ghosts.c). The cell is lo + H f,
+ * f in [0, 1) on the periodic axes, H upper triangular with columns
+ * h[k] (h[k][i] = 0 for i > k; a non-periodic axis keeps h[k] = e_k).
+ *
+ * Ghosts are the images of balls near a face, shifted by cell vectors, that
+ * the contact passes see like any other ball: they live in the ball arrays
+ * past the real balls, in slots [base, base + n), copied from their owners
+ * at every step (position + the shift, velocity + the shift's rate, spin)
+ * and made afresh at every build. A contact through the boundary is one
+ * pair (real ball, ghost), kept once by the owner rule: the real end has
+ * the smaller id. The ghost's force is added to its owner after the pass,
+ * in ghost order, so every ball's force is summed in a fixed order. The
+ * same slots are meant for balls owned by other MPI ranks (issue 16). */
+typedef struct sx_cell {
+    bool axis[3];
+    double lo[3];
+    double h[3][3];         /* h[k]: the k-th cell vector, m */
+    double hdot[3][3];      /* its rate, m/s, set by the control each step */
+    sx_cell_control ctl;
+    bool controlled;        /* some component not fixed */
+    double moved;           /* how far an image may have moved against its owner since the last build, m */
+    int64_t n, cap, base;   /* ghosts in ball slots [base, base + n) */
+    int32_t *owner;         /* the real ball (dense index) each ghost images; -1 after its removal */
+    int8_t *image;          /* the cell vectors it is shifted by, 3 per ghost (-1, 0, 1) */
+} sx_cell;
+
 struct sx_model {
     int dim, rdim;
     double gravity[3];
@@ -284,6 +310,7 @@ struct sx_model {
     bool guard_dirty;        /* the system was changed by the user: take a new energy baseline */
 
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
+    sx_cell *cell;            /* periodic space (periodic.c); NULL while the space is not periodic */
 };
 
 /* Ball i's local damping: its own, or its material's. */
@@ -318,6 +345,11 @@ typedef struct sx_kernels {
     bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
     int64_t (*count_contacts)(const sx_model *m);
     bool (*plan)(sx_model *m);                  /* chunks of the ball-ball pass for the pair store as it is (a restore) */
+    /* periodic space: the ghosts' positions, velocities and spins from their owners (a restore) */
+    void (*ghosts_refresh)(sx_model *m, bool all);
+    /* the cell's average stress (compression positive) and the servo's
+     * stiffnesses K per component (sx_cell_control) from the pair store */
+    void (*cell_stress)(const sx_model *m, double stress[3][3], double stiff[6]);
 } sx_kernels;
 
 extern const sx_kernels sx_kernels_2d, sx_kernels_3d;
@@ -375,6 +407,43 @@ const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
 void sx__material_derive(sx_material *t);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
+
+/* Periodic space (periodic.c): hooks of the other stages; callers test
+ * m->cell, so a scene without periodic space pays nothing. */
+/* The ghost block of ball slots moves to start at slot `to` (a ball added
+ * at the old base, balls removed below it); with rename, the pair ends in
+ * it follow (a removal renames them through sx__cell_ghosts_remap). */
+void sx__cell_ghosts_move(sx_model *m, int64_t to, bool rename);
+/* Extends remap (old dense index -> new or -1, base + n entries) over the
+ * ghost slots for a removal that keeps `keep` balls; owners follow. */
+void sx__cell_ghosts_remap(sx_model *m, int32_t *remap, int64_t keep);
+/* Ball or ghost j: its real ball (dense index; -1 for a ghost whose owner
+ * was removed) and the shift (m, dim) it is seen through. */
+int64_t sx__cell_owner(const sx_model *m, int64_t j, double *shift);
+/* Fractional coordinates f (3) of x in the cell on its periodic axes (0 on the others). */
+void sx__cell_frac(const sx_cell *c, int dim, const double *x, double *f);
+/* Moves x into the cell by whole cell vectors, n (3) of each; exact
+ * whenever the cell's numbers and x allow it (the same binade). */
+void sx__cell_wrap(const sx_cell *c, int dim, double *x, int32_t *n);
+/* The clumps' centroids wrapped, their pebbles moved with them (wrap per ball). */
+void sx__cell_wrap_clumps(sx_model *m, int32_t *wrap);
+/* The distance between the cell's two faces across periodic axis k, m. */
+double sx__cell_thickness(const sx_cell *c, int dim, int k);
+/* SX_EINVAL when the cell is too thin for the balls' contact reach. */
+sx_status sx__cell_check(sx_model *m);
+/* After the step's motion: sets the cell's rates (a servo from the
+ * stress) and moves the cell. */
+void sx__cell_step(sx_model *m);
+uint64_t sx__cell_hash(const sx_model *m, uint64_t h);
+size_t sx__cell_bytes(const sx_model *m);
+/* Room for n ghosts in the table and in the ball slots past base; SX_ENOMEM. */
+sx_status sx__cell_reserve(sx_model *m, int64_t base, int64_t n);
+void sx__cell_free(sx_model *m);
+/* A restore (the I/O layer): the cell as saved (its scalars; n ghosts),
+ * room for the ghosts made, then, once their table is filled,
+ * sx__cell_finish checks it and fills the ghosts' ball slots. */
+sx_status sx__cell_restore(sx_model *m, const sx_cell *saved);
+sx_status sx__cell_finish(sx_model *m);
 
 /* Clumps (clumps.c): the hooks of the other stages, all no-ops while
  * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */

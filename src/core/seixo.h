@@ -375,6 +375,8 @@ typedef struct sx_contact_info {
     double pb_fs[3];     ///< N, parallel-bond shear force on b
     double pb_moment[3]; ///< N m, parallel-bond moment on b (twist + bending; 2D: [0])
     double pb_radius;    ///< m, parallel-bond radius (4-53)
+    double shift[3];     ///< m, periodic space: the period b is seen through (b's image at
+                         ///< its centre + shift touches a); 0 for a contact inside the cell
 } sx_contact_info;
 
 /// Calls fn for every contact of the last step's force evaluation (bonded
@@ -485,6 +487,69 @@ SX_API int sx_flatjoint_get(const sx_model *m, int64_t a, int64_t b, int e, sx_f
 /// and from now on carries compression and friction only; no crack.
 SX_API sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e);
 SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
+
+/* ------------------------------------------------------- periodic space */
+
+/// Periodic space (PFC's periodic space, YADE's periodic cell): a ball that
+/// leaves the cell on a periodic axis comes back at the opposite face, and
+/// balls near a face touch the images of the balls near the opposite one.
+/// The cell is lo + H f with f in [0, 1) on each periodic axis; H is upper
+/// triangular: the cell vectors are len[0] e_x, (tilt_xy, len[1]) and, in 3D,
+/// (tilt_xz, tilt_yz, len[2]), so a tilted cell is a general parallelepiped
+/// (simple shear). A tilt couples two periodic axes only.
+typedef struct sx_periodic_def {
+    bool axis[3];    ///< the periodic axes (any subset; 2D uses [0..1])
+    double lo[3];    ///< m, the cell's corner on the periodic axes
+    double len[3];   ///< m, its edge along each periodic axis
+    double tilt[3];  ///< m, H's entries xy, xz, yz (0: an orthogonal box)
+} sx_periodic_def;
+
+/// Makes the model's space periodic (no axis set: not periodic). Balls
+/// outside the cell are brought in at the next build. The cell must be
+/// thicker than twice the contact reach (4 radii + 2 skins) across each
+/// periodic axis; a thinner one is refused at the build, with the size.
+SX_API sx_status sx_model_set_periodic(sx_model *m, const sx_periodic_def *def);
+/// The cell as it is now (it deforms under sx_cell_set_control); false and
+/// a zeroed def when the space is not periodic.
+SX_API bool sx_model_periodic(const sx_model *m, sx_periodic_def *out);
+
+/// Components of the cell's deformation and stress: the normal ones along
+/// x, y, z and the shear ones xy, xz, yz (2D: xx, yy, xy).
+typedef enum sx_cell_component {
+    SX_CELL_XX, SX_CELL_YY, SX_CELL_ZZ, SX_CELL_XY, SX_CELL_XZ, SX_CELL_YZ, SX_CELL_COMPONENTS
+} sx_cell_component;
+
+typedef enum sx_cell_mode {
+    SX_CELL_FIXED,   ///< the component does not change
+    SX_CELL_RATE,    ///< a strain rate: d len_i/dt = rate len_i; shear ij: d tilt_ij/dt = rate len_j
+    SX_CELL_STRESS,  ///< a servo on the cell's average stress (PFC's periodic servo)
+} sx_cell_mode;
+
+/// How the cell deforms, component by component. A servo'd component moves
+/// at rate = alpha (sigma - target) / (K dt) each step, K = (1/V) sum over
+/// the contacts of kn l_i^2 (shear: ks l_j^2), the stress the cell gains
+/// per unit strain, so that one step removes about a fraction alpha of the
+/// error. Compression positive: a normal stress above target makes the
+/// cell grow.
+typedef struct sx_cell_control {
+    sx_cell_mode mode[SX_CELL_COMPONENTS];
+    double rate[SX_CELL_COMPONENTS];   ///< 1/s (SX_CELL_RATE)
+    double target[SX_CELL_COMPONENTS]; ///< Pa (2D: N/m), compression positive (SX_CELL_STRESS)
+    double alpha;                      ///< servo gain fraction, 0 < alpha <= 1 (default 0.5)
+    double max_rate;                   ///< 1/s, bound on a servo's strain rate (> 0, default 1)
+} sx_cell_control;
+
+SX_API sx_cell_control sx_cell_default_control(void); ///< every component fixed, alpha 0.5, max_rate 1
+/// Drives the periodic cell (every axis of the model must be periodic).
+/// Images move with the cell: their velocity is the owner's plus the rate
+/// of the cell vectors that carry them.
+SX_API sx_status sx_cell_set_control(sx_model *m, const sx_cell_control *c);
+SX_API sx_status sx_cell_control_get(const sx_model *m, sx_cell_control *c);
+/// The cell's average stress from the last step's contacts (Love-Weber
+/// over every ball-ball contact, bonds included, branch vectors through the
+/// boundary), Pa (2D: N/m), compression positive, and the cell's volume
+/// (m^3; 2D: m^2). SX_EINVAL when the space is not periodic on every axis.
+SX_API sx_status sx_cell_stress(const sx_model *m, double stress[3][3], double *volume);
 
 /* ---------------------------------------------------------- measurement */
 

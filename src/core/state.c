@@ -258,12 +258,12 @@ static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
 
 static sx_status check_pairs(sx_model *m)
 {
-    const int64_t n = m->balls.n;
+    const int64_t n = m->balls.n, ends = n + (m->cell ? m->cell->n : 0); /* b may be a ghost */
     const sx_pairs *p = &m->bb;
     for (int64_t c = 0; c < p->n; c++) {
         if (!pair_finite(m, p, c))
             return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a non-finite history", (long long)c);
-        if (p->a[c] < 0 || p->a[c] >= p->b[c] || p->b[c] >= n)
+        if (p->a[c] < 0 || p->a[c] >= n || p->a[c] >= p->b[c] || p->b[c] >= ends)
             return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld refers to balls %d, %d of %lld", (long long)c,
                             p->a[c], p->b[c], (long long)n);
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a bad touching flag", (long long)c);
@@ -339,7 +339,8 @@ sx_status sx__state_finish(sx_model *m)
 {
     sx_status st;
     if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
-        (st = check_pairs(m)) || (st = check_bonds(m)) || (st = sx__clumps_finish(m)))
+        (m->cell && (st = sx__cell_finish(m))) || (st = check_pairs(m)) || (st = check_bonds(m)) ||
+        (st = sx__clumps_finish(m)))
         return st;
     sx__balls_compact(m);
     /* the ball-ball pass's chunks follow from the pair store alone: planned
@@ -490,6 +491,10 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
         hasher one = {FNV_BASIS};
         put_int(&one, ia);
         put_int(&one, ib);
+        if (!walls && m->cell && p->b[c] >= m->cell->base) { /* b is a ghost: the image it is seen through */
+            const int8_t *image = m->cell->image + (p->b[c] - m->cell->base) * 3;
+            for (int k = 0; k < 3; k++) put_int(&one, (int64_t)(sign * image[k]));
+        }
         for (int j = 0; j < nf; j++) {
             /* the ends are the ids above; the bond slot below, present or not */
             if (f[j].end || f[j].data == (void **)&p->bond) continue;
@@ -597,5 +602,6 @@ uint64_t sx_model_state_hash(const sx_model *m)
     hash_pairs(&s, m, &m->bw, true);
     hash_bonds(&s, m);
     if (m->clumps) s.h = sx__clumps_hash(m, s.h);
+    if (m->cell) s.h = sx__cell_hash(m, s.h);
     return s.h;
 }

@@ -902,6 +902,68 @@ static void load_clumps(sx_h5 *h, hid_t f, sx_model *m)
     load_group(h, f, "/clumps/template_pebbles", fl, template_pebble_fields(m, fl), C->tp_n);
 }
 
+/* ------------------------------------------------------ periodic space */
+
+/* The periodic cell (core model_internal.h, sx_cell) in its own group
+ * /periodic, written only when the space is periodic: the cell and its
+ * control as attributes, the ghosts' table as datasets (ghost g is ball
+ * slot count + g, a pair's b past the balls); the ghosts' own state is
+ * derived from their owners on load (sx__cell_finish). */
+static void save_periodic(sx_h5 *h, hid_t f, const sx_model *m)
+{
+    const sx_cell *c = m->cell;
+    if (!c) return;
+    hid_t g = sx_h5_group(h, f, "periodic");
+    int64_t axes[3], modes[SX_CELL_COMPONENTS];
+    for (int k = 0; k < 3; k++) axes[k] = c->axis[k];
+    for (int k = 0; k < SX_CELL_COMPONENTS; k++) modes[k] = c->ctl.mode[k];
+    sx_h5_attr_i64(h, g, "axes", axes, 3, false);
+    sx_h5_attr_f64(h, g, "lo", c->lo, 3, false);
+    sx_h5_attr_f64(h, g, "h", &c->h[0][0], 9, false);
+    sx_h5_attr_f64(h, g, "hdot", &c->hdot[0][0], 9, false);
+    sx_h5_attr_double(h, g, "moved", c->moved);
+    sx_h5_attr_i64(h, g, "control_mode", modes, SX_CELL_COMPONENTS, false);
+    sx_h5_attr_f64(h, g, "control_rate", c->ctl.rate, SX_CELL_COMPONENTS, false);
+    sx_h5_attr_f64(h, g, "control_target", c->ctl.target, SX_CELL_COMPONENTS, false);
+    sx_h5_attr_double(h, g, "control_alpha", c->ctl.alpha);
+    sx_h5_attr_double(h, g, "control_max_rate", c->ctl.max_rate);
+    sx_h5_write(h, g, "ghost_owner", H5T_NATIVE_INT32, H5T_STD_I32LE, c->owner, c->n, 1, NULL);
+    sx_h5_write(h, g, "ghost_image", H5T_NATIVE_INT8, H5T_STD_I8LE, c->image, c->n, 3, NULL);
+    sx_h5_close(g);
+}
+
+static void load_periodic(sx_h5 *h, hid_t f, sx_model *m)
+{
+    if (H5Lexists(f, "/periodic", H5P_DEFAULT) <= 0) return;
+    hid_t g = sx_h5_open_group(h, f, "/periodic", true);
+    if (g < 0) return;
+    sx_cell c;
+    memset(&c, 0, sizeof c);
+    int64_t axes[3] = {0}, modes[SX_CELL_COMPONENTS] = {0};
+    sx_h5_get_i64(h, g, "/periodic", "axes", axes, 3, true);
+    sx_h5_get_f64(h, g, "/periodic", "lo", c.lo, 3, true);
+    sx_h5_get_f64(h, g, "/periodic", "h", &c.h[0][0], 9, true);
+    sx_h5_get_f64(h, g, "/periodic", "hdot", &c.hdot[0][0], 9, true);
+    sx_h5_get_f64(h, g, "/periodic", "moved", &c.moved, 1, true);
+    sx_h5_get_i64(h, g, "/periodic", "control_mode", modes, SX_CELL_COMPONENTS, true);
+    sx_h5_get_f64(h, g, "/periodic", "control_rate", c.ctl.rate, SX_CELL_COMPONENTS, true);
+    sx_h5_get_f64(h, g, "/periodic", "control_target", c.ctl.target, SX_CELL_COMPONENTS, true);
+    sx_h5_get_f64(h, g, "/periodic", "control_alpha", &c.ctl.alpha, 1, true);
+    sx_h5_get_f64(h, g, "/periodic", "control_max_rate", &c.ctl.max_rate, 1, true);
+    for (int k = 0; k < 3; k++) c.axis[k] = axes[k] != 0;
+    for (int k = 0; k < SX_CELL_COMPONENTS; k++)
+        c.ctl.mode[k] = modes[k] >= 0 && modes[k] <= SX_CELL_STRESS ? (sx_cell_mode)modes[k] : (sx_cell_mode)-1;
+    c.n = sx_h5_rows(h, g, "/periodic", "ghost_owner", 1, true);
+    if (!h->failed && sx_h5_rows(h, g, "/periodic", "ghost_image", 3, true) != c.n)
+        sx_h5_fail(h, "damaged: /periodic's ghost_owner and ghost_image differ in rows");
+    if (!h->failed && sx__cell_restore(m, &c)) sx_h5_fail(h, "damaged or too large: %s", sx_model_error(m));
+    if (!h->failed) {
+        sx_h5_read(h, g, "/periodic", "ghost_owner", H5T_NATIVE_INT32, m->cell->owner, c.n, 1, true);
+        sx_h5_read(h, g, "/periodic", "ghost_image", H5T_NATIVE_INT8, m->cell->image, c.n, 3, true);
+    }
+    sx_h5_close(g);
+}
+
 /* ---------------------------------------------------------------- save */
 
 static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
@@ -962,6 +1024,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
 
     save_walls(h, f, m);
     save_clumps(h, f, m);
+    save_periodic(h, f, m);
     if (o) sx_io_histories_write(h, f, o->histories, o->nhistories);
 
     if (o && o->ntrees > 0) {
@@ -1150,6 +1213,7 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         g = sx_h5_open_group(&h, f, "/materials", true);
         if (g >= 0) load_materials(&h, g, m);
         sx_h5_close(g);
+        load_periodic(&h, f, m); /* before the balls: the ghosts' slots come with the ball arrays */
 
         field fl[MAX_FIELDS];
         const ball_cols bc = {m->balls.alpha, m->balls.group, NULL};

@@ -52,6 +52,9 @@ int sx_lua_ball_disp(lua_State *L, const sx_model *m, int64_t id);
 /* Functions of the seixo table beside the loader's own. */
 extern const luaL_Reg sx_lua_optimize_functions[];  ///< optimize.c: seixo.optimize
 extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, executable, rank, ranks, send, receive
+extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
+/// lab.c: pushes a dim x dim tensor as an array of rows.
+void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);
 
 /* Classes other than the model's; each leaves nothing on the stack. */
 void sx_lua_balls_register(lua_State *L);

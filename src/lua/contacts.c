@@ -105,6 +105,7 @@ static int get_point(lua_State *L) { return push_vec(L, offsetof(sx_contact_info
 static int get_fs(lua_State *L) { return push_vec(L, offsetof(sx_contact_info, shear), false); }
 static int get_pb_fs(lua_State *L) { return push_vec(L, offsetof(sx_contact_info, pb_fs), false); }
 static int get_pb_moment(lua_State *L) { return push_vec(L, offsetof(sx_contact_info, pb_moment), true); }
+static int get_shift(lua_State *L) { return push_vec(L, offsetof(sx_contact_info, shift), false); }
 static int get_overlap(lua_State *L) { return push_num(L, offsetof(sx_contact_info, overlap)); }
 static int get_fn(lua_State *L) { return push_num(L, offsetof(sx_contact_info, fn)); }
 static int get_kn(lua_State *L) { return push_num(L, offsetof(sx_contact_info, kn)); }
@@ -237,6 +238,7 @@ void sx_lua_contacts_register(lua_State *L)
         {"pb_fs", get_pb_fs},
         {"pb_moment", get_pb_moment},
         {"pb_radius", get_pb_radius},
+        {"shift", get_shift},
         {NULL, NULL},
     };
     sx_lua_newclass(L, SX_LUA_CONTACT, "contact", meta, NULL, getters, NULL);

@@ -95,7 +95,7 @@ static void read_region(lua_State *L, sx_model *m, int arg, sx_region *r)
     lua_settop(L, top);
 }
 
-static void push_tensor(lua_State *L, const double t[3][3], int dim)
+void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim)
 {
     lua_createtable(L, dim, 0);
     for (int i = 0; i < dim; i++) {
@@ -117,9 +117,9 @@ static int model_measure(lua_State *L)
     sx_lua_check(L, m, sx_measure(m, &r, &out), "m:measure");
     const int dim = sx_model_dim(m);
     lua_createtable(L, 0, 8);
-    push_tensor(L, out.stress, dim);
+    sx_lua_push_tensor(L, out.stress, dim);
     lua_setfield(L, -2, "stress");
-    push_tensor(L, out.fabric, dim);
+    sx_lua_push_tensor(L, out.fabric, dim);
     lua_setfield(L, -2, "fabric");
     const struct {
         const char *name;

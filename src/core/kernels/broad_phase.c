@@ -22,7 +22,20 @@ typedef struct transfer {
     int32_t *a, *b, *src;
     int64_t n, cap;
     uint8_t *seen;            /* per bond slot: found again by the grid */
+    /* periodic space: the cell vectors each old ball was wrapped by (3 per
+     * ball), and the old ghosts (slots gbase + g: owner, image) */
+    int32_t *wrap;
+    int64_t nwrap;
+    int64_t gbase, gcap;
+    int32_t *gowner;
+    int8_t *gimage;
 } transfer;
+
+/* periodic space (kernels/ghosts.c) */
+static void wrap_balls(sx_model *m, int32_t *wrap);
+static bool make_ghosts(sx_model *m);
+static void build_ghost_pairs(sx_model *m, transfer *tr, int64_t *count);
+static bool bonded_ends(sx_model *m, int32_t a, int32_t b, int32_t *ra, int32_t *rb);
 
 /* First pair of each ball in a store grouped by a, into row (nb + 1). */
 static void rows_of(const sx_pairs *p, int64_t nb, int32_t *row)
@@ -35,9 +48,19 @@ static void rows_of(const sx_pairs *p, int64_t nb, int32_t *row)
 static bool transfer_begin(sx_model *m, transfer *tr)
 {
     memset(tr, 0, sizeof *tr);
+    sx_cell *cell = m->cell;
+    if (cell) { /* the wrap of every ball, history or not */
+        tr->wrap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(m->balls.n * 3), sizeof *tr->wrap);
+        if (!tr->wrap) return false;
+        tr->nwrap = m->balls.n;
+    }
     for (int64_t c = 0; c < m->bb.n && !tr->history; c++) tr->history = m->bb.touching[c];
     for (int64_t c = 0; c < m->bw.n && !tr->history; c++) tr->history = m->bw.touching[c];
     if (!tr->history) return true;
+    if (cell) { /* the old ghosts name the old pairs' far ends; make_ghosts starts a new table */
+        tr->gbase = cell->base, tr->gcap = cell->cap, tr->gowner = cell->owner, tr->gimage = cell->image;
+        cell->owner = NULL, cell->image = NULL, cell->cap = cell->n = 0;
+    }
     tr->nold = m->balls.n;
     const size_t rows = (size_t)tr->nold + 1;
     tr->row_bb = sx_alloc_resize(&m->alloc, NULL, 0, rows, sizeof *tr->row_bb);
@@ -61,6 +84,9 @@ static void transfer_end(sx_model *m, transfer *tr)
     sx_alloc_free(&m->alloc, tr->a, (size_t)tr->cap, sizeof *tr->a);
     sx_alloc_free(&m->alloc, tr->b, (size_t)tr->cap, sizeof *tr->b);
     sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
+    sx_alloc_free(&m->alloc, tr->wrap, tr->wrap ? (size_t)(tr->nwrap * 3) : 0, sizeof *tr->wrap);
+    sx_alloc_free(&m->alloc, tr->gowner, (size_t)tr->gcap, sizeof *tr->gowner);
+    sx_alloc_free(&m->alloc, tr->gimage, (size_t)tr->gcap * 3, sizeof *tr->gimage);
 }
 
 /* Room for cap listed pairs (the list emptied when fresh). */
@@ -91,6 +117,47 @@ static int32_t old_pair(const transfer *tr, const sx_pairs *p, const int32_t *ro
     const int64_t lo = wall || oa < ob ? oa : ob, hi = wall || oa < ob ? ob : oa;
     for (int32_t c = row[lo]; c < row[lo + 1]; c++)
         if (p->b[c] == hi) return p->touching[c] ? (oa == lo ? c + 1 : -(c + 1)) : 0;
+    return 0;
+}
+
+/* An end of an old ball-ball pair: its ball (old index) and, for a ghost,
+ * the image it was seen through. */
+static int64_t old_end(const transfer *tr, int64_t b, int32_t *img)
+{
+    img[0] = img[1] = img[2] = 0;
+    if (!tr->gowner || b < tr->gbase) return b;
+    for (int k = 0; k < 3; k++) img[k] = tr->gimage[(b - tr->gbase) * 3 + k];
+    return tr->gowner[b - tr->gbase];
+}
+
+/* Old pair of new ball-ball pair (a, b) (see old_pair). Periodic space: b
+ * may be a ghost, and either end may have been wrapped since; the pair is
+ * the same contact when the image of b seen from a, counted in cell
+ * vectors from the balls' old places (s - wrap_b + wrap_a), matches, kept
+ * under a, or the reverse under b. */
+static int32_t old_ball_pair(const sx_model *m, const transfer *tr, int64_t a, int64_t b)
+{
+    if (!m->cell || !tr->history) return old_pair(tr, &m->bb, tr->row_bb, a, b, false);
+    const sx_cell *c = m->cell;
+    int32_t s[3] = {0, 0, 0};
+    int64_t ob = b;
+    if (b >= c->base) {
+        for (int k = 0; k < 3; k++) s[k] = c->image[(b - c->base) * 3 + k];
+        ob = c->owner[b - c->base];
+    }
+    const int64_t oa = tr->order[a];
+    ob = tr->order[ob];
+    for (int k = 0; k < 3; k++) s[k] += tr->wrap[oa * 3 + k] - tr->wrap[ob * 3 + k];
+    for (int side = 0; side < 2; side++) {
+        const int64_t lo = side ? ob : oa, hi = side ? oa : ob;
+        for (int32_t q = tr->row_bb[lo]; q < tr->row_bb[lo + 1]; q++) {
+            int32_t img[3];
+            if (old_end(tr, m->bb.b[q], img) != hi) continue;
+            bool same = true;
+            for (int k = 0; k < 3; k++) same &= img[k] == (side ? -s[k] : s[k]);
+            if (same) return m->bb.touching[q] ? (side ? -(q + 1) : q + 1) : 0;
+        }
+    }
     return 0;
 }
 
@@ -172,11 +239,13 @@ static bool keep_bonded_pairs(sx_model *m, transfer *tr)
     for (int64_t s = 0; s < bs->n; s++) {
         if (!bs->kind[s] || tr->seen[s]) continue;
         int32_t a = m->balls.index_of[bs->ida[s]], b = m->balls.index_of[bs->idb[s]];
-        if (a > b) {
+        if (m->cell) { /* through the boundary, maybe */
+            if (!bonded_ends(m, a, b, &a, &b)) return false;
+        } else if (a > b) {
             const int32_t t = a;
             a = b, b = t;
         }
-        transfer_push(tr, a, b, old_pair(tr, &m->bb, tr->row_bb, a, b, false));
+        transfer_push(tr, a, b, old_ball_pair(m, tr, a, b));
     }
     return true;
 }
@@ -362,7 +431,7 @@ static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, in
         (*count)++;
         return;
     }
-    const int32_t src = old_pair(tr, &m->bb, tr->row_bb, i, j, false);
+    const int32_t src = old_ball_pair(m, tr, i, j);
     if (src && m->bb.bond) {
         const int32_t bond = m->bb.bond[src > 0 ? src - 1 : -src - 1];
         if (bond) tr->seen[bond - 1] = 1;
@@ -429,9 +498,11 @@ static bool build_store(sx_model *m, transfer *tr, bool walls)
     int64_t count = 0;
     if (walls) build_wall_pairs(m, tr, &count);
     else build_ball_pairs(m, tr, &count);
+    if (!walls && m->cell) build_ghost_pairs(m, tr, &count);
     if (!transfer_list(m, tr, count, true)) return false;
     if (walls) build_wall_pairs(m, tr, NULL);
     else build_ball_pairs(m, tr, NULL);
+    if (!walls && m->cell) build_ghost_pairs(m, tr, NULL);
     return (walls || keep_bonded_pairs(m, tr)) && transfer_store(m, walls ? &m->bw : &m->bb, tr);
 }
 
@@ -441,6 +512,7 @@ static bool KERNEL(build)(sx_model *m)
 {
     if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
         m->bb.n = m->bw.n = 0;
+        if (m->cell) m->cell->n = m->cell->base = 0;
         m->nchunk = m->nblock = 0;
         m->builds++;
         m->build_needed = false;
@@ -458,8 +530,10 @@ static bool KERNEL(build)(sx_model *m)
     /* each pair store made from its counted pairs, so it holds no more than
      * them and never grows while it is filled */
     transfer tr;
-    bool ok = transfer_begin(m, &tr) && grid_setup(m) && sort_balls(m, &tr) && build_store(m, &tr, false) &&
-              build_store(m, &tr, true);
+    bool ok = transfer_begin(m, &tr);
+    if (ok && m->cell) wrap_balls(m, tr.wrap); /* periodic space: balls into the cell, then their ghosts */
+    ok = ok && grid_setup(m) && sort_balls(m, &tr) && (!m->cell || make_ghosts(m)) && build_store(m, &tr, false) &&
+         build_store(m, &tr, true);
     transfer_end(m, &tr);
     if (!ok || !plan_chunks(m)) return false;
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));

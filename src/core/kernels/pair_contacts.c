@@ -822,7 +822,10 @@ static bool plan_chunks(sx_model *m)
     const sx_pairs *p = &m->bb;
     const int64_t n = m->balls.n;
     int64_t k = 1;
-    while (2 * k <= MAX_CHUNKS && 2 * k * CHUNK_PAIRS <= p->n) k *= 2;
+    /* periodic space: a ghost may be the b of pairs in any chunk, so the
+     * pass is one chunk (ghosts' forces are added to their owners after it) */
+    const bool ghosts = m->cell && m->cell->n > 0;
+    while (!ghosts && 2 * k <= MAX_CHUNKS && 2 * k * CHUNK_PAIRS <= p->n) k *= 2;
     if (k > m->cap_chunk) {
         sx_chunk *q = sx_alloc_resize(&m->alloc, m->chunks, (size_t)m->cap_chunk, (size_t)k, sizeof *q);
         if (!q) return false;
@@ -887,14 +890,19 @@ static bool plan_chunks(sx_model *m)
 
 /* Runs the even chunks, then the odd ones (each phase in parallel), then
  * merges energies, cracks and errors in chunk order. */
+static void KERNEL(ghosts_refresh)(sx_model *m, bool all);
+static void fold_ghosts(sx_model *m);
+
 static sx_status KERNEL(contacts)(sx_model *m)
 {
     const int64_t nchunk = m->nchunk;
+    if (m->cell) KERNEL(ghosts_refresh)(m, false); /* the ghosts where their owners are now */
 #pragma omp parallel num_threads(m->threads) if (nchunk > 2)
     for (int64_t phase = 0; phase < 2; phase++) {
 #pragma omp for schedule(static)
         for (int64_t c = phase; c < nchunk; c += 2) ball_chunk(m, &m->chunks[c]);
     }
+    if (m->cell) fold_ghosts(m);
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);

@@ -113,6 +113,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     ci.a = B->id[i];
     ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
     ci.is_wall = is_wall;
+    if (!is_wall && m->cell) sx__cell_owner(m, p->b[c], ci.shift); /* through the boundary */
     const int32_t slot = !is_wall && p->bond ? p->bond[c] - 1 : -1;
     if (slot >= 0) {
         const sx_bonds *b = &m->bonds;

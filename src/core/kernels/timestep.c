@@ -38,8 +38,9 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
                 const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
                 const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
-                ct[i] += cn + cs, ct[j] += cn + cs;
-                cr[i] += cs * B->rad[i] * B->rad[i], cr[j] += cs * B->rad[j] * B->rad[j];
+                const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base];
+                ct[i] += cn + cs, ct[jo] += cn + cs;
+                cr[i] += cs * B->rad[i] * B->rad[i], cr[jo] += cs * B->rad[j] * B->rad[j];
             }
             kn *= sx__law(law->law)->tangent; /* 4-29 */
             ktr = kn + ks;
@@ -59,10 +60,11 @@ static double KERNEL(critical_dt)(sx_model *m)
             krot_i += krb + b->ks[slot] * area * B->rad[i] * B->rad[i];
             krot_j += krb + b->ks[slot] * area * B->rad[j] * B->rad[j];
         }
+        const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
         kt[i] += ktr;
-        kt[j] += ktr;
+        kt[jo] += ktr;
         kr[i] += krot_i;
-        kr[j] += krot_j;
+        kr[jo] += krot_j;
     }
     p = &m->bw;
     for (int64_t c = 0; c < p->n; c++) {

@@ -1,0 +1,363 @@
+-- Periodic space (issue 15): balls through the boundary against the same
+-- motion unwrapped, a periodic cell against a large box's interior, the
+-- closed-form shear modulus of a regular packing under simple shear, the
+-- cell's servo, restarts and threads.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+
+local function material(m, extra)
+  local def = {kn = 1e7, ks = 5e6, friction = 0.5, density = 2000, damping = 0,
+               bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e12,
+                       cohesion = 1e12}}
+  for k, v in pairs(extra or {}) do def[k] = v end
+  m:material("rock", def)
+end
+
+-- Two bonded, touching balls spinning and drifting along +x through the
+-- face x = 3 of a cell [2, 3): every coordinate stays in the binade
+-- [2, 4), where moving by the period (1) is exact, so the periodic run
+-- and the unwrapped one must agree to the bit, forces, spins and the
+-- bond's state included (carried through the wrap and the ghost).
+local function crossing(dim, periodic)
+  local m = seixo.model{dim = dim, timestep = 2e-5}
+  material(m)
+  if periodic then
+    local lo, hi = {2, -1}, {3, 1}
+    if dim == 3 then lo[3], hi[3] = -1, 1 end
+    m:periodic{min = lo, max = hi, axes = "x"}
+  end
+  local r = 0.02
+  local p1, p2 = {2.93, 0.011}, {2.93 + 2 * r * math.cos(0.3), 0.011 + 2 * r * math.sin(0.3)}
+  if dim == 3 then p1[3], p2[3] = 0.004, 0.009 end
+  local a = m:ball{pos = p1, radius = r, vel = dim == 3 and {0.9, 0.05, 0.01} or {0.9, 0.05}}
+  local b = m:ball{pos = p2, radius = r, vel = dim == 3 and {1.1, -0.03, 0.02} or {1.1, -0.03},
+                   spin = dim == 3 and {3, -2, 7} or 7}
+  T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1, "one bond")
+  local out = {}
+  for s = 1, 12 do
+    m:cycle(500)
+    for i, ball in ipairs({a, b}) do
+      out[#out + 1] = {ball.pos, ball.vel, ball.spin, ball.force, ball.moment}
+    end
+  end
+  return out, m
+end
+
+local function same_bits(x, y, what)
+  if type(x) == "number" then
+    T.eq(x, y, what)
+    return
+  end
+  for k = 1, #y do T.eq(x[k], y[k], what .. " [" .. k .. "]") end
+end
+
+-- A position of the periodic run against the unwrapped one: the same, or
+-- brought back by exactly one period (at a build after it crossed x = 3).
+local function same_place(x, y, what)
+  local shift = y[1] - x[1]
+  T.check(shift == 0 or (shift == 1 and y[1] >= 3), what .. ": moved by " .. shift)
+  same_bits({x[1] + shift, table.unpack(x, 2)}, y, what)
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("a bonded pair crosses the boundary as it moves unwrapped, to the bit (" .. dim .. "D)", function()
+    local p, mp = crossing(dim, true)
+    local u = crossing(dim, false)
+    T.eq(#p, #u)
+    for n = 1, #p do
+      same_place(p[n][1], u[n][1], "position " .. n)
+      for q = 2, 5 do same_bits(p[n][q], u[n][q], "state " .. q .. " of entry " .. n) end
+    end
+    -- both balls went through: the periodic ones are back in the cell, the bond intact
+    for ball in mp:balls() do T.check(ball.pos[1] < 3 and ball.pos[1] >= 2, "wrapped into the cell") end
+    T.check(u[#u - 1][1][1] > 3 and u[#u][1][1] > 3, "the unwrapped balls left the cell's span")
+    T.eq(mp:bond_count(), 1, "the bond is intact")
+    local c = mp:contacts()()
+    T.check(c and c.bond == "parallel", "the bonded pair is still listed")
+  end)
+end
+
+-- A random packing of disks (spheres) in a cell of side L, and the same
+-- packing tiled 3 x 3 (x 3) in open space: the middle tile's balls have the
+-- neighbours a periodic ball has, so a few steps later (before the open
+-- boundary is felt) the middle tile's stress and coordination are the
+-- periodic cell's.
+local function packing(dim, tiles)
+  local m = seixo.model{dim = dim, timestep = 1e-5}
+  -- undamped: local damping switches with the sign of a velocity, which a
+  -- rounding difference (a wrapped position) may flip near rest
+  material(m)
+  local L, n, r = 0.1, 6, 0.0088
+  local rng = 12345
+  local function rand() rng = (rng * 1103515245 + 12345) % 2147483648; return rng / 2147483648 end
+  local pts = {}
+  local per = dim == 3 and n * n * n or n * n
+  for q = 0, per - 1 do
+    local i, j, k = q % n, (q // n) % n, q // (n * n)
+    local p = {(i + 0.5) * L / n + 0.001 * (rand() - 0.5), (j + 0.5) * L / n + 0.001 * (rand() - 0.5)}
+    if dim == 3 then p[3] = (k + 0.5) * L / n + 0.001 * (rand() - 0.5) end
+    pts[#pts + 1] = {p, r * (0.96 + 0.08 * rand())}
+  end
+  local span = tiles and 1 or 0
+  for tz = (dim == 3 and -span or 0), (dim == 3 and span or 0) do
+    for ty = -span, span do
+      for tx = -span, span do
+        for _, q in ipairs(pts) do
+          local p = {q[1][1] + tx * L, q[1][2] + ty * L}
+          if dim == 3 then p[3] = q[1][3] + tz * L end
+          m:ball{pos = p, radius = q[2]}
+        end
+      end
+    end
+  end
+  if not tiles then
+    m:periodic{min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {L, L, L} or {L, L}}
+  end
+  m:cycle(3)
+  local box = {min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {L, L, L} or {L, L}}
+  return m, m:measure{box = box}
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("a periodic cell has the stress and contacts of a large box's interior (" .. dim .. "D)", function()
+    local mp, sp = packing(dim, false)
+    local _, sb = packing(dim, true)
+    T.check(sp.coordination > 2, "the packing is in contact: " .. sp.coordination)
+    T.near(sp.coordination, sb.coordination, 1e-12)
+    T.eq(sp.balls, sb.balls)
+    local scale = math.abs(sb.stress[1][1])
+    for i = 1, dim do
+      for j = 1, dim do T.near(sp.stress[i][j], sb.stress[i][j], 1e-9 * scale / math.max(math.abs(sb.stress[i][j]), 1e-300)) end
+    end
+    -- the cell's own stress (branch vectors through the boundary, as the
+    -- step evaluated them) is the measurement's once the balls stand still
+    mp:set{fix = "all", vel = dim == 3 and {0, 0, 0} or {0, 0}}
+    mp:cycle(1)
+    local box = {min = dim == 3 and {0, 0, 0} or {0, 0}, max = dim == 3 and {0.1, 0.1, 0.1} or {0.1, 0.1}}
+    local still, cs, vol = mp:measure{box = box}, mp:cell_stress()
+    T.near(vol, dim == 3 and 1e-3 or 1e-2, 1e-12)
+    for i = 1, dim do
+      for j = 1, dim do T.near(cs[i][j], still.stress[i][j], 1e-9 * scale / math.max(math.abs(still.stress[i][j]), 1e-300)) end
+    end
+  end)
+end
+
+-- Simple shear of a square (simple cubic) lattice of balls whose spins are
+-- fixed, slightly compressed: the vertical contacts shear by gamma d, so
+-- sigma_xy = -ks gamma / d^(dim-2) (2D: per unit thickness; compression
+-- positive). The balls start
+-- on the affine velocity field the cell imposes, which no force disturbs.
+local function simple_shear(dim)
+  local n, r, rate = 6, 0.01, 1.0
+  local d = 2 * r * (1 - 1e-5) -- a small overlap keeps the tilting contacts closed
+  local L = n * d
+  local m = seixo.model{dim = dim, timestep = 1e-5}
+  material(m, {friction = 1e4}) -- elastic: the contacts never slip
+  local zero = dim == 3 and {0, 0, 0} or {0, 0}
+  m:periodic{min = zero, max = dim == 3 and {L, L, L} or {L, L}}
+  for k = 0, (dim == 3 and n - 1 or 0) do
+    for j = 0, n - 1 do
+      for i = 0, n - 1 do
+        local y = (j + 0.5) * d
+        local p, v = {(i + 0.5) * d, y}, {rate * y, 0}
+        if dim == 3 then p[3], v[3] = (k + 0.5) * d, 0 end
+        local b = m:ball{pos = p, radius = r, vel = v}
+        b.fix = "spin"
+      end
+    end
+  end
+  m:cell_control{xy = {rate = rate}}
+  m:cycle(100)
+  local cell = m:periodic()
+  local gamma = cell.tilt.xy / cell.size[2]
+  T.near(gamma, 100 * 1e-5 * rate, 1e-9)
+  local s = m:cell_stress()
+  -- compression positive: a shear that moves the top along +x is negative
+  -- the contact's ks: the two balls' springs in series (4-23)
+  return s[1][2], -2.5e6 * gamma / (dim == 3 and d or 1), m
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("simple shear of a regular packing gives the closed-form shear modulus (" .. dim .. "D)", function()
+    local tau, expected = simple_shear(dim)
+    T.near(tau, expected, 0.01)
+  end)
+end
+
+-- Isotropic compression of a granular gas to a target stress by the
+-- cell's servo alone (no walls), then the target held.
+local function servo(dim, threads)
+  seixo.threads = threads
+  local m = seixo.model{dim = dim}
+  seixo.threads = nil
+  material(m, {damping = 0.7})
+  local L, n = dim == 3 and 0.1 or 0.2, dim == 3 and 5 or 10
+  local zero = dim == 3 and {0, 0, 0} or {0, 0}
+  m:periodic{min = zero, max = dim == 3 and {L, L, L} or {L, L}}
+  local rng = 99
+  local function rand() rng = (rng * 1103515245 + 12345) % 2147483648; return rng / 2147483648 end
+  for q = 0, (dim == 3 and n * n * n or n * n) - 1 do
+    local p = {((q % n) + 0.5) * L / n, ((q // n % n) + 0.5) * L / n}
+    if dim == 3 then p[3] = (q // (n * n) + 0.5) * L / n end
+    m:ball{pos = p, radius = 0.006 + 0.003 * rand()}
+  end
+  local target = dim == 3 and 1e6 or 2e4
+  local c = {xx = {stress = target}, yy = {stress = target}, max_rate = 2}
+  if dim == 3 then c.zz = {stress = target} end
+  m:cell_control(c)
+  return m, target
+end
+
+T.test("a periodic cell under servo reaches and holds its target stress within 1 % (2D)", function()
+  local m, target = servo(2, 1)
+  m:cycle(40000)
+  local worst = 0
+  for s = 1, 20 do
+    m:cycle(100)
+    local st = m:cell_stress()
+    for k = 1, 2 do worst = math.max(worst, math.abs(st[k][k] - target) / target) end
+  end
+  T.check(worst < 0.01, "largest error over 2000 steps: " .. worst)
+  T.check(m:ratio() < 0.05, "the cell settles: ratio " .. m:ratio())
+end)
+
+T.test("1 and 2 threads: the same bits in a periodic cell (3D, servo)", function()
+  local m1 = servo(3, 1)
+  local m2 = servo(3, 2)
+  m1:cycle(3000)
+  m2:cycle(3000)
+  T.eq(m1:hash(), m2:hash())
+  T.check(m1:contact_count() > 0, "the cell is in contact")
+end)
+
+T.test("a periodic cell restarts bit-for-bit: servo, sheared and tilted cell, bonds through the boundary (2D, 3D)", function()
+  for _, dim in ipairs({2, 3}) do
+    local m = servo(dim, 1)
+    m:cycle(dim == 3 and 3000 or 20000)
+    T.check(m:contact_count() > 0, "in contact")
+    -- a bond through the boundary, a shear on the cell
+    T.check(m:bond{gap = 1e-4, kind = "parallel"} > 0, "bonds installed")
+    local c = m:cell_control()
+    c.xy = {rate = 0.5}
+    m:cell_control(c)
+    m:cycle(300)
+    local through = 0
+    for ct in m:contacts() do if ct.bond and (ct.shift[1] ~= 0 or ct.shift[2] ~= 0) then through = through + 1 end end
+    T.check(through > 0, "a bond through the boundary")
+    local path = "periodic_restart_" .. dim .. ".h5"
+    m:save(path)
+    local r = seixo.load(path)
+    T.eq(r:hash(), m:hash(), "the state as saved")
+    T.eq(r:periodic().tilt.xy, m:periodic().tilt.xy)
+    m:cycle(500)
+    r:cycle(500)
+    T.eq(r:hash(), m:hash(), "500 steps later")
+    os.remove(path)
+  end
+end)
+
+-- A clump (two pebbles) spinning through the face x = 3 of the cell
+-- [2, 3) with a ball bonded to it, against the same motion unwrapped: the
+-- clump is wrapped as a body, its pebble's bond and contact keep their
+-- history.
+local function clump_crossing(dim, periodic)
+  local m = seixo.model{dim = dim, timestep = 2e-5}
+  material(m)
+  if periodic then m:periodic{min = dim == 3 and {2, -1, -1} or {2, -1}, max = dim == 3 and {3, 1, 1} or {3, 1}, axes = "x"} end
+  local r = 0.02
+  m:clump_template("pair", dim == 3 and {{-r, 0, 0, r}, {r, 0, 0, r}} or {{-r, 0, r}, {r, 0, r}})
+  local c = m:clump{template = "pair", pos = dim == 3 and {2.9, 0.01, 0.003} or {2.9, 0.01},
+                    vel = dim == 3 and {1, 0, 0.01} or {1, 0}, spin = dim == 3 and {0, 0, 2} or 2}
+  local b = m:ball{pos = dim == 3 and {2.9 + r, 0.01 + 2 * r * 0.999, 0.003} or {2.9 + r, 0.01 + 2 * r * 0.999},
+                   radius = r, vel = dim == 3 and {1.05, -0.01, 0.0} or {1.05, -0.01}}
+  T.eq(m:bond{gap = 1e-4, kind = "parallel"}, 1, "the ball bonded to a pebble")
+  local out = {}
+  for s = 1, 10 do
+    m:cycle(500)
+    out[#out + 1] = {c.pos, c.vel, c.spin, b.pos, b.vel, b.spin, b.force}
+  end
+  return out, m
+end
+
+for _, dim in ipairs({2, 3}) do
+  T.test("a clump crosses the boundary as it moves unwrapped, to the bit (" .. dim .. "D)", function()
+    local p, mp = clump_crossing(dim, true)
+    local u = clump_crossing(dim, false)
+    local touched = 0
+    for n = 1, #p do
+      for q = 1, 7 do
+        if q == 1 or q == 4 then same_place(p[n][q], u[n][q], "entry " .. n .. " field " .. q)
+        else same_bits(p[n][q], u[n][q], "entry " .. n .. " field " .. q) end
+      end
+      if type(u[n][7]) == "table" and u[n][7][2] ~= 0 then touched = touched + 1 end
+    end
+    T.check(touched > 0, "the ball stays in contact with the clump")
+    T.check(u[#u][1][1] > 3 and u[#u][4][1] > 3, "both crossed x = 3")
+    for cl in mp:clumps() do T.check(cl.pos[1] < 3, "the clump is wrapped into the cell") end
+  end)
+end
+
+-- Balls added and removed while two balls touch through the boundary:
+-- the ghosts' slots move with the ball count, and the pair keeps its
+-- history, as in a model where nothing else happened.
+T.test("adding and removing balls keeps the contacts through the boundary", function()
+  local function run(others)
+    local m = seixo.model{dim = 2, timestep = 1e-5}
+    material(m)
+    m:periodic{min = {0, 0}, max = {1, 1}}
+    local a = m:ball{pos = {0.0149, 0.5}, radius = 0.02, vel = {0.01, 0.02}}
+    local b = m:ball{pos = {0.975, 0.501}, radius = 0.02, vel = {0, -0.02}, spin = 3}
+    T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1)
+    m:cycle(100)
+    if others then
+      local c = m:ball{pos = {0.5, 0.5}, radius = 0.02}
+      local d = m:ball{pos = {0.5, 0.015}, radius = 0.02}
+      local e = m:ball{pos = {0.5, 0.98}, radius = 0.02} -- d and e touch through the boundary too
+      T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1, "d and e bonded")
+      m:cycle(100)
+      c:remove()
+      d:remove()
+      m:cycle(50)
+      e:remove()
+      m:cycle(50)
+    else
+      m:cycle(200)
+    end
+    local cs = m:contacts()()
+    return {a.pos, a.vel, a.spin, b.pos, b.vel, b.spin, a.force, cs.fs, cs.shift}, m
+  end
+  local x, mx = run(true)
+  local y = run(false)
+  for q = 1, #y do same_bits(x[q], y[q], "field " .. q) end
+  T.eq(mx:ball_count(), 2)
+  T.eq(mx:bond_count(), 1, "d-e's bond went with d")
+  T.check(x[9][1] ~= 0, "the pair acts through the boundary")
+end)
+
+T.test("bad periodic input is a clear error", function()
+  local m = seixo.model{dim = 2}
+  material(m)
+  local function refuses(fn, text)
+    local ok, err = pcall(fn)
+    T.check(not ok and tostring(err):find(text, 1, true), "expected '" .. text .. "', got " .. tostring(err))
+  end
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 0}} end, "axis y needs a finite corner lo and a length > 0 m")
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 1}, axes = "xz"} end, "letters of 'xy' expected")
+  refuses(function() m:periodic{min = {0, 0}, max = {1, 1}, axes = "x", tilt = {xy = 0.1}} end,
+          "a tilt xy couples two periodic axes")
+  refuses(function() m:cell_control{xx = {rate = 1}} end, "the space must be periodic on every axis")
+  m:periodic{min = {0, 0}, max = {1, 1}, axes = "x"}
+  refuses(function() m:cell_control{xx = {rate = 1}} end, "the space must be periodic on every axis")
+  refuses(function() m:cell_stress() end, "periodic on every axis")
+  m:periodic{min = {0, 0}, max = {1, 1}}
+  refuses(function() m:cell_control{xx = {rate = 1, stress = 2}} end, "give either rate (1/s) or stress (Pa)")
+  refuses(function() m:cell_control{zz = {rate = 1}} end, "a 2D cell has xx, yy and xy only")
+  refuses(function() m:cell_control{xx = {rate = 1}, alpha = 2} end, "alpha must be in (0, 1]")
+  -- balls too large for the cell: the first cycle says what size it needs
+  m:ball{pos = {0.5, 0.5}, radius = 0.3}
+  refuses(function() m:cycle(1) end, "less than twice the contact reach")
+  m:periodic(false)
+  m:cycle(1)
+  T.eq(m:periodic(), nil)
+end)
+
+T.done()

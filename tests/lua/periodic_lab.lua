@@ -1,0 +1,51 @@
+-- seixo.periodic (lab.periodic): a periodic specimen, its triaxial test
+-- with the lateral stress held by the cell's servo, simple shear at
+-- constant normal stress (issue 15).
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local lab = require "seixo.lab"
+
+local granular = lab.periodic.specimen{dim = 2, size = 0.008, radius = {0.4e-3, 0.66e-3}, bonds = false,
+                                       path = "periodic_granular.h5", log = false}
+
+T.test("a granular periodic specimen", function()
+  T.check(granular.balls > 50, "balls: " .. granular.balls)
+  T.eq(granular.bonds, 0)
+  T.check(granular.porosity > 0.1 and granular.porosity < 0.3, "porosity " .. granular.porosity)
+  local again = lab.open("periodic_granular.h5")
+  T.check(again.periodic and again.balls == granular.balls, "lab.open reads it back")
+  local ok, err = pcall(lab.triaxial, again, {confining = 1e6})
+  T.check(not ok and err:find("lab.periodic", 1, true), "the walled test refuses it: " .. tostring(err))
+  -- the cell holds sigma0 at rest
+  local m = seixo.load("periodic_granular.h5")
+  local s = m:cell_stress()
+  for k = 1, 2 do T.near(s[k][k], granular.sigma0, 0.01) end
+  T.check(m:wall_count() == 0, "no walls")
+  m:close()
+end)
+
+T.test("periodic triaxial: the lateral stress held within 1 % while the cell is compressed", function()
+  local r = lab.periodic.triaxial(granular, {confining = 1e6, strain_rate = 0.5, max_strain = 0.001, log = false})
+  T.check(#r.rows > 5, "rows")
+  for _, row in ipairs(r.rows) do T.near(row.sl, 1e6, 0.01) end
+  T.check(r.peak_deviator > 0.3e6, "the deviator rises: " .. r.peak_deviator)
+  T.check(r.young and r.young > 0 and r.poisson == r.poisson, "a modulus and a Poisson's ratio")
+  T.near(r.rows[#r.rows].ea, 0.001, 0.1)
+end)
+
+T.test("periodic simple shear at constant normal stress", function()
+  local r = lab.periodic.shear(granular, {normal = 1e6, shear_rate = 2, max_strain = 0.004, log = false})
+  local last = r.rows[#r.rows]
+  T.check(last.gamma >= 0.004, "sheared to the strain")
+  T.near(last.sn, 1e6, 0.05)
+  T.check(r.friction_angle > 5 and r.friction_angle < 45, "a granular friction angle: " .. r.friction_angle)
+end)
+
+T.test("a bonded periodic specimen", function()
+  local spec = lab.periodic.specimen{dim = 2, size = 0.008, radius = {0.4e-3, 0.66e-3}, path = "periodic_bonded.h5",
+                                     log = false}
+  T.check(spec.bonds > spec.balls, "bonds: " .. spec.bonds)
+  os.remove("periodic_bonded.h5")
+end)
+
+os.remove("periodic_granular.h5")
+T.done()
