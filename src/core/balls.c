@@ -360,6 +360,8 @@ int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
     f[n++] = (sx_pair_field){(void **)&p->touching, 1, SX_PAIR_U8, false, false, "touching", NULL};
     f[n++] = (sx_pair_field){(void **)&p->fn, 1, SX_PAIR_F64, false, false, "normal_force", "N"};
     if (p->bond) f[n++] = (sx_pair_field){(void **)&p->bond, 1, SX_PAIR_I32, false, false, "bond", NULL};
+    /* a mesh's facet is a third end of a ball-wall pair: listed by the broad phase */
+    if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_PAIR_I32, false, true, "facet", NULL};
     return n;
 }
 

@@ -404,7 +404,7 @@ static bool unforced(const sx_model *m)
         /* a servo sets its wall moving, and a cylinder's radius moves at radial_vel */
         if (m->walls[w].servo_on || m->walls[w].def.radial_vel != 0) return false;
         for (int k = 0; k < m->dim; k++)
-            if (m->walls[w].def.vel[k] != 0) return false;
+            if (m->walls[w].def.vel[k] != 0 || m->walls[w].def.spin[k] != 0) return false;
     }
     if (m->balls.fapp) return false;
     for (int64_t i = 0; i < m->balls.n; i++)
@@ -484,6 +484,11 @@ static void move_walls(sx_model *m, double *max_wall)
         if (w->def.kind == SX_WALL_CYLINDER) {
             w->def.radius += w->def.radial_vel * m->dt;
             w->moved += fabs(w->def.radial_vel) * m->dt;
+        }
+        if (w->mesh) { /* a moving mesh: the turn about its point, then its vertices */
+            const double turned = sx__mesh_turn(w, m->dt);
+            w->moved += turned;
+            if (turned > 0 || s > 0) sx__mesh_pose(w);
         }
         if (w->moved > *max_wall) *max_wall = w->moved;
     }
@@ -668,6 +673,7 @@ uint64_t sx_model_state_hash(const sx_model *m)
             if (!p->touching[c]) continue;
             const int32_t ends[2] = {b->id[p->a[c]], s == 0 ? b->id[p->b[c]] : p->b[c]};
             h = sx__fnv(h, ends, sizeof ends);
+            if (s == 1 && p->facet) h = sx__fnv(h, p->facet + c, sizeof *p->facet);
             h = sx__fnv(h, p->fs + c * (int64_t)d, d * sizeof(double));
         }
     }
@@ -680,6 +686,11 @@ uint64_t sx_model_state_hash(const sx_model *m)
          * velocities it set are state a continuing run depends on */
         h = sx__fnv(h, wl->def.vel, sizeof wl->def.vel);
         h = sx__fnv(h, &wl->def.radial_vel, sizeof wl->def.radial_vel);
+        if (wl->mesh) { /* its turn and spin */
+            h = sx__fnv(h, wl->mesh->q, sizeof wl->mesh->q);
+            h = sx__fnv(h, wl->def.spin, sizeof wl->def.spin);
+            h = sx__fnv(h, wl->moment, sizeof wl->moment);
+        }
         const uint8_t on = wl->servo_on;
         h = sx__fnv(h, &on, 1);
         if (on) {

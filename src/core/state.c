@@ -17,6 +17,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->applied = m->balls.fapp != NULL;
     out->bb = m->bb.n;
     out->bw = m->bw.n;
+    out->bw_facets = m->mesh_pairs;
     out->bb_bonds = m->bb.bond != NULL;
     out->bonds = m->bonds.n;
     out->cracks = m->cracks.n;
@@ -72,7 +73,8 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     /* pairs: a store that carried bond slots gets them back, even when empty */
     if (sx__pairs_reserve(m, &m->bb, s->bb_bonds && s->bb == 0 ? 1 : s->bb)) goto nomem;
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
-    if (sx__pairs_reserve(m, &m->bw, s->bw)) goto nomem;
+    if (sx__pairs_reserve(m, &m->bw, s->bw_facets && s->bw == 0 ? 1 : s->bw)) goto nomem;
+    if (s->bw_facets && sx__pairs_expand_facets(m)) goto nomem;
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 
@@ -176,12 +178,31 @@ static sx_status check_balls(sx_model *m)
     return SX_OK;
 }
 
+/* A restored mesh: its numbers in range, then what follows from them. */
+static sx_status check_mesh(sx_model *m, sx_wall *w)
+{
+    sx_mesh *s = w->mesh;
+    const double *q = s->q, qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if (!finite_all(s->body, 3 * s->nv) || !finite_all(w->def.spin, 3) || !finite_all(q, 4) || !(fabs(qq - 1) < 1e-9))
+        return sx__fail(m, SX_EINVAL, "state: mesh wall %lld has a non-finite vertex or spin, or an orientation that "
+                                      "is not a unit quaternion", (long long)w->id);
+    for (int64_t t = 0; t < 3 * s->nt; t++)
+        if (s->tri[t] < 0 || s->tri[t] >= s->nv)
+            return sx__fail(m, SX_EINVAL, "state: mesh wall %lld: triangle %lld names vertex %d of %lld", (long long)w->id,
+                            (long long)(t / 3), s->tri[t], (long long)s->nv);
+    if (!sx__mesh_derive(m, s)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
+    sx__mesh_pose(w);
+    return SX_OK;
+}
+
 static sx_status check_walls(sx_model *m)
 {
+    sx_status st;
     for (int64_t i = 0; i < m->nwall; i++) {
         const sx_wall *w = &m->walls[i];
         const sx_wall_kind k = w->def.kind;
-        const bool ok = m->dim == 3 ? (k == SX_WALL_PLANE || k == SX_WALL_RECT || k == SX_WALL_CYLINDER)
+        const bool ok = m->dim == 3 ? ((k == SX_WALL_PLANE || k == SX_WALL_RECT || k == SX_WALL_CYLINDER) && !w->mesh) ||
+                                          (k == SX_WALL_MESH && w->mesh)
                                     : (k == SX_WALL_LINE || k == SX_WALL_SEGMENT);
         if (!ok) return sx__fail(m, SX_EINVAL, "state: wall %lld has kind %d, not a %dD wall", (long long)w->id, (int)k, m->dim);
         if (w->id < 1 || w->id > m->next_wall_id)
@@ -204,6 +225,7 @@ static sx_status check_walls(sx_model *m)
         if (w->servo_on && (!isfinite(s->target) || !(s->area > 0) || !isfinite(s->area) ||
                             !(s->alpha > 0 && s->alpha <= 1) || !(s->max_speed > 0) || !isfinite(s->max_speed)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has servo settings out of range", (long long)w->id);
+        if (w->mesh && (st = check_mesh(m, &m->walls[i]))) return st;
     }
     return SX_OK;
 }
@@ -237,6 +259,11 @@ static sx_status check_pairs(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld refers to ball %d of %lld, wall %d of %lld",
                             (long long)c, p->a[c], (long long)n, p->b[c], (long long)m->nwall);
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld has a bad touching flag", (long long)c);
+        const sx_mesh *mesh = m->walls[p->b[c]].mesh;
+        const int32_t facet = p->facet ? p->facet[c] : 0;
+        if (facet < 0 || (mesh ? facet >= mesh->nt : facet != 0))
+            return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld names facet %d of wall %lld, which has none such",
+                            (long long)c, facet, (long long)m->walls[p->b[c]].id);
     }
     return SX_OK;
 }
