@@ -127,6 +127,7 @@ typedef struct snap {
     double time;
     int64_t step, balls, contacts, wall_contacts, bonds, walls;
     int64_t wall_cells, wall_points; /* a cylinder is drawn with many cells */
+    int64_t mesh_cells, mesh_points; /* mesh walls' triangles, a grid of their own */
     unsigned fields;
     int dim;
     bool clumps; /* the balls carry their clump ids (pebbles of a clump, 0 for free balls) */
@@ -187,7 +188,7 @@ static void geometry(buf *b, const char *base, int64_t k, const char *ds, int64_
 static void lines(buf *b, const char *base, int64_t k, const char *ds, int64_t cells, int nodes, const char *topo)
 {
     put(b, "     <Topology TopologyType=\"%s\" NumberOfElements=\"%lld\"", topo, (long long)cells);
-    if (strcmp(topo, "Quadrilateral") != 0) put(b, " NodesPerElement=\"%d\"", nodes);
+    if (strcmp(topo, "Quadrilateral") != 0 && strcmp(topo, "Triangle") != 0) put(b, " NodesPerElement=\"%d\"", nodes);
     put(b, ">");
     item(b, base, k, ds, cells, nodes, "Int", 4);
     put(b, "</Topology>\n");
@@ -255,6 +256,16 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "id", "walls/id", c, 1, "Int", 8, true);
         attribute(b, base, k, "velocity", "walls/velocity", c, 3, "Float", 8, true);
         attribute(b, base, k, "force", "walls/force", c, 3, "Float", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_WALLS) && s->mesh_cells > 0) {
+        const int64_t c = s->mesh_cells;
+        put(b, "    <Grid Name=\"meshes\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "meshes/connectivity", c, 3, "Triangle");
+        geometry(b, base, k, "meshes/points", s->mesh_points);
+        attribute(b, base, k, "id", "meshes/id", c, 1, "Int", 8, true);
+        attribute(b, base, k, "velocity", "meshes/velocity", c, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "meshes/force", c, 3, "Float", 8, true);
         put(b, "    </Grid>\n");
     }
     put(b, "   </Grid>\n");
@@ -493,6 +504,7 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
     const double half = diag > 0 ? 0.6 * sqrt(diag) : 1.0;
     int64_t ncells = 0, npts = 0;
     for (int64_t w = 0; w < nw; w++) {
+        if (m->walls[w].mesh) continue; /* in write_meshes */
         const bool cyl = m->walls[w].def.kind == SX_WALL_CYLINDER;
         ncells += cyl ? CYL_SIDES : 1;
         npts += cyl ? 2 * CYL_SIDES : per;
@@ -511,6 +523,7 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
         const sx_wall_def *def = &wl->def;
         double *p = pts + pt * 3;
         const int64_t first = cell;
+        if (wl->mesh) continue;
         if (def->kind == SX_WALL_CYLINDER) {
             const double *n = def->normal;
             double u[3], v[3], t0 = 0, t1 = def->height;
@@ -585,6 +598,59 @@ done:
     free(ids);
 }
 
+/* Mesh walls as their triangles, where they are; each cell carries its
+ * wall's id and force and the surface velocity at the facet's centroid
+ * (the translation and the spin about the mesh's point). */
+static void write_meshes(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
+{
+    int64_t ncells = 0, npts = 0;
+    for (int64_t w = 0; w < m->nwall; w++)
+        if (m->walls[w].mesh) ncells += m->walls[w].mesh->nt, npts += m->walls[w].mesh->nv;
+    sn->mesh_cells = ncells, sn->mesh_points = npts;
+    if (!ncells) return;
+    double *pts = malloc((size_t)npts * 3 * sizeof *pts), *vel = malloc((size_t)ncells * 3 * sizeof *vel);
+    double *frc = malloc((size_t)ncells * 3 * sizeof *frc);
+    int32_t *conn = malloc((size_t)ncells * 3 * sizeof *conn);
+    int64_t *ids = malloc((size_t)ncells * sizeof *ids);
+    if (!pts || !vel || !frc || !conn || !ids) {
+        sx_h5_fail(h, "out of memory");
+        goto done;
+    }
+    int64_t cell = 0, pt = 0;
+    for (int64_t w = 0; w < m->nwall; w++) {
+        const sx_wall *wl = &m->walls[w];
+        const sx_mesh *s = wl->mesh;
+        if (!s) continue;
+        memcpy(pts + 3 * pt, s->x, (size_t)s->nv * 3 * sizeof *pts);
+        for (int64_t t = 0; t < s->nt; t++, cell++) {
+            double r[3];
+            for (int k = 0; k < 3; k++) {
+                conn[3 * cell + k] = (int32_t)(pt + s->tri[3 * t + k]);
+                r[k] = (s->x[3 * s->tri[3 * t] + k] + s->x[3 * s->tri[3 * t + 1] + k] + s->x[3 * s->tri[3 * t + 2] + k]) / 3 -
+                       wl->def.point[k];
+            }
+            const double *o = wl->def.spin;
+            const double turn[3] = {o[1] * r[2] - o[2] * r[1], o[2] * r[0] - o[0] * r[2], o[0] * r[1] - o[1] * r[0]};
+            for (int k = 0; k < 3; k++) vel[3 * cell + k] = wl->def.vel[k] + turn[k], frc[3 * cell + k] = wl->force[k];
+            ids[cell] = wl->id;
+        }
+        pt += s->nv;
+    }
+    hid_t g = sx_h5_group(h, snapg, "meshes");
+    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, npts, 3, "m");
+    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, ncells, 3, NULL);
+    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, ncells, 1, NULL);
+    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, ncells, 3, "m/s");
+    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, ncells, 3, "N");
+    sx_h5_close(g);
+done:
+    free(pts);
+    free(vel);
+    free(frc);
+    free(conn);
+    free(ids);
+}
+
 static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f, snap *s)
 {
     memset(s, 0, sizeof *s);
@@ -643,6 +709,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     if (f & SX_OUT_WALLS) {
         s->walls = m->nwall;
         write_walls(h, snapg, m, s);
+        write_meshes(h, snapg, m, s);
     }
     sx_h5_attr_double(h, snapg, "time", s->time);
     sx_h5_attr_int(h, snapg, "step", s->step);
@@ -654,6 +721,10 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     sx_h5_attr_int(h, snapg, "walls", s->walls);
     sx_h5_attr_int(h, snapg, "wall_cells", s->wall_cells);
     sx_h5_attr_int(h, snapg, "wall_points", s->wall_points);
+    if (s->mesh_cells) {
+        sx_h5_attr_int(h, snapg, "mesh_cells", s->mesh_cells);
+        sx_h5_attr_int(h, snapg, "mesh_points", s->mesh_points);
+    }
     sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
     if (s->clumps) sx_h5_attr_int(h, snapg, "clumps", 1);
 }
@@ -710,6 +781,8 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     s->wall_points = s->walls * (dim == 3 ? 4 : 2);
     sx_h5_get_i64(h, g, name, "wall_cells", &s->wall_cells, 1, false);
     sx_h5_get_i64(h, g, name, "wall_points", &s->wall_points, 1, false);
+    sx_h5_get_i64(h, g, name, "mesh_cells", &s->mesh_cells, 1, false); /* absent without meshes */
+    sx_h5_get_i64(h, g, name, "mesh_points", &s->mesh_points, 1, false);
     sx_h5_close(g);
     return !h->failed;
 }
