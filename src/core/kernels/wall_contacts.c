@@ -403,7 +403,7 @@ SX_VECTOR_CLONES static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *a
     dash_memo memo = {NAN, NAN, 0};
     for (int64_t c = o->w0; c < o->w1;) {
 #if D == 3
-        if (m->walls[m->bw.b[c]].mesh) { /* the ball's rows of this mesh together */
+        if (m->mesh_pairs && m->walls[m->bw.b[c]].mesh) { /* the ball's rows of this mesh together */
             int64_t e = c + 1;
             while (e < o->w1 && m->bw.a[e] == m->bw.a[c] && m->bw.b[e] == m->bw.b[c]) e++;
             if (!mesh_rows(m, o, acc, c, e, &memo)) return;
