@@ -4,14 +4,15 @@
 -- beads (Jop, Forterre & Pouliquen 2006, Nature 441: mu_s = tan 20.9 deg,
 -- the angle at which a bed of glass beads starts and stops flowing, which
 -- the free surface of a slowly rotating drum keeps).
---   scripts/run examples/drum.lua [revolutions = 0.6] [output.h5]
+--   scripts/run examples/drum.lua [revolutions = 0.6] [balls = 1500] [output.h5]
 -- The angle is measured two ways, each averaged over the second half of
 -- the run: the bed's centre of mass lies on the perpendicular to a flat
 -- free surface through the axis, so its direction from the axis gives the
 -- slope (atan of its horizontal over its vertical offset); and a straight
 -- line fitted to the top balls of the central part of the surface.
 local revolutions = tonumber(arg and arg[1]) or 0.6
-local out = arg and arg[2]
+local balls = tonumber(arg and arg[2]) or 1500
+local out = arg and arg[3]
 
 local R, L = 0.05, 0.04          -- m, drum radius and length (axis along y)
 local r = {1.8e-3, 2.2e-3}       -- m, ball radii
@@ -20,27 +21,31 @@ local g = 9.81
 local m = seixo.model{dim = 3, gravity = {0, 0, -g}}
 m:material("glass", {density = 2500, kn = 2e4, ks = 2e4, friction = 0.5, viscous_normal = 0.3})
 
--- The drum: n flat strips round the axis (two triangles each) and two
--- fans of n triangles closing its ends; the vertices lie on the circle,
--- so the strips' mid-lines are R cos(pi/n) from the axis (0.2 % inside).
+-- The drum: n flat strips round the axis (two triangles each), rough, and
+-- two fans of n triangles closing its ends, frictionless: a short drum's
+-- end walls hold its bed up (by mu_w h / L in tan(angle), Jop, Forterre &
+-- Pouliquen 2005, J. Fluid Mech. 541), and smooth caps stand in for a long
+-- drum. The vertices lie on the circle, so the strips' mid-lines are
+-- R cos(pi/n) from the axis (0.2 % inside). Both meshes turn about the axis.
 local n = 48
-local tris = {}
+local shell, caps = {}, {}
 local function rim(k, y)
   local a = 2 * math.pi * k / n
   return {R * math.cos(a), y, R * math.sin(a)}
 end
 for k = 0, n - 1 do
   local a0, a1, b0, b1 = rim(k, 0), rim(k + 1, 0), rim(k, L), rim(k + 1, L)
-  tris[#tris + 1] = {a0, a1, b1}
-  tris[#tris + 1] = {a0, b1, b0}
-  tris[#tris + 1] = {{0, 0, 0}, a1, a0}
-  tris[#tris + 1] = {{0, L, 0}, b0, b1}
+  shell[#shell + 1] = {a0, a1, b1}
+  shell[#shell + 1] = {a0, b1, b0}
+  caps[#caps + 1] = {{0, 0, 0}, a1, a0}
+  caps[#caps + 1] = {{0, L, 0}, b0, b1}
 end
-local drum = m:wall{kind = "mesh", triangles = tris, point = {0, 0, 0}, kn = 2e4, ks = 2e4, friction = 0.5}
-print(string.format("drum: %d facets on %d vertices, R = %g m, L = %g m", drum.facet_count, drum.vertex_count, R, L))
+local drum = m:wall{kind = "mesh", triangles = shell, point = {0, 0, 0}, kn = 2e4, ks = 2e4, friction = 0.5}
+local ends = m:wall{kind = "mesh", triangles = caps, point = {0, 0, 0}, kn = 2e4, ks = 2e4, friction = 0}
+print(string.format("drum: %d + %d facets, R = %g m, L = %g m", drum.facet_count, ends.facet_count, R, L))
 
 -- about a quarter full: balls placed anywhere in the drum, then settled
-local count = m:generate{count = 1500, radius = r, seed = 11, material = "glass",
+local count = m:generate{count = balls, radius = r, seed = 11, material = "glass",
                          region = {cylinder = {p1 = {0, 0.0025, 0}, p2 = {0, L - 0.0025, 0}, radius = R - 0.001}}}
 m:solve{ratio = 1e-3, time = 1.5}
 print(string.format("%d balls settled at t = %.2f s (timestep %.3g s)", count, m:time(), m:timestep()))
@@ -69,7 +74,7 @@ local function angles()
 end
 
 local o = out and m:output{path = out, every = 2000, fields = {"all"}}
-drum.spin = {0, omega, 0}
+drum.spin, ends.spin = {0, omega, 0}, {0, omega, 0}
 local turn = 2 * math.pi * revolutions / omega
 local t0, clock = m:time(), seixo.clock()
 local samples, sum_com, sum_fit = 0, 0, 0
@@ -82,10 +87,17 @@ while m:time() - t0 < turn do
 end
 if o then o:close() end
 local com, fit = sum_com / samples, sum_fit / samples
+-- every ball still inside the turning drum (in its frame the shell is at R, the caps at y = 0 and L)
+local outside = 0
+for b in m:balls() do
+  local x, y, z = b.pos[1], b.pos[2], b.pos[3]
+  if math.sqrt(x * x + z * z) > R or y < 0 or y > L then outside = outside + 1 end
+end
+print(string.format("%d balls, %d outside the drum", count, outside))
 local f, mo = drum.force, drum.moment
 print(string.format("%.2f revolutions at %g rad/s (Fr = %.4f) in %.0f s of computing", revolutions, omega,
                     omega * omega * R / g, seixo.clock() - clock))
-print(string.format("drum: force (%.3g, %.3g, %.3g) N, torque about its axis %.4g N m", f[1], f[2], f[3], mo[2]))
+print(string.format("drum shell: force (%.3g, %.3g, %.3g) N, torque about its axis %.4g N m", f[1], f[2], f[3], mo[2]))
 print(string.format("dynamic angle of repose: %.1f deg (centre of mass), %.1f deg (surface fit), %d samples",
                     com, fit, samples))
 local ref = 20.9
