@@ -233,6 +233,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     const bool density_changed = m->mats[i].def.density != d->density;
     const bool damping_changed = m->mats[i].def.damping != d->damping;
     m->mats[i].def = *d;
+    sx__material_derive(&m->mats[i]);
     for (int64_t b = 0; b < m->balls.n; b++) {
         if (m->balls.mat[b] != i) continue;
         if (density_changed) sx__ball_update_mass(m, b);
@@ -274,7 +275,8 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
     const sx_material_def *a = &m->mats[mat].def;
     sx_pair_law l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, a, NULL);
+    sx__law(l.law)->mix(&l, &m->mats[mat], NULL, l.law);
+    sx__law_parts_mix(&l, &m->mats[mat], NULL);
     return l;
 }
 
@@ -285,7 +287,8 @@ sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb)
                             0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
     /* a pair of materials of two laws is refused where it may touch (check_models) */
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, a, b);
+    sx__law(l.law)->mix(&l, &m->mats[ma], &m->mats[mb], l.law);
+    sx__law_parts_mix(&l, &m->mats[ma], &m->mats[mb]);
     return l;
 }
 
@@ -306,6 +309,9 @@ static sx_status refresh_laws(sx_model *m)
             if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
+    for (int i = 0; i < n; i++) /* a law's history joins the pair stores once a material uses it */
+        if (m->mats[i].def.rolling_friction > 0 && sx__pairs_expand_rolling(m))
+            return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     return SX_OK;
 }
 

@@ -19,6 +19,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->bw = m->bw.n;
     out->bw_facets = m->mesh_pairs;
     out->bb_bonds = m->bb.bond != NULL;
+    out->rolling = m->bb.mr != NULL;
     out->bonds = m->bonds.n;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
@@ -75,6 +76,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
     if (sx__pairs_reserve(m, &m->bw, s->bw_facets && s->bw == 0 ? 1 : s->bw)) goto nomem;
     if (s->bw_facets && sx__pairs_expand_facets(m)) goto nomem;
+    if (s->rolling && sx__pairs_expand_rolling(m)) goto nomem;
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 
@@ -142,6 +144,7 @@ static sx_status check_materials(sx_model *m)
         if (sx__law_check(&t->def, why, sizeof why))
             return sx__fail(m, SX_EINVAL, "state: material '%s' (contact model %d): %s", t->name, (int)t->def.model,
                             why);
+        sx__material_derive(t);
         if (!(t->def.density > 0) || !isfinite(t->def.density) || !(t->def.stiffness_ratio > 0))
             return sx__fail(m, SX_EINVAL, "state: material '%s' has a density or stiffness ratio <= 0", t->name);
     }

@@ -38,6 +38,7 @@ typedef struct sx_state_sizes {
     int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
     bool bw_facets;       ///< the ball-wall store carries mesh facets
     bool bb_bonds;        ///< the ball-ball store carries bond slots
+    bool rolling;         ///< both pair stores carry rolling moments (laws/rolling.h)
     int64_t bonds;        ///< bond slots (intact or broken)
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;

@@ -8,6 +8,7 @@ local function model(threads, gravity)
   local m = seixo.model{dim = 3, gravity = gravity or {0, 0, -9.81}, timestep = 2e-5}
   seixo.threads = was
   m:material("rock", {density = 2650, kn = 1e6, ks = 1e6, friction = 0.4})
+  m:material("rolling", {density = 2650, kn = 1e6, ks = 1e6, friction = 0.4, rolling_friction = 0.05})
   m:material("damped", {density = 2650, kn = 1e6, ks = 1e6, friction = 0.4, viscous_normal = 0.3})
   return m
 end
@@ -31,7 +32,7 @@ local square = {
   {{-1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
 }
 
-T.test("a ball rolling across the shared edge of two coplanar facets moves as on the plane, to the bit", function()
+local function rolling_across(material)
   local p, q = model(), model()
   p:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
   local mesh = q:wall{kind = "mesh", triangles = square, kn = 1e6, ks = 1e6}
@@ -40,7 +41,7 @@ T.test("a ball rolling across the shared edge of two coplanar facets moves as on
   -- sliding at first, then rolling; x - y goes from -0.2 through 0 at t = 0.25 s
   for _, m in ipairs{p, q} do
     -- resting on the surface: the weight's overlap m g / kn is 1.09e-7 m
-    m:ball{pos = {-0.5, -0.3, 0.0099999}, radius = 0.01, material = "rock", vel = {1, 0.2, 0}, spin = {0, 0, 3}}
+    m:ball{pos = {-0.5, -0.3, 0.0099999}, radius = 0.01, material = material, vel = {1, 0.2, 0}, spin = {0, 0, 3}}
   end
   local crossed = false
   for _ = 1, 40 do
@@ -53,6 +54,14 @@ T.test("a ball rolling across the shared edge of two coplanar facets moves as on
   T.check(crossed, "the ball did not cross the diagonal")
   T.near(q:ball(1).pos[3], p:ball(1).pos[3], 0)
   T.eq(q:contact_count(), 1) -- one contact, not one per facet
+end
+
+T.test("a ball rolling across the shared edge of two coplanar facets moves as on the plane, to the bit", function()
+  rolling_across("rock")
+end)
+
+T.test("with rolling resistance too (the rolling moment passes to the next facet)", function()
+  rolling_across("rolling")
 end)
 
 -- The box [0, L]^3: each side two triangles, in the order of the box's

@@ -232,6 +232,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 double kn, ks;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
                 if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+                if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum);
             }
             touching[c] = 0;
             fn_all[c] = 0; /* its last evaluation: no force */
@@ -277,7 +278,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         if (slot >= 0)
             for (int k = 0; k < D; k++) xc[k] = x[i * D + k] + la * n[k];
 
-        double kn, ks, fn = 0, F[D], mb[RD];
+        double kn, ks, fn = 0, F[D], mb[RD], mroll[RD] = {0};
         bool bond_moment = false;
         const bool active = un > 0 || (bonds & SX_BOND_CONTACT); /* a contact bond carries tension */
         bool slip = false;
@@ -323,6 +324,18 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     for (int k = 0; k < D; k++) fs[k] *= sc;
                     slip = true;
                 }
+            }
+            if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h) */
+                double *mr = p->mr + c * RD, dtheta[RD];
+                if (!touching[c])
+                    for (int k = 0; k < RD; k++) mr[k] = 0;
+#if D == 3
+                carry_apply(&rot, mr);
+#endif
+                for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
+                const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, ri * rj / rsum, un > 0 ? fn : 0);
+                if (track) o->slip += e;
+                for (int k = 0; k < RD; k++) mroll[k] = mr[k];
             }
             double fd = fn, dsh[D];
             bool shear_dashpot = false;
@@ -383,6 +396,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < RD; k++) {
             double ma = la * nf[k], mj = -lb * nf[k];
             if (bond_moment) ma += mb[k], mj += mb[k];
+            ma += mroll[k], mj += mroll[k];
             ti[k] -= ma;
             tj[k] += mj;
         }

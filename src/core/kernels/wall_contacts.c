@@ -24,6 +24,7 @@ static void wall_release(sx_model *m, sx_block *o, int64_t c)
         double kn, ks;
         stiffness(law, r, 0, r, 0, &kn, &ks);
         if (ks > 0) o->slip += 0.5 * dot(p->fs + c * D, p->fs + c * D) / ks;
+        if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, r); /* and the rolling spring's */
     }
     p->touching[c] = 0;
 }
@@ -76,8 +77,13 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     const double fn = stiffness(law, r, 0, r, un, &kn, &ks);
     if (!p->touching[c])
         for (int k = 0; k < D; k++) fs[k] = 0, p->geo[c * D + k] = n[k];
+    /* the wall is entity A of 4-8/4-9: only a mesh spins */
+    const double *wspin = NULL;
+#if D == 3
+    if (wl->mesh) wspin = wl->def.spin;
+#endif
     carry rot;
-    carry_make(&rot, p->geo + c * D, n, NULL, B->w + i * RD, dt);
+    carry_make(&rot, p->geo + c * D, n, wspin, B->w + i * RD, dt);
     carry_apply(&rot, fs);
     double f0[D];
     for (int k = 0; k < D; k++) f0[k] = fs[k];
@@ -94,6 +100,19 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
         }
         for (int k = 0; k < D; k++) fs[k] *= sc;
         slip = true;
+    }
+    double mroll[RD] = {0};
+    if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h): the ball's turn relative to the wall's */
+        double *mr = p->mr + c * RD, dtheta[RD];
+        if (!p->touching[c])
+            for (int k = 0; k < RD; k++) mr[k] = 0;
+#if D == 3
+        carry_apply(&rot, mr);
+#endif
+        for (int k = 0; k < RD; k++) dtheta[k] = (B->w[i * RD + k] - (wspin ? wspin[k] : 0)) * dt;
+        const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, r, fn);
+        if (track) o->slip += e;
+        for (int k = 0; k < RD; k++) mroll[k] = mr[k];
     }
     for (int k = 0; k < D; k++) p->geo[c * D + k] = n[k];
     p->touching[c] = 1;
@@ -144,8 +163,8 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
 #endif
     moment_of(arm, F, mw);
     for (int k = 0; k < RD; k++) {
-        t[i * RD + k] -= lb * nf[k];
-        wa->moment[k] -= mw[k];
+        t[i * RD + k] += mroll[k] - lb * nf[k];
+        wa->moment[k] -= mw[k] + mroll[k];
     }
     return true;
 }
@@ -197,6 +216,21 @@ static bool shadowed(const sx_mesh *s, const int32_t *facet, const facet_hit *h,
     return false;
 }
 
+/* Pair `to` takes over pair `from`'s history: every field of the store
+ * but its ends (the shear force, the last normal, a law's history such as
+ * the rolling moment, the touching flag). */
+static void inherit(sx_model *m, int64_t to, int64_t from)
+{
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, &m->bw, f);
+    for (int q = 0; q < nf; q++) {
+        if (f[q].end) continue;
+        const size_t row = (size_t)f[q].per * sx__pair_size(&f[q]);
+        char *data = *f[q].data;
+        memcpy(data + (size_t)to * row, data + (size_t)from * row, row);
+    }
+}
+
 /* Ball i's candidate facets of one mesh, rows [c0, c1): every touching
  * closest feature, faces first, then edges, then vertices, each kept
  * unless shadowed; a contact a facet takes over (the ball rolled onto it)
@@ -235,9 +269,7 @@ static bool mesh_rows(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, in
         }
         if (best < 0) continue;
         given[best] = 1;
-        memcpy(p->fs + (c0 + k) * D, p->fs + (c0 + best) * D, D * sizeof(double));
-        memcpy(p->geo + (c0 + k) * D, p->geo + (c0 + best) * D, D * sizeof(double));
-        p->touching[c0 + k] = 1;
+        inherit(m, c0 + k, c0 + best);
     }
     for (int64_t k = 0; k < n; k++) {
         if (keep[k]) continue;

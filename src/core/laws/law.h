@@ -23,29 +23,43 @@ typedef struct sx_law_param {
     const char *name;     /* the material key (Lua) and dataset name (HDF5) */
     const char *unit;
     size_t offset;        /* offsetof(sx_material_def, ...) */
-    double lo, hi;        /* valid range: lo < x < hi, or lo <= x when lo_closed */
-    bool lo_closed;
+    double lo, hi;        /* valid range: lo < x < hi, with <= on a closed end */
+    bool lo_closed, hi_closed;
     const char *what;     /* for the error message */
 } sx_law_param;
+
+/* What a unit of the registry is: a normal law (a material's `model`,
+ * one per contact) or a part every contact runs beside it, switched on by
+ * its parameters (rolling resistance, damping by restitution). */
+typedef enum sx_law_kind { SX_LAW_MODEL, SX_LAW_PART } sx_law_kind;
 
 typedef struct sx_law {
     const char *name;
     const char *summary;
+    sx_law_kind kind;
     const sx_law_param *params;
     int nparams;
     /* Completes the pair law l (its springs in series, friction and
-     * dashpot ratios already mixed by the model, 4-22/4-23/4-30) for
-     * materials a and b; b is NULL for a ball against a wall. */
-    void (*mix)(sx_pair_law *l, const sx_material_def *a, const sx_material_def *b);
-    double strain;        /* the normal spring's strain energy is strain x Fn Un */
-    double tangent;       /* tangent / secant normal stiffness, for the critical timestep */
-    bool series;          /* a pair's springs are its two sides' in series (a ball's own is twice its
-                           * contact with itself) */
-    bool bonds;           /* bonds may join materials of this law */
+     * dashpot ratios already mixed by the model, 4-22/4-23/4-30; a part
+     * after the contact's law) for materials a and b; b is NULL for a
+     * ball against a wall. */
+    void (*mix)(sx_pair_law *l, const sx_material *a, const sx_material *b, int self); /* self: its number */
+    /* A material's constant of this unit, derived once when it is set or
+     * loaded (into sx_material.derived[its number]); NULL: none. */
+    double (*derive)(const sx_material_def *d);
+    /* Why the parameters do not go together, or NULL; NULL: no such rule. */
+    const char *(*check)(const sx_material_def *d);
+    double strain;        /* a law: the normal spring's strain energy is strain x Fn Un */
+    double tangent;       /* a law: tangent / secant normal stiffness, for the critical timestep */
+    bool series;          /* a law: a pair's springs are its two sides' in series (a ball's own is
+                           * twice its contact with itself) */
+    bool bonds;           /* a law: bonds may join materials of this law */
 } sx_law;
 
-/* The law numbered id, or NULL (laws.c). */
+/* The law or part numbered id, or NULL (laws.c). */
 const sx_law *sx__law(int id);
+/* Mixes every part into l (after its law's mix). */
+void sx__law_parts_mix(sx_pair_law *l, const sx_material *a, const sx_material *b);
 /* A material's parameter of a law. */
 static inline double *sx__law_value(sx_material_def *d, const sx_law_param *p)
 {
