@@ -221,6 +221,9 @@ static int by_coords(const void *pa, const void *pb)
     return a->i < b->i ? -1 : a->i > b->i;
 }
 
+/* Equal coordinates (-0 and 0 alike, as the sort has them). */
+static bool by_coords_equal(const double *a, const double *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
 /* map[v]: the welded index of input vertex v, welded vertices numbered in
  * order of first appearance; returns their count, -1 out of memory. */
 static int64_t weld(const double *x, int64_t nv, int64_t *map)
@@ -236,7 +239,7 @@ static int64_t weld(const double *x, int64_t nv, int64_t *map)
     qsort(k, (size_t)nv, sizeof *k, by_coords);
     /* each input vertex points to the first input vertex of its coordinates */
     for (int64_t j = 0; j < nv; j++)
-        first[k[j].i] = j > 0 && memcmp(k[j].x, k[j - 1].x, sizeof k[j].x) == 0 ? first[k[j - 1].i] : k[j].i;
+        first[k[j].i] = j > 0 && by_coords_equal(k[j].x, k[j - 1].x) ? first[k[j - 1].i] : k[j].i;
     int64_t n = 0;
     for (int64_t v = 0; v < nv; v++) map[v] = first[v] == v ? n++ : map[first[v]];
     free(k);
