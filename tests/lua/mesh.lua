@@ -143,12 +143,13 @@ T.test("a flipped triangle is turned round to wind as its neighbours", function(
   end
 end)
 
--- A drum-like scene: balls in a mesh box spinning about the x axis, enough
+-- A drum-like scene: balls in a mesh box spinning about the x axis (and
+-- drifting along it), enough
 -- of them (more than 256) for the per-ball passes to run in two blocks.
 local function spinning(threads)
   local m = model(threads)
   m:set_timestep(1.5e-5)
-  m:wall{kind = "mesh", triangles = box_triangles(0.2), point = {0.1, 0.1, 0.1}, spin = {2, 0, 0},
+  m:wall{kind = "mesh", triangles = box_triangles(0.2), point = {0.1, 0.1, 0.1}, spin = {2, 0, 0}, vel = {0.02, 0, 0},
          kn = 1e6, ks = 1e6}
   m:generate{count = 300, radius = {0.004, 0.005}, region = {box = {{0.01, 0.01, 0.005}, {0.19, 0.19, 0.04}}},
              material = "damped", seed = 3}
@@ -175,6 +176,8 @@ T.test("a run restarted from a snapshot with a spinning mesh goes on to the bit"
   T.eq(w.kind, "mesh")
   T.eq(w.facet_count, 12)
   T.vec_eq(w.spin, {2, 0, 0})
+  T.vec_eq(w.point, a:walls()().point) -- the pose as the run left it
+  T.vec_eq(w.vertices[5], a:walls()().vertices[5])
 end)
 
 T.test("a mesh wall reports force and moment, and refuses bad input", function()
