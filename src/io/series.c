@@ -483,6 +483,47 @@ static void frame(const double *n, double *u, double *v)
 /* Facets around a cylinder: a 32-gon is within 0.5 % of its radius. */
 enum { CYL_SIDES = 32 };
 
+/* Walls drawn as cells: the points, the cells' corners (per each) and what
+ * each cell carries (its wall's id, a velocity, the wall's force). */
+typedef struct drawn {
+    double *pts, *vel, *frc;
+    int32_t *conn;
+    int64_t *ids;
+} drawn;
+
+static bool drawn_alloc(drawn *w, int64_t npts, int64_t ncells, int per)
+{
+    w->pts = calloc((size_t)(npts * 3 + 1), sizeof *w->pts);
+    w->vel = calloc((size_t)(ncells * 3 + 1), sizeof *w->vel);
+    w->frc = calloc((size_t)(ncells * 3 + 1), sizeof *w->frc);
+    w->conn = calloc((size_t)(ncells * per + 1), sizeof *w->conn);
+    w->ids = calloc((size_t)(ncells + 1), sizeof *w->ids);
+    return w->pts && w->vel && w->frc && w->conn && w->ids;
+}
+
+/* Writes the cells into group `name` of the snapshot (or fails out of
+ * memory when ok is false), then frees them. */
+static void drawn_write(sx_h5 *h, hid_t snapg, const char *name, drawn *w, bool ok, int64_t npts, int64_t ncells,
+                        int per)
+{
+    if (!ok) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        hid_t g = sx_h5_group(h, snapg, name);
+        sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->pts, npts, 3, "m");
+        sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, w->conn, ncells, per, NULL);
+        sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, w->ids, ncells, 1, NULL);
+        sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->vel, ncells, 3, "m/s");
+        sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->frc, ncells, 3, "N");
+        sx_h5_close(g);
+    }
+    free(w->pts);
+    free(w->vel);
+    free(w->frc);
+    free(w->conn);
+    free(w->ids);
+}
+
 /* Walls as drawable cells: a 3D plane as a square across the balls'
  * bounding box, a rectangle as itself, a cylinder as CYL_SIDES
  * quadrilaterals around its axis (from its first end over its height; an
@@ -509,16 +550,13 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
         ncells += cyl ? CYL_SIDES : 1;
         npts += cyl ? 2 * CYL_SIDES : per;
     }
-    double *pts = calloc((size_t)(npts * 3 + 1), sizeof *pts);
-    double *vel = calloc((size_t)(ncells * 3 + 1), sizeof *vel), *frc = calloc((size_t)(ncells * 3 + 1), sizeof *frc);
-    int32_t *conn = calloc((size_t)(ncells * per + 1), sizeof *conn);
-    int64_t *ids = calloc((size_t)(ncells + 1), sizeof *ids);
-    if (!pts || !vel || !frc || !conn || !ids) {
-        sx_h5_fail(h, "out of memory");
-        goto done;
-    }
+    drawn dw;
+    const bool ok = drawn_alloc(&dw, npts, ncells, per);
+    double *pts = dw.pts, *vel = dw.vel, *frc = dw.frc;
+    int32_t *conn = dw.conn;
+    int64_t *ids = dw.ids;
     int64_t cell = 0, pt = 0;
-    for (int64_t w = 0; w < nw; w++) {
+    for (int64_t w = 0; w < nw && ok; w++) {
         const sx_wall *wl = &m->walls[w];
         const sx_wall_def *def = &wl->def;
         double *p = pts + pt * 3;
@@ -583,19 +621,7 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
     }
     sn->wall_cells = ncells;
     sn->wall_points = npts;
-    hid_t g = sx_h5_group(h, snapg, "walls");
-    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, npts, 3, "m");
-    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, ncells, per, NULL);
-    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, ncells, 1, NULL);
-    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, ncells, 3, "m/s");
-    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, ncells, 3, "N");
-    sx_h5_close(g);
-done:
-    free(pts);
-    free(vel);
-    free(frc);
-    free(conn);
-    free(ids);
+    drawn_write(h, snapg, "walls", &dw, ok, npts, ncells, per);
 }
 
 /* Mesh walls as their triangles, where they are; each cell carries its
@@ -608,16 +634,13 @@ static void write_meshes(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
         if (m->walls[w].mesh) ncells += m->walls[w].mesh->nt, npts += m->walls[w].mesh->nv;
     sn->mesh_cells = ncells, sn->mesh_points = npts;
     if (!ncells) return;
-    double *pts = malloc((size_t)npts * 3 * sizeof *pts), *vel = malloc((size_t)ncells * 3 * sizeof *vel);
-    double *frc = malloc((size_t)ncells * 3 * sizeof *frc);
-    int32_t *conn = malloc((size_t)ncells * 3 * sizeof *conn);
-    int64_t *ids = malloc((size_t)ncells * sizeof *ids);
-    if (!pts || !vel || !frc || !conn || !ids) {
-        sx_h5_fail(h, "out of memory");
-        goto done;
-    }
+    drawn dw;
+    const bool ok = drawn_alloc(&dw, npts, ncells, 3);
+    double *pts = dw.pts, *vel = dw.vel, *frc = dw.frc;
+    int32_t *conn = dw.conn;
+    int64_t *ids = dw.ids;
     int64_t cell = 0, pt = 0;
-    for (int64_t w = 0; w < m->nwall; w++) {
+    for (int64_t w = 0; w < m->nwall && ok; w++) {
         const sx_wall *wl = &m->walls[w];
         const sx_mesh *s = wl->mesh;
         if (!s) continue;
@@ -636,19 +659,7 @@ static void write_meshes(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
         }
         pt += s->nv;
     }
-    hid_t g = sx_h5_group(h, snapg, "meshes");
-    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, npts, 3, "m");
-    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, ncells, 3, NULL);
-    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, ncells, 1, NULL);
-    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, ncells, 3, "m/s");
-    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, ncells, 3, "N");
-    sx_h5_close(g);
-done:
-    free(pts);
-    free(vel);
-    free(frc);
-    free(conn);
-    free(ids);
+    drawn_write(h, snapg, "meshes", &dw, ok, npts, ncells, 3);
 }
 
 static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f, snap *s)
