@@ -41,6 +41,7 @@
  * dimension, so every helper stays static and inlined as one file had it. */
 #include "kernels/vec.h"
 
+#include "kernels/facets.c"
 #include "kernels/broad_phase.c"
 #include "kernels/pair_contacts.c"
 #include "kernels/ghosts.c"

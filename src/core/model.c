@@ -482,7 +482,7 @@ static bool unforced(const sx_model *m)
         /* a servo sets its wall moving, and a cylinder's radius moves at radial_vel */
         if (m->walls[w].servo_on || m->walls[w].def.radial_vel != 0) return false;
         for (int k = 0; k < m->dim; k++)
-            if (m->walls[w].def.vel[k] != 0) return false;
+            if (m->walls[w].def.vel[k] != 0 || m->walls[w].def.spin[k] != 0) return false;
     }
     if (m->balls.fapp) return false;
     if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
@@ -563,6 +563,11 @@ static void move_walls(sx_model *m, double *max_wall)
         if (w->def.kind == SX_WALL_CYLINDER) {
             w->def.radius += w->def.radial_vel * m->dt;
             w->moved += fabs(w->def.radial_vel) * m->dt;
+        }
+        if (w->mesh) { /* a moving mesh: the turn about its point, then its vertices */
+            const double turned = sx__mesh_turn(w, m->dt);
+            w->moved += turned;
+            if (turned > 0 || s > 0) sx__mesh_pose(w);
         }
         if (w->moved > *max_wall) *max_wall = w->moved;
     }

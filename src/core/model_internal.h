@@ -94,6 +94,29 @@ typedef struct sx_balls {
     int64_t index_cap, next_id;
 } sx_balls;
 
+/* A triangle mesh (mesh.c): its shape in its own frame, fixed at creation,
+ * and its pose (the wall's point and an orientation); the world vertices
+ * and facet normals follow the pose at every step. The facets' grid is in
+ * the mesh's frame, so a moving mesh never rebuilds it: a ball is taken
+ * into that frame to find its facets. */
+typedef struct sx_mesh {
+    int64_t nv, nt;
+    double *body;          /* vertices relative to the point, in the mesh's frame (3 nv) */
+    int32_t *tri;          /* three vertex indices per facet (3 nt) */
+    double q[4];           /* orientation: unit quaternion (w, x, y, z), body -> world */
+    double rot[9];         /* its rotation matrix, row-major */
+    double *x;             /* world vertices: point + rot body (3 nv) */
+    double *nrm;           /* facets' unit normals (x1 - x0) x (x2 - x0), world (3 nt) */
+    double reach;          /* the largest distance of a vertex from the point, m */
+    /* the facets' grid (mesh frame): cells of side cell from lo, CSR lists */
+    double lo[3], cell;
+    int64_t nc[3];
+    int32_t *start, *items;
+    int64_t nitems;
+    uint32_t *stamp;       /* per facet: the last query that met it (one query lists a facet once) */
+    uint32_t query;
+} sx_mesh;
+
 typedef struct sx_wall {
     int64_t id;
     sx_wall_def def;       /* def.point moves with the wall */
@@ -106,6 +129,7 @@ typedef struct sx_wall {
     bool servo_on;
     sx_servo_def servo;
     double moved;          /* distance moved since the last broad-phase build */
+    sx_mesh *mesh;         /* SX_WALL_MESH: its mesh (owned), else NULL */
 } sx_wall;
 
 /* Candidate pairs of the broad phase with their history, in one flat
@@ -128,6 +152,7 @@ typedef struct sx_pairs {
     double *mr;            /* rolling moment on b (rdim, laws/rolling.h); NULL while no material rolls */
     double *us;            /* accumulated tangential displacement of b (dim, laws/total_shear.h); NULL
                             * while no material asks for the total form */
+    int32_t *facet;        /* m->bw: a mesh wall's facet (0 for other walls); NULL until the model has a mesh */
     /* the last force evaluation, for queries consistent with the balls' forces */
     double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
@@ -277,6 +302,7 @@ struct sx_model {
 
     sx_wall *walls;
     int64_t nwall, cap_wall, next_wall_id;
+    bool mesh_pairs;        /* the ball-wall store carries facets (bw.facet): the model has had a mesh */
 
     sx_pairs bb, bw;        /* ball-ball and ball-wall candidate pairs */
     sx_chunk *chunks;       /* the ball-ball pass's chunks, planned at each build */
@@ -380,6 +406,23 @@ size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p);
 bool sx__pairs_sort(sx_model *m, sx_pairs *p);
 void sx__walls_free(sx_model *m);
 void sx__wall_prepare(sx_model *m, sx_wall *w);
+/* sx_wall_add, with the mesh (owned from then on) of a mesh wall. */
+sx_status sx__wall_add(sx_model *m, const sx_wall_def *def, sx_mesh *mesh, int64_t *id);
+/* Meshes (mesh.c). */
+void sx__mesh_free(sx_model *m, sx_mesh *mesh);
+/* World vertices and normals from the wall's point and the mesh's orientation. */
+void sx__mesh_pose(const sx_wall *w);
+/* Turns the mesh by its spin over dt (about the wall's point, which the
+ * caller moves); returns the largest vertex displacement of the turn. */
+double sx__mesh_turn(sx_wall *w, double dt);
+/* A mesh from its frame's vertices and triangles as stored (a restore):
+ * derived arrays and the grid; false when out of memory. */
+bool sx__mesh_derive(sx_model *m, sx_mesh *mesh);
+/* Sets m->mesh_pairs, with m->bw.facet (zeros) at the store's size; SX_ENOMEM. */
+sx_status sx__pairs_expand_facets(sx_model *m);
+/* Calls fn on each facet of mesh whose box in the mesh's frame meets the
+ * cube of half-side h about body-frame point xb, each once, in cell order. */
+void sx__mesh_query(sx_mesh *mesh, const double xb[3], double h, void (*fn)(int32_t facet, void *ud), void *ud);
 void sx__walls_servo(sx_model *m); /* servo velocities from the step's wall loads */
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);

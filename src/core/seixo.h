@@ -287,6 +287,7 @@ typedef enum sx_wall_kind {
     SX_WALL_RECT,     ///< 3D finite rectangle: corner + two edge vectors; two-sided
     SX_WALL_SEGMENT,  ///< 2D finite segment: two end points; two-sided
     SX_WALL_CYLINDER, ///< 3D cylinder: axis point + axis direction (normal), radius, height; balls inside
+    SX_WALL_MESH,     ///< 3D triangle mesh (sx_wall_add_mesh): two-sided facets; moves at vel and spins at spin about point
 } sx_wall_kind;
 
 typedef struct sx_wall_def {
@@ -296,6 +297,7 @@ typedef struct sx_wall_def {
     double edge1[3];   ///< rect: first edge from the corner; segment: second end minus first
     double edge2[3];   ///< rect: second edge from the corner (orthogonal to edge1)
     double vel[3];     ///< m/s, imposed translational velocity
+    double spin[3];    ///< mesh: rad/s, imposed angular velocity about point (0 for the other kinds)
     double radius;     ///< cylinder: m, its radius (changes at radial_vel)
     double height;     ///< cylinder: m, its length along the axis from point (0: infinite)
     double radial_vel; ///< cylinder: m/s, rate of change of the radius (> 0 expands)
@@ -325,6 +327,45 @@ typedef enum sx_wall_scalar {
     SX_WALL_FRICTION,  ///< Coulomb coefficient (>= 0)
     SX_WALL_RADIUS,    ///< cylinder: m, its radius (> 0)
 } sx_wall_scalar;
+
+/// A triangle mesh for sx_wall_add_mesh: nv vertices (x, y, z in m) and nt
+/// triangles (three 0-based vertex indices each). Vertices at exactly the
+/// same coordinates are welded into one, so a triangle soup (an STL file)
+/// gets the shared edges and vertices that contacts need.
+typedef struct sx_mesh_def {
+    const double *vertices; ///< 3 nv, m
+    int64_t nv;
+    const int32_t *triangles; ///< 3 nt vertex indices
+    int64_t nt;
+    /// false: a degenerate triangle (a repeated vertex or zero area) is an
+    /// error naming it; true: such triangles are dropped and counted.
+    bool repair;
+} sx_mesh_def;
+
+/// What sx_wall_add_mesh changed in the mesh it was given.
+typedef struct sx_mesh_report {
+    int64_t dropped;  ///< degenerate triangles dropped (repair only)
+    int64_t flipped;  ///< triangles turned round to wind as their neighbours (always)
+    int64_t welded;   ///< vertices merged into an identical one
+    int64_t first_dropped, first_flipped; ///< the input index of the first of each (-1: none)
+} sx_mesh_report;
+
+/// Adds a triangle-mesh wall (3D only). def gives the point the mesh spins
+/// about (def.point), its velocity and spin, kn, ks and friction (def.kind
+/// is ignored). A ball touches a facet's face, an edge or a vertex; where
+/// facets meet, one contact is kept (a face before the edges and vertices
+/// it borders), and a contact's shear history passes to the facet that
+/// takes it over, so a ball rolls across facets as on one surface.
+/// report (may be NULL) says what was repaired.
+SX_API sx_status sx_wall_add_mesh(sx_model *m, const sx_wall_def *def, const sx_mesh_def *mesh, int64_t *id,
+                                  sx_mesh_report *report);
+/// A mesh wall's vertex and triangle counts (after welding and repair).
+SX_API sx_status sx_wall_mesh_size(const sx_model *m, int64_t id, int64_t *nv, int64_t *nt);
+/// A mesh wall's vertices where they are now (3 nv doubles, m) and its
+/// triangles (3 nt indices); either may be NULL.
+SX_API sx_status sx_wall_mesh_get(const sx_model *m, int64_t id, double *vertices, int32_t *triangles);
+/// A mesh wall's angular velocity about its point (rad/s).
+SX_API sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3]);
 
 /// Sets a stiffness, the friction or a cylinder's radius; the next step
 /// (and its timestep) uses the new value.

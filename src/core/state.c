@@ -18,6 +18,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->applied = m->balls.fapp != NULL;
     out->bb = m->bb.n;
     out->bw = m->bw.n;
+    out->bw_facets = m->mesh_pairs;
     out->bb_bonds = m->bb.bond != NULL;
     out->rolling = m->bb.mr != NULL;
     out->total_shear = m->bb.us != NULL;
@@ -76,7 +77,8 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     /* pairs: a store that carried bond slots gets them back, even when empty */
     if (sx__pairs_reserve(m, &m->bb, s->bb_bonds && s->bb == 0 ? 1 : s->bb)) goto nomem;
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
-    if (sx__pairs_reserve(m, &m->bw, s->bw)) goto nomem;
+    if (sx__pairs_reserve(m, &m->bw, s->bw_facets && s->bw == 0 ? 1 : s->bw)) goto nomem;
+    if (s->bw_facets && sx__pairs_expand_facets(m)) goto nomem;
     if (s->rolling && sx__pairs_expand(m, offsetof(sx_pairs, mr), r)) goto nomem;
     if (s->total_shear && sx__pairs_expand(m, offsetof(sx_pairs, us), d)) goto nomem;
     m->bb.n = s->bb;
@@ -204,12 +206,31 @@ static sx_status check_balls(sx_model *m)
     return SX_OK;
 }
 
+/* A restored mesh: its numbers in range, then what follows from them. */
+static sx_status check_mesh(sx_model *m, sx_wall *w)
+{
+    sx_mesh *s = w->mesh;
+    const double *q = s->q, qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if (!finite_all(s->body, 3 * s->nv) || !finite_all(w->def.spin, 3) || !finite_all(q, 4) || !(fabs(qq - 1) < 1e-9))
+        return sx__fail(m, SX_EINVAL, "state: mesh wall %lld has a non-finite vertex or spin, or an orientation that "
+                                      "is not a unit quaternion", (long long)w->id);
+    for (int64_t t = 0; t < 3 * s->nt; t++)
+        if (s->tri[t] < 0 || s->tri[t] >= s->nv)
+            return sx__fail(m, SX_EINVAL, "state: mesh wall %lld: triangle %lld names vertex %d of %lld", (long long)w->id,
+                            (long long)(t / 3), s->tri[t], (long long)s->nv);
+    if (!sx__mesh_derive(m, s)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
+    sx__mesh_pose(w);
+    return SX_OK;
+}
+
 static sx_status check_walls(sx_model *m)
 {
+    sx_status st;
     for (int64_t i = 0; i < m->nwall; i++) {
         const sx_wall *w = &m->walls[i];
         const sx_wall_kind k = w->def.kind;
-        const bool ok = m->dim == 3 ? (k == SX_WALL_PLANE || k == SX_WALL_RECT || k == SX_WALL_CYLINDER)
+        const bool ok = m->dim == 3 ? ((k == SX_WALL_PLANE || k == SX_WALL_RECT || k == SX_WALL_CYLINDER) && !w->mesh) ||
+                                          (k == SX_WALL_MESH && w->mesh)
                                     : (k == SX_WALL_LINE || k == SX_WALL_SEGMENT);
         if (!ok) return sx__fail(m, SX_EINVAL, "state: wall %lld has kind %d, not a %dD wall", (long long)w->id, (int)k, m->dim);
         if (w->id < 1 || w->id > m->next_wall_id)
@@ -243,6 +264,7 @@ static sx_status check_walls(sx_model *m)
         if (w->servo_on && (!isfinite(s->target) || !(s->area > 0) || !isfinite(s->area) ||
                             !(s->alpha > 0 && s->alpha <= 1) || !(s->max_speed > 0) || !isfinite(s->max_speed)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has servo settings out of range", (long long)w->id);
+        if (w->mesh && (st = check_mesh(m, &m->walls[i]))) return st;
     }
     return SX_OK;
 }
@@ -289,6 +311,11 @@ static sx_status check_pairs(sx_model *m)
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld has a bad touching flag", (long long)c);
         if (!pair_finite(m, p, c))
             return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld has a non-finite history", (long long)c);
+        const sx_mesh *mesh = m->walls[p->b[c]].mesh;
+        const int32_t facet = p->facet ? p->facet[c] : 0;
+        if (facet < 0 || (mesh ? facet >= mesh->nt : facet != 0))
+            return sx__fail(m, SX_EINVAL, "state: ball-wall pair %lld names facet %d of wall %lld, which has none such",
+                            (long long)c, facet, (long long)m->walls[p->b[c]].id);
     }
     return SX_OK;
 }
@@ -496,8 +523,8 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
             for (int k = 0; k < 3; k++) put_int(&one, (int64_t)(sign * image[k]));
         }
         for (int j = 0; j < nf; j++) {
-            /* the ends are the ids above; the bond slot below, present or not */
-            if (f[j].end || f[j].data == (void **)&p->bond) continue;
+            /* the ends are the ids above (a mesh's facet is hashed here); the bond slot below, present or not */
+            if (f[j].data == (void **)&p->a || f[j].data == (void **)&p->b || f[j].data == (void **)&p->bond) continue;
             const int64_t at = c * f[j].per;
             if (f[j].type == SX_PAIR_F64)
                 put_doubles(&one, (const double *)*f[j].data + at, f[j].per, f[j].sign ? sign : 1);
@@ -586,6 +613,10 @@ static void hash_walls(hasher *s, const sx_model *m)
         const double last[] = {w->load, w->kn_sum, m->build_needed ? 0 : w->moved};
         put_doubles(s, last, 3, 1);
         put_int(s, w->contacts);
+        if (w->mesh) { /* its turn and spin */
+            put_doubles(s, w->mesh->q, sizeof w->mesh->q / sizeof(double), 1);
+            put_doubles(s, w->def.spin, 3, 1);
+        }
         put_int(s, w->servo_on);
         if (w->servo_on) put_doubles(s, (const double *)&w->servo, sizeof w->servo / sizeof(double), 1);
     }

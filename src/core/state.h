@@ -16,7 +16,8 @@
  *            bonds, crack log, walls (definition incl. a cylinder's radius,
  *            height and radial velocity, frame, force, moment, the last
  *            step's load, stiffness sum and contact count, servo settings,
- *            distance moved), materials with BPM parameters, and every
+ *            distance moved; a mesh's vertices in its frame, triangles and
+ *            orientation), materials with BPM parameters, and every
  *            scalar of sx_model below `dim` (timestep state, skin, time,
  *            step, builds, build flag, guard, energy tracking);
  *   derived  id -> index map, intact bonds (here), pair laws (refreshed by
@@ -35,6 +36,7 @@ typedef struct sx_state_sizes {
     int64_t next_ball_id; ///< ids in use are 1 .. next_ball_id - 1
     bool applied;         ///< the applied force / moment arrays exist
     int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
+    bool bw_facets;       ///< the ball-wall store carries mesh facets
     bool bb_bonds;        ///< the ball-ball store carries bond slots
     bool rolling;         ///< both pair stores carry rolling moments (laws/rolling.h)
     bool total_shear;     ///< both pair stores carry shear displacements (laws/total_shear.h)
@@ -52,6 +54,11 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out);
 /// used, to hold exactly s (arrays zeroed, counts set). SX_EINVAL when m is
 /// not empty or a size is out of range, SX_ENOMEM; the message is in m.
 sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s);
+
+/// A mesh for a wall being restored: nv vertices and nt triangles, its
+/// arrays zeroed for the I/O layer to fill (body, tri, q) before
+/// sx__state_finish derives the rest; NULL when out of memory.
+sx_mesh *sx__mesh_alloc(sx_model *m, int64_t nv, int64_t nt);
 
 /// After the arrays are filled: rebuilds the id -> index map and the
 /// intact-bond count and checks every index, id, kind and material

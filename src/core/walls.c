@@ -52,7 +52,7 @@ void sx__wall_prepare(sx_model *m, sx_wall *w)
         def->normal[0] = w->u[1] * w->v[2] - w->u[2] * w->v[1];
         def->normal[1] = w->u[2] * w->v[0] - w->u[0] * w->v[2];
         def->normal[2] = w->u[0] * w->v[1] - w->u[1] * w->v[0];
-    } else {
+    } else if (def->kind == SX_WALL_SEGMENT) {
         w->seg_len = norm(def->edge1, 2);
         def->normal[0] = -def->edge1[1] / w->seg_len;
         def->normal[1] = def->edge1[0] / w->seg_len;
@@ -66,15 +66,15 @@ static bool finite3(const double *v, int d)
     return true;
 }
 
-static sx_status validate(sx_model *m, const sx_wall_def *def)
+static sx_status validate(sx_model *m, const sx_wall_def *def, const sx_mesh *mesh)
 {
     const int d = m->dim;
     const bool ok_kind = d == 3 ? (def->kind == SX_WALL_PLANE || def->kind == SX_WALL_RECT ||
-                                   def->kind == SX_WALL_CYLINDER)
+                                   def->kind == SX_WALL_CYLINDER || def->kind == SX_WALL_MESH)
                                 : (def->kind == SX_WALL_LINE || def->kind == SX_WALL_SEGMENT);
     if (!ok_kind)
         return sx__fail(m, SX_EINVAL,
-                        "wall_add: kind %d is not a %dD wall (3D: plane, rect, cylinder; 2D: line, segment)",
+                        "wall_add: kind %d is not a %dD wall (3D: plane, rect, cylinder, mesh; 2D: line, segment)",
                         (int)def->kind, d);
     if (!finite3(def->point, d) || !finite3(def->vel, d) || !finite3(def->normal, d) ||
         !finite3(def->edge1, d) || !finite3(def->edge2, d))
@@ -96,6 +96,9 @@ static sx_status validate(sx_model *m, const sx_wall_def *def)
             return sx__fail(m, SX_EINVAL, "wall_add: rect edges must be orthogonal (edge1.edge2 = %g)", dot);
         break;
     }
+    case SX_WALL_MESH:
+        if (!mesh) return sx__fail(m, SX_EINVAL, "wall_add: a mesh wall is added with its triangles (wall_add_mesh)");
+        break;
     case SX_WALL_SEGMENT:
         if (!(norm(def->edge1, 2) > 0)) return sx__fail(m, SX_EINVAL, "wall_add: the segment has zero length");
         break;
@@ -111,11 +114,13 @@ static sx_status validate(sx_model *m, const sx_wall_def *def)
     return SX_OK;
 }
 
-sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id)
+sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id) { return sx__wall_add(m, def, NULL, id); }
+
+sx_status sx__wall_add(sx_model *m, const sx_wall_def *def, sx_mesh *mesh, int64_t *id)
 {
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "wall_add: the model is stepping");
-    sx_status st = validate(m, def);
+    sx_status st = validate(m, def, mesh);
     if (st) return st;
     if (m->nwall == m->cap_wall) {
         const int64_t cap = m->cap_wall ? 2 * m->cap_wall : 8;
@@ -130,6 +135,8 @@ sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id)
     for (int k = m->dim; k < 3; k++) /* a 2D wall has no third component */
         w->def.point[k] = w->def.normal[k] = w->def.edge1[k] = w->def.edge2[k] = w->def.vel[k] = 0;
     w->id = ++m->next_wall_id;
+    w->mesh = mesh;
+    if (def->kind != SX_WALL_MESH) memset(w->def.spin, 0, sizeof w->def.spin); /* only a mesh turns */
     sx__wall_prepare(m, w);
     m->build_needed = true;
     m->dt_stale = true;
@@ -153,6 +160,7 @@ sx_status sx_wall_remove(sx_model *m, int64_t id)
         k++;
     }
     p->n = k;
+    sx__mesh_free(m, m->walls[i].mesh);
     m->walls[i] = m->walls[last];
     m->nwall--;
     m->build_needed = true;
@@ -213,6 +221,7 @@ sx_status sx_wall_set_point(sx_model *m, int64_t id, const double p[3])
     if (!w) return SX_ENOTFOUND;
     if (!finite3(p, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_point: the point must be finite");
     for (int k = 0; k < m->dim; k++) w->def.point[k] = p[k];
+    if (w->mesh) sx__mesh_pose(w);
     m->build_needed = true; /* a jump, not a motion the skin covers */
     return SX_OK;
 }
@@ -279,6 +288,7 @@ sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def)
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_servo");
     if (!w) return SX_ENOTFOUND;
+    if (w->mesh) return sx__fail(m, SX_EINVAL, "wall_set_servo: wall %lld is a mesh, which has no one normal to servo along", (long long)id);
     if (!isfinite(def->target))
         return sx__fail(m, SX_EINVAL, "wall_set_servo: the target stress must be finite (got %g)", def->target);
     if (!(def->area > 0) || !isfinite(def->area))
@@ -339,6 +349,7 @@ void sx__walls_servo(sx_model *m)
 
 void sx__walls_free(sx_model *m)
 {
+    for (int64_t i = 0; i < m->nwall; i++) sx__mesh_free(m, m->walls[i].mesh);
     sx_alloc_free(&m->alloc, m->walls, (size_t)m->cap_wall, sizeof *m->walls);
     m->walls = NULL;
     m->nwall = m->cap_wall = 0;

@@ -13,6 +13,14 @@
 /// The newest file format this build writes; it reads every format up to it.
 #define SX_IO_FORMAT_VERSION 3
 
+/* ---------------------------------------------------------- STL files */
+
+/// Reads an STL file, ASCII or binary (told apart by the binary form's
+/// size), into *xyz: nine doubles per triangle, its three corners (x, y, z)
+/// as written, m; *nt triangles. *xyz is malloc'd (free it). The facet
+/// normals the file writes are not read: the corners' order is the facet's.
+sx_status sx_io_read_stl(const char *path, double **xyz, int64_t *nt, char *err, size_t errlen);
+
 /* -------------------------------------------------------- value trees */
 
 /// Kinds of keys and values of a tree node (as stored in the file).

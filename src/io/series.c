@@ -129,6 +129,7 @@ typedef struct snap {
     double time;
     int64_t step, balls, contacts, wall_contacts, bonds, walls, cracks;
     int64_t wall_cells, wall_points; /* a cylinder is drawn with many cells */
+    int64_t mesh_cells, mesh_points; /* mesh walls' triangles, a grid of their own */
     unsigned fields;
     int dim;
     bool clumps; /* the balls carry their clump ids (pebbles of a clump, 0 for free balls) */
@@ -189,7 +190,7 @@ static void geometry(buf *b, const char *base, int64_t k, const char *ds, int64_
 static void lines(buf *b, const char *base, int64_t k, const char *ds, int64_t cells, int nodes, const char *topo)
 {
     put(b, "     <Topology TopologyType=\"%s\" NumberOfElements=\"%lld\"", topo, (long long)cells);
-    if (strcmp(topo, "Quadrilateral") != 0) put(b, " NodesPerElement=\"%d\"", nodes);
+    if (strcmp(topo, "Quadrilateral") != 0 && strcmp(topo, "Triangle") != 0) put(b, " NodesPerElement=\"%d\"", nodes);
     put(b, ">");
     item(b, base, k, ds, cells, nodes, "Int", 4);
     put(b, "</Topology>\n");
@@ -267,6 +268,16 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "id", "walls/id", c, 1, "Int", 8, true);
         attribute(b, base, k, "velocity", "walls/velocity", c, 3, "Float", 8, true);
         attribute(b, base, k, "force", "walls/force", c, 3, "Float", 8, true);
+        put(b, "    </Grid>\n");
+    }
+    if ((f & SX_OUT_WALLS) && s->mesh_cells > 0) {
+        const int64_t c = s->mesh_cells;
+        put(b, "    <Grid Name=\"meshes\" GridType=\"Uniform\">\n");
+        lines(b, base, k, "meshes/connectivity", c, 3, "Triangle");
+        geometry(b, base, k, "meshes/points", s->mesh_points);
+        attribute(b, base, k, "id", "meshes/id", c, 1, "Int", 8, true);
+        attribute(b, base, k, "velocity", "meshes/velocity", c, 3, "Float", 8, true);
+        attribute(b, base, k, "force", "meshes/force", c, 3, "Float", 8, true);
         put(b, "    </Grid>\n");
     }
     put(b, "   </Grid>\n");
@@ -484,6 +495,47 @@ static void frame(const double *n, double *u, double *v)
 /* Facets around a cylinder: a 32-gon is within 0.5 % of its radius. */
 enum { CYL_SIDES = 32 };
 
+/* Walls drawn as cells: the points, the cells' corners (per each) and what
+ * each cell carries (its wall's id, a velocity, the wall's force). */
+typedef struct drawn {
+    double *pts, *vel, *frc;
+    int32_t *conn;
+    int64_t *ids;
+} drawn;
+
+static bool drawn_alloc(drawn *w, int64_t npts, int64_t ncells, int per)
+{
+    w->pts = calloc((size_t)(npts * 3 + 1), sizeof *w->pts);
+    w->vel = calloc((size_t)(ncells * 3 + 1), sizeof *w->vel);
+    w->frc = calloc((size_t)(ncells * 3 + 1), sizeof *w->frc);
+    w->conn = calloc((size_t)(ncells * per + 1), sizeof *w->conn);
+    w->ids = calloc((size_t)(ncells + 1), sizeof *w->ids);
+    return w->pts && w->vel && w->frc && w->conn && w->ids;
+}
+
+/* Writes the cells into group `name` of the snapshot (or fails out of
+ * memory when ok is false), then frees them. */
+static void drawn_write(sx_h5 *h, hid_t snapg, const char *name, drawn *w, bool ok, int64_t npts, int64_t ncells,
+                        int per)
+{
+    if (!ok) {
+        sx_h5_fail(h, "out of memory");
+    } else {
+        hid_t g = sx_h5_group(h, snapg, name);
+        sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->pts, npts, 3, "m");
+        sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, w->conn, ncells, per, NULL);
+        sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, w->ids, ncells, 1, NULL);
+        sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->vel, ncells, 3, "m/s");
+        sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, w->frc, ncells, 3, "N");
+        sx_h5_close(g);
+    }
+    free(w->pts);
+    free(w->vel);
+    free(w->frc);
+    free(w->conn);
+    free(w->ids);
+}
+
 /* Walls as drawable cells: a 3D plane as a square across the balls'
  * bounding box, a rectangle as itself, a cylinder as CYL_SIDES
  * quadrilaterals around its axis (from its first end over its height; an
@@ -505,24 +557,23 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
     const double half = diag > 0 ? 0.6 * sqrt(diag) : 1.0;
     int64_t ncells = 0, npts = 0;
     for (int64_t w = 0; w < nw; w++) {
+        if (m->walls[w].mesh) continue; /* in write_meshes */
         const bool cyl = m->walls[w].def.kind == SX_WALL_CYLINDER;
         ncells += cyl ? CYL_SIDES : 1;
         npts += cyl ? 2 * CYL_SIDES : per;
     }
-    double *pts = calloc((size_t)(npts * 3 + 1), sizeof *pts);
-    double *vel = calloc((size_t)(ncells * 3 + 1), sizeof *vel), *frc = calloc((size_t)(ncells * 3 + 1), sizeof *frc);
-    int32_t *conn = calloc((size_t)(ncells * per + 1), sizeof *conn);
-    int64_t *ids = calloc((size_t)(ncells + 1), sizeof *ids);
-    if (!pts || !vel || !frc || !conn || !ids) {
-        sx_h5_fail(h, "out of memory");
-        goto done;
-    }
+    drawn dw;
+    const bool ok = drawn_alloc(&dw, npts, ncells, per);
+    double *pts = dw.pts, *vel = dw.vel, *frc = dw.frc;
+    int32_t *conn = dw.conn;
+    int64_t *ids = dw.ids;
     int64_t cell = 0, pt = 0;
-    for (int64_t w = 0; w < nw; w++) {
+    for (int64_t w = 0; w < nw && ok; w++) {
         const sx_wall *wl = &m->walls[w];
         const sx_wall_def *def = &wl->def;
         double *p = pts + pt * 3;
         const int64_t first = cell;
+        if (wl->mesh) continue;
         if (def->kind == SX_WALL_CYLINDER) {
             const double *n = def->normal;
             double u[3], v[3], t0 = 0, t1 = def->height;
@@ -582,19 +633,45 @@ static void write_walls(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
     }
     sn->wall_cells = ncells;
     sn->wall_points = npts;
-    hid_t g = sx_h5_group(h, snapg, "walls");
-    sx_h5_write(h, g, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, pts, npts, 3, "m");
-    sx_h5_write(h, g, "connectivity", H5T_NATIVE_INT32, H5T_STD_I32LE, conn, ncells, per, NULL);
-    sx_h5_write(h, g, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, ids, ncells, 1, NULL);
-    sx_h5_write(h, g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, vel, ncells, 3, "m/s");
-    sx_h5_write(h, g, "force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frc, ncells, 3, "N");
-    sx_h5_close(g);
-done:
-    free(pts);
-    free(vel);
-    free(frc);
-    free(conn);
-    free(ids);
+    drawn_write(h, snapg, "walls", &dw, ok, npts, ncells, per);
+}
+
+/* Mesh walls as their triangles, where they are; each cell carries its
+ * wall's id and force and the surface velocity at the facet's centroid
+ * (the translation and the spin about the mesh's point). */
+static void write_meshes(sx_h5 *h, hid_t snapg, const sx_model *m, snap *sn)
+{
+    int64_t ncells = 0, npts = 0;
+    for (int64_t w = 0; w < m->nwall; w++)
+        if (m->walls[w].mesh) ncells += m->walls[w].mesh->nt, npts += m->walls[w].mesh->nv;
+    sn->mesh_cells = ncells, sn->mesh_points = npts;
+    if (!ncells) return;
+    drawn dw;
+    const bool ok = drawn_alloc(&dw, npts, ncells, 3);
+    double *pts = dw.pts, *vel = dw.vel, *frc = dw.frc;
+    int32_t *conn = dw.conn;
+    int64_t *ids = dw.ids;
+    int64_t cell = 0, pt = 0;
+    for (int64_t w = 0; w < m->nwall && ok; w++) {
+        const sx_wall *wl = &m->walls[w];
+        const sx_mesh *s = wl->mesh;
+        if (!s) continue;
+        memcpy(pts + 3 * pt, s->x, (size_t)s->nv * 3 * sizeof *pts);
+        for (int64_t t = 0; t < s->nt; t++, cell++) {
+            double r[3];
+            for (int k = 0; k < 3; k++) {
+                conn[3 * cell + k] = (int32_t)(pt + s->tri[3 * t + k]);
+                r[k] = (s->x[3 * s->tri[3 * t] + k] + s->x[3 * s->tri[3 * t + 1] + k] + s->x[3 * s->tri[3 * t + 2] + k]) / 3 -
+                       wl->def.point[k];
+            }
+            const double *o = wl->def.spin;
+            const double turn[3] = {o[1] * r[2] - o[2] * r[1], o[2] * r[0] - o[0] * r[2], o[0] * r[1] - o[1] * r[0]};
+            for (int k = 0; k < 3; k++) vel[3 * cell + k] = wl->def.vel[k] + turn[k], frc[3 * cell + k] = wl->force[k];
+            ids[cell] = wl->id;
+        }
+        pt += s->nv;
+    }
+    drawn_write(h, snapg, "meshes", &dw, ok, npts, ncells, 3);
 }
 
 /* The crack log so far as points (the bonds' field brings it): position,
@@ -689,6 +766,7 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     if (f & SX_OUT_WALLS) {
         s->walls = m->nwall;
         write_walls(h, snapg, m, s);
+        write_meshes(h, snapg, m, s);
     }
     sx_h5_attr_double(h, snapg, "time", s->time);
     sx_h5_attr_int(h, snapg, "step", s->step);
@@ -701,6 +779,10 @@ static void write_snapshot(sx_h5 *h, hid_t snapg, const sx_model *m, unsigned f,
     sx_h5_attr_int(h, snapg, "cracks", s->cracks);
     sx_h5_attr_int(h, snapg, "wall_cells", s->wall_cells);
     sx_h5_attr_int(h, snapg, "wall_points", s->wall_points);
+    if (s->mesh_cells) {
+        sx_h5_attr_int(h, snapg, "mesh_cells", s->mesh_cells);
+        sx_h5_attr_int(h, snapg, "mesh_points", s->mesh_points);
+    }
     sx_h5_attr_int(h, snapg, "fields", (int64_t)s->fields);
     if (s->clumps) sx_h5_attr_int(h, snapg, "clumps", 1);
 }
@@ -758,6 +840,8 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     sx_h5_get_i64(h, g, name, "wall_cells", &s->wall_cells, 1, false);
     sx_h5_get_i64(h, g, name, "wall_points", &s->wall_points, 1, false);
     sx_h5_get_i64(h, g, name, "cracks", &s->cracks, 1, false); /* absent before crack maps */
+    sx_h5_get_i64(h, g, name, "mesh_cells", &s->mesh_cells, 1, false); /* absent without meshes */
+    sx_h5_get_i64(h, g, name, "mesh_points", &s->mesh_points, 1, false);
     sx_h5_close(g);
     return !h->failed;
 }

@@ -414,8 +414,9 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
 
 /* --------------------------------------------------------------- walls */
 
-static const char *const wall_kind_names[] = {"plane", "line", "rect", "segment", "cylinder"};
-static const int wall_kind_values[] = {SX_WALL_PLANE, SX_WALL_LINE, SX_WALL_RECT, SX_WALL_SEGMENT, SX_WALL_CYLINDER};
+static const char *const wall_kind_names[] = {"plane", "line", "rect", "segment", "cylinder", "mesh"};
+static const int wall_kind_values[] = {SX_WALL_PLANE,   SX_WALL_LINE,     SX_WALL_RECT,
+                                       SX_WALL_SEGMENT, SX_WALL_CYLINDER, SX_WALL_MESH};
 enum { WALL_KINDS = sizeof wall_kind_values / sizeof *wall_kind_values };
 
 /* The walls' arrays, gathered from (or scattered to) the array of structs. */
@@ -427,6 +428,7 @@ typedef struct wall_cols {
     double *u, *v, *len_u, *len_v, *seg_len, *force, *moment, *moved;
     double *radius, *height, *radial_vel, *load, *kn_sum;
     double *target, *area, *alpha, *max_speed;
+    double *spin;
 } wall_cols;
 
 static bool wall_cols_alloc(wall_cols *c, int64_t n)
@@ -437,7 +439,7 @@ static bool wall_cols_alloc(wall_cols *c, int64_t n)
     c->contacts = calloc(k, sizeof *c->contacts);
     c->kind = calloc(k, sizeof *c->kind);
     c->servo_on = calloc(k, sizeof *c->servo_on);
-    double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment};
+    double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment, &c->spin};
     double **sc[] = {&c->kn,     &c->ks,     &c->friction,   &c->len_u, &c->len_v,  &c->seg_len, &c->moved,
                      &c->radius, &c->height, &c->radial_vel, &c->load,  &c->kn_sum, &c->target,  &c->area,
                      &c->alpha,  &c->max_speed};
@@ -452,7 +454,7 @@ static void wall_cols_free(wall_cols *c)
     void *p[] = {c->id,       c->contacts, c->kind,    c->servo_on,   c->point,  c->normal, c->edge1,  c->edge2,
                  c->vel,      c->kn,       c->ks,      c->friction,   c->u,      c->v,      c->len_u,  c->len_v,
                  c->seg_len,  c->force,    c->moment,  c->moved,      c->radius, c->height, c->radial_vel,
-                 c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed};
+                 c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed, c->spin};
     for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
 }
 
@@ -473,6 +475,14 @@ static int wall_fields2(const sx_model *m, const wall_cols *c, field *f)
     f[n++] = F("servo_area", T_F64, c->area, 1, d3 ? "m^2" : "m");
     f[n++] = F("servo_alpha", T_F64, c->alpha, 1, "1");
     f[n++] = F("servo_max_speed", T_F64, c->max_speed, 1, "m/s");
+    return n;
+}
+
+/* Meshes' spin (3D), optional: a file without meshes may lack it. */
+static int wall_fields_mesh(const sx_model *m, const wall_cols *c, field *f)
+{
+    int n = 0;
+    if (m->dim == 3) f[n++] = F("spin", T_F64, c->spin, 3, "rad/s");
     return n;
 }
 
@@ -524,6 +534,7 @@ static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bo
     V(v, w->v, d);
     V(force, w->force, d);
     V(moment, w->moment, r);
+    V(spin, w->def.spin, 3);
     S(kn, w->def.kn);
     S(ks, w->def.ks);
     S(friction, w->def.friction);
@@ -548,6 +559,44 @@ static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bo
 #undef S
 }
 
+/* A mesh wall's group /walls/mesh_<id>: its vertices in its own frame
+ * (relative to the wall's point), its triangles and its orientation, from
+ * which the vertices where they are follow (sx__mesh_pose). */
+static void mesh_group_name(const sx_wall *w, char *name, size_t len)
+{
+    snprintf(name, len, "mesh_%lld", (long long)w->id);
+}
+
+static void save_mesh(sx_h5 *h, hid_t walls, const sx_wall *w)
+{
+    char name[64];
+    mesh_group_name(w, name, sizeof name);
+    hid_t g = sx_h5_group(h, walls, name);
+    const sx_mesh *s = w->mesh;
+    sx_h5_write(h, g, "body_vertices", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, s->body, s->nv, 3, "m");
+    sx_h5_write(h, g, "triangles", H5T_NATIVE_INT32, H5T_STD_I32LE, s->tri, s->nt, 3, NULL);
+    sx_h5_write(h, g, "orientation", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, s->q, 1, 4, "1");
+    sx_h5_close(g);
+}
+
+static void load_mesh(sx_h5 *h, hid_t walls, sx_model *m, sx_wall *w)
+{
+    char name[64], where[96];
+    mesh_group_name(w, name, sizeof name);
+    snprintf(where, sizeof where, "/walls/%s", name);
+    hid_t g = sx_h5_open_group(h, walls, name, true);
+    if (g < 0) return;
+    const int64_t nv = sx_h5_rows(h, g, where, "body_vertices", 3, true), nt = sx_h5_rows(h, g, where, "triangles", 3, true);
+    if (!h->failed && (nv < 3 || nt < 1)) sx_h5_fail(h, "damaged: %s has %lld vertices and %lld triangles", where, (long long)nv, (long long)nt);
+    if (!h->failed && !(w->mesh = sx__mesh_alloc(m, nv, nt))) sx_h5_fail(h, "out of memory");
+    if (!h->failed) {
+        sx_h5_read(h, g, where, "body_vertices", H5T_NATIVE_DOUBLE, w->mesh->body, nv, 3, true);
+        sx_h5_read(h, g, where, "triangles", H5T_NATIVE_INT32, w->mesh->tri, nt, 3, true);
+        sx_h5_read(h, g, where, "orientation", H5T_NATIVE_DOUBLE, w->mesh->q, 1, 4, true);
+    }
+    sx_h5_close(g);
+}
+
 static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
 {
     hid_t g = sx_h5_group(h, f, "walls");
@@ -564,6 +613,9 @@ static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
         field fl[MAX_FIELDS];
         write_fields(h, g, fl, wall_fields(m, &c, fl), n);
         write_fields(h, g, fl, wall_fields2(m, &c, fl), n);
+        write_fields(h, g, fl, wall_fields_mesh(m, &c, fl), n);
+        for (int64_t i = 0; i < n; i++)
+            if (m->walls[i].mesh) save_mesh(h, g, &m->walls[i]);
     }
     wall_cols_free(&c);
     sx_h5_close(mem);
@@ -585,8 +637,12 @@ static void load_walls(sx_h5 *h, hid_t g, sx_model *m, int version)
         sx_h5_read(h, g, "/walls", "id", H5T_NATIVE_INT64, c.id, n, 1, true);
         sx_h5_read(h, g, "/walls", "kind", mem, c.kind, n, 1, true);
         if (read_fields(h, g, "/walls", fl, wall_fields(m, &c, fl), n, true) &&
-            read_fields(h, g, "/walls", fl, wall_fields2(m, &c, fl), n, version >= 2))
-            for (int64_t i = 0; i < n; i++) wall_copy(m, &m->walls[i], &c, i, false);
+            read_fields(h, g, "/walls", fl, wall_fields2(m, &c, fl), n, version >= 2) &&
+            read_fields(h, g, "/walls", fl, wall_fields_mesh(m, &c, fl), n, false))
+            for (int64_t i = 0; i < n && !h->failed; i++) {
+                wall_copy(m, &m->walls[i], &c, i, false);
+                if (m->walls[i].def.kind == SX_WALL_MESH) load_mesh(h, g, m, &m->walls[i]);
+            }
     }
     wall_cols_free(&c);
     sx_h5_close(mem);
@@ -1085,6 +1141,7 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/contacts/ball_wall", true);
     s->bw = sx_h5_rows(h, g, "/contacts/ball_wall", "a", 1, true);
+    s->bw_facets = g >= 0 && H5Lexists(g, "facet", H5P_DEFAULT) > 0;
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/bonds", true);
     s->bonds = sx_h5_rows(h, g, "/bonds", "kind", 1, true);

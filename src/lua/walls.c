@@ -5,14 +5,17 @@
  * stiffnesses and friction are writable; its orientation and extent are
  * fixed when it is made), and `extra` holds user values, as a ball's. */
 #include "bindings.h"
+#include "seixo_io.h"
 
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
-static const char *const kind_names[] = {"plane", "line", "rect", "segment", "cylinder", "box", NULL};
-enum { KIND_BOX = 5 };
+static const char *const kind_names[] = {"plane", "line", "rect", "segment", "cylinder", "mesh", "box", NULL};
+enum { KIND_BOX = 6 };
 _Static_assert(SX_WALL_PLANE == 0 && SX_WALL_LINE == 1 && SX_WALL_RECT == 2 && SX_WALL_SEGMENT == 3 &&
-                   SX_WALL_CYLINDER == 4,
+                   SX_WALL_CYLINDER == 4 && SX_WALL_MESH == 5,
                "kind_names is indexed by sx_wall_kind");
 
 static const char *const plane_keys[] = {"kind", "point", "normal", "kn", "ks", "friction", "vel", NULL};
@@ -21,6 +24,8 @@ static const char *const cylinder_keys[] = {"kind", "point", "axis",     "radius
 static const char *const rect_keys[] = {"kind", "corner", "point", "edge1", "edge2", "kn", "ks", "friction", "vel",
                                         NULL};
 static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", NULL};
+static const char *const mesh_keys[] = {"kind", "file", "triangles", "vertices", "point", "vel",    "spin",
+                                        "kn",   "ks",   "friction",  "repair",   NULL};
 static const char *const box_keys[] = {"kind", "min", "max", "kn", "ks", "friction", NULL};
 
 /* What a wall kind needs: its dimension, its counterpart in the other
@@ -35,6 +40,7 @@ static const struct shape {
     [SX_WALL_RECT] = {3, "segment", rect_keys},
     [SX_WALL_SEGMENT] = {2, "rect", segment_keys},
     [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
+    [SX_WALL_MESH] = {3, "set of segments", mesh_keys},
 };
 
 static const char *const wall_shown[] = {"kind", "point", "normal", "vel", "force", NULL};
@@ -76,6 +82,7 @@ static int get_normal(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_de
 static int get_edge1(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge1)); }
 static int get_edge2(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge2)); }
 static int get_vel(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, vel)); }
+static int get_spin(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, spin)); }
 static int get_kn(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, kn)); }
 static int get_ks(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, ks)); }
 static int get_friction(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, friction)); }
@@ -120,6 +127,59 @@ static int set_vel(lua_State *L)
     sx_lua_checkfield(L, m, sx_wall_set_vel(m, id, v), "wall");
     return 0;
 }
+
+static int set_spin(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    double v[3] = {0, 0, 0};
+    sx_lua_checkvalue(L, 3, 3, v, "wall", "spin");
+    sx_lua_checkfield(L, m, sx_wall_set_spin(m, id, v), "wall");
+    return 0;
+}
+
+/* A mesh's vertex (which = 0) or facet (1) count. */
+static int push_mesh_count(lua_State *L, int which)
+{
+    int64_t id, n[2];
+    const sx_model *m = check_wall(L, &id);
+    sx_lua_checkfield(L, m, sx_wall_mesh_size(m, id, &n[0], &n[1]), "wall");
+    lua_pushinteger(L, (lua_Integer)n[which]);
+    return 1;
+}
+
+/* A mesh's vertices where they are now ({x, y, z} each), or its
+ * triangles (three 1-based vertex numbers each). */
+static int push_mesh(lua_State *L, bool triangles)
+{
+    int64_t id, n[2];
+    const sx_model *m = check_wall(L, &id);
+    sx_lua_checkfield(L, m, sx_wall_mesh_size(m, id, &n[0], &n[1]), "wall");
+    double *x = lua_newuserdatauv(L, (size_t)n[0] * 3 * sizeof *x, 0);
+    int32_t *t = lua_newuserdatauv(L, (size_t)n[1] * 3 * sizeof *t, 0);
+    sx_lua_checkfield(L, m, sx_wall_mesh_get(m, id, x, t), "wall");
+    const int64_t count = triangles ? n[1] : n[0];
+    lua_createtable(L, (int)count, 0);
+    for (int64_t e = 0; e < count; e++) {
+        if (triangles) {
+            lua_createtable(L, 3, 0);
+            for (int j = 0; j < 3; j++) {
+                lua_pushinteger(L, t[3 * e + j] + 1);
+                lua_rawseti(L, -2, j + 1);
+            }
+        } else {
+            sx_lua_pushvec(L, x + 3 * e, 3);
+        }
+        lua_rawseti(L, -2, e + 1);
+    }
+    return 1;
+}
+
+static int get_vertices(lua_State *L) { return push_mesh(L, false); }
+static int get_triangles(lua_State *L) { return push_mesh(L, true); }
+
+static int get_vertex_count(lua_State *L) { return push_mesh_count(L, 0); }
+static int get_facet_count(lua_State *L) { return push_mesh_count(L, 1); }
 
 static int set_point(lua_State *L)
 {
@@ -183,6 +243,99 @@ static void read_corner(lua_State *L, double *corner)
     if (!named_corner && !named_point) luaL_argerror(L, 2, "field 'corner' (or 'point') is required");
 }
 
+/* The triangles of a mesh wall as a soup (nine doubles per triangle) or as
+ * vertices with 0-based indices, from `file` (STL), `triangles` (a list of
+ * three corners each) or `vertices` with `triangles` (a list of three
+ * 1-based vertex numbers each). Arrays on the Lua stack as userdata. */
+static void read_mesh(lua_State *L, sx_mesh_def *md)
+{
+    const bool file = lua_getfield(L, 2, "file") != LUA_TNIL;
+    lua_pop(L, 1);
+    const bool tris = lua_getfield(L, 2, "triangles") == LUA_TTABLE;
+    const bool verts = lua_getfield(L, 2, "vertices") == LUA_TTABLE;
+    if (file == tris) luaL_argerror(L, 2, "a mesh needs 'file' (an STL file) or 'triangles', one of them");
+    if (verts && !tris) luaL_argerror(L, 2, "field 'vertices' goes with 'triangles' (three vertex numbers each)");
+    int64_t nv, nt;
+    double *x;
+    if (file) {
+        const char *path = sx_lua_optstrfield(L, 2, "file");
+        if (!path) luaL_argerror(L, 2, "field 'file' must be a file name");
+        char err[512];
+        double *soup;
+        if (sx_io_read_stl(path, &soup, &nt, err, sizeof err)) luaL_error(L, "m:wall: %s", err);
+        x = lua_newuserdatauv(L, (size_t)nt * 9 * sizeof *x, 0);
+        memcpy(x, soup, (size_t)nt * 9 * sizeof *x);
+        free(soup);
+        nv = 3 * nt;
+    } else {
+        nt = (int64_t)luaL_len(L, -2);
+        nv = verts ? (int64_t)luaL_len(L, -1) : 3 * nt;
+        x = lua_newuserdatauv(L, (size_t)(nv > 0 ? nv : 1) * 3 * sizeof *x, 0);
+        for (int64_t t = 0; t < nt; t++) {
+            if (lua_geti(L, -3, t + 1) != LUA_TTABLE || luaL_len(L, -1) != 3)
+                luaL_error(L, "m:wall: field 'triangles': entry %d must be a list of three %s", (int)t + 1,
+                           verts ? "vertex numbers" : "corners {x, y, z}");
+            for (int j = 0; j < 3 && !verts; j++) {
+                lua_geti(L, -1, j + 1);
+                const char *why = sx_lua_tovec(L, -1, 3, x + 9 * t + 3 * j);
+                if (why) luaL_error(L, "m:wall: field 'triangles': triangle %d, corner %d: %s", (int)t + 1, j + 1, why);
+                lua_pop(L, 1);
+            }
+            lua_pop(L, 1);
+        }
+        for (int64_t v = 0; v < nv && verts; v++) {
+            lua_geti(L, -2, v + 1);
+            const char *why = sx_lua_tovec(L, -1, 3, x + 3 * v);
+            if (why) luaL_error(L, "m:wall: field 'vertices': vertex %d: %s", (int)v + 1, why);
+            lua_pop(L, 1);
+        }
+    }
+    int32_t *ix = lua_newuserdatauv(L, (size_t)(nt > 0 ? nt : 1) * 3 * sizeof *ix, 0);
+    for (int64_t t = 0; t < nt; t++)
+        for (int j = 0; j < 3; j++) {
+            if (!verts) {
+                ix[3 * t + j] = (int32_t)(3 * t + j);
+                continue;
+            }
+            lua_geti(L, -4, t + 1);
+            lua_geti(L, -1, j + 1);
+            int ok;
+            const lua_Integer k = lua_tointegerx(L, -1, &ok);
+            if (!ok || k < 1 || k > nv)
+                luaL_error(L, "m:wall: field 'triangles': triangle %d, corner %d must be a vertex number from 1 to %d",
+                           (int)t + 1, j + 1, (int)nv);
+            ix[3 * t + j] = (int32_t)(k - 1);
+            lua_pop(L, 2);
+        }
+    md->vertices = x, md->nv = nv;
+    md->triangles = ix, md->nt = nt;
+    lua_getfield(L, 2, "repair");
+    md->repair = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+}
+
+/* A mesh wall; what a repair changed is said on stderr. */
+static int add_mesh(lua_State *L, sx_model *m, sx_wall_def *d)
+{
+    sx_mesh_def md;
+    read_mesh(L, &md);
+    sx_lua_optvecfield(L, 2, "point", 3, d->point);
+    sx_lua_optvecfield(L, 2, "spin", 3, d->spin);
+    int64_t id;
+    sx_mesh_report rep;
+    sx_lua_check(L, m, sx_wall_add_mesh(m, d, &md, &id, &rep), "m:wall");
+    if (rep.dropped)
+        fprintf(stderr, "seixo: warning: mesh wall %lld: %lld degenerate triangle(s) dropped (the first: triangle %lld)\n",
+                (long long)id, (long long)rep.dropped, (long long)rep.first_dropped + 1);
+    if (rep.flipped)
+        fprintf(stderr,
+                "seixo: warning: mesh wall %lld: %lld triangle(s) turned round to wind as their neighbours (the first: "
+                "triangle %lld)\n",
+                (long long)id, (long long)rep.flipped, (long long)rep.first_flipped + 1);
+    sx_lua_pushhandle(L, 1, &wall_kind, id);
+    return 1;
+}
+
 static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
 {
     const int dim = sx_model_dim(m);
@@ -195,6 +348,8 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
     d.kind = kind;
     read_common(L, dim, &d);
     switch (kind) {
+    case SX_WALL_MESH:
+        return add_mesh(L, m, &d);
     case SX_WALL_PLANE:
     case SX_WALL_LINE:
         sx_lua_checkvecfield(L, 2, "point", dim, d.point);
@@ -322,6 +477,11 @@ void sx_lua_walls_register(lua_State *L)
         {"normal", get_normal},
         {"edge1", get_edge1},
         {"edge2", get_edge2},
+        {"spin", get_spin},
+        {"vertex_count", get_vertex_count},
+        {"vertices", get_vertices},
+        {"triangles", get_triangles},
+        {"facet_count", get_facet_count},
         {"kn", get_kn},
         {"ks", get_ks},
         {"friction", get_friction},
@@ -330,6 +490,7 @@ void sx_lua_walls_register(lua_State *L)
     };
     static const luaL_Reg setters[] = {
         {"vel", set_vel},
+        {"spin", set_spin},
         {"point", set_point},
         {"kn", set_kn},
         {"ks", set_ks},

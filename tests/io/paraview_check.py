@@ -63,6 +63,12 @@ def main():
     if not lines:
         fail("no contacts or bonds as line cells with a 'normal_force' field")
     print("line datasets (contacts, bonds, wall contacts): %s cells" % [p.GetNumberOfCells() for p in lines])
+    # the scene's mesh wall, a tetrahedron: four triangles (VTK cell type 5)
+    meshes = [p for p in parts if p.GetNumberOfCells() > 0 and p.GetCellType(0) == 5]
+    if len(meshes) != 1 or meshes[0].GetNumberOfCells() != 4 or meshes[0].GetNumberOfPoints() != 4:
+        fail("no dataset of the mesh wall's 4 triangles on 4 points: %s" %
+             [(p.GetNumberOfCells(), p.GetNumberOfPoints()) for p in meshes])
+    print("mesh wall: %d triangles" % meshes[0].GetNumberOfCells())
 
     # the balls as spheres of their radius, coloured by speed: the dataset
     # with a 'radius' point field picked out of the snapshot

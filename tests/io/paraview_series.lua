@@ -1,12 +1,15 @@
 -- Writes the series that tests/io/paraview_check.py reads with ParaView:
 -- a bonded block of balls of three radii falling onto a plane, a tilted
--- rectangle beside it; prints "snapshots balls rmin rmax".
+-- rectangle beside it, a tetrahedron of four triangles (a mesh wall) away
+-- from them, turning; prints "snapshots balls rmin rmax".
 --   seixo paraview_series.lua OUT.h5
 local out = assert(arg[1], "usage: seixo paraview_series.lua OUT.h5")
 local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
 m:material("rock", {kn = 1e6, ks = 1e6, friction = 0.5, density = 2600, damping = 0.1})
 m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
 m:wall{kind = "rect", point = {-0.03, -0.03, 0.02}, edge1 = {0, 0.15, 0}, edge2 = {-0.01, 0, 0.05}}
+m:wall{kind = "mesh", vertices = {{0.2, 0, 0.01}, {0.25, 0, 0.01}, {0.2, 0.05, 0.01}, {0.2, 0, 0.06}},
+       triangles = {{1, 3, 2}, {1, 2, 4}, {2, 3, 4}, {3, 1, 4}}, point = {0.21, 0.01, 0.02}, spin = {0, 0, 3}}
 local n, rmin, rmax = 0, math.huge, 0
 for i = 0, 9 do
   for j = 0, 9 do

@@ -399,7 +399,7 @@ end)
 test("wall errors", function()
   local m = model3()
   raises(function() m:wall{point = {0, 0, 0}} end, HERE, "field 'kind' is required")
-  raises(function() m:wall{kind = "disk"} end, HERE, "unknown kind 'disk'", "plane, line, rect, segment, cylinder, box")
+  raises(function() m:wall{kind = "disk"} end, HERE, "unknown kind 'disk'", "plane, line, rect, segment, cylinder, mesh, box")
   raises(function() m:wall{kind = "line", point = {0, 0}, normal = {0, 1}} end, HERE, "3D", "'plane'")
   raises(function() m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, p1 = {0, 0, 0}} end, HERE,
          "unknown key 'p1'", "normal")

@@ -20,6 +20,7 @@ typedef struct transfer {
     /* the new pairs as listed: src is the old pair + 1 (negated when the
      * pair turned round), 0 when it had no history (src NULL: none had) */
     int32_t *a, *b, *src;
+    int32_t *f;               /* the listed ball-wall pairs' facets (mesh walls; NULL without meshes) */
     int64_t n, cap;
     uint8_t *seen;            /* per bond slot: found again by the grid */
     /* periodic space: the cell vectors each old ball was wrapped by (3 per
@@ -29,6 +30,8 @@ typedef struct transfer {
     int64_t gbase, gcap;
     int32_t *gowner;
     int8_t *gimage;
+    bool facets;              /* the store being listed carries facets */
+    int32_t *near;            /* one ball's candidate facets of one mesh (room for the largest mesh) */
 } transfer;
 
 /* periodic space (kernels/ghosts.c) */
@@ -87,6 +90,8 @@ static void transfer_end(sx_model *m, transfer *tr)
     sx_alloc_free(&m->alloc, tr->wrap, tr->wrap ? (size_t)(tr->nwrap * 3) : 0, sizeof *tr->wrap);
     sx_alloc_free(&m->alloc, tr->gowner, (size_t)tr->gcap, sizeof *tr->gowner);
     sx_alloc_free(&m->alloc, tr->gimage, (size_t)tr->gcap * 3, sizeof *tr->gimage);
+    sx_alloc_free(&m->alloc, tr->f, (size_t)tr->cap, sizeof *tr->f);
+    free(tr->near);
 }
 
 /* Room for cap listed pairs (the list emptied when fresh). */
@@ -96,8 +101,9 @@ static bool transfer_list(sx_model *m, transfer *tr, int64_t cap, bool fresh)
     if (cap < 16) cap = 16; /* never an empty allocation */
     if (cap > INT32_MAX) return false;
     if (cap == tr->cap) return true;
-    int32_t **q[3] = {&tr->a, &tr->b, &tr->src};
-    for (int k = 0; k < (tr->history ? 3 : 2); k++) {
+    int32_t **q[4] = {&tr->a, &tr->b, &tr->f, &tr->src};
+    for (int k = 0; k < 4; k++) {
+        if ((k == 2 && !tr->facets) || (k == 3 && !tr->history)) continue;
         int32_t *r = sx_alloc_resize(&m->alloc, *q[k], (size_t)tr->cap, (size_t)cap, sizeof *r);
         if (!r) return false;
         *q[k] = r;
@@ -109,14 +115,16 @@ static bool transfer_list(sx_model *m, transfer *tr, int64_t cap, bool fresh)
 /* The old pair of new pair (a, b) in old store p (rows row): old pair + 1,
  * negated when the pair turned round; 0 without history (not found, or
  * not touching). A ball-ball pair is kept under its lower old index, a
- * ball-wall pair (wall) under its ball. */
-static int32_t old_pair(const transfer *tr, const sx_pairs *p, const int32_t *row, int64_t a, int64_t b, bool wall)
+ * ball-wall pair (wall) under its ball, a mesh's by its facet too. */
+static int32_t old_pair(const transfer *tr, const sx_pairs *p, const int32_t *row, int64_t a, int64_t b, bool wall,
+                        int32_t facet)
 {
     if (!tr->history) return 0;
     const int64_t oa = tr->order[a], ob = wall ? b : tr->order[b];
     const int64_t lo = wall || oa < ob ? oa : ob, hi = wall || oa < ob ? ob : oa;
     for (int32_t c = row[lo]; c < row[lo + 1]; c++)
-        if (p->b[c] == hi) return p->touching[c] ? (oa == lo ? c + 1 : -(c + 1)) : 0;
+        if (p->b[c] == hi && (!p->facet || p->facet[c] == facet))
+            return p->touching[c] ? (oa == lo ? c + 1 : -(c + 1)) : 0;
     return 0;
 }
 
@@ -137,7 +145,7 @@ static int64_t old_end(const transfer *tr, int64_t b, int32_t *img)
  * under a, or the reverse under b. */
 static int32_t old_ball_pair(const sx_model *m, const transfer *tr, int64_t a, int64_t b)
 {
-    if (!m->cell || !tr->history) return old_pair(tr, &m->bb, tr->row_bb, a, b, false);
+    if (!m->cell || !tr->history) return old_pair(tr, &m->bb, tr->row_bb, a, b, false, 0);
     const sx_cell *c = m->cell;
     int32_t s[3] = {0, 0, 0};
     int64_t ob = b;
@@ -161,9 +169,10 @@ static int32_t old_ball_pair(const sx_model *m, const transfer *tr, int64_t a, i
     return 0;
 }
 
-static void transfer_push(transfer *tr, int32_t a, int32_t b, int32_t src)
+static void transfer_push(transfer *tr, int32_t a, int32_t b, int32_t facet, int32_t src)
 {
     tr->a[tr->n] = a, tr->b[tr->n] = b;
+    if (tr->f) tr->f[tr->n] = facet;
     if (tr->src) tr->src[tr->n] = src;
     tr->n++;
 }
@@ -202,6 +211,11 @@ static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
     sx_alloc_free(&m->alloc, p->b, (size_t)old, sizeof *p->b);
     p->a = tr->a, p->b = tr->b;
     tr->a = tr->b = NULL;
+    if (tr->f) { /* the facets too are ends */
+        sx_alloc_free(&m->alloc, p->facet, (size_t)old, sizeof *p->facet);
+        p->facet = tr->f;
+        tr->f = NULL;
+    }
     if (p->bond && tr->src) /* a bond's vectors follow its pair's orientation */
         for (int64_t c = 0; c < tr->n; c++) {
             const int32_t s = tr->src[c], bond = s ? p->bond[s > 0 ? s - 1 : -s - 1] : 0;
@@ -245,7 +259,7 @@ static bool keep_bonded_pairs(sx_model *m, transfer *tr)
             const int32_t t = a;
             a = b, b = t;
         }
-        transfer_push(tr, a, b, old_ball_pair(m, tr, a, b));
+        transfer_push(tr, a, b, 0, old_ball_pair(m, tr, a, b));
     }
     return true;
 }
@@ -436,7 +450,7 @@ static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, in
         const int32_t bond = m->bb.bond[src > 0 ? src - 1 : -src - 1];
         if (bond) tr->seen[bond - 1] = 1;
     }
-    transfer_push(tr, i, j, src);
+    transfer_push(tr, i, j, 0, src);
 }
 
 /* The grid's candidate pairs in cell order; with count, only counts them
@@ -476,6 +490,48 @@ static void build_ball_pairs(sx_model *m, transfer *tr, int64_t *count)
             }
 }
 
+#if D == 3
+typedef struct near_list {
+    int32_t *near;
+    int64_t n;
+} near_list;
+
+static void near_push(int32_t t, void *ud)
+{
+    near_list *l = ud;
+    l->near[l->n++] = t;
+}
+
+static int by_index(const void *a, const void *b)
+{
+    const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Ball i's facets of mesh wall w closer than its radius plus the skin, in
+ * facet order, found through the mesh's grid (the ball taken into the
+ * mesh's frame); with count, only counts them. */
+static void list_mesh_pairs(sx_model *m, transfer *tr, int64_t i, int64_t w, int64_t *count)
+{
+    const sx_wall *wl = &m->walls[w];
+    sx_mesh *s = wl->mesh;
+    const double *x = m->balls.x + i * D, reach = m->balls.rad[i] + m->skin;
+    double r[3], xb[3];
+    for (int k = 0; k < 3; k++) r[k] = x[k] - wl->def.point[k];
+    for (int k = 0; k < 3; k++) xb[k] = s->rot[k] * r[0] + s->rot[3 + k] * r[1] + s->rot[6 + k] * r[2];
+    near_list l = {tr->near, 0};
+    sx__mesh_query(s, xb, reach, near_push, &l);
+    qsort(l.near, (size_t)l.n, sizeof *l.near, by_index);
+    for (int64_t e = 0; e < l.n; e++) {
+        facet_hit h;
+        facet_closest(s, l.near[e], x, &h);
+        if (!(h.dist < reach)) continue;
+        if (count) (*count)++;
+        else transfer_push(tr, (int32_t)i, (int32_t)w, l.near[e], old_pair(tr, &m->bw, tr->row_bw, i, w, true, l.near[e]));
+    }
+}
+#endif
+
 /* Ball-wall candidates, ball-major so the contact loop walks balls in
  * order; with count, only counts them (as build_ball_pairs). */
 static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
@@ -483,11 +539,17 @@ static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
     const sx_balls *b = &m->balls;
     for (int64_t i = 0; i < b->n; i++)
         for (int64_t w = 0; w < m->nwall; w++) {
+#if D == 3
+            if (m->walls[w].mesh) {
+                list_mesh_pairs(m, tr, i, w, count);
+                continue;
+            }
+#endif
             double n[D];
             const double dist = wall_distance(&m->walls[w], b->x + i * D, n);
             if (dist >= b->rad[i] + m->skin) continue;
             if (count) (*count)++;
-            else transfer_push(tr, (int32_t)i, (int32_t)w, old_pair(tr, &m->bw, tr->row_bw, i, w, true));
+            else transfer_push(tr, (int32_t)i, (int32_t)w, 0, old_pair(tr, &m->bw, tr->row_bw, i, w, true, 0));
         }
 }
 
@@ -495,7 +557,11 @@ static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
  * then carried over into the store. */
 static bool build_store(sx_model *m, transfer *tr, bool walls)
 {
-    int64_t count = 0;
+    int64_t count = 0, most = 0;
+    tr->facets = walls && m->mesh_pairs;
+    for (int64_t w = 0; walls && w < m->nwall; w++)
+        if (m->walls[w].mesh && m->walls[w].mesh->nt > most) most = m->walls[w].mesh->nt;
+    if (most && !(tr->near = malloc((size_t)most * sizeof *tr->near))) return false;
     if (walls) build_wall_pairs(m, tr, &count);
     else build_ball_pairs(m, tr, &count);
     if (!walls && m->cell) build_ghost_pairs(m, tr, &count);

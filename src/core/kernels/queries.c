@@ -68,7 +68,8 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         double n[D], kn, ks;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
-        const double un = B->rad[i] - wall_distance(wl, B->x + i * D, n);
+        /* a mesh's contacts as the last step kept them (a shadowed facet stores nothing) */
+        const double un = wl->mesh ? (m->bw.touching[c] ? m->bw.un[c] : 0) : B->rad[i] - wall_distance(wl, B->x + i * D, n);
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
         if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);

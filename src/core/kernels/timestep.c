@@ -70,7 +70,10 @@ static double KERNEL(critical_dt)(sx_model *m)
     for (int64_t c = 0; c < p->n; c++) {
         const int64_t i = p->a[c];
         double nrm[D];
-        const double un = B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
+        /* a mesh's contacts as the last step kept them (a shadowed facet adds no stiffness) */
+        const bool mesh = m->walls[p->b[c]].mesh != NULL;
+        const double un = mesh ? (p->touching[c] ? p->un[c] : 0)
+                               : B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
         if (un <= 0) continue;
         const sx_pair_law law = sx__wall_law(m, B->mat[i], &m->walls[p->b[c]]);
         double kn, ks;

@@ -12,8 +12,27 @@ typedef struct dash_memo {
     double dash, im, cn;
 } dash_memo;
 
-/* One ball-wall contact c, every law and wall kind; false on an overlap error. */
-static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c, dash_memo *memo)
+/* Contact c ended (or gave way to another): the energy its shear spring
+ * held is counted as slip, as for ball-ball contacts. */
+static void wall_release(sx_model *m, sx_block *o, int64_t c)
+{
+    sx_pairs *p = &m->bw;
+    const int64_t i = p->a[c];
+    if (p->touching[c] && m->track_energy) { /* a Hertz spring holds nothing at zero overlap: ks = 0 */
+        const sx_pair_law *law = &m->wlaw[m->balls.mat[i] * m->nwall + p->b[c]];
+        const double r = m->balls.rad[i];
+        double kn, ks;
+        stiffness(law, r, 0, r, 0, &kn, &ks);
+        if (ks > 0) o->slip += 0.5 * dot(p->fs + c * D, p->fs + c * D) / ks;
+        if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, r); /* and the rolling spring's */
+    }
+    p->touching[c] = 0;
+}
+
+/* The force of ball-wall contact c at distance dist < r along unit normal
+ * n (from the wall to the ball), every law and wall kind; false on an
+ * overlap error. */
+static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c, dash_memo *memo, double dist, const double *n)
 {
     sx_balls *B = &m->balls;
     double *restrict f = B->f, *restrict t = B->t;
@@ -25,19 +44,7 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     sx_wall_acc *wa = &acc[p->b[c]];
     const double *xi = B->x + i * D, r = B->rad[i];
     double *fs = p->fs + c * D;
-    double n[D];
-    const double dist = wall_distance(wl, xi, n);
     const sx_pair_law *law = &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
-    if (dist >= r) {
-        if (p->touching[c] && track) { /* a Hertz spring holds nothing at zero overlap: ks = 0 */
-            double kn, ks;
-            stiffness(law, r, 0, r, 0, &kn, &ks);
-            if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
-            if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, r); /* and the rolling spring's */
-        }
-        p->touching[c] = 0;
-        return true;
-    }
     const double un = r - dist; /* 4-3 */
     if (un > r) {
         o->st = SX_EUNSTABLE;
@@ -48,12 +55,20 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     double xc[D];
     for (int k = 0; k < D; k++) xc[k] = xi[k] - lb * n[k]; /* 4-4 */
     /* the contact point's velocity: the ball's, with its arm -lb n, less the
-     * wall's surface velocity (its translation, and a cylinder's radial
-     * motion along -n) */
-    double wn[D], vc[D];
+     * wall's surface velocity (its translation, a cylinder's radial motion
+     * along -n, a mesh's spin about its point) */
+    double wn[D], vc[D], ws[D];
     spin_cross(B->w + i * RD, n, wn);
-    for (int k = 0; k < D; k++)
-        vc[k] = (B->v[i * D + k] - lb * wn[k]) - (wl->def.vel[k] - wl->def.radial_vel * n[k]);
+    for (int k = 0; k < D; k++) ws[k] = wl->def.vel[k] - wl->def.radial_vel * n[k];
+#if D == 3
+    if (wl->mesh) {
+        double arm0[3], turn[3];
+        for (int k = 0; k < 3; k++) arm0[k] = xc[k] - wl->def.point[k];
+        spin_cross(wl->def.spin, arm0, turn);
+        for (int k = 0; k < 3; k++) ws[k] += turn[k];
+    }
+#endif
+    for (int k = 0; k < D; k++) vc[k] = (B->v[i * D + k] - lb * wn[k]) - ws[k];
     const double vn = dot(vc, n);
     double vs[D];
     for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k];
@@ -62,8 +77,13 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     const double fn = stiffness(law, r, 0, r, un, &kn, &ks);
     if (!p->touching[c])
         for (int k = 0; k < D; k++) fs[k] = 0, p->geo[c * D + k] = n[k];
+    /* the wall is entity A of 4-8/4-9: only a mesh spins */
+    const double *wspin = NULL;
+#if D == 3
+    if (wl->mesh) wspin = wl->def.spin;
+#endif
     carry rot;
-    carry_make(&rot, p->geo + c * D, n, NULL, B->w + i * RD, dt);
+    carry_make(&rot, p->geo + c * D, n, wspin, B->w + i * RD, dt);
     carry_apply(&rot, fs);
     double f0[D];
     for (int k = 0; k < D; k++) f0[k] = fs[k];
@@ -80,14 +100,14 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     const bool slip = sx__law_cap(D, fs, f0, dot(fs, fs), law->mu * fn, ks, track ? &o->slip : NULL, &sc);
     if (slip && us) sx_law_total_shear_slip(D, us, sc);
     double mroll[RD] = {0};
-    if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h): the wall does not spin */
+    if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h): the ball's turn relative to the wall's */
         double *mr = p->mr + c * RD, dtheta[RD];
         if (!p->touching[c])
             for (int k = 0; k < RD; k++) mr[k] = 0;
 #if D == 3
         carry_apply(&rot, mr);
 #endif
-        for (int k = 0; k < RD; k++) dtheta[k] = B->w[i * RD + k] * dt;
+        for (int k = 0; k < RD; k++) dtheta[k] = (B->w[i * RD + k] - (wspin ? wspin[k] : 0)) * dt;
         const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, r, fn);
         if (track) o->slip += e;
         for (int k = 0; k < RD; k++) mroll[k] = mr[k];
@@ -146,6 +166,119 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     }
     return true;
 }
+
+/* One ball-wall contact c of a wall that is not a mesh. */
+static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c, dash_memo *memo)
+{
+    const int64_t i = m->bw.a[c];
+    double n[D];
+    const double dist = wall_distance(&m->walls[m->bw.b[c]], m->balls.x + i * D, n);
+    if (dist >= m->balls.rad[i]) {
+        wall_release(m, o, c);
+        return true;
+    }
+    return wall_force(m, o, acc, c, memo, dist, n);
+}
+
+/* The most candidate facets one ball may have on one mesh. */
+#define MESH_ROWS_MAX 256
+
+#if D == 3
+
+/* Whether touching feature k is already felt through a kept one: a face
+ * of the same plane at the same point (two facets met at their shared
+ * edge), the same edge or vertex reached from another facet, or an edge or
+ * vertex of a kept face or edge (the face is the surface there). */
+static bool shadowed(const sx_mesh *s, const int32_t *facet, const facet_hit *h, const uint8_t *keep, int64_t n,
+                     int64_t k, double r)
+{
+    const facet_hit *a = &h[k];
+    for (int64_t j = 0; j < n; j++) {
+        if (!keep[j]) continue;
+        const facet_hit *b = &h[j];
+        if (b->kind == FACET_FACE && a->kind == FACET_FACE) {
+            double dq[3];
+            for (int e = 0; e < 3; e++) dq[e] = a->q[e] - b->q[e];
+            if (dot(dq, dq) <= 1e-18 * r * r && dot(a->n, b->n) >= 1 - 1e-12) return true;
+        } else if (b->kind == FACET_FACE) {
+            const int32_t *tv = s->tri + 3 * (int64_t)facet[j];
+            const bool has0 = tv[0] == a->v0 || tv[1] == a->v0 || tv[2] == a->v0;
+            const bool has1 = tv[0] == a->v1 || tv[1] == a->v1 || tv[2] == a->v1;
+            if (has0 && has1) return true;
+        } else if (b->kind == FACET_EDGE && a->kind == FACET_EDGE) {
+            if (a->v0 == b->v0 && a->v1 == b->v1) return true;
+        } else if (a->kind == FACET_VERTEX) { /* b an edge or a vertex */
+            if (a->v0 == b->v0 || a->v0 == b->v1) return true;
+        }
+    }
+    return false;
+}
+
+/* Pair `to` takes over pair `from`'s history: every field of the store
+ * but its ends (the shear force, the last normal, a law's history such as
+ * the rolling moment, the touching flag). */
+static void inherit(sx_model *m, int64_t to, int64_t from)
+{
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, &m->bw, f);
+    for (int q = 0; q < nf; q++) {
+        if (f[q].end) continue;
+        const size_t row = (size_t)f[q].per * sx__pair_size(&f[q]);
+        char *data = *f[q].data;
+        memcpy(data + (size_t)to * row, data + (size_t)from * row, row);
+    }
+}
+
+/* Ball i's candidate facets of one mesh, rows [c0, c1): every touching
+ * closest feature, faces first, then edges, then vertices, each kept
+ * unless shadowed; a contact a facet takes over (the ball rolled onto it)
+ * inherits the shear force and last normal of the nearest-normal contact
+ * that just ended, so the history runs on as on one surface; then each
+ * kept contact's force, as wall_force does for any wall. */
+static bool mesh_rows(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, int64_t c1, dash_memo *memo)
+{
+    sx_pairs *p = &m->bw;
+    const int64_t i = p->a[c0], n = c1 - c0;
+    const sx_wall *wl = &m->walls[p->b[c0]];
+    const double r = m->balls.rad[i], *x = m->balls.x + i * D;
+    if (n > MESH_ROWS_MAX) {
+        o->st = SX_EINVAL;
+        o->err_ball = m->balls.id[i], o->err_wall = wl->id, o->err_un = (double)n, o->err_r = r;
+        return false;
+    }
+    facet_hit h[MESH_ROWS_MAX];
+    uint8_t keep[MESH_ROWS_MAX], given[MESH_ROWS_MAX];
+    for (int64_t k = 0; k < n; k++) {
+        facet_closest(wl->mesh, p->facet[c0 + k], x, &h[k]);
+        keep[k] = given[k] = 0;
+    }
+    for (int kind = FACET_FACE; kind <= FACET_VERTEX; kind++)
+        for (int64_t k = 0; k < n; k++)
+            if (h[k].kind == kind && h[k].dist < r)
+                keep[k] = !shadowed(wl->mesh, p->facet + c0, h, keep, n, k, r);
+    for (int64_t k = 0; k < n; k++) {
+        if (!keep[k] || p->touching[c0 + k]) continue;
+        int64_t best = -1;
+        double near = 0;
+        for (int64_t j = 0; j < n; j++) {
+            if (keep[j] || given[j] || !p->touching[c0 + j]) continue;
+            const double cosine = dot(p->geo + (c0 + j) * D, h[k].n);
+            if (cosine > near) near = cosine, best = j;
+        }
+        if (best < 0) continue;
+        given[best] = 1;
+        inherit(m, c0 + k, c0 + best);
+    }
+    for (int64_t k = 0; k < n; k++) {
+        if (keep[k]) continue;
+        if (given[k]) p->touching[c0 + k] = 0; /* its history lives on in its heir */
+        else wall_release(m, o, c0 + k);
+    }
+    for (int64_t k = 0; k < n; k++)
+        if (keep[k] && !wall_force(m, o, acc, c0 + k, memo, h[k].dist, h[k].n)) return false;
+    return true;
+}
+#endif
 
 /* Four ball-wall contacts [c0, c0 + 4) at once where each is plain (an
  * infinite wall, a linear law without a shear dashpot, no energy
@@ -299,6 +432,15 @@ SX_VECTOR_CLONES static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *a
     o->st = SX_OK;
     dash_memo memo = {NAN, NAN, 0};
     for (int64_t c = o->w0; c < o->w1;) {
+#if D == 3
+        if (m->mesh_pairs && m->walls[m->bw.b[c]].mesh) { /* the ball's rows of this mesh together */
+            int64_t e = c + 1;
+            while (e < o->w1 && m->bw.a[e] == m->bw.a[c] && m->bw.b[e] == m->bw.b[c]) e++;
+            if (!mesh_rows(m, o, acc, c, e, &memo)) return;
+            c = e;
+            continue;
+        }
+#endif
         bool lanes = !m->track_energy && c + LANES <= o->w1;
         for (int q = 0; q < LANES && lanes; q++) lanes = plain_wall_contact(m, c + q);
         if (lanes) {
@@ -342,6 +484,11 @@ static sx_status KERNEL(walls)(sx_model *m)
     }
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
+        if (o->st == SX_EINVAL)
+            return sx__fail(m, SX_EINVAL,
+                            "ball %lld is near %.0f facets of mesh wall %lld, more than %d: the mesh is too fine for "
+                            "a ball of radius %g m (coarsen it)",
+                            (long long)o->err_ball, o->err_un, (long long)o->err_wall, MESH_ROWS_MAX, o->err_r);
         if (o->st) return overlap_error(m, "ball and wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
         m->acc.slip += o->slip;
         m->acc.viscous += o->viscous;
@@ -354,8 +501,14 @@ static sx_status KERNEL(walls)(sx_model *m)
             wl->contacts += a->contacts;
         }
     }
-    if (m->track_energy) /* boundary work of the moving walls over this step */
-        for (int64_t w = 0; w < nw; w++)
-            m->acc.boundary_work -= (dot(m->walls[w].force, m->walls[w].def.vel) + m->walls[w].def.radial_vel * m->walls[w].load) * m->dt;
+    if (m->track_energy) /* boundary work of the moving walls over this step (and a mesh's turn) */
+        for (int64_t w = 0; w < nw; w++) {
+            const sx_wall *wl = &m->walls[w];
+            double turn = 0;
+#if D == 3
+            if (wl->mesh) turn = dot(wl->moment, wl->def.spin);
+#endif
+            m->acc.boundary_work -= (dot(wl->force, wl->def.vel) + wl->def.radial_vel * wl->load + turn) * m->dt;
+        }
     return SX_OK;
 }
