@@ -740,7 +740,11 @@ sx_energy sx_model_energy(sx_model *m)
     memset(&e, 0, sizeof e);
     /* materials or positions may have changed since the last cycle: the
      * broad phase the next cycle would build anyway sees every overlap */
-    if (sx__prepare(m)) return e;
+    if (sx__prepare(m)) { /* no energy rather than a silent zero */
+        double *t = (double *)&e;
+        for (size_t k = 0; k < sizeof e / sizeof(double); k++) t[k] = NAN;
+        return e;
+    }
     kernels(m)->energy(m, &e);
     return e;
 }

@@ -633,7 +633,8 @@ typedef struct sx_energy {
 } sx_energy;
 
 /// Energies of the current state (computed on demand, O(N + contacts)) and
-/// the accumulated terms.
+/// the accumulated terms; every term NaN when the model cannot be prepared
+/// (sx_model_error says why: a skin refused, materials that cannot meet).
 SX_API sx_energy sx_model_energy(sx_model *m);
 /// Switches tracking of the accumulated terms on (reset to zero) or off.
 SX_API void sx_model_track_energy(sx_model *m, bool on);

@@ -429,7 +429,9 @@ static int model_ratio(lua_State *L)
 
 static int model_energy(lua_State *L)
 {
-    const sx_energy e = sx_model_energy(sx_lua_checkmodel(L, 1));
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_energy e = sx_model_energy(m);
+    if (isnan(e.kinetic)) sx_lua_check(L, m, SX_EINVAL, "m:energy");
     const struct {
         const char *name;
         double value;

@@ -10,6 +10,7 @@
 --   [FUZZ_TIMEOUT=s] [FUZZ_LIMIT=s] [FUZZ_JOBS=n] seixo tests/fuzz/driver.lua
 -- scripts/fuzz sets these; the meson test 'fuzz' runs a bounded number.
 local here = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
+if here:sub(1, 1) ~= "/" then here = assert(os.getenv("PWD"), "PWD") .. "/" .. here end -- the children run elsewhere
 local seixo_exe = assert(os.getenv("FUZZ_SEIXO") or (arg and arg[-1]), "FUZZ_SEIXO: the seixo executable")
 local mutator = os.getenv("FUZZ_H5MUTATE")
 local docs = os.getenv("FUZZ_DOCS") or ""
@@ -48,6 +49,7 @@ local function start(script, first, count, id)
   -- by HDF5's frames: only the slow unwinder sees them (HDF5 has no frame pointers)
   if script == "files.lua" then
     env = env .. ' LSAN_OPTIONS="${LSAN_OPTIONS:-}:fast_unwind_on_malloc=0:malloc_context_size=16"'
+              .. ' ASAN_OPTIONS="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0:malloc_context_size=16"'
   end
   -- scripts/fuzz --lsan: LeakSanitizer preloaded into a build without the sanitizers
   if os.getenv("FUZZ_PRELOAD") then env = env .. " LD_PRELOAD=" .. quote(os.getenv("FUZZ_PRELOAD")) end

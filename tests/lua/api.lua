@@ -711,8 +711,18 @@ test("errors name the Lua call, not the core's function", function()
   says(function() w:servo{target = 1, area = -1} end, "w:servo: the area must be > 0")
   says(function() w:set_radial_vel(1) end, "w:set_radial_vel: wall " .. w.id .. " is not a cylinder")
   says(function() w:set_radius(1) end, "w:set_radius:", "not a cylinder")
-  says(function() seixo.model{dim = 3, timestep = -1} end, "seixo.model: timestep must be >= 0")
-  says(function() m:set_timestep(-1) end, "m:set_timestep: the timestep must be > 0 s")
+  says(function() seixo.model{dim = 3, timestep = -1} end, "seixo.model: timestep must be 0 (automatic) or in [1e-15, 1] s")
+  says(function() m:set_timestep(-1) end, "m:set_timestep: the timestep must be in [1e-15, 1] s")
+  -- issue 18: a timestep of 1.5 s, 2^63 s or a denormal is refused, not taken
+  for _, dt in ipairs({1.5, 2 ^ 63, 4.9e-324, 1e-16}) do
+    says(function() m:set_timestep(dt) end, "m:set_timestep: the timestep must be in [1e-15, 1] s")
+    says(function() seixo.model{dim = 2, timestep = dt} end, "seixo.model: timestep must be 0 (automatic) or in")
+  end
+  -- a radius that gives an infinite or zero mass, NaN Hertz parameters on a linear material
+  says(function() m:ball{pos = {0, 0, 0}, radius = 1e300} end, "gives a mass or inertia of 0 or infinity")
+  says(function() m:ball{pos = {0, 0, 0}, radius = 1e-200} end, "gives a mass or inertia of 0 or infinity")
+  says(function() m:material("nanlin", {poisson = 0 / 0}) end, "Poisson's ratio must be in [0, 0.5)")
+  says(function() m:material("nanlin", {shear_modulus = math.huge}) end, "shear_modulus must be >= 0 Pa")
   says(function() m:set_gravity{0 / 0, 0, 0} end, "m:set_gravity: components must be finite")
   says(function() m:material("x", {density = -1}) end, "m:material: material 'x': density must be > 0")
   says(function() m:bond{kind = "contact", gap = -1} end, "m:bond: gap must be >= 0")

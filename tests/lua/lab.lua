@@ -53,11 +53,11 @@ do
   local lab = require("seixo.lab")
   local here = "lab.lua:" .. (debug.getinfo(1, "l").currentline + 2) .. ": "
   local cases = {
-    {"ucs every = 0", function() lab.ucs({dim = 2, shape = "rect", path = "absent.h5"}, {every = 0}) end, "every must be a whole number"},
-    {"ucs every = NaN", function() lab.ucs({dim = 2, shape = "rect", path = "absent.h5"}, {every = 0 / 0}) end, "every must be"},
-    {"ucs max_steps = 0.5", function() lab.ucs({dim = 2, shape = "rect", path = "absent.h5"}, {max_steps = 0.5}) end, "max_steps must be"},
-    {"brazilian every = 0", function() lab.brazilian({dim = 2, shape = "disk", path = "absent.h5"}, {every = 0}) end, "every must be"},
-    {"triaxial unknown option", function() lab.triaxial({dim = 2, shape = "rect", path = "absent.h5"}, {bogus = 1}) end, "unknown option"},
+    {"ucs every = 0", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {every = 0}) end, "every must be a whole number"},
+    {"ucs every = NaN", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {every = 0 / 0}) end, "every must be"},
+    {"ucs max_steps = 0.5", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {max_steps = 0.5}) end, "max_steps must be"},
+    {"brazilian every = 0", function() lab.brazilian({dim = 2, shape = "disk", path = "none.h5"}, {every = 0}) end, "every must be"},
+    {"triaxial unknown option", function() lab.triaxial({dim = 2, shape = "rect", path = "none.h5"}, {bogus = 1}) end, "unknown option"},
     {"mohr_coulomb", function() lab.mohr_coulomb(5) end, "two failure states"},
     {"a number for a specimen", function() lab.ucs(5) end, "a specimen (from lab.specimen or lab.open) expected"},
   }

@@ -331,6 +331,7 @@ test("a skin wider than the assembly is refused, quickly", function()
   m:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
   eq(m:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}, 8000)
   raises(function() m:cycle(1) end, HERE, "a skin of 1000 m makes about", "lower the skin")
+  raises(function() m:energy() end, HERE, "m:energy", "lower the skin") -- not a silent zero
   local m2 = seixo.model{dim = 3}
   m2:material("r", {bond = {normal_strength = 1, shear_strength = 1}})
   m2:generate{method = "lattice", packing = "cubic", radius = 0.005, region = region}
