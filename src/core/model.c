@@ -7,6 +7,7 @@
 #include "model_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -236,6 +237,7 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     const bool density_changed = m->mats[i].def.density != d->density;
     const bool damping_changed = m->mats[i].def.damping != d->damping;
     m->mats[i].def = *d;
+    sx__material_derive(&m->mats[i]);
     for (int64_t b = 0; b < m->balls.n; b++) {
         if (m->balls.mat[b] != i) continue;
         if (density_changed) sx__ball_update_mass(m, b);
@@ -277,7 +279,8 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
     const sx_material_def *a = &m->mats[mat].def;
     sx_pair_law l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, a, NULL);
+    sx__law(l.law)->mix(&l, &m->mats[mat], NULL, l.law);
+    sx__law_parts_mix(&l, &m->mats[mat], NULL);
     return l;
 }
 
@@ -288,7 +291,8 @@ sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb)
                             0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
     /* a pair of materials of two laws is refused where it may touch (check_models) */
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, a, b);
+    sx__law(l.law)->mix(&l, &m->mats[ma], &m->mats[mb], l.law);
+    sx__law_parts_mix(&l, &m->mats[ma], &m->mats[mb]);
     return l;
 }
 
@@ -309,6 +313,12 @@ static sx_status refresh_laws(sx_model *m)
             if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
+    for (int i = 0; i < n; i++) { /* a law's history joins the pair stores once a material uses it */
+        const sx_material_def *d = &m->mats[i].def;
+        if ((d->rolling_friction > 0 && sx__pairs_expand(m, offsetof(sx_pairs, mr), m->rdim)) ||
+            (d->total_shear == 1 && sx__pairs_expand(m, offsetof(sx_pairs, us), m->dim)))
+            return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    }
     return SX_OK;
 }
 

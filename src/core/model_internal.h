@@ -20,10 +20,13 @@
 /* pi to double precision (M_PI is not C11) */
 #define SX_PI 3.14159265358979323846
 
+#define SX_LAW_MAX 16 /* units of the law registry, at most */
+
 typedef struct sx_material {
     char name[64];
     sx_material_def def;
     sx_bpm_def bpm;
+    double derived[SX_LAW_MAX]; /* the registry units' constants of the material (sx__material_derive) */
 } sx_material;
 
 /* Bonds live apart from pairs, so an unbonded scene stores none. A pair
@@ -122,6 +125,9 @@ typedef struct sx_pairs {
     double *geo;
     uint8_t *touching;     /* history is live (touching, or bonded) */
     int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
+    double *mr;            /* rolling moment on b (rdim, laws/rolling.h); NULL while no material rolls */
+    double *us;            /* accumulated tangential displacement of b (dim, laws/total_shear.h); NULL
+                            * while no material asks for the total form */
     /* the last force evaluation, for queries consistent with the balls' forces */
     double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
@@ -142,8 +148,9 @@ typedef struct sx_pair_field {
     const char *unit;      /* its unit (NULL: none) */
 } sx_pair_field;
 #define SX_PAIR_FIELDS_MAX 12
-/* The fields store p has (bond slots only once the model has bonds, the
- * overlap only in the ball-wall store), into f; returns their count. */
+/* The fields store p has (bond slots only once the model has bonds, rolling
+ * moments once a material rolls, the overlap only in the ball-wall store),
+ * into f; returns their count. */
 int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f);
 /* Bytes of one element of a field. */
 static inline size_t sx__pair_size(const sx_pair_field *f)
@@ -206,6 +213,8 @@ typedef struct sx_block {
 typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
+    double mu_r;            /* rolling friction (laws/rolling.h; 0: no rolling resistance) */
+    bool total_shear;       /* Mindlin's total tangential form (laws/total_shear.h) */
     double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
     uint8_t law;            /* its number in the registry (laws/registry.h) */
     bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */
@@ -323,6 +332,9 @@ sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
+/* Gives both pair stores the history array at byte offset `field` of
+ * sx_pairs (per components a pair, zero) if absent; SX_ENOMEM. */
+sx_status sx__pairs_expand(sx_model *m, size_t field, int per);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */
@@ -356,6 +368,8 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
 /* NULL when material d's law and its parameters are valid, else why not
  * (written into why[len]; laws.c). */
 const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
+/* Derives the registry units' constants of material t from its definition (laws.c). */
+void sx__material_derive(sx_material *t);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
 

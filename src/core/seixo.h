@@ -168,16 +168,25 @@ typedef struct sx_material_def {
     double damping;         ///< local (non-viscous) damping coefficient alpha in [0, 1)
     double viscous_normal;  ///< normal critical-damping ratio of the contact dashpot, >= 0
     double viscous_shear;   ///< shear critical-damping ratio of the contact dashpot, >= 0
+    double restitution;     ///< coefficient of restitution e in (0, 1] of a normal impact: the normal
+                            ///< dashpot's ratio is derived from it for the law (0: viscous_normal gives it)
+    double rolling_friction;///< rolling resistance mu_r >= 0: rolling spring ks R^2, moment <= mu_r R Fn
+                            ///< (0: none; a contact uses the smaller of its two)
+    double total_shear;     ///< 1: Mindlin's total tangential form Fs = -ks Us (both materials of a
+                            ///< contact); 0: the seed's incremental form (4-20)
 } sx_material_def;
 
-/// The contact laws of the registry (src/core/laws/registry.h), numbered in its order
-/// (SX_MODEL_LINEAR, SX_MODEL_HERTZ are laws 0 and 1): their count, the name and a one-line
-/// summary of law `law` (NULL out of range), the number of a name (-1: none).
+/// The units of the contact-law registry (src/core/laws/registry.h), numbered in its order:
+/// the normal laws a material's `model` names (SX_MODEL_LINEAR, SX_MODEL_HERTZ are 0 and 1;
+/// sx_law_is_model), then the parts every contact runs beside its law, switched on by their
+/// parameters (restitution, ...). Their count, the name and a one-line summary of unit `law`
+/// (NULL out of range), the number of a name (-1: none).
 SX_API int sx_law_count(void);
+SX_API bool sx_law_is_model(int law);
 SX_API const char *sx_law_name(int law);
 SX_API const char *sx_law_summary(int law);
 SX_API int sx_law_find(const char *name);
-/// The material parameters a law reads (beside the common ones of sx_material_def): their
+/// The material parameters a unit reads (beside the common ones of sx_material_def): their
 /// count, the k-th one's key (its unit into *unit if not NULL; NULL out of range), and its
 /// field in a definition (NULL out of range).
 SX_API int sx_law_param_count(int law);
@@ -361,10 +370,10 @@ typedef struct sx_contact_info {
     double shear[3];     ///< N, elastic shear force on b (the shear dashpot is not included)
     double kn, ks;       ///< N/m, contact stiffnesses (Hertz: secant normal, current shear)
     unsigned bond;       ///< SX_BOND_* bits intact on this contact (0: unbonded)
-    double pb_fn;        ///< N, parallel-bond normal force (compression positive)
-    double pb_fs[3];     ///< N, parallel-bond shear force on b
-    double pb_moment[3]; ///< N m, parallel-bond moment on b (twist + bending; 2D: [0])
-    double pb_radius;    ///< m, parallel-bond radius (4-53)
+    double pb_fn;        ///< N, parallel-bond (or flat-joint face) normal force (compression positive)
+    double pb_fs[3];     ///< N, parallel-bond (or flat-joint face) shear force on b
+    double pb_moment[3]; ///< N m, parallel-bond (or face) moment on b about the contact point (2D: [0])
+    double pb_radius;    ///< m, parallel-bond radius (4-53), or the flat joint's face radius
 } sx_contact_info;
 
 /// Calls fn for every contact of the last step's force evaluation (bonded

@@ -7,6 +7,7 @@
 #include "clumps.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
@@ -18,6 +19,8 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->bb = m->bb.n;
     out->bw = m->bw.n;
     out->bb_bonds = m->bb.bond != NULL;
+    out->rolling = m->bb.mr != NULL;
+    out->total_shear = m->bb.us != NULL;
     out->bonds = m->bonds.n;
     out->fj_elements = m->fjel.n;
     out->cracks = m->cracks.n;
@@ -74,6 +77,8 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (sx__pairs_reserve(m, &m->bb, s->bb_bonds && s->bb == 0 ? 1 : s->bb)) goto nomem;
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
     if (sx__pairs_reserve(m, &m->bw, s->bw)) goto nomem;
+    if (s->rolling && sx__pairs_expand(m, offsetof(sx_pairs, mr), r)) goto nomem;
+    if (s->total_shear && sx__pairs_expand(m, offsetof(sx_pairs, us), d)) goto nomem;
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 
@@ -155,6 +160,7 @@ static sx_status check_materials(sx_model *m)
         if (sx__law_check(&t->def, why, sizeof why))
             return sx__fail(m, SX_EINVAL, "state: material '%s' (contact model %d): %s", t->name, (int)t->def.model,
                             why);
+        sx__material_derive(t);
         if (!(t->def.density > 0) || !isfinite(t->def.density) || !(t->def.stiffness_ratio > 0))
             return sx__fail(m, SX_EINVAL, "state: material '%s' has a density or stiffness ratio <= 0", t->name);
     }

@@ -36,6 +36,8 @@ typedef struct sx_state_sizes {
     bool applied;         ///< the applied force / moment arrays exist
     int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
     bool bb_bonds;        ///< the ball-ball store carries bond slots
+    bool rolling;         ///< both pair stores carry rolling moments (laws/rolling.h)
+    bool total_shear;     ///< both pair stores carry shear displacements (laws/total_shear.h)
     int64_t bonds;        ///< bond slots (intact or broken)
     int64_t fj_elements;  ///< flat-joint elements
     int64_t cracks;       ///< entries of the crack log

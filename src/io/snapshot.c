@@ -295,8 +295,8 @@ static hid_t law_enum(hid_t base)
 {
     const char *names[MAX_LAWS];
     int values[MAX_LAWS];
-    const int n = sx_law_count() < MAX_LAWS ? sx_law_count() : MAX_LAWS;
-    for (int k = 0; k < n; k++) names[k] = sx_law_name(k), values[k] = k;
+    int n = 0;
+    while (n < MAX_LAWS && sx_law_is_model(n)) names[n] = sx_law_name(n), values[n] = n, n++;
     return sx_h5_enum(base, names, values, n);
 }
 
@@ -396,9 +396,15 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
         }
         mat_column c[MAT_MAX];
         const int nc = mat_columns(c);
-        for (int k = 0; k < nc && !h->failed; k++)
-            if (sx_h5_read(h, g, "/materials", c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))
+        /* a law's parameter a file predates takes its default (the law is newer than the file) */
+        sx_material def = {.def = sx_material_default_def()};
+        for (int k = 0; k < nc && !h->failed; k++) {
+            const bool newer = c[k].law >= 0 && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
+            if (newer)
+                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = *mat_number(&def, &c[k]);
+            else if (sx_h5_read(h, g, "/materials", c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))
                 for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = col[i];
+        }
     }
     sx_h5_close(mem);
     free(names);
@@ -1011,6 +1017,8 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     g = sx_h5_open_group(h, f, "/contacts/ball_ball", true);
     s->bb = sx_h5_rows(h, g, "/contacts/ball_ball", "a", 1, true);
     s->bb_bonds = g >= 0 && H5Lexists(g, "bond", H5P_DEFAULT) > 0;
+    s->rolling = g >= 0 && H5Lexists(g, "rolling_moment", H5P_DEFAULT) > 0;
+    s->total_shear = g >= 0 && H5Lexists(g, "shear_displacement", H5P_DEFAULT) > 0;
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/contacts/ball_wall", true);
     s->bw = sx_h5_rows(h, g, "/contacts/ball_wall", "a", 1, true);

@@ -60,10 +60,10 @@ void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has
     const char *model = sx_lua_optstrfield(L, arg, "model");
     if (model) {
         const int k = sx_law_find(model);
-        if (k < 0) {
+        if (!sx_law_is_model(k)) {
             luaL_Buffer b;
             luaL_buffinit(L, &b);
-            for (int i = 0; i < sx_law_count(); i++) {
+            for (int i = 0; sx_law_is_model(i); i++) {
                 if (i) luaL_addstring(&b, ", ");
                 lua_pushfstring(L, "'%s'", sx_law_name(i));
                 luaL_addvalue(&b);

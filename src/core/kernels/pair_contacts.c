@@ -316,19 +316,10 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
                 bonded = false;
             }
         }
-        if (!bonded) { /* compression and Coulomb friction only */
-            const double fmax = mu * (l.fn > 0 ? l.fn : 0);
-            if (fsn > fmax) {
-                const double sc = fmax / fsn;
-                /* slip work, as the contact's: the mean shear force along the
-                 * slip (trial - final) / (ks A); a break's drop is released */
-                if (track && !released) {
-                    double e = 0;
-                    for (int k = 0; k < D - 1; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                    o->slip += 0.5 * e / ksa;
-                }
-                for (int k = 0; k < D - 1; k++) fs[k] *= sc;
-            }
+        if (!bonded) { /* compression and Coulomb friction only; a break's drop is released, not slip */
+            double sc;
+            sx__law_cap(D - 1, fs, f0, fsn * fsn, mu * (l.fn > 0 ? l.fn : 0), ksa, track && !released ? &o->slip : NULL,
+                        &sc);
             if (released) released -= l.energy + fj_shear_energy(fs, ks, g.area);
         }
         if (track) o->released += released;
@@ -417,6 +408,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 double kn, ks;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
                 if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+                if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum);
             }
             touching[c] = 0;
             fn_all[c] = 0; /* its last evaluation: no force */
@@ -462,7 +454,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         if (slot >= 0)
             for (int k = 0; k < D; k++) xc[k] = x[i * D + k] + la * n[k];
 
-        double kn, ks, fn = 0, F[D], mb[RD];
+        double kn, ks, fn = 0, F[D], mb[RD], mroll[RD] = {0};
         bool bond_moment = false;
         /* a contact bond carries tension; a flat joint replaces the contact law */
         const bool active = !(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT));
@@ -474,6 +466,13 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             for (int k = 0; k < D; k++) f0[k] = fs[k];
             const double ksdt = ks * dt;
             for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+            double *us = law->total_shear ? p->us + c * D : NULL; /* Mindlin's total form (laws/total_shear.h) */
+            if (us) {
+                if (!touching[c])
+                    for (int k = 0; k < D; k++) us[k] = 0;
+                carry_apply(&rot, us);
+                sx_law_total_shear_force(D, us, fs, vs, ks, dt);
+            }
             if (bonds & SX_BOND_CONTACT) {
                 const double fsn = sqrt(dot(fs, fs));
                 if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
@@ -482,6 +481,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
+                    if (us) sx_law_total_shear_slip(D, us, 0);
                 } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
                     log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
@@ -493,22 +493,25 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
+                    if (us) sx_law_total_shear_slip(D, us, 0);
                 }
                 /* 4-30/4-31: Coulomb slip with the smaller friction */
                 const double fmax = law->mu * (fn > 0 ? fn : 0);
-                const double f2 = dot(fs, fs);
-                if (f2 > fmax * fmax) {
-                    const double sc = fmax / sqrt(f2);
-                    /* slip work: the mean of the shear force before and after the step along the
-                     * slip displacement (trial - final force) / ks */
-                    if (track && ks > 0) {
-                        double e = 0;
-                        for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                        o->slip += 0.5 * e / ks;
-                    }
-                    for (int k = 0; k < D; k++) fs[k] *= sc;
-                    slip = true;
-                }
+                double sc;
+                slip = sx__law_cap(D, fs, f0, dot(fs, fs), fmax, ks, track ? &o->slip : NULL, &sc);
+                if (slip && us) sx_law_total_shear_slip(D, us, sc);
+            }
+            if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h) */
+                double *mr = p->mr + c * RD, dtheta[RD];
+                if (!touching[c])
+                    for (int k = 0; k < RD; k++) mr[k] = 0;
+#if D == 3
+                carry_apply(&rot, mr);
+#endif
+                for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
+                const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, ri * rj / rsum, un > 0 ? fn : 0);
+                if (track) o->slip += e;
+                for (int k = 0; k < RD; k++) mroll[k] = mr[k];
             }
             double fd = fn, dsh[D];
             bool shear_dashpot = false;
@@ -575,6 +578,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < RD; k++) {
             double ma = la * nf[k], mj = -lb * nf[k];
             if (bond_moment) ma += mb[k], mj += mb[k];
+            ma += mroll[k], mj += mroll[k];
             ti[k] -= ma;
             tj[k] += mj;
         }

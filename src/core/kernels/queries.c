@@ -28,6 +28,12 @@ static double pair_force(const sx_model *m, int64_t c, double un, double *kn, do
     return active ? fn : 0;
 }
 
+/* The rolling spring's energy of a touching pair whose law rolls. */
+static double rolling_strain(const sx_pair_law *l, const sx_pairs *p, int64_t c, double ks, double rbar)
+{
+    return l->mu_r > 0 && p->touching[c] ? sx_law_rolling_strain(D, p->mr + c * RD, ks, rbar) : 0;
+}
+
 static void KERNEL(energy)(const sx_model *m, sx_energy *e)
 {
     const sx_balls *B = &m->balls;
@@ -52,6 +58,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const double fn = pair_force(m, c, un, &kn, &ks);
         const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
         e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
+        e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
@@ -65,6 +72,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
         const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
         if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
+        if (un > 0) e->strain += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
     }
 }
 

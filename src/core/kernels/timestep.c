@@ -45,6 +45,10 @@ static double KERNEL(critical_dt)(sx_model *m)
             ktr = kn + ks;
             krot_i = ks * B->rad[i] * B->rad[i];
             krot_j = ks * B->rad[j] * B->rad[j];
+            if (law->mu_r > 0) { /* the rolling spring kr = ks R-bar^2 (laws/rolling.h) */
+                const double rbar = B->rad[i] * B->rad[j] / rsum;
+                krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
+            }
         }
         if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) { /* a flat joint's face: the section of 4-35 */
             const sx_bonds *b = &m->bonds;
@@ -77,7 +81,7 @@ static double KERNEL(critical_dt)(sx_model *m)
         }
         kn *= sx__law(law.law)->tangent;
         kt[i] += kn + ks;
-        kr[i] += ks * B->rad[i] * B->rad[i];
+        kr[i] += ks * B->rad[i] * B->rad[i] * (law.mu_r > 0 ? 2 : 1); /* with the rolling spring ks R^2 */
     }
     double best = INFINITY;
     for (int64_t i = 0; i < n; i++) {

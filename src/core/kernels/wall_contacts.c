@@ -33,6 +33,7 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
             double kn, ks;
             stiffness(law, r, 0, r, 0, &kn, &ks);
             if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
+            if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, r); /* and the rolling spring's */
         }
         p->touching[c] = 0;
         return true;
@@ -68,17 +69,28 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
     for (int k = 0; k < D; k++) f0[k] = fs[k];
     const double ksdt = ks * dt;
     for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k];
-    const double fmax = law->mu * fn, f2 = dot(fs, fs);
-    bool slip = false;
-    if (f2 > fmax * fmax) {
-        const double sc = fmax / sqrt(f2);
-        if (track && ks > 0) { /* as for ball-ball contacts */
-            double e = 0;
-            for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-            o->slip += 0.5 * e / ks;
-        }
-        for (int k = 0; k < D; k++) fs[k] *= sc;
-        slip = true;
+    double *us = law->total_shear ? p->us + c * D : NULL; /* Mindlin's total form (laws/total_shear.h) */
+    if (us) {
+        if (!p->touching[c])
+            for (int k = 0; k < D; k++) us[k] = 0;
+        carry_apply(&rot, us);
+        sx_law_total_shear_force(D, us, fs, vs, ks, dt);
+    }
+    double sc;
+    const bool slip = sx__law_cap(D, fs, f0, dot(fs, fs), law->mu * fn, ks, track ? &o->slip : NULL, &sc);
+    if (slip && us) sx_law_total_shear_slip(D, us, sc);
+    double mroll[RD] = {0};
+    if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h): the wall does not spin */
+        double *mr = p->mr + c * RD, dtheta[RD];
+        if (!p->touching[c])
+            for (int k = 0; k < RD; k++) mr[k] = 0;
+#if D == 3
+        carry_apply(&rot, mr);
+#endif
+        for (int k = 0; k < RD; k++) dtheta[k] = B->w[i * RD + k] * dt;
+        const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, r, fn);
+        if (track) o->slip += e;
+        for (int k = 0; k < RD; k++) mroll[k] = mr[k];
     }
     for (int k = 0; k < D; k++) p->geo[c * D + k] = n[k];
     p->touching[c] = 1;
@@ -129,8 +141,8 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
 #endif
     moment_of(arm, F, mw);
     for (int k = 0; k < RD; k++) {
-        t[i * RD + k] -= lb * nf[k];
-        wa->moment[k] -= mw[k];
+        t[i * RD + k] += mroll[k] - lb * nf[k];
+        wa->moment[k] -= mw[k] + mroll[k];
     }
     return true;
 }

@@ -22,22 +22,25 @@ static inline double sx_law_hertz_force(const sx_pair_law *l, int dim, double ra
     return fn;
 }
 
-static inline void sx_law_hertz_mix(sx_pair_law *l, const sx_material_def *a, const sx_material_def *b)
+static inline void sx_law_hertz_mix(sx_pair_law *l, const sx_material *a, const sx_material *b,
+                                    int self)
 {
-    l->g = b ? 0.5 * (a->shear_modulus + b->shear_modulus) : a->shear_modulus; /* 4-27, 4-28 */
-    l->nu = b ? 0.5 * (a->poisson + b->poisson) : a->poisson;
+    (void)self;
+    l->g = b ? 0.5 * (a->def.shear_modulus + b->def.shear_modulus) : a->def.shear_modulus; /* 4-27, 4-28 */
+    l->nu = b ? 0.5 * (a->def.poisson + b->def.poisson) : a->def.poisson;
 }
 
 static inline const sx_law *sx_law_hertz(void)
 {
     static const sx_law_param params[] = {
-        {"shear_modulus", "Pa", offsetof(sx_material_def, shear_modulus), 0, INFINITY, false,
+        {"shear_modulus", "Pa", offsetof(sx_material_def, shear_modulus), 0, INFINITY, false, false,
          "the Hertz shear modulus must be > 0 Pa"},
-        {"poisson", "1", offsetof(sx_material_def, poisson), 0, 0.5, true,
+        {"poisson", "1", offsetof(sx_material_def, poisson), 0, 0.5, true, false,
          "the Hertz Poisson's ratio must be in [0, 0.5)"},
     };
     static const sx_law law = {
         .name = "hertz",
+        .kind = SX_LAW_MODEL,
         .summary = "Hertz-Mindlin from shear_modulus and poisson (4-25 ... 4-29)",
         .params = params,
         .nparams = 2,

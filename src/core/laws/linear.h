@@ -25,9 +25,10 @@ static inline double sx_law_linear_force(const sx_pair_law *l, int dim, double r
     return *kn * un; /* 4-6 */
 }
 
-static inline void sx_law_linear_mix(sx_pair_law *l, const sx_material_def *a, const sx_material_def *b)
+static inline void sx_law_linear_mix(sx_pair_law *l, const sx_material *a, const sx_material *b,
+                                     int self)
 {
-    (void)a, (void)b;
+    (void)a, (void)b, (void)self;
     l->plain = !l->per_radius;
 }
 
@@ -35,6 +36,7 @@ static inline const sx_law *sx_law_linear(void)
 {
     static const sx_law law = {
         .name = "linear",
+        .kind = SX_LAW_MODEL,
         .summary = "linear springs kn, ks in series (4-22/4-23), or from the BPM modulus (4-49/4-50)",
         .mix = sx_law_linear_mix,
         .strain = 0.5,

@@ -1,0 +1,225 @@
+-- The contact-law registry and the laws added through it (issue 12):
+-- names and parameters from the registry, and damping by restitution,
+-- each against its closed form.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+
+T.test("the registry names the models and lists them on a bad name", function()
+  local m = seixo.model{dim = 3}
+  local h = m:material("h", {model = "hertz"})
+  T.eq(m:materials()[h].model, "hertz")
+  local ok, err = pcall(m.material, m, "x", {model = "hooke"})
+  T.check(not ok and tostring(err):find("'linear', 'hertz'", 1, true), err)
+  ok, err = pcall(m.material, m, "x", {model = "restitution"}) -- a part, not a model
+  T.check(not ok and tostring(err):find("got 'restitution'", 1, true), err)
+end)
+
+T.test("law parameters are checked from the registry's ranges", function()
+  local m = seixo.model{dim = 3}
+  local ok, err = pcall(m.material, m, "x", {model = "hertz", poisson = 0.5})
+  T.check(not ok and tostring(err):find("Poisson"), err)
+  ok, err = pcall(m.material, m, "x", {restitution = 1.5})
+  T.check(not ok and tostring(err):find("restitution must be in %(0, 1%]"), err)
+  ok, err = pcall(m.material, m, "x", {restitution = 0.5, viscous_normal = 0.1})
+  T.check(not ok and tostring(err):find("not both"), err)
+  local y = m:material("y", {restitution = 0.5})
+  T.eq(m:materials()[y].restitution, 0.5)
+end)
+
+-- A normal impact at speed v, ball-wall (a fixed plane) or ball-ball (two
+-- equal balls head on), no gravity; returns the measured restitution. The
+-- timestep is 1 us, about 1/400 of the contact (4e-4 s for the sphere on
+-- the plane): the dashpot reads the velocity half a step late, which errs
+-- in e by about 2 beta omega dt (tests/verification/impact.c), here < 0.003.
+local function impact(dim, model, e, against)
+  local m = seixo.model{dim = dim, timestep = 1e-6}
+  -- Chung & Ooi's test 3 sphere: aluminium alloy, R = 0.1 m, E = 70 GPa,
+  -- nu = 0.33, 2699 kg/m^3, 3.9 m/s
+  local nu, E = 0.33, 70e9
+  m:material("al", {model = model, density = 2699, shear_modulus = E / (2 * (1 + nu)), poisson = nu,
+                    kn = 1e9, ks = 1e9, friction = 0, restitution = e})
+  local r, v = 0.1, 3.9
+  local function vec(x) if dim == 3 then return {x, 0, 0} else return {x, 0} end end
+  local a = m:ball{pos = vec(r + 1e-4), radius = r, vel = vec(-v)}
+  local b
+  if against == "wall" then
+    m:wall{kind = dim == 3 and "plane" or "line", point = vec(0), normal = vec(1), kn = 1e9, ks = 1e9}
+  else
+    b = m:ball{pos = vec(-r - 1e-4), radius = r, vel = vec(v)}
+  end
+  local touched = false
+  for _ = 1, 200000 do
+    m:cycle(1)
+    local c = m:contact_count()
+    if c > 0 then touched = true elseif touched then break end
+  end
+  T.check(touched, "no impact")
+  local va = a.vel[1]
+  if against == "wall" then return va / v end
+  return (va - b.vel[1]) / (2 * v)
+end
+
+for _, model in ipairs{"hertz", "linear"} do
+  for _, against in ipairs{"wall", "ball"} do
+    for _, dim in ipairs{3, 2} do
+      T.test(string.format("restitution %s %s %dD: e from 0.1 to 1 within 0.01 (Chung & Ooi test 3)", model, against,
+                           dim), function()
+        local worst = 0
+        for k = 1, 10 do
+          local e = k / 10
+          local got = impact(dim, model, e, against)
+          worst = math.max(worst, math.abs(got - e))
+          T.check(math.abs(got - e) <= 0.01, string.format("e = %.2f: measured %.4f", e, got))
+        end
+        print(string.format("restitution %s %s %dD: worst |e_measured - e| = %.4f", model, against, dim, worst))
+      end)
+    end
+  end
+end
+
+-- Rolling resistance (laws/rolling.h). A ball rolling on a floor with
+-- rolling friction mu_r meets a moment that grows on the rolling spring
+-- kr = ks R^2 (rotation theta1 = Ml / kr) and then stays at its limit
+-- Ml = mu_r R Fn, Fn = m g; rolling without slip, its kinetic energy
+-- T = (m + I/R^2) v0^2 / 2 is spent as T = Ml theta1 / 2 + Ml (theta - theta1),
+-- so it stops after rolling theta = T / Ml + theta1 / 2, a distance R theta
+-- (3D: 0.7 v0^2 / (mu_r g) + ..., 2D disks: 0.75 v0^2 / (mu_r g) + ...).
+-- The shear spring's energy at the friction the deceleration needs is
+-- below 1e-4 of T here; tolerance 0.5 %.
+local function roll_on_floor(dim)
+  local g = 9.81
+  local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -g} or {0, -g}}
+  local kn, mur, r, v0 = 1e6, 0.1, 0.01, 0.2
+  m:material("s", {density = 2650, kn = kn, ks = kn, friction = 0.5, rolling_friction = mur, viscous_normal = 0.5})
+  local up = dim == 3 and 3 or 2
+  local function vec(x, z) if dim == 3 then return {x, 0, z} else return {x, z} end end
+  m:wall{kind = dim == 3 and "plane" or "line", point = vec(0, 0), normal = vec(0, 1), kn = kn, ks = kn}
+  local b = m:ball{pos = vec(0, r), radius = r}
+  local kstar = kn / 2 -- ball and wall springs in series
+  b.pos = vec(0, r - b.mass * g / kstar) -- at rest on the floor
+  m:cycle(2000) -- the normal dashpot settles the bounce
+  b.vel = vec(v0, 0)
+  b.spin = dim == 3 and {0, v0 / r, 0} or -v0 / r -- rolling to +x
+  local x0, xmax, moving = b.pos[1], b.pos[1], 0
+  for _ = 1, 4000 do
+    m:cycle(20)
+    xmax = math.max(xmax, b.pos[1])
+    if b.vel[1] <= 0 then break end
+    moving = moving + 1
+  end
+  T.check(b.vel[1] <= 0, "still rolling")
+  local T0 = 0.5 * (b.mass + b.inertia / r ^ 2) * v0 ^ 2
+  local Ml = mur * r * b.mass * g
+  local theta1 = Ml / (kstar * r * r)
+  local expect = r * (T0 / Ml + theta1 / 2)
+  print(string.format("rolling %dD on a floor: stopped after %.6f m, closed form %.6f m (%.3f %%)", dim, xmax - x0,
+                      expect, 100 * (xmax - x0 - expect) / expect))
+  return xmax - x0, expect
+end
+
+for _, dim in ipairs{3, 2} do
+  T.test(string.format("rolling resistance %dD: a ball rolling on a floor stops where the limit moment says", dim),
+         function()
+    local got, expect = roll_on_floor(dim)
+    T.near(got, expect, 5e-3)
+  end)
+end
+
+-- Ball-ball: ball B spinning at w0 against a fixed ball A, its centre held
+-- (velocity fixed), pressed with a constant overlap (Fn = k d), no friction.
+-- Rolling moment on the spring kr = ks R-bar^2, R-bar = R/2, up to its limit
+-- Ml = mu_r R-bar Fn: the spin stops after theta = I w0^2 / (2 Ml) + theta1 / 2,
+-- theta1 = Ml / kr. A spin about the normal (3D) is a twist: not resisted.
+T.test("rolling resistance ball-ball 2D and 3D: the spin stops where the limit moment says; the twist is free",
+       function()
+  for _, dim in ipairs{3, 2} do
+    local m = seixo.model{dim = dim}
+    local k, mur, r, d, w0 = 1e6, 1e-3, 0.01, 1e-5, 5 -- about 1700 steps to stop
+    m:material("s", {density = 2650, kn = k, ks = k, friction = 0, rolling_friction = mur})
+    local function vec(x) if dim == 3 then return {x, 0, 0} else return {x, 0} end end
+    local a = m:ball{pos = vec(0), radius = r}
+    local b = m:ball{pos = vec(2 * r - d), radius = r}
+    a.fix = "all"
+    b.fix = "vel"
+    b.spin = dim == 3 and {1, 0, w0} or w0 -- 1 rad/s of twist about the normal x
+    local dt = m:timestep()
+    local theta, last = 0, w0
+    for _ = 1, 200000 do
+      m:cycle(1)
+      local w = dim == 3 and b.spin[3] or b.spin
+      if w <= 0 then break end
+      theta = theta + w * dt
+      last = w
+    end
+    T.check(last > 0 and (dim == 3 and b.spin[3] or b.spin) <= 0, "spin did not stop")
+    local rbar, ks = r / 2, k / 2
+    local Ml = mur * rbar * (k / 2) * d
+    local expect = b.inertia * w0 ^ 2 / (2 * Ml) + Ml / (ks * rbar ^ 2) / 2
+    print(string.format("rolling ball-ball %dD: the spin stopped after %.5f rad, closed form %.5f rad", dim, theta, expect))
+    T.near(theta, expect, 5e-3)
+    if dim == 3 then T.near(b.spin[1], 1, 1e-12) end
+  end
+end)
+
+T.test("a saved model with rolling moments, total shear and restitution continues bit for bit", function()
+  for _, dim in ipairs{3, 2} do
+    local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81}}
+    m:material("s", {model = "hertz", shear_modulus = 1e8, poisson = 0.3, rolling_friction = 0.05, restitution = 0.4,
+                     total_shear = 1})
+    local function vec(x, z) if dim == 3 then return {x, 0, z} else return {x, z} end end
+    m:wall{kind = dim == 3 and "plane" or "line", point = vec(0, 0), normal = vec(0, 1), kn = 1e7, ks = 1e7}
+    for i = 0, 5 do m:ball{pos = vec(0.021 * i, 0.011 + 0.004 * (i % 2)), radius = 0.01, vel = vec(0.1, 0)} end
+    m:cycle(3000)
+    local path = string.format("laws_rolling_%d.h5", dim)
+    m:save(path)
+    local l = seixo.load(path)
+    T.eq(l:hash(), m:hash(), "loaded")
+    m:cycle(500)
+    l:cycle(500)
+    T.eq(l:hash(), m:hash(), "continued")
+    T.eq(l:materials().s.rolling_friction, 0.05)
+    os.remove(path)
+  end
+end)
+
+-- Mindlin's total tangential form (laws/total_shear.h) against the seed's
+-- incremental one. A Hertz ball pressed on a floor (its motion imposed) is
+-- sheared by Us at overlap d1, then pressed further to d2 without
+-- tangential motion. Incremental (4-20): the force stays what the shear
+-- built, ks(d1) Us; total: Fs = ks(d2) Us, the current stiffness times the
+-- accumulated displacement. ks(d) is 4-26 with the wall convention 4-28
+-- (R-bar = R, the ball's G and nu) at Fn = kn(d) d, 4-25.
+T.test("total tangential form: Fs = ks(current) Us; the incremental form keeps ks(then) Us", function()
+  for _, dim in ipairs{3, 2} do
+    for _, total in ipairs{0, 1} do
+      local dt = 1e-6
+      local m = seixo.model{dim = dim, timestep = dt}
+      local G, nu, r = 1e8, 0.3, 0.01
+      m:material("h", {model = "hertz", shear_modulus = G, poisson = nu, friction = 10, total_shear = total})
+      local function vec(x, z) if dim == 3 then return {x, 0, z} else return {x, z} end end
+      m:wall{kind = dim == 3 and "plane" or "line", point = vec(0, 0), normal = vec(0, 1), friction = 10}
+      local d1, d2, v, n = 1e-5, 4e-5, 0.01, 100
+      local b = m:ball{pos = vec(0, r - d1), radius = r}
+      b.fix = "all"
+      m:cycle(1)
+      b.vel = vec(v, 0)
+      m:cycle(n) -- Us = v n dt
+      b.vel = vec(0, -(d2 - d1) / (n * dt))
+      m:cycle(n)
+      b.vel = vec(0, 0)
+      m:cycle(1)
+      local fs
+      for c in m:contacts() do fs = math.abs(c.fs[1]) end
+      local function ks(d)
+        local fn = 2 * G * math.sqrt(2 * r) / (3 * (1 - nu)) * math.sqrt(d) * d
+        return 2 * (G * G * 3 * (1 - nu) * r) ^ (1 / 3) / (2 - nu) * fn ^ (1 / 3)
+      end
+      local us = v * n * dt
+      local expect = ks(total == 1 and d2 or d1) * us
+      print(string.format("%dD %s form: |Fs| = %.6e N, closed form %.6e N", dim, total == 1 and "total" or "incremental",
+                          fs, expect))
+      T.near(fs, expect, 1e-6)
+    end
+  end
+end)
+
+T.done()
