@@ -303,9 +303,9 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         double released = 0;
         if (bonded) {
             const double sigma = -l.fn / g.area, tau = fsn / g.area;
-            const int mode = sigma >= E->sigma_c[x]                    ? SX_CRACK_TENSION
+            const int mode = sigma >= E->sigma_c[x]                ? SX_CRACK_TENSION
                              : tau >= E->coh[x] - sigma * tanphi ? SX_CRACK_SHEAR
-                                                                          : 0;
+                                                                 : 0;
             if (mode) {
                 double pos[D];
                 for (int k = 0; k < D; k++) pos[k] = xc[k] + g.y * t1[k] + (D == 3 ? g.z * t2[k] : 0);
