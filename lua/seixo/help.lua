@@ -94,7 +94,9 @@ local entries = {
   ["model:history_csv"] = {"m:history_csv(path[, names])", "Writes step, time and the histories as CSV (names quoted as needed; a unique temporary name, fsync, rename)."},
 
   -- model: bonds
-  ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
+  ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact' | 'flatjoint', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
+  ["model:flatjoint"] = {"m:flatjoint(a, b) -> {{state, area, centroid, gap, fn, fs, tensile_strength, cohesion}, ...} | nil", "The elements of the flat joint between balls a and b."},
+  ["model:flatjoint_unbond"] = {"m:flatjoint_unbond(a, b, e)", "Makes element e of the flat joint between a and b a slit (compression and friction only)."},
   ["model:bond_count"] = {"m:bond_count() -> n", "Intact bonds."},
   ["model:cracks"] = {"m:cracks() -> {{time, step, pos, mode, kind, a, b, fn, fs, mn, ms}, ...}", "The log of broken bonds."},
   ["model:crack_count"] = {"m:crack_count([mode]) -> n", "Broken bonds, all or of mode 'tension' | 'shear'."},

@@ -566,7 +566,7 @@ end
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
                                 "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "seed", "path",
-                                "log", "max_steps", "clump"})
+                                "log", "max_steps", "clump", "model"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
   local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
@@ -724,9 +724,11 @@ function lab.specimen(opts)
   local _, loaded = loaded_contacts(m)
   gen.coordination = 2 * loaded / n
 
-  local bonds = m:bond{kind = "parallel", gap = gap, seed = seed}
-  say(opts, "lab.specimen: %d parallel bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
-      .. "ball %.3f", bonds, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
+  local kind = opts.model or "parallel" -- "flatjoint": seixo.joints (its parameters in the material's bond table)
+  if kind ~= "parallel" and kind ~= "flatjoint" then fail("lab.specimen: model must be 'parallel' or 'flatjoint'") end
+  local bonds = m:bond{kind = kind, gap = gap, seed = seed}
+  say(opts, "lab.specimen: %d %s bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
+      .. "ball %.3f", bonds, kind, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
 
   -- out of the vessel: the specimen relaxes and its locked-in stresses fall
   for _, w in ipairs(v.walls) do w:remove() end
@@ -786,7 +788,7 @@ function lab.specimen(opts)
     path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
     genesis = gen, rmax = rmax,
-    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, genesis_steps = m:step(), clumps = m:clump_count(),
+    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, model = kind, genesis_steps = m:step(), clumps = m:clump_count(),
     clump = copy(grain),
     genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
     depth = opts.depth, thickness = opts.thickness,

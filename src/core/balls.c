@@ -256,7 +256,8 @@ static void patch_pairs_after_remove(sx_model *m, const int32_t *remap)
     for (int64_t c = 0; c < p->n; c++) {
         const int32_t a = remap[p->a[c]], bb = remap[p->b[c]];
         if (a < 0 || bb < 0) {
-            if (p->bond && p->bond[c]) sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL);
+            if (p->bond && p->bond[c])
+                sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT);
             continue;
         }
         sx__pair_move(m, p, k, c);

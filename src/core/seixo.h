@@ -412,10 +412,10 @@ typedef struct sx_contact_info {
     double shear[3];     ///< N, elastic shear force on b (the shear dashpot is not included)
     double kn, ks;       ///< N/m, contact stiffnesses (Hertz: secant normal, current shear)
     unsigned bond;       ///< SX_BOND_* bits intact on this contact (0: unbonded)
-    double pb_fn;        ///< N, parallel-bond normal force (compression positive)
-    double pb_fs[3];     ///< N, parallel-bond shear force on b
-    double pb_moment[3]; ///< N m, parallel-bond moment on b (twist + bending; 2D: [0])
-    double pb_radius;    ///< m, parallel-bond radius (4-53)
+    double pb_fn;        ///< N, parallel-bond (or flat-joint face) normal force (compression positive)
+    double pb_fs[3];     ///< N, parallel-bond (or flat-joint face) shear force on b
+    double pb_moment[3]; ///< N m, parallel-bond (or face) moment on b about the contact point (2D: [0])
+    double pb_radius;    ///< m, parallel-bond radius (4-53), or the flat joint's face radius
     double shift[3];     ///< m, periodic space: the period b is seen through (b's image at
                          ///< its centre + shift touches a); 0 for a contact inside the cell
 } sx_contact_info;

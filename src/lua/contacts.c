@@ -129,6 +129,7 @@ static int get_bond(lua_State *L)
     const unsigned b = check_contact(L)->bond;
     if (!b) lua_pushnil(L);
     else if (b == (SX_BOND_CONTACT | SX_BOND_PARALLEL)) lua_pushliteral(L, "both");
+    else if (b & SX_BOND_FLATJOINT) lua_pushliteral(L, "flatjoint");
     else lua_pushstring(L, b & SX_BOND_CONTACT ? "contact" : "parallel");
     return 1;
 }

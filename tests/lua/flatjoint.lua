@@ -100,5 +100,18 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D energy closes within 1 %", math.abs(balance) < 0.01 * e.boundary_work, balance)
 end
 
+-- a removed ball takes its joints with it (the broad phase must not list them again)
+for _, dim in ipairs{2, 3} do
+  local m, a, b = pair(dim)
+  local c = m:ball{pos = dim == 3 and {4, 0, 0} or {4, 0}, radius = 1}
+  m:bond{kind = "flatjoint", gap = 1e-6, seed = 6, materials = "r"}
+  check(dim .. "D two joints", m:bond_count() == 2, m:bond_count())
+  m:remove_balls{where = function(x) return x.id == b.id end}
+  check(dim .. "D its joints go with a removed ball", m:bond_count() == 0, m:bond_count())
+  local p = c.pos; p[1] = p[1] + 0.5; c.pos = p -- a build
+  m:cycle(50)
+  check(dim .. "D no joint left", m:flatjoint(a.id, c.id) == nil and m:bond_count() == 0, m:bond_count())
+end
+
 print(string.format("flatjoint: %d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

@@ -303,9 +303,9 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         double released = 0;
         if (bonded) {
             const double sigma = -l.fn / g.area, tau = fsn / g.area;
-            const int mode = sigma >= E->sigma_c[x]                    ? SX_CRACK_TENSION
+            const int mode = sigma >= E->sigma_c[x]                ? SX_CRACK_TENSION
                              : tau >= E->coh[x] - sigma * tanphi ? SX_CRACK_SHEAR
-                                                                          : 0;
+                                                                 : 0;
             if (mode) {
                 double pos[D];
                 for (int k = 0; k < D; k++) pos[k] = xc[k] + g.y * t1[k] + (D == 3 ? g.z * t2[k] : 0);
@@ -316,19 +316,10 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
                 bonded = false;
             }
         }
-        if (!bonded) { /* compression and Coulomb friction only */
-            const double fmax = mu * (l.fn > 0 ? l.fn : 0);
-            if (fsn > fmax) {
-                const double sc = fmax / fsn;
-                /* slip work, as the contact's: the mean shear force along the
-                 * slip (trial - final) / (ks A); a break's drop is released */
-                if (track && !released) {
-                    double e = 0;
-                    for (int k = 0; k < D - 1; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                    o->slip += 0.5 * e / ksa;
-                }
-                for (int k = 0; k < D - 1; k++) fs[k] *= sc;
-            }
+        if (!bonded) { /* compression and Coulomb friction only; a break's drop is released, not slip */
+            double sc;
+            sx__law_cap(D - 1, fs, f0, fsn * fsn, mu * (l.fn > 0 ? l.fn : 0), ksa, track && !released ? &o->slip : NULL,
+                        &sc);
             if (released) released -= l.energy + fj_shear_energy(fs, ks, g.area);
         }
         if (track) o->released += released;
