@@ -361,20 +361,22 @@ int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
     f[n++] = (sx_pair_field){(void **)&p->fn, 1, SX_PAIR_F64, false, false, "normal_force", "N"};
     if (p->bond) f[n++] = (sx_pair_field){(void **)&p->bond, 1, SX_PAIR_I32, false, false, "bond", NULL};
     if (p->mr) f[n++] = (sx_pair_field){(void **)&p->mr, m->rdim, SX_PAIR_F64, true, false, "rolling_moment", "N m"};
+    if (p->us)
+        f[n++] = (sx_pair_field){(void **)&p->us, d, SX_PAIR_F64, true, false, "shear_displacement", "m"};
     /* a mesh's facet is a third end of a ball-wall pair: listed by the broad phase */
     if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_PAIR_I32, false, true, "facet", NULL};
     return n;
 }
 
-sx_status sx__pairs_expand_rolling(sx_model *m)
+sx_status sx__pairs_expand(sx_model *m, size_t field, int per)
 {
     sx_pairs *ps[2] = {&m->bb, &m->bw};
     for (int s = 0; s < 2; s++) {
-        sx_pairs *p = ps[s];
-        if (p->mr) continue;
-        if (sx__pairs_reserve(m, p, 1)) return SX_ENOMEM; /* a store with room, so the array exists */
-        p->mr = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(p->cap * m->rdim), sizeof *p->mr);
-        if (!p->mr) return SX_ENOMEM;
+        double **data = (double **)((char *)ps[s] + field);
+        if (*data) continue;
+        if (sx__pairs_reserve(m, ps[s], 1)) return SX_ENOMEM; /* a store with room, so the array exists */
+        *data = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(ps[s]->cap * per), sizeof **data);
+        if (!*data) return SX_ENOMEM;
     }
     return SX_OK;
 }

@@ -7,6 +7,7 @@
 #include "model_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -309,9 +310,12 @@ static sx_status refresh_laws(sx_model *m)
             if (!l->plain || l->beta_s > 0) plain = false;
         }
     m->law_plain = plain;
-    for (int i = 0; i < n; i++) /* a law's history joins the pair stores once a material uses it */
-        if (m->mats[i].def.rolling_friction > 0 && sx__pairs_expand_rolling(m))
+    for (int i = 0; i < n; i++) { /* a law's history joins the pair stores once a material uses it */
+        const sx_material_def *d = &m->mats[i].def;
+        if ((d->rolling_friction > 0 && sx__pairs_expand(m, offsetof(sx_pairs, mr), m->rdim)) ||
+            (d->total_shear == 1 && sx__pairs_expand(m, offsetof(sx_pairs, us), m->dim)))
             return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    }
     return SX_OK;
 }
 

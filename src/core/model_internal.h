@@ -130,6 +130,8 @@ typedef struct sx_pairs {
     uint8_t *touching;     /* history is live (touching, or bonded) */
     int32_t *bond;         /* bond slot + 1, 0 = none; NULL while the model has no bonds */
     double *mr;            /* rolling moment on b (rdim, laws/rolling.h); NULL while no material rolls */
+    double *us;            /* accumulated tangential displacement of b (dim, laws/total_shear.h); NULL
+                            * while no material asks for the total form */
     int32_t *facet;        /* m->bw: a mesh wall's facet (0 for other walls); NULL until the model has a mesh */
     /* the last force evaluation, for queries consistent with the balls' forces */
     double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
@@ -217,6 +219,7 @@ typedef struct sx_pair_law {
     double kn, ks, mu;      /* springs in series, smaller friction */
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
     double mu_r;            /* rolling friction (laws/rolling.h; 0: no rolling resistance) */
+    bool total_shear;       /* Mindlin's total tangential form (laws/total_shear.h) */
     double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
     uint8_t law;            /* its number in the registry (laws/registry.h) */
     bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */
@@ -334,8 +337,9 @@ sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
-/* Gives both pair stores their rolling moments (zero) if absent; SX_ENOMEM. */
-sx_status sx__pairs_expand_rolling(sx_model *m);
+/* Gives both pair stores the history array at byte offset `field` of
+ * sx_pairs (per components a pair, zero) if absent; SX_ENOMEM. */
+sx_status sx__pairs_expand(sx_model *m, size_t field, int per);
 void sx__pairs_free(sx_model *m, sx_pairs *p);
 void sx__pair_move(sx_model *m, sx_pairs *p, int64_t to, int64_t from);
 void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-express the history */

@@ -172,6 +172,8 @@ typedef struct sx_material_def {
                             ///< dashpot's ratio is derived from it for the law (0: viscous_normal gives it)
     double rolling_friction;///< rolling resistance mu_r >= 0: rolling spring ks R^2, moment <= mu_r R Fn
                             ///< (0: none; a contact uses the smaller of its two)
+    double total_shear;     ///< 1: Mindlin's total tangential form Fs = -ks Us (both materials of a
+                            ///< contact); 0: the seed's incremental form (4-20)
 } sx_material_def;
 
 /// The units of the contact-law registry (src/core/laws/registry.h), numbered in its order:

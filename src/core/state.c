@@ -7,6 +7,7 @@
 #include "clumps.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
@@ -20,6 +21,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->bw_facets = m->mesh_pairs;
     out->bb_bonds = m->bb.bond != NULL;
     out->rolling = m->bb.mr != NULL;
+    out->total_shear = m->bb.us != NULL;
     out->bonds = m->bonds.n;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
@@ -76,7 +78,8 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (s->bb_bonds && sx__bonds_reserve_pairs(m)) goto nomem;
     if (sx__pairs_reserve(m, &m->bw, s->bw_facets && s->bw == 0 ? 1 : s->bw)) goto nomem;
     if (s->bw_facets && sx__pairs_expand_facets(m)) goto nomem;
-    if (s->rolling && sx__pairs_expand_rolling(m)) goto nomem;
+    if (s->rolling && sx__pairs_expand(m, offsetof(sx_pairs, mr), r)) goto nomem;
+    if (s->total_shear && sx__pairs_expand(m, offsetof(sx_pairs, us), d)) goto nomem;
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 

@@ -39,6 +39,7 @@ typedef struct sx_state_sizes {
     bool bw_facets;       ///< the ball-wall store carries mesh facets
     bool bb_bonds;        ///< the ball-ball store carries bond slots
     bool rolling;         ///< both pair stores carry rolling moments (laws/rolling.h)
+    bool total_shear;     ///< both pair stores carry shear displacements (laws/total_shear.h)
     int64_t bonds;        ///< bond slots (intact or broken)
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;

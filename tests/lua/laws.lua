@@ -160,10 +160,11 @@ T.test("rolling resistance ball-ball 2D and 3D: the spin stops where the limit m
   end
 end)
 
-T.test("a saved model with rolling moments and restitution continues bit for bit", function()
+T.test("a saved model with rolling moments, total shear and restitution continues bit for bit", function()
   for _, dim in ipairs{3, 2} do
     local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81}}
-    m:material("s", {model = "hertz", shear_modulus = 1e8, poisson = 0.3, rolling_friction = 0.05, restitution = 0.4})
+    m:material("s", {model = "hertz", shear_modulus = 1e8, poisson = 0.3, rolling_friction = 0.05, restitution = 0.4,
+                     total_shear = 1})
     local function vec(x, z) if dim == 3 then return {x, 0, z} else return {x, z} end end
     m:wall{kind = dim == 3 and "plane" or "line", point = vec(0, 0), normal = vec(0, 1), kn = 1e7, ks = 1e7}
     for i = 0, 5 do m:ball{pos = vec(0.021 * i, 0.011 + 0.004 * (i % 2)), radius = 0.01, vel = vec(0.1, 0)} end
@@ -177,6 +178,47 @@ T.test("a saved model with rolling moments and restitution continues bit for bit
     T.eq(l:hash(), m:hash(), "continued")
     T.eq(l:materials().s.rolling_friction, 0.05)
     os.remove(path)
+  end
+end)
+
+-- Mindlin's total tangential form (laws/total_shear.h) against the seed's
+-- incremental one. A Hertz ball pressed on a floor (its motion imposed) is
+-- sheared by Us at overlap d1, then pressed further to d2 without
+-- tangential motion. Incremental (4-20): the force stays what the shear
+-- built, ks(d1) Us; total: Fs = ks(d2) Us, the current stiffness times the
+-- accumulated displacement. ks(d) is 4-26 with the wall convention 4-28
+-- (R-bar = R, the ball's G and nu) at Fn = kn(d) d, 4-25.
+T.test("total tangential form: Fs = ks(current) Us; the incremental form keeps ks(then) Us", function()
+  for _, dim in ipairs{3, 2} do
+    for _, total in ipairs{0, 1} do
+      local dt = 1e-6
+      local m = seixo.model{dim = dim, timestep = dt}
+      local G, nu, r = 1e8, 0.3, 0.01
+      m:material("h", {model = "hertz", shear_modulus = G, poisson = nu, friction = 10, total_shear = total})
+      local function vec(x, z) if dim == 3 then return {x, 0, z} else return {x, z} end end
+      m:wall{kind = dim == 3 and "plane" or "line", point = vec(0, 0), normal = vec(0, 1), friction = 10}
+      local d1, d2, v, n = 1e-5, 4e-5, 0.01, 100
+      local b = m:ball{pos = vec(0, r - d1), radius = r}
+      b.fix = "all"
+      m:cycle(1)
+      b.vel = vec(v, 0)
+      m:cycle(n) -- Us = v n dt
+      b.vel = vec(0, -(d2 - d1) / (n * dt))
+      m:cycle(n)
+      b.vel = vec(0, 0)
+      m:cycle(1)
+      local fs
+      for c in m:contacts() do fs = math.abs(c.fs[1]) end
+      local function ks(d)
+        local fn = 2 * G * math.sqrt(2 * r) / (3 * (1 - nu)) * math.sqrt(d) * d
+        return 2 * (G * G * 3 * (1 - nu) * r) ^ (1 / 3) / (2 - nu) * fn ^ (1 / 3)
+      end
+      local us = v * n * dt
+      local expect = ks(total == 1 and d2 or d1) * us
+      print(string.format("%dD %s form: |Fs| = %.6e N, closed form %.6e N", dim, total == 1 and "total" or "incremental",
+                          fs, expect))
+      T.near(fs, expect, 1e-6)
+    end
   end
 end)
 

@@ -289,6 +289,13 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             for (int k = 0; k < D; k++) f0[k] = fs[k];
             const double ksdt = ks * dt;
             for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k]; /* 4-18 ... 4-20 */
+            double *us = law->total_shear ? p->us + c * D : NULL; /* Mindlin's total form (laws/total_shear.h) */
+            if (us) {
+                if (!touching[c])
+                    for (int k = 0; k < D; k++) us[k] = 0;
+                carry_apply(&rot, us);
+                sx_law_total_shear_force(D, us, fs, vs, ks, dt);
+            }
             if (bonds & SX_BOND_CONTACT) {
                 const double fsn = sqrt(dot(fs, fs));
                 if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
@@ -297,6 +304,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
+                    if (us) sx_law_total_shear_slip(D, us, 0);
                 } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
                     log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, i, j, fn, fsn, 0, 0);
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
@@ -308,22 +316,13 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
+                    if (us) sx_law_total_shear_slip(D, us, 0);
                 }
                 /* 4-30/4-31: Coulomb slip with the smaller friction */
                 const double fmax = law->mu * (fn > 0 ? fn : 0);
-                const double f2 = dot(fs, fs);
-                if (f2 > fmax * fmax) {
-                    const double sc = fmax / sqrt(f2);
-                    /* slip work: the mean of the shear force before and after the step along the
-                     * slip displacement (trial - final force) / ks */
-                    if (track && ks > 0) {
-                        double e = 0;
-                        for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-                        o->slip += 0.5 * e / ks;
-                    }
-                    for (int k = 0; k < D; k++) fs[k] *= sc;
-                    slip = true;
-                }
+                double sc;
+                slip = sx__law_cap(D, fs, f0, dot(fs, fs), fmax, ks, track ? &o->slip : NULL, &sc);
+                if (slip && us) sx_law_total_shear_slip(D, us, sc);
             }
             if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h) */
                 double *mr = p->mr + c * RD, dtheta[RD];

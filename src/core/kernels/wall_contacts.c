@@ -89,18 +89,16 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     for (int k = 0; k < D; k++) f0[k] = fs[k];
     const double ksdt = ks * dt;
     for (int k = 0; k < D; k++) fs[k] -= ksdt * vs[k];
-    const double fmax = law->mu * fn, f2 = dot(fs, fs);
-    bool slip = false;
-    if (f2 > fmax * fmax) {
-        const double sc = fmax / sqrt(f2);
-        if (track && ks > 0) { /* as for ball-ball contacts */
-            double e = 0;
-            for (int k = 0; k < D; k++) e += (f0[k] + sc * fs[k]) * (1 - sc) * fs[k];
-            o->slip += 0.5 * e / ks;
-        }
-        for (int k = 0; k < D; k++) fs[k] *= sc;
-        slip = true;
+    double *us = law->total_shear ? p->us + c * D : NULL; /* Mindlin's total form (laws/total_shear.h) */
+    if (us) {
+        if (!p->touching[c])
+            for (int k = 0; k < D; k++) us[k] = 0;
+        carry_apply(&rot, us);
+        sx_law_total_shear_force(D, us, fs, vs, ks, dt);
     }
+    double sc;
+    const bool slip = sx__law_cap(D, fs, f0, dot(fs, fs), law->mu * fn, ks, track ? &o->slip : NULL, &sc);
+    if (slip && us) sx_law_total_shear_slip(D, us, sc);
     double mroll[RD] = {0};
     if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h): the ball's turn relative to the wall's */
         double *mr = p->mr + c * RD, dtheta[RD];

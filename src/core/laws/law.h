@@ -16,6 +16,7 @@
 
 #include "../model_internal.h"
 
+#include <math.h>
 #include <stddef.h>
 
 /* A material parameter of a law: a double of sx_material_def. */
@@ -64,4 +65,24 @@ void sx__law_parts_mix(sx_pair_law *l, const sx_material *a, const sx_material *
 static inline double *sx__law_value(sx_material_def *d, const sx_law_param *p)
 {
     return (double *)((char *)d + p->offset);
+}
+
+/* The cap of a spring force (Coulomb slip 4-30/4-31, the rolling limit):
+ * when |v|^2 = v2 exceeds limit^2, scales v (n components) to the limit,
+ * adds to *work (if not NULL) the plastic work, the mean of the force
+ * before the step (v0) and after it along the plastic displacement
+ * (trial - final) / k, and gives the scale in *scale; false within it. */
+static inline bool sx__law_cap(int n, double *v, const double *v0, double v2, double limit, double k, double *work,
+                               double *scale)
+{
+    if (!(v2 > limit * limit)) return false;
+    const double sc = limit / sqrt(v2);
+    if (work && k > 0) {
+        double e = 0;
+        for (int i = 0; i < n; i++) e += (v0[i] + sc * v[i]) * (1 - sc) * v[i];
+        *work += 0.5 * e / k;
+    }
+    for (int i = 0; i < n; i++) v[i] *= sc;
+    *scale = sc;
+    return true;
 }

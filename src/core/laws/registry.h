@@ -9,9 +9,10 @@
 #include "linear.h"
 #include "restitution.h"
 #include "rolling.h"
+#include "total_shear.h"
 
 #define SX_LAWS(X) X(linear) X(hertz)
-#define SX_PARTS(X) X(restitution) X(rolling)
+#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear)
 
 #define SX_LAW_ID(name) SX_LAW_ID_##name
 #define SX_LAW_ENUM_(name) SX_LAW_ID(name),

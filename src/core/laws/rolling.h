@@ -46,15 +46,9 @@ static inline double sx_law_rolling_moment(const sx_pair_law *l, int dim, double
         mr[k] -= kr * (dtheta[k] - (dim == 3 ? twist * n[k] : 0));
         m2 += mr[k] * mr[k];
     }
-    const double limit = l->mu_r * rbar * (fn > 0 ? fn : 0);
-    if (m2 <= limit * limit) return 0;
-    const double sc = limit / sqrt(m2);
-    double e = 0;
-    for (int k = 0; k < rd; k++) {
-        e += (m0[k] + sc * mr[k]) * (1 - sc) * mr[k];
-        mr[k] *= sc;
-    }
-    return kr > 0 ? 0.5 * e / kr : 0;
+    double work = 0, sc;
+    sx__law_cap(rd, mr, m0, m2, l->mu_r * rbar * (fn > 0 ? fn : 0), kr, &work, &sc);
+    return work;
 }
 
 /* The rolling spring's energy |Mr|^2 / (2 kr), kr = ks R-bar^2. */
