@@ -196,6 +196,8 @@ T.test("a mesh wall reports force and moment, and refuses bad input", function()
   T.check(not ok and err:find("three", 1, true), err)
   ok, err = pcall(function() return m:wall{kind = "mesh", vertices = {{0, 0, 0}}, triangles = {{1, 2, 3}}} end)
   T.check(not ok and err:find("vertex number", 1, true), err)
+  ok, err = pcall(function() w:servo{target = 1e5} end)
+  T.check(not ok and err:find("is a mesh", 1, true), err)
   local m2 = seixo.model{dim = 2}
   ok, err = pcall(function() return m2:wall{kind = "mesh", triangles = square} end)
   T.check(not ok and err:find("3D", 1, true), err)
