@@ -258,6 +258,8 @@ local entries = {
     "A UCS and triaxial tests at each sigma3 [Pa], the Mohr-Coulomb fit of their peaks and the plots (out: a file prefix)."},
   ["lab.calibrate"] = {"lab.calibrate{targets =, parameters =, specimen =, material =, seeds =, workers =, out =, ...} -> result",
     "Finds micro-parameters whose lab tests reproduce target macro-properties (E, nu, UCS, BTS, c, phi or a stress-strain curve): the BPM's scalings, then NLopt's BOBYQA; seeds' mean and scatter; worker processes or MPI ranks; resumes from its log (out)."},
+  ["lab.periodic"] = {"lab.periodic (require \"seixo.periodic\")",
+    "Laboratory tests on a periodic cell, without walls: periodic.specimen{...}, periodic.triaxial(spec, {...}), periodic.shear(spec, {...}) (see docs/lua-api.md, lab.periodic)."},
   ["lab.write_csv"] = {"lab.write_csv(path, header, rows)", "Writes rows (arrays of numbers) under a header to a CSV file, atomically."},
   ["plot.live"] = {"plot.live(m, names[, {every = 1000, terminal =, output =, title =, x = 'step' | 'time', log =}]) -> plot",
     "A gnuplot plot of histories of m, redrawn every `every` steps while m cycles (p:draw() now, p:close() stops it); the run's bits do not change."},
