@@ -190,8 +190,10 @@ static sx_status check_balls(sx_model *m)
                             (int)b->mat[i], m->nmat);
         if (b->fix[i] & ~valid) return sx__fail(m, SX_EINVAL, "state: ball %lld has invalid fixity bits", (long long)id);
         const double alpha = sx__ball_damping(m, i);
+        /* (a denormal 1/m is an infinite mass: the reciprocals must be finite too) */
         if (!(b->rad[i] > 0) || !isfinite(b->rad[i]) || !(b->inv_mass[i] > 0) || !isfinite(b->inv_mass[i]) ||
-            !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) || !(alpha >= 0 && alpha < 1))
+            !isfinite(1 / b->inv_mass[i]) || !(b->inv_inertia[i] > 0) || !isfinite(b->inv_inertia[i]) ||
+            !isfinite(1 / b->inv_inertia[i]) || !(alpha >= 0 && alpha < 1))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a radius, mass, inertia or damping out of range",
                             (long long)id);
         if (!finite_all(b->x + i * d, d) || !finite_all(b->x_build + i * d, d) || !finite_all(b->v + i * d, d) ||
@@ -320,6 +322,18 @@ static sx_status check_pairs(sx_model *m)
     return SX_OK;
 }
 
+static sx_status check_cracks(sx_model *m)
+{
+    for (int64_t i = 0; i < m->cracks.n; i++) {
+        const sx_crack *c = &m->cracks.ev[i];
+        const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
+        if (!finite_all(v, (int64_t)(sizeof v / sizeof *v)))
+            return sx__fail(m, SX_EINVAL, "state: crack %lld has a non-finite time, position, force or moment",
+                            (long long)i);
+    }
+    return SX_OK;
+}
+
 static sx_status check_bonds(sx_model *m)
 {
     sx_bonds *k = &m->bonds;
@@ -366,7 +380,7 @@ sx_status sx__state_finish(sx_model *m)
 {
     sx_status st;
     if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
-        (m->cell && (st = sx__cell_finish(m))) || (st = check_pairs(m)) || (st = check_bonds(m)) ||
+        (m->cell && (st = sx__cell_finish(m))) || (st = check_pairs(m)) || (st = check_bonds(m)) || (st = check_cracks(m)) ||
         (st = sx__clumps_finish(m)))
         return st;
     sx__balls_compact(m);

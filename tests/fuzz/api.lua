@@ -54,6 +54,8 @@ local function scene(dim)
   m:history("ke", "kinetic")
   m:bond{kind = "parallel", gap = 1e-3}
   m:cycle(3)
+  -- a step budget: m:cycle(2^63 - 1) is valid (and a Ctrl-C stops it), not a hang
+  m:on("cycle", function(mm) if mm:step() > 20000 then error("fuzz: step budget spent") end end, {every = 1000})
   for k in m:contacts() do c.c = k break end
   return c
 end
@@ -346,41 +348,9 @@ local function fail(case, what)
   io.stderr:write(string.format("FAIL case %d (FUZZ_SEED=%d FUZZ_FIRST=%d FUZZ_COUNT=1): %s\n", case, seed, case, what))
 end
 
--- the error of a failed call: a string naming a line of this file
-local function clean(err)
-  return type(err) == "string" and err:find(HERE, 1, true) ~= nil and not err:find("\n", 1, true)
-end
-
-local function finite(v)
-  if type(v) == "number" then return v == v and v > -math.huge and v < math.huge end
-  if type(v) == "table" then
-    for _, x in ipairs(v) do if not finite(x) then return false end end
-  end
-  return true
-end
-
--- A non-finite value anywhere in an open model: its name, else nil.
-local function nan_in(m)
-  local ok, closed = pcall(function() return m:time() end)
-  if not ok then return nil end -- closed
-  if not finite(closed) then return "time" end
-  for b in m:balls() do
-    for _, f in ipairs({"pos", "vel", "spin", "force", "radius", "mass", "applied_force"}) do
-      if not finite(b[f]) then return "ball " .. b.id .. " " .. f end
-    end
-  end
-  for w in m:walls() do
-    for _, f in ipairs({"point", "vel", "normal", "force"}) do
-      if not finite(w[f]) then return "wall " .. w.id .. " " .. f end
-    end
-  end
-  for cl in m:clumps() do
-    for _, f in ipairs({"pos", "vel", "orientation", "mass"}) do
-      if not finite(cl[f]) then return "clump " .. cl.id .. " " .. f end
-    end
-  end
-  return nil
-end
+local checks = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "checks.lua")
+local nan_in = checks.nan_in
+local function clean(err) return checks.clean(err, HERE) end
 
 -- (no tail calls: an error must find this file's frame as its caller's)
 local function run_call(call)

@@ -84,44 +84,9 @@ local function fail(case, what)
   io.stderr:write(string.format("FAIL file case %d (FUZZ_SEED=%d FUZZ_FIRST=%d FUZZ_COUNT=1): %s\n", case, seed, case, what))
 end
 
-local function clean(err, path)
-  return type(err) == "string" and err:find(HERE, 1, true) ~= nil and not err:find("\n", 1, true)
-         and (path == nil or err:find(path, 1, true) ~= nil)
-end
-
-local function finite(v)
-  if type(v) == "number" then return v == v and v > -math.huge and v < math.huge end
-  if type(v) == "table" then
-    for _, x in pairs(v) do if not finite(x) then return false end end
-  end
-  return true
-end
-
-local function nan_in(m)
-  if not finite(m:time()) or not finite(m:timestep()) then return "time or timestep" end
-  for name, mat in pairs(m:materials()) do
-    if not finite(mat) then return "material " .. name end
-  end
-  for b in m:balls() do
-    for _, f in ipairs({"pos", "vel", "spin", "force", "radius", "mass", "inertia", "applied_force", "damping"}) do
-      if not finite(b[f]) then return "ball " .. b.id .. " " .. f end
-    end
-  end
-  for w in m:walls() do
-    for _, f in ipairs({"point", "vel", "normal", "force", "friction"}) do
-      if not finite(w[f]) then return "wall " .. w.id .. " " .. f end
-    end
-  end
-  for c in m:contacts() do
-    for _, f in ipairs({"normal", "force", "overlap", "pb_fn", "pb_fs", "pb_moment"}) do
-      if not finite(c[f]) then return "contact " .. c.a .. "-" .. c.b .. " " .. f end
-    end
-  end
-  for _, cr in ipairs(m:cracks()) do
-    if not finite(cr) then return "crack" end
-  end
-  return nil
-end
+local checks = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "checks.lua")
+local nan_in = checks.nan_in
+local function clean(err, path) return checks.clean(err, HERE, path) end
 
 local function load(p, dim) local m = seixo.load(p, {dim = dim}) return m end
 local function cycle(m, n) m:cycle(n) end

@@ -464,6 +464,8 @@ START_TEST(meaningless_values)
         {"/materials/kn", 0, NAN, "kn must be > 0 N/m"},
         {"/materials/poisson", 0, NAN, "Poisson's ratio"},
         {"/materials/bond_tensile_strength", 0, -5, "bond parameter that is negative or not finite"},
+        /* found by the file fuzzer: a denormal 1/m (an infinite mass) */
+        {"/balls/inv_mass", 0, 4.9e-310, "a radius, mass, inertia or damping out of range"},
     };
     char p[512];
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
