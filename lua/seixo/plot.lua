@@ -68,7 +68,16 @@ end
 --- file for a file terminal, rewritten at each refresh), title, x = "step"
 --- (default) or "time", log = true for a logarithmic y axis.
 function plot.live(m, names, opts)
+  if getmetatable(m) == nil or type(m) ~= "userdata" or not pcall(function() return m.histories end) then
+    fail("plot.live: a model expected, got %s", type(m))
+  end
   opts = opts or {}
+  if type(opts) ~= "table" then fail("plot.live: an options table expected, got %s", type(opts)) end
+  for _, k in ipairs({"terminal", "output", "title"}) do
+    if opts[k] ~= nil and type(opts[k]) ~= "string" then
+      fail("plot.live: %s must be a string (got %s)", k, type(opts[k]))
+    end
+  end
   if type(names) == "string" then names = {names} end
   if type(names) ~= "table" or #names == 0 then fail("plot.live: names of histories expected") end
   for k in pairs(opts) do
@@ -81,7 +90,7 @@ function plot.live(m, names, opts)
   end
   if opts.x ~= nil and opts.x ~= "step" and opts.x ~= "time" then fail("plot.live: x must be 'step' or 'time'") end
   local every = opts.every or 1000
-  if math.type(every) ~= "integer" and not (type(every) == "number" and every == math.floor(every)) or every < 1 then
+  if type(every) ~= "number" or every ~= math.floor(every) or every < 1 or every == math.huge then
     fail("plot.live: every must be a whole number of steps >= 1")
   end
   local pipe = io.popen("gnuplot 2>/dev/null", "w")

@@ -285,6 +285,50 @@ E("lab.mohr_coulomb", function() return fn(lab.mohr_coulomb, {{sigma3 = 0, sigma
 E("lab.series", function() return fn(lab.series, junk_spec, {confining = {1}}) end)
 E("lab.write_csv", function() return fn(lab.write_csv, path(".csv"), {"a", "b"}, {{1, 2}, {3, 4}}) end)
 E("lab.have_gnuplot", function() return fn(lab.have_gnuplot) end)
+-- the functions of issues 13, 14, 15 and 17
+local plot = require("seixo.plot")
+local function cube(c) return {min = V(c, -0.1, -0.1, -0.1), max = V(c, 0.1, 0.1, 0.1)} end
+E("seixo.vec", function() return fn(seixo.vec, 1, 2, 3) end)
+E("seixo.models", function() return fn(seixo.models) end)
+E("seixo.optimize", function()
+  return fn(seixo.optimize, function(x) return (x[1] - 1) ^ 2 end, {x0 = {0}, lower = {-2}, upper = {2}, maxeval = 20})
+end)
+E("seixo.cores", function() return fn(seixo.cores) end)
+E("seixo.executable", function() return fn(seixo.executable) end)
+E("seixo.rank", function() return fn(seixo.rank) end)
+E("seixo.send", function() return fn(seixo.send, 0, "text") end)
+E("m:reset_disp", function(c) return method(c.m, "reset_disp", {group = "top"}) end)
+E("b.disp", function(c)
+  c.m:reset_disp()
+  return {get = c.b, field = "disp"}
+end)
+E("b.groups", function(c) return {get = c.b, field = "groups"} end)
+E("b:set_group", function(c) return method(c.b, "set_group", "second", 2) end)
+E("w.spin", function(c) return {get = c.w, field = "spin"} end)
+local function mesh(c)
+  if c.dim ~= 3 then return c.w end
+  return c.m:wall{kind = "mesh", triangles = {{{0.5, 0.5, 0.5}, {0.6, 0.5, 0.5}, {0.5, 0.6, 0.5}}}}
+end
+E("w.vertices", function(c) return {get = mesh(c), field = "vertices"} end)
+E("w.triangles", function(c) return {get = mesh(c), field = "triangles"} end)
+E("m:periodic", function(c) return method(c.m, "periodic", cube(c)) end)
+E("m:cell_control", function(c)
+  c.m:periodic(cube(c))
+  return method(c.m, "cell_control", {xx = {rate = -0.01}, yy = {stress = 1e3}})
+end)
+E("m:cell_stress", function(c)
+  c.m:periodic(cube(c))
+  return method(c.m, "cell_stress")
+end)
+E("c.shift", function(c) return {get = c.c, field = "shift"} end)
+E("m:flatjoint", function(c) return method(c.m, "flatjoint", c.b.id, c.b2.id) end)
+E("m:flatjoint_unbond", function(c) return method(c.m, "flatjoint_unbond", c.b.id, c.b2.id, 1) end)
+E("plot.live", function(c) return fn(plot.live, c.m, "ke", {every = 1000, terminal = "dumb", output = path(".txt")}) end)
+E("lab.calibrate", function()
+  return fn(lab.calibrate, {targets = {E = 2e9}, parameters = {modulus = {1e9, 1e10}}, workers = 1, maxeval = 3,
+                            seeds = 1, out = path(""), plot = false, print = false,
+                            evaluate = function(mat) return {E = mat.modulus or 1e9} end})
+end)
 E("help", function() return fn(function(x) local ok = pcall(help, x) return ok end, seixo.clock) end)
 
 -- every documented function, method and field has an entry
