@@ -729,9 +729,11 @@ START_TEST(cycle_without_balls)
 }
 END_TEST
 
-/* A step that leaves a ball's position, velocity or spin non-finite stops
- * the cycle and names the ball; a finite state, however far it went (its
- * displacement's square overflows), does not. */
+/* A ball's state or load that no double can integrate (a force of
+ * DBL_MAX, a velocity of 1e200 m/s: their squares overflow in the step) is
+ * refused where it is set, naming the bound (issue 18: such a value used
+ * to reach the step and stop it as "non-finite"); a large value within the
+ * bound is taken and its step stays finite. */
 START_TEST(non_finite_state_stops)
 {
     const int dim = _i;
@@ -740,21 +742,16 @@ START_TEST(non_finite_state_stops)
         const int64_t calm = scene_ball(m, (const double[3]){0, 0, 0}, NULL, 1e-3);
         const int64_t id = scene_ball(m, (const double[3]){1, 1, 1}, NULL, 1e-3);
         (void)calm;
-        if (what == 2) { /* 1e200 m/s: 1e197 m in a step, finite */
-            ck_assert_int_eq(sx_ball_set_vec(m, id, SX_BALL_VEL, (const double[3]){1e200, 0, 0}), SX_OK);
+        const sx_ball_vec field = what == 0 ? SX_BALL_APPLIED_FORCE : what == 1 ? SX_BALL_APPLIED_MOMENT : SX_BALL_VEL;
+        const double huge[3] = {what == 2 ? 1e200 : DBL_MAX, 0, 0};
+        ck_assert_int_eq(sx_ball_set_vec(m, id, field, huge), SX_EINVAL);
+        ck_assert_msg_has(m, "below 1e100");
+        if (what == 2) { /* 1e90 m/s: 1e87 m in a step, finite */
+            ck_assert_int_eq(sx_ball_set_vec(m, id, SX_BALL_VEL, (const double[3]){1e90, 0, 0}), SX_OK);
             ck_assert_cycle(m, 3);
             double x[3];
             ck_assert_int_eq(sx_ball_get_vec(m, id, SX_BALL_POS, x), SX_OK);
-            ck_assert(isfinite(x[0]) && x[0] > 1e197);
-        } else { /* a force or a moment that no double can integrate */
-            const double big[3] = {DBL_MAX, DBL_MAX, DBL_MAX};
-            ck_assert_int_eq(sx_ball_set_vec(m, id, what == 0 ? SX_BALL_APPLIED_FORCE : SX_BALL_APPLIED_MOMENT, big),
-                             SX_OK);
-            ck_assert_int_eq(sx_model_cycle(m, 3), SX_EUNSTABLE);
-            ck_assert_msg_has(m, "non-finite");
-            char ball[32];
-            snprintf(ball, sizeof ball, "ball %lld ", (long long)id);
-            ck_assert_msg_has(m, ball);
+            ck_assert(isfinite(x[0]) && x[0] > 1e87);
         }
         sx_model_destroy(m);
     }
