@@ -386,13 +386,8 @@ end
 
 ---------------------------------------------------------------- a case
 
-local failures = 0
-local function fail(case, what)
-  failures = failures + 1
-  io.stderr:write(string.format("FAIL case %d (FUZZ_SEED=%d FUZZ_FIRST=%d FUZZ_COUNT=1): %s\n", case, seed, case, what))
-end
-
 local checks = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "checks.lua")
+local fail = checks.reporter("case", seed)
 local nan_in = checks.nan_in
 local function clean(err) return checks.clean(err, HERE) end
 
@@ -493,5 +488,5 @@ end
 collectgarbage()
 collectgarbage()
 os.execute("rm -rf " .. scratch)
-print(string.format("api: %d cases from %d (seed %d), %d failed", count, first, seed, failures))
-if failures > 0 then os.exit(1) end
+print(string.format("api: %d cases from %d (seed %d), %d failed", count, first, seed, fail.count))
+if fail.count > 0 then os.exit(1) end

@@ -9,6 +9,16 @@ function checks.clean(err, here, path)
          and (path == nil or err:find(path, 1, true) ~= nil)
 end
 
+-- The fuzzers' failure report: fail(case, what) prints the case with the
+-- settings that replay it alone; fail.count is how many failed.
+function checks.reporter(label, seed)
+  return setmetatable({count = 0}, {__call = function(self, case, what)
+    self.count = self.count + 1
+    io.stderr:write(string.format("FAIL %s %d (FUZZ_SEED=%d FUZZ_FIRST=%d FUZZ_COUNT=1): %s\n", label, case, seed, case,
+                                  what))
+  end})
+end
+
 function checks.finite(v)
   if type(v) == "number" then return v == v and v > -math.huge and v < math.huge end
   if type(v) == "table" then

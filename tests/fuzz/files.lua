@@ -78,13 +78,8 @@ end
 
 ---------------------------------------------------------------- checks
 
-local failures = 0
-local function fail(case, what)
-  failures = failures + 1
-  io.stderr:write(string.format("FAIL file case %d (FUZZ_SEED=%d FUZZ_FIRST=%d FUZZ_COUNT=1): %s\n", case, seed, case, what))
-end
-
 local checks = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "checks.lua")
+local fail = checks.reporter("file case", seed)
 local nan_in = checks.nan_in
 local function clean(err, path) return checks.clean(err, HERE, path) end
 
@@ -158,5 +153,5 @@ os.execute("rm -rf " .. dir)
 local targets = 0
 for _, b in ipairs(bases) do targets = targets + #b.targets end
 print(string.format("files: %d cases from %d (seed %d) over %d datasets and attributes, %d failed", count, first, seed,
-                    targets, failures))
-if failures > 0 then os.exit(1) end
+                    targets, fail.count))
+if fail.count > 0 then os.exit(1) end
