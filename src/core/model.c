@@ -291,15 +291,30 @@ static sx_pair_law combine(const sx_material_def *a, double kn, double ks, doubl
     return l;
 }
 
-/* A ball against a wall: the wall's springs in series; the ball's law
- * completes it from the ball's material alone. */
+/* A ball against a wall. A wall of a material mixes with the ball's as a
+ * ball's would (the law and its parts see it as b); a plain wall puts its
+ * springs in series and the ball's law completes the contact from the
+ * ball's material alone (b NULL); a rigid one adds no spring of its own
+ * (the ball's kn, ks; for Hertz, laws/hertz.h's rigid plane). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
 {
     const sx_material_def *a = &m->mats[mat].def;
-    sx_pair_law l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
+    const sx_material *wm = w->def.material >= 0 ? &m->mats[w->def.material] : NULL;
+    sx_pair_law l;
+    if (wm)
+        l = combine(a, wm->def.kn, wm->def.ks, 0, 1, wm->def.friction, 0.5 * (a->viscous_normal + wm->def.viscous_normal),
+                    0.5 * (a->viscous_shear + wm->def.viscous_shear));
+    else
+        l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
+    if (w->def.rigid) { /* springs in series with an infinite one: the ball's alone */
+        l.kn = a->kn, l.ks = a->ks;
+        l.dash_n = 4 * l.beta_n * l.beta_n * l.kn;
+    }
+    l.wall = true;
+    l.rigid = w->def.rigid;
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, &m->mats[mat], NULL, l.law);
-    sx__law_parts_mix(&l, &m->mats[mat], NULL);
+    sx__law(l.law)->mix(&l, &m->mats[mat], wm, l.law);
+    sx__law_parts_mix(&l, &m->mats[mat], wm);
     return l;
 }
 
@@ -358,6 +373,22 @@ static sx_status check_models(sx_model *m)
                         "a contact between materials of two laws is not defined: use one model for both",
                         m->mats[first].name, sx_law_name(m->mats[first].def.model), m->mats[other].name,
                         sx_law_name(m->mats[other].def.model));
+    /* a wall's material mixes with the balls' under one law, and has no radius for the BPM modulus */
+    for (int64_t w = 0; first >= 0 && w < m->nwall; w++) {
+        const int k = m->walls[w].def.material;
+        if (k < 0) continue;
+        if (m->mats[k].def.model != m->mats[first].def.model)
+            return sx__fail(m, SX_EINVAL,
+                            "contact model: wall %lld is of material '%s' (%s) and balls of material '%s' (%s) may "
+                            "touch it; a contact between materials of two laws is not defined: use one model for both",
+                            (long long)m->walls[w].id, m->mats[k].name, sx_law_name(m->mats[k].def.model),
+                            m->mats[first].name, sx_law_name(m->mats[first].def.model));
+        if (m->mats[k].def.modulus > 0)
+            return sx__fail(m, SX_EINVAL,
+                            "contact model: wall %lld's material '%s' uses the BPM modulus, which needs a ball's "
+                            "radius: give it kn and ks",
+                            (long long)m->walls[w].id, m->mats[k].name);
+    }
     /* a material switched to a law without bonds (or a ball moved onto one)
      * after bonds were installed: the rule holds whenever it is cycled */
     if (first < 0 || sx__law(m->mats[first].def.model)->bonds) return SX_OK;

@@ -19,6 +19,7 @@
 
 /* pi to double precision (M_PI is not C11) */
 #define SX_PI 3.14159265358979323846
+#define SX_SQRT2 1.41421356237309504880
 
 #define SX_LAW_MAX 16 /* units of the law registry, at most */
 
@@ -244,6 +245,7 @@ typedef struct sx_pair_law {
     uint8_t law;            /* its number in the registry (laws/registry.h) */
     bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */
     double g, nu;           /* Hertz-Mindlin's G and nu (laws/hertz.h) */
+    bool wall, rigid;       /* a ball against a wall (R-bar = R, 4-28); the wall rigid (sx_wall_def) */
     /* BPM modulus mode (4-49/4-50): a side with ec > 0 has kn = 4 R ec (3D)
      * or 2 ec (2D) and ks = kn / ratio, put in series per contact; a side
      * with ec = 0 keeps its kn, ks. */

@@ -175,6 +175,9 @@ typedef struct sx_material_def {
                             ///< (0: none; a contact uses the smaller of its two)
     double total_shear;     ///< 1: Mindlin's total tangential form Fs = -ks Us (both materials of a
                             ///< contact); 0: the seed's incremental form (4-20)
+    double hertz_mixing;    ///< Hertz, two different materials (or a ball and a wall's material):
+                            ///< 0: the means of G and nu (4-27); 1: the literature's
+                            ///< 1/E* = sum (1 - nu_i^2)/E_i, 1/G* = sum (2 - nu_i)/G_i (both ask)
 } sx_material_def;
 
 /// The units of the contact-law registry (src/core/laws/registry.h), numbered in its order:
@@ -303,9 +306,20 @@ typedef struct sx_wall_def {
     double radial_vel; ///< cylinder: m/s, rate of change of the radius (> 0 expands)
     double kn, ks;     ///< N/m, wall stiffnesses (in series with the ball's, 4-22)
     double friction;   ///< Coulomb coefficient; the contact uses the smaller of ball and wall
+    /// -1: none (kn, ks, friction above, and a Hertz ball's own G, nu with R-bar = R, 4-28);
+    /// else the index of a material of the wall's own, of the balls' law, that replaces kn,
+    /// ks and friction: the contact mixes it with the ball's as two balls' materials mix
+    /// (4-22/4-23/4-30; Hertz 4-27 or the literature's rule, `hertz_mixing`), with R-bar = R.
+    /// Not in the BPM modulus mode (a wall has no radius).
+    int material;
+    /// true: the wall does not deform (no material; kn, ks ignored, friction kept): a
+    /// linear contact has the ball's own kn, ks; a Hertz one is the literature's rigid
+    /// plane, E* = E/(1 - nu^2), G* = G/(2 - nu), R* = R.
+    bool rigid;
 } sx_wall_def;
 
-/// A plane at the origin with normal +z (2D: a line with normal +y), kn = ks = 1e8, friction 0.5.
+/// A plane at the origin with normal +z (2D: a line with normal +y), kn = ks = 1e8, friction 0.5,
+/// no material, not rigid.
 SX_API sx_wall_def sx_wall_default_def(int dim);
 
 SX_API sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id);
@@ -370,6 +384,9 @@ SX_API sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3])
 /// Sets a stiffness, the friction or a cylinder's radius; the next step
 /// (and its timestep) uses the new value.
 SX_API sx_status sx_wall_set(sx_model *m, int64_t id, sx_wall_scalar which, double value);
+/// Gives a wall its own material (an index, or -1 for none) or makes it rigid
+/// (material -1 only); the next step uses it. See sx_wall_def.
+SX_API sx_status sx_wall_set_material(sx_model *m, int64_t id, int material, bool rigid);
 /// Cylinder: the rate of change of its radius (m/s, > 0 expands).
 SX_API sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel);
 /// Resultant force (N) of the balls on the wall in the last step, and its

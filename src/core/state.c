@@ -253,6 +253,9 @@ static sx_status check_walls(sx_model *m)
             !(w->def.friction >= 0) || !isfinite(w->def.friction) || !(w->moved >= 0) || !isfinite(w->moved))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a stiffness, friction or move out of range",
                             (long long)w->id);
+        if (w->def.material < -1 || w->def.material >= m->nmat || (w->def.material >= 0 && w->def.rigid))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld names material %d of %d%s", (long long)w->id,
+                            w->def.material, m->nmat, w->def.material >= 0 && w->def.rigid ? " and is rigid" : "");
         if ((k == SX_WALL_RECT && !(w->len_u > 0 && w->len_v > 0)) || (k == SX_WALL_SEGMENT && !(w->seg_len > 0)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a zero extent", (long long)w->id);
         if (k == SX_WALL_CYLINDER &&
@@ -480,6 +483,15 @@ static void hash_materials(hasher *s, const sx_model *m)
                               t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
         put_doubles(s, def, sizeof def / sizeof *def, 1);
         put_doubles(s, (const double *)&t->bpm, sizeof t->bpm / sizeof(double), 1);
+        /* the parameters of the registry's parts that are on (0 is off: a model that uses none hashes as before) */
+        for (int u = 0; u < sx_law_count(); u++)
+            for (int k = 0; !sx_law_is_model(u) && k < sx_law_param_count(u); k++) {
+                const double x = *sx_law_param_value((sx_material_def *)&t->def, u, k);
+                if (x == 0) continue;
+                put_int(s, u);
+                put_int(s, k);
+                put_double(s, x);
+            }
     }
 }
 
@@ -627,6 +639,10 @@ static void hash_walls(hasher *s, const sx_model *m)
         const double last[] = {w->load, w->kn_sum, m->build_needed ? 0 : w->moved};
         put_doubles(s, last, 3, 1);
         put_int(s, w->contacts);
+        if (w->def.material >= 0 || w->def.rigid) { /* a plain wall hashes as before they existed */
+            put_int(s, w->def.material);
+            put_int(s, w->def.rigid);
+        }
         if (w->mesh) { /* its turn and spin */
             put_doubles(s, w->mesh->q, sizeof w->mesh->q / sizeof(double), 1);
             put_doubles(s, w->def.spin, 3, 1);

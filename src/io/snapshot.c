@@ -423,7 +423,8 @@ enum { WALL_KINDS = sizeof wall_kind_values / sizeof *wall_kind_values };
 typedef struct wall_cols {
     int64_t *id, *contacts;
     int *kind;
-    uint8_t *servo_on;
+    int32_t *material;
+    uint8_t *servo_on, *rigid;
     double *point, *normal, *edge1, *edge2, *vel, *kn, *ks, *friction;
     double *u, *v, *len_u, *len_v, *seg_len, *force, *moment, *moved;
     double *radius, *height, *radial_vel, *load, *kn_sum;
@@ -439,11 +440,14 @@ static bool wall_cols_alloc(wall_cols *c, int64_t n)
     c->contacts = calloc(k, sizeof *c->contacts);
     c->kind = calloc(k, sizeof *c->kind);
     c->servo_on = calloc(k, sizeof *c->servo_on);
+    c->material = calloc(k, sizeof *c->material);
+    c->rigid = calloc(k, sizeof *c->rigid);
     double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment, &c->spin};
     double **sc[] = {&c->kn,     &c->ks,     &c->friction,   &c->len_u, &c->len_v,  &c->seg_len, &c->moved,
                      &c->radius, &c->height, &c->radial_vel, &c->load,  &c->kn_sum, &c->target,  &c->area,
                      &c->alpha,  &c->max_speed};
-    bool ok = c->id && c->contacts && c->kind && c->servo_on;
+    bool ok = c->id && c->contacts && c->kind && c->servo_on && c->material && c->rigid;
+    for (size_t i = 0; c->material && i < k; i++) c->material[i] = -1; /* a file from before wall materials */
     for (size_t i = 0; i < sizeof vec / sizeof *vec; i++) ok &= (*vec[i] = calloc(3 * k, sizeof(double))) != NULL;
     for (size_t i = 0; i < sizeof sc / sizeof *sc; i++) ok &= (*sc[i] = calloc(k, sizeof(double))) != NULL;
     return ok;
@@ -454,7 +458,8 @@ static void wall_cols_free(wall_cols *c)
     void *p[] = {c->id,       c->contacts, c->kind,    c->servo_on,   c->point,  c->normal, c->edge1,  c->edge2,
                  c->vel,      c->kn,       c->ks,      c->friction,   c->u,      c->v,      c->len_u,  c->len_v,
                  c->seg_len,  c->force,    c->moment,  c->moved,      c->radius, c->height, c->radial_vel,
-                 c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed, c->spin};
+                 c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed, c->spin,
+                 c->material, c->rigid};
     for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
 }
 
@@ -483,6 +488,16 @@ static int wall_fields_mesh(const sx_model *m, const wall_cols *c, field *f)
 {
     int n = 0;
     if (m->dim == 3) f[n++] = F("spin", T_F64, c->spin, 3, "rad/s");
+    return n;
+}
+
+/* A wall's material (its index among /materials, -1: none) and rigidity,
+ * optional: a file from before them has neither. */
+static int wall_fields_material(const wall_cols *c, field *f)
+{
+    int n = 0;
+    f[n++] = F("material", T_I32, c->material, 1, NULL);
+    f[n++] = F("rigid", T_U8, c->rigid, 1, NULL);
     return n;
 }
 
@@ -553,8 +568,9 @@ static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bo
     S(area, w->servo.area);
     S(alpha, w->servo.alpha);
     S(max_speed, w->servo.max_speed);
-    if (to_cols) c->kind[i] = (int)w->def.kind, c->servo_on[i] = w->servo_on;
-    else w->def.kind = (sx_wall_kind)c->kind[i], w->servo_on = c->servo_on[i] != 0;
+    S(material, w->def.material);
+    if (to_cols) c->kind[i] = (int)w->def.kind, c->servo_on[i] = w->servo_on, c->rigid[i] = w->def.rigid;
+    else w->def.kind = (sx_wall_kind)c->kind[i], w->servo_on = c->servo_on[i] != 0, w->def.rigid = c->rigid[i] != 0;
 #undef V
 #undef S
 }
@@ -614,6 +630,7 @@ static void save_walls(sx_h5 *h, hid_t f, const sx_model *m)
         write_fields(h, g, fl, wall_fields(m, &c, fl), n);
         write_fields(h, g, fl, wall_fields2(m, &c, fl), n);
         write_fields(h, g, fl, wall_fields_mesh(m, &c, fl), n);
+        write_fields(h, g, fl, wall_fields_material(&c, fl), n);
         for (int64_t i = 0; i < n; i++)
             if (m->walls[i].mesh) save_mesh(h, g, &m->walls[i]);
     }
@@ -638,7 +655,8 @@ static void load_walls(sx_h5 *h, hid_t g, sx_model *m, int version)
         sx_h5_read(h, g, "/walls", "kind", mem, c.kind, n, 1, true);
         if (read_fields(h, g, "/walls", fl, wall_fields(m, &c, fl), n, true) &&
             read_fields(h, g, "/walls", fl, wall_fields2(m, &c, fl), n, version >= 2) &&
-            read_fields(h, g, "/walls", fl, wall_fields_mesh(m, &c, fl), n, false))
+            read_fields(h, g, "/walls", fl, wall_fields_mesh(m, &c, fl), n, false) &&
+            read_fields(h, g, "/walls", fl, wall_fields_material(&c, fl), n, false))
             for (int64_t i = 0; i < n && !h->failed; i++) {
                 wall_copy(m, &m->walls[i], &c, i, false);
                 if (m->walls[i].def.kind == SX_WALL_MESH) load_mesh(h, g, m, &m->walls[i]);

@@ -18,15 +18,16 @@ _Static_assert(SX_WALL_PLANE == 0 && SX_WALL_LINE == 1 && SX_WALL_RECT == 2 && S
                    SX_WALL_CYLINDER == 4 && SX_WALL_MESH == 5,
                "kind_names is indexed by sx_wall_kind");
 
-static const char *const plane_keys[] = {"kind", "point", "normal", "kn", "ks", "friction", "vel", NULL};
-static const char *const cylinder_keys[] = {"kind", "point", "axis",     "radius", "height", "radial_vel",
-                                            "kn",   "ks",    "friction", "vel",    NULL};
+static const char *const plane_keys[] = {"kind", "point", "normal", "kn", "ks", "friction", "vel", "material", "rigid",
+                                         NULL};
+static const char *const cylinder_keys[] = {"kind", "point", "axis", "radius", "height", "radial_vel", "kn",
+                                            "ks",   "friction", "vel", "material", "rigid", NULL};
 static const char *const rect_keys[] = {"kind", "corner", "point", "edge1", "edge2", "kn", "ks", "friction", "vel",
-                                        NULL};
-static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", NULL};
-static const char *const mesh_keys[] = {"kind", "file", "triangles", "vertices", "point", "vel",    "spin",
-                                        "kn",   "ks",   "friction",  "repair",   NULL};
-static const char *const box_keys[] = {"kind", "min", "max", "kn", "ks", "friction", NULL};
+                                        "material", "rigid", NULL};
+static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", "material", "rigid", NULL};
+static const char *const mesh_keys[] = {"kind", "file",   "triangles", "vertices", "point", "vel", "spin",
+                                        "kn",   "ks",     "friction",  "repair",   "material", "rigid", NULL};
+static const char *const box_keys[] = {"kind", "min", "max", "kn", "ks", "friction", "material", "rigid", NULL};
 
 /* What a wall kind needs: its dimension, its counterpart in the other
  * dimension (for the error message) and its valid keys. */
@@ -86,6 +87,24 @@ static int get_spin(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def,
 static int get_kn(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, kn)); }
 static int get_ks(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, ks)); }
 static int get_friction(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, friction)); }
+
+/* The wall's material by name (nil: none) and its rigidity. */
+static int get_material(lua_State *L)
+{
+    sx_wall_def d;
+    const sx_model *m = wall_def(L, &d);
+    if (d.material >= 0) lua_pushstring(L, sx_material_name(m, d.material));
+    else lua_pushnil(L);
+    return 1;
+}
+
+static int get_rigid(lua_State *L)
+{
+    sx_wall_def d;
+    wall_def(L, &d);
+    lua_pushboolean(L, d.rigid);
+    return 1;
+}
 
 static int get_kind(lua_State *L)
 {
@@ -201,6 +220,34 @@ static int set_scalar(lua_State *L, sx_wall_scalar which)
     return 0;
 }
 
+/* w.material = name | nil, w.rigid = true | false. */
+static int set_material(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    int k = -1;
+    if (!lua_isnil(L, 3)) {
+        const char *name = lua_tostring(L, 3);
+        if (!lua_isstring(L, 3) || (k = sx_material_find(m, name)) < 0)
+            return luaL_error(L, "wall field 'material': %s is not a material of the model (m:material defines one)",
+                              luaL_tolstring(L, 3, NULL));
+    }
+    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, k, false), "wall");
+    return 0;
+}
+
+static int set_rigid(lua_State *L)
+{
+    int64_t id;
+    sx_model *m = check_wall(L, &id);
+    if (!lua_isboolean(L, 3))
+        return luaL_error(L, "wall field 'rigid': true or false expected, got %s", luaL_typename(L, 3));
+    sx_wall_def d;
+    sx_lua_checkfield(L, m, sx_wall_get(m, id, &d), "wall");
+    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, d.material, lua_toboolean(L, 3)), "wall");
+    return 0;
+}
+
 static int set_kn(lua_State *L) { return set_scalar(L, SX_WALL_KN); }
 static int set_ks(lua_State *L) { return set_scalar(L, SX_WALL_KS); }
 static int set_friction(lua_State *L) { return set_scalar(L, SX_WALL_FRICTION); }
@@ -225,13 +272,31 @@ static int wall_tostring(lua_State *L) { return sx_lua_handle_tostring(L, &wall_
 
 /* ------------------------------------------------------- model methods */
 
-/* The keys every kind but the box shares (the box has no velocity). */
-static void read_common(lua_State *L, int dim, sx_wall_def *d)
+/* The keys every kind shares (the box has no velocity): the wall's
+ * springs and friction, or a material of the model (which gives them), or
+ * rigid = true (no springs; friction kept). */
+static void read_common(lua_State *L, sx_model *m, int dim, sx_wall_def *d)
 {
-    sx_lua_optnumfield(L, 2, "kn", &d->kn);
-    sx_lua_optnumfield(L, 2, "ks", &d->ks);
-    sx_lua_optnumfield(L, 2, "friction", &d->friction);
+    const bool own = sx_lua_optnumfield(L, 2, "kn", &d->kn) | sx_lua_optnumfield(L, 2, "ks", &d->ks);
+    const bool friction = sx_lua_optnumfield(L, 2, "friction", &d->friction);
     sx_lua_optvecfield(L, 2, "vel", dim, d->vel);
+    if (lua_getfield(L, 2, "rigid") != LUA_TNIL) {
+        if (!lua_isboolean(L, -1)) luaL_argerror(L, 2, "field 'rigid': true or false expected");
+        d->rigid = lua_toboolean(L, -1);
+    }
+    lua_pop(L, 1);
+    if (lua_getfield(L, 2, "material") != LUA_TNIL) {
+        const char *name = lua_isstring(L, -1) ? lua_tostring(L, -1) : NULL;
+        d->material = name ? sx_material_find(m, name) : -1;
+        if (d->material < 0)
+            luaL_argerror(L, 2, lua_pushfstring(L, "field 'material': %s is not a material of the model "
+                                                   "(m:material defines one)", luaL_tolstring(L, -1, NULL)));
+        if (own || friction)
+            luaL_argerror(L, 2, "a wall of a material takes kn, ks and friction from it: give the material or them");
+        if (d->rigid) luaL_argerror(L, 2, "a wall is either rigid or of a material, not both");
+    }
+    lua_pop(L, 1);
+    if (d->rigid && own) luaL_argerror(L, 2, "a rigid wall has no kn or ks of its own (its friction stays)");
 }
 
 /* A rect's corner, given as `corner` or as `point` like the other kinds. */
@@ -346,7 +411,7 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
     sx_lua_checkkeys(L, 2, s->keys);
     sx_wall_def d = sx_wall_default_def(dim);
     d.kind = kind;
-    read_common(L, dim, &d);
+    read_common(L, m, dim, &d);
     switch (kind) {
     case SX_WALL_MESH:
         return add_mesh(L, m, &d);
@@ -401,7 +466,7 @@ static int add_box(lua_State *L, sx_model *m)
     sx_lua_checkvecfield(L, 2, "max", dim, hi);
     for (int c = 0; c < dim; c++) luaL_argcheck(L, lo[c] < hi[c], 2, "field 'max': each component must exceed min's");
     sx_wall_def d = sx_wall_default_def(dim);
-    read_common(L, dim, &d);
+    read_common(L, m, dim, &d);
     int64_t ids[6];
     int n = 0;
     lua_createtable(L, 2 * dim, 0);
@@ -485,6 +550,8 @@ void sx_lua_walls_register(lua_State *L)
         {"kn", get_kn},
         {"ks", get_ks},
         {"friction", get_friction},
+        {"material", get_material},
+        {"rigid", get_rigid},
         {"extra", get_extra},
         {NULL, NULL},
     };
@@ -495,6 +562,8 @@ void sx_lua_walls_register(lua_State *L)
         {"kn", set_kn},
         {"ks", set_ks},
         {"friction", set_friction},
+        {"material", set_material},
+        {"rigid", set_rigid},
         {"extra", set_extra_table},
         {NULL, NULL},
     };

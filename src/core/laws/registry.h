@@ -6,13 +6,14 @@
 #pragma once
 
 #include "hertz.h"
+#include "hertz_mixing.h"
 #include "linear.h"
 #include "restitution.h"
 #include "rolling.h"
 #include "total_shear.h"
 
 #define SX_LAWS(X) X(linear) X(hertz)
-#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear)
+#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear) X(hertz_mixing)
 
 #define SX_LAW_ID(name) SX_LAW_ID_##name
 #define SX_LAW_ENUM_(name) SX_LAW_ID(name),
