@@ -208,6 +208,8 @@ local entries = {
   ["wall.kn"] = {"w.kn", "Normal stiffness [N/m] (writable, > 0)."},
   ["wall.ks"] = {"w.ks", "Shear stiffness [N/m] (writable, >= 0)."},
   ["wall.friction"] = {"w.friction", "Friction coefficient (writable, >= 0)."},
+  ["wall.material"] = {"w.material", "The wall's own material by name, or nil (writable): it replaces kn, ks and friction."},
+  ["wall.rigid"] = {"w.rigid", "true: the wall does not deform (writable): a Hertz ball meets the rigid plane E* = E/(1-nu^2)."},
   ["wall.extra"] = {"w.extra", "A table of user values kept with the wall: w.extra.tag = 1."},
 
   -- contact
