@@ -233,7 +233,8 @@ local fields = {
        "material", "fix", "damping", "group", "extra", "clump"},
   cl = {"id", "pos", "vel", "spin", "orientation", "force", "moment", "angular_momentum", "mass", "volume", "inertia",
         "principal", "scale", "template", "material", "damping", "fix", "pebbles"},
-  w = {"id", "kind", "force", "moment", "vel", "point", "normal", "edge1", "edge2", "friction", "extra"},
+  w = {"id", "kind", "force", "moment", "vel", "point", "normal", "edge1", "edge2", "friction", "extra", "material",
+       "rigid"},
   c = {"a", "b", "kind", "normal", "point", "overlap", "fn", "fs", "force", "bond", "pb_fn", "pb_fs", "pb_moment",
        "pb_radius"},
 }
@@ -241,7 +242,7 @@ local writable = {
   b = {pos = "v", vel = "v", spin = "r", applied_force = "v", applied_moment = "r", radius = 0.012, material = "soft",
        fix = "vel", damping = 0.1, group = "g", extra = {a = 1}},
   cl = {pos = "v", vel = "v", spin = "r", orientation = "q", scale = 1.1, material = "soft", damping = 0.2, fix = "spin"},
-  w = {vel = "v", point = "v", normal = "v", friction = 0.2, extra = "x"},
+  w = {vel = "v", point = "v", normal = "v", friction = 0.2, extra = "x", material = "soft", rigid = true},
 }
 for kind, list in pairs(fields) do
   for _, f in ipairs(list) do
