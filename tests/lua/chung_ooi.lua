@@ -1,0 +1,78 @@
+-- Chung & Ooi (2011) tests 4-6: oblique impacts of a Hertz sphere
+-- (aluminium oxide, R = 2.5 mm, mu = 0.092) on a rigid plane, with the
+-- seed's incremental shear force (4-20) and Mindlin's total form
+-- (total_shear = 1), against the rigid-body closed form in gross sliding
+-- and against each form's no-slip limit integrated as an ODE
+-- (tests/lua/impact_lib.lua; docs/lua-api.md, "Oblique impacts").
+local here = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
+local T = dofile(here .. "harness.lua")
+local I = dofile(here .. "impact_lib.lua")
+local s = I.sphere
+
+local function incidence(deg, form, extra)
+  local a = math.rad(deg)
+  local o = {vn = 3.9 * math.cos(a), vt = 3.9 * math.sin(a), total_shear = form}
+  for k, x in pairs(extra or {}) do o[k] = x end
+  return I.run(o), I.sliding(o), o
+end
+
+T.test("gross sliding (test 4 from 40 degrees, test 6 at -2000 rad/s): the rigid-body closed form within 1 %", function()
+  for form = 0, 1 do
+    for _, deg in ipairs{40, 60, 80} do
+      local r, c, o = incidence(deg, form)
+      T.check(o.vt > c.limit, "gross sliding throughout")
+      T.near(r.vz, o.vn, 1e-6) -- elastic
+      T.near(r.vx / o.vt, c.vx / o.vt, 1e-6) -- the tangential restitution of the centre
+      -- the spin: the shear force acts at the contact point, R - Un/2 from the centre (4-4, 4-21),
+      -- which takes Un/(2R) = 0.16 % off the rigid body's spin
+      T.near(r.wy, c.wy, 0.005)
+      T.near(math.atan(r.vx, r.vz), math.atan(c.vx, c.vz), 0.01) -- the rebound angle
+      T.near(math.atan(r.vt_after, r.vz), math.atan(c.vt_after, c.vz), 0.01) -- the contact patch's
+    end
+    -- test 6: no tangential velocity, a backspin whose contact point slides at R |w| = 5 m/s
+    local o = {vn = 5, vt = 0, wy = -2000, total_shear = form}
+    local r, c = I.run(o), I.sliding(o)
+    T.near(r.vx, c.vx, 1e-6)
+    T.near(r.vt_after, c.vt_after, 0.01)
+  end
+  -- on the Coulomb cap throughout, both forms are one law: the same bits
+  local a, b = incidence(60, 0), incidence(60, 1)
+  T.eq(a.vx, b.vx)
+  T.eq(a.wy, b.wy)
+end)
+
+T.test("the sticking regime: the contact point's tangential velocity reverses (test 4 at 15-25 degrees)", function()
+  for form = 0, 1 do
+    for _, deg in ipairs{15, 20, 25} do
+      local r, c = incidence(deg, form)
+      T.check(r.vt_before < c.limit, "within the rigid body's sticking range")
+      -- the rigid body ends rolling (vt_after = 0); tangential compliance sends the contact point back
+      T.check(r.vt_after / r.vt_before < -0.2,
+              string.format("form %d, %g degrees: vt after / before = %.4f", form, deg, r.vt_after / r.vt_before))
+    end
+    -- at a small incidence the tangential spring returns it forwards
+    local r = incidence(2, form)
+    T.check(r.vt_after / r.vt_before > 0.8, string.format("form %d, 2 degrees: %.4f", form, r.vt_after / r.vt_before))
+  end
+  -- the two forms differ where the contact partly slips (psi1 = 0.83 at 5 degrees): 0.642 and 0.839
+  local a, b = incidence(5, 0), incidence(5, 1)
+  T.check(b.vt_after / b.vt_before - a.vt_after / a.vt_before > 0.1, "incremental and total forms at 5 degrees")
+end)
+
+T.test("no slip: both forms give their ODE's rebound, the same one (1.0135), to 0.5 %", function()
+  local inc, tot, md = I.no_slip("incremental", nil, 100000), I.no_slip("total", nil, 100000), I.no_slip("md", nil, 100000)
+  -- y'' = -k ks(t) y with ks(t) symmetric in time: the incremental form follows y(0) = 1, y'(0) = 0 to y(tc),
+  -- the total form y(0) = 0, y'(0) = 1 to y'(tc), which are equal (a time-reversible Hill equation)
+  T.near(tot, inc, 1e-8)
+  T.near(inc, 1.013513, 1e-5)
+  T.near(md, 0.588154, 1e-5)
+  for form = 0, 1 do
+    local r = I.run{vn = 3.9, vt = 0.2, total_shear = form, friction = 1e3}
+    local got = r.vt_after / r.vt_before
+    print(string.format("no slip, form %d: vt after / before %.6f (ODE %.6f, %+.3f %%)", form, got, inc,
+                        100 * (got / inc - 1)))
+    T.near(got, inc, 0.005)
+  end
+end)
+
+T.done()
