@@ -15,7 +15,7 @@ local function add(test, x, o)
     o.total_shear = form
     r[form] = I.run(o)
   end
-  local slide = I.sliding(o)
+  local slide = I.rigid_body(o)
   local psi1 = kappa * (o.vt - s.radius * (o.wy or 0)) / (s.friction * o.vn)
   local row = {test, x, psi1}
   for form = 0, 1 do
@@ -28,7 +28,7 @@ local function add(test, x, o)
   row[#row + 1] = slide.vx / o.vt
   row[#row + 1] = slide.wy
   row[#row + 1] = math.deg(math.atan(slide.vx, slide.vz))
-  row[#row + 1] = kappa * math.max(slide.vt_after, 0) / (s.friction * o.vn) -- rigid body: rolling at the end
+  row[#row + 1] = kappa * slide.vt_after / (s.friction * o.vn)
   rows[#rows + 1] = row
   io.write(string.format("test %d  %6.2f  psi1 %7.3f  psi2 incremental %7.3f total %7.3f rigid-body %7.3f\n", test, x,
                          psi1, row[7], row[11], row[15]))
@@ -72,7 +72,7 @@ set datafile separator ","
 set key left top
 set grid
 set output "%schung-ooi-psi.png"
-set title "Chung & Ooi tests 4-6: the contact point's tangential velocity, Maw's scaling (psi = kappa v_t / (mu v_n))"
+set title "Chung and Ooi tests 4-6: the contact point's tangential velocity, Maw's scaling (psi = kappa v_t / (mu v_n))"
 set xlabel "psi1 (before)"
 set ylabel "psi2 (after)"
 set xrange [0:12]
@@ -86,7 +86,7 @@ plot "%s" using ($1==4?$3:1/0):7 with linespoints pt 7 title "test 4, incrementa
      %g * x with lines dt 3 title "no slip: incremental = total", \
      %g * x with lines dt 4 title "no slip: Mindlin-Deresiewicz"
 set output "%schung-ooi-test4.png"
-set title "Chung & Ooi test 4 (aluminium oxide, 3.9 m/s): tangential restitution of the centre"
+set title "Chung and Ooi test 4 (aluminium oxide, 3.9 m/s): tangential restitution of the centre"
 set xlabel "incidence angle (degrees)"
 set ylabel "v_x after / v_x before"
 set xrange [0:90]
@@ -94,7 +94,7 @@ set yrange [0.4:1.05]
 set key right bottom
 plot "%s" using ($1==4?$2:1/0):4 with linespoints pt 7 title "incremental (4-20)", \
      "%s" using ($1==4?$2:1/0):8 with linespoints pt 6 title "total form", \
-     "%s" using ($1==4?$2:1/0):12 with lines lw 2 dt 2 title "rigid body, gross sliding"
+     "%s" using ($1==4?$2:1/0):12 with lines lw 2 dt 2 title "rigid body (sliding, or rolling at the end)"
 ]], img, csv, csv, csv, csv, csv, csv, 7 * kappa, 7 * kappa,
     lim[1], lim[3], img, csv, csv, csv))
 gp:close()

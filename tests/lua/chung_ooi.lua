@@ -13,7 +13,7 @@ local function incidence(deg, form, extra)
   local a = math.rad(deg)
   local o = {vn = 3.9 * math.cos(a), vt = 3.9 * math.sin(a), total_shear = form}
   for k, x in pairs(extra or {}) do o[k] = x end
-  return I.run(o), I.sliding(o), o
+  return I.run(o), I.rigid_body(o), o
 end
 
 T.test("gross sliding (test 4 from 40 degrees, test 6 at -2000 rad/s): the rigid-body closed form within 1 %", function()
@@ -31,7 +31,7 @@ T.test("gross sliding (test 4 from 40 degrees, test 6 at -2000 rad/s): the rigid
     end
     -- test 6: no tangential velocity, a backspin whose contact point slides at R |w| = 5 m/s
     local o = {vn = 5, vt = 0, wy = -2000, total_shear = form}
-    local r, c = I.run(o), I.sliding(o)
+    local r, c = I.run(o), I.rigid_body(o)
     T.near(r.vx, c.vx, 1e-6)
     T.near(r.vt_after, c.vt_after, 0.01)
   end
@@ -54,6 +54,12 @@ T.test("the sticking regime: the contact point's tangential velocity reverses (t
     local r = incidence(2, form)
     T.check(r.vt_after / r.vt_before > 0.8, string.format("form %d, 2 degrees: %.4f", form, r.vt_after / r.vt_before))
   end
+  -- at 1 degree (psi1 = 0.165) the total form sticks throughout (its no-slip value 1.0135, as with mu = 1000),
+  -- the incremental one slips as Fn falls at the end (its force, built at the stiffer compression, exceeds mu Fn)
+  local inc1, tot1 = incidence(1, 0), incidence(1, 1)
+  local inc1s, tot1s = incidence(1, 0, {friction = 1e3}), incidence(1, 1, {friction = 1e3})
+  T.near(tot1.vt_after / tot1.vt_before, tot1s.vt_after / tot1s.vt_before, 1e-4)
+  T.check(inc1.vt_after / inc1.vt_before < 0.95 * inc1s.vt_after / inc1s.vt_before, "the incremental form slips at 1 degree")
   -- the two forms differ where the contact partly slips (psi1 = 0.83 at 5 degrees): 0.642 and 0.839
   local a, b = incidence(5, 0), incidence(5, 1)
   T.check(b.vt_after / b.vt_before - a.vt_after / a.vt_before > 0.1, "incremental and total forms at 5 degrees")

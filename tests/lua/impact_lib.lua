@@ -13,12 +13,14 @@ M.sphere = {radius = 0.0025, E = 3.8e11, nu = 0.23, density = 4000, friction = 0
 local function shear_modulus(s) return s.E / (2 * (1 + s.nu)) end
 
 -- The contact's constants on a rigid plane: K (Fn = K d^1.5), the shear
--- stiffness factor (ks = S sqrt(d)), the mass, and 1 + m R^2 / I (7/2).
+-- stiffness factor (ks = S sqrt(d)), the mass, and 1 + m R^2 / I (7/2 for
+-- a solid sphere; s.lever another body's, as Maw et al.'s slice).
 function M.constants(s)
   s = s or M.sphere
   local m = s.density * 4 / 3 * math.pi * s.radius ^ 3
   return {K = 4 / 3 * s.E / (1 - s.nu ^ 2) * math.sqrt(s.radius),
-          S = 8 * shear_modulus(s) / (2 - s.nu) * math.sqrt(s.radius), mass = m, lever = 1 + m * s.radius ^ 2 / (0.4 * m * s.radius ^ 2)}
+          S = 8 * shear_modulus(s) / (2 - s.nu) * math.sqrt(s.radius), mass = m,
+          lever = s.lever or 1 + m * s.radius ^ 2 / (0.4 * m * s.radius ^ 2)}
 end
 
 -- Runs one impact in seixo: normal approach speed vn, tangential velocity
@@ -49,17 +51,19 @@ function M.run(o)
   return {vx = v[1], vz = v[3], wy = w[2], vt_before = o.vt - r * (o.wy or 0), vt_after = v[1] - r * w[2]}
 end
 
--- The rigid-body closed form when the contact slides throughout (Coulomb,
--- e = 1): the tangential impulse is mu (1 + e) m vn, so the centre loses
--- mu (1 + e) vn, the spin gains 5 mu (1 + e) vn / (2 R) (solid sphere) and
--- the contact point loses mu (1 + e) vn (1 + m R^2/I) = 7 mu vn (e = 1).
--- It holds while vt_before > 7 mu vn (else the contact ends rolling).
-function M.sliding(o)
+-- The rigid-body closed form (Coulomb, e = 1). While the contact point's
+-- slip s = vt - R wy exceeds 7 mu vn it slides throughout: the tangential
+-- impulse is mu (1 + e) m vn, so the centre loses 2 mu vn, the spin gains
+-- 5 mu vn / R (solid sphere) and the contact point loses 2 mu vn (1 + m R^2/I)
+-- = 7 mu vn. Below that it sticks and the contact ends rolling: the centre
+-- loses s/(1 + m R^2/I) = 2 s/7 and the contact point's velocity is 0.
+function M.rigid_body(o)
   local s = o.sphere or M.sphere
   local mu = o.friction or s.friction
-  local dv = 2 * mu * o.vn
-  return {vx = o.vt - dv, vz = o.vn, wy = (o.wy or 0) + 2.5 * dv / s.radius,
-          vt_after = o.vt - s.radius * (o.wy or 0) - 3.5 * dv, limit = 7 * mu * o.vn}
+  local wy, slip = o.wy or 0, o.vt - s.radius * (o.wy or 0)
+  local limit = 7 * mu * o.vn
+  local dv = slip > limit and 2 * mu * o.vn or slip / 3.5
+  return {vx = o.vt - dv, vz = o.vn, wy = wy + 2.5 * dv / s.radius, vt_after = slip - 3.5 * dv, limit = limit}
 end
 
 -- The no-slip limit (friction without bound) of one tangential form, as
