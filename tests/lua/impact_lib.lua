@@ -51,6 +51,47 @@ function M.run(o)
   return {vx = v[1], vz = v[3], wy = w[2], vt_before = o.vt - r * (o.wy or 0), vt_after = v[1] - r * w[2]}
 end
 
+-- Test 8's impact of two spheres of the sphere's material, radii ra (A,
+-- above) and rb (B, at rest below), head on along z at vn, A spinning at
+-- wy about y; their contact point slips at s = -ra wy. Returns the
+-- rebound: A's and B's vx and wy, and the slip before and after.
+function M.run_pair(o)
+  local s = o.sphere or M.sphere
+  local c = M.constants(s)
+  local ma, mb = s.density * 4 / 3 * math.pi * o.ra ^ 3, s.density * 4 / 3 * math.pi * o.rb ^ 3
+  local mstar, rstar = ma * mb / (ma + mb), o.ra * o.rb / (o.ra + o.rb)
+  local K = 4 / 3 * s.E / (2 * (1 - s.nu ^ 2)) * math.sqrt(rstar) -- one material: E* = E / (2 (1 - nu^2))
+  local tc = 2.9432 * (5 * mstar * o.vn ^ 2 / (4 * K)) ^ 0.4 / o.vn
+  local dt = tc / (o.steps_per_contact or 2000)
+  local m = seixo.model{dim = 3, timestep = dt}
+  m:material("ball", {model = "hertz", density = s.density, shear_modulus = shear_modulus(s), poisson = s.nu,
+                      friction = o.friction or s.friction, total_shear = o.total_shear or 0})
+  local b = m:ball{pos = {0, 0, 0}, radius = o.rb, material = "ball"}
+  local a = m:ball{pos = {0, 0, o.ra + o.rb + 0.5 * o.vn * dt}, radius = o.ra, vel = {0, 0, -o.vn}, material = "ball"}
+  a.spin = {0, o.wy, 0}
+  local touched = false
+  for _ = 1, 100 * (o.steps_per_contact or 2000) do
+    m:cycle(1)
+    if m:contact_count() > 0 then touched = true elseif touched then break end
+  end
+  assert(touched, "impact: no contact")
+  local function slip() return a.vel[1] - o.ra * a.spin[2] - b.vel[1] - o.rb * b.spin[2] end
+  return {vxa = a.vel[1], vxb = b.vel[1], wya = a.spin[2], wyb = b.spin[2], vza = a.vel[3], vzb = b.vel[3],
+          slip_before = -o.ra * o.wy, slip_after = slip(), c = c, mstar = mstar}
+end
+
+-- The rigid-body closed form of test 8 while the pair slides throughout
+-- (slip > 7 mu vn): the normal impulse 2 m* vn, the tangential one mu times
+-- it, against the slip on A and with it on B.
+function M.rigid_pair(o)
+  local s = o.sphere or M.sphere
+  local mu = o.friction or s.friction
+  local ma, mb = s.density * 4 / 3 * math.pi * o.ra ^ 3, s.density * 4 / 3 * math.pi * o.rb ^ 3
+  local J = mu * 2 * ma * mb / (ma + mb) * o.vn
+  return {vxa = -J / ma, vxb = J / mb, wya = o.wy + o.ra * J / (0.4 * ma * o.ra ^ 2), wyb = o.rb * J / (0.4 * mb * o.rb ^ 2),
+          slip_after = -o.ra * o.wy - 7 * mu * o.vn, limit = 7 * mu * o.vn}
+end
+
 -- The rigid-body closed form (Coulomb, e = 1). While the contact point's
 -- slip s = vt - R wy exceeds 7 mu vn it slides throughout: the tangential
 -- impulse is mu (1 + e) m vn, so the centre loses 2 mu vn, the spin gains
