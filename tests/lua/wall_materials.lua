@@ -202,6 +202,30 @@ T.test("a mesh of a material behaves as a plane of it, to the bit (a bounce, sli
   end
 end)
 
+T.test("2D: a line of a material or rigid, as in 3D; saved and restored", function()
+  local m = seixo.model{dim = 2, timestep = 1e-7}
+  m:material("ball", {kn = 3e6, ks = 2e6, friction = 0.7})
+  m:material("wallmat", {kn = 6e6, ks = 1e6, friction = 0.3})
+  m:wall{kind = "line", point = {0, 0}, normal = {0, 1}, material = "wallmat"}
+  m:wall{kind = "segment", p1 = {-1, 0.1}, p2 = {1, 0.1}, rigid = true}
+  m:ball{pos = {0, 0.002 - 1e-6}, radius = 0.002, material = "ball"}
+  m:ball{pos = {0.5, 0.1 - 0.002 + 1e-6}, radius = 0.002, material = "ball"}
+  m:cycle(1)
+  local kn = {}
+  for c in m:contacts() do kn[#kn + 1] = c.kn end
+  table.sort(kn)
+  T.near(kn[1], 2e6, 1e-15) -- in series
+  T.eq(kn[2], 3e6) -- rigid: the ball's
+  local path = os.tmpname()
+  m:save(path)
+  local l = seixo.load(path)
+  os.remove(path)
+  T.eq(l:hash(), m:hash())
+  m:cycle(100)
+  l:cycle(100)
+  T.eq(l:hash(), m:hash())
+end)
+
 T.test("wall materials: Lua fields, files, hash, errors", function()
   local m = seixo.model{dim = 3}
   m:material("b", {model = "hertz"})
