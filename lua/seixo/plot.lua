@@ -68,7 +68,8 @@ end
 --- file for a file terminal, rewritten at each refresh), title, x = "step"
 --- (default) or "time", log = true for a logarithmic y axis.
 function plot.live(m, names, opts)
-  if getmetatable(m) == nil or type(m) ~= "userdata" or not pcall(function() return m.histories end) then
+  local ok, method = pcall(function() return m.histories end)
+  if getmetatable(m) == nil or type(m) ~= "userdata" or not ok or type(method) ~= "function" then
     fail("plot.live: a model expected, got %s", type(m))
   end
   opts = opts or {}
