@@ -306,12 +306,13 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
                     0.5 * (a->viscous_shear + wm->def.viscous_shear));
     else
         l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
-    if (w->def.rigid) { /* springs in series with an infinite one: the ball's alone */
+    const bool rigid = w->def.material == SX_WALL_RIGID;
+    if (rigid) { /* springs in series with an infinite one: the ball's alone */
         l.kn = a->kn, l.ks = a->ks;
         l.dash_n = 4 * l.beta_n * l.beta_n * l.kn;
     }
     l.wall = true;
-    l.rigid = w->def.rigid;
+    l.rigid = rigid;
     l.law = (uint8_t)a->model;
     sx__law(l.law)->mix(&l, &m->mats[mat], wm, l.law);
     sx__law_parts_mix(&l, &m->mats[mat], wm);

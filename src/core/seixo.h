@@ -293,8 +293,20 @@ typedef enum sx_wall_kind {
     SX_WALL_MESH,     ///< 3D triangle mesh (sx_wall_add_mesh): two-sided facets; moves at vel and spins at spin about point
 } sx_wall_kind;
 
+/// sx_wall_def.material: no material of the wall's own, or a rigid wall.
+enum { SX_WALL_NO_MATERIAL = -1, SX_WALL_RIGID = -2 };
+
 typedef struct sx_wall_def {
     sx_wall_kind kind;
+    /// SX_WALL_NO_MATERIAL: the wall's kn, ks, friction below (and a Hertz ball's own G, nu
+    /// with R-bar = R, 4-28). SX_WALL_RIGID: the wall does not deform (kn, ks ignored,
+    /// friction kept): a linear contact has the ball's own kn, ks; a Hertz one is the
+    /// literature's rigid plane, E* = E/(1 - nu^2), G* = G/(2 - nu), R* = R. Else the index
+    /// of a material of the wall's own, of the balls' law, that replaces kn, ks and friction:
+    /// the contact mixes it with the ball's as two balls' materials mix (4-22/4-23/4-30;
+    /// Hertz 4-27 or the literature's rule, `hertz_mixing`), with R-bar = R. Not in the BPM
+    /// modulus mode (a wall has no radius).
+    int material;
     double point[3];   ///< plane/line: a point on it; rect: a corner; segment: first end
     double normal[3];  ///< plane/line: normal towards the balls (normalised on input)
     double edge1[3];   ///< rect: first edge from the corner; segment: second end minus first
@@ -306,20 +318,10 @@ typedef struct sx_wall_def {
     double radial_vel; ///< cylinder: m/s, rate of change of the radius (> 0 expands)
     double kn, ks;     ///< N/m, wall stiffnesses (in series with the ball's, 4-22)
     double friction;   ///< Coulomb coefficient; the contact uses the smaller of ball and wall
-    /// -1: none (kn, ks, friction above, and a Hertz ball's own G, nu with R-bar = R, 4-28);
-    /// else the index of a material of the wall's own, of the balls' law, that replaces kn,
-    /// ks and friction: the contact mixes it with the ball's as two balls' materials mix
-    /// (4-22/4-23/4-30; Hertz 4-27 or the literature's rule, `hertz_mixing`), with R-bar = R.
-    /// Not in the BPM modulus mode (a wall has no radius).
-    int material;
-    /// true: the wall does not deform (no material; kn, ks ignored, friction kept): a
-    /// linear contact has the ball's own kn, ks; a Hertz one is the literature's rigid
-    /// plane, E* = E/(1 - nu^2), G* = G/(2 - nu), R* = R.
-    bool rigid;
 } sx_wall_def;
 
 /// A plane at the origin with normal +z (2D: a line with normal +y), kn = ks = 1e8, friction 0.5,
-/// no material, not rigid.
+/// no material (SX_WALL_NO_MATERIAL).
 SX_API sx_wall_def sx_wall_default_def(int dim);
 
 SX_API sx_status sx_wall_add(sx_model *m, const sx_wall_def *def, int64_t *id);
@@ -384,9 +386,9 @@ SX_API sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3])
 /// Sets a stiffness, the friction or a cylinder's radius; the next step
 /// (and its timestep) uses the new value.
 SX_API sx_status sx_wall_set(sx_model *m, int64_t id, sx_wall_scalar which, double value);
-/// Gives a wall its own material (an index, or -1 for none) or makes it rigid
-/// (material -1 only); the next step uses it. See sx_wall_def.
-SX_API sx_status sx_wall_set_material(sx_model *m, int64_t id, int material, bool rigid);
+/// Gives a wall its own material (an index), none (SX_WALL_NO_MATERIAL) or makes it rigid
+/// (SX_WALL_RIGID); the next step uses it. See sx_wall_def.
+SX_API sx_status sx_wall_set_material(sx_model *m, int64_t id, int material);
 /// Cylinder: the rate of change of its radius (m/s, > 0 expands).
 SX_API sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel);
 /// Resultant force (N) of the balls on the wall in the last step, and its

@@ -253,9 +253,9 @@ static sx_status check_walls(sx_model *m)
             !(w->def.friction >= 0) || !isfinite(w->def.friction) || !(w->moved >= 0) || !isfinite(w->moved))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a stiffness, friction or move out of range",
                             (long long)w->id);
-        if (w->def.material < -1 || w->def.material >= m->nmat || (w->def.material >= 0 && w->def.rigid))
-            return sx__fail(m, SX_EINVAL, "state: wall %lld names material %d of %d%s", (long long)w->id,
-                            w->def.material, m->nmat, w->def.material >= 0 && w->def.rigid ? " and is rigid" : "");
+        if (w->def.material < SX_WALL_RIGID || w->def.material >= m->nmat)
+            return sx__fail(m, SX_EINVAL, "state: wall %lld names material %d of %d", (long long)w->id, w->def.material,
+                            m->nmat);
         if ((k == SX_WALL_RECT && !(w->len_u > 0 && w->len_v > 0)) || (k == SX_WALL_SEGMENT && !(w->seg_len > 0)))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a zero extent", (long long)w->id);
         if (k == SX_WALL_CYLINDER &&
@@ -639,10 +639,7 @@ static void hash_walls(hasher *s, const sx_model *m)
         const double last[] = {w->load, w->kn_sum, m->build_needed ? 0 : w->moved};
         put_doubles(s, last, 3, 1);
         put_int(s, w->contacts);
-        if (w->def.material >= 0 || w->def.rigid) { /* a plain wall hashes as before they existed */
-            put_int(s, w->def.material);
-            put_int(s, w->def.rigid);
-        }
+        if (w->def.material != SX_WALL_NO_MATERIAL) put_int(s, w->def.material); /* a plain wall hashes as before */
         if (w->mesh) { /* its turn and spin */
             put_doubles(s, w->mesh->q, sizeof w->mesh->q / sizeof(double), 1);
             put_doubles(s, w->def.spin, 3, 1);

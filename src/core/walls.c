@@ -16,21 +16,18 @@ sx_wall_def sx_wall_default_def(int dim)
     d.kn = 1e8;
     d.ks = 1e8;
     d.friction = 0.5;
-    d.material = -1;
+    d.material = SX_WALL_NO_MATERIAL;
     return d;
 }
 
 /* A wall's material or rigidity (sx_wall_def): a material of the model,
- * not in the BPM modulus mode (its per-ball stiffness needs a radius),
- * and not beside rigid. */
-static sx_status check_material(sx_model *m, const char *fn, int material, bool rigid)
+ * not in the BPM modulus mode (its per-ball stiffness needs a radius). */
+static sx_status check_material(sx_model *m, const char *fn, int material)
 {
-    if (material < -1 || material >= m->nmat)
-        return sx__fail(m, SX_EINVAL, "%s: material %d is not a material of the model (0 .. %d, or -1 for none)", fn,
+    if (material < SX_WALL_RIGID || material >= m->nmat)
+        return sx__fail(m, SX_EINVAL,
+                        "%s: material %d is not a material of the model (0 .. %d, or -1 for none, -2 for rigid)", fn,
                         material, m->nmat - 1);
-    if (material >= 0 && rigid)
-        return sx__fail(m, SX_EINVAL, "%s: a wall is either rigid or of a material (here '%s'), not both", fn,
-                        m->mats[material].name);
     if (material >= 0 && m->mats[material].def.modulus > 0)
         return sx__fail(m, SX_EINVAL,
                         "%s: material '%s' uses the BPM modulus (its stiffness grows with a ball's radius, which a "
@@ -103,7 +100,7 @@ static sx_status validate(sx_model *m, const sx_wall_def *def, const sx_mesh *me
         return sx__fail(m, SX_EINVAL, "wall_add: kn must be > 0 and ks >= 0 (got kn=%g, ks=%g)", def->kn, def->ks);
     if (!(def->friction >= 0) || !isfinite(def->friction))
         return sx__fail(m, SX_EINVAL, "wall_add: friction must be >= 0 (got %g)", def->friction);
-    sx_status st = check_material(m, "wall_add", def->material, def->rigid);
+    sx_status st = check_material(m, "wall_add", def->material);
     if (st) return st;
     switch (def->kind) {
     case SX_WALL_PLANE:
@@ -248,14 +245,13 @@ sx_status sx_wall_set_point(sx_model *m, int64_t id, const double p[3])
     return SX_OK;
 }
 
-sx_status sx_wall_set_material(sx_model *m, int64_t id, int material, bool rigid)
+sx_status sx_wall_set_material(sx_model *m, int64_t id, int material)
 {
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set_material");
     if (!w) return SX_ENOTFOUND;
-    sx_status st = check_material(m, "wall_set_material", material, rigid);
+    sx_status st = check_material(m, "wall_set_material", material);
     if (st) return st;
     w->def.material = material;
-    w->def.rigid = rigid;
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     m->dt_stale = true;    /* the critical timestep sees the wall's contacts */
     return SX_OK;
@@ -266,9 +262,9 @@ sx_status sx_wall_set(sx_model *m, int64_t id, sx_wall_scalar which, double valu
     m->guard_dirty = true; /* new energy baseline for the stability guard */
     sx_wall *w = (sx_wall *)lookup(m, id, "wall_set");
     if (!w) return SX_ENOTFOUND;
-    if ((which == SX_WALL_KN || which == SX_WALL_KS) && (w->def.material >= 0 || w->def.rigid))
+    if ((which == SX_WALL_KN || which == SX_WALL_KS) && w->def.material != SX_WALL_NO_MATERIAL)
         return sx__fail(m, SX_EINVAL, "wall_set: wall %lld is %s: its stiffness is not its own kn, ks", (long long)id,
-                        w->def.rigid ? "rigid" : "of a material");
+                        w->def.material == SX_WALL_RIGID ? "rigid" : "of a material");
     if (which == SX_WALL_FRICTION && w->def.material >= 0)
         return sx__fail(m, SX_EINVAL, "wall_set: wall %lld's friction is its material's ('%s')", (long long)id,
                         m->mats[w->def.material].name);

@@ -424,7 +424,7 @@ typedef struct wall_cols {
     int64_t *id, *contacts;
     int *kind;
     int32_t *material;
-    uint8_t *servo_on, *rigid;
+    uint8_t *servo_on;
     double *point, *normal, *edge1, *edge2, *vel, *kn, *ks, *friction;
     double *u, *v, *len_u, *len_v, *seg_len, *force, *moment, *moved;
     double *radius, *height, *radial_vel, *load, *kn_sum;
@@ -441,13 +441,12 @@ static bool wall_cols_alloc(wall_cols *c, int64_t n)
     c->kind = calloc(k, sizeof *c->kind);
     c->servo_on = calloc(k, sizeof *c->servo_on);
     c->material = calloc(k, sizeof *c->material);
-    c->rigid = calloc(k, sizeof *c->rigid);
     double **vec[] = {&c->point, &c->normal, &c->edge1, &c->edge2, &c->vel, &c->u, &c->v, &c->force, &c->moment, &c->spin};
     double **sc[] = {&c->kn,     &c->ks,     &c->friction,   &c->len_u, &c->len_v,  &c->seg_len, &c->moved,
                      &c->radius, &c->height, &c->radial_vel, &c->load,  &c->kn_sum, &c->target,  &c->area,
                      &c->alpha,  &c->max_speed};
-    bool ok = c->id && c->contacts && c->kind && c->servo_on && c->material && c->rigid;
-    for (size_t i = 0; c->material && i < k; i++) c->material[i] = -1; /* a file from before wall materials */
+    bool ok = c->id && c->contacts && c->kind && c->servo_on && c->material;
+    for (size_t i = 0; c->material && i < k; i++) c->material[i] = SX_WALL_NO_MATERIAL; /* a file from before them */
     for (size_t i = 0; i < sizeof vec / sizeof *vec; i++) ok &= (*vec[i] = calloc(3 * k, sizeof(double))) != NULL;
     for (size_t i = 0; i < sizeof sc / sizeof *sc; i++) ok &= (*sc[i] = calloc(k, sizeof(double))) != NULL;
     return ok;
@@ -459,7 +458,7 @@ static void wall_cols_free(wall_cols *c)
                  c->vel,      c->kn,       c->ks,      c->friction,   c->u,      c->v,      c->len_u,  c->len_v,
                  c->seg_len,  c->force,    c->moment,  c->moved,      c->radius, c->height, c->radial_vel,
                  c->load,     c->kn_sum,   c->target,  c->area,       c->alpha,  c->max_speed, c->spin,
-                 c->material, c->rigid};
+                 c->material};
     for (size_t i = 0; i < sizeof p / sizeof *p; i++) free(p[i]);
 }
 
@@ -491,13 +490,12 @@ static int wall_fields_mesh(const sx_model *m, const wall_cols *c, field *f)
     return n;
 }
 
-/* A wall's material (its index among /materials, -1: none) and rigidity,
- * optional: a file from before them has neither. */
+/* A wall's material (its index among /materials; -1: none, -2: rigid),
+ * optional: a file from before wall materials has none. */
 static int wall_fields_material(const wall_cols *c, field *f)
 {
     int n = 0;
     f[n++] = F("material", T_I32, c->material, 1, NULL);
-    f[n++] = F("rigid", T_U8, c->rigid, 1, NULL);
     return n;
 }
 
@@ -569,8 +567,8 @@ static void wall_copy(const sx_model *m, sx_wall *w, wall_cols *c, int64_t i, bo
     S(alpha, w->servo.alpha);
     S(max_speed, w->servo.max_speed);
     S(material, w->def.material);
-    if (to_cols) c->kind[i] = (int)w->def.kind, c->servo_on[i] = w->servo_on, c->rigid[i] = w->def.rigid;
-    else w->def.kind = (sx_wall_kind)c->kind[i], w->servo_on = c->servo_on[i] != 0, w->def.rigid = c->rigid[i] != 0;
+    if (to_cols) c->kind[i] = (int)w->def.kind, c->servo_on[i] = w->servo_on;
+    else w->def.kind = (sx_wall_kind)c->kind[i], w->servo_on = c->servo_on[i] != 0;
 #undef V
 #undef S
 }

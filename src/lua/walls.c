@@ -102,7 +102,7 @@ static int get_rigid(lua_State *L)
 {
     sx_wall_def d;
     wall_def(L, &d);
-    lua_pushboolean(L, d.rigid);
+    lua_pushboolean(L, d.material == SX_WALL_RIGID);
     return 1;
 }
 
@@ -225,14 +225,14 @@ static int set_material(lua_State *L)
 {
     int64_t id;
     sx_model *m = check_wall(L, &id);
-    int k = -1;
+    int k = SX_WALL_NO_MATERIAL;
     if (!lua_isnil(L, 3)) {
         const char *name = lua_tostring(L, 3);
         if (!lua_isstring(L, 3) || (k = sx_material_find(m, name)) < 0)
             return luaL_error(L, "wall field 'material': %s is not a material of the model (m:material defines one)",
                               luaL_tolstring(L, 3, NULL));
     }
-    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, k, false), "wall");
+    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, k), "wall");
     return 0;
 }
 
@@ -244,7 +244,12 @@ static int set_rigid(lua_State *L)
         return luaL_error(L, "wall field 'rigid': true or false expected, got %s", luaL_typename(L, 3));
     sx_wall_def d;
     sx_lua_checkfield(L, m, sx_wall_get(m, id, &d), "wall");
-    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, d.material, lua_toboolean(L, 3)), "wall");
+    if (lua_toboolean(L, 3) && d.material >= 0)
+        return luaL_error(L, "wall field 'rigid': the wall is of material '%s'; a wall is either rigid or of a "
+                             "material, not both (w.material = nil first)", sx_material_name(m, d.material));
+    if (lua_toboolean(L, 3)) d.material = SX_WALL_RIGID;
+    else if (d.material == SX_WALL_RIGID) d.material = SX_WALL_NO_MATERIAL;
+    sx_lua_checkfield(L, m, sx_wall_set_material(m, id, d.material), "wall");
     return 0;
 }
 
@@ -280,11 +285,13 @@ static void read_common(lua_State *L, sx_model *m, int dim, sx_wall_def *d)
     const bool own = sx_lua_optnumfield(L, 2, "kn", &d->kn) | sx_lua_optnumfield(L, 2, "ks", &d->ks);
     const bool friction = sx_lua_optnumfield(L, 2, "friction", &d->friction);
     sx_lua_optvecfield(L, 2, "vel", dim, d->vel);
+    bool rigid = false;
     if (lua_getfield(L, 2, "rigid") != LUA_TNIL) {
         if (!lua_isboolean(L, -1)) luaL_argerror(L, 2, "field 'rigid': true or false expected");
-        d->rigid = lua_toboolean(L, -1);
+        rigid = lua_toboolean(L, -1);
     }
     lua_pop(L, 1);
+    if (rigid) d->material = SX_WALL_RIGID;
     if (lua_getfield(L, 2, "material") != LUA_TNIL) {
         const char *name = lua_isstring(L, -1) ? lua_tostring(L, -1) : NULL;
         d->material = name ? sx_material_find(m, name) : -1;
@@ -293,10 +300,10 @@ static void read_common(lua_State *L, sx_model *m, int dim, sx_wall_def *d)
                                                    "(m:material defines one)", luaL_tolstring(L, -1, NULL)));
         if (own || friction)
             luaL_argerror(L, 2, "a wall of a material takes kn, ks and friction from it: give the material or them");
-        if (d->rigid) luaL_argerror(L, 2, "a wall is either rigid or of a material, not both");
+        if (rigid) luaL_argerror(L, 2, "a wall is either rigid or of a material, not both");
     }
     lua_pop(L, 1);
-    if (d->rigid && own) luaL_argerror(L, 2, "a rigid wall has no kn or ks of its own (its friction stays)");
+    if (rigid && own) luaL_argerror(L, 2, "a rigid wall has no kn or ks of its own (its friction stays)");
 }
 
 /* A rect's corner, given as `corner` or as `point` like the other kinds. */
