@@ -104,6 +104,10 @@ static void poke_all(sx_model *a, sx_model *b)
     POKE(mats[0].def.damping, F64);
     POKE(mats[0].def.viscous_normal, F64);
     POKE(mats[0].def.viscous_shear, F64);
+    POKE(mats[0].def.restitution, F64); /* the registry's parts, hashed when on */
+    POKE(mats[0].def.rolling_friction, F64);
+    POKE(mats[0].def.total_shear, F64);
+    POKE(mats[0].def.hertz_mixing, F64);
     POKE(mats[0].bpm.radius_multiplier, F64);
     POKE(mats[0].bpm.tensile_strength, F64);
     POKE(mats[0].bpm.shear_strength_sd, F64);
@@ -141,6 +145,7 @@ static void poke_all(sx_model *a, sx_model *b)
         POKE(walls[w].def.kn, F64);
         POKE(walls[w].def.ks, F64);
         POKE(walls[w].def.friction, F64);
+        POKE(walls[w].def.material, INT); /* none (-1) to material 0 */
         POKE(walls[w].force[0], F64);
         POKE(walls[w].moment[2], F64);
         POKE(walls[w].load, F64);
