@@ -66,9 +66,9 @@ T.test("a Hertz ball on a rigid plane: the literature's impact (Chung & Ooi test
     local tc = 2 * I * dm / v
     local dt = tc / 4000
     local got_d, got_t, vout = drop(r, rho, E, nu, v, function() return {rigid = true} end, dt)
-    print(string.format("rigid plane, %s: max overlap %.6e m (closed form %.6e, %+.4f %%), duration %.6e s "
-                        .. "(%.6e, %+.4f %%), e = %.6f", name, got_d, dm, 100 * (got_d / dm - 1), got_t, tc,
-                        100 * (got_t / tc - 1), vout / v))
+    print(string.format("rigid plane, %s: max overlap %.6e m (closed form %.6e, relative error %+.1e), duration "
+                        .. "%.6e s (%.6e, %+.1e), e = %.8f", name, got_d, dm, got_d / dm - 1, got_t, tc,
+                        got_t / tc - 1, vout / v))
     T.near(got_d, dm, 0.01)
     T.near(got_t, tc, 0.01)
     T.near(vout, v, 1e-3) -- elastic
