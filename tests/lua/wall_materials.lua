@@ -121,6 +121,42 @@ T.test("two Hertz materials mix as the literature (hertz_mixing = 1) or by the s
   T.near(c1.fn, 4 / 3 * steel.E / (2 * (1 - steel.nu ^ 2)) * math.sqrt(rs) * c1.overlap ^ 1.5, 1e-12)
 end)
 
+T.test("a steel ball meets a glass ball head on: Hertz's impact at the literature's E*, R*, m* within 1 %", function()
+  local I = hertz_integral()
+  local ra, rb, v = 0.002, 0.003, 0.5 -- closing speed
+  local rhoa, rhob = 7800, 2500
+  local m = seixo.model{dim = 3, timestep = 1e-9}
+  local a, b = def(steel), def(glass)
+  a.model, b.model, a.hertz_mixing, b.hertz_mixing, a.density, b.density = "hertz", "hertz", 1, 1, rhoa, rhob
+  m:material("steel", a)
+  m:material("glass", b)
+  local ba = m:ball{pos = {0, 0, 0}, radius = ra, material = "steel", vel = {0.5 * v, 0, 0}}
+  local bb = m:ball{pos = {ra + rb + 1e-9, 0, 0}, radius = rb, material = "glass", vel = {-0.5 * v, 0, 0}}
+  local ma, mb = rhoa * 4 / 3 * math.pi * ra ^ 3, rhob * 4 / 3 * math.pi * rb ^ 3
+  local mstar, rstar = ma * mb / (ma + mb), ra * rb / (ra + rb)
+  local es = 1 / ((1 - steel.nu ^ 2) / steel.E + (1 - glass.nu ^ 2) / glass.E)
+  local K = 4 / 3 * es * math.sqrt(rstar)
+  local dm = (5 * mstar * v * v / (4 * K)) ^ 0.4
+  local tc = 2 * I * dm / v
+  local dt = tc / 4000
+  m:set_timestep(dt)
+  local steps, dmax, touched = 0, 0, false
+  for _ = 1, 100000 do
+    m:cycle(1)
+    local c = contact(m)
+    if c and c.overlap > 0 then
+      touched, steps, dmax = true, steps + 1, math.max(dmax, c.overlap)
+    elseif touched then
+      break
+    end
+  end
+  print(string.format("steel on glass: max overlap %.6e m (closed form %.6e, %+.1e), duration %.6e s (%.6e, %+.1e)",
+                      dmax, dm, dmax / dm - 1, steps * dt, tc, steps * dt / tc - 1))
+  T.near(dmax, dm, 0.01)
+  T.near(steps * dt, tc, 0.01)
+  T.near(bb.vel[1] - ba.vel[1], v, 1e-6) -- elastic: the closing speed comes back
+end)
+
 -- A ball of material `ball` resting against a plane with wall keys `w`,
 -- overlapping it by d: the contact after one step.
 local function on_wall(ball, w, d, walldef)
