@@ -31,9 +31,10 @@ end
 -- A Hertz ball (radius r, density rho, E, nu) dropped at v onto a plane
 -- wall given by `wall` (extra keys of m:wall); no gravity, no damping.
 -- Returns the largest overlap, the contact's duration and the rebound speed.
-local function drop(r, rho, E, nu, v, wall, dt)
+local function drop(r, rho, E, nu, v, wall, dt, e)
   local m = seixo.model{dim = 3, timestep = dt}
-  m:material("ball", {model = "hertz", density = rho, shear_modulus = G(E, nu), poisson = nu, friction = 0})
+  m:material("ball", {model = "hertz", density = rho, shear_modulus = G(E, nu), poisson = nu, friction = 0,
+                      restitution = e or 0})
   local w = {kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
   for k, x in pairs(wall(m)) do w[k] = x end
   m:wall(w)
@@ -76,6 +77,12 @@ T.test("a Hertz ball on a rigid plane: the literature's impact (Chung & Ooi test
     local Ks = 4 / 3 * G(E, nu) / (1 - nu) * math.sqrt(r / 2)
     local seed_d = drop(r, rho, E, nu, v, function() return {} end, dt)
     T.near(seed_d, (5 * mass * v * v / (4 * Ks)) ^ 0.4, 0.01)
+    -- Chung & Ooi test 3 on the rigid plane: the damping derived from e gives e (laws/restitution.h)
+    for _, e in ipairs{0.1, 0.5, 0.9} do
+      local _, _, out = drop(r, rho, E, nu, v, function() return {rigid = true} end, dt, e)
+      print(string.format("rigid plane, %s, restitution %.1f: measured %.5f", name, e, out / v))
+      T.near(out / v, e, 0.01 / e)
+    end
   end
 end)
 
