@@ -7,6 +7,7 @@
 #include "bindings.h"
 #include "seixo_io.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,23 +71,36 @@ static int push_def_vec(lua_State *L, size_t offset)
     return 1;
 }
 
-static int push_def_number(lua_State *L, size_t offset)
-{
-    sx_wall_def d;
-    wall_def(L, &d);
-    lua_pushnumber(L, *(const double *)((const char *)&d + offset));
-    return 1;
-}
-
 static int get_point(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, point)); }
 static int get_normal(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, normal)); }
 static int get_edge1(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge1)); }
 static int get_edge2(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge2)); }
 static int get_vel(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, vel)); }
 static int get_spin(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, spin)); }
-static int get_kn(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, kn)); }
-static int get_ks(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, ks)); }
-static int get_friction(lua_State *L) { return push_def_number(L, offsetof(sx_wall_def, friction)); }
+/* A stiffness or the friction as the contacts use it: the wall's own, its
+ * material's, or a rigid wall's infinite stiffness (and its own friction). */
+static int push_spring(lua_State *L, size_t wall_offset, size_t material_offset)
+{
+    sx_wall_def d;
+    const sx_model *m = wall_def(L, &d);
+    if (d.material == SX_WALL_RIGID && wall_offset != offsetof(sx_wall_def, friction)) {
+        lua_pushnumber(L, HUGE_VAL);
+    } else if (d.material >= 0) {
+        sx_material_def md;
+        sx_lua_checkfield(L, m, sx_material_get(m, d.material, &md), "wall");
+        lua_pushnumber(L, *(const double *)((const char *)&md + material_offset));
+    } else {
+        lua_pushnumber(L, *(const double *)((const char *)&d + wall_offset));
+    }
+    return 1;
+}
+
+static int get_kn(lua_State *L) { return push_spring(L, offsetof(sx_wall_def, kn), offsetof(sx_material_def, kn)); }
+static int get_ks(lua_State *L) { return push_spring(L, offsetof(sx_wall_def, ks), offsetof(sx_material_def, ks)); }
+static int get_friction(lua_State *L)
+{
+    return push_spring(L, offsetof(sx_wall_def, friction), offsetof(sx_material_def, friction));
+}
 
 /* The wall's material by name (nil: none) and its rigidity. */
 static int get_material(lua_State *L)

@@ -283,6 +283,16 @@ T.test("wall materials: Lua fields, files, hash, errors", function()
   T.eq(s.material, nil)
   T.eq(s.rigid, false)
   T.eq(m:materials().w.hertz_mixing, 1)
+  -- the springs and friction the contacts use: the material's, a rigid wall's infinite stiffness
+  m:material("lw", {kn = 3e7, ks = 2e7, friction = 0.25})
+  local lw = m:wall{kind = "plane", point = {0, 0, -5}, normal = {0, 0, 1}, material = "lw"}
+  T.eq(lw.kn, 3e7)
+  T.eq(lw.ks, 2e7)
+  T.eq(lw.friction, 0.25)
+  T.eq(q.kn, math.huge)
+  T.eq(q.ks, math.huge)
+  T.eq(q.friction, 0.2)
+  lw:remove()
   m:ball{pos = {0.5, 0, 0.5}, radius = 0.1, material = "b", vel = {0, 0, -1}}
   m:cycle(10)
   s.rigid = true -- (a wall's change makes the automatic timestep due again, which the hash covers)
