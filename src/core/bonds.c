@@ -477,6 +477,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
                 p->fs[c * d + k] = 0;
             }
             p->touching[c] = 1;
+            if (p->cmodel) p->cmodel[c] = sx__cmodel_pick(m, i, j); /* a contact created: its row (cmodel.c) */
         }
         installed++;
     }

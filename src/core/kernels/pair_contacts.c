@@ -387,6 +387,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
     const int32_t *restrict bond = p->bond;
+    int32_t *restrict cmodel = p->cmodel; /* the contact-model table's rows (cmodel.c); NULL: none */
     double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
@@ -402,6 +403,10 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
         const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
         const sx_pair_law *law = &laws[mat[i] * nlaw + mat[j]];
+        if (cmodel) { /* a contact takes its row when it is created and keeps it */
+            if (!touching[c]) cmodel[c] = sx__cmodel_pick(m, i, j);
+            if (cmodel[c]) law = &m->cmodel[cmodel[c] - 1].law;
+        }
         double *restrict fs = fs_all + c * D, *restrict rel = geo_all + c * D;
         if (d2 >= rsum * rsum && slot < 0) {
             if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
@@ -780,7 +785,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
 
 static void ball_chunk(sx_model *m, sx_chunk *o)
 {
-    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_batched(m, o);
+    if (m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->track_energy) ball_chunk_batched(m, o);
     else ball_chunk_pass(m, o);
 }
 
