@@ -514,6 +514,18 @@ typedef struct sx_bpm_def {
     double friction_angle, friction, elements, sectors, unbonded_fraction, initial_gap;
 } sx_bpm_def;
 SX_API sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def);
+/// The bond kinds of the registry (src/core/laws/bonds.h): their count, and
+/// kind k's name (m:bond's `kind`; its bit into *kind if not NULL), NULL out of range.
+SX_API int sx_bond_kind_count(void);
+SX_API const char *sx_bond_kind_name(int k, sx_bond_kind *kind);
+/// The kinds' micro-parameters, each once (a material's `bond` keys, the
+/// files' bond_* columns, m:bond's keys): their count, key i's name (its
+/// unit into *unit if not NULL), and its field in an sx_bpm_def and in an
+/// sx_bond_def (NULL out of range).
+SX_API int sx_bond_key_count(void);
+SX_API const char *sx_bond_key(int i, const char **unit);
+SX_API double *sx_bond_key_material(sx_bpm_def *d, int i);
+SX_API double *sx_bond_key_call(sx_bond_def *d, int i);
 SX_API sx_status sx_material_get_bpm(const sx_model *m, int material, sx_bpm_def *out);
 
 typedef enum sx_crack_mode { SX_CRACK_TENSION = 1, SX_CRACK_SHEAR = 2 } sx_crack_mode;

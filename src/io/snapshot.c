@@ -300,35 +300,43 @@ static hid_t law_enum(hid_t base)
     return sx_h5_enum(base, names, values, n);
 }
 
-/* A material's numbers: its definition, its BPM parameters, then every
- * law's parameters (each once, from the registry). */
-#define MAT_FIXED 20
-#define MAT_MAX (MAT_FIXED + 32)
+/* A material's numbers: its definition, its bond micro-parameters (bond_
+ * and the key, from the bond registry: sx_bond_key), then every law's
+ * parameters (each once, from the law registry). */
+#define MAT_FIXED 9
+#define MAT_MAX (MAT_FIXED + 96)
 static const char *const mat_fixed_names[MAT_FIXED] = {
-    "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping",
-    "viscous_normal", "viscous_shear",
-    "bond_radius_multiplier", "bond_modulus", "bond_stiffness_ratio", "bond_tensile_strength",
-    "bond_tensile_strength_sd", "bond_cohesion", "bond_cohesion_sd", "bond_normal_strength",
-    "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd"};
-static const char *const mat_fixed_units[MAT_FIXED] = {
-    "kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1",
-    "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N"};
+    "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping", "viscous_normal", "viscous_shear"};
+static const char *const mat_fixed_units[MAT_FIXED] = {"kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1"};
 
+enum { COL_FIXED = -1, COL_BOND = -2 };
 typedef struct mat_column {
-    const char *name, *unit;
-    int law, k; /* a law's parameter k, or law -1: fixed number k */
+    char name[64];
+    const char *unit;
+    int law, k; /* a law's parameter k, COL_BOND: bond key k, COL_FIXED: fixed number k */
 } mat_column;
+
+static void column(mat_column *c, const char *prefix, const char *name, const char *unit, int law, int k)
+{
+    snprintf(c->name, sizeof c->name, "%s%s", prefix, name);
+    c->unit = unit, c->law = law, c->k = k;
+}
 
 static int mat_columns(mat_column *c)
 {
     int n = 0;
-    for (int k = 0; k < MAT_FIXED; k++) c[n++] = (mat_column){mat_fixed_names[k], mat_fixed_units[k], -1, k};
+    for (int k = 0; k < MAT_FIXED; k++) column(&c[n++], "", mat_fixed_names[k], mat_fixed_units[k], COL_FIXED, k);
+    for (int k = 0; k < sx_bond_key_count() && n < MAT_MAX; k++) {
+        const char *unit, *name = sx_bond_key(k, &unit);
+        column(&c[n++], "bond_", name, unit, COL_BOND, k);
+    }
+    const int laws = n;
     for (int law = 0; law < sx_law_count(); law++)
         for (int k = 0; k < sx_law_param_count(law) && n < MAT_MAX; k++) {
             const char *unit, *name = sx_law_param_name(law, k, &unit);
             bool seen = false;
-            for (int j = MAT_FIXED; j < n && !seen; j++) seen = strcmp(c[j].name, name) == 0;
-            if (!seen) c[n++] = (mat_column){name, unit, law, k};
+            for (int j = laws; j < n && !seen; j++) seen = strcmp(c[j].name, name) == 0;
+            if (!seen) column(&c[n++], "", name, unit, law, k);
         }
     return n;
 }
@@ -336,13 +344,10 @@ static int mat_columns(mat_column *c)
 static double *mat_number(sx_material *t, const mat_column *c)
 {
     if (c->law >= 0) return sx_law_param_value(&t->def, c->law, c->k);
+    if (c->law == COL_BOND) return sx_bond_key_material(&t->bpm, c->k);
     sx_material_def *d = &t->def;
-    sx_bpm_def *b = &t->bpm;
     double *p[MAT_FIXED] = {&d->density, &d->kn, &d->ks, &d->modulus, &d->stiffness_ratio, &d->friction,
-                            &d->damping, &d->viscous_normal, &d->viscous_shear,
-                            &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
-                            &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                            &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+                            &d->damping, &d->viscous_normal, &d->viscous_shear};
     return p[c->k];
 }
 
@@ -403,10 +408,10 @@ static void read_mats(sx_h5 *h, hid_t g, const char *where, sx_material *first, 
         }
         mat_column c[MAT_MAX];
         const int nc = mat_columns(c);
-        /* a law's parameter a file predates takes its default (the law is newer than the file) */
+        /* a law's or bond kind's parameter a file predates takes its default (the law is newer than the file) */
         sx_material def = {.def = sx_material_default_def()};
         for (int k = 0; k < nc && !h->failed; k++) {
-            const bool newer = c[k].law >= 0 && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
+            const bool newer = c[k].law != COL_FIXED && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
             if (newer)
                 for (int i = 0; i < n; i++) *mat_number(MAT_AT(first, stride, i), &c[k]) = *mat_number(&def, &c[k]);
             else if (sx_h5_read(h, g, where, c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))

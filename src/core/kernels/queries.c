@@ -60,7 +60,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
         e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
-        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += sx_bond_parallel_strain(D, &m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
             e->bond_strain += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
     }

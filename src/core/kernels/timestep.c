@@ -60,15 +60,8 @@ static double KERNEL(critical_dt)(sx_model *m)
                 krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
             }
         }
-        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) { /* a flat joint's face: the section of 4-35 */
-            const sx_bonds *b = &m->bonds;
-            double area, inertia, polar;
-            pb_section(b->rbar[slot], &area, &inertia, &polar);
-            ktr += (b->kn[slot] + b->ks[slot]) * area;
-            const double krb = b->kn[slot] * inertia + b->ks[slot] * polar;
-            krot_i += krb + b->ks[slot] * area * B->rad[i] * B->rad[i];
-            krot_j += krb + b->ks[slot] * area * B->rad[j] * B->rad[j];
-        }
+        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) /* a flat joint's face: the section of 4-35 */
+            sx_bond_parallel_stiffness(D, &m->bonds, slot, B->rad[i], B->rad[j], &ktr, &krot_i, &krot_j);
         const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
         kt[i] += ktr;
         kt[jo] += ktr;
