@@ -34,12 +34,6 @@ int32_t sx__cmodel_pick(const sx_model *m, int64_t i, int64_t j)
     return 0;
 }
 
-sx_pair_law sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j)
-{
-    const int32_t r = !m->bb.cmodel ? 0 : m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
-    return r ? m->cmodel[r - 1].law : sx__pair_law(m, m->balls.mat[i], m->balls.mat[j]);
-}
-
 /* Why def cannot be a row of m, or NULL. */
 static const char *invalid(const sx_model *m, const sx_cmodel_def *d, char *why, size_t len)
 {

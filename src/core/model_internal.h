@@ -378,8 +378,6 @@ static inline const sx_pair_law *sx__bb_step_law(const sx_model *m, int64_t c, i
     const int32_t r = m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
     return r ? &m->cmodel[r - 1].law : l;
 }
-/* The same for queries, mixed from the materials as they are. */
-sx_pair_law sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j);
 /* Rows' laws that need history the stores lack (rolling, total form):
  * expands the stores; and bonded contacts under a row whose law takes no
  * bonds are refused (seed 4.3.3). */
@@ -388,6 +386,12 @@ sx_status sx__cmodel_prepare(sx_model *m);
 void sx__cmodel_derive(sx_cmodel_row *r);
 /* The mixed pair law of two materials (model.c). */
 sx_pair_law sx__pair_law_of(const sx_material *ma, const sx_material *mb);
+/* The law of ball-ball pair c for queries: its row's, or mixed from the materials as they are. */
+static inline sx_pair_law sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j)
+{
+    const int32_t r = !m->bb.cmodel ? 0 : m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
+    return r ? m->cmodel[r - 1].law : sx__pair_law_of(&m->mats[m->balls.mat[i]], &m->mats[m->balls.mat[j]]);
+}
 
 /* The first rule d breaks (its value in *bad), or NULL (model.c). */
 const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len);
