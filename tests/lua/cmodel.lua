@@ -124,6 +124,18 @@ T.test("bad rows are refused with the reason", function()
   T.raises(function() b:cycle(1) end, "bonded", "seed 4.3.3")
 end)
 
+T.test("the table is part of the state hash, and nothing else changes without it", function()
+  local a, b = scene(3, 1e-5), scene(3, 1e-5)
+  T.eq(a:hash(), b:hash())
+  a:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = G, poisson = NU}
+  T.check(a:hash() ~= b:hash(), "a row changes the hash")
+  b:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = G, poisson = NU, rolling_friction = 0.1}
+  T.check(a:hash() ~= b:hash(), "a row's parameter (rolling_friction) changes the hash")
+  local c = scene(3, 1e-5)
+  c:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = G, poisson = NU}
+  T.eq(c:hash(), a:hash(), "equal tables")
+end)
+
 -- A bed under gravity in two groups, a Hertz row between them: enough
 -- pairs (> 4096) for the ball-ball pass to run in several chunks.
 local function bed(threads)
