@@ -124,6 +124,43 @@ T.test("bad rows are refused with the reason", function()
   T.raises(function() b:cycle(1) end, "bonded", "seed 4.3.3")
 end)
 
+T.test("a bonded specimen keeps its law and bonds; its platen balls press it under a Hertz row", function()
+  local m = seixo.model{dim = 2, timestep = 1e-7}
+  m:material("rock", {kn = KN, ks = KN, friction = 0.5, density = 2650, damping = 0.7,
+                      bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e9,
+                              cohesion = 1e9}})
+  for j = 0, 3 do
+    for i = 0, 5 do m:ball{pos = {(2 * i + (j % 2) + 1) * R, (1 + j * math.sqrt(3)) * R}, radius = R, group = "rock"} end
+  end
+  T.check(m:bond{gap = 1e-9} > 0, "bonds installed")
+  local top = (1 + 3 * math.sqrt(3)) * R
+  local platen = {}
+  for i = 0, 5 do
+    local b = m:ball{pos = {(2 * i + 2) * R, top + 2 * R + 1e-6}, radius = R, group = "platen"}
+    b.fix = "vel"
+    b.vel = {0, -0.1}
+    platen[#platen + 1] = b
+  end
+  m:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = G, poisson = NU}
+  local bonds = m:bond_count()
+  m:cycle(400)
+  local pressed, bonded = 0, 0
+  for c in m:contacts() do
+    local ga, gb = c.a.group, c.b.group
+    if ga ~= gb then
+      pressed = pressed + 1
+      T.eq(c.contact_model, 1)
+      T.check(math.abs(c.fn - hertz(c.overlap)) <= 1e-9 * c.fn, string.format("Hertz: %.17g vs %.17g", c.fn, hertz(c.overlap)))
+    elseif c.bond then
+      bonded = bonded + 1
+      T.eq(c.contact_model, nil, "a bonded contact keeps its materials' law")
+    end
+  end
+  T.check(pressed > 0 and bonded > 0, string.format("%d platen contacts, %d bonded", pressed, bonded))
+  print(string.format("bonded specimen: %d platen contacts under the Hertz row, %d bonded contacts under the materials' law", pressed, bonded))
+  T.eq(m:bond_count(), bonds)
+end)
+
 T.test("the table is part of the state hash, and nothing else changes without it", function()
   local a, b = scene(3, 1e-5), scene(3, 1e-5)
   T.eq(a:hash(), b:hash())
