@@ -88,6 +88,8 @@ const char *sx__bond_params_invalid(const void *d, bool call, char *why, size_t 
                             p[i]->hi_closed ? "]" : ")", *unit ? " " : "", unit, x),
                    why;
         }
+        if (p[i]->whole && x != floor(x))
+            return snprintf(why, len, "%s must be a whole number (got %g)", p[i]->name, x), why;
     }
     return NULL;
 }

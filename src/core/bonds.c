@@ -174,16 +174,11 @@ sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out)
 /* ------------------------------------------------------- micro-parameters */
 
 /* The micro-parameters of d (a material's sx_bpm_def, or with call an
- * installing call's sx_bond_def) in their kinds' ranges (laws/bonds.h),
- * and the flat joint's element counts whole numbers (a joint's uint8 holds
- * them; the range caps them at 64). */
-static sx_status check_bpm(sx_model *m, const char *who, const void *d, bool call, double elements, double sectors)
+ * installing call's sx_bond_def) in their kinds' ranges (laws/bonds.h). */
+static sx_status check_bpm(sx_model *m, const char *who, const void *d, bool call)
 {
     char why[256];
     if (sx__bond_params_invalid(d, call, why, sizeof why)) return sx__fail(m, SX_EINVAL, "%s: %s", who, why);
-    if (elements != floor(elements) || sectors != floor(sectors))
-        return sx__fail(m, SX_EINVAL, "%s: elements and sectors must be whole numbers <= 64 (got %g, %g)", who,
-                        elements, sectors);
     return SX_OK;
 }
 
@@ -191,7 +186,7 @@ sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def)
 {
     if (material < 0 || material >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "material_set_bpm: no material with index %d", material);
-    const sx_status st = check_bpm(m, "material_set_bpm", def, false, def->elements, def->sectors);
+    const sx_status st = check_bpm(m, "material_set_bpm", def, false);
     if (st) return st;
     m->mats[material].bpm = *def;
     return SX_OK;
@@ -367,7 +362,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         return sx__fail(m, SX_EINVAL, "bond: kind must be contact, parallel or flatjoint");
     if (!(def->gap >= 0) || !isfinite(def->gap))
         return sx__fail(m, SX_EINVAL, "bond: gap must be >= 0 m (got %g)", def->gap);
-    sx_status st = check_bpm(m, "bond", def, true, def->elements, def->sectors);
+    sx_status st = check_bpm(m, "bond", def, true);
     if (st) return st;
     if (def->material_a >= m->nmat || def->material_b >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "bond: no material with index %d",

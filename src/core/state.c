@@ -5,6 +5,7 @@
 #include "state.h"
 
 #include "clumps.h"
+#include "laws/bond.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -173,6 +174,8 @@ static sx_status check_materials(sx_model *m)
             if (!(bpm[k] >= 0) || !isfinite(bpm[k]))
                 return sx__fail(m, SX_EINVAL, "state: material '%s' has a bond parameter that is negative or not "
                                               "finite (%g)", t->name, bpm[k]);
+        if (sx__bond_params_invalid(&t->bpm, false, why, sizeof why)) /* the ranges of sx_material_set_bpm */
+            return sx__fail(m, SX_EINVAL, "state: material '%s': bond %s", t->name, why);
         sx__material_derive(t);
     }
     return SX_OK;

@@ -149,7 +149,7 @@ do
   ok, err = pcall(m.material, m, "q", {bond = {unbonded_fraction = 1.5}})
   check("a key's range comes from its kind", not ok and tostring(err):find("unbonded_fraction must be in [0, 1]", 1, true), err)
   ok, err = pcall(m.material, m, "q", {bond = {elements = 2.5}})
-  check("element counts are whole", not ok and tostring(err):find("whole numbers", 1, true), err)
+  check("element counts are whole", not ok and tostring(err):find("elements must be a whole number", 1, true), err)
 end
 
 print(string.format("%d passed, %d failed", passed, failed))

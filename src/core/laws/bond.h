@@ -26,10 +26,13 @@ typedef struct sx_bond_param {
     size_t call;          /* offsetof(sx_bond_def, ...) */
     double lo, hi;        /* valid range: lo <= x, x < hi (x <= hi when hi_closed); lo is 0 for all */
     bool hi_closed;
+    bool whole;           /* a count: a whole number */
 } sx_bond_param;
 
 #define SX_BOND_PARAM(field, unit, hi, hi_closed) \
-    {#field, unit, offsetof(sx_bpm_def, field), offsetof(sx_bond_def, field), 0, hi, hi_closed}
+    {#field, unit, offsetof(sx_bpm_def, field), offsetof(sx_bond_def, field), 0, hi, hi_closed, false}
+/* A count in [0, hi]. */
+#define SX_BOND_COUNT(field, hi) {#field, "1", offsetof(sx_bpm_def, field), offsetof(sx_bond_def, field), 0, hi, true, true}
 
 typedef struct sx_bond_law {
     const char *name;

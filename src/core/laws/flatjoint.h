@@ -209,8 +209,8 @@ static inline const sx_bond_law *sx_bond_flatjoint(void)
         SX_BOND_PARAM(cohesion_sd, "Pa", INFINITY, false),
         SX_BOND_PARAM(friction_angle, "deg", 90, false),
         SX_BOND_PARAM(friction, "1", INFINITY, false),
-        SX_BOND_PARAM(elements, "1", 64, true),
-        SX_BOND_PARAM(sectors, "1", 64, true),
+        SX_BOND_COUNT(elements, 64), /* a joint's uint8 holds them */
+        SX_BOND_COUNT(sectors, 64),
         SX_BOND_PARAM(unbonded_fraction, "1", 1, true),
         SX_BOND_PARAM(initial_gap, "m", INFINITY, false),
     };
