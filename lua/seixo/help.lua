@@ -35,6 +35,9 @@ local entries = {
   ["model:material"] = {"m:material(name, {density =, kn =, ks =, friction =, damping =, ...}) -> name",
     "Defines or redefines a material. density [kg/m^3], kn, ks [N/m], friction, damping (local, in [0, 1)), viscous_normal, viscous_shear (critical-damping ratios), model = 'linear' | 'hertz' (shear_modulus [Pa], poisson), modulus [Pa] and stiffness_ratio (BPM), bond = {...} (bond micro-parameters)."},
   ["model:materials"] = {"m:materials() -> {name = {density =, kn =, ...}}", "Every material and its properties."},
+  ["model:contact_model"] = {"m:contact_model{groups = {a, b} | materials = {a, b} | default = true, model =, material =, name =, ...} -> row",
+    "A row of the contact-model table (PFC's CMAT): new ball-ball contacts of those groups or materials (or any other, default) take the row's law and parameters, read as m:material reads them, and keep them while they last."},
+  ["model:contact_models"] = {"m:contact_models() -> {{...}, ...}", "The contact-model table's rows in order."},
   ["model:ball"] = {"m:ball{pos =, radius =, vel =, spin =, material =, group =} -> ball;  m:ball(id) -> ball | nil",
     "Adds a ball (pos [m], radius [m], vel [m/s], spin [rad/s]), or finds one by id."},
   ["model:balls"] = {"m:balls([filter]) -> iterator", "for b in m:balls() do ... end; filter = {group =, region =, where = fn}. Iterates over a snapshot."},
@@ -229,6 +232,7 @@ local entries = {
   ["contact.pb_fs"] = {"c.pb_fs", "Parallel-bond shear force on b [N]."},
   ["contact.pb_moment"] = {"c.pb_moment", "Parallel-bond moment on b [N m]."},
   ["contact.pb_radius"] = {"c.pb_radius", "Parallel-bond radius [m]."},
+  ["contact.contact_model"] = {"c.contact_model", "The contact-model row the contact took when it was created (m:contact_model), nil for its materials' law."},
   ["contact.shift"] = {"c.shift", "Periodic space: the period [m] b is seen through (its image at b.pos + shift touches a); zeros inside the cell."},
 
   -- seixo.util

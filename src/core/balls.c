@@ -386,6 +386,7 @@ int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
     if (p->mr) f[n++] = (sx_pair_field){(void **)&p->mr, m->rdim, SX_PAIR_F64, true, false, "rolling_moment", "N m"};
     if (p->us)
         f[n++] = (sx_pair_field){(void **)&p->us, d, SX_PAIR_F64, true, false, "shear_displacement", "m"};
+    if (p->cmodel) f[n++] = (sx_pair_field){(void **)&p->cmodel, 1, SX_PAIR_I32, false, false, "contact_model", NULL};
     /* a mesh's facet is a third end of a ball-wall pair: listed by the broad phase */
     if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_PAIR_I32, false, true, "facet", NULL};
     return n;

@@ -2,7 +2,7 @@
  * joint, laws/flatjoint.h), their installation from the bonded-particle
  * micro-parameters (4.4), and the crack log of broken bonds. The bond
  * forces themselves are computed with the contact in kernels.c. */
-#include "laws/flatjoint.h"
+#include "laws/bonds.h"
 #include "laws/law.h"
 #include "model_internal.h"
 
@@ -173,30 +173,12 @@ sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out)
 
 /* ------------------------------------------------------- micro-parameters */
 
-static sx_status check_bpm(sx_model *m, const char *who, const double *v, const char *const *names, int n)
+/* The micro-parameters of d (a material's sx_bpm_def, or with call an
+ * installing call's sx_bond_def) in their kinds' ranges (laws/bonds.h). */
+static sx_status check_bpm(sx_model *m, const char *who, const void *d, bool call)
 {
-    for (int k = 0; k < n; k++)
-        if (!(v[k] >= 0) || !isfinite(v[k]))
-            return sx__fail(m, SX_EINVAL, "%s: %s must be >= 0 (got %g)", who, names[k], v[k]);
-    return SX_OK;
-}
-
-static const char *const bpm_names[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
-                                        "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
-                                        "normal_strength_sd", "shear_strength", "shear_strength_sd",
-                                        "friction_angle", "friction", "elements", "sectors",
-                                        "unbonded_fraction", "initial_gap"};
-
-/* The flat joint's parameters beyond being >= 0: an angle below 90 deg, a
- * fraction, whole element counts a joint's uint8 holds. */
-static sx_status check_fj(sx_model *m, const char *who, double phi, double elements, double sectors, double fraction)
-{
-    if (!(phi < 90)) return sx__fail(m, SX_EINVAL, "%s: friction_angle must be in [0, 90) degrees (got %g)", who, phi);
-    if (!(fraction <= 1))
-        return sx__fail(m, SX_EINVAL, "%s: unbonded_fraction must be in [0, 1] (got %g)", who, fraction);
-    if (!(elements <= 64) || elements != floor(elements) || !(sectors <= 64) || sectors != floor(sectors))
-        return sx__fail(m, SX_EINVAL, "%s: elements and sectors must be whole numbers <= 64 (got %g, %g)", who,
-                        elements, sectors);
+    char why[256];
+    if (sx__bond_params_invalid(d, call, why, sizeof why)) return sx__fail(m, SX_EINVAL, "%s: %s", who, why);
     return SX_OK;
 }
 
@@ -204,13 +186,7 @@ sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def)
 {
     if (material < 0 || material >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "material_set_bpm: no material with index %d", material);
-    const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
-                        def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
-                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd,
-                        def->friction_angle, def->friction, def->elements, def->sectors,
-                        def->unbonded_fraction, def->initial_gap};
-    sx_status st = check_bpm(m, "material_set_bpm", v, bpm_names, (int)(sizeof v / sizeof *v));
-    if (!st) st = check_fj(m, "material_set_bpm", def->friction_angle, def->elements, def->sectors, def->unbonded_fraction);
+    const sx_status st = check_bpm(m, "material_set_bpm", def, false);
     if (st) return st;
     m->mats[material].bpm = *def;
     return SX_OK;
@@ -386,13 +362,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         return sx__fail(m, SX_EINVAL, "bond: kind must be contact, parallel or flatjoint");
     if (!(def->gap >= 0) || !isfinite(def->gap))
         return sx__fail(m, SX_EINVAL, "bond: gap must be >= 0 m (got %g)", def->gap);
-    const double v[] = {def->radius_multiplier, def->modulus, def->stiffness_ratio, def->tensile_strength,
-                        def->tensile_strength_sd, def->cohesion, def->cohesion_sd, def->normal_strength,
-                        def->normal_strength_sd, def->shear_strength, def->shear_strength_sd,
-                        def->friction_angle, def->friction, def->elements, def->sectors,
-                        def->unbonded_fraction, def->initial_gap};
-    sx_status st = check_bpm(m, "bond", v, bpm_names, (int)(sizeof v / sizeof *v));
-    if (!st) st = check_fj(m, "bond", def->friction_angle, def->elements, def->sectors, def->unbonded_fraction);
+    sx_status st = check_bpm(m, "bond", def, true);
     if (st) return st;
     if (def->material_a >= m->nmat || def->material_b >= m->nmat)
         return sx__fail(m, SX_ENOTFOUND, "bond: no material with index %d",
@@ -477,6 +447,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
                 p->fs[c * d + k] = 0;
             }
             p->touching[c] = 1;
+            if (p->cmodel) p->cmodel[c] = sx__cmodel_pick(m, i, j); /* a contact created: its row (cmodel.c) */
         }
         installed++;
     }

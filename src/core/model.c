@@ -99,6 +99,7 @@ void sx_model_destroy(sx_model *m)
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
     sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof(double));
     sx_alloc_free(&m->alloc, m->mats, (size_t)m->cap_mat, sizeof *m->mats);
+    sx_alloc_free(&m->alloc, m->cmodel, (size_t)m->cap_cmodel, sizeof *m->cmodel);
     free(m);
 }
 
@@ -319,17 +320,19 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
     return l;
 }
 
-sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb)
+sx_pair_law sx__pair_law_of(const sx_material *ma, const sx_material *mb)
 {
-    const sx_material_def *a = &m->mats[ma].def, *b = &m->mats[mb].def;
+    const sx_material_def *a = &ma->def, *b = &mb->def;
     sx_pair_law l = combine(a, b->kn, b->ks, b->modulus, b->stiffness_ratio, b->friction,
                             0.5 * (a->viscous_normal + b->viscous_normal), 0.5 * (a->viscous_shear + b->viscous_shear));
     /* a pair of materials of two laws is refused where it may touch (check_models) */
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, &m->mats[ma], &m->mats[mb], l.law);
-    sx__law_parts_mix(&l, &m->mats[ma], &m->mats[mb]);
+    sx__law(l.law)->mix(&l, ma, mb, l.law);
+    sx__law_parts_mix(&l, ma, mb);
     return l;
 }
+
+sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb) { return sx__pair_law_of(&m->mats[ma], &m->mats[mb]); }
 
 static sx_status refresh_laws(sx_model *m)
 {
@@ -446,6 +449,7 @@ sx_status sx__prepare(sx_model *m)
 {
     sx_status st = refresh_laws(m);
     if (!st) st = check_models(m);
+    if (!st && m->ncmodel) st = sx__cmodel_prepare(m);
     if (!st && m->build_needed) st = check_skin(m);
     if (st) return st;
     if (m->build_needed && m->cell && (st = sx__cell_check(m))) return st;

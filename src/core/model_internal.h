@@ -154,6 +154,8 @@ typedef struct sx_pairs {
     double *us;            /* accumulated tangential displacement of b (dim, laws/total_shear.h); NULL
                             * while no material asks for the total form */
     int32_t *facet;        /* m->bw: a mesh wall's facet (0 for other walls); NULL until the model has a mesh */
+    int32_t *cmodel;       /* m->bb: the contact-model row the contact took (from 1; 0: its materials'
+                            * law), cmodel.c; NULL while the table is empty */
     /* the last force evaluation, for queries consistent with the balls' forces */
     double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
@@ -253,6 +255,15 @@ typedef struct sx_pair_law {
     double kn_a, ks_a, ec_a, ratio_a, kn_b, ks_b, ec_b, ratio_b;
 } sx_pair_law;
 
+/* A row of the contact-model table (cmodel.c): its match, its law read as
+ * a material (name, definition, derived constants) and the contact it
+ * makes, mixed once (rows never change). */
+typedef struct sx_cmodel_row {
+    sx_cmodel_def def;
+    sx_material mat;
+    sx_pair_law law;
+} sx_cmodel_row;
+
 /* Periodic space (periodic.c; kernels/ghosts.c). The cell is lo + H f,
  * f in [0, 1) on the periodic axes, H upper triangular with columns
  * h[k] (h[k][i] = 0 for i > k; a non-periodic axis keeps h[k] = e_k).
@@ -337,6 +348,8 @@ struct sx_model {
     bool guard_on;
     bool guard_dirty;        /* the system was changed by the user: take a new energy baseline */
 
+    sx_cmodel_row *cmodel;   /* the contact-model table (cmodel.c); NULL while it is empty */
+    int ncmodel, cap_cmodel;
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
     sx_cell *cell;            /* periodic space (periodic.c); NULL while the space is not periodic */
 };
@@ -353,6 +366,33 @@ static inline double sx__damped(double force, double vel, double alpha)
 {
     if (alpha == 0 || vel == 0) return force;
     return force - alpha * fabs(force) * (vel > 0 ? 1.0 : -1.0);
+}
+
+/* The contact-model table (cmodel.c). The row (from 1) a contact between
+ * dense balls i and j takes if created now, 0 for none. */
+int32_t sx__cmodel_pick(const sx_model *m, int64_t i, int64_t j);
+/* The law of ball-ball pair c (balls i, j) for the step: the row it took
+ * (touching) or would take now, else its materials' in the step's table. */
+static inline const sx_pair_law *sx__bb_step_law(const sx_model *m, int64_t c, int64_t i, int64_t j)
+{
+    const sx_pair_law *l = &m->law[m->balls.mat[i] * m->law_n + m->balls.mat[j]];
+    if (!m->bb.cmodel) return l;
+    const int32_t r = m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
+    return r ? &m->cmodel[r - 1].law : l;
+}
+/* Rows' laws that need history the stores lack (rolling, total form):
+ * expands the stores; and bonded contacts under a row whose law takes no
+ * bonds are refused (seed 4.3.3). */
+sx_status sx__cmodel_prepare(sx_model *m);
+/* A row's derived constants and its contact's law (on adding it, on a restore). */
+void sx__cmodel_derive(sx_cmodel_row *r);
+/* The mixed pair law of two materials (model.c). */
+sx_pair_law sx__pair_law_of(const sx_material *ma, const sx_material *mb);
+/* The law of ball-ball pair c for queries: its row's, or mixed from the materials as they are. */
+static inline sx_pair_law sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j)
+{
+    const int32_t r = !m->bb.cmodel ? 0 : m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
+    return r ? m->cmodel[r - 1].law : sx__pair_law_of(&m->mats[m->balls.mat[i]], &m->mats[m->balls.mat[j]]);
 }
 
 /* The first rule d breaks (its value in *bad), or NULL (model.c). */

@@ -210,6 +210,40 @@ SX_API int sx_material_count(const sx_model *m);
 SX_API const char *sx_material_name(const sx_model *m, int index);
 SX_API sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out);
 
+/// The contact-model table (PFC's contact model assignment table): each row
+/// gives the ball-ball contacts it matches their own law and parameters,
+/// in place of those their two materials mix. A row matches a pair of
+/// groups (the balls' core group numbers, in either order), a pair of
+/// materials (indices, in either order), or any pair (the default row). A
+/// contact takes its row when it is created (its balls start touching, or
+/// it is bonded): the newest row of a group pair that matches, else the
+/// newest of a material pair, else the newest default row, else none (its
+/// materials' law). A created contact keeps the row it took while it
+/// lasts, whatever rows are added later. A row's `law` is read as a
+/// material: the contact is the one two balls of that material would make
+/// (linear springs in series, 4-22/4-23). Rows are never removed: a newer
+/// row for the same match replaces the older one for new contacts only.
+/// Ball-wall contacts keep the laws of their ball and wall.
+typedef enum sx_cmodel_match {
+    SX_CMODEL_DEFAULT = 0,   ///< any pair no other row matches
+    SX_CMODEL_GROUPS = 1,    ///< balls of groups a and b (0: no group)
+    SX_CMODEL_MATERIALS = 2, ///< balls of materials a and b
+} sx_cmodel_match;
+
+typedef struct sx_cmodel_def {
+    sx_cmodel_match match;
+    int32_t a, b;            ///< group numbers (>= 0) or material indices; unordered
+    sx_material_def law;     ///< the law (its `model`) and its parameters, as a material's
+} sx_cmodel_def;
+
+/// Appends a row (named for reports, 1 to 63 characters); its number
+/// (from 1) into *row if not NULL. SX_EINVAL on a bad match or law.
+SX_API sx_status sx_cmodel_add(sx_model *m, const char *name, const sx_cmodel_def *def, int *row);
+/// Rows in the table.
+SX_API int sx_cmodel_count(const sx_model *m);
+/// Row `row` (from 1) and its name; SX_ENOTFOUND out of range.
+SX_API sx_status sx_cmodel_get(const sx_model *m, int row, sx_cmodel_def *def, const char **name);
+
 /* ---------------------------------------------------------------- balls */
 
 typedef struct sx_ball_def {
@@ -437,6 +471,7 @@ typedef struct sx_contact_info {
     double pb_radius;    ///< m, parallel-bond radius (4-53), or the flat joint's face radius
     double shift[3];     ///< m, periodic space: the period b is seen through (b's image at
                          ///< its centre + shift touches a); 0 for a contact inside the cell
+    int cmodel;          ///< the contact-model row it took (from 1; 0: its materials' law)
 } sx_contact_info;
 
 /// Calls fn for every contact of the last step's force evaluation (bonded
@@ -498,6 +533,18 @@ typedef struct sx_bpm_def {
     double friction_angle, friction, elements, sectors, unbonded_fraction, initial_gap;
 } sx_bpm_def;
 SX_API sx_status sx_material_set_bpm(sx_model *m, int material, const sx_bpm_def *def);
+/// The bond kinds of the registry (src/core/laws/bonds.h): their count, and
+/// kind k's name (m:bond's `kind`; its bit into *kind if not NULL), NULL out of range.
+SX_API int sx_bond_kind_count(void);
+SX_API const char *sx_bond_kind_name(int k, sx_bond_kind *kind);
+/// The kinds' micro-parameters, each once (a material's `bond` keys, the
+/// files' bond_* columns, m:bond's keys): their count, key i's name (its
+/// unit into *unit if not NULL), and its field in an sx_bpm_def and in an
+/// sx_bond_def (NULL out of range).
+SX_API int sx_bond_key_count(void);
+SX_API const char *sx_bond_key(int i, const char **unit);
+SX_API double *sx_bond_key_material(sx_bpm_def *d, int i);
+SX_API double *sx_bond_key_call(sx_bond_def *d, int i);
 SX_API sx_status sx_material_get_bpm(const sx_model *m, int material, sx_bpm_def *out);
 
 typedef enum sx_crack_mode { SX_CRACK_TENSION = 1, SX_CRACK_SHEAR = 2 } sx_crack_mode;

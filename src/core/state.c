@@ -5,6 +5,7 @@
 #include "state.h"
 
 #include "clumps.h"
+#include "laws/bond.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -27,6 +28,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
     out->materials = m->nmat;
+    out->cmodels = m->ncmodel;
 }
 
 /* An array of n elements of `size` bytes, zeroed; false when out of memory. */
@@ -50,7 +52,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (s->balls < 0 || s->next_ball_id < 1 || s->balls > s->next_ball_id - 1 || s->next_ball_id >= INT32_MAX ||
         s->bb < 0 || s->bb > INT32_MAX || s->bw < 0 || s->bw > INT32_MAX || s->bonds < 0 ||
         s->bonds > INT32_MAX - 1 || s->fj_elements < 0 || s->fj_elements > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
-        s->materials > UINT16_MAX)
+        s->materials > UINT16_MAX || s->cmodels < 0 || s->cmodels > 4096)
         return sx__fail(m, SX_EINVAL,
                         "state: sizes out of range (%lld balls, next id %lld, %lld + %lld pairs, %lld bonds, "
                         "%lld walls, %d materials)",
@@ -118,6 +120,11 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     m->nwall = m->cap_wall = s->walls;
     if (!alloc_array(m, (void **)&m->mats, s->materials, sizeof(sx_material))) goto nomem;
     m->nmat = m->cap_mat = s->materials;
+    if (!alloc_array(m, (void **)&m->cmodel, s->cmodels, sizeof(sx_cmodel_row))) goto nomem;
+    m->ncmodel = m->cap_cmodel = s->cmodels;
+    if (s->cmodels > 0 && (sx__pairs_reserve(m, &m->bb, 1) || /* a store with room, so the array exists */
+                           !alloc_array(m, (void **)&m->bb.cmodel, m->bb.cap, sizeof(int32_t))))
+        goto nomem;
     return SX_OK;
 nomem:
     return sx__fail(m, SX_ENOMEM, "state: out of memory for %lld balls, %lld pairs, %lld bonds", (long long)s->balls,
@@ -167,8 +174,37 @@ static sx_status check_materials(sx_model *m)
             if (!(bpm[k] >= 0) || !isfinite(bpm[k]))
                 return sx__fail(m, SX_EINVAL, "state: material '%s' has a bond parameter that is negative or not "
                                               "finite (%g)", t->name, bpm[k]);
+        if (sx__bond_params_invalid(&t->bpm, false, why, sizeof why)) /* the ranges of sx_material_set_bpm */
+            return sx__fail(m, SX_EINVAL, "state: material '%s': bond %s", t->name, why);
         sx__material_derive(t);
     }
+    return SX_OK;
+}
+
+/* The contact-model rows by the rules of sx_cmodel_add, and each contact's
+ * row in range. */
+static sx_status check_cmodels(sx_model *m)
+{
+    for (int r = 0; r < m->ncmodel; r++) {
+        sx_cmodel_row *t = &m->cmodel[r];
+        const sx_cmodel_def *d = &t->def;
+        char why[256];
+        if (!memchr(t->mat.name, 0, sizeof t->mat.name) || !t->mat.name[0])
+            return sx__fail(m, SX_EINVAL, "state: contact-model row %d has no valid name", r + 1);
+        if ((d->match != SX_CMODEL_DEFAULT && d->match != SX_CMODEL_GROUPS && d->match != SX_CMODEL_MATERIALS) ||
+            (d->match != SX_CMODEL_DEFAULT && (d->a < 0 || d->b < 0)) ||
+            (d->match == SX_CMODEL_MATERIALS && (d->a >= m->nmat || d->b >= m->nmat)))
+            return sx__fail(m, SX_EINVAL, "state: contact-model row '%s' has a bad match (%d: %d, %d)", t->mat.name,
+                            (int)d->match, (int)d->a, (int)d->b);
+        t->def.law = t->mat.def; /* a file stores the row's law as a material */
+        if (sx__material_invalid(&t->mat.def, why, sizeof why))
+            return sx__fail(m, SX_EINVAL, "state: contact-model row '%s': %s", t->mat.name, why);
+        sx__cmodel_derive(t);
+    }
+    for (int64_t c = 0; m->bb.cmodel && c < m->bb.n; c++)
+        if (m->bb.cmodel[c] < 0 || m->bb.cmodel[c] > m->ncmodel)
+            return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has contact-model row %d, there are %d",
+                            (long long)c, (int)m->bb.cmodel[c], m->ncmodel);
     return SX_OK;
 }
 
@@ -382,7 +418,7 @@ static sx_status check_bonds(sx_model *m)
 sx_status sx__state_finish(sx_model *m)
 {
     sx_status st;
-    if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
+    if ((st = check_scalars(m)) || (st = check_materials(m)) || (st = check_cmodels(m)) || (st = check_balls(m)) || (st = check_walls(m)) ||
         (m->cell && (st = sx__cell_finish(m))) || (st = check_pairs(m)) || (st = check_bonds(m)) || (st = check_cracks(m)) ||
         (st = sx__clumps_finish(m)))
         return st;
@@ -471,27 +507,41 @@ static void hash_scalars(hasher *s, const sx_model *m)
     put_int(s, m->next_wall_id);
 }
 
+static void hash_material(hasher *s, const sx_material *t)
+{
+    put(s, t->name, strnlen(t->name, sizeof t->name));
+    put_int(s, t->def.model);
+    const double def[] = {t->def.density,  t->def.kn,        t->def.ks,       t->def.modulus,
+                          t->def.stiffness_ratio, t->def.shear_modulus, t->def.poisson, t->def.friction,
+                          t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
+    put_doubles(s, def, sizeof def / sizeof *def, 1);
+    put_doubles(s, (const double *)&t->bpm, sizeof t->bpm / sizeof(double), 1);
+    /* the parameters of the registry's parts that are on (0 is off: a model that uses none hashes as before) */
+    for (int u = 0; u < sx_law_count(); u++)
+        for (int k = 0; !sx_law_is_model(u) && k < sx_law_param_count(u); k++) {
+            const double x = *sx_law_param_value((sx_material_def *)&t->def, u, k);
+            if (x == 0) continue;
+            put_int(s, u);
+            put_int(s, k);
+            put_double(s, x);
+        }
+}
+
 static void hash_materials(hasher *s, const sx_model *m)
 {
     put_int(s, m->nmat);
-    for (int i = 0; i < m->nmat; i++) {
-        const sx_material *t = &m->mats[i];
-        put(s, t->name, strnlen(t->name, sizeof t->name));
-        put_int(s, t->def.model);
-        const double def[] = {t->def.density,  t->def.kn,        t->def.ks,       t->def.modulus,
-                              t->def.stiffness_ratio, t->def.shear_modulus, t->def.poisson, t->def.friction,
-                              t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
-        put_doubles(s, def, sizeof def / sizeof *def, 1);
-        put_doubles(s, (const double *)&t->bpm, sizeof t->bpm / sizeof(double), 1);
-        /* the parameters of the registry's parts that are on (0 is off: a model that uses none hashes as before) */
-        for (int u = 0; u < sx_law_count(); u++)
-            for (int k = 0; !sx_law_is_model(u) && k < sx_law_param_count(u); k++) {
-                const double x = *sx_law_param_value((sx_material_def *)&t->def, u, k);
-                if (x == 0) continue;
-                put_int(s, u);
-                put_int(s, k);
-                put_double(s, x);
-            }
+    for (int i = 0; i < m->nmat; i++) hash_material(s, &m->mats[i]);
+    if (!m->ncmodel) return; /* a model without the table hashes as before it existed */
+    put_int(s, m->ncmodel);
+    for (int r = 0; r < m->ncmodel; r++) { /* each row: its match and its law with every registry parameter */
+        const sx_cmodel_row *t = &m->cmodel[r];
+        put_int(s, t->def.match);
+        put_int(s, t->def.a);
+        put_int(s, t->def.b);
+        hash_material(s, &t->mat);
+        for (int law = 0; law < sx_law_count(); law++)
+            for (int k = 0; k < sx_law_param_count(law); k++)
+                put_double(s, *sx_law_param_value((sx_material_def *)&t->mat.def, law, k));
     }
 }
 

@@ -17,11 +17,12 @@
  *            height and radial velocity, frame, force, moment, the last
  *            step's load, stiffness sum and contact count, servo settings,
  *            distance moved; a mesh's vertices in its frame, triangles and
- *            orientation), materials with BPM parameters, and every
+ *            orientation), materials with BPM parameters, the contact-model
+ *            table's rows (their match, name and law; cmodel.c), and every
  *            scalar of sx_model below `dim` (timestep state, skin, time,
  *            step, builds, build flag, guard, energy tracking);
  *   derived  id -> index map, intact bonds (here), pair laws (refreshed by
- *            every cycle), the grid and scratch (rebuilt by every build).
+ *            every cycle; a contact-model row's when restored), the grid and scratch (rebuilt by every build).
  * Clumps (clumps.h) are sized and checked by their own module: the I/O
  * layer calls sx__clumps_alloc after sx__state_alloc, and sx__state_finish
  * calls sx__clumps_finish, which also rebuilds the balls' clump ids.
@@ -45,6 +46,8 @@ typedef struct sx_state_sizes {
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;
     int materials;
+    int cmodels;          ///< rows of the contact-model table (cmodel.c); the ball-ball store carries
+                          ///< each contact's row when there are any
 } sx_state_sizes;
 
 /// The sizes of m's stores now.

@@ -300,35 +300,43 @@ static hid_t law_enum(hid_t base)
     return sx_h5_enum(base, names, values, n);
 }
 
-/* A material's numbers: its definition, its BPM parameters, then every
- * law's parameters (each once, from the registry). */
-#define MAT_FIXED 20
-#define MAT_MAX (MAT_FIXED + 32)
+/* A material's numbers: its definition, its bond micro-parameters (bond_
+ * and the key, from the bond registry: sx_bond_key), then every law's
+ * parameters (each once, from the law registry). */
+#define MAT_FIXED 9
+#define MAT_MAX (MAT_FIXED + 96)
 static const char *const mat_fixed_names[MAT_FIXED] = {
-    "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping",
-    "viscous_normal", "viscous_shear",
-    "bond_radius_multiplier", "bond_modulus", "bond_stiffness_ratio", "bond_tensile_strength",
-    "bond_tensile_strength_sd", "bond_cohesion", "bond_cohesion_sd", "bond_normal_strength",
-    "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd"};
-static const char *const mat_fixed_units[MAT_FIXED] = {
-    "kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1",
-    "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N"};
+    "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping", "viscous_normal", "viscous_shear"};
+static const char *const mat_fixed_units[MAT_FIXED] = {"kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1"};
 
+enum { COL_FIXED = -1, COL_BOND = -2 };
 typedef struct mat_column {
-    const char *name, *unit;
-    int law, k; /* a law's parameter k, or law -1: fixed number k */
+    char name[64];
+    const char *unit;
+    int law, k; /* a law's parameter k, COL_BOND: bond key k, COL_FIXED: fixed number k */
 } mat_column;
+
+static void column(mat_column *c, const char *prefix, const char *name, const char *unit, int law, int k)
+{
+    snprintf(c->name, sizeof c->name, "%s%s", prefix, name);
+    c->unit = unit, c->law = law, c->k = k;
+}
 
 static int mat_columns(mat_column *c)
 {
     int n = 0;
-    for (int k = 0; k < MAT_FIXED; k++) c[n++] = (mat_column){mat_fixed_names[k], mat_fixed_units[k], -1, k};
+    for (int k = 0; k < MAT_FIXED; k++) column(&c[n++], "", mat_fixed_names[k], mat_fixed_units[k], COL_FIXED, k);
+    for (int k = 0; k < sx_bond_key_count() && n < MAT_MAX; k++) {
+        const char *unit, *name = sx_bond_key(k, &unit);
+        column(&c[n++], "bond_", name, unit, COL_BOND, k);
+    }
+    const int laws = n;
     for (int law = 0; law < sx_law_count(); law++)
         for (int k = 0; k < sx_law_param_count(law) && n < MAT_MAX; k++) {
             const char *unit, *name = sx_law_param_name(law, k, &unit);
             bool seen = false;
-            for (int j = MAT_FIXED; j < n && !seen; j++) seen = strcmp(c[j].name, name) == 0;
-            if (!seen) c[n++] = (mat_column){name, unit, law, k};
+            for (int j = laws; j < n && !seen; j++) seen = strcmp(c[j].name, name) == 0;
+            if (!seen) column(&c[n++], "", name, unit, law, k);
         }
     return n;
 }
@@ -336,21 +344,20 @@ static int mat_columns(mat_column *c)
 static double *mat_number(sx_material *t, const mat_column *c)
 {
     if (c->law >= 0) return sx_law_param_value(&t->def, c->law, c->k);
+    if (c->law == COL_BOND) return sx_bond_key_material(&t->bpm, c->k);
     sx_material_def *d = &t->def;
-    sx_bpm_def *b = &t->bpm;
     double *p[MAT_FIXED] = {&d->density, &d->kn, &d->ks, &d->modulus, &d->stiffness_ratio, &d->friction,
-                            &d->damping, &d->viscous_normal, &d->viscous_shear,
-                            &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
-                            &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                            &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+                            &d->damping, &d->viscous_normal, &d->viscous_shear};
     return p[c->k];
 }
 
-static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
+/* Material i of n stored `stride` bytes apart from the first (the
+ * materials, or the contact-model rows' laws). */
+#define MAT_AT(first, stride, i) ((sx_material *)((char *)(first) + (size_t)(i) * (stride)))
+
+static void write_mats(sx_h5 *h, hid_t g, sx_material *first, size_t stride, int n)
 {
-    hid_t g = sx_h5_group(h, f, "materials");
-    const int n = m->nmat;
-    char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
+    char *names = calloc((size_t)n + 1, sizeof first->name);
     int *model = calloc((size_t)n + 1, sizeof *model);
     double *col = calloc((size_t)n + 1, sizeof *col);
     hid_t mem = law_enum(H5T_NATIVE_INT);
@@ -359,15 +366,15 @@ static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
         sx_h5_fail(h, "out of memory");
     } else {
         for (int i = 0; i < n; i++) {
-            memcpy(names + (size_t)i * sizeof m->mats[0].name, m->mats[i].name, sizeof m->mats[0].name);
-            model[i] = (int)m->mats[i].def.model;
+            memcpy(names + (size_t)i * sizeof first->name, MAT_AT(first, stride, i)->name, sizeof first->name);
+            model[i] = (int)MAT_AT(first, stride, i)->def.model;
         }
-        sx_io_write_strings(h, g, "name", names, sizeof m->mats[0].name, n);
+        sx_io_write_strings(h, g, "name", names, sizeof first->name, n);
         sx_h5_write(h, g, "model", mem, file, model, n, 1, NULL);
         mat_column c[MAT_MAX];
         const int nc = mat_columns(c);
         for (int k = 0; k < nc; k++) {
-            for (int i = 0; i < n; i++) col[i] = *mat_number(&m->mats[i], &c[k]);
+            for (int i = 0; i < n; i++) col[i] = *mat_number(MAT_AT(first, stride, i), &c[k]);
             sx_h5_write(h, g, c[k].name, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, col, n, 1, c[k].unit);
         }
     }
@@ -376,40 +383,94 @@ static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
     free(names);
     free(model);
     free(col);
+}
+
+static void save_materials(sx_h5 *h, hid_t f, sx_model *m)
+{
+    hid_t g = sx_h5_group(h, f, "materials");
+    write_mats(h, g, m->mats, sizeof *m->mats, m->nmat);
     sx_h5_close(g);
 }
 
-static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
+static void read_mats(sx_h5 *h, hid_t g, const char *where, sx_material *first, size_t stride, int n)
 {
-    const int n = m->nmat;
-    char *names = calloc((size_t)n + 1, sizeof m->mats[0].name);
+    char *names = calloc((size_t)n + 1, sizeof first->name);
     int *model = calloc((size_t)n + 1, sizeof *model);
     double *col = calloc((size_t)n + 1, sizeof *col);
     hid_t mem = law_enum(H5T_NATIVE_INT);
     if (!names || !model || !col || mem < 0) {
         sx_h5_fail(h, "out of memory");
-    } else if (sx_io_read_strings(h, g, "/materials", "name", names, sizeof m->mats[0].name, n) &&
-               sx_h5_read(h, g, "/materials", "model", mem, model, n, 1, true)) {
+    } else if (sx_io_read_strings(h, g, where, "name", names, sizeof first->name, n) &&
+               sx_h5_read(h, g, where, "model", mem, model, n, 1, true)) {
         for (int i = 0; i < n; i++) {
-            memcpy(m->mats[i].name, names + (size_t)i * sizeof m->mats[0].name, sizeof m->mats[0].name);
-            m->mats[i].def.model = (sx_contact_model)model[i];
+            memcpy(MAT_AT(first, stride, i)->name, names + (size_t)i * sizeof first->name, sizeof first->name);
+            MAT_AT(first, stride, i)->def.model = (sx_contact_model)model[i];
         }
         mat_column c[MAT_MAX];
         const int nc = mat_columns(c);
-        /* a law's parameter a file predates takes its default (the law is newer than the file) */
+        /* a law's or bond kind's parameter a file predates takes its default (the law is newer than the file) */
         sx_material def = {.def = sx_material_default_def()};
         for (int k = 0; k < nc && !h->failed; k++) {
-            const bool newer = c[k].law >= 0 && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
+            const bool newer = c[k].law != COL_FIXED && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
             if (newer)
-                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = *mat_number(&def, &c[k]);
-            else if (sx_h5_read(h, g, "/materials", c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))
-                for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = col[i];
+                for (int i = 0; i < n; i++) *mat_number(MAT_AT(first, stride, i), &c[k]) = *mat_number(&def, &c[k]);
+            else if (sx_h5_read(h, g, where, c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))
+                for (int i = 0; i < n; i++) *mat_number(MAT_AT(first, stride, i), &c[k]) = col[i];
         }
     }
     sx_h5_close(mem);
     free(names);
     free(model);
     free(col);
+}
+
+static void load_materials(sx_h5 *h, hid_t g, sx_model *m) { read_mats(h, g, "/materials", m->mats, sizeof *m->mats, m->nmat); }
+
+/* The contact-model table (cmodel.c), when it has rows: each row's law as
+ * a material (its name, model and numbers, as /materials), and its match
+ * (0 default, 1 groups, 2 materials) with the two group numbers or
+ * material indices. */
+static void save_cmodels(sx_h5 *h, hid_t f, sx_model *m)
+{
+    const int n = m->ncmodel;
+    if (n == 0) return;
+    hid_t g = sx_h5_group(h, f, "contact_models");
+    write_mats(h, g, &m->cmodel[0].mat, sizeof *m->cmodel, n);
+    int32_t *col = calloc((size_t)n, sizeof *col);
+    if (!col) sx_h5_fail(h, "out of memory");
+    for (int k = 0; col && k < 3; k++) {
+        static const char *const names[] = {"match", "a", "b"};
+        for (int r = 0; r < n; r++) {
+            const sx_cmodel_def *d = &m->cmodel[r].def;
+            col[r] = k == 0 ? (int32_t)d->match : k == 1 ? d->a : d->b;
+        }
+        sx_h5_write(h, g, names[k], H5T_NATIVE_INT32, H5T_STD_I32LE, col, n, 1, NULL);
+    }
+    free(col);
+    sx_h5_close(g);
+}
+
+static void load_cmodels(sx_h5 *h, hid_t f, sx_model *m)
+{
+    const int n = m->ncmodel;
+    if (n == 0) return;
+    hid_t g = sx_h5_open_group(h, f, "/contact_models", true);
+    if (g < 0) return;
+    read_mats(h, g, "/contact_models", &m->cmodel[0].mat, sizeof *m->cmodel, n);
+    int32_t *col = calloc((size_t)n, sizeof *col);
+    if (!col) sx_h5_fail(h, "out of memory");
+    for (int k = 0; col && k < 3 && !h->failed; k++) {
+        static const char *const names[] = {"match", "a", "b"};
+        if (!sx_h5_read(h, g, "/contact_models", names[k], H5T_NATIVE_INT32, col, n, 1, true)) break;
+        for (int r = 0; r < n; r++) {
+            sx_cmodel_def *d = &m->cmodel[r].def;
+            if (k == 0) d->match = (sx_cmodel_match)col[r];
+            else if (k == 1) d->a = col[r];
+            else d->b = col[r];
+        }
+    }
+    free(col);
+    sx_h5_close(g);
 }
 
 /* --------------------------------------------------------------- walls */
@@ -1051,6 +1112,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     write_scalars(h, g, m);
     sx_h5_close(g);
     save_materials(h, f, m);
+    save_cmodels(h, f, m);
 
     field fl[MAX_FIELDS];
     g = sx_h5_group(h, f, "balls");
@@ -1177,6 +1239,12 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     const int64_t nm = sx_h5_rows(h, g, "/materials", "name", 1, true);
     sx_h5_close(g);
     s->materials = nm >= 0 && nm <= UINT16_MAX ? (int)nm : -1;
+    if (H5Lexists(f, "/contact_models", H5P_DEFAULT) > 0) {
+        g = sx_h5_open_group(h, f, "/contact_models", true);
+        const int64_t nr = sx_h5_rows(h, g, "/contact_models", "name", 1, true);
+        sx_h5_close(g);
+        s->cmodels = nr >= 0 && nr <= INT32_MAX ? (int)nr : -1;
+    }
     (void)d;
     return !h->failed;
 }
@@ -1286,6 +1354,7 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         g = sx_h5_open_group(&h, f, "/materials", true);
         if (g >= 0) load_materials(&h, g, m);
         sx_h5_close(g);
+        load_cmodels(&h, f, m);
         load_periodic(&h, f, m); /* before the balls: the ghosts' slots come with the ball arrays */
 
         field fl[MAX_FIELDS];

@@ -11,36 +11,27 @@
 
 #include <string.h>
 
-static const char *const bpm_keys[] = {"radius_multiplier", "modulus", "stiffness_ratio", "tensile_strength",
-                                       "tensile_strength_sd", "cohesion", "cohesion_sd", "normal_strength",
-                                       "normal_strength_sd", "shear_strength", "shear_strength_sd",
-                                       "friction_angle", "friction", "elements", "sectors", "unbonded_fraction",
-                                       "initial_gap", NULL};
-
-/* The bpm fields in bpm_keys order, so one loop reads them all. */
-static double *bpm_field(sx_bpm_def *b, int k)
+/* The bond kinds' micro-parameter keys from the registry (sx_bond_key),
+ * after n keys already in keys (room for cap), NULL-terminated; their count. */
+enum { BOND_KEYS_MAX = 64 };
+static int bond_keys(const char **keys, int n, int cap)
 {
-    double *const fields[] = {&b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
-                              &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                              &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd,
-                              &b->friction_angle, &b->friction, &b->elements, &b->sectors, &b->unbonded_fraction,
-                              &b->initial_gap};
-    return fields[k];
+    for (int k = 0; k < sx_bond_key_count() && n < cap - 1; k++) keys[n++] = sx_bond_key(k, NULL);
+    keys[n] = NULL;
+    return n;
 }
-
-static const char *const kind_names[] = {"contact", "parallel", "flatjoint", NULL};
-static const sx_bond_kind kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX_BOND_FLATJOINT};
 
 static const char *kind_name(sx_bond_kind k)
 {
-    for (int i = 0; kind_names[i]; i++)
-        if (kind_values[i] == k) return kind_names[i];
+    sx_bond_kind bit;
+    for (int i = 0; i < sx_bond_kind_count(); i++)
+        if (sx_bond_kind_name(i, &bit) && bit == k) return sx_bond_kind_name(i, NULL);
     return "?";
 }
 
 static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
 {
-    for (int k = 0; bpm_keys[k]; k++) sx_lua_optnumfield(L, arg, bpm_keys[k], bpm_field(b, k));
+    for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_optnumfield(L, arg, sx_bond_key(k, NULL), sx_bond_key_material(b, k));
 }
 
 int sx_lua_law_keys(const char **keys, int n, int cap)
@@ -84,7 +75,9 @@ void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has
     if (lua_getfield(L, arg, "bond") != LUA_TNIL) {
         if (!lua_istable(L, -1)) luaL_argerror(L, arg, "field 'bond': a table of bond micro-parameters expected");
         const int t = lua_gettop(L);
-        sx_lua_checkkeys(L, t, bpm_keys);
+        const char *keys[BOND_KEYS_MAX];
+        bond_keys(keys, 0, BOND_KEYS_MAX);
+        sx_lua_checkkeys(L, t, keys);
         read_bpm(L, t, bpm);
         *has_bpm = true;
     }
@@ -101,22 +94,27 @@ static int material_index(lua_State *L, sx_model *m, int arg, const char *name)
 
 static int model_bond(lua_State *L)
 {
-    static const char *const keys[] = {"kind", "gap", "seed", "materials", "radius_multiplier", "modulus",
-                                       "stiffness_ratio", "tensile_strength", "tensile_strength_sd", "cohesion",
-                                       "cohesion_sd", "normal_strength", "normal_strength_sd", "shear_strength",
-                                       "shear_strength_sd", "friction_angle", "friction", "elements", "sectors",
-                                       "unbonded_fraction", "initial_gap", NULL};
+    const char *keys[BOND_KEYS_MAX] = {"kind", "gap", "seed", "materials"};
+    bond_keys(keys, 4, BOND_KEYS_MAX); /* and the kinds' micro-parameters */
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
     sx_bond_def d = sx_bond_default_def();
     const char *kind = sx_lua_optstrfield(L, 2, "kind");
     if (kind) {
-        const int k = sx_lua_find(kind, kind_names);
-        if (k < 0)
-            luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': 'contact', 'parallel' or 'flatjoint' expected, got '%s'",
-                                                kind));
-        d.kind = kind_values[k];
+        int k = 0;
+        while (k < sx_bond_kind_count() && strcmp(sx_bond_kind_name(k, NULL), kind) != 0) k++;
+        if (k == sx_bond_kind_count()) {
+            luaL_Buffer b;
+            luaL_buffinit(L, &b);
+            for (int i = 0; i < sx_bond_kind_count(); i++) {
+                lua_pushfstring(L, "%s'%s'", i ? ", " : "", sx_bond_kind_name(i, NULL));
+                luaL_addvalue(&b);
+            }
+            luaL_pushresult(&b);
+            luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': one of %s expected, got '%s'", lua_tostring(L, -1), kind));
+        }
+        sx_bond_kind_name(k, &d.kind);
     }
     sx_lua_optnumfield(L, 2, "gap", &d.gap);
     double seed = 1;
@@ -142,26 +140,7 @@ static int model_bond(lua_State *L)
         }
     }
     lua_pop(L, 1);
-    sx_bpm_def b;
-    memset(&b, 0, sizeof b);
-    read_bpm(L, 2, &b);
-    d.radius_multiplier = b.radius_multiplier;
-    d.modulus = b.modulus;
-    d.stiffness_ratio = b.stiffness_ratio;
-    d.tensile_strength = b.tensile_strength;
-    d.tensile_strength_sd = b.tensile_strength_sd;
-    d.cohesion = b.cohesion;
-    d.cohesion_sd = b.cohesion_sd;
-    d.normal_strength = b.normal_strength;
-    d.normal_strength_sd = b.normal_strength_sd;
-    d.shear_strength = b.shear_strength;
-    d.shear_strength_sd = b.shear_strength_sd;
-    d.friction_angle = b.friction_angle;
-    d.friction = b.friction;
-    d.elements = b.elements;
-    d.sectors = b.sectors;
-    d.unbonded_fraction = b.unbonded_fraction;
-    d.initial_gap = b.initial_gap;
+    for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_optnumfield(L, 2, sx_bond_key(k, NULL), sx_bond_key_call(&d, k));
     int64_t count = 0;
     sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
     sx_lua_record_seed(L, 1, (int64_t)d.seed); /* the strengths drawn from it: the files' provenance lists it */

@@ -124,6 +124,15 @@ static int get_force(lua_State *L)
     return 1;
 }
 
+/* The contact-model row the contact took (from 1), nil for its materials' law. */
+static int get_contact_model(lua_State *L)
+{
+    const int r = check_contact(L)->cmodel;
+    if (r) lua_pushinteger(L, r);
+    else lua_pushnil(L);
+    return 1;
+}
+
 static int get_bond(lua_State *L)
 {
     const unsigned b = check_contact(L)->bond;
@@ -240,6 +249,7 @@ void sx_lua_contacts_register(lua_State *L)
         {"pb_moment", get_pb_moment},
         {"pb_radius", get_pb_radius},
         {"shift", get_shift},
+        {"contact_model", get_contact_model},
         {NULL, NULL},
     };
     sx_lua_newclass(L, SX_LUA_CONTACT, "contact", meta, NULL, getters, NULL);

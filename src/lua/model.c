@@ -280,6 +280,41 @@ static int model_summary(lua_State *L)
 
 /* ----------------------------------------------------------- materials */
 
+/* A material's keys into the table on top, as m:material takes them. */
+static void push_material(lua_State *L, sx_material_def *d)
+{
+    lua_pushstring(L, sx_law_name(d->model));
+    lua_setfield(L, -2, "model");
+    sx_lua_setnum(L, "density", d->density);
+    sx_lua_setnum(L, "kn", d->kn);
+    sx_lua_setnum(L, "ks", d->ks);
+    sx_lua_setnum(L, "friction", d->friction);
+    sx_lua_setnum(L, "damping", d->damping);
+    sx_lua_setnum(L, "viscous_normal", d->viscous_normal);
+    sx_lua_setnum(L, "viscous_shear", d->viscous_shear);
+    sx_lua_setnum(L, "modulus", d->modulus);
+    sx_lua_setnum(L, "stiffness_ratio", d->stiffness_ratio);
+    for (int law = 0; law < sx_law_count(); law++)
+        for (int k = 0; k < sx_law_param_count(law); k++)
+            sx_lua_setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(d, law, k));
+}
+
+/* The material keys of the table at arg into d (keys already checked). */
+static void read_material(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm)
+{
+    sx_lua_optnumfield(L, arg, "kn", &d->kn);
+    sx_lua_optnumfield(L, arg, "ks", &d->ks);
+    sx_lua_optnumfield(L, arg, "friction", &d->friction);
+    sx_lua_optnumfield(L, arg, "density", &d->density);
+    sx_lua_optnumfield(L, arg, "damping", &d->damping);
+    sx_lua_optnumfield(L, arg, "viscous_normal", &d->viscous_normal);
+    sx_lua_optnumfield(L, arg, "viscous_shear", &d->viscous_shear);
+    sx_lua_material_extras(L, arg, d, has_bpm, bpm);
+    sx_lua_check_range(L, 1, "density", d->density, 100, 3e4, "kg/m^3");
+    sx_lua_check_range(L, 1, "modulus", d->modulus, 1e5, 1e12, "Pa");
+    sx_lua_check_range(L, 1, "shear_modulus", d->shear_modulus, 1e5, 1e12, "Pa");
+}
+
 static int model_material(lua_State *L)
 {
     const char *keys[48] = {"kn",      "ks",             "friction",      "density", "damping",
@@ -294,23 +329,124 @@ static int model_material(lua_State *L)
     memset(&bpm, 0, sizeof bpm);
     if (!lua_isnoneornil(L, 3)) {
         sx_lua_checkkeys(L, 3, keys);
-        sx_lua_optnumfield(L, 3, "kn", &d.kn);
-        sx_lua_optnumfield(L, 3, "ks", &d.ks);
-        sx_lua_optnumfield(L, 3, "friction", &d.friction);
-        sx_lua_optnumfield(L, 3, "density", &d.density);
-        sx_lua_optnumfield(L, 3, "damping", &d.damping);
-        sx_lua_optnumfield(L, 3, "viscous_normal", &d.viscous_normal);
-        sx_lua_optnumfield(L, 3, "viscous_shear", &d.viscous_shear);
-        sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
-        sx_lua_check_range(L, 1, "density", d.density, 100, 3e4, "kg/m^3");
-        sx_lua_check_range(L, 1, "modulus", d.modulus, 1e5, 1e12, "Pa");
-        sx_lua_check_range(L, 1, "shear_modulus", d.shear_modulus, 1e5, 1e12, "Pa");
+        read_material(L, 3, &d, &has_bpm, &bpm);
     }
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");
     if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm), "m:material");
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
+}
+
+/* The two names of field `key` of the table at arg ({"x", "y"}, or one
+ * name for both) as group numbers or material indices. */
+static void pair_field(lua_State *L, int arg, const char *key, bool groups, int32_t *a, int32_t *b)
+{
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    lua_getfield(L, arg, key);
+    const int t = lua_gettop(L);
+    const int n = lua_type(L, t) == LUA_TSTRING ? 1 : lua_istable(L, t) ? (int)lua_rawlen(L, t) : 0;
+    if (n < 1 || n > 2 || (lua_istable(L, t) && lua_rawlen(L, t) != (size_t)n))
+        sx_lua_fielderror(L, arg, key, "a name or a list of two names expected");
+    int32_t v[2];
+    for (int k = 0; k < n; k++) {
+        if (lua_istable(L, t)) lua_rawgeti(L, t, k + 1);
+        else lua_pushvalue(L, t);
+        if (lua_type(L, -1) != LUA_TSTRING) sx_lua_fielderror(L, arg, key, "names expected");
+        const char *name = lua_tostring(L, -1);
+        if (groups) {
+            v[k] = sx_lua_group_id(L, 1, name, true); /* a group may be named before it has balls */
+        } else {
+            v[k] = sx_material_find(m, name);
+            if (v[k] < 0) sx_lua_fielderror(L, arg, key, lua_pushfstring(L, "no material named '%s'", name));
+        }
+        lua_pop(L, 1);
+    }
+    *a = v[0], *b = v[n - 1];
+    lua_settop(L, t - 1);
+}
+
+/* m:contact_model{groups = {g1, g2} | materials = {m1, m2} | default = true,
+ * model = law, material = base, name = ..., its law's keys}: a row of the
+ * contact-model table (cmodel.c) -> its number. */
+static int model_contact_model(lua_State *L)
+{
+    const char *keys[56] = {"kn",      "ks",      "friction", "density",  "damping",    "viscous_normal",
+                            "viscous_shear", "model", "modulus", "stiffness_ratio", "groups", "materials",
+                            "default", "material", "name"};
+    keys[sx_lua_law_keys(keys, 15, 55)] = NULL; /* and the laws' parameters */
+    sx_model *m = sx_lua_checkmodel(L, 1);
+    luaL_checktype(L, 2, LUA_TTABLE);
+    sx_lua_checkkeys(L, 2, keys);
+    sx_cmodel_def d;
+    memset(&d, 0, sizeof d);
+    const bool groups = lua_getfield(L, 2, "groups") != LUA_TNIL, materials = lua_getfield(L, 2, "materials") != LUA_TNIL,
+               dflt = lua_getfield(L, 2, "default") != LUA_TNIL;
+    if (dflt && !lua_toboolean(L, -1)) luaL_argerror(L, 2, "field 'default': true expected (or leave it out)");
+    lua_pop(L, 3);
+    if (groups + materials + dflt != 1)
+        luaL_argerror(L, 2, "exactly one of groups = {a, b}, materials = {a, b} or default = true expected");
+    d.match = groups ? SX_CMODEL_GROUPS : materials ? SX_CMODEL_MATERIALS : SX_CMODEL_DEFAULT;
+    if (!dflt) pair_field(L, 2, groups ? "groups" : "materials", groups, &d.a, &d.b);
+    d.law = sx_material_default_def();
+    const char *base = sx_lua_optstrfield(L, 2, "material");
+    if (base) sx_lua_check(L, m, sx_material_get(m, sx_lua_material_arg(L, m, 2, "material", base), &d.law),
+                           "m:contact_model");
+    bool has_bpm;
+    sx_bpm_def bpm;
+    read_material(L, 2, &d.law, &has_bpm, &bpm);
+    const char *name = sx_lua_optstrfield(L, 2, "name");
+    char auto_name[64];
+    if (!name && dflt) name = "default";
+    if (!name) { /* its match, for reports: "a-b" */
+        const sx_cmodel_def *p = &d;
+        char both[2][64];
+        for (int k = 0; k < 2; k++) {
+            const int32_t v = k ? p->b : p->a;
+            if (groups) sx_lua_push_group_name(L, 1, v);
+            else lua_pushstring(L, sx_material_name(m, v));
+            snprintf(both[k], sizeof both[k], "%s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "none");
+            lua_pop(L, 1);
+        }
+        snprintf(auto_name, sizeof auto_name, "%.31s-%.31s", both[0], both[1]);
+        name = auto_name;
+    }
+    int row = 0;
+    sx_lua_check(L, m, sx_cmodel_add(m, name, &d, &row), "m:contact_model");
+    lua_pushinteger(L, row);
+    return 1;
+}
+
+/* m:contact_models(): the table's rows in order, each as m:contact_model takes it. */
+static int model_contact_models(lua_State *L)
+{
+    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const int n = sx_cmodel_count(m);
+    lua_createtable(L, n, 0);
+    for (int r = 1; r <= n; r++) {
+        sx_cmodel_def d;
+        const char *name;
+        sx_lua_check(L, m, sx_cmodel_get(m, r, &d, &name), "m:contact_models");
+        lua_createtable(L, 0, 16);
+        lua_pushstring(L, name);
+        lua_setfield(L, -2, "name");
+        if (d.match == SX_CMODEL_DEFAULT) {
+            lua_pushboolean(L, 1);
+            lua_setfield(L, -2, "default");
+        } else {
+            lua_createtable(L, 2, 0);
+            for (int k = 0; k < 2; k++) {
+                const int32_t v = k ? d.b : d.a;
+                if (d.match == SX_CMODEL_GROUPS) sx_lua_push_group_name(L, 1, v);
+                else lua_pushstring(L, sx_material_name(m, v));
+                lua_rawseti(L, -2, k + 1);
+            }
+            lua_setfield(L, -2, d.match == SX_CMODEL_GROUPS ? "groups" : "materials");
+        }
+        push_material(L, &d.law);
+        lua_rawseti(L, -2, r);
+    }
+    return 1;
 }
 
 /* m:materials(): name -> its properties, as m:material takes them. */
@@ -323,20 +459,7 @@ static int model_materials(lua_State *L)
         sx_material_def d;
         sx_lua_check(L, m, sx_material_get(m, i, &d), "m:materials");
         lua_createtable(L, 0, 12);
-        lua_pushstring(L, sx_law_name(d.model));
-        lua_setfield(L, -2, "model");
-        sx_lua_setnum(L, "density", d.density);
-        sx_lua_setnum(L, "kn", d.kn);
-        sx_lua_setnum(L, "ks", d.ks);
-        sx_lua_setnum(L, "friction", d.friction);
-        sx_lua_setnum(L, "damping", d.damping);
-        sx_lua_setnum(L, "viscous_normal", d.viscous_normal);
-        sx_lua_setnum(L, "viscous_shear", d.viscous_shear);
-        sx_lua_setnum(L, "modulus", d.modulus);
-        sx_lua_setnum(L, "stiffness_ratio", d.stiffness_ratio);
-        for (int law = 0; law < sx_law_count(); law++)
-            for (int k = 0; k < sx_law_param_count(law); k++)
-                sx_lua_setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(&d, law, k));
+        push_material(L, &d);
         lua_setfield(L, -2, sx_material_name(m, i));
     }
     return 1;
@@ -550,6 +673,8 @@ const luaL_Reg sx_lua_model_methods[] = {
     {"summary", model_summary},
     {"material", model_material},
     {"materials", model_materials},
+    {"contact_model", model_contact_model},
+    {"contact_models", model_contact_models},
     {"dim", model_dim},
     {"time", model_time},
     {"step", model_step},

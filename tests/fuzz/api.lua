@@ -103,6 +103,11 @@ E("m:material", function(c)
                 modulus = 0, stiffness_ratio = 1})
 end)
 E("m:materials", function(c) return method(c.m, "materials") end)
+E("m:contact_model", function(c)
+  return method(c.m, "contact_model", {groups = {"top", "g"}, model = "linear", kn = 1e7, ks = 1e7, friction = 0.3,
+                name = "top-g", material = "rock"})
+end)
+E("m:contact_models", function(c) return method(c.m, "contact_models") end)
 E("m:summary", function(c) return method(c.m, "summary") end)
 E("m:close", function(c) return method(c.m, "close") end)
 for _, name in ipairs({"dim", "time", "step", "timestep", "critical_timestep", "gravity", "ratio", "energy",
@@ -236,7 +241,7 @@ local fields = {
   w = {"id", "kind", "force", "moment", "vel", "point", "normal", "edge1", "edge2", "friction", "extra", "material",
        "rigid"},
   c = {"a", "b", "kind", "normal", "point", "overlap", "fn", "fs", "force", "bond", "pb_fn", "pb_fs", "pb_moment",
-       "pb_radius"},
+       "pb_radius", "contact_model"},
 }
 local writable = {
   b = {pos = "v", vel = "v", spin = "r", applied_force = "v", applied_moment = "r", radius = 0.012, material = "soft",

@@ -464,6 +464,8 @@ START_TEST(meaningless_values)
         {"/materials/kn", 0, NAN, "kn must be > 0 N/m"},
         {"/materials/poisson", 0, NAN, "Poisson's ratio"},
         {"/materials/bond_tensile_strength", 0, -5, "bond parameter that is negative or not finite"},
+        {"/materials/bond_elements", 0, 2.5, "bond elements must be a whole number"},
+        {"/materials/bond_unbonded_fraction", 0, 3, "bond unbonded_fraction must be in [0, 1]"},
         /* found by the file fuzzer: a denormal 1/m (an infinite mass) */
         {"/balls/inv_mass", 0, 4.9e-310, "a radius, mass, inertia or damping out of range"},
     };

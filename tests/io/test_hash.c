@@ -173,6 +173,18 @@ static void poke_all(sx_model *a, sx_model *b)
             POKE(bonds.ms[s * r], F64);
         }
     }
+    /* the contact-model table (cmodel.c) and a contact's row */
+    if (b->ncmodel > 0) {
+        POKE(cmodel[0].def.match, INT);
+        POKE(cmodel[0].def.a, I32);
+        POKE(cmodel[0].def.b, I32);
+        POKE(cmodel[0].mat.name[0], CHAR);
+        POKE(cmodel[0].mat.def.model, INT);
+        POKE(cmodel[0].mat.def.kn, F64);
+        POKE(cmodel[0].mat.def.friction, F64);
+        POKE(cmodel[0].mat.def.rolling_friction, F64);
+        if (c >= 0) POKE(bb.cmodel[c], I32);
+    }
     if (cw >= 0) {
         POKE(bw.fs[cw * d], F64);
         POKE(bw.geo[cw * d], F64);
@@ -211,7 +223,17 @@ static void poke_all(sx_model *a, sx_model *b)
 
 typedef sx_model *(*scene_fn)(int dim);
 static sx_model *granular(int dim) { return io_scene_granular(dim, 120); }
-static const scene_fn scenes[] = {granular, io_scene_bonded, io_scene_servo, io_scene_hertz};
+/* the granular scene whose contacts take a default row of the contact-model table */
+static sx_model *granular_table(int dim)
+{
+    sx_model *m = io_scene_granular(dim, 120);
+    sx_cmodel_def row = {.match = SX_CMODEL_DEFAULT};
+    ck_assert_int_eq(sx_material_get(m, 0, &row.law), SX_OK);
+    row.law.kn *= 2;
+    ck_assert_int_eq(sx_cmodel_add(m, "stiffer", &row, NULL), SX_OK);
+    return m;
+}
+static const scene_fn scenes[] = {granular, io_scene_bonded, io_scene_servo, io_scene_hertz, granular_table};
 enum { NSCENES = sizeof scenes / sizeof *scenes };
 
 static void cycled_pair(int scene, int dim, sx_model **a, sx_model **b)
@@ -236,7 +258,8 @@ START_TEST(every_restored_field)
     /* every field was covered by some scene */
     static const char *const must[] = {"balls.fapp[i * d]", "balls.group[i]", "balls.alpha[i]", "walls[w].servo.target",
                                        "bonds.fs[s * d]", "bonds.ms[s * r]", "cracks.ev[0].fs", "bw.un[cw]",
-                                       "bb.fs[c * d]", "dt", "balls.x_build[i * d]", "walls[w].moved"};
+                                       "bb.fs[c * d]", "dt", "balls.x_build[i * d]", "walls[w].moved",
+                                       "cmodel[0].mat.def.kn", "bb.cmodel[c]"};
     for (size_t k = 0; k < sizeof must / sizeof *must; k++) {
         bool found = false;
         for (int i = 0; i < nseen; i++) found |= strcmp(seen[i], must[k]) == 0;

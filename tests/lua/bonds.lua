@@ -130,5 +130,27 @@ do
   check("nothing installed by refused calls", m:bond_count() == 0, m:bond_count())
 end
 
+do
+  -- the bond kinds and their keys come from the registry (src/core/laws/bonds.h): every kind's
+  -- micro-parameters, flat joint's included, are saved with the material and restored
+  local m = seixo.model{dim = 2}
+  m:material("r", {kn = 1e7, ks = 1e7, density = 2500,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2, tensile_strength = 1e6,
+                           cohesion = 2e6, normal_strength = 3, shear_strength = 4, friction_angle = 30,
+                           friction = 0.6, elements = 3, sectors = 5, unbonded_fraction = 0.25, initial_gap = 1e-6}})
+  m:ball{pos = {0, 0}, radius = 1}
+  local path = "bonds_registry.h5"
+  m:save(path)
+  local l = seixo.load(path)
+  check("every bond micro-parameter survives a save and load", l:hash() == m:hash(), l:hash() .. " vs " .. m:hash())
+  os.remove(path)
+  local ok, err = pcall(m.bond, m, {kind = "glue", gap = 1e-6})
+  check("an unknown kind lists the registry's", not ok and tostring(err):find("'parallel', 'contact', 'flatjoint'", 1, true), err)
+  ok, err = pcall(m.material, m, "q", {bond = {unbonded_fraction = 1.5}})
+  check("a key's range comes from its kind", not ok and tostring(err):find("unbonded_fraction must be in [0, 1]", 1, true), err)
+  ok, err = pcall(m.material, m, "q", {bond = {elements = 2.5}})
+  check("element counts are whole", not ok and tostring(err):find("elements must be a whole number", 1, true), err)
+end
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

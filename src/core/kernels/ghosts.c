@@ -245,7 +245,7 @@ static void KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double s
         if (!stiff) continue;
         const int64_t a = p->a[c], b = p->b[c];
         const double ra = B->rad[a], rb = B->rad[b];
-        const sx_pair_law *law = &m->law[B->mat[a] * m->law_n + B->mat[b]];
+        const sx_pair_law *law = sx__bb_step_law(m, c, a, b);
         double kn, ks;
         stiffness(law, ra, rb, 2 * ra * rb / (ra + rb), ra + rb - d, &kn, &ks);
         for (int k = 0; k < D; k++) k6[k] += kn * l[k] * l[k];

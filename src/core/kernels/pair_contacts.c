@@ -64,34 +64,6 @@ static inline double contact_strain(const sx_pair_law *l, double fn, double un, 
     return normal + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
 }
 
-/* Section of a parallel bond: area, moment of inertia, polar moment (4-35;
- * 2D: a beam of unit thickness, A = 2R, I = 2/3 R^3, no twist). */
-static inline void pb_section(double r, double *area, double *inertia, double *polar)
-{
-#if D == 3
-    *area = SX_PI * r * r;
-    *inertia = 0.25 * SX_PI * r * r * r * r;
-    *polar = 0.5 * SX_PI * r * r * r * r;
-#else
-    *area = 2 * r;
-    *inertia = 2.0 / 3.0 * r * r * r;
-    *polar = 0;
-#endif
-}
-
-static double pb_strain(const sx_bonds *b, int64_t s)
-{
-    double area, inertia, polar;
-    pb_section(b->rbar[s], &area, &inertia, &polar);
-    const double *fs = b->fs + s * D, *ms = b->ms + s * RD;
-    double e = 0.5 * b->fn[s] * b->fn[s] / (b->kn[s] * area) + 0.5 * dot(fs, fs) / (b->ks[s] * area);
-    double m2 = 0;
-    for (int k = 0; k < RD; k++) m2 += ms[k] * ms[k];
-    e += 0.5 * m2 / (b->kn[s] * inertia);
-    if (D == 3) e += 0.5 * b->mn[s] * b->mn[s] / (b->ks[s] * polar);
-    return e;
-}
-
 /* The flat joint of bond s (laws/flatjoint.h): its face axes t1, t2 for
  * the joint's normal n (3D: t1 as carried; 2D: n turned by +90 deg, t2 = z). */
 static inline void fj_axes(const sx_bonds *b, int32_t s, const double *n, double *t1, double *t2)
@@ -188,51 +160,25 @@ static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode 
     o->cracks[o->ncracks++] = c;
 }
 
-/* The parallel bond of pair (i, j), 4-32 ... 4-39: carried with the contact,
- * incremented from the relative motion, checked against its strengths.
- * Adds its force to F (on j) and its moment to mb (on j). Returns false
- * when it broke. */
+/* The parallel bond of pair (i, j) (laws/parallel_bond.h): carried with
+ * the contact (4-13 ... 4-15), then stepped and tested by its law. Adds its
+ * force to F (on j) and its moment to mb (on j). Returns false when it
+ * broke (logged, its energy released). */
 static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *n, double vn, const double *vs,
                           const double *dtheta, const double *xc, int64_t i, int64_t j, double *F, double *mb)
 {
     sx_bonds *b = &m->bonds;
-    const double dt = motion_dt(m), rbar = b->rbar[s];
-    double area, inertia, polar;
-    pb_section(rbar, &area, &inertia, &polar);
-    double *fs = b->fs + s * D, *ms = b->ms + s * RD;
-    carry_apply(rot, fs);
+    carry_apply(rot, b->fs + s * D);
 #if D == 3
-    carry_apply(rot, ms);
+    carry_apply(rot, b->ms + s * RD);
 #endif
-    b->fn[s] += b->kn[s] * area * (-vn * dt); /* 4-33, compression positive */
-    for (int k = 0; k < D; k++) fs[k] -= b->ks[s] * area * vs[k] * dt; /* 4-33 with dUs (seed typo corrected) */
-#if D == 3
-    const double twist = dot(dtheta, n);
-    b->mn[s] -= b->ks[s] * polar * twist; /* 4-34 */
-    for (int k = 0; k < 3; k++) ms[k] -= b->kn[s] * inertia * (dtheta[k] - twist * n[k]);
-#else
-    (void)polar;
-    ms[0] -= b->kn[s] * inertia * dtheta[0];
-#endif
-    double ms2 = 0;
-    for (int k = 0; k < RD; k++) ms2 += ms[k] * ms[k];
-    const double msn = sqrt(ms2), fsn = sqrt(dot(fs, fs)), mnn = fabs(b->mn[s]);
-    /* 4-38 as corrected: magnitudes, the twist only in 3D */
-    const double sigma = -b->fn[s] / area + msn * rbar / inertia;
-    const double tau = fsn / area + (D == 3 ? mnn * rbar / polar : 0);
-    if (sigma >= b->sigma_c[s] || tau >= b->tau_c[s]) {
-        const bool tension = sigma / b->sigma_c[s] >= tau / b->tau_c[s];
-        log_crack(m, o, xc, tension ? SX_CRACK_TENSION : SX_CRACK_SHEAR, SX_BOND_PARALLEL, -1, i, j, b->fn[s], fsn, mnn,
-                  msn);
-        if (m->track_energy) o->released += pb_strain(b, s);
+    sx_bond_break br;
+    if (sx_bond_parallel_step(D, b, s, n, vn, vs, dtheta, motion_dt(m), &br)) {
+        log_crack(m, o, xc, br.mode, SX_BOND_PARALLEL, -1, i, j, b->fn[s], br.fsn, br.mnn, br.msn);
+        if (m->track_energy) o->released += sx_bond_parallel_strain(D, b, s);
         return false;
     }
-    for (int k = 0; k < D; k++) F[k] += b->fn[s] * n[k] + fs[k]; /* 4-32 */
-#if D == 3
-    for (int k = 0; k < 3; k++) mb[k] += b->mn[s] * n[k] + ms[k];
-#else
-    mb[0] += ms[0];
-#endif
+    sx_bond_parallel_add(D, b, s, n, F, mb);
     return true;
 }
 
@@ -387,6 +333,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
     const int32_t *restrict bond = p->bond;
+    int32_t *restrict cmodel = p->cmodel; /* the contact-model table's rows (cmodel.c); NULL: none */
     double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
@@ -402,6 +349,10 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
         const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
         const sx_pair_law *law = &laws[mat[i] * nlaw + mat[j]];
+        if (cmodel) { /* a contact takes its row when it is created and keeps it */
+            if (!touching[c]) cmodel[c] = sx__cmodel_pick(m, i, j);
+            if (cmodel[c]) law = &m->cmodel[cmodel[c] - 1].law;
+        }
         double *restrict fs = fs_all + c * D, *restrict rel = geo_all + c * D;
         if (d2 >= rsum * rsum && slot < 0) {
             if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
@@ -473,18 +424,18 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 carry_apply(&rot, us);
                 sx_law_total_shear_force(D, us, fs, vs, ks, dt);
             }
-            if (bonds & SX_BOND_CONTACT) {
+            if (bonds & SX_BOND_CONTACT) { /* laws/contact_bond.h */
                 const double fsn = sqrt(dot(fs, fs));
-                if (-fn >= m->bonds.cb_n[slot]) { /* tension failure: both components vanish */
-                    log_crack(m, o, xc, SX_CRACK_TENSION, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
-                    if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * fsn * fsn / ks : 0);
+                const int mode = sx_bond_contact_test(fn, fsn, m->bonds.cb_n[slot], m->bonds.cb_s[slot]);
+                if (mode) {
+                    log_crack(m, o, xc, (sx_crack_mode)mode, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
+                }
+                if (mode == SX_CRACK_TENSION) { /* both components vanish; in shear, slip takes over */
+                    if (track) o->released += sx_bond_contact_released(fn, un, fsn, ks);
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                     if (us) sx_law_total_shear_slip(D, us, 0);
-                } else if (fsn >= m->bonds.cb_s[slot]) { /* shear failure: slip takes over */
-                    log_crack(m, o, xc, SX_CRACK_SHEAR, SX_BOND_CONTACT, -1, i, j, fn, fsn, 0, 0);
-                    bonds &= ~(unsigned)SX_BOND_CONTACT;
                 }
             }
             if (!(bonds & SX_BOND_CONTACT)) {
@@ -780,7 +731,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
 
 static void ball_chunk(sx_model *m, sx_chunk *o)
 {
-    if (m->law_plain && !m->bb.bond && !m->track_energy) ball_chunk_batched(m, o);
+    if (m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->track_energy) ball_chunk_batched(m, o);
     else ball_chunk_pass(m, o);
 }
 

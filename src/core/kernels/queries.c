@@ -19,7 +19,7 @@ static double pair_force(const sx_model *m, int64_t c, double un, double *kn, do
 {
     const sx_balls *B = &m->balls;
     const int64_t i = m->bb.a[c], j = m->bb.b[c];
-    const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
+    const sx_pair_law law = sx__bb_law(m, c, i, j);
     const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
     const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
     const bool active = !(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT));
@@ -56,11 +56,11 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
         const double fn = pair_force(m, c, un, &kn, &ks);
-        const sx_pair_law law = sx__pair_law(m, B->mat[i], B->mat[j]);
+        const sx_pair_law law = sx__bb_law(m, c, i, j);
         e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
         e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
-        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += pb_strain(&m->bonds, slot);
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += sx_bond_parallel_strain(D, &m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
             e->bond_strain += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
     }
@@ -99,7 +99,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     sx_contact_info ci;
     memset(&ci, 0, sizeof ci);
     const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])
-                                    : sx__pair_law(m, B->mat[i], B->mat[p->b[c]]);
+                                    : sx__bb_law(m, c, i, p->b[c]);
     const double rj = is_wall ? B->rad[i] : B->rad[p->b[c]];
     stiffness(&law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
     /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
@@ -114,6 +114,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     ci.a = B->id[i];
     ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
     ci.is_wall = is_wall;
+    ci.cmodel = !is_wall && p->cmodel && p->touching[c] ? p->cmodel[c] : 0;
     if (!is_wall && m->cell) sx__cell_owner(m, p->b[c], ci.shift); /* through the boundary */
     const int32_t slot = !is_wall && p->bond ? p->bond[c] - 1 : -1;
     if (slot >= 0) {

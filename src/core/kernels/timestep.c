@@ -13,6 +13,15 @@
  * stiffness. A ball is never rated below its own stiffness (as if touching
  * one entity like itself), so the first impact is already resolved and the
  * timestep does not jump as contacts form. */
+/* A ball's own rating under pair law l: its stiffnesses against an entity of its own. */
+static void self_rating(const sx_pair_law *l, double r, double *kn, double *ks)
+{
+    stiffness(l, r, r, r, HERTZ_REFERENCE_OVERLAP * r, kn, ks);
+    const sx_law *own = sx__law(l->law);
+    *kn *= own->tangent;
+    if (own->series) *kn *= 2, *ks *= 2; /* undo the series combination with itself */
+}
+
 static double KERNEL(critical_dt)(sx_model *m)
 {
     sx_balls *B = &m->balls;
@@ -29,7 +38,7 @@ static double KERNEL(critical_dt)(sx_model *m)
         double dx[D];
         for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
         const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
-        const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
+        const sx_pair_law *law = sx__bb_step_law(m, c, i, j);
         double ktr = 0, krot_i = 0, krot_j = 0;
         const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
         if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
@@ -51,15 +60,8 @@ static double KERNEL(critical_dt)(sx_model *m)
                 krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
             }
         }
-        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) { /* a flat joint's face: the section of 4-35 */
-            const sx_bonds *b = &m->bonds;
-            double area, inertia, polar;
-            pb_section(b->rbar[slot], &area, &inertia, &polar);
-            ktr += (b->kn[slot] + b->ks[slot]) * area;
-            const double krb = b->kn[slot] * inertia + b->ks[slot] * polar;
-            krot_i += krb + b->ks[slot] * area * B->rad[i] * B->rad[i];
-            krot_j += krb + b->ks[slot] * area * B->rad[j] * B->rad[j];
-        }
+        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) /* a flat joint's face: the section of 4-35 */
+            sx_bond_parallel_stiffness(D, &m->bonds, slot, B->rad[i], B->rad[j], &ktr, &krot_i, &krot_j);
         const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
         kt[i] += ktr;
         kt[jo] += ktr;
@@ -91,13 +93,14 @@ static double KERNEL(critical_dt)(sx_model *m)
     double best = INFINITY;
     for (int64_t i = 0; i < n; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
-        const sx_pair_law *self = &m->law[B->mat[i] * m->law_n + B->mat[i]];
         const double r = B->rad[i];
         double kn, ks;
-        stiffness(self, r, r, r, HERTZ_REFERENCE_OVERLAP * r, &kn, &ks);
-        const sx_law *own = sx__law(self->law);
-        kn *= own->tangent;
-        if (own->series) kn *= 2, ks *= 2; /* undo the series combination with itself */
+        self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], r, &kn, &ks);
+        for (int row = 0; row < m->ncmodel; row++) { /* and not below a contact-model row's (cmodel.c) */
+            double knr, ksr;
+            self_rating(&m->cmodel[row].law, r, &knr, &ksr);
+            if (knr + ksr > kn + ks) kn = knr, ks = ksr;
+        }
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
         if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */

@@ -192,3 +192,34 @@ static inline sx_law_fj_load sx_law_fj_load_of(int dim, const sx_law_fj_geom *g,
 {
     return bonded ? sx_law_fj_whole(g, kn, gc, ay, az) : sx_law_fj_contact(dim, g, kn, gc, ay, az);
 }
+
+/* Its micro-parameters (laws/bond.h): the parallel bond's face and
+ * strengths (drawn per element) and its own. */
+#include "bond.h"
+
+static inline const sx_bond_law *sx_bond_flatjoint(void)
+{
+    static const sx_bond_param params[] = {
+        SX_BOND_PARAM(radius_multiplier, "1", INFINITY, false),
+        SX_BOND_PARAM(modulus, "Pa", INFINITY, false),
+        SX_BOND_PARAM(stiffness_ratio, "1", INFINITY, false),
+        SX_BOND_PARAM(tensile_strength, "Pa", INFINITY, false),
+        SX_BOND_PARAM(tensile_strength_sd, "Pa", INFINITY, false),
+        SX_BOND_PARAM(cohesion, "Pa", INFINITY, false),
+        SX_BOND_PARAM(cohesion_sd, "Pa", INFINITY, false),
+        SX_BOND_PARAM(friction_angle, "deg", 90, false),
+        SX_BOND_PARAM(friction, "1", INFINITY, false),
+        SX_BOND_COUNT(elements, 64), /* a joint's uint8 holds them */
+        SX_BOND_COUNT(sectors, 64),
+        SX_BOND_PARAM(unbonded_fraction, "1", 1, true),
+        SX_BOND_PARAM(initial_gap, "m", INFINITY, false),
+    };
+    static const sx_bond_law law = {
+        .name = "flatjoint",
+        .kind = SX_BOND_FLATJOINT,
+        .summary = "flat joint: a face of bonded and unbonded elements in place of the contact law (Potyondy 2012)",
+        .params = params,
+        .nparams = 13,
+    };
+    return &law;
+}

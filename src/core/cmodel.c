@@ -1,0 +1,118 @@
+/* The contact-model table (PFC's contact model assignment table; issue 12
+ * item 7): rows giving the ball-ball contacts of a pair of groups, of a
+ * pair of materials, or any other, their own law and parameters. A contact
+ * takes its row when it is created and keeps it (sx_pairs.cmodel, a field
+ * of the pair schema: restarts, the hash and snapshots carry it); a model
+ * without rows has no such field and runs as it did before the table. */
+#include "laws/law.h"
+
+#include <stdio.h>
+#include <string.h>
+
+enum { CMODEL_MAX = 4096 }; /* rows, at most: a table is a handful of lines */
+
+/* Does row r match balls of groups ga, gb and materials ma, mb? */
+static bool matches(const sx_cmodel_def *r, int32_t ga, int32_t gb, int32_t ma, int32_t mb)
+{
+    if (r->match == SX_CMODEL_GROUPS) return (r->a == ga && r->b == gb) || (r->a == gb && r->b == ga);
+    if (r->match == SX_CMODEL_MATERIALS) return (r->a == ma && r->b == mb) || (r->a == mb && r->b == ma);
+    return true;
+}
+
+int32_t sx__cmodel_pick(const sx_model *m, int64_t i, int64_t j)
+{
+    const sx_balls *B = &m->balls;
+    const int32_t ga = B->group ? B->group[i] : 0, gb = B->group ? B->group[j] : 0;
+    const int32_t ma = B->mat[i], mb = B->mat[j];
+    /* the most specific kind first, the newest row of a kind first */
+    static const sx_cmodel_match order[] = {SX_CMODEL_GROUPS, SX_CMODEL_MATERIALS, SX_CMODEL_DEFAULT};
+    for (int k = 0; k < 3; k++)
+        for (int r = m->ncmodel - 1; r >= 0; r--) {
+            const sx_cmodel_def *d = &m->cmodel[r].def;
+            if (d->match == order[k] && matches(d, ga, gb, ma, mb)) return r + 1;
+        }
+    return 0;
+}
+
+/* Why def cannot be a row of m, or NULL. */
+static const char *invalid(const sx_model *m, const sx_cmodel_def *d, char *why, size_t len)
+{
+    if (d->match == SX_CMODEL_GROUPS && (d->a < 0 || d->b < 0))
+        return snprintf(why, len, "a group number must be >= 0 (got %d and %d)", (int)d->a, (int)d->b), why;
+    if (d->match == SX_CMODEL_MATERIALS && (d->a < 0 || d->a >= m->nmat || d->b < 0 || d->b >= m->nmat))
+        return snprintf(why, len, "no material with index %d or %d (there are %d)", (int)d->a, (int)d->b, m->nmat), why;
+    if (d->match != SX_CMODEL_DEFAULT && d->match != SX_CMODEL_GROUPS && d->match != SX_CMODEL_MATERIALS)
+        return snprintf(why, len, "the match must be default, groups or materials"), why;
+    return sx__material_invalid(&d->law, why, len);
+}
+
+sx_status sx_cmodel_add(sx_model *m, const char *name, const sx_cmodel_def *def, int *row)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "contact_model: the model is stepping");
+    if (!name || !*name || strlen(name) >= sizeof m->cmodel[0].mat.name)
+        return sx__fail(m, SX_EINVAL, "contact_model: the name must have 1 to %zu characters",
+                        sizeof m->cmodel[0].mat.name - 1);
+    char why[256];
+    if (invalid(m, def, why, sizeof why)) return sx__fail(m, SX_EINVAL, "contact_model '%s': %s", name, why);
+    if (m->ncmodel >= CMODEL_MAX) return sx__fail(m, SX_EINVAL, "contact_model: more than %d rows", CMODEL_MAX);
+    /* the ball-ball store carries each contact's row from the first row on */
+    if (sx__pairs_reserve(m, &m->bb, 1)) return sx__fail(m, SX_ENOMEM, "contact_model: out of memory");
+    if (!m->bb.cmodel &&
+        !(m->bb.cmodel = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)m->bb.cap, sizeof *m->bb.cmodel)))
+        return sx__fail(m, SX_ENOMEM, "contact_model: out of memory");
+    if (m->ncmodel == m->cap_cmodel) {
+        const int cap = m->cap_cmodel ? 2 * m->cap_cmodel : 4;
+        sx_cmodel_row *q = sx_alloc_resize(&m->alloc, m->cmodel, (size_t)m->cap_cmodel, (size_t)cap, sizeof *q);
+        if (!q) return sx__fail(m, SX_ENOMEM, "contact_model: out of memory");
+        m->cmodel = q;
+        m->cap_cmodel = cap;
+    }
+    sx_cmodel_row *r = &m->cmodel[m->ncmodel];
+    memset(r, 0, sizeof *r);
+    r->def = *def;
+    snprintf(r->mat.name, sizeof r->mat.name, "%s", name);
+    r->mat.def = def->law;
+    sx__cmodel_derive(r);
+    m->ncmodel++;
+    m->dt_stale = true;
+    if (row) *row = m->ncmodel;
+    return SX_OK;
+}
+
+void sx__cmodel_derive(sx_cmodel_row *r)
+{
+    sx__material_derive(&r->mat);
+    r->law = sx__pair_law_of(&r->mat, &r->mat); /* two balls of the row's material (4-22/4-23) */
+}
+
+int sx_cmodel_count(const sx_model *m) { return m->ncmodel; }
+
+sx_status sx_cmodel_get(const sx_model *m, int row, sx_cmodel_def *def, const char **name)
+{
+    if (row < 1 || row > m->ncmodel)
+        return sx__fail((sx_model *)m, SX_ENOTFOUND, "contact_model: no row %d (there are %d)", row, m->ncmodel);
+    if (def) *def = m->cmodel[row - 1].def;
+    if (name) *name = m->cmodel[row - 1].mat.name;
+    return SX_OK;
+}
+
+sx_status sx__cmodel_prepare(sx_model *m)
+{
+    for (int r = 0; r < m->ncmodel; r++) { /* a row's law's history joins the pair stores, as a material's */
+        const sx_material_def *d = &m->cmodel[r].mat.def;
+        if ((d->rolling_friction > 0 && sx__pairs_expand(m, offsetof(sx_pairs, mr), m->rdim)) ||
+            (d->total_shear == 1 && sx__pairs_expand(m, offsetof(sx_pairs, us), m->dim)))
+            return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    }
+    const sx_pairs *p = &m->bb;
+    for (int64_t c = 0; p->bond && c < p->n; c++) { /* seed 4.3.3: a bonded contact's law must take bonds */
+        const int32_t r = p->touching[c] ? p->cmodel[c] : sx__cmodel_pick(m, p->a[c], p->b[c]);
+        if (!p->bond[c] || !r || sx__law(m->cmodel[r - 1].law.law)->bonds) continue;
+        return sx__fail(m, SX_EINVAL,
+                        "contact model: balls %lld and %lld are bonded but their contact-model row '%s' uses the %s "
+                        "model, which is not to be combined with bonds (seed 4.3.3)",
+                        (long long)m->balls.id[p->a[c]], (long long)m->balls.id[p->b[c]], m->cmodel[r - 1].mat.name,
+                        sx_law_name(m->cmodel[r - 1].law.law));
+    }
+    return SX_OK;
+}
