@@ -464,7 +464,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 if (track) o->slip += e;
                 for (int k = 0; k < RD; k++) mroll[k] = mr[k];
             }
-            double fd = fn, dsh[D];
+            double fd = fn, dsh[D] = {0}; /* set when shear_dashpot; zeroed for the compiler's flow analysis */
             bool shear_dashpot = false;
             if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
                 /* viscous dashpots at the critical-damping ratios on the reduced mass
