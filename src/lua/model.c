@@ -126,6 +126,7 @@ int sx_lua_model_new(lua_State *L)
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
+    u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
     const int self = lua_gettop(L);
     list_model(L, self);
     /* the executable's --threads N (seixo.threads); results do not depend on it */
