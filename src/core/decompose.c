@@ -73,6 +73,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     return SX_OK;
 }
 
+int sx_model_ranks(const sx_model *m) { return m->dd ? m->dd->x.ranks : 1; }
+
 /* First index c of sorted a[0..n) with a[c] >= key. */
 static int64_t first_at(const int32_t *a, int64_t n, int64_t key)
 {

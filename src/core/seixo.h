@@ -120,6 +120,8 @@ typedef struct sx_exchange {
 /// reason) for what is not decomposed yet: bonds, clumps, periodic space,
 /// meshes, energy tracking.
 SX_API sx_status sx_model_decompose(sx_model *m, const sx_exchange *x);
+/// The number of ranks m's cycles are decomposed over (1: not decomposed).
+SX_API int sx_model_ranks(const sx_model *m);
 
 /// Bytes currently allocated by the model.
 SX_API size_t sx_model_bytes(const sx_model *m);

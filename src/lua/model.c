@@ -455,6 +455,13 @@ static int model_hash(lua_State *L)
     return 1;
 }
 
+/* m:ranks() -> the number of MPI ranks its cycles are decomposed over (1: serial) */
+static int model_ranks(lua_State *L)
+{
+    lua_pushinteger(L, sx_model_ranks(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
 static int model_bytes(lua_State *L)
 {
     lua_pushinteger(L, (lua_Integer)sx_model_bytes(sx_lua_checkmodel(L, 1)));
@@ -563,6 +570,7 @@ const luaL_Reg sx_lua_model_methods[] = {
     {"ratio", model_ratio},
     {"energy", model_energy},
     {"hash", model_hash},
+    {"ranks", model_ranks},
     {"bytes", model_bytes},
     {"memory", model_memory},
     {"profile", model_profile},

@@ -6,7 +6,7 @@ local steps = tonumber(arg and arg[2]) or 3000
 local dim = tonumber(arg and arg[3]) or 3
 local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81}}
 m:material("glass", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.7, viscous_normal = 0.3})
-local width = dim == 3 and 0.1 or 0.5 * count / 600
+local width = dim == 3 and 0.085 or 0.5 * count / 600
 local height = dim == 3 and 0.2 or 0.4
 local walls
 if dim == 3 then
@@ -25,3 +25,5 @@ m:cycle(steps - half)
 print(string.format("end %d contacts %d floor %.17g ratio %.17g kinetic %.17g", m:step(), m:contact_count(),
                     floor.force[dim], m:ratio(), m:energy().kinetic))
 print(string.format("hash %s", m:hash()))
+-- (on stderr: the serial run's output must equal the decomposed runs')
+io.stderr:write(string.format("ranks %d\n", m:ranks()))
