@@ -56,6 +56,9 @@ extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, exec
 bool sx_lua_parallel_decompose(sx_model *m);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);
+/// parallel.c: this process's MPI rank (0 without MPI); every rank waits for all.
+int sx_lua_parallel_rank(void);
+void sx_lua_parallel_barrier(void);
 /// parallel.c: on ranks other than 0, print does nothing.
 void sx_lua_parallel_open(lua_State *L);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress

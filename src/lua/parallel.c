@@ -231,6 +231,15 @@ void sx_lua_parallel_fail(const char *message)
     exit(1);
 }
 
+int sx_lua_parallel_rank(void) { return world_rank; }
+
+void sx_lua_parallel_barrier(void)
+{
+#ifdef SX_HAVE_MPI
+    if (mpi_started) MPI_Barrier(MPI_COMM_WORLD);
+#endif
+}
+
 /* seixo.decompose([on]) -> whether models made from now on are decomposed */
 static int seixo_decompose(lua_State *L)
 {

@@ -3,7 +3,9 @@
 # and under mpirun -np 1, 2, 3, 4 (decomposed over the ranks), prints the
 # same state hashes, contact count, floor force, unbalanced-force ratio and
 # kinetic energy, to the bit; a 3D pour and a 2D one of 3,000 disks (several
-# chunks of the contact pass, twelve wall blocks). Skipped without mpirun.
+# chunks of the contact pass, twelve wall blocks). Then a pour saved with 3
+# ranks and loaded with 2 ranks, and serially, ends as the serial run does.
+# Skipped without mpirun.
 #   mpi_pour.sh SEIXO mpi_pour.lua
 set -u
 seixo=$1
@@ -40,5 +42,23 @@ for scene in "600 6000 3" "3000 4000 2"; do
       echo "-np $np differs:"; diff "$dir/serial" "$dir/out"; fail=1
     fi
   done
+done
+# a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit
+restart=$(dirname "$script")/mpi_restart.lua
+"$seixo" "$restart" save "$dir/serial.h5" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+echo "restart, serial:"; cat "$dir/serial"
+# shellcheck disable=SC2086
+mpirun $root --oversubscribe -np 3 "$seixo" "$restart" save "$dir/three.h5" >"$dir/saved" 2>"$dir/err" &&
+  grep -q "^ranks 3$" "$dir/err" || { echo "the save with 3 ranks failed:"; cat "$dir/err"; exit 1; }
+# shellcheck disable=SC2086
+mpirun $root --oversubscribe -np 2 "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded" 2>"$dir/err" &&
+  grep -q "^ranks 2$" "$dir/err" || { echo "the load with 2 ranks failed:"; cat "$dir/err"; exit 1; }
+"$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded1" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+for run in saved loaded loaded1; do
+  if cmp -s "$dir/serial" "$dir/$run"; then
+    echo "restart, $run: identical"
+  else
+    echo "restart, $run differs:"; diff "$dir/serial" "$dir/$run"; fail=1
+  fi
 done
 exit $fail
