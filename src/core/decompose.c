@@ -129,7 +129,7 @@ void sx__dd_plan(sx_model *m)
          * (a block's lanes as in the serial pass), so their ghosts too */
         sx_span *run = &d->wrun[r];
         run->lo = bl, run->hi = wb->hi;
-        if (run->hi < m->nblock && m->blocks[run->hi].b0 < own->hi) run->hi++;
+        if (own->hi > own->lo && run->hi < m->nblock && m->blocks[run->hi].b0 < own->hi) run->hi++;
         int64_t lo = lo_a;
         if (run->hi > run->lo && m->blocks[run->lo].b0 < lo) lo = m->blocks[run->lo].b0;
         if (run->hi > run->lo && m->blocks[run->hi - 1].b1 > hi) hi = m->blocks[run->hi - 1].b1;
