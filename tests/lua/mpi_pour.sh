@@ -4,7 +4,8 @@
 # same state hashes, contact count, floor force, unbalanced-force ratio and
 # kinetic energy, to the bit; a 3D pour and a 2D one of 3,000 disks (several
 # chunks of the contact pass, twelve wall blocks). Then a pour saved with 3
-# ranks and loaded with 2 ranks, and serially, ends as the serial run does.
+# ranks and loaded with 2 ranks, and serially, ends as the serial run does;
+# and a servo-controlled lid moves alike with 2 and 3 ranks.
 # Skipped without mpirun.
 #   mpi_pour.sh SEIXO mpi_pour.lua
 set -u
@@ -42,6 +43,19 @@ for scene in "600 6000 3" "3000 4000 2"; do
       echo "-np $np differs:"; diff "$dir/serial" "$dir/out"; fail=1
     fi
   done
+done
+# a servo-controlled lid (a wall force summed over the ranks' blocks drives it)
+servo=$(dirname "$script")/mpi_servo.lua
+"$seixo" "$servo" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+echo "servo, serial:"; cat "$dir/serial"
+for np in 2 3; do
+  # shellcheck disable=SC2086
+  if mpirun $root --oversubscribe -np "$np" "$seixo" "$servo" >"$dir/out" 2>"$dir/err" &&
+     grep -q "^ranks $np$" "$dir/err" && cmp -s "$dir/serial" "$dir/out"; then
+    echo "servo, -np $np: identical"
+  else
+    echo "servo, -np $np differs or failed:"; cat "$dir/out" "$dir/err"; fail=1
+  fi
 done
 # a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit
 restart=$(dirname "$script")/mpi_restart.lua
