@@ -605,6 +605,9 @@ end
 local function calibrate(lab, helpers, opts)
   local o = check_options(lab, opts)
   o.gnuplot, o.write_file = helpers.gnuplot, helpers.write_file
+  -- over MPI ranks every rank runs specimens of its own, not one model
+  -- decomposed: the models made from here on are each rank's (seixo.decompose)
+  if seixo.ranks() > 1 then seixo.decompose(false) end
   if seixo.rank() > 0 then return serve_rank(o) end
 
   -- a worker process started for one run of this calibration

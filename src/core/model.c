@@ -90,6 +90,7 @@ void sx_model_destroy(sx_model *m)
     sx__bonds_free(m);
     sx__clumps_free(m);
     sx__cell_free(m);
+    sx__dd_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
@@ -465,7 +466,13 @@ static sx_status next_timestep(sx_model *m, double *dt)
     if (m->dt_user > 0) {
         *dt = m->dt_user;
     } else if (m->dt_stale || m->step % DT_REFRESH_STEPS == 0 || !(m->dt > 0)) {
-        const double crit = kernels(m)->critical_dt(m);
+        double crit = kernels(m)->critical_dt(m);
+        if (m->dd && m->dd->active) { /* each rank rates its own balls: the smallest of all (exact) */
+            crit = -crit;
+            if (!m->dd->x.max(m->dd->x.ud, &crit))
+                return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
+            crit = -crit;
+        }
         if (!isfinite(crit))
             return sx__fail(m, SX_EINVAL,
                             "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
@@ -634,6 +641,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
     if (st) return st;
     if ((st = update_timestep(m))) return st;
     const sx_kernels *k = kernels(m);
+    if (m->dd && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
+    sx_dd *dd = m->dd;
     m->locked = true;
     /* the energy baseline is taken when the user has changed the system, not
      * at every call: a script cycling one step at a time is guarded too */
@@ -650,7 +659,12 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         }
         if (m->build_needed) {
             if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
+            if (dd && !sx__dd_gather(m)) { /* the serial build, on every rank, from the whole state */
+                st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+                break;
+            }
             const bool ok = k->build(m);
+            if (ok && dd) sx__dd_plan(m); /* the new slabs: balls migrate */
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (!ok) {
                 st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
@@ -661,6 +675,10 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         double t1 = now();
         other += t1 - t;
         if (st) break;
+        if (dd && !sx__dd_halo(m)) {
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange ghosts");
+            break;
+        }
         st = k->contacts(m);
         t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
         if (st) break;
@@ -669,6 +687,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
+        if (!st && dd && !dd->x.max(dd->x.ud, &max_disp)) /* every rank decides the same rebuild */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
         if (!st && m->clumps) st = sx__clumps_step(m, &max_disp); /* clumps.c: the bodies move their pebbles */
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
@@ -685,12 +705,20 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
         /* a ghost moves with its owner and with the cell vectors that shift it */
         if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
-        if (m->step % GUARD_STEPS == 0) st = guard_check(m);
+        if (m->step % GUARD_STEPS == 0) {
+            if (dd && m->guard_on && !sx__dd_gather(m)) /* the guard's energy is the whole model's */
+                st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+            if (!st) st = guard_check(m);
+        }
         other += now() - t;
         if (st) break;
     }
     m->prof.seconds[SX_STAGE_OTHER] += other;
     m->locked = false;
+    /* the whole state on every rank again (after an error the ranks are
+     * out of step: the caller stops them all) */
+    if (dd && !st) st = sx__dd_end(m, k->plan);
+    if (dd) dd->active = false;
     return st;
 }
 

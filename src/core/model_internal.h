@@ -290,6 +290,19 @@ typedef struct sx_cell {
     int8_t *image;          /* the cell vectors it is shifted by, 3 per ghost (-1, 0, 1) */
 } sx_cell;
 
+/* Domain decomposition (decompose.c; docs/developer.md). Between cycles
+ * every rank holds the whole model, identical; inside a cycle rank r
+ * integrates the balls own[r] (dense indices: slabs of the cell order),
+ * keeps the balls need[2r], need[2r + 1] below and above them current as
+ * ghosts, evaluates the ball-ball pairs pairs[r] (those of its balls and
+ * of its ghosts, in the serial order) and completes the wall blocks
+ * wblk[r]. Every ball's sums thus run in the serial run's order. */
+typedef struct sx_dd {
+    sx_exchange x;
+    bool active;            /* inside a decomposed cycle: the plan below holds */
+    sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: 2 per rank) */
+} sx_dd;
+
 struct sx_model {
     int dim, rdim;
     double gravity[3];
@@ -352,6 +365,7 @@ struct sx_model {
     int ncmodel, cap_cmodel;
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
     sx_cell *cell;            /* periodic space (periodic.c); NULL while the space is not periodic */
+    sx_dd *dd;                /* domain decomposition (decompose.c); NULL in a serial run */
 };
 
 /* Ball i's local damping: its own, or its material's. */
@@ -478,6 +492,17 @@ sx_status sx__bonds_reserve_pairs(sx_model *m); /* allocates pairs.bond when bon
 /* Re-expresses a bond's vectors for the reversed pair orientation (b -> a). */
 void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
+/* domain decomposition (decompose.c): the checks and plan of a cycle's
+ * start, the plan after a build, the ghosts' refresh, the whole state on
+ * every rank (false: the exchange failed), the wall blocks' sums, and the
+ * end of a cycle (the whole state, then replan: the serial chunk plan) */
+void sx__dd_free(sx_model *m);
+sx_status sx__dd_begin(sx_model *m);
+void sx__dd_plan(sx_model *m);
+bool sx__dd_halo(sx_model *m);
+bool sx__dd_gather(sx_model *m);
+bool sx__dd_walls(sx_model *m);
+sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
 /* Law of a contact of materials ma and mb, from the materials as they are

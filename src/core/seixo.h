@@ -92,6 +92,37 @@ SX_API double sx_model_unbalanced_ratio(const sx_model *m);
 /// hashes mean states that continue bit-identically. Queries leave it as it is.
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
 
+/// Domain decomposition (issue 16; docs/developer.md, "MPI domain
+/// decomposition"). The core makes no MPI call: whoever runs the ranks
+/// fills this table, and every rank holds the same model between cycles.
+/// A span is a range [lo, hi) of a dense array.
+typedef struct sx_span {
+    int64_t lo, hi;
+} sx_span;
+typedef struct sx_exchange {
+    int rank, ranks;        ///< this process and their number (>= 1)
+    void *ud;               ///< passed to the functions
+    /// Rank r holds elements own[r] of an array of `size`-byte elements
+    /// (the same address range on every rank) and needs need[r * per + k],
+    /// k < per: every rank sends what it holds of the others' needs and
+    /// receives what it needs into data. False on failure.
+    bool (*share)(void *ud, void *data, size_t size, const sx_span *own, const sx_span *need, int per);
+    /// *v becomes the largest *v of all ranks. False on failure.
+    bool (*max)(void *ud, double *v);
+    /// True when every rank passed the same value.
+    bool (*agree)(void *ud, uint64_t v);
+} sx_exchange;
+
+/// Cycles of m run decomposed over x's ranks (NULL: not decomposed): each
+/// rank integrates a slab of the balls, balanced by count, with ghost
+/// copies of its neighbours' balls; every cycle ends with the whole state
+/// on every rank, bit-identical to a serial run's. SX_EINVAL (with the
+/// reason) for what is not decomposed yet: bonds, clumps, periodic space,
+/// meshes, energy tracking.
+SX_API sx_status sx_model_decompose(sx_model *m, const sx_exchange *x);
+/// The number of ranks m's cycles are decomposed over (1: not decomposed).
+SX_API int sx_model_ranks(const sx_model *m);
+
 /// Bytes currently allocated by the model.
 SX_API size_t sx_model_bytes(const sx_model *m);
 

@@ -51,7 +51,16 @@ int sx_lua_ball_disp(lua_State *L, const sx_model *m, int64_t id);
 
 /* Functions of the seixo table beside the loader's own. */
 extern const luaL_Reg sx_lua_optimize_functions[];  ///< optimize.c: seixo.optimize
-extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, executable, rank, ranks, send, receive
+extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, executable, rank, ranks, send, receive, decompose
+/// parallel.c: decomposes m over the MPI ranks when MPI runs and seixo.decompose is on; true if it did.
+bool sx_lua_parallel_decompose(sx_model *m);
+/// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
+_Noreturn void sx_lua_parallel_fail(const char *message);
+/// parallel.c: this process's MPI rank (0 without MPI); every rank waits for all.
+int sx_lua_parallel_rank(void);
+void sx_lua_parallel_barrier(void);
+/// parallel.c: on ranks other than 0, print does nothing.
+void sx_lua_parallel_open(lua_State *L);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.
 void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);
@@ -76,6 +85,7 @@ typedef struct sx_lua_model {
     int callback;          ///< depth of user callbacks being run (removals are queued while > 0)
     double overlap_limit;  ///< seixo.model{overlap_limit}: the largest overlap placed, a fraction of the radius
     bool unchecked;        ///< a ball or wall was added since the last placement check (geometry.c)
+    bool decomposed;       ///< its cycles run decomposed over the MPI ranks (parallel.c)
 } sx_lua_model;
 
 /// seixo.models() -> {model, ...}: the open models, in order of creation.

@@ -126,6 +126,7 @@ int sx_lua_model_new(lua_State *L)
     char err[256];
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
+    u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
     const int self = lua_gettop(L);
     list_model(L, self);
     /* the executable's --threads N (seixo.threads); results do not depend on it */
@@ -577,6 +578,13 @@ static int model_hash(lua_State *L)
     return 1;
 }
 
+/* m:ranks() -> the number of MPI ranks its cycles are decomposed over (1: serial) */
+static int model_ranks(lua_State *L)
+{
+    lua_pushinteger(L, sx_model_ranks(sx_lua_checkmodel(L, 1)));
+    return 1;
+}
+
 static int model_bytes(lua_State *L)
 {
     lua_pushinteger(L, (lua_Integer)sx_model_bytes(sx_lua_checkmodel(L, 1)));
@@ -687,6 +695,7 @@ const luaL_Reg sx_lua_model_methods[] = {
     {"ratio", model_ratio},
     {"energy", model_energy},
     {"hash", model_hash},
+    {"ranks", model_ranks},
     {"bytes", model_bytes},
     {"memory", model_memory},
     {"profile", model_profile},

@@ -15,6 +15,8 @@
 #include "bindings.h"
 #include "seixo_lua.h"
 
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -143,8 +145,127 @@ static int seixo_receive(lua_State *L)
 #endif
 }
 
+/* ------------------------------------------------- domain decomposition */
+
+/* The models made while this is on run their cycles decomposed over the
+ * ranks (seixo.decompose; lab.calibrate turns it off: its ranks run
+ * models of their own). */
+static bool decompose_on = true;
+
+#ifdef SX_HAVE_MPI
+enum { SHARE_TAG = 8 };
+
+/* What rank `from` holds of span `want`: their intersection (may be empty). */
+static sx_span meet(sx_span held, sx_span want)
+{
+    sx_span s = {held.lo > want.lo ? held.lo : want.lo, held.hi < want.hi ? held.hi : want.hi};
+    if (s.hi < s.lo) s.hi = s.lo;
+    return s;
+}
+
+/* sx_exchange.share over MPI: nonblocking sends of what this rank holds of
+ * each other rank's needs, receives of what it needs from each holder,
+ * straight into the array (the spans of one call never overlap). */
+static bool mpi_share(void *ud, void *data, size_t size, const sx_span *own, const sx_span *need, int per)
+{
+    (void)ud;
+    const int R = world_size, me = world_rank;
+    MPI_Request *req = malloc((size_t)(2 * R * per) * sizeof *req);
+    if (!req) return false;
+    int nreq = 0;
+    bool ok = true;
+    char *base = data;
+    for (int r = 0; r < R && ok; r++) {
+        if (r == me) continue;
+        for (int k = 0; k < per && ok; k++) {
+            const sx_span out = meet(own[me], need[r * per + k]), in = meet(own[r], need[me * per + k]);
+            const size_t nout = (size_t)(out.hi - out.lo) * size, nin = (size_t)(in.hi - in.lo) * size;
+            if (nout > INT_MAX || nin > INT_MAX) ok = false; /* a message of more than 2 GB: not yet */
+            if (ok && nout)
+                MPI_Isend(base + (size_t)out.lo * size, (int)nout, MPI_BYTE, r, SHARE_TAG + k, MPI_COMM_WORLD,
+                          &req[nreq++]);
+            if (ok && nin)
+                MPI_Irecv(base + (size_t)in.lo * size, (int)nin, MPI_BYTE, r, SHARE_TAG + k, MPI_COMM_WORLD,
+                          &req[nreq++]);
+        }
+    }
+    ok = MPI_Waitall(nreq, req, MPI_STATUSES_IGNORE) == MPI_SUCCESS && ok;
+    free(req);
+    return ok;
+}
+
+static bool mpi_max(void *ud, double *v)
+{
+    (void)ud;
+    return MPI_Allreduce(MPI_IN_PLACE, v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD) == MPI_SUCCESS;
+}
+
+static bool mpi_agree(void *ud, uint64_t v)
+{
+    (void)ud;
+    uint64_t lo = v, hi = v;
+    return MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD) == MPI_SUCCESS &&
+           MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD) == MPI_SUCCESS && lo == hi;
+}
+#endif
+
+bool sx_lua_parallel_decompose(sx_model *m)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || !decompose_on) return false;
+    const sx_exchange x = {world_rank, world_size, NULL, mpi_share, mpi_max, mpi_agree};
+    return sx_model_decompose(m, &x) == SX_OK;
+#else
+    (void)m;
+    return false;
+#endif
+}
+
+void sx_lua_parallel_fail(const char *message)
+{
+    fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
+    fflush(stderr);
+#ifdef SX_HAVE_MPI
+    if (mpi_started) MPI_Abort(MPI_COMM_WORLD, 1);
+#endif
+    exit(1);
+}
+
+int sx_lua_parallel_rank(void) { return world_rank; }
+
+void sx_lua_parallel_barrier(void)
+{
+#ifdef SX_HAVE_MPI
+    if (mpi_started) MPI_Barrier(MPI_COMM_WORLD);
+#endif
+}
+
+/* seixo.decompose([on]) -> whether models made from now on are decomposed */
+static int seixo_decompose(lua_State *L)
+{
+    if (!lua_isnoneornil(L, 1)) {
+        luaL_checktype(L, 1, LUA_TBOOLEAN);
+        decompose_on = lua_toboolean(L, 1);
+    }
+    lua_pushboolean(L, decompose_on);
+    return 1;
+}
+
+static int quiet_print(lua_State *L)
+{
+    (void)L;
+    return 0;
+}
+
+void sx_lua_parallel_open(lua_State *L)
+{
+    /* one rank prints: the others would repeat every line */
+    if (world_rank > 0) lua_register(L, "print", quiet_print);
+}
+
 const luaL_Reg sx_lua_parallel_functions[] = {
     {"cores", seixo_cores}, {"executable", seixo_executable}, {"rank", seixo_rank},
     {"ranks", seixo_ranks}, {"send", seixo_send},             {"receive", seixo_receive},
+    {"decompose", seixo_decompose},
     {NULL, NULL},
 };

@@ -257,6 +257,11 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
 {
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle(r->m, n);
+    if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s: %s", r->what, sx_lua_core_message(sx_model_error(r->m)));
+        sx_lua_parallel_fail(msg);
+    }
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);
     /* the first step since balls or walls were placed (run_model takes it alone) */
     if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
@@ -541,7 +546,8 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = steps_to_time(m, lim->time, taken);
             if (k < n) n = k;
         }
-        if (p->mode && p->chunk < n) n = p->chunk;
+        /* (a chunk of 0.1 s of cycling differs between ranks, which must cut their cycles alike) */
+        if (p->mode && p->chunk < n && !r->ud->decomposed) n = p->chunk;
         /* a placement check follows the first step; contact and region events are per step */
         if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         sx_lua_run_cycle(L, r, n);

@@ -88,4 +88,5 @@ void sx_lua_open(lua_State *L)
     lua_pop(L, 1);
     luaL_requiref(L, "seixo", luaopen_seixo, 1);
     lua_pop(L, 1);
+    sx_lua_parallel_open(L);
 }

@@ -111,7 +111,7 @@ E("m:contact_models", function(c) return method(c.m, "contact_models") end)
 E("m:summary", function(c) return method(c.m, "summary") end)
 E("m:close", function(c) return method(c.m, "close") end)
 for _, name in ipairs({"dim", "time", "step", "timestep", "critical_timestep", "gravity", "ratio", "energy",
-                       "contact_count", "hash", "bytes", "memory"}) do
+                       "contact_count", "hash", "ranks", "bytes", "memory"}) do
   E("m:" .. name, function(c) return method(c.m, name) end)
 end
 E("m:set_timestep", function(c) return method(c.m, "set_timestep", 2e-5) end)
@@ -302,6 +302,7 @@ end)
 E("seixo.cores", function() return fn(seixo.cores) end)
 E("seixo.executable", function() return fn(seixo.executable) end)
 E("seixo.rank", function() return fn(seixo.rank) end)
+E("seixo.decompose", function() return fn(seixo.decompose, true) end)
 E("seixo.send", function() return fn(seixo.send, 0, "text") end)
 E("m:reset_disp", function(c) return method(c.m, "reset_disp", {group = "top"}) end)
 E("b.disp", function(c)

@@ -190,8 +190,21 @@ SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     const int64_t nb = m->nblock;
+    if (m->dd && m->dd->active) { /* decomposed: this rank's own balls of each block */
+        const sx_span own = m->dd->own[m->dd->x.rank];
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
-    for (int64_t b = 0; b < nb; b++) integrate_block(m, &m->blocks[b]);
+        for (int64_t b = 0; b < nb; b++) {
+            sx_block *o = &m->blocks[b], part = *o;
+            part.b0 = o->b0 > own.lo ? o->b0 : own.lo;
+            part.b1 = o->b1 < own.hi ? o->b1 : own.hi;
+            part.worst = 0, part.bad = -1;
+            if (part.b1 > part.b0) integrate_block(m, &part);
+            o->worst = part.worst, o->bad = part.bad;
+        }
+    } else {
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
+        for (int64_t b = 0; b < nb; b++) integrate_block(m, &m->blocks[b]);
+    }
     double worst = 0;
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];

@@ -31,8 +31,11 @@ static double KERNEL(critical_dt)(sx_model *m)
     if (!kt) return INFINITY;
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
     memset(kt, 0, (size_t)(4 * n) * sizeof(double));
+    /* decomposed: this rank's balls, summed over their pairs in the serial order (decompose.c) */
+    const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
-    for (int64_t c = 0; c < p->n; c++) {
+    const int64_t c0 = dd ? dd->pairs[dd->x.rank].lo : 0, c1 = dd ? dd->pairs[dd->x.rank].hi : p->n;
+    for (int64_t c = c0; c < c1; c++) {
         const int64_t i = p->a[c], j = p->b[c];
         const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
         double dx[D];
@@ -69,7 +72,8 @@ static double KERNEL(critical_dt)(sx_model *m)
         kr[jo] += krot_j;
     }
     p = &m->bw;
-    for (int64_t c = 0; c < p->n; c++) {
+    const int64_t w0 = dd ? dd->bw_own[dd->x.rank].lo : 0, w1 = dd ? dd->bw_own[dd->x.rank].hi : p->n;
+    for (int64_t c = w0; c < w1; c++) {
         const int64_t i = p->a[c];
         double nrm[D];
         /* a mesh's contacts as the last step kept them (a shadowed facet adds no stiffness) */
@@ -91,7 +95,8 @@ static double KERNEL(critical_dt)(sx_model *m)
         kr[i] += ks * B->rad[i] * B->rad[i] * (law.mu_r > 0 ? 2 : 1); /* with the rolling spring ks R^2 */
     }
     double best = INFINITY;
-    for (int64_t i = 0; i < n; i++) {
+    const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : n;
+    for (int64_t i = i0; i < i1; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
         const double r = B->rad[i];
         double kn, ks;

@@ -473,8 +473,16 @@ static sx_status KERNEL(walls)(sx_model *m)
         m->wall_acc = q;
         m->cap_wall_acc = nb * nw;
     }
-#pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
-    for (int64_t b = 0; b < nb; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
+    /* decomposed: this rank runs the blocks with a ball of its own, then
+     * every rank has the sums of every block from the rank owning its last
+     * ball (decompose.c) */
+    const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
+    const int64_t b_lo = dd ? dd->wrun[dd->x.rank].lo : 0, b_hi = dd ? dd->wrun[dd->x.rank].hi : nb;
+    for (int64_t b = 0; dd && b < nb; b++)
+        if (b < b_lo || b >= b_hi) m->blocks[b].st = SX_OK, m->blocks[b].slip = m->blocks[b].viscous = 0;
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (b_hi - b_lo > 1)
+    for (int64_t b = b_lo; b < b_hi; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
+    if (dd && !sx__dd_walls(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     for (int64_t w = 0; w < nw; w++) {
         sx_wall *wl = &m->walls[w];
         memset(wl->force, 0, sizeof wl->force);
