@@ -302,13 +302,14 @@ static int model_material(lua_State *L)
         sx_lua_optnumfield(L, 3, "viscous_normal", &d.viscous_normal);
         sx_lua_optnumfield(L, 3, "viscous_shear", &d.viscous_shear);
         sx_lua_material_extras(L, 3, &d, &has_bpm, &bpm);
-        sx_lua_check_range(L, 1, "density", d.density, 100, 3e4, "kg/m^3");
-        sx_lua_check_range(L, 1, "modulus", d.modulus, 1e5, 1e12, "Pa");
-        sx_lua_check_range(L, 1, "shear_modulus", d.shear_modulus, 1e5, 1e12, "Pa");
     }
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");
     if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm), "m:material");
+    /* only a value the core accepted can be unusual: an invalid one has had its error */
+    sx_lua_check_range(L, 1, "density", d.density, 100, 3e4, "kg/m^3");
+    sx_lua_check_range(L, 1, "modulus", d.modulus, 1e5, 1e12, "Pa");
+    sx_lua_check_range(L, 1, "shear_modulus", d.shear_modulus, 1e5, 1e12, "Pa");
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
 }

@@ -251,6 +251,32 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("an invalid value is an error with no range warning before it; a valid, unusual one warns", function()
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 3}
+print(pcall(m.material, m, "a", {density = -1}))
+print(pcall(m.material, m, "b", {modulus = -5}))
+print(pcall(m.material, m, "c", {density = 2.5, kn = -1}))
+print(pcall(m.material, m, "d", {shear_modulus = 0/0, modulus = 1e9}))
+w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+print(pcall(w.servo, w, {target = 0/0, area = 1}))
+print(pcall(w.servo, w, {target = 10, area = -1}))
+print("valid")
+m:material("e", {density = 2.5})
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("density must be > 0 kg/m^3 (got -1)", 1, true), out)
+  check(out:find("modulus must be >= 0 Pa", 1, true), out)
+  check(out:find("kn must be > 0 N/m (got -1)", 1, true), out)
+  check(out:find("w:servo: the target stress must be finite", 1, true), out)
+  check(out:find("w:servo: the area must be > 0 (got -1)", 1, true), out)
+  -- no warning before "valid": the invalid values only failed (material c's density 2.5 included)
+  local before = out:sub(1, out:find("valid", 1, true))
+  check(not before:find("warning", 1, true), out)
+  check(out:find("valid\nseixo: warning: (command line):10: density 2.5 is outside the range", 1, true), out)
+  check(out:find("done\n$"), out)
+end)
+
 test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API", function()
   local v, w = seixo.vec(1, 2, 3), seixo.vec{0, 1, 0}
   eq(tostring(v + w), "{1.0, 3.0, 3.0}")
