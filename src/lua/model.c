@@ -447,10 +447,15 @@ static int model_energy(lua_State *L)
     return 1;
 }
 
+/* The core's state hash, with the group slots 2 and up (Lua state that a
+ * restart restores) folded in when a ball has one. */
 static int model_hash(lua_State *L)
 {
     char hex[17];
-    snprintf(hex, sizeof hex, "%016" PRIx64, sx_model_state_hash(sx_lua_checkmodel(L, 1)));
+    uint64_t h = sx_model_state_hash(sx_lua_checkmodel(L, 1));
+    const uint64_t slots = sx_lua_slots_digest(L, 1);
+    if (slots) h = (h ^ slots) * 0x9e3779b97f4a7c15u + 1;
+    snprintf(hex, sizeof hex, "%016" PRIx64, h);
     lua_pushstring(L, hex);
     return 1;
 }
