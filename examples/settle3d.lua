@@ -40,3 +40,9 @@ print(string.format("settle3d: stopped on %s after %d steps, %.2f s: %.0f steps/
                     why, m:step(), elapsed, m:step() / elapsed, n * m:step() / elapsed))
 print(string.format("settle3d: bed height %.4f m, floor load %.4g N for a weight of %.4g N",
                     m:max("pos")[3], -floor.force[3], m:sum("mass") * 9.81))
+-- at rest the walls together carry the weight; the side walls' friction may
+-- point down (locked in when the bed rebounded), so the floor can carry more
+local sides = 0
+for k = 1, 4 do sides = sides - walls[k].force[3] end
+print(string.format("settle3d: the walls carry %.5g N (floor %.5g N, side walls %.3g N) for a weight of %.5g N",
+                    -floor.force[3] + sides - walls[6].force[3], -floor.force[3], sides, m:sum("mass") * 9.81))
