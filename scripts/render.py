@@ -8,7 +8,7 @@ lines and the cracks (the bonds broken so far) as points, red in tension and
 blue in shear. SNAPSHOT is an index into the series, negative from the end
 (default -1, the last). The blocks are picked by their names in the .xmf
 (balls, walls, bonds, cracks) through ParaView's "XDMF Reader" (XdmfReader),
-which keeps the names (suffixed "[k]" when a name repeats in the file) and
+which keeps the names (each block a temporal collection of the .xmf) and
 finds the .h5 beside an .xmf given by a bare file name. The Xdmf3 readers
 do neither: "Xdmf3 Reader (Top Level Partition)", the one OpenDataFile
 picks, makes every snapshot one dataset of unnamed pieces, and both Xdmf3
