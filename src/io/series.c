@@ -174,7 +174,6 @@ static void xdoc_free(xdoc *d)
     free(d->out.p);
 }
 
-
 static void xml_escaped(buf *b, const char *s)
 {
     for (; *s; s++) {
