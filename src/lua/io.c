@@ -145,7 +145,8 @@ static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char 
                 lua_pop(L, 1);
                 n.kind = SX_IO_TABLE;
                 const int64_t me = add(s, &n);
-                if (me >= 0) ser_table(L, s, val, me, p);
+                /* a field vector (b.pos) is saved as its components */
+                if (me >= 0) ser_table(L, s, sx_lua_vec_array(L, val), me, p);
                 break;
             default: skip(L, s, p, luaL_typename(L, val)); break;
             }

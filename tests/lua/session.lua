@@ -332,6 +332,15 @@ test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API",
   eq(tostring(p - seixo.vec(5, 1, 2.5)), "{0.0, 0.0, 0.0}")
   local b2 = m:ball{pos = p + seixo.vec(1, 0, 0), radius = 0.1}
   eq(tostring(b2.pos), "{6.0, 1.0, 2.5}")
+  -- kept in m:vars(), it is saved as its components
+  m:vars().where = b.pos
+  local file = os.tmpname() .. ".h5"
+  eq(#m:save(file), 0, "nothing skipped")
+  local loaded = seixo.load(file)
+  eq(loaded:vars().where[1], 5.0)
+  eq(#loaded:vars().where, 3)
+  loaded:close()
+  os.remove(file)
   m:close()
 end)
 
