@@ -7,9 +7,12 @@ radius coloured by speed, the walls as translucent surfaces, the bonds as
 lines and the cracks (the bonds broken so far) as points, red in tension and
 blue in shear. SNAPSHOT is an index into the series, negative from the end
 (default -1, the last). The blocks are picked by their names in the .xmf
-(balls, walls, bonds, cracks), which the Xdmf3ReaderT reader keeps; the
-path is made absolute first, as ParaView's Xdmf3 readers cannot find the
-.h5 of an .xmf given as a bare file name."""
+(balls, walls, bonds, cracks) through ParaView's "XDMF Reader" (XdmfReader),
+which keeps the names (each block a temporal collection of the .xmf) and
+finds the .h5 beside an .xmf given by a bare file name. The Xdmf3 readers
+do neither: "Xdmf3 Reader (Top Level Partition)", the one OpenDataFile
+picks, makes every snapshot one dataset of unnamed pieces, and both Xdmf3
+readers look for the .h5 of a bare "series.xmf" at "series.xmfseries.h5"."""
 import os
 import sys
 
@@ -44,9 +47,9 @@ def main():
     if len(sys.argv) < 3:
         print("usage: pvbatch render.py SERIES.xmf OUT.png [SNAPSHOT]")
         sys.exit(2)
-    xmf, png = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    xmf, png = sys.argv[1], os.path.abspath(sys.argv[2])  # the reader finds the .h5 by a bare name too
     which = int(sys.argv[3]) if len(sys.argv) > 3 else -1
-    reader = Xdmf3ReaderT(FileName=[xmf])
+    reader = XDMFReader(FileNames=[xmf])
     times = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
     if not -len(times) <= which < len(times):
         print("render: the series has %d snapshots, no snapshot %d" % (len(times), which))

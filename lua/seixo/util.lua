@@ -5,10 +5,19 @@
 
 local util = {}
 
+-- A vector read from an object's field (b.pos) keeps its components in an
+-- inner vector, read through metamethods: the checks read that plain copy.
+local function plain(v)
+  local mt = getmetatable(v)
+  if type(mt) == "table" and rawget(mt, "__name") == "seixo.fieldvec" then return v:copy() end
+  return v
+end
+
 -- The checks raise at `level` (default 3: the caller of the util function
 -- that called them), so the message points at the user's script.
 local function check_vec(v, name, fn, level)
   level = level or 3
+  v = plain(v)
   if type(v) ~= "table" or rawlen(v) ~= 2 and rawlen(v) ~= 3 then
     error(string.format("bad argument '%s' to 'util.%s' (vector of 2 or 3 numbers expected, got %s)",
                         name, fn, type(v) == "table" and rawlen(v) .. " components" or type(v)), level)
@@ -24,6 +33,7 @@ end
 local function check_pair(a, b, fn)
   check_vec(a, "a", fn, 4)
   check_vec(b, "b", fn, 4)
+  a, b = plain(a), plain(b)
   if rawlen(a) ~= rawlen(b) then
     error(string.format("bad arguments to 'util.%s' (vectors of %d and %d components)", fn, rawlen(a), rawlen(b)), 3)
   end

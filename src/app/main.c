@@ -64,6 +64,9 @@ static void usage(FILE *out)
 {
     fprintf(out,
             "usage: %s [options] [script [args]]\n"
+            "       %s render SERIES.xmf OUT.png [SNAPSHOT]\n"
+            "                 draw a snapshot of an output series to a PNG through\n"
+            "                 ParaView (pvbatch), headless (scripts/render)\n"
             "  -e stat        run the Lua chunk 'stat' (may be repeated)\n"
             "  -i             enter the interactive mode after the script\n"
             "  -t             show a traceback with each error\n"
@@ -78,7 +81,7 @@ static void usage(FILE *out)
             "With no script and no -e, seixo starts the interactive mode.\n"
             "Environment: SEIXO_LUA_PATH (the directory of the Lua library),\n"
             "SEIXO_HISTORY (the REPL's history file; empty: none).\n",
-            progname);
+            progname, progname);
 }
 
 static void message(const char *msg)
@@ -998,9 +1001,51 @@ static enum parsed parse(int argc, char **argv, options *o)
     return RUN;
 }
 
+/* `seixo render ...`: scripts/render, found like the Lua library: beside
+ * the executable's directory (a build directory in the source tree), in
+ * the installed share/seixo, else in the source tree it was built from.
+ * Returns only when it cannot run it. */
+static int run_render(int argc, char **argv)
+{
+    char exe[4096], path[4200];
+    const char *dirs[3] = {NULL, NULL, NULL};
+    char rel[2][4200];
+    const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n > 0) {
+        exe[n] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash) *slash = 0;
+        snprintf(rel[0], sizeof rel[0], "%s/../scripts", exe);
+        snprintf(rel[1], sizeof rel[1], "%s/../share/seixo", exe);
+        dirs[0] = rel[0], dirs[1] = rel[1];
+    }
+#ifdef SX_SCRIPTS_DIR
+    dirs[2] = SX_SCRIPTS_DIR;
+#endif
+    for (int i = 0; i < 3; i++) {
+        if (!dirs[i]) continue;
+        snprintf(path, sizeof path, "%s/render", dirs[i]);
+        if (access(path, R_OK) != 0) continue;
+        char **args = calloc((size_t)argc + 2, sizeof *args);
+        if (!args) break;
+        args[0] = "sh";
+        setenv("SEIXO_RENDER_NAME", "seixo render", 1);
+        args[1] = path;
+        for (int k = 2; k < argc; k++) args[k] = argv[k];
+        execv("/bin/sh", args);
+        fprintf(stderr, "%s render: cannot run /bin/sh %s: %s\n", progname, path, strerror(errno));
+        free(args);
+        return EXIT_FAILURE;
+    }
+    fprintf(stderr, "%s render: the render script (scripts/render, installed in share/seixo) was not found\n", progname);
+    return EXIT_FAILURE;
+}
+
 int main(int argc, char **argv)
 {
     options o = {0};
+    /* a subcommand, before MPI or Lua: ./render runs a script named render */
+    if (argc > 1 && strcmp(argv[1], "render") == 0) return run_render(argc, argv);
     sx_lua_parallel_start(&argc, &argv);  // MPI_Init under mpirun, before anything reads argv
     switch (parse(argc, argv, &o)) {
     case DONE: sx_lua_parallel_stop(1); return EXIT_SUCCESS;

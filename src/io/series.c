@@ -43,6 +43,19 @@ typedef struct buf {
     bool oom;
 } buf;
 
+/* The XDMF's blocks: one temporal collection each, so that a reader shows
+ * each block under its own name at every time (ParaView's XDMF Reader
+ * suffixes "[k]" to a name that repeats, as the grids of one spatial
+ * collection per snapshot did). */
+enum { K_BALLS, K_CONTACTS, K_WALL_CONTACTS, K_BONDS, K_CRACKS, K_WALLS, K_MESHES, NKINDS };
+static const char *const kind_names[NKINDS] = {"balls", "contacts", "wall_contacts", "bonds", "cracks", "walls", "meshes"};
+
+/* The XDMF in memory: each block's grids so far, and the whole text. */
+typedef struct xdoc {
+    buf kind[NKINDS];
+    buf out;
+} xdoc;
+
 /* A history the file holds: its complete rows and their last step. */
 typedef struct held {
     char *name;
@@ -58,7 +71,7 @@ struct sx_series {
     unsigned fields;
     int compression;
     int64_t count;    /* complete snapshots */
-    buf xbody;        /* the XDMF without its closing tags: header and one grid per complete snapshot */
+    xdoc x;           /* the XDMF: a grid per block and complete snapshot */
     held *held;       /* histories met so far */
     int nheld, capheld;
 };
@@ -135,14 +148,30 @@ typedef struct snap {
     bool clumps; /* the balls carry their clump ids (pebbles of a clump, 0 for free balls) */
 } snap;
 
-static const char xmf_trailer[] = "  </Grid>\n </Domain>\n</Xdmf>\n";
-
-static void xmf_header(buf *b)
+/* The whole document: the blocks that have grids, each a temporal collection. */
+static bool xmf_compose(xdoc *d)
 {
+    buf *b = &d->out;
+    b->n = 0;
     put(b, "<?xml version=\"1.0\" ?>\n"
-           "<!-- seixo output series: the snapshots of the .h5 beside this file, for ParaView or VisIt -->\n"
-           "<Xdmf Version=\"2.0\">\n <Domain>\n"
-           "  <Grid Name=\"seixo\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+           "<!-- seixo output series: the snapshots of the .h5 beside this file, for ParaView (its XDMF Reader) or "
+           "VisIt; one temporal collection per block -->\n"
+           "<Xdmf Version=\"2.0\">\n <Domain>\n");
+    for (int k = 0; k < NKINDS; k++) {
+        if (d->kind[k].oom) b->oom = true;
+        if (!d->kind[k].n) continue;
+        put(b, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", kind_names[k]);
+        put(b, "%.*s", (int)d->kind[k].n, d->kind[k].p);
+        put(b, "  </Grid>\n");
+    }
+    put(b, " </Domain>\n</Xdmf>\n");
+    return !b->oom;
+}
+
+static void xdoc_free(xdoc *d)
+{
+    for (int k = 0; k < NKINDS; k++) free(d->kind[k].p);
+    free(d->out.p);
 }
 
 static void xml_escaped(buf *b, const char *s)
@@ -196,13 +225,20 @@ static void lines(buf *b, const char *base, int64_t k, const char *ds, int64_t c
     put(b, "</Topology>\n");
 }
 
-static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
+/* A block's grid of one snapshot, opened: its step and time. */
+static buf *grid_open(xdoc *d, int kind, const snap *s)
+{
+    buf *b = &d->kind[kind];
+    put(b, "   <Grid Name=\"step %lld\" GridType=\"Uniform\">\n", (long long)s->step);
+    put(b, "    <Time Value=\"%.17g\"/>\n", s->time);
+    return b;
+}
+
+static void xmf_step(xdoc *d, const char *base, int64_t k, const snap *s)
 {
     const unsigned f = s->fields;
-    put(b, "   <Grid Name=\"step %lld\" GridType=\"Collection\" CollectionType=\"Spatial\">\n", (long long)s->step);
-    put(b, "    <Time Value=\"%.17g\"/>\n", s->time);
     /* balls: points with their fields */
-    put(b, "    <Grid Name=\"balls\" GridType=\"Uniform\">\n");
+    buf *b = grid_open(d, K_BALLS, s);
     /* explicit vertices: the Xdmf3 readers make no cells of an implicit Polyvertex */
     lines(b, base, k, "balls/vertices", s->balls, 1, "Polyvertex");
     geometry(b, base, k, "balls/position", s->balls);
@@ -216,9 +252,9 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
     if (f & SX_OUT_MATERIAL) attribute(b, base, k, "material", "balls/material", s->balls, 1, "Int", 4, false);
     if (f & SX_OUT_MASS) attribute(b, base, k, "mass", "balls/mass", s->balls, 1, "Float", 8, false);
     if (s->clumps) attribute(b, base, k, "clump", "balls/clump", s->balls, 1, "Int", 8, false);
-    put(b, "    </Grid>\n");
+    put(b, "   </Grid>\n");
     if ((f & SX_OUT_CONTACTS) && s->contacts > 0) {
-        put(b, "    <Grid Name=\"contacts\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_CONTACTS, s);
         lines(b, base, k, "contacts/connectivity", s->contacts, 2, "Polyline");
         geometry(b, base, k, "balls/position", s->balls);
         attribute(b, base, k, "normal_force", "contacts/normal_force", s->contacts, 1, "Float", 8, true);
@@ -226,20 +262,20 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "force", "contacts/force", s->contacts, 3, "Float", 8, true);
         attribute(b, base, k, "overlap", "contacts/overlap", s->contacts, 1, "Float", 8, true);
         attribute(b, base, k, "bond", "contacts/bond", s->contacts, 1, "Int", 8, true);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
     if ((f & SX_OUT_CONTACTS) && s->wall_contacts > 0) {
-        put(b, "    <Grid Name=\"wall_contacts\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_WALL_CONTACTS, s);
         lines(b, base, k, "wall_contacts/connectivity", s->wall_contacts, 2, "Polyline");
         geometry(b, base, k, "wall_contacts/points", 2 * s->wall_contacts);
         attribute(b, base, k, "normal_force", "wall_contacts/normal_force", s->wall_contacts, 1, "Float", 8, true);
         attribute(b, base, k, "shear_force", "wall_contacts/shear_force", s->wall_contacts, 3, "Float", 8, true);
         attribute(b, base, k, "force", "wall_contacts/force", s->wall_contacts, 3, "Float", 8, true);
         attribute(b, base, k, "wall", "wall_contacts/wall", s->wall_contacts, 1, "Int", 8, true);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
     if ((f & SX_OUT_BONDS) && s->bonds > 0) {
-        put(b, "    <Grid Name=\"bonds\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_BONDS, s);
         lines(b, base, k, "bonds/connectivity", s->bonds, 2, "Polyline");
         geometry(b, base, k, "balls/position", s->balls);
         attribute(b, base, k, "kind", "bonds/kind", s->bonds, 1, "Int", 8, true);
@@ -247,40 +283,39 @@ static void xmf_step(buf *b, const char *base, int64_t k, const snap *s)
         attribute(b, base, k, "shear_force", "bonds/shear_force", s->bonds, 3, "Float", 8, true);
         attribute(b, base, k, "moment", "bonds/moment", s->bonds, 3, "Float", 8, true);
         attribute(b, base, k, "radius", "bonds/radius", s->bonds, 1, "Float", 8, true);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
     if ((f & SX_OUT_BONDS) && s->cracks > 0) {  // the crack map: every bond broken so far, a point each
-        put(b, "    <Grid Name=\"cracks\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_CRACKS, s);
         lines(b, base, k, "cracks/connectivity", s->cracks, 1, "Polyvertex");
         geometry(b, base, k, "cracks/position", s->cracks);
         attribute(b, base, k, "mode", "cracks/mode", s->cracks, 1, "Int", 8, false);
         attribute(b, base, k, "kind", "cracks/kind", s->cracks, 1, "Int", 8, false);
         attribute(b, base, k, "time", "cracks/time", s->cracks, 1, "Float", 8, false);
         attribute(b, base, k, "step", "cracks/step", s->cracks, 1, "Int", 8, false);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
     if ((f & SX_OUT_WALLS) && s->wall_cells > 0) {
         const bool quad = s->dim == 3; /* 3D: quadrilaterals */
         const int64_t c = s->wall_cells;
-        put(b, "    <Grid Name=\"walls\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_WALLS, s);
         lines(b, base, k, "walls/connectivity", c, quad ? 4 : 2, quad ? "Quadrilateral" : "Polyline");
         geometry(b, base, k, "walls/points", s->wall_points);
         attribute(b, base, k, "id", "walls/id", c, 1, "Int", 8, true);
         attribute(b, base, k, "velocity", "walls/velocity", c, 3, "Float", 8, true);
         attribute(b, base, k, "force", "walls/force", c, 3, "Float", 8, true);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
     if ((f & SX_OUT_WALLS) && s->mesh_cells > 0) {
         const int64_t c = s->mesh_cells;
-        put(b, "    <Grid Name=\"meshes\" GridType=\"Uniform\">\n");
+        b = grid_open(d, K_MESHES, s);
         lines(b, base, k, "meshes/connectivity", c, 3, "Triangle");
         geometry(b, base, k, "meshes/points", s->mesh_points);
         attribute(b, base, k, "id", "meshes/id", c, 1, "Int", 8, true);
         attribute(b, base, k, "velocity", "meshes/velocity", c, 3, "Float", 8, true);
         attribute(b, base, k, "force", "meshes/force", c, 3, "Float", 8, true);
-        put(b, "    </Grid>\n");
+        put(b, "   </Grid>\n");
     }
-    put(b, "   </Grid>\n");
 }
 
 /* ---------------------------------------------------------- gathering */
@@ -859,25 +894,20 @@ static bool write_whole(sx_h5 *h, const char *path, const char *data, size_t n)
 }
 
 /* The XDMF of the first `count` snapshots of file, without its closing tags. */
-static bool xmf_body(sx_h5 *h, buf *b, const char *base, hid_t file, int dim, int64_t count)
+static bool xmf_body(sx_h5 *h, xdoc *d, const char *base, hid_t file, int dim, int64_t count)
 {
-    b->n = 0;
-    xmf_header(b);
+    for (int k = 0; k < NKINDS; k++) d->kind[k].n = 0;
     for (int64_t k = 0; k < count && !h->failed; k++) {
         snap s;
-        if (read_snap(h, file, dim, k, &s)) xmf_step(b, base, k, &s);
+        if (read_snap(h, file, dim, k, &s)) xmf_step(d, base, k, &s);
     }
-    return !h->failed && (!b->oom || sx_h5_fail(h, "out of memory"));
+    return !h->failed;
 }
 
-/* The body with its closing tags, written whole (temporary name, rename). */
-static bool xmf_write(sx_h5 *h, const char *xmf, buf *b)
+/* The whole document, written whole (temporary name, rename). */
+static bool xmf_write(sx_h5 *h, const char *xmf, xdoc *d)
 {
-    const size_t at = b->n;
-    put(b, "%s", xmf_trailer);
-    const bool ok = b->oom ? sx_h5_fail(h, "out of memory") : write_whole(h, xmf, b->p, b->n);
-    b->n = at;
-    return ok;
+    return xmf_compose(d) ? write_whole(h, xmf, d->out.p, d->out.n) : sx_h5_fail(h, "out of memory");
 }
 
 /* The file's descriptor (sec2 driver), or -1. */
@@ -989,7 +1019,7 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
         }
         if (!h.failed && s->count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
         /* the XDMF of what the file holds now, kept in memory from here on */
-        if (!h.failed && xmf_body(&h, &s->xbody, s->base, s->file, s->dim, s->count)) xmf_write(&h, s->xmf, &s->xbody);
+        if (!h.failed && xmf_body(&h, &s->x, s->base, s->file, s->dim, s->count)) xmf_write(&h, s->xmf, &s->x);
     }
     const bool failed = h.failed;
     sx_h5_end(&h);
@@ -1105,7 +1135,8 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
     snap sn;
     char tmp[4096];
     bool have_tmp = false;
-    const size_t xat = s->xbody.n;
+    size_t xat[NKINDS]; /* the blocks' lengths, to drop a failed snapshot's grids */
+    for (int k = 0; k < NKINDS; k++) xat[k] = s->x.kind[k].n;
     if (!p) {
         sx_h5_fail(&h, "out of memory");
     } else if (m && m->dim != s->dim) {
@@ -1134,12 +1165,9 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
         /* 2. the XDMF that lists it, on disk under a temporary name */
         if (m && !h.failed) {
-            xmf_step(&s->xbody, s->base, s->count, &sn);
-            const size_t body = s->xbody.n;
-            put(&s->xbody, "%s", xmf_trailer);
-            if (s->xbody.oom) sx_h5_fail(&h, "out of memory");
-            else have_tmp = sx_h5_write_temp(&h, s->xmf, s->xbody.p, s->xbody.n, tmp, sizeof tmp);
-            s->xbody.n = body;
+            xmf_step(&s->x, s->base, s->count, &sn);
+            if (!xmf_compose(&s->x)) sx_h5_fail(&h, "out of memory");
+            else have_tmp = sx_h5_write_temp(&h, s->xmf, s->x.out.p, s->x.out.n, tmp, sizeof tmp);
         }
         /* 3. the counts, and at once 4. the XDMF renamed into place */
         if (!h.failed) {
@@ -1154,7 +1182,7 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
             /* 5. the counts durable too */
             if (!sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the counts");
         } else {
-            s->xbody.n = xat;
+            for (int k = 0; k < NKINDS; k++) s->x.kind[k].n = xat[k];
         }
     }
     if (have_tmp) remove(tmp);
@@ -1186,7 +1214,7 @@ sx_status sx_series_close(sx_series *s, char *err, size_t errlen)
     sx_h5_end(&h);
     for (int i = 0; i < s->nheld; i++) free(s->held[i].name);
     free(s->held);
-    free(s->xbody.p);
+    xdoc_free(&s->x);
     free(s->path);
     free(s->xmf);
     free(s->base);
@@ -1204,13 +1232,14 @@ sx_status sx_series_write_xdmf(const char *h5path, char *err, size_t errlen)
     int64_t count = 0;
     char *xmf = xmf_path_of(h5path ? h5path : "");
     const char *slash = h5path ? strrchr(h5path, '/') : NULL;
-    buf b = {0};
+    xdoc d;
+    memset(&d, 0, sizeof d);
     if (f >= 0 && sx_h5_get_i64(&h, f, "/", "count", &count, 1, true)) {
         if (!xmf) sx_h5_fail(&h, "out of memory");
         else if (count < 0) sx_h5_fail(&h, "damaged: negative snapshot count");
-        else if (xmf_body(&h, &b, slash ? slash + 1 : h5path, f, dim, count)) xmf_write(&h, xmf, &b);
+        else if (xmf_body(&h, &d, slash ? slash + 1 : h5path, f, dim, count)) xmf_write(&h, xmf, &d);
     }
-    free(b.p);
+    xdoc_free(&d);
     free(xmf);
     if (f >= 0) H5Fclose(f);
     const bool failed = h.failed;

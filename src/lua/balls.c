@@ -295,7 +295,10 @@ void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n,
     }
     sx_model *m = sx_lua_checkmodel(L, model);
     sx_lua_check(L, m, sx_ball_remove_many(m, ids, n), what);
-    for (int64_t i = 0; i < n; i++) sx_lua_forget_extras(L, model, &ball_kind, ids[i]);
+    for (int64_t i = 0; i < n; i++) {
+        sx_lua_forget_extras(L, model, &ball_kind, ids[i]);
+        sx_lua_slots_forget(L, model, ids[i]);
+    }
 }
 
 void sx_lua_remove_ball(lua_State *L, int model, int64_t id, const char *what)

@@ -166,6 +166,12 @@ enum { SX_LUA_SLOTS = 8 };
 int32_t sx_lua_slot_group(lua_State *L, int model, const sx_model *m, int64_t id, int slot);
 /// Puts ball id in group g (0: none) in slot; an error of `what` when the core refuses.
 void sx_lua_set_slot_group(lua_State *L, int model, sx_model *m, int64_t id, int slot, int32_t g, const char *what);
+/// The name of slot's table in the model's Lua state ("slot2" ...), NULL for slot 1 or out of range.
+const char *sx_lua_slot_table(int slot);
+/// Drops ball id from slots 2 and up (the ball was removed).
+void sx_lua_slots_forget(lua_State *L, int model, int64_t id);
+/// An order-free digest of slots 2 and up (ball id, slot, group number); 0 when they are empty.
+uint64_t sx_lua_slots_digest(lua_State *L, int model);
 
 /* ----------------------------------------------------------- region.c */
 
@@ -312,6 +318,13 @@ const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out);
 void sx_lua_pushvec(lua_State *L, const double *v, int n);
 /// vec.c: pushes a seixo.vec of n (1 to 4) components.
 void sx_lua_pushnewvec(lua_State *L, const double *v, int n);
+/// vec.c: turns the plain seixo.vec on the stack top into a read-only field
+/// vector of kind.key (b.pos): setting a component is an error saying how
+/// to set the field (writable) or that it is read-only. Other values stay.
+void sx_lua_vec_seal(lua_State *L, const char *kind, const char *key, bool writable);
+/// vec.c: pushes the plain array holding the components of the vector at idx
+/// (a field vector's inner vector, else the value itself); returns its index.
+int sx_lua_vec_array(lua_State *L, int idx);
 /// vec.c: creates the seixo.vec class and adds seixo.vec to the module table on the stack top.
 void sx_lua_vec_register(lua_State *L);
 /// Sets field k of the table on the stack top to the number v.

@@ -19,7 +19,9 @@
  * the model's state (`slot2`, ...: ball id -> group number), made when a
  * group is first put in them, so a model that uses one slot pays nothing.
  * A filter's group matches a ball that has it in any slot, or in the slot
- * given by the filter's `slot`. Slots 2 and up are not saved by m:save. */
+ * given by the filter's `slot`. m:save writes slots 2 and up with the rest
+ * of the Lua state (io.c), seixo.load restores them, and m:hash() covers
+ * them (sx_lua_slots_digest). */
 #include <math.h>
 #include <string.h>
 
@@ -86,6 +88,54 @@ int32_t sx_lua_slot_group(lua_State *L, int model, const sx_model *m, int64_t id
     }
     lua_pop(L, 2);
     return g;
+}
+
+const char *sx_lua_slot_table(int slot)
+{
+    return slot >= 2 && slot <= SX_LUA_SLOTS ? slot_names[slot] : NULL;
+}
+
+void sx_lua_slots_forget(lua_State *L, int model, int64_t id)
+{
+    lua_getiuservalue(L, model, 1);
+    for (int k = 2; k <= SX_LUA_SLOTS; k++) {
+        if (lua_getfield(L, -1, slot_names[k]) == LUA_TTABLE) {
+            lua_pushnil(L);
+            lua_rawseti(L, -2, (lua_Integer)id);
+        }
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+}
+
+/* splitmix64's finaliser: one entry's bits spread over the word */
+static uint64_t mix(uint64_t x)
+{
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9u;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebu;
+    return x ^ (x >> 31);
+}
+
+uint64_t sx_lua_slots_digest(lua_State *L, int model)
+{
+    model = lua_absindex(L, model);
+    uint64_t sum = 0; /* a sum: the tables' order of traversal does not matter */
+    lua_getiuservalue(L, model, 1);
+    for (int k = 2; k <= SX_LUA_SLOTS; k++) {
+        if (lua_getfield(L, -1, slot_names[k]) == LUA_TTABLE) {
+            lua_pushnil(L);
+            while (lua_next(L, -2)) {
+                const uint64_t id = (uint64_t)lua_tointeger(L, -2), g = (uint64_t)lua_tointeger(L, -1);
+                if (g) sum += mix(mix(id * 16 + (uint64_t)k) ^ g);
+                lua_pop(L, 1);
+            }
+        }
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    return sum;
 }
 
 void sx_lua_set_slot_group(lua_State *L, int model, sx_model *m, int64_t id, int slot, int32_t g, const char *what)

@@ -145,7 +145,8 @@ static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char 
                 lua_pop(L, 1);
                 n.kind = SX_IO_TABLE;
                 const int64_t me = add(s, &n);
-                if (me >= 0) ser_table(L, s, val, me, p);
+                /* a field vector (b.pos) is saved as its components */
+                if (me >= 0) ser_table(L, s, sx_lua_vec_array(L, val), me, p);
                 break;
             default: skip(L, s, p, luaL_typename(L, val)); break;
             }
@@ -294,6 +295,19 @@ static int model_save(lua_State *L)
         if (me >= 0) ser_table(L, &s, -1, me, saved_state[k]);
         lua_pop(L, 1);
     }
+    /* group slots 2 and up: only those in use, so a model without them writes what it did before */
+    lua_getiuservalue(L, 1, 1);
+    for (int k = 2; k <= SX_LUA_SLOTS && !s.oom; k++) {
+        const char *name = sx_lua_slot_table(k);
+        if (lua_getfield(L, -1, name) == LUA_TTABLE) {
+            sx_io_node n = {.parent = -1, .key_kind = SX_IO_STRING, .key_string = (char *)name,
+                            .key_length = strlen(name), .kind = SX_IO_TABLE};
+            const int64_t me = add(&s, &n);
+            if (me >= 0) ser_table(L, &s, -1, me, name);
+        }
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
     if (s.oom) return luaL_error(L, "'%s': out of memory", path);
 
     sx_snapshot_opts o;
@@ -369,6 +383,9 @@ static int seixo_load(lua_State *L)
         } else {
             for (int q = 0; saved_state[q]; q++)
                 if (lua_getfield(L, -2, saved_state[q]) == LUA_TTABLE) lua_setfield(L, -2, saved_state[q]);
+                else lua_pop(L, 1);
+            for (int q = 2; q <= SX_LUA_SLOTS; q++)
+                if (lua_getfield(L, -2, sx_lua_slot_table(q)) == LUA_TTABLE) lua_setfield(L, -2, sx_lua_slot_table(q));
                 else lua_pop(L, 1);
         }
         lua_pop(L, 2);

@@ -26,10 +26,11 @@ static int wall_servo(lua_State *L)
     sx_lua_optnumfield(L, 2, "area", &d.area);
     sx_lua_optnumfield(L, 2, "alpha", &d.alpha);
     sx_lua_optnumfield(L, 2, "max_speed", &d.max_speed);
+    sx_lua_check(L, m, sx_wall_set_servo(m, id, &d), "w:servo");
+    /* after the core accepted the target: an invalid one gets its error, not a warning */
     lua_getiuservalue(L, 1, 1);
     sx_lua_check_range(L, lua_gettop(L), "servo target stress", d.target, 1e3, 1e10, "Pa");
     lua_pop(L, 1);
-    sx_lua_check(L, m, sx_wall_set_servo(m, id, &d), "w:servo");
     return 0;
 }
 

@@ -311,6 +311,13 @@ static void read_material(lua_State *L, int arg, sx_material_def *d, bool *has_b
     sx_lua_optnumfield(L, arg, "viscous_normal", &d->viscous_normal);
     sx_lua_optnumfield(L, arg, "viscous_shear", &d->viscous_shear);
     sx_lua_material_extras(L, arg, d, has_bpm, bpm);
+}
+
+/* Warnings for values the core accepted but that are unusual for rocks and
+ * grains (wrong units, most likely): only after the core's checks, so an
+ * invalid value has had its error and no warning. */
+static void warn_unusual(lua_State *L, const sx_material_def *d)
+{
     sx_lua_check_range(L, 1, "density", d->density, 100, 3e4, "kg/m^3");
     sx_lua_check_range(L, 1, "modulus", d->modulus, 1e5, 1e12, "Pa");
     sx_lua_check_range(L, 1, "shear_modulus", d->shear_modulus, 1e5, 1e12, "Pa");
@@ -335,6 +342,7 @@ static int model_material(lua_State *L)
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");
     if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm), "m:material");
+    warn_unusual(L, &d);
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
 }
@@ -414,6 +422,7 @@ static int model_contact_model(lua_State *L)
     }
     int row = 0;
     sx_lua_check(L, m, sx_cmodel_add(m, name, &d, &row), "m:contact_model");
+    warn_unusual(L, &d.law);
     lua_pushinteger(L, row);
     return 1;
 }
@@ -570,10 +579,15 @@ static int model_energy(lua_State *L)
     return 1;
 }
 
+/* The core's state hash, with the group slots 2 and up (Lua state that a
+ * restart restores) folded in when a ball has one. */
 static int model_hash(lua_State *L)
 {
     char hex[17];
-    snprintf(hex, sizeof hex, "%016" PRIx64, sx_model_state_hash(sx_lua_checkmodel(L, 1)));
+    uint64_t h = sx_model_state_hash(sx_lua_checkmodel(L, 1));
+    const uint64_t slots = sx_lua_slots_digest(L, 1);
+    if (slots) h = (h ^ slots) * 0x9e3779b97f4a7c15u + 1;
+    snprintf(hex, sizeof hex, "%016" PRIx64, h);
     lua_pushstring(L, hex);
     return 1;
 }

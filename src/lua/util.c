@@ -105,6 +105,13 @@ void sx_lua_checksubkeys(lua_State *L, int idx, int arg, const char *field, cons
 
 /* ------------------------------------------------------------- vectors */
 
+/* The message on the stack top, with the array under it removed. */
+static const char *popped_error(lua_State *L, const char *msg)
+{
+    lua_remove(L, -2);
+    return msg;
+}
+
 const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
 {
     idx = lua_absindex(L, idx);
@@ -116,20 +123,22 @@ const char *sx_lua_tovec(lua_State *L, int idx, int n, double *out)
     }
     if (!lua_istable(L, idx))
         return lua_pushfstring(L, "array of %d numbers expected, got %s", n, luaL_typename(L, idx));
+    idx = sx_lua_vec_array(L, idx); /* a field vector's components; popped before returning */
     const lua_Unsigned len = lua_rawlen(L, idx);
     if (len != (lua_Unsigned)n && n <= 3)
-        return lua_pushfstring(L, "%d components expected in a %dD model, got %I", n, n, (lua_Integer)len);
+        return popped_error(L, lua_pushfstring(L, "%d components expected in a %dD model, got %I", n, n, (lua_Integer)len));
     if (len != (lua_Unsigned)n) /* a quaternion, a pebble {x, y, z, r} */
-        return lua_pushfstring(L, "%d components expected, got %I", n, (lua_Integer)len);
+        return popped_error(L, lua_pushfstring(L, "%d components expected, got %I", n, (lua_Integer)len));
     double v[4];
     for (int k = 0; k < n; k++) {
         const int t = lua_rawgeti(L, idx, k + 1);
         v[k] = lua_tonumber(L, -1);
         lua_pop(L, 1);
         if (t != LUA_TNUMBER)
-            return lua_pushfstring(L, "component %d: number expected, got %s", k + 1, lua_typename(L, t));
+            return popped_error(L, lua_pushfstring(L, "component %d: number expected, got %s", k + 1, lua_typename(L, t)));
     }
     memcpy(out, v, (size_t)n * sizeof *v);
+    lua_pop(L, 1);
     return NULL;
 }
 
@@ -295,7 +304,9 @@ static int no_field(lua_State *L, const char *what)
     return luaL_error(L, "%s has no %s %s%s (%ss: %s)", kind, what, key, hint, what, names);
 }
 
-/* upvalues: methods, getters, kind, the readable field names */
+/* upvalues: methods, getters, kind, the readable field names, setters.
+ * A vector field is returned sealed: b.pos[1] = 5 is an error, not a
+ * change to a copy. */
 static int object_index(lua_State *L)
 {
     lua_settop(L, 2);
@@ -305,7 +316,14 @@ static int object_index(lua_State *L)
     lua_rawget(L, lua_upvalueindex(2));
     const lua_CFunction get = lua_tocfunction(L, -1);
     lua_settop(L, 2);
-    return get ? get(L) : no_field(L, "field");
+    if (!get) return no_field(L, "field");
+    const int results = get(L);
+    if (results != 1) return results;
+    lua_pushvalue(L, 2);
+    const bool writable = lua_rawget(L, lua_upvalueindex(5)) != LUA_TNIL;
+    lua_pop(L, 1);
+    sx_lua_vec_seal(L, lua_tostring(L, lua_upvalueindex(3)), lua_tostring(L, 2), writable);
+    return 1;
 }
 
 /* upvalues: setters, getters, kind, the writable field names */
@@ -344,7 +362,8 @@ void sx_lua_newclass(lua_State *L, const char *tname, const char *kind, const lu
     lua_pushvalue(L, getters_at);
     lua_pushstring(L, kind);
     push_names(L, getters);
-    lua_pushcclosure(L, object_index, 4);
+    push_regs(L, setters);
+    lua_pushcclosure(L, object_index, 5);
     lua_setfield(L, mt, "__index");
 
     push_regs(L, setters);

@@ -62,6 +62,8 @@ with h5py.File(d + "/series.h5", "r") as f:
     assert np.all(np.diff(ke["step"][:n]) > 0)
 
 xmf = ET.parse(d + "/series.xmf")
-times = [t.get("Value") for t in xmf.iter("Time")]
+balls = [g for g in xmf.getroot().iter("Grid") if g.get("Name") == "balls"]
+assert len(balls) == 1 and balls[0].get("CollectionType") == "Temporal", balls
+times = [t.get("Value") for t in balls[0].iter("Time")]
 assert len(times) == 7, times
 print("h5py %s read the snapshot and the series (%d snapshots)" % (h5py.__version__, len(times)))

@@ -1,14 +1,17 @@
 #!/bin/sh
 # scripts/render draws a series with ParaView headless: a series whose
 # bonds break (tests/io/render_series.lua) is written and rendered from its
-# own directory by bare file names (the name ParaView's Xdmf3 readers once
-# failed on), and the PNG shows the balls and the crack map.
+# own directory by bare file names (the name ParaView's Xdmf3 readers fail
+# on), by scripts/render and by `seixo render`, and the PNG shows the balls
+# and the crack map; ParaView's XDMF Reader shows the blocks by name
+# (pv_names.py), by a bare name and by a relative path.
 #   render.sh SEIXO SOURCE_DIR
 # Skipped (exit 77) when pvbatch or Xvfb is not installed.
 set -eu
 seixo=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") src=$(cd "$2" && pwd)
 command -v pvbatch > /dev/null 2>&1 || { echo "pvbatch not found: skipped"; exit 77; }
 command -v Xvfb > /dev/null 2>&1 || { echo "Xvfb not found: skipped"; exit 77; }
+command -v pvpython > /dev/null 2>&1 || { echo "pvpython not found: skipped"; exit 77; }
 dir=$(mktemp -d "${TMPDIR:-/tmp}/seixo-render-test-XXXXXX")
 trap 'rm -rf "$dir"' EXIT
 cd "$dir"
@@ -24,6 +27,22 @@ echo "$out" | grep -q "(snapshot $1 of $1, t = [0-9.e-]* s): $2 balls, 0 wall ce
 file cracks.png | grep -q 'PNG image data, 1024 x 768' || { file cracks.png; exit 1; }
 size=$(wc -c < cracks.png)
 [ "$size" -gt 10000 ] || { echo "cracks.png has only $size bytes"; exit 1; }
+# the same through the seixo executable's subcommand
+out=$(env -u DISPLAY "$seixo" render cracks.xmf again.png 0)
+echo "$out"
+echo "$out" | grep -q "(snapshot 1 of $1, t = 0 s): $2 balls, 0 wall cells, [0-9]* bonds, 0 cracks$" ||
+    { echo "render.sh: seixo render: not the counts of the first snapshot"; exit 1; }
+file again.png | grep -q 'PNG image data, 1024 x 768' || { file again.png; exit 1; }
+if "$seixo" render 2> err.txt; then echo "seixo render without arguments succeeded"; exit 1; fi
+grep -q "^usage: seixo render SERIES.xmf OUT.png \[SNAPSHOT\]" err.txt || { cat err.txt; exit 1; }
+# ParaView's XDMF Reader shows the blocks by name, from the series' directory
+# by a bare name and from another directory by a relative path
+pvpython "$src/pv_names.py" cracks.xmf "$1" balls contacts bonds cracks > names.txt 2>&1 || true
+cat names.txt
+grep -q '^pv_names: OK' names.txt || exit 1
+mkdir sub
+(cd sub && pvpython "$src/pv_names.py" ../cracks.xmf "$1" balls contacts bonds cracks > ../names.txt 2>&1) || true
+grep -q '^pv_names: OK' names.txt || { cat names.txt; exit 1; }
 # a snapshot out of the series is refused, naming the count
 if env -u DISPLAY "$src/../../scripts/render" cracks.xmf x.png 99 2> err.txt; then echo "snapshot 99 accepted"; exit 1; fi
 grep -q "the series has $1 snapshots, no snapshot 99" err.txt || { cat err.txt; exit 1; }

@@ -112,7 +112,7 @@ static int count_steps(const char *xmf)
     int n = 0;
     bool closed = false;
     while (fgets(line, sizeof line, f)) {
-        n += strstr(line, "<Time Value=") != NULL;
+        n += strstr(line, "/balls/vertices</DataItem>") != NULL; /* the balls' grid of each snapshot */
         closed = strstr(line, "</Xdmf>") != NULL;
     }
     fclose(f);

@@ -108,7 +108,7 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D two joints", m:bond_count() == 2, m:bond_count())
   m:remove_balls{where = function(x) return x.id == b.id end}
   check(dim .. "D its joints go with a removed ball", m:bond_count() == 0, m:bond_count())
-  local p = c.pos; p[1] = p[1] + 0.5; c.pos = p -- a build
+  local p = c.pos:copy(); p[1] = p[1] + 0.5; c.pos = p -- a build
   m:cycle(50)
   check(dim .. "D no joint left", m:flatjoint(a.id, c.id) == nil and m:bond_count() == 0, m:bond_count())
 end

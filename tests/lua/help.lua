@@ -96,7 +96,7 @@ end)
 -- shows after each "> " line is exactly what the REPL prints (stdin is not
 -- a terminal, so no prompts are printed, only results and errors).
 test("the docs' example session prints what it shows", function()
-  local block = (doc .. "\n"):match("An example session.-\n\n(.-)\n\n")
+  local block = (doc .. "\n"):match("An example session.-\n\n<!%-%- example [^\n]*%-%->\n\n(.-)\n\n")
   check(block, "no example session in docs/lua-api.md")
   local input, expected = {}, {}
   for line in (block .. "\n"):gmatch("(.-)\n") do

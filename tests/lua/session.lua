@@ -251,6 +251,32 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("an invalid value is an error with no range warning before it; a valid, unusual one warns", function()
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 3}
+print(pcall(m.material, m, "a", {density = -1}))
+print(pcall(m.material, m, "b", {modulus = -5}))
+print(pcall(m.material, m, "c", {density = 2.5, kn = -1}))
+print(pcall(m.material, m, "d", {shear_modulus = 0/0, modulus = 1e9}))
+w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+print(pcall(w.servo, w, {target = 0/0, area = 1}))
+print(pcall(w.servo, w, {target = 10, area = -1}))
+print("valid")
+m:material("e", {density = 2.5})
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("density must be > 0 kg/m^3 (got -1)", 1, true), out)
+  check(out:find("modulus must be >= 0 Pa", 1, true), out)
+  check(out:find("kn must be > 0 N/m (got -1)", 1, true), out)
+  check(out:find("w:servo: the target stress must be finite", 1, true), out)
+  check(out:find("w:servo: the area must be > 0 (got -1)", 1, true), out)
+  -- no warning before "valid": the invalid values only failed (material c's density 2.5 included)
+  local before = out:sub(1, out:find("valid", 1, true))
+  check(not before:find("warning", 1, true), out)
+  check(out:find("valid\nseixo: warning: (command line):10: density 2.5 is outside the range", 1, true), out)
+  check(out:find("done\n$"), out)
+end)
+
 test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API", function()
   local v, w = seixo.vec(1, 2, 3), seixo.vec{0, 1, 0}
   eq(tostring(v + w), "{1.0, 3.0, 3.0}")
@@ -274,13 +300,47 @@ test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API",
   local m = seixo.model{dim = 3, gravity = {0, 0, -10}}
   m:material("a")
   local b = m:ball{pos = seixo.vec(0, 0, 1), radius = 0.1, vel = v}
-  eq(getmetatable(b.pos), getmetatable(v))
+  eq(getmetatable(b.pos:copy()), getmetatable(v))
   b.pos = b.pos + b.vel * 0.5
   eq(tostring(b.pos), "{0.5, 1.0, 2.5}")
   eq(tostring(m:gravity()), "{0.0, 0.0, -10.0}")
-  local copy = b.pos
+  -- a field's vector is a read-only copy: setting a component says how to set the field
+  raises(function() b.pos[1] = 5 end, "ball.pos is a copy of the field: setting its component 1 would not change "
+         .. "the object; assign the whole vector (local v = ball.pos:copy(); v[1] = ...; ball.pos = v)")
+  raises(function() b.vel.x = 5 end, "ball.vel is a copy of the field: setting its component x")
+  raises(function() b.force[2] = 0 end, "ball.force is a copy of a read-only field: its component 2 cannot be set")
+  local w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  raises(function() w.point[3] = 1 end, "wall.point is a copy of the field")
+  eq(b.pos.x, 0.5)
+  local copy = b.pos:copy()
   copy[1] = 5
-  eq(b.pos.x, 0.5, "a returned vector is a copy")
+  eq(b.pos.x, 0.5, "a copy is a copy")
+  b.pos = copy
+  eq(tostring(b.pos), "{5.0, 1.0, 2.5}")
+  -- a field vector reads like a vector: length, components, pairs, ipairs, unpack, arithmetic, == and the API
+  local p = b.pos
+  eq(#p, 3)
+  eq(p[1] + p.y + p[3], 8.5)
+  local n = 0
+  for k, x in pairs(p) do n = n + k * x end
+  eq(n, 5 + 2 + 7.5)
+  n = 0
+  for k, x in ipairs(p) do n = n + k * x end
+  eq(n, 14.5)
+  eq(select("#", table.unpack(p)), 3)
+  check(p == seixo.vec(5, 1, 2.5) and p:norm() == seixo.vec(5, 1, 2.5):norm())
+  eq(tostring(p - seixo.vec(5, 1, 2.5)), "{0.0, 0.0, 0.0}")
+  local b2 = m:ball{pos = p + seixo.vec(1, 0, 0), radius = 0.1}
+  eq(tostring(b2.pos), "{6.0, 1.0, 2.5}")
+  -- kept in m:vars(), it is saved as its components
+  m:vars().where = b.pos
+  local file = os.tmpname() .. ".h5"
+  eq(#m:save(file), 0, "nothing skipped")
+  local loaded = seixo.load(file)
+  eq(loaded:vars().where[1], 5.0)
+  eq(#loaded:vars().where, 3)
+  loaded:close()
+  os.remove(file)
   m:close()
 end)
 
@@ -334,6 +394,61 @@ test("group slots: a ball in several groups, filters by any slot or one", functi
   raises(function() m:count{group = "left", slot = 0} end, "a group slot from 1 to 8 expected")
   raises(function() b:set_group("x", 9) end, "a group slot from 1 to 8 expected")
   m:close()
+end)
+
+test("group slots 2 to 8: saved by m:save, restored by seixo.load, in m:hash(), dropped with their ball", function()
+  local m = seixo.model{dim = 3}
+  m:material("a")
+  for i = 1, 8 do m:ball{pos = {i, 0, 0}, radius = 0.1} end
+  local plain = m:hash()
+  m:group("left", {where = function(b) return b.pos.x < 4.5 end})
+  m:group("even", function(b) return b.id % 2 == 0 end, 2)
+  m:ball(3):set_group("odd", 8)
+  m:ball(5):set_group("special", 5)
+  local h = m:hash()
+  check(h ~= plain, "slot 1 is in the core's hash")
+  -- a group in slot 2 changes the hash; taken away, the hash is back
+  m:ball(7):set_group("even", 2)
+  local h7 = m:hash()
+  check(h7 ~= h, "a slot-2 group changes the hash")
+  m:ball(7):set_group(nil, 2)
+  eq(m:hash(), h)
+  m:ball(7):set_group("even", 2)
+  local path = os.tmpname() .. ".h5"
+  m:save(path)
+  local r = seixo.load(path)
+  eq(r:hash(), h7, "same hash after the load")
+  eq(r:ball(2).groups[2], "even")
+  eq(r:ball(7).groups[2], "even")
+  eq(r:ball(3).groups[8], "odd")
+  eq(r:ball(5).groups[5], "special")
+  eq(r:ball(1).groups[2], nil)
+  eq(r:count{group = "even", slot = 2}, 5)
+  eq(r:count{group = "odd"}, 1)
+  eq(r:groups().even, 5)
+  -- the two continue alike
+  m:cycle(20)
+  r:cycle(20)
+  eq(r:hash(), m:hash())
+  -- a removed ball leaves its slots; the hash sees it
+  local before = r:hash()
+  r:ball(2):remove()
+  eq(r:count{group = "even", slot = 2}, 4)
+  check(r:hash() ~= before)
+  r:save(path)
+  local r2 = seixo.load(path)
+  eq(r2:count{group = "even", slot = 2}, 4)
+  eq(r2:hash(), r:hash())
+  -- a model without slots 2 to 8 keeps the core's hash
+  local q = seixo.model{dim = 3}
+  q:material("a")
+  q:ball{pos = {0, 0, 0}, radius = 0.1}
+  local hq = q:hash()
+  q:ball(1):set_group("x", 3)
+  q:ball(1):set_group(nil, 3)
+  eq(q:hash(), hq)
+  os.remove(path)
+  for _, x in ipairs{m, r, r2, q} do x:close() end
 end)
 
 T.done()
