@@ -62,6 +62,15 @@ m:generate{count = 30, radius = {1e-3, 1.2e-3}, region = {box = {{0, 0, 0}, {0.0
 ]],
   lab = [[lab = require "seixo.lab"
 ]],
+  -- a 3D model with materials sand and steel, a ball of each, all in group "rock"
+  cmodel = [[
+m = seixo.model{dim = 3}
+m:material("sand", {density = 2650, kn = 1e6, ks = 1e6, friction = 0.5})
+m:material("steel", {density = 7800, kn = 1e8, ks = 1e8, friction = 0.2})
+m:ball{pos = {0.5, 0.5, 0.05}, radius = 0.01, material = "sand"}
+m:ball{pos = {0.5, 0.5, 0.5}, radius = 0.01, material = "steel"}
+m:group("rock", {})
+]],
 }
 
 local function read(path) return assert(io.open(T.root .. path)):read("a") end
