@@ -15,6 +15,7 @@
  * vector extensions), beside the full scalar forms; both give the same
  * bits (tests/test_determinism.c).
  */
+#include "joints.h"
 #include "laws/flatjoint.h"
 #include "laws/registry.h"
 #include "model_internal.h"

@@ -33,6 +33,7 @@ static const sx_bond_kind kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX
 
 static const char *kind_name(sx_bond_kind k)
 {
+    if (k == SX_BOND_SMOOTHJOINT) return "smoothjoint"; /* installed by m:joint, not m:bond */
     for (int i = 0; kind_names[i]; i++)
         if (kind_values[i] == k) return kind_names[i];
     return "?";

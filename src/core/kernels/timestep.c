@@ -32,7 +32,13 @@ static double KERNEL(critical_dt)(sx_model *m)
         const sx_pair_law *law = &m->law[B->mat[i] * m->law_n + B->mat[j]];
         double ktr = 0, krot_i = 0, krot_j = 0;
         const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
-        if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
+        if (p->joint && p->joint[c] && p->touching[c]) { /* a smooth joint's springs (laws/smoothjoint.h) */
+            const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+            const double area = sx_law_sj_area(D, L, B->rad[i], B->rad[j]);
+            ktr = (L->kn + L->ks) * area;
+            krot_i = L->ks * area * B->rad[i] * B->rad[i];
+            krot_j = L->ks * area * B->rad[j] * B->rad[j];
+        } else if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
             double kn, ks;
             stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
             if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
@@ -98,6 +104,11 @@ static double KERNEL(critical_dt)(sx_model *m)
         const sx_law *own = sx__law(self->law);
         kn *= own->tangent;
         if (own->series) kn *= 2, ks *= 2; /* undo the series combination with itself */
+        for (int64_t q = 0; q < m->njoint; q++) { /* a smooth joint's contact may form at any step */
+            const sx_law_sj *L = &m->joints[q].law;
+            const double area = sx_law_sj_area(D, L, r, r);
+            if ((L->kn + L->ks) * area > kn + ks) kn = L->kn * area, ks = L->ks * area;
+        }
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
         if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
