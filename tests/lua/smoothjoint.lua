@@ -146,4 +146,94 @@ T.test("a block on a joint: held as the joint is tilted to tan(theta) = 0.99 mu"
   m:close()
 end)
 
+T.test("a block on a dilating joint: opens by tan(psi) per unit slip", function()
+  local psi = 10
+  local m, top = block{tan = 1.1 * mu, dilation = psi}
+  m:cycle(800)
+  local x1, y1 = centre(top)
+  m:cycle(1600) -- within the contacts' reach (their overlap shrinks as the joint opens)
+  local x2, y2 = centre(top)
+  T.check(x2 - x1 > 2e-5, "slid " .. (x2 - x1))
+  T.near((y2 - y1) / (x2 - x1), math.tan(math.rad(psi)), 0.02)
+  m:close()
+end)
+
+T.test("restart and threads: the same bits", function()
+  local function run(threads)
+    local m, top = block{tan = 1.1 * mu, dilation = 5, threads = threads}
+    m:cycle(500)
+    return m, top
+  end
+  local m1 = run(1)
+  local m2 = run(2)
+  T.eq(m1:hash(), m2:hash(), "1 and 2 threads")
+  local path = os.tmpname()
+  m1:save(path)
+  local r = seixo.load(path)
+  os.remove(path)
+  T.eq(r:hash(), m1:hash(), "as saved")
+  T.eq(#r:joints(), 1, "the joint restored")
+  T.eq(r:joints()[1].dilation, 5, "its dilation")
+  m1:cycle(700)
+  r:cycle(700)
+  T.eq(r:hash(), m1:hash(), "700 steps later")
+  m1:close(); m2:close(); r:close()
+end)
+
+-- A parallel-bonded pair across a bonded joint: the joint takes the bond's
+-- place, stress free, and breaks in tension at tension x A (A = 2 R in 2D,
+-- pi R^2 in 3D), logged as a smooth-joint crack.
+for _, dim in ipairs{2, 3} do
+  T.test(dim .. "D bonded joint: breaks at tension x area", function()
+    local m = seixo.model{dim = dim}
+    m:material("r", {density = 2600, damping = 0.7, kn = 1e8, ks = 1e8, friction = 0.5,
+                     bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 1, tensile_strength = 1e12,
+                             cohesion = 1e12}})
+    local a = m:ball{pos = v(dim, 0, 0), radius = R}
+    local b = m:ball{pos = v(dim, 0.4 * R, 2 * R * math.cos(math.asin(0.2))), radius = R}
+    T.eq(m:bond{kind = "parallel", gap = 1e-6}, 1, "bonded")
+    a.fix = "all"
+    b.fix = "spin"
+    local tension = 1e5
+    local _, bonds = m:joint{point = v(dim, 0, R), normal = v(dim, 0, 1), kn = 1e10, ks = 1e10, tension = tension,
+                             cohesion = 1e9}
+    T.eq(bonds, 1, "the bond replaced")
+    local c
+    for cc in m:contacts() do c = cc end
+    T.eq(c.bond, "smoothjoint")
+    local area = dim == 3 and math.pi * R * R or 2 * R
+    local limit = tension * area
+    for k = 1, 200 do
+      b.applied_force = v(dim, 0, limit * k / 100)
+      m:cycle(50)
+      if m:crack_count() > 0 then break end
+    end
+    local cr = m:cracks()[1]
+    T.check(cr, "broke")
+    T.eq(cr.kind, "smoothjoint")
+    T.eq(cr.mode, "tension")
+    T.near(-cr.fn, limit, 0.02) -- the load ramps by 1 % of the limit per 50 steps
+    T.eq(m:bond_count(), 0)
+    m:close()
+  end)
+end
+
+T.test("bad joints are named", function()
+  local m = seixo.model{dim = 3}
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 0}, kn = 1, ks = 1} end, "normal")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = -1, ks = 1} end, "kn")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, dilation = 90} end, "dilation")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, tension = 1} end, "cohesion")
+  T.raises(function() m:joint{point = {0, 0, 0}, kn = 1, ks = 1} end, "normal or dip")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, dip = 30, kn = 1, ks = 1} end, "normal or dip")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, glue = 1} end, "glue")
+  m:joint{point = {0, 0, 0}, dip = 30, dip_direction = 90, kn = 1, ks = 1}
+  local n = m:joints()[1].normal
+  T.near(n[1], 0.5, 1e-12); T.near(n[3], math.cos(math.rad(30)), 1e-12)
+  local m2 = seixo.model{dim = 2}
+  T.raises(function() m2:joint{point = {0, 0}, dip = 10, dip_direction = 5, kn = 1, ks = 1} end, "dip only")
+  m2:joint{point = {0, 0}, dip = 30, kn = 1, ks = 1}
+  T.near(m2:joints()[1].normal[1], -0.5, 1e-12)
+end)
+
 T.done()
