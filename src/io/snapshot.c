@@ -302,18 +302,24 @@ static hid_t law_enum(hid_t base)
 }
 
 /* A material's numbers: its definition, its BPM parameters, then every
- * law's parameters (each once, from the registry). */
-#define MAT_FIXED 20
+ * law's parameters (each once, from the registry). The flat joint's BPM
+ * parameters (from bond_friction_angle) are newer than format 3's first
+ * files: absent, they load as 0 (the defaults of m:bond). */
+#define MAT_FIXED 26
+#define MAT_FLATJOINT 20 /* the first of them */
 #define MAT_MAX (MAT_FIXED + 32)
 static const char *const mat_fixed_names[MAT_FIXED] = {
     "density", "kn", "ks", "modulus", "stiffness_ratio", "friction", "damping",
     "viscous_normal", "viscous_shear",
     "bond_radius_multiplier", "bond_modulus", "bond_stiffness_ratio", "bond_tensile_strength",
     "bond_tensile_strength_sd", "bond_cohesion", "bond_cohesion_sd", "bond_normal_strength",
-    "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd"};
+    "bond_normal_strength_sd", "bond_shear_strength", "bond_shear_strength_sd",
+    "bond_friction_angle", "bond_friction", "bond_elements", "bond_sectors", "bond_unbonded_fraction",
+    "bond_initial_gap"};
 static const char *const mat_fixed_units[MAT_FIXED] = {
     "kg/m^3", "N/m", "N/m", "Pa", "1", "1", "1", "1", "1",
-    "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N"};
+    "1", "Pa", "1", "Pa", "Pa", "Pa", "Pa", "N", "N", "N", "N",
+    "degree", "1", "1", "1", "1", "m"};
 
 typedef struct mat_column {
     const char *name, *unit;
@@ -343,7 +349,9 @@ static double *mat_number(sx_material *t, const mat_column *c)
                             &d->damping, &d->viscous_normal, &d->viscous_shear,
                             &b->radius_multiplier, &b->modulus, &b->stiffness_ratio, &b->tensile_strength,
                             &b->tensile_strength_sd, &b->cohesion, &b->cohesion_sd, &b->normal_strength,
-                            &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd};
+                            &b->normal_strength_sd, &b->shear_strength, &b->shear_strength_sd,
+                            &b->friction_angle, &b->friction, &b->elements, &b->sectors, &b->unbonded_fraction,
+                            &b->initial_gap};
     return p[c->k];
 }
 
@@ -400,7 +408,7 @@ static void load_materials(sx_h5 *h, hid_t g, sx_model *m)
         /* a law's parameter a file predates takes its default (the law is newer than the file) */
         sx_material def = {.def = sx_material_default_def()};
         for (int k = 0; k < nc && !h->failed; k++) {
-            const bool newer = c[k].law >= 0 && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
+            const bool newer = (c[k].law >= 0 || c[k].k >= MAT_FLATJOINT) && H5Lexists(g, c[k].name, H5P_DEFAULT) <= 0;
             if (newer)
                 for (int i = 0; i < n; i++) *mat_number(&m->mats[i], &c[k]) = *mat_number(&def, &c[k]);
             else if (sx_h5_read(h, g, "/materials", c[k].name, H5T_NATIVE_DOUBLE, col, n, 1, true))

@@ -44,6 +44,14 @@ static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
     for (int k = 0; bpm_keys[k]; k++) sx_lua_optnumfield(L, arg, bpm_keys[k], bpm_field(b, k));
 }
 
+void sx_lua_push_bpm(lua_State *L, const sx_model *m, int material)
+{
+    sx_bpm_def b;
+    sx_lua_check(L, m, sx_material_get_bpm(m, material, &b), "m:materials");
+    lua_createtable(L, 0, (int)(sizeof bpm_keys / sizeof *bpm_keys));
+    for (int k = 0; bpm_keys[k]; k++) sx_lua_setnum(L, bpm_keys[k], *bpm_field(&b, k));
+}
+
 int sx_lua_law_keys(const char **keys, int n, int cap)
 {
     for (int law = 0; law < sx_law_count(); law++)

@@ -337,6 +337,8 @@ static int model_materials(lua_State *L)
         for (int law = 0; law < sx_law_count(); law++)
             for (int k = 0; k < sx_law_param_count(law); k++)
                 sx_lua_setnum(L, sx_law_param_name(law, k, NULL), *sx_law_param_value(&d, law, k));
+        sx_lua_push_bpm(L, m, i);
+        lua_setfield(L, -2, "bond");
         lua_setfield(L, -2, sx_material_name(m, i));
     }
     return 1;

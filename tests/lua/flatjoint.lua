@@ -113,5 +113,20 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D no joint left", m:flatjoint(a.id, c.id) == nil and m:bond_count() == 0, m:bond_count())
 end
 
+-- the material's flat-joint parameters survive a save and a load (issue 15 asked)
+do
+  local m = pair(3)
+  local path = os.tmpname()
+  m:save(path)
+  local r = seixo.load(path)
+  os.remove(path)
+  local want, got = m:materials().r.bond, r:materials().r.bond
+  for _, k in ipairs{"friction_angle", "friction", "elements", "sectors", "unbonded_fraction", "initial_gap",
+                     "tensile_strength", "cohesion"} do
+    check("saved bond " .. k, got and got[k] == want[k], got and tostring(got[k]) .. " vs " .. tostring(want[k]))
+  end
+  check("saved hash", r:hash() == m:hash(), "")
+end
+
 print(string.format("flatjoint: %d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end
