@@ -495,7 +495,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
         const double un = rsum - d;
         const double rmin = ri < rj ? ri : rj;
-        if (un > rmin) {
+        /* a smooth joint's contact may overlap deeply: its balls slide past each other along the plane */
+        if (un > rmin && !(p->joint && p->joint[c] && touching[c])) {
             o->st = SX_EUNSTABLE;
             o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un, o->err_r = rmin;
             return;
