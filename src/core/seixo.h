@@ -461,6 +461,8 @@ typedef struct sx_bond_def {
     double sectors;             ///< 3D: sectors of each ring (0: 4)
     double unbonded_fraction;   ///< probability that an element starts unbonded, in [0, 1]
     double initial_gap;         ///< m, >= 0: the gap of the elements that start unbonded
+    bool gapped;                ///< a pair installed apart (surface gap > 0) gets a gapped face: every element
+                                ///< unbonded, its gap the pair's (Potyondy 2012's gapped grains)
 } sx_bond_def;
 
 /// Zero everywhere (take the materials' values), kind parallel, gap 0, seed 1, any materials.

@@ -114,7 +114,7 @@ static int model_bond(lua_State *L)
                                        "stiffness_ratio", "tensile_strength", "tensile_strength_sd", "cohesion",
                                        "cohesion_sd", "normal_strength", "normal_strength_sd", "shear_strength",
                                        "shear_strength_sd", "friction_angle", "friction", "elements", "sectors",
-                                       "unbonded_fraction", "initial_gap", NULL};
+                                       "unbonded_fraction", "initial_gap", "gapped", NULL};
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
@@ -171,6 +171,11 @@ static int model_bond(lua_State *L)
     d.sectors = b.sectors;
     d.unbonded_fraction = b.unbonded_fraction;
     d.initial_gap = b.initial_gap;
+    if (lua_getfield(L, 2, "gapped") != LUA_TNIL) {
+        luaL_argcheck(L, lua_isboolean(L, -1), 2, "field 'gapped': true or false expected");
+        d.gapped = lua_toboolean(L, -1);
+    }
+    lua_pop(L, 1);
     int64_t count = 0;
     sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
     sx_lua_record_seed(L, 1, (int64_t)d.seed); /* the strengths drawn from it: the files' provenance lists it */

@@ -244,7 +244,8 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
  * orientation (as installed); its resultants are turned to the pair's:
  * the force on j added to F, its moment about the contact point to mb, and
  * both kept in the bond's fn, fs, mn, ms (as the parallel bond's). Returns
- * false when the joint is gone: no element bonded and none in contact. */
+ * false when the joint is gone: no element bonded and none in contact (a
+ * gapped face: and its balls apart by more than twice its gap). */
 static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *np, double d,
                        const double *vsp, const double *dthp, const double *xc, int64_t i, int64_t j, double *F,
                        double *mb)
@@ -281,7 +282,7 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
     const double delta = d - b->fj_d0[s], tanphi = b->fj_tanphi[s], mu = b->fj_mu[s];
     const int nr = b->fj_nr[s], na = b->fj_na[s];
     double fn_sum = 0, fs_sum[2] = {0, 0}, m1 = 0, m2 = 0, mt = 0;
-    bool alive = false;
+    bool alive = false, gapped = true;
     for (int el = 0; el < nr * na; el++) {
         const int64_t x = b->fj_first[s] + el;
         sx_law_fj_geom g;
@@ -325,6 +326,7 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         if (track) o->released += released;
         E->fn[x] = l.fn;
         alive = alive || bonded || l.fn > 0;
+        gapped = gapped && E->gap0[x] > 0;
         /* the element's moment about the contact point: re x (Fn n + Fs) + its own */
         fn_sum += l.fn;
         fs_sum[0] += fs[0];
@@ -335,6 +337,10 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         mt += g.y * fs[1] - g.z * fs[0];
 #endif
     }
+    /* a gapped face (every element installed open: Potyondy's gapped grains)
+     * waits for its balls to close while they have not opened by more than
+     * its gap again */
+    if (!alive && gapped) alive = delta < E->gap0[b->fj_first[s]];
     /* resultants, turned to the pair's orientation (sg) */
     double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
     b->fn[s] = fn_sum;
