@@ -4,7 +4,7 @@ set datafile separator ","
 set key top center
 intact = 183.4
 c_in = 10; mu_in = tan(30 * pi / 180)
-c_eff = C_EFF; mu_eff = MU_EFF
+c_eff = 5.62; mu_eff = 0.360 # the direct-shear peak envelope (docs/joints.md)
 jaeger(b, c, mu) = (b * pi / 180 > atan(mu) && b < 90) ? 2 * c / ((1 - mu / tan(b * pi / 180)) * sin(2 * b * pi / 180)) : 1e9
 cap(x) = x < intact ? x : intact
 set output "docs/img/joint-angle-ucs.png"
@@ -28,5 +28,7 @@ set xlabel ""
 set ylabel "UCS / BTS"
 set yrange [0:*]
 set xrange [*:*]
-set xtics rotate by -25
+set xtics rotate by -30
+set bmargin 11
+set rmargin 16
 plot "docs/data/ucs_bts.csv" every ::1 using 4:xtic(1) title "UCS/BTS", 15 with lines dt 2 lw 2, 8 with lines dt 3 lw 2
