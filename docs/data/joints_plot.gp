@@ -1,5 +1,5 @@
 # The charts of docs/joints.md (gnuplot docs/data/joints_plot.gp, from the repository's root).
-set terminal pngcairo size 900,600 font "sans,11"
+set terminal pngcairo size 1000,650 font "sans,11"
 set datafile separator ","
 set key top center
 intact = 183.4
@@ -29,6 +29,6 @@ set ylabel "UCS / BTS"
 set yrange [0:*]
 set xrange [*:*]
 set xtics rotate by -30
-set bmargin 11
-set rmargin 16
+set bmargin 13
+set rmargin 26
 plot "docs/data/ucs_bts.csv" every ::1 using 4:xtic(1) title "UCS/BTS", 15 with lines dt 2 lw 2, 8 with lines dt 3 lw 2
