@@ -35,8 +35,9 @@ end
 --- UCS, biaxial (or triaxial) and Brazilian tests of a parallel-bonded and a
 --- flat-jointed rock on the same specimens (genesis seed, size). opts: dim,
 --- width, height, diameter, radius, seed, confining (for phi; default
---- {0, 5e6, 10e6}), parallel and flatjoint (material overrides), out (CSV
---- and figure prefix), log. Returns {parallel = row, flatjoint = row} with
+--- {0, 5e6, 10e6}), parallel and flatjoint (material overrides), gap and
+--- gapped (the flat-jointed specimens' installation: lab.specimen's), out
+--- (CSV and figure prefix), log. Returns {parallel = row, flatjoint = row} with
 --- rows {ucs, bts, ratio, phi, c}.
 function joints.compare(opts)
   opts = opts or {}
@@ -49,6 +50,7 @@ function joints.compare(opts)
     local mat = model == "flatjoint" and joints.rock(opts.flatjoint) or lab.rock(opts.parallel)
     local common = {dim = dim, radius = radius, seed = opts.seed or 3, model = model, material = mat,
                     log = opts.log}
+    if model == "flatjoint" then common.gap, common.gapped = opts.gap, opts.gapped end
     local spec = lab.specimen(merge(common, {shape = dim == 3 and "cylinder" or "rect", width = opts.width or 0.01,
                                              diameter = opts.width or 0.01, height = opts.height or 0.02,
                                              path = out .. "_" .. model .. "_ucs.h5"}))
