@@ -53,9 +53,10 @@ function joints.compare(opts)
     if model == "flatjoint" then common.gap, common.gapped = opts.gap, opts.gapped end
     local spec = lab.specimen(merge(common, {shape = dim == 3 and "cylinder" or "rect", width = opts.width or 0.01,
                                              diameter = opts.width or 0.01, height = opts.height or 0.02,
-                                             path = out .. "_" .. model .. "_ucs.h5"}))
+                                             path = out .. "_" .. model .. "_specimen.h5"}))
     local disk = lab.specimen(merge(common, {shape = dim == 3 and "disc" or "disk", diameter = opts.diameter or 0.012,
-                                             thickness = opts.thickness, path = out .. "_" .. model .. "_bts.h5"}))
+                                             thickness = opts.thickness, path = out .. "_" .. model .. "_disk.h5"}))
+    -- (the series writes out_model_ucs.h5, the end of its UCS test: the specimen has a name of its own)
     local s = lab.series(spec, {confining = confining, out = out .. "_" .. model, log = opts.log})
     local b = lab.brazilian(disk, {log = opts.log})
     local ucs = s.tests[1].peak
