@@ -4,7 +4,7 @@ set datafile separator ","
 set key top center
 intact = 183.4
 c_in = 10; mu_in = tan(30 * pi / 180)
-c_eff = 5.62; mu_eff = 0.360 # the direct-shear peak envelope (docs/joints.md)
+c_eff = 5.80; mu_eff = 0.337 # the direct-shear peak envelope (docs/joints.md)
 jaeger(b, c, mu) = (b * pi / 180 > atan(mu) && b < 90) ? 2 * c / ((1 - mu / tan(b * pi / 180)) * sin(2 * b * pi / 180)) : 1e9
 cap(x) = x < intact ? x : intact
 set output "docs/img/joint-angle-ucs.png"
