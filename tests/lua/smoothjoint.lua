@@ -180,6 +180,37 @@ T.test("restart and threads: the same bits", function()
   m1:close(); m2:close(); r:close()
 end)
 
+-- A bed of about 4,500 disks in a box settling across two joints (one bonded),
+-- enough pairs for the contact pass to run in several chunks: 1 and 2
+-- threads must give the same bits.
+T.test("a bed across joints: 1 and 2 threads the same bits", function()
+  local function bed(threads)
+    seixo.threads = threads
+    local m = seixo.model{dim = 2, gravity = {0, -9.81}}
+    seixo.threads = nil
+    m:material("r", {density = 2600, kn = 1e7, ks = 1e7, friction = 0.5, damping = 0.2,
+                     bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e5,
+                             cohesion = 1e5}})
+    m:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
+    m:wall{kind = "line", point = {0, 0}, normal = {1, 0}}
+    m:wall{kind = "line", point = {0.5, 0}, normal = {-1, 0}}
+    m:generate{porosity = 0.3, radius = {0.003, 0.004}, region = {box = {{0, 0}, {0.5, 0.5}}}, method = "distribute",
+               seed = 4}
+    m:cycle(300)
+    m:bond{kind = "parallel", gap = 1e-4}
+    m:joint{point = {0.25, 0.1}, dip = 20, kn = 5e8, ks = 5e8, friction = 0.3, dilation = 5}
+    m:joint{point = {0.25, 0.2}, dip = -10, kn = 5e8, ks = 5e8, tension = 2e4, cohesion = 2e4, friction_angle = 20}
+    m:cycle(400)
+    return m
+  end
+  local m1, m2 = bed(1), bed(2)
+  local n = 0
+  for c in m1:contacts() do if c.joint then n = n + 1 end end
+  T.check(n > 50, "joint contacts: " .. n)
+  T.eq(m1:hash(), m2:hash(), "1 and 2 threads")
+  m1:close(); m2:close()
+end)
+
 -- A parallel-bonded pair across a bonded joint: the joint takes the bond's
 -- place, stress free, and breaks in tension at tension x A (A = 2 R in 2D,
 -- pi R^2 in 3D), logged as a smooth-joint crack.
