@@ -144,6 +144,7 @@ static int joint_install(sx_model *m, int64_t k, int64_t c, const double *nrm)
     }
     p->joint[c] = (int32_t)(k + 1);
     for (int q = 0; q < d; q++) p->jnormal[c * d + q] = nrm[q], p->fs[c * d + q] = 0, p->geo[c * d + q] = dx[q];
+    for (int q = 0; p->mr && q < m->rdim; q++) p->mr[c * m->rdim + q] = 0; /* the joint has no rolling moment */
     p->touching[c] = 1;
     return what;
 }

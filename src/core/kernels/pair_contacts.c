@@ -525,6 +525,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (!touching[c] && (*jk = sx__joint_crossed(m, D, x + i * D, x + j * D, jn))) {
                 p->jun[c] = un * fabs(dot(n, jn));
                 for (int k = 0; k < D; k++) fs[k] = 0;
+                if (p->mr) /* no rolling moment: an old contact's would be released when this one ends */
+                    for (int k = 0; k < RD; k++) p->mr[c * RD + k] = 0;
             }
             if (*jk) {
                 double xc[D], F[D];
