@@ -101,6 +101,8 @@ local entries = {
   -- model: bonds
   ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact' | 'flatjoint', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
   ["model:flatjoint"] = {"m:flatjoint(a, b) -> {{state, area, centroid, gap, fn, fs, tensile_strength, cohesion}, ...} | nil", "The elements of the flat joint between balls a and b."},
+  ["model:joint"] = {"m:joint{point =, normal = | dip = [, dip_direction =], kn =, ks =, friction =, dilation =, tension =, cohesion =, friction_angle =, radius_multiplier =} -> number, bonds, contacts", "Adds a smooth joint: contacts and bonds across the plane take the smooth-joint law."},
+  ["model:joints"] = {"m:joints() -> {{point, normal, kn, ks, ...}, ...}", "The model's smooth joints as given."},
   ["model:flatjoint_unbond"] = {"m:flatjoint_unbond(a, b, e)", "Makes element e of the flat joint between a and b a slit (compression and friction only)."},
   ["model:bond_count"] = {"m:bond_count() -> n", "Intact bonds."},
   ["model:cracks"] = {"m:cracks() -> {{time, step, pos, mode, kind, a, b, fn, fs, mn, ms}, ...}", "The log of broken bonds."},
@@ -235,6 +237,7 @@ local entries = {
   ["contact.pb_moment"] = {"c.pb_moment", "Parallel-bond moment on b [N m]."},
   ["contact.pb_radius"] = {"c.pb_radius", "Parallel-bond radius [m]."},
   ["contact.contact_model"] = {"c.contact_model", "The contact-model row the contact took when it was created (m:contact_model), nil for its materials' law."},
+  ["contact.joint"] = {"c.joint", "The smooth joint (m:joint's number) whose law the contact takes, or nil."},
   ["contact.shift"] = {"c.shift", "Periodic space: the period [m] b is seen through (its image at b.pos + shift touches a); zeros inside the cell."},
 
   -- seixo.util

@@ -5,6 +5,9 @@
 --   local joints = require("seixo.joints")
 --   local spec = lab.specimen{..., model = "flatjoint", material = joints.rock()}
 --   local t = joints.compare{dim = 2, out = "cmp"}   -- UCS/BTS and phi of both
+--   local js = joints.jointed(spec, {angle = 60, cohesion = 20e6, friction_angle = 30, path = "j60.h5"})
+--   local d = joints.direct_shear(spec, {normal_stress = 10e6, cohesion = 20e6, ...})
+--   local c = joints.angle_series(spec, {angles = {0, 15, ..., 90}, cohesion = 20e6, ...})
 local lab = require("seixo.lab")
 
 local joints = {}
@@ -32,8 +35,9 @@ end
 --- UCS, biaxial (or triaxial) and Brazilian tests of a parallel-bonded and a
 --- flat-jointed rock on the same specimens (genesis seed, size). opts: dim,
 --- width, height, diameter, radius, seed, confining (for phi; default
---- {0, 5e6, 10e6}), parallel and flatjoint (material overrides), out (CSV
---- and figure prefix), log. Returns {parallel = row, flatjoint = row} with
+--- {0, 5e6, 10e6}), parallel and flatjoint (material overrides), gap and
+--- gapped (the flat-jointed specimens' installation: lab.specimen's), out
+--- (CSV and figure prefix), log. Returns {parallel = row, flatjoint = row} with
 --- rows {ucs, bts, ratio, phi, c}.
 function joints.compare(opts)
   opts = opts or {}
@@ -46,11 +50,13 @@ function joints.compare(opts)
     local mat = model == "flatjoint" and joints.rock(opts.flatjoint) or lab.rock(opts.parallel)
     local common = {dim = dim, radius = radius, seed = opts.seed or 3, model = model, material = mat,
                     log = opts.log}
+    if model == "flatjoint" then common.gap, common.gapped = opts.gap, opts.gapped end
     local spec = lab.specimen(merge(common, {shape = dim == 3 and "cylinder" or "rect", width = opts.width or 0.01,
                                              diameter = opts.width or 0.01, height = opts.height or 0.02,
-                                             path = out .. "_" .. model .. "_ucs.h5"}))
+                                             path = out .. "_" .. model .. "_specimen.h5"}))
     local disk = lab.specimen(merge(common, {shape = dim == 3 and "disc" or "disk", diameter = opts.diameter or 0.012,
-                                             thickness = opts.thickness, path = out .. "_" .. model .. "_bts.h5"}))
+                                             thickness = opts.thickness, path = out .. "_" .. model .. "_disk.h5"}))
+    -- (the series writes out_model_ucs.h5, the end of its UCS test: the specimen has a name of its own)
     local s = lab.series(spec, {confining = confining, out = out .. "_" .. model, log = opts.log})
     local b = lab.brazilian(disk, {log = opts.log})
     local ucs = s.tests[1].peak
@@ -63,6 +69,210 @@ function joints.compare(opts)
   end
   lab.write_csv(out .. ".csv", {"model", "ucs_MPa", "bts_MPa", "ucs_over_bts", "phi_deg", "c_MPa"}, rows)
   return res
+end
+
+-- ------------------------------------------------------ jointed rock
+
+local joint_keys = {angle = true, path = true, point = true, kn = true, ks = true, friction = true, dilation = true,
+                    tension = true, cohesion = true, friction_angle = true, radius_multiplier = true}
+
+local function check_keys(fn, opts, keys)
+  for k in pairs(opts) do
+    if not keys[k] then error(string.format("joints.%s: unknown option '%s'", fn, tostring(k)), 3) end
+  end
+end
+
+-- The joint's parameters from opts, its stiffnesses by default the
+-- specimen's bonds' (4-51, 4-52 at the mean pair: kn = Ec / (rmin + rmax)).
+local function joint_def(spec, opts, point, normal)
+  local b = spec.material.bond or {}
+  local r = spec.radius
+  local kn = opts.kn or (b.modulus or spec.material.modulus) / (r[1] + r[2])
+  return {point = point, normal = normal, kn = kn, ks = opts.ks or kn / (b.stiffness_ratio or 2.5),
+          friction = opts.friction or 0.5, dilation = opts.dilation, tension = opts.tension or opts.cohesion,
+          cohesion = opts.cohesion, friction_angle = opts.friction_angle, radius_multiplier = opts.radius_multiplier}
+end
+
+--- A jointed specimen: spec (lab.specimen's) with a smooth joint through
+--- its centre (or `point`) whose normal makes `angle` degrees (beta) with
+--- the loading axis (y in 2D, z in 3D; turned towards x), saved to `path`.
+--- Bonds across the plane are cut, or replaced by the joint's bond when it
+--- has a cohesion (and a tension, default the cohesion). opts: angle, path,
+--- point, kn, ks (Pa/m; default the bonds'), friction (default 0.5),
+--- dilation, tension, cohesion (Pa), friction_angle (degrees),
+--- radius_multiplier. Returns the new spec, with spec.joint = {angle,
+--- bonds (cut or replaced), contacts, def}.
+function joints.jointed(spec, opts)
+  check_keys("jointed", opts, joint_keys)
+  if type(opts.angle) ~= "number" or opts.angle < 0 or opts.angle > 90 then
+    error("joints.jointed: angle must be a number of degrees in [0, 90]", 2)
+  end
+  if type(opts.path) ~= "string" then error("joints.jointed: path (the jointed specimen's file) is required", 2) end
+  local dim = spec.dim
+  local m = seixo.load(spec.path)
+  local point = opts.point
+  if not point then
+    point = {}
+    for k = 1, dim do point[k] = 0.5 * (spec.lo[k] + spec.hi[k]) end
+  end
+  local beta = math.rad(opts.angle)
+  local normal = dim == 2 and {math.sin(beta), math.cos(beta)} or {math.sin(beta), 0, math.cos(beta)}
+  local def = joint_def(spec, opts, point, normal)
+  local _, bonds, contacts = m:joint(def)
+  local out = merge(spec, {})
+  out.path = opts.path
+  out.bonds = m:bond_count()
+  out.joint = {angle = opts.angle, bonds = bonds, contacts = contacts, def = def}
+  m:vars().lab_specimen = merge(out, {})
+  m:save(opts.path)
+  m:close()
+  return out
+end
+
+--- Jaeger's single plane of weakness: the axial stress sigma1 at which a
+--- joint of cohesion cj and friction mu_j whose normal makes beta (degrees)
+--- with sigma1 slips under the confining stress sigma3,
+---   sigma1 = sigma3 + 2 (cj + mu_j sigma3) / ((1 - mu_j cot beta) sin 2 beta),
+--- or nil where the joint cannot slip (beta <= phi_j or beta = 90).
+function joints.jaeger(beta_deg, cj, muj, sigma3)
+  sigma3 = sigma3 or 0
+  local b = math.rad(beta_deg)
+  local den = (1 - muj / math.tan(b)) * math.sin(2 * b)
+  if not (den > 1e-12) then return nil end
+  return sigma3 + 2 * (cj + muj * sigma3) / den
+end
+
+--- UCS of jointed specimens against the joint's angle: for each angle of
+--- `angles` (degrees, default 0, 15, ..., 90) joints.jointed(spec, joint)
+--- and lab.ucs, beside Jaeger's curve with the joint's cohesion and
+--- tan(friction_angle), capped by the intact UCS (angle -1 in the rows).
+--- opts: angles, joint (joints.jointed's options less angle and path),
+--- test (lab.ucs's options), out (path prefix: out.csv, and out.png with
+--- gnuplot), log. Returns {intact =, rows = {{angle, ucs, jaeger}, ...}}.
+function joints.angle_series(spec, opts)
+  local angles = opts.angles or {0, 15, 30, 45, 52.5, 60, 67.5, 75, 90}
+  local out = opts.out or "angle_series"
+  local joint = opts.joint or {}
+  local test = merge(opts.test or {}, {log = opts.log})
+  local intact = lab.ucs(spec, test).peak
+  local cj, muj = joint.cohesion or 0, math.tan(math.rad(joint.friction_angle or 0))
+  local rows, csv = {}, {}
+  for i, a in ipairs(angles) do
+    local js = joints.jointed(spec, merge(joint, {angle = a, path = out .. "_" .. i .. ".h5"}))
+    local peak = lab.ucs(js, test).peak
+    local j = joints.jaeger(a, cj, muj)
+    local theory = j and math.min(j, intact) or intact
+    rows[i] = {angle = a, ucs = peak, jaeger = theory}
+    csv[i] = {a, peak / 1e6, theory / 1e6, intact / 1e6}
+    if opts.log then opts.log(string.format("joints.angle_series: beta %g deg: UCS %.4g MPa, Jaeger %.4g MPa", a,
+                                            peak / 1e6, theory / 1e6)) end
+  end
+  lab.write_csv(out .. ".csv", {"angle_deg", "ucs_MPa", "jaeger_MPa", "intact_MPa"}, csv)
+  return {intact = intact, rows = rows, cohesion = cj, friction = muj}
+end
+
+-- The joint contacts' resultant on the upper side (axis ax up): the normal
+-- and shear stresses over the joint's length (2D) or area (3D), and the
+-- count. A contact's force on b is fn N + fs, N from a's side to b's.
+local function joint_stress(m, area, ax)
+  local sn, tau, n = 0, 0, 0
+  for c in m:contacts() do
+    if c.joint then
+      local up = c.normal[ax] > 0 and 1 or -1 -- b above the joint: the force on b is the upper side's
+      sn = sn + up * (c.fn * c.normal[ax] + c.fs[ax])
+      tau = tau - up * (c.fn * c.normal[1] + c.fs[1])
+      n = n + 1
+    end
+  end
+  return sn / area, tau / area, n
+end
+
+--- A direct-shear test of a joint: a horizontal smooth joint through the
+--- middle of spec (a 2D rect or a 3D prism); the balls of the lowest
+--- quarter held still, those of the highest quarter a grip that moves at
+--- `speed` along +x while its vertical speed is servo-controlled to hold
+--- the normal stress on the joint at `normal_stress` (the joint contacts'
+--- normal forces over the joint's length or area). Records the joint's
+--- shear and normal stress against the grip's shear displacement until
+--- `displacement`. opts: normal_stress (Pa), joint (joints.jointed's
+--- options less angle, path), speed (m/s, default 0.02), displacement
+--- (default spec.radius[1]), every (steps, default 50), gain (default 0.2),
+--- out (CSV prefix), log. Returns {peak, residual (the mean over the last
+--- fifth), normal_stress, rows = {{disp, tau, sigma_n, dilation}, ...}}.
+function joints.direct_shear(spec, opts)
+  local dim = spec.dim
+  if dim == 3 and spec.shape ~= "prism" or dim == 2 and spec.shape ~= "rect" then
+    error("joints.direct_shear: a 2D rect or a 3D prism specimen", 2)
+  end
+  local sn = opts.normal_stress
+  if type(sn) ~= "number" or not (sn > 0) then error("joints.direct_shear: normal_stress must be > 0", 2) end
+  local js = joints.jointed(spec, merge(opts.joint or {}, {angle = 0, path = (opts.out or "direct_shear") .. ".h5"}))
+  local m = seixo.load(js.path)
+  local ax = dim
+  local lo, hi = spec.lo[ax], spec.hi[ax]
+  local h = hi - lo
+  local area = (spec.hi[1] - spec.lo[1]) * (dim == 3 and (spec.hi[2] - spec.lo[2]) or 1)
+  local grip = {}
+  for b in m:balls() do
+    local y = b.pos[ax]
+    if y < lo + 0.25 * h then
+      b.vel = dim == 3 and {0, 0, 0} or {0, 0}
+      b.fix = "all"
+    elseif y > hi - 0.25 * h then
+      b.fix = "all"
+      grip[#grip + 1] = b
+    end
+  end
+  local speed = opts.speed or 0.02
+  local every = opts.every or 50
+  local gain = opts.gain or 0.2
+  local target = opts.displacement or spec.radius[1]
+  local dt = m:timestep()
+  -- the grip's normal stiffness: the joint's contacts in series with the
+  -- specimen, estimated from the joint's kn (the servo's gain scales it)
+  local kj = js.joint.def.kn
+  local function set_grip(vx, vy)
+    for _, b in ipairs(grip) do b.vel = dim == 3 and {vx, 0, vy} or {vx, vy} end
+  end
+  local function servo(vx)
+    local s = joint_stress(m, area, ax)
+    -- vy = gain (s - sn) / (kj dt): a step of the stress error over the joint's stiffness per step
+    local vy = gain * (s - sn) / (kj * every * dt)
+    local cap = 10 * speed
+    vy = math.max(-cap, math.min(cap, vy))
+    set_grip(vx, vy)
+    return s
+  end
+  -- the normal stress first
+  local steps = 0
+  repeat
+    local s = servo(0)
+    m:cycle(every)
+    steps = steps + every
+  until (math.abs(s - sn) < 0.01 * sn and steps > 20 * every) or steps > 200000
+  local x0, y0 = grip[1].pos[1], grip[1].pos[ax]
+  local rows, peak = {}, -math.huge
+  while grip[1].pos[1] - x0 < target do
+    servo(speed)
+    m:cycle(every)
+    local s, tau = joint_stress(m, area, ax)
+    local d = grip[1].pos[1] - x0
+    rows[#rows + 1] = {d, tau, s, grip[1].pos[ax] - y0}
+    peak = math.max(peak, tau)
+  end
+  local n0 = math.floor(0.8 * #rows)
+  local res, k = 0, 0
+  for i = n0 + 1, #rows do res, k = res + rows[i][2], k + 1 end
+  res = k > 0 and res / k or 0
+  if opts.out then
+    lab.write_csv(opts.out .. ".csv", {"shear_disp_m", "tau_Pa", "sigma_n_Pa", "normal_disp_m"}, rows)
+  end
+  if opts.log then
+    opts.log(string.format("joints.direct_shear: sigma_n %.4g MPa: peak %.4g MPa, residual %.4g MPa (%d rows)",
+                           sn / 1e6, peak / 1e6, res / 1e6, #rows))
+  end
+  m:close()
+  return {peak = peak, residual = res, normal_stress = sn, rows = rows}
 end
 
 return joints

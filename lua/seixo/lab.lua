@@ -565,7 +565,7 @@ end
 --- bonds, porosity, floaters, sigma0, material, ...}.
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
-                                "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "seed", "path",
+                                "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "gapped", "seed", "path",
                                 "log", "max_steps", "clump", "model"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
@@ -726,7 +726,8 @@ function lab.specimen(opts)
 
   local kind = opts.model or "parallel" -- "flatjoint": seixo.joints (its parameters in the material's bond table)
   if kind ~= "parallel" and kind ~= "flatjoint" then fail("lab.specimen: model must be 'parallel' or 'flatjoint'") end
-  local bonds = m:bond{kind = kind, gap = gap, seed = seed}
+  if opts.gapped ~= nil and kind ~= "flatjoint" then fail("lab.specimen: gapped is an option of flat joints") end
+  local bonds = m:bond{kind = kind, gap = gap, seed = seed, gapped = opts.gapped}
   say(opts, "lab.specimen: %d %s bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
       .. "ball %.3f", bonds, kind, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
 

@@ -260,7 +260,7 @@ static void patch_pairs_after_remove(sx_model *m, const int32_t *remap)
         const int32_t a = remap[p->a[c]], bb = remap[p->b[c]];
         if (a < 0 || bb < 0) {
             if (p->bond && p->bond[c])
-                sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT);
+                sx__bond_break(m, p->bond[c] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT | SX_BOND_SMOOTHJOINT);
             continue;
         }
         sx__pair_move(m, p, k, c);
@@ -387,6 +387,11 @@ int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
     if (p->us)
         f[n++] = (sx_pair_field){(void **)&p->us, d, SX_PAIR_F64, true, false, "shear_displacement", "m"};
     if (p->cmodel) f[n++] = (sx_pair_field){(void **)&p->cmodel, 1, SX_PAIR_I32, false, false, "contact_model", NULL};
+    if (!walls && p->joint) { /* smooth joints (laws/smoothjoint.h) */
+        f[n++] = (sx_pair_field){(void **)&p->joint, 1, SX_PAIR_I32, false, false, "joint", NULL};
+        f[n++] = (sx_pair_field){(void **)&p->jnormal, d, SX_PAIR_F64, true, false, "joint_normal", "1"};
+        f[n++] = (sx_pair_field){(void **)&p->jun, 1, SX_PAIR_F64, false, false, "joint_overlap", "m"};
+    }
     /* a mesh's facet is a third end of a ball-wall pair: listed by the broad phase */
     if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_PAIR_I32, false, true, "facet", NULL};
     return n;

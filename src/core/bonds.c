@@ -338,10 +338,13 @@ static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t
         for (int k = 0; k < 3; k++) t[k] /= len;
     }
     const double fraction = param(def->unbonded_fraction, pa->unbonded_fraction, pb->unbonded_fraction);
-    const double gap0 = param(def->initial_gap, pa->initial_gap, pb->initial_gap);
+    /* a gapped face: its balls apart, every element open by their surface gap */
+    const double surface = b->fj_d0[s] - ri - rj;
+    const bool gapped = def->gapped && surface > 0;
+    const double gap0 = gapped ? surface : param(def->initial_gap, pa->initial_gap, pb->initial_gap);
     for (int e = 0; e < nr * na; e++) {
         const int64_t x = E->n++;
-        const bool bonded = !(fraction > 0 && uniform01(rng) < fraction);
+        const bool bonded = !gapped && !(fraction > 0 && uniform01(rng) < fraction);
         E->state[x] = (uint8_t)(bonded ? SX_FJ_BONDED : SX_FJ_UNBONDED);
         E->gap0[x] = bonded ? 0 : gap0;
         E->sigma_c[x] = draw_strength(rng, param(def->tensile_strength, pa->tensile_strength, pb->tensile_strength),

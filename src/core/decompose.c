@@ -36,6 +36,7 @@ static const char *not_decomposed(const sx_model *m)
     if (m->bonds.n) return "bonds";
     if (m->clumps) return "clumps";
     if (m->cell) return "periodic space";
+    if (m->njoint) return "smooth joints";
     if (m->track_energy) return "energy tracking";
     for (int64_t w = 0; w < m->nwall; w++)
         if (m->walls[w].mesh) return "mesh walls";

@@ -15,7 +15,9 @@
  * vector extensions), beside the full scalar forms; both give the same
  * bits (tests/test_determinism.c).
  */
+#include "joints.h"
 #include "laws/bonds.h"
+#include "laws/flatjoint.h"
 #include "laws/registry.h"
 #include "model_internal.h"
 

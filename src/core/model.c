@@ -3,6 +3,7 @@
  *     broad phase (when needed) -> timestep (auto) -> contact forces
  *     -> law of motion -> walls -> time, guard
  * with the dimension-specific stages in kernels.c. */
+#include "joints.h"
 #include "laws/law.h"
 #include "model_internal.h"
 
@@ -91,6 +92,7 @@ void sx_model_destroy(sx_model *m)
     sx__clumps_free(m);
     sx__cell_free(m);
     sx__dd_free(m);
+    sx__joints_free(m);
     for (int64_t c = 0; c < m->cap_chunk; c++) free(m->chunks[c].cracks);
     sx_alloc_free(&m->alloc, m->chunks, (size_t)m->cap_chunk, sizeof *m->chunks);
     sx_alloc_free(&m->alloc, m->blocks, m->blocks ? SX_MOTION_BLOCKS : 0, sizeof *m->blocks);
@@ -117,7 +119,7 @@ sx_memory sx_model_memory(const sx_model *m)
     r.total = m->alloc.bytes;
     r.peak = m->alloc.peak;
     r.balls = sx__balls_bytes(m);
-    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw) + sx__cell_bytes(m);
+    r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw) + sx__cell_bytes(m) + sx__joints_bytes(m);
     const sx_bonds *k = &m->bonds;
     const size_t d = (size_t)m->dim;
     const size_t per_bond = 3 + 3 * sizeof(int32_t) +

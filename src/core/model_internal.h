@@ -156,6 +156,10 @@ typedef struct sx_pairs {
     int32_t *facet;        /* m->bw: a mesh wall's facet (0 for other walls); NULL until the model has a mesh */
     int32_t *cmodel;       /* m->bb: the contact-model row the contact took (from 1; 0: its materials'
                             * law), cmodel.c; NULL while the table is empty */
+    /* m->bb, smooth joints (laws/smoothjoint.h): NULL until the model has a joint */
+    int32_t *joint;        /* the joint this contact crosses + 1 (0: none) */
+    double *jnormal;       /* its normal from a's side to b's (dim) */
+    double *jun;           /* the elastic normal overlap along it, m */
     /* the last force evaluation, for queries consistent with the balls' forces */
     double *un;            /* overlap (m->bw only: a ball-ball pair's follows from geo) */
     double *fn;            /* normal force incl. the normal dashpot, compression positive */
@@ -175,7 +179,7 @@ typedef struct sx_pair_field {
     const char *name;      /* the files' dataset */
     const char *unit;      /* its unit (NULL: none) */
 } sx_pair_field;
-#define SX_PAIR_FIELDS_MAX 12
+#define SX_PAIR_FIELDS_MAX 16
 /* The fields store p has (bond slots only once the model has bonds, rolling
  * moments once a material rolls, the overlap only in the ball-wall store),
  * into f; returns their count. */
@@ -366,6 +370,8 @@ struct sx_model {
     struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
     sx_cell *cell;            /* periodic space (periodic.c); NULL while the space is not periodic */
     sx_dd *dd;                /* domain decomposition (decompose.c); NULL in a serial run */
+    struct sx_joint *joints;  /* smooth joints (joints.c), in the order added */
+    int64_t njoint, cap_joint;
 };
 
 /* Ball i's local damping: its own, or its material's. */

@@ -388,7 +388,7 @@ static void drop_ghost_pairs(sx_model *m)
     int64_t k = 0;
     for (int64_t q = 0; q < p->n; q++) {
         if (p->b[q] >= m->cell->base) {
-            if (p->bond && p->bond[q]) sx__bond_break(m, p->bond[q] - 1, SX_BOND_CONTACT | SX_BOND_PARALLEL);
+            if (p->bond && p->bond[q]) sx__bond_break(m, p->bond[q] - 1, m->bonds.kind[p->bond[q] - 1]);
             continue;
         }
         sx__pair_move(m, p, k++, q);

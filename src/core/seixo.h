@@ -500,6 +500,7 @@ typedef struct sx_contact_info {
     double pb_fs[3];     ///< N, parallel-bond (or flat-joint face) shear force on b
     double pb_moment[3]; ///< N m, parallel-bond (or face) moment on b about the contact point (2D: [0])
     double pb_radius;    ///< m, parallel-bond radius (4-53), or the flat joint's face radius
+    int64_t joint;       ///< the smooth joint (1-based, sx_joint_add) whose law the contact takes; 0: none
     double shift[3];     ///< m, periodic space: the period b is seen through (b's image at
                          ///< its centre + shift touches a); 0 for a contact inside the cell
     int cmodel;          ///< the contact-model row it took (from 1; 0: its materials' law)
@@ -517,6 +518,7 @@ typedef enum sx_bond_kind {
     SX_BOND_CONTACT = 1,   ///< contact bond: normal and shear strengths as forces (4.3.5)
     SX_BOND_PARALLEL = 2,  ///< parallel bond: a cement disk/beam (4-32 ... 4-39)
     SX_BOND_FLATJOINT = 4, ///< flat joint (Potyondy 2012): a face of bonded/unbonded elements; replaces the contact law
+    SX_BOND_SMOOTHJOINT = 8, ///< bonded smooth joint (sx_joint_add): a contact across a joint plane, until it breaks
 } sx_bond_kind;
 
 /// Bond installation, like PFC's: every ball-ball pair closer than `gap`
@@ -544,6 +546,8 @@ typedef struct sx_bond_def {
     double sectors;             ///< 3D: sectors of each ring (0: 4)
     double unbonded_fraction;   ///< probability that an element starts unbonded, in [0, 1]
     double initial_gap;         ///< m, >= 0: the gap of the elements that start unbonded
+    bool gapped;                ///< a pair installed apart (surface gap > 0) gets a gapped face: every element
+                                ///< unbonded, its gap the pair's (Potyondy 2012's gapped grains)
 } sx_bond_def;
 
 /// Zero everywhere (take the materials' values), kind parallel, gap 0, seed 1, any materials.
@@ -625,6 +629,39 @@ SX_API int sx_flatjoint_get(const sx_model *m, int64_t a, int64_t b, int e, sx_f
 /// and from now on carries compression and friction only; no crack.
 SX_API sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e);
 SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
+
+/* --------------------------------------------------------- smooth joints */
+
+/// A smooth joint (Mas Ivars et al. 2011; src/core/laws/smoothjoint.h): a
+/// plane through the model. A contact or bond between two balls whose
+/// centres lie on opposite sides takes the smooth-joint law: its normal is
+/// the plane's, its shear lies in the plane.
+typedef struct sx_joint_def {
+    double point[3];          ///< m, a point of the plane
+    double normal[3];         ///< its normal (any length > 0; 2D: z ignored)
+    double kn, ks;            ///< Pa/m, normal and shear stiffness per unit area (> 0)
+    double friction;          ///< mu >= 0
+    double dilation;          ///< degrees, psi in [0, 90)
+    double tension;           ///< Pa, bond's tensile strength (0 with cohesion 0: unbonded)
+    double cohesion;          ///< Pa, bond's shear strength at zero normal stress
+    double friction_angle;    ///< degrees, the bond's phi_b in [0, 90): c + sigma_n tan(phi_b)
+    double radius_multiplier; ///< lambda > 0: the interface radius is lambda min(RA, RB)
+} sx_joint_def;
+
+/// Plane through the origin with normal +y, kn = ks = 0 (to be given), friction 0.5, no
+/// dilation, unbonded, lambda 1.
+SX_API sx_joint_def sx_joint_default_def(void);
+/// Adds a joint (number sx_joint_count - 1 afterwards) and installs it on the
+/// pairs it crosses: each bond between balls on opposite sides is removed,
+/// and a bonded joint takes its place, stress free (*bonds counts them);
+/// each other overlapping pair takes the joint's law as an unbonded contact
+/// (*contacts counts these). Later contacts across the plane take it as
+/// they form (the first joint crossed, in joint order). Bonds installed
+/// after a joint are not cut by it.
+SX_API sx_status sx_joint_add(sx_model *m, const sx_joint_def *def, int64_t *bonds, int64_t *contacts);
+SX_API int64_t sx_joint_count(const sx_model *m);
+/// Joint k (0-based) as given (its normal made unit).
+SX_API sx_status sx_joint_get(const sx_model *m, int64_t k, sx_joint_def *out);
 
 /* ------------------------------------------------------- periodic space */
 

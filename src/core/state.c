@@ -6,6 +6,7 @@
 
 #include "clumps.h"
 #include "laws/bond.h"
+#include "joints.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -25,6 +26,7 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->total_shear = m->bb.us != NULL;
     out->bonds = m->bonds.n;
     out->fj_elements = m->fjel.n;
+    out->joints = m->njoint;
     out->cracks = m->cracks.n;
     out->walls = m->nwall;
     out->materials = m->nmat;
@@ -51,7 +53,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (!empty(m)) return sx__fail(m, SX_EINVAL, "state: the model to restore into must be new and empty");
     if (s->balls < 0 || s->next_ball_id < 1 || s->balls > s->next_ball_id - 1 || s->next_ball_id >= INT32_MAX ||
         s->bb < 0 || s->bb > INT32_MAX || s->bw < 0 || s->bw > INT32_MAX || s->bonds < 0 ||
-        s->bonds > INT32_MAX - 1 || s->fj_elements < 0 || s->fj_elements > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
+        s->bonds > INT32_MAX - 1 || s->joints < 0 || s->joints > INT32_MAX || s->fj_elements < 0 || s->fj_elements > INT32_MAX - 1 || s->cracks < 0 || s->walls < 0 || s->walls > INT32_MAX || s->materials < 0 ||
         s->materials > UINT16_MAX || s->cmodels < 0 || s->cmodels > 4096)
         return sx__fail(m, SX_EINVAL,
                         "state: sizes out of range (%lld balls, next id %lld, %lld + %lld pairs, %lld bonds, "
@@ -83,6 +85,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     if (s->bw_facets && sx__pairs_expand_facets(m)) goto nomem;
     if (s->rolling && sx__pairs_expand(m, offsetof(sx_pairs, mr), r)) goto nomem;
     if (s->total_shear && sx__pairs_expand(m, offsetof(sx_pairs, us), d)) goto nomem;
+    if (s->joints > 0 && sx__joints_reserve_pairs(m)) goto nomem; /* their definitions: sx__joints_restore */
     m->bb.n = s->bb;
     m->bw.n = s->bw;
 
@@ -316,7 +319,8 @@ static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
 {
     const int d = m->dim;
     return finite_all(p->fs + c * d, d) && finite_all(p->geo + c * d, d) && isfinite(p->fn[c]) &&
-           (!p->un || isfinite(p->un[c]));
+           (!p->un || isfinite(p->un[c])) &&
+           (!p->jun || (isfinite(p->jun[c]) && finite_all(p->jnormal + c * d, d)));
 }
 
 static sx_status check_pairs(sx_model *m)
@@ -330,6 +334,13 @@ static sx_status check_pairs(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld refers to balls %d, %d of %lld", (long long)c,
                             p->a[c], p->b[c], (long long)n);
         if (p->touching[c] > 1) return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a bad touching flag", (long long)c);
+        if (p->joint && (p->joint[c] < 0 || p->joint[c] > m->njoint))
+            return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld names joint %d of %lld", (long long)c, p->joint[c],
+                            (long long)m->njoint);
+        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
+        if (slot >= 0 && slot < m->bonds.n && (m->bonds.kind[slot] & SX_BOND_SMOOTHJOINT) &&
+            !(p->joint && p->joint[c] && p->touching[c]))
+            return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has a smooth-joint bond but no joint", (long long)c);
         if (p->bond) {
             const int32_t s = p->bond[c];
             if (s < 0 || s > m->bonds.n)
@@ -378,7 +389,8 @@ static sx_status check_bonds(sx_model *m)
     sx_bonds *k = &m->bonds;
     k->intact = 0;
     for (int64_t s = 0; s < k->n; s++) {
-        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT))
+        if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT | SX_BOND_SMOOTHJOINT) ||
+            ((k->kind[s] & SX_BOND_SMOOTHJOINT) && k->kind[s] != SX_BOND_SMOOTHJOINT))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has an unknown kind %d", (long long)s, k->kind[s]);
         if (!k->kind[s]) continue; /* broken: its balls may be gone */
         if (!m->bb.bond) return sx__fail(m, SX_EINVAL, "state: intact bonds but no bond slots in the pair store");
@@ -711,5 +723,6 @@ uint64_t sx_model_state_hash(const sx_model *m)
     hash_bonds(&s, m);
     if (m->clumps) s.h = sx__clumps_hash(m, s.h);
     if (m->cell) s.h = sx__cell_hash(m, s.h);
+    if (m->njoint) s.h = sx__joints_hash(m, s.h);
     return s.h;
 }

@@ -43,6 +43,7 @@ typedef struct sx_state_sizes {
     bool total_shear;     ///< both pair stores carry shear displacements (laws/total_shear.h)
     int64_t bonds;        ///< bond slots (intact or broken)
     int64_t fj_elements;  ///< flat-joint elements
+    int64_t joints;       ///< smooth joints (the ball-ball store carries their fields when > 0)
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;
     int materials;

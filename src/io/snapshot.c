@@ -16,6 +16,7 @@
 #include "state.h"
 
 #include "clumps.h"
+#include "joints.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -729,8 +730,8 @@ static void load_walls(sx_h5 *h, hid_t g, sx_model *m, int version)
 
 static const char *const mode_names[] = {"tension", "shear"};
 static const int mode_values[] = {SX_CRACK_TENSION, SX_CRACK_SHEAR};
-static const char *const bond_kind_names[] = {"contact", "parallel", "flatjoint"};
-static const int bond_kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX_BOND_FLATJOINT};
+static const char *const bond_kind_names[] = {"contact", "parallel", "flatjoint", "smoothjoint"};
+static const int bond_kind_values[] = {SX_BOND_CONTACT, SX_BOND_PARALLEL, SX_BOND_FLATJOINT, SX_BOND_SMOOTHJOINT};
 
 typedef struct crack_cols {
     double *time, *pos, *fn, *fs, *mn, *ms;
@@ -773,8 +774,10 @@ static void crack_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
     hid_t mf = sx_h5_enum(H5T_STD_U8LE, mode_names, mode_values, 2);
     /* the flat joint's kind and the element column only in files of models with flat joints */
     const bool fj = write ? m->fjel.n > 0 : H5Lexists(g, "element", H5P_DEFAULT) > 0;
-    hid_t km = sx_h5_enum(H5T_NATIVE_INT, bond_kind_names, bond_kind_values, fj ? 3 : 2);
-    hid_t kf = sx_h5_enum(H5T_STD_U8LE, bond_kind_names, bond_kind_values, fj ? 3 : 2);
+    /* the smooth joint's kind only in files of models with smooth joints; read, any of the four */
+    const int nk = !write ? 4 : m->njoint > 0 ? 4 : fj ? 3 : 2;
+    hid_t km = sx_h5_enum(H5T_NATIVE_INT, bond_kind_names, bond_kind_values, nk);
+    hid_t kf = sx_h5_enum(H5T_STD_U8LE, bond_kind_names, bond_kind_values, nk);
     if (!crack_cols_alloc(&c, n) || mm < 0 || mf < 0 || km < 0 || kf < 0) {
         sx_h5_fail(h, "out of memory");
         goto done;
@@ -1097,6 +1100,78 @@ static void load_periodic(sx_h5 *h, hid_t f, sx_model *m)
     sx_h5_close(g);
 }
 
+/* -------------------------------------------------------- smooth joints */
+
+/* The smooth joints' definitions (core sx_joint_def) in their own group
+ * /joints, one row per joint, written only when the model has joints; the
+ * contacts' joint fields are the ball-ball store's (joint, joint_normal,
+ * joint_overlap). */
+enum { JOINT_COLS = 14 };
+
+static int joint_fields(field *f, double *cols, int64_t n)
+{
+    int k = 0;
+    f[k++] = F("point", T_F64, cols, 3, "m");
+    f[k++] = F("normal", T_F64, cols + 3 * n, 3, "1");
+    static const char *const names[] = {"kn", "ks", "friction", "dilation", "tension", "cohesion", "friction_angle",
+                                        "radius_multiplier"};
+    static const char *const units[] = {"Pa/m", "Pa/m", "1", "degree", "Pa", "Pa", "degree", "1"};
+    for (int q = 0; q < 8; q++) f[k++] = F(names[q], T_F64, cols + (6 + q) * n, 1, units[q]);
+    return k;
+}
+
+/* Between the definitions and the columns (to_cols: defs to cols). */
+static void joint_columns(sx_joint_def *defs, double *cols, int64_t n, bool to_cols)
+{
+    for (int64_t i = 0; i < n; i++) {
+        sx_joint_def *d = &defs[i];
+        double *v[JOINT_COLS] = {&d->point[0], &d->point[1], &d->point[2], &d->normal[0], &d->normal[1],
+                                 &d->normal[2], &d->kn, &d->ks, &d->friction, &d->dilation, &d->tension,
+                                 &d->cohesion, &d->friction_angle, &d->radius_multiplier};
+        for (int q = 0; q < JOINT_COLS; q++) {
+            double *c = q < 6 ? cols + (q / 3) * 3 * n + i * 3 + q % 3 : cols + (int64_t)q * n + i;
+            if (to_cols) *c = *v[q];
+            else *v[q] = *c;
+        }
+    }
+}
+
+static void save_joints(sx_h5 *h, hid_t f, const sx_model *m)
+{
+    const int64_t n = sx_joint_count(m);
+    if (n == 0) return;
+    sx_joint_def *defs = calloc((size_t)n, sizeof *defs);
+    double *cols = calloc((size_t)(n * JOINT_COLS), sizeof *cols);
+    if (!defs || !cols) sx_h5_fail(h, "out of memory");
+    else {
+        for (int64_t i = 0; i < n; i++) sx_joint_get(m, i, &defs[i]);
+        joint_columns(defs, cols, n, true);
+        hid_t g = sx_h5_group(h, f, "joints");
+        sx_h5_attr_int(h, g, "count", n);
+        field fl[MAX_FIELDS];
+        write_fields(h, g, fl, joint_fields(fl, cols, n), n);
+        sx_h5_close(g);
+    }
+    free(defs);
+    free(cols);
+}
+
+static void load_joints(sx_h5 *h, hid_t f, sx_model *m, int64_t n)
+{
+    if (n == 0) return;
+    sx_joint_def *defs = calloc((size_t)n, sizeof *defs);
+    double *cols = calloc((size_t)(n * JOINT_COLS), sizeof *cols);
+    if (!defs || !cols) sx_h5_fail(h, "out of memory");
+    else {
+        field fl[MAX_FIELDS];
+        load_group(h, f, "/joints", fl, joint_fields(fl, cols, n), n);
+        joint_columns(defs, cols, n, false);
+        if (!h->failed && sx__joints_restore(m, defs, n)) sx_h5_fail(h, "damaged: %s", sx_model_error(m));
+    }
+    free(defs);
+    free(cols);
+}
+
 /* ---------------------------------------------------------------- save */
 
 static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
@@ -1159,6 +1234,7 @@ static void save_all(sx_h5 *h, hid_t f, sx_model *m, const sx_snapshot_opts *o)
     save_walls(h, f, m);
     save_clumps(h, f, m);
     save_periodic(h, f, m);
+    save_joints(h, f, m);
     if (o) sx_io_histories_write(h, f, o->histories, o->nhistories);
 
     if (o && o->ntrees > 0) {
@@ -1224,6 +1300,11 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     g = sx_h5_open_group(h, f, "/bonds", true);
     s->bonds = sx_h5_rows(h, g, "/bonds", "kind", 1, true);
     sx_h5_close(g);
+    if (H5Lexists(f, "/joints", H5P_DEFAULT) > 0) {
+        g = sx_h5_open_group(h, f, "/joints", true);
+        s->joints = sx_h5_rows(h, g, "/joints", "kn", 1, true);
+        sx_h5_close(g);
+    }
     if (H5Lexists(f, "/flatjoints", H5P_DEFAULT) > 0) {
         g = sx_h5_open_group(h, f, "/flatjoints/elements", true);
         s->fj_elements = sx_h5_rows(h, g, "/flatjoints/elements", "state", 1, true);
@@ -1356,6 +1437,7 @@ sx_model *sx_snapshot_load(const char *path, int want_dim, sx_snapshot_info *inf
         sx_h5_close(g);
         load_cmodels(&h, f, m);
         load_periodic(&h, f, m); /* before the balls: the ghosts' slots come with the ball arrays */
+        load_joints(&h, f, m, s.joints);
 
         field fl[MAX_FIELDS];
         const ball_cols bc = {m->balls.alpha, m->balls.group, NULL};

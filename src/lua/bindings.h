@@ -44,6 +44,7 @@ void sx_lua_lab_register(lua_State *L);
 extern const luaL_Reg sx_lua_bonds_methods[];     ///< bonds.c: bond, bond_count, cracks, crack_count, track_energy
 extern const luaL_Reg sx_lua_clumps_methods[];    ///< clumps.c: clump_template(s), clump, clumps, clump_count
 extern const luaL_Reg sx_lua_disp_methods[];      ///< disp.c: reset_disp
+extern const luaL_Reg sx_lua_joints_methods[];    ///< joints.c: joint, joints
 /// disp.c: records a reference position for each ball that has none, once m:reset_disp made the table.
 void sx_lua_disp_fill(lua_State *L, int model);
 /// disp.c: pushes b.disp of ball id, the handle at index 1 (an error before any m:reset_disp).

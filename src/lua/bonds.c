@@ -23,6 +23,7 @@ static int bond_keys(const char **keys, int n, int cap)
 
 static const char *kind_name(sx_bond_kind k)
 {
+    if (k == SX_BOND_SMOOTHJOINT) return "smoothjoint"; /* installed by m:joint, not m:bond */
     sx_bond_kind bit;
     for (int i = 0; i < sx_bond_kind_count(); i++)
         if (sx_bond_kind_name(i, &bit) && bit == k) return sx_bond_kind_name(i, NULL);
@@ -94,8 +95,8 @@ static int material_index(lua_State *L, sx_model *m, int arg, const char *name)
 
 static int model_bond(lua_State *L)
 {
-    const char *keys[BOND_KEYS_MAX] = {"kind", "gap", "seed", "materials"};
-    bond_keys(keys, 4, BOND_KEYS_MAX); /* and the kinds' micro-parameters */
+    const char *keys[BOND_KEYS_MAX] = {"kind", "gap", "seed", "materials", "gapped"};
+    bond_keys(keys, 5, BOND_KEYS_MAX); /* and the kinds' micro-parameters */
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
@@ -141,6 +142,11 @@ static int model_bond(lua_State *L)
     }
     lua_pop(L, 1);
     for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_optnumfield(L, 2, sx_bond_key(k, NULL), sx_bond_key_call(&d, k));
+    if (lua_getfield(L, 2, "gapped") != LUA_TNIL) {
+        luaL_argcheck(L, lua_isboolean(L, -1), 2, "field 'gapped': true or false expected");
+        d.gapped = lua_toboolean(L, -1);
+    }
+    lua_pop(L, 1);
     int64_t count = 0;
     sx_lua_check(L, m, sx_bond_install(m, &d, &count), "m:bond");
     sx_lua_record_seed(L, 1, (int64_t)d.seed); /* the strengths drawn from it: the files' provenance lists it */

@@ -139,7 +139,17 @@ static int get_bond(lua_State *L)
     if (!b) lua_pushnil(L);
     else if (b == (SX_BOND_CONTACT | SX_BOND_PARALLEL)) lua_pushliteral(L, "both");
     else if (b & SX_BOND_FLATJOINT) lua_pushliteral(L, "flatjoint");
+    else if (b & SX_BOND_SMOOTHJOINT) lua_pushliteral(L, "smoothjoint");
     else lua_pushstring(L, b & SX_BOND_CONTACT ? "contact" : "parallel");
+    return 1;
+}
+
+/* c.joint: the smooth joint whose law the contact takes (m:joint's number), or nil. */
+static int get_joint(lua_State *L)
+{
+    const sx_contact_info *c = check_contact(L);
+    if (c->joint) lua_pushinteger(L, (lua_Integer)c->joint);
+    else lua_pushnil(L);
     return 1;
 }
 
@@ -250,6 +260,7 @@ void sx_lua_contacts_register(lua_State *L)
         {"pb_radius", get_pb_radius},
         {"shift", get_shift},
         {"contact_model", get_contact_model},
+        {"joint", get_joint},
         {NULL, NULL},
     };
     sx_lua_newclass(L, SX_LUA_CONTACT, "contact", meta, NULL, getters, NULL);

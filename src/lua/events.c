@@ -221,7 +221,10 @@ static void deliver_bonds(lua_State *L, int model, int handlers, int state, cons
         lua_setfield(L, -2, "pos");
         lua_pushstring(L, c.mode == SX_CRACK_TENSION ? "tension" : "shear");
         lua_setfield(L, -2, "mode");
-        lua_pushstring(L, c.kind == SX_BOND_PARALLEL ? "parallel" : "contact");
+        lua_pushstring(L, c.kind == SX_BOND_PARALLEL      ? "parallel"
+                          : c.kind == SX_BOND_FLATJOINT   ? "flatjoint"
+                          : c.kind == SX_BOND_SMOOTHJOINT ? "smoothjoint"
+                                                          : "contact");
         lua_setfield(L, -2, "bond");
         sx_lua_setnum(L, "fn", c.fn);
         sx_lua_setnum(L, "fs", c.fs);

@@ -14,7 +14,7 @@ static const luaL_Reg *const model_methods[] = {
     sx_lua_walls_methods,    sx_lua_contacts_methods, sx_lua_groups_methods,
     sx_lua_history_methods,  sx_lua_generate_methods, sx_lua_bonds_methods,
     sx_lua_lab_methods,      sx_lua_clumps_methods,   sx_lua_disp_methods,
-    sx_lua_periodic_methods, NULL,
+    sx_lua_periodic_methods, sx_lua_joints_methods, NULL,
 };
 
 /* seixo.progress([mode[, every]]): the progress display of long cycles

@@ -330,6 +330,15 @@ end)
 E("c.shift", function(c) return {get = c.c, field = "shift"} end)
 E("m:flatjoint", function(c) return method(c.m, "flatjoint", c.b.id, c.b2.id) end)
 E("m:flatjoint_unbond", function(c) return method(c.m, "flatjoint_unbond", c.b.id, c.b2.id, 1) end)
+E("m:joint", function(c)
+  return method(c.m, "joint", {point = V(c, 0.5, 0.5, 0.5), normal = V(c, 0, 1, 0), kn = 1e9, ks = 1e9, friction = 0.4,
+                               dilation = 5, tension = 1e5, cohesion = 1e5, friction_angle = 20})
+end)
+E("m:joints", function(c)
+  c.m:joint{point = V(c, 0.5, 0.5, 0.5), dip = 30, kn = 1e9, ks = 1e9}
+  return method(c.m, "joints")
+end)
+E("c.joint", function(c) return {get = c.c, field = "joint"} end)
 E("plot.live", function(c) return fn(plot.live, c.m, "ke", {every = 1000, terminal = "dumb", output = path(".txt")}) end)
 E("lab.calibrate", function()
   return fn(lab.calibrate, {targets = {E = 2e9}, parameters = {modulus = {1e9, 1e10}}, workers = 1, maxeval = 3,

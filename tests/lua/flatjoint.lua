@@ -113,5 +113,63 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D no joint left", m:flatjoint(a.id, c.id) == nil and m:bond_count() == 0, m:bond_count())
 end
 
+-- a gapped face (m:bond{gapped = true}, Potyondy's gapped grains): a pair
+-- installed apart by g gets every element open by g; closed by more than
+-- g it carries kn A (closure - g); apart by more than 2 g it is gone
+do
+  local m = seixo.model{dim = 2}
+  m:material("r", {density = 1000, kn = 1e9, ks = 1e9, friction = 0.5,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 2e6, friction = 0.6, elements = 4}})
+  local g = 1e-3
+  local a = m:ball{pos = {0, 0}, radius = 1}
+  local b = m:ball{pos = {2 + g, 0}, radius = 1}
+  check("gapped installed", m:bond{kind = "flatjoint", gap = 2 * g, gapped = true} == 1, "")
+  local open = true
+  for _, e in ipairs(m:flatjoint(a.id, b.id)) do
+    open = open and e.state == "unbonded" and math.abs(e.gap - g) < 1e-12
+  end
+  check("gapped: every element open by the gap", open, "")
+  a.fix = "all"
+  b.fix = "all"
+  b.pos = {2 - 0.5 * g, 0} -- closed by 1.5 g
+  m:cycle(1)
+  local c = m:contacts()()
+  local kn = 1e9 / 2 -- modulus / (RA + RB), per unit area
+  check("gapped: compression past the gap", c and math.abs(c.pb_fn - kn * 2 * 0.5 * g) < 1e-9 * kn * g,
+        c and c.pb_fn)
+  b.pos = {2 + 2.5 * g, 0}
+  m:cycle(1)
+  check("gapped: gone once apart by more than 2 g", m:bond_count() == 0, m:bond_count())
+  local m2 = seixo.model{dim = 2}
+  m2:material("r", {density = 1000, kn = 1e9, ks = 1e9, friction = 0.5,
+                    bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                            cohesion = 2e6, friction = 0.6, elements = 4}})
+  m2:ball{pos = {0, 0}, radius = 1}.fix = "all"
+  local b2 = m2:ball{pos = {2 + g, 0}, radius = 1}
+  b2.fix = "all"
+  m2:bond{kind = "flatjoint", gap = 2 * g, gapped = true}
+  b2.pos = {2 + 1.5 * g, 0}
+  m2:cycle(1)
+  check("gapped: apart by less than 2 g, kept", m2:bond_count() == 1, m2:bond_count())
+  local ok, err = pcall(m2.bond, m2, {kind = "flatjoint", gap = 1, gapped = 1})
+  check("gapped: a boolean", not ok and tostring(err):find("gapped"), err)
+end
+
+-- the material's flat-joint parameters survive a save and a load (issue 15 asked)
+do
+  local m = pair(3)
+  local path = os.tmpname()
+  m:save(path)
+  local r = seixo.load(path)
+  os.remove(path)
+  local want, got = m:materials().r.bond, r:materials().r.bond
+  for _, k in ipairs{"friction_angle", "friction", "elements", "sectors", "unbonded_fraction", "initial_gap",
+                     "tensile_strength", "cohesion"} do
+    check("saved bond " .. k, got and got[k] == want[k], got and tostring(got[k]) .. " vs " .. tostring(want[k]))
+  end
+  check("saved hash", r:hash() == m:hash(), "")
+end
+
 print(string.format("flatjoint: %d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

@@ -17,9 +17,11 @@ end
 -- [2, 4), where moving by the period (1) is exact, so the periodic run
 -- and the unwrapped one must agree to the bit, forces, spins and the
 -- bond's state included (carried through the wrap and the ghost).
-local function crossing(dim, periodic)
+local function crossing(dim, periodic, kind)
   local m = seixo.model{dim = dim, timestep = 2e-5}
-  material(m)
+  material(m, kind == "flatjoint" and {bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2,
+                                               tensile_strength = 1e12, cohesion = 1e12, friction_angle = 20,
+                                               friction = 0.4, elements = 4, sectors = 3}} or nil)
   if periodic then
     local lo, hi = {2, -1}, {3, 1}
     if dim == 3 then lo[3], hi[3] = -1, 1 end
@@ -31,7 +33,7 @@ local function crossing(dim, periodic)
   local a = m:ball{pos = p1, radius = r, vel = dim == 3 and {0.9, 0.05, 0.01} or {0.9, 0.05}}
   local b = m:ball{pos = p2, radius = r, vel = dim == 3 and {1.1, -0.03, 0.02} or {1.1, -0.03},
                    spin = dim == 3 and {3, -2, 7} or 7}
-  T.eq(m:bond{gap = 1e-3, kind = "parallel"}, 1, "one bond")
+  T.eq(m:bond{gap = 1e-3, kind = kind or "parallel"}, 1, "one bond")
   local out = {}
   for s = 1, 12 do
     m:cycle(500)
@@ -73,6 +75,28 @@ for _, dim in ipairs({2, 3}) do
     T.eq(mp:bond_count(), 1, "the bond is intact")
     local c = mp:contacts()()
     T.check(c and c.bond == "parallel", "the bonded pair is still listed")
+  end)
+  -- issue 15: bonds of every kind across the boundary; the flat joint's
+  -- face, its elements and its carried axis (3D) go through the wrap
+  T.test("a flat-jointed pair crosses the boundary as it moves unwrapped, to the bit (" .. dim .. "D)", function()
+    local p, mp = crossing(dim, true, "flatjoint")
+    local u, mu = crossing(dim, false, "flatjoint")
+    T.eq(#p, #u)
+    for n = 1, #p do
+      same_place(p[n][1], u[n][1], "position " .. n)
+      for q = 2, 5 do same_bits(p[n][q], u[n][q], "state " .. q .. " of entry " .. n) end
+    end
+    T.check(u[#u - 1][1][1] > 3 and u[#u][1][1] > 3, "the unwrapped balls left the cell's span")
+    T.eq(mp:bond_count(), 1, "the joint is intact")
+    local c = mp:contacts()()
+    T.check(c and c.bond == "flatjoint", "the flat-jointed pair is still listed")
+    local ep, eu = mp:flatjoint(1, 2), mu:flatjoint(1, 2)
+    T.eq(#ep, #eu, "elements")
+    for e = 1, #eu do
+      T.eq(ep[e].fn, eu[e].fn, "element " .. e .. " normal force")
+      T.eq(ep[e].fs, eu[e].fs, "element " .. e .. " shear force")
+      T.eq(ep[e].gap, eu[e].gap, "element " .. e .. " gap")
+    end
   end)
 end
 

@@ -190,7 +190,8 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
  * orientation (as installed); its resultants are turned to the pair's:
  * the force on j added to F, its moment about the contact point to mb, and
  * both kept in the bond's fn, fs, mn, ms (as the parallel bond's). Returns
- * false when the joint is gone: no element bonded and none in contact. */
+ * false when the joint is gone: no element bonded and none in contact (a
+ * gapped face: and its balls apart by more than twice its gap). */
 static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *np, double d,
                        const double *vsp, const double *dthp, const double *xc, int64_t i, int64_t j, double *F,
                        double *mb)
@@ -227,7 +228,7 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
     const double delta = d - b->fj_d0[s], tanphi = b->fj_tanphi[s], mu = b->fj_mu[s];
     const int nr = b->fj_nr[s], na = b->fj_na[s];
     double fn_sum = 0, fs_sum[2] = {0, 0}, m1 = 0, m2 = 0, mt = 0;
-    bool alive = false;
+    bool alive = false, gapped = true;
     for (int el = 0; el < nr * na; el++) {
         const int64_t x = b->fj_first[s] + el;
         sx_law_fj_geom g;
@@ -271,6 +272,7 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         if (track) o->released += released;
         E->fn[x] = l.fn;
         alive = alive || bonded || l.fn > 0;
+        gapped = gapped && E->gap0[x] > 0;
         /* the element's moment about the contact point: re x (Fn n + Fs) + its own */
         fn_sum += l.fn;
         fs_sum[0] += fs[0];
@@ -281,6 +283,10 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
         mt += g.y * fs[1] - g.z * fs[0];
 #endif
     }
+    /* a gapped face (every element installed open: Potyondy's gapped grains)
+     * waits for its balls to close while they have not opened by more than
+     * its gap again */
+    if (!alive && gapped) alive = delta < E->gap0[b->fj_first[s]];
     /* resultants, turned to the pair's orientation (sg) */
     double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
     b->fn[s] = fn_sum;
@@ -300,6 +306,76 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
     mb[0] += bms[0];
 #endif
     return alive;
+}
+
+/* 4-21 and 4-39: F on j and -F on i at the contact point, whose arms la n
+ * from i and -lb n from j both lie along n (so both moments are multiples
+ * of n x F), plus a moment mb on j and -mb on i (a bond's; NULL: none) and
+ * the rolling moment mroll alike. */
+static inline void pair_apply(double *f, double *t, int64_t i, int64_t j, const double *n, double la, double lb,
+                              const double *F, const double *mb, const double *mroll)
+{
+    double nf[RD];
+    moment_of(n, F, nf);
+    double *fi = f + i * D, *ti = t + i * RD, *fj = f + j * D, *tj = t + j * RD;
+    for (int k = 0; k < D; k++) {
+        fi[k] -= F[k];
+        fj[k] += F[k];
+    }
+    for (int k = 0; k < RD; k++) {
+        double ma = la * nf[k], mj = -lb * nf[k];
+        if (mb) ma += mb[k], mj += mb[k];
+        ma += mroll[k], mj += mroll[k];
+        ti[k] -= ma;
+        tj[k] += mj;
+    }
+}
+
+/* The smooth joint of pair c (laws/smoothjoint.h) in place of its contact
+ * law and bond: its overlap along the joint normal and its shear force in
+ * the plane incremented from vc, the contact point's relative velocity
+ * (4-16); a bonded joint (bit SX_BOND_SMOOTHJOINT of *bonds) checked
+ * against its strengths (a break cleared from *bonds, logged at xc); an
+ * unbonded one open, or slipping with dilation. The force on j to F. */
+static void smooth_joint(sx_model *m, sx_chunk *o, int64_t c, int32_t slot, unsigned *bonds, const double *vc,
+                         const double *xc, int64_t i, int64_t j, double *F)
+{
+    sx_pairs *p = &m->bb;
+    const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+    const double *N = p->jnormal + c * D;
+    double *fs = p->fs + c * D, *un = p->jun + c;
+    const double dt = motion_dt(m), area = sx_law_sj_area(D, L, m->balls.rad[i], m->balls.rad[j]);
+    const bool track = m->track_energy;
+    const double vn = dot(vc, N);
+    double fs0[D];
+    for (int k = 0; k < D; k++) fs0[k] = fs[k];
+    *un -= vn * dt;
+    for (int k = 0; k < D; k++) fs[k] -= L->ks * area * (vc[k] - vn * N[k]) * dt;
+    double fn = L->kn * area * *un;
+    bool bonded = *bonds & SX_BOND_SMOOTHJOINT;
+    double before = 0; /* a break releases the energy the bond loses */
+    if (bonded) {
+        const double fsn = sqrt(dot(fs, fs));
+        const int mode = sx_law_sj_breaks(L, area, fn, fsn);
+        if (mode) {
+            log_crack(m, o, xc, (sx_crack_mode)mode, SX_BOND_SMOOTHJOINT, -1, i, j, fn, fsn, 0, 0);
+            *bonds &= ~(unsigned)SX_BOND_SMOOTHJOINT;
+            bonded = false;
+            before = sx_law_sj_strain(D, L, area, *un, fs);
+        }
+    }
+    if (!bonded) {
+        if (track && *un <= 0 && !before) /* opening releases the shear spring */
+            o->slip += sx_law_sj_strain(D, L, area, 0, fs);
+        fn = sx_law_sj_unbonded(D, L, area, un, fs, fs0, track && !before ? &o->slip : NULL);
+        if (track && before) o->released += before - sx_law_sj_strain(D, L, area, *un > 0 ? *un : 0, fs);
+    }
+    for (int k = 0; k < D; k++) F[k] = fn * N[k] + fs[k];
+    p->fn[c] = fn;
+    if (slot >= 0 && bonded) { /* the bond's resultants, as a parallel bond's */
+        m->bonds.fn[slot] = fn;
+        for (int k = 0; k < D; k++) m->bonds.fs[slot * D + k] = fs[k];
+    }
 }
 
 /* A chunk's results start empty; the balls it clears start from their
@@ -360,6 +436,11 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
                 if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
                 if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum);
+                if (p->joint && p->joint[c]) { /* a smooth joint's springs instead */
+                    const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+                    o->slip += sx_law_sj_strain(D, L, sx_law_sj_area(D, L, ri, rj), fmax(p->jun[c], 0), fs) -
+                               (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+                }
             }
             touching[c] = 0;
             fn_all[c] = 0; /* its last evaluation: no force */
@@ -371,7 +452,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         for (int k = 0; k < D; k++) n[k] = dx[k] * inv_d;
         const double un = rsum - d;
         const double rmin = ri < rj ? ri : rj;
-        if (un > rmin) {
+        /* a smooth joint's contact may overlap deeply: its balls slide past each other along the plane */
+        if (un > rmin && !(p->joint && p->joint[c] && touching[c])) {
             o->st = SX_EUNSTABLE;
             o->err_a = B->id[i], o->err_b = B->id[j], o->err_un = un, o->err_r = rmin;
             return;
@@ -388,6 +470,32 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         double vs[D];
         for (int k = 0; k < D; k++) vs[k] = vc[k] - vn * n[k]; /* 4-17 */
 
+        if (p->joint) { /* a smooth joint: a new contact across a joint plane takes it */
+            int32_t *jk = p->joint + c;
+            double *jn = p->jnormal + c * D;
+            if (!touching[c] && (*jk = sx__joint_crossed(m, D, x + i * D, x + j * D, jn))) {
+                p->jun[c] = un * fabs(dot(n, jn));
+                for (int k = 0; k < D; k++) fs[k] = 0;
+                if (p->mr) /* no rolling moment: an old contact's would be released when this one ends */
+                    for (int k = 0; k < RD; k++) p->mr[c * RD + k] = 0;
+            }
+            if (*jk) {
+                double xc[D], F[D];
+                for (int k = 0; k < D; k++) xc[k] = x[i * D + k] + la * n[k];
+                unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+                smooth_joint(m, o, c, slot, &bonds, vc, xc, i, j, F);
+                if (slot >= 0 && !bonds) {
+                    m->bonds.kind[slot] = 0;
+                    p->bond[c] = 0;
+                    o->lost_bonds++;
+                }
+                for (int k = 0; k < D; k++) rel[k] = dx[k];
+                touching[c] = 1;
+                const double none[RD] = {0};
+                pair_apply(f, t, i, j, n, la, lb, F, NULL, none);
+                continue;
+            }
+        }
         /* the previous normal, from the last evaluation's relative position as n
          * was computed from dx (the same bits); none for a new contact */
         double nold[D];
@@ -518,21 +626,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         }
         for (int k = 0; k < D; k++) rel[k] = dx[k];
         touching[c] = active || bonds;
-        /* 4-21 and 4-39: both arms lie along n, so both moments are multiples of n x F */
-        double nf[RD];
-        moment_of(n, F, nf);
-        double *fi = f + i * D, *ti = t + i * RD, *fj = f + j * D, *tj = t + j * RD;
-        for (int k = 0; k < D; k++) {
-            fi[k] -= F[k];
-            fj[k] += F[k];
-        }
-        for (int k = 0; k < RD; k++) {
-            double ma = la * nf[k], mj = -lb * nf[k];
-            if (bond_moment) ma += mb[k], mj += mb[k];
-            ma += mroll[k], mj += mroll[k];
-            ti[k] -= ma;
-            tj[k] += mj;
-        }
+        pair_apply(f, t, i, j, n, la, lb, F, bond_moment ? mb : NULL, mroll);
     }
 }
 
@@ -731,7 +825,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
 
 static void ball_chunk(sx_model *m, sx_chunk *o)
 {
-    if (m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->track_energy) ball_chunk_batched(m, o);
+    if (m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->bb.joint && !m->track_energy) ball_chunk_batched(m, o);
     else ball_chunk_pass(m, o);
 }
 

@@ -57,6 +57,16 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const double un = pair_geometry(m, i, j, n);
         const double fn = pair_force(m, c, un, &kn, &ks);
         const sx_pair_law law = sx__bb_law(m, c, i, j);
+        if (m->bb.joint && m->bb.joint[c] && m->bb.touching[c]) { /* a smooth joint (laws/smoothjoint.h) */
+            const sx_law_sj *L = &m->joints[m->bb.joint[c] - 1].law;
+            const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
+            const bool bonded = slot >= 0 && (m->bonds.kind[slot] & SX_BOND_SMOOTHJOINT);
+            const double ju = bonded || m->bb.jun[c] > 0 ? m->bb.jun[c] : 0;
+            const double s = sx_law_sj_strain(D, L, sx_law_sj_area(D, L, B->rad[i], B->rad[j]), ju, m->bb.fs + c * D);
+            if (bonded) e->bond_strain += s;
+            else e->strain += s;
+            continue;
+        }
         e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
         e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
@@ -116,6 +126,13 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     ci.is_wall = is_wall;
     ci.cmodel = !is_wall && p->cmodel && p->touching[c] ? p->cmodel[c] : 0;
     if (!is_wall && m->cell) sx__cell_owner(m, p->b[c], ci.shift); /* through the boundary */
+    if (!is_wall && p->joint && p->joint[c]) { /* a smooth joint: its normal and stiffnesses */
+        const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+        const double area = sx_law_sj_area(D, L, B->rad[i], B->rad[p->b[c]]);
+        for (int k = 0; k < D; k++) ci.normal[k] = p->jnormal[c * D + k];
+        ci.kn = L->kn * area, ci.ks = L->ks * area;
+        ci.joint = p->joint[c];
+    }
     const int32_t slot = !is_wall && p->bond ? p->bond[c] - 1 : -1;
     if (slot >= 0) {
         const sx_bonds *b = &m->bonds;

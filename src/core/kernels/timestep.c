@@ -44,7 +44,13 @@ static double KERNEL(critical_dt)(sx_model *m)
         const sx_pair_law *law = sx__bb_step_law(m, c, i, j);
         double ktr = 0, krot_i = 0, krot_j = 0;
         const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
-        if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
+        if (p->joint && p->joint[c] && p->touching[c]) { /* a smooth joint's springs (laws/smoothjoint.h) */
+            const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+            const double area = sx_law_sj_area(D, L, B->rad[i], B->rad[j]);
+            ktr = (L->kn + L->ks) * area;
+            krot_i = L->ks * area * B->rad[i] * B->rad[i];
+            krot_j = L->ks * area * B->rad[j] * B->rad[j];
+        } else if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
             double kn, ks;
             stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
             if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
@@ -105,6 +111,11 @@ static double KERNEL(critical_dt)(sx_model *m)
             double knr, ksr;
             self_rating(&m->cmodel[row].law, r, &knr, &ksr);
             if (knr + ksr > kn + ks) kn = knr, ks = ksr;
+        }
+        for (int64_t q = 0; q < m->njoint; q++) { /* a smooth joint's contact may form at any step */
+            const sx_law_sj *L = &m->joints[q].law;
+            const double area = sx_law_sj_area(D, L, r, r);
+            if ((L->kn + L->ks) * area > kn + ks) kn = L->kn * area, ks = L->ks * area;
         }
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;

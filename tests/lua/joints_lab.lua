@@ -1,0 +1,58 @@
+-- Jointed specimens in seixo.joints (issue 14, item 3): Jaeger's single
+-- plane of weakness in closed form, a smooth joint through a bonded
+-- specimen at an angle, and the direct-shear test of an unbonded joint,
+-- whose residual shear stress is Coulomb's mu sigma_n.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local lab = require("seixo.lab")
+local joints = require("seixo.joints")
+
+T.test("Jaeger's single plane of weakness", function()
+  local mu = math.tan(math.rad(30))
+  -- beta = 60: sin 2 beta = sqrt(3)/2, 1 - mu cot beta = 2/3
+  T.near(joints.jaeger(60, 10e6, mu), 2 * 10e6 / (2 / 3 * math.sqrt(3) / 2), 1e-12)
+  T.near(joints.jaeger(60, 10e6, mu, 5e6), 5e6 + 2 * (10e6 + mu * 5e6) / (2 / 3 * math.sqrt(3) / 2), 1e-12)
+  T.eq(joints.jaeger(30, 10e6, mu), nil, "no slip at beta = phi")
+  T.eq(joints.jaeger(20, 10e6, mu), nil, "no slip below phi")
+  T.eq(joints.jaeger(90, 10e6, mu), nil, "no slip along sigma1")
+  -- the minimum at 45 + phi / 2
+  local best, at = math.huge, nil
+  for b = 31, 89 do
+    local s = joints.jaeger(b, 10e6, mu)
+    if s < best then best, at = s, b end
+  end
+  T.eq(at, 60, "the weakest angle")
+end)
+
+local dir = os.tmpname()
+os.remove(dir)
+os.execute("mkdir -p " .. T.quote(dir))
+local spec = lab.specimen{dim = 2, shape = "rect", width = 0.004, height = 0.008, radius = {0.2e-3, 0.33e-3}, seed = 2,
+                          path = dir .. "/rect.h5", log = false}
+
+T.test("a jointed specimen: the joint cuts the bonds across it", function()
+  local js = joints.jointed(spec, {angle = 45, cohesion = 10e6, friction_angle = 30, path = dir .. "/j45.h5"})
+  T.check(js.joint.bonds > 5, "bonds replaced: " .. js.joint.bonds)
+  T.eq(js.bonds, spec.bonds, "bonded: every bond kept, those across as the joint's")
+  local m = seixo.load(js.path)
+  local j = m:joints()[1]
+  T.near(j.normal[1], math.sqrt(0.5), 1e-12)
+  T.near(j.point[2], 0.5 * (spec.lo[2] + spec.hi[2]), 1e-12)
+  local n = 0
+  for c in m:contacts() do if c.bond == "smoothjoint" then n = n + 1 end end
+  T.eq(n, js.joint.bonds, "the joint's bonds")
+  m:close()
+  local cut = joints.jointed(spec, {angle = 45, path = dir .. "/c45.h5"})
+  T.eq(cut.bonds, spec.bonds - cut.joint.bonds, "unbonded: the bonds across are cut")
+  T.raises(function() joints.jointed(spec, {angle = 100, path = dir .. "/x.h5"}) end, "angle")
+  T.raises(function() joints.jointed(spec, {angle = 10, path = dir .. "/x.h5", glue = 1}) end, "glue")
+end)
+
+T.test("direct shear of an unbonded joint: residual mu sigma_n", function()
+  local r = joints.direct_shear(spec, {normal_stress = 5e6, joint = {friction = 0.4}, speed = 0.1, displacement = 5e-5,
+                                       log = false, out = dir .. "/ds"})
+  T.near(r.residual, 0.4 * 5e6, 0.02)
+  T.check(r.peak >= r.residual, "peak " .. r.peak)
+end)
+
+os.execute("rm -rf " .. T.quote(dir))
+T.done()
