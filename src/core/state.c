@@ -420,14 +420,7 @@ typedef struct hasher {
 
 static void put(hasher *s, const void *data, size_t n) { s->h = sx__fnv(s->h, data, n); }
 
-static void put_doubles(hasher *s, const double *v, int64_t n, double sign)
-{
-    for (int64_t i = 0; i < n; i++) {
-        const double x = v ? sign * v[i] : 0;
-        const double c = x == 0 ? 0.0 : x; /* -0 as +0 */
-        put(s, &c, sizeof c);
-    }
-}
+static void put_doubles(hasher *s, const double *v, int64_t n, double sign) { s->h = sx__fnv_doubles(s->h, v, n, sign); }
 
 static void put_double(hasher *s, double v) { put_doubles(s, &v, 1, 1); }
 
