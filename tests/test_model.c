@@ -434,24 +434,25 @@ START_TEST(interrupt_request_stops_long_loops)
 {
     const int dim = _i;
     sx_model *m[2];
-    const double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2}, g[3] = {0, -9.81, 0};
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.06}, g[3] = {0, -9.81, 0};
     for (int k = 0; k < 2; k++) {
         m[k] = scene_model(dim, g, 1e-5, 1e6, 0.5, 1000);
         scene_box_walls(m[k], lo, hi, 1e6, 0.5);
-        scene_random_balls(m[k], 200, lo, hi, 0.005, 0.01, 0.5, 0.05, 3, NULL);
-        ck_assert_cycle(m[k], 300);
+        /* packed enough that many balls touch from the start */
+        scene_random_balls(m[k], dim == 3 ? 150 : 50, lo, hi, 0.004, 0.006, 1.0, 0.1, 3, NULL);
+        ck_assert_cycle(m[k], 1000);
         /* a ball set where it is: the next cycle starts with a build */
         double x[3];
         const int64_t id = sx_ball_id_at(m[k], 0);
         ck_assert_int_eq(sx_ball_get_vec(m[k], id, SX_BALL_POS, x), SX_OK);
         ck_assert_int_eq(sx_ball_set_vec(m[k], id, SX_BALL_POS, x), SX_OK);
     }
-    ck_assert_int_gt(sx_contact_count(m[0]), 10); /* a history to carry over */
+    ck_assert_int_gt(sx_contact_count(m[0]), 0); /* a history to carry over */
     const uint64_t h = sx_model_state_hash(m[0]);
     sx_interrupt_request();
     ck_assert_int_eq(sx_model_cycle(m[0], 10), SX_EINTERRUPT);
     ck_assert_msg_has(m[0], "interrupted in the broad phase");
-    ck_assert_int_eq(sx_model_step_count(m[0]), 300);
+    ck_assert_int_eq(sx_model_step_count(m[0]), 1000);
     sx_bond_def b = sx_bond_default_def();
     b.kind = SX_BOND_CONTACT;
     b.gap = 1e-3;

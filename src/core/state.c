@@ -639,7 +639,8 @@ uint64_t sx_model_state_hash(const sx_model *m)
     hash_pairs(&s, m, &m->bb, false);
     hash_pairs(&s, m, &m->bw, true);
     hash_bonds(&s, m);
-    if (m->clumps) s.h = sx__clumps_hash(m, s.h);
+    /* an empty clump store (a template that was refused) is no clumps */
+    if (m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0)) s.h = sx__clumps_hash(m, s.h);
     if (m->cell) s.h = sx__cell_hash(m, s.h);
     return s.h;
 }
