@@ -1739,6 +1739,12 @@ sx_status sx__clumps_finish(sx_model *m)
             !finite_n(C->q + c * qd, qd) || (C->L && !finite_n(C->L + c * 3, 3)) || !isfinite(C->mass[c]) ||
             !isfinite(C->scale[c]))
             return sx__fail(m, SX_EINVAL, "state: clump %lld has a non-finite or out-of-range state", (long long)id);
+        if (qd == 4) { /* a unit quaternion as saved (a zero one made a NaN orientation) */
+            const double *q = C->q + c * 4;
+            if (!(fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) - 1) < 1e-6))
+                return sx__fail(m, SX_EINVAL, "state: clump %lld has an orientation that is not a unit quaternion",
+                                (long long)id);
+        }
         for (int k = 0; k < r; k++)
             if (!(C->inertia[c * r + k] > 0) || !isfinite(C->inertia[c * r + k]))
                 return sx__fail(m, SX_EINVAL, "state: clump %lld has an inertia <= 0", (long long)id);

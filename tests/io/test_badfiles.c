@@ -503,6 +503,22 @@ START_TEST(meaningless_values)
         H5Fclose(f);
         expect_error(p, 0, cases[k].error);
     }
+    /* found by the file fuzzer: a clump's orientation of zeros (the dataset
+     * retyped to integers) was loaded, and normalised into NaN */
+    sx_model *m = io_scene_bonded(3);
+    const double pos[6] = {0, 0, 0, 0.006, 0, 0}, rad[2] = {0.005, 0.004};
+    const sx_clump_template_def t = {pos, rad, 2, 0};
+    ck_assert_int_eq(sx_clump_template_add(m, "pair", &t, NULL), SX_OK);
+    sx_clump_def c = sx_clump_default_def();
+    c.pos[0] = c.pos[1] = c.pos[2] = 1; /* away from the bonded balls */
+    ck_assert_int_eq(sx_clump_add(m, &c, NULL), SX_OK);
+    char q[512];
+    io_save(m, io_path(q, sizeof q, "clump.h5"));
+    sx_model_destroy(m);
+    hid_t f = edit(q, p, sizeof p, "clump_q0.h5");
+    for (hsize_t k = 0; k < 4; k++) poke_at(f, "/clumps/orientation", k, 0);
+    H5Fclose(f);
+    expect_error(p, 3, "clump 1 has an orientation that is not a unit quaternion");
 }
 END_TEST
 
