@@ -607,6 +607,9 @@ local function check_options(lab, opts)
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")
   o.plot = opts.plot
+  if opts.print ~= nil and opts.print ~= false and type(opts.print) ~= "function" then
+    fail("print must be a function or false (got %s)", type(opts.print))
+  end
   o.print = opts.print == false and function() end or opts.print or print
   return o
 end

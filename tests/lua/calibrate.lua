@@ -248,6 +248,8 @@ test("bad options are clear errors at the caller", function()
                                     maxeval = "zz"} end, "lab.calibrate: maxeval must be a whole number >= 0 (got zz)")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
                                     tolerance = 0 / 0} end, "lab.calibrate: tolerance must be a finite number >= 0")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    print = math.mininteger} end, "lab.calibrate: print must be a function or false (got number)")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {2e9, 1e9}}, evaluate = synthetic} end,
            "parameters.modulus must be {lower, upper}")
   T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
