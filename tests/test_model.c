@@ -425,6 +425,63 @@ START_TEST(interrupt_before_cycle_is_cleared)
 }
 END_TEST
 
+/* A process-wide interrupt request (a Ctrl-C: sx_interrupt_request) stops
+ * the core's long loops outside the steps, each leaving the model as it
+ * was: the broad phase (in a cycle, and in m:bond's build), a clump
+ * template's mass properties. The balls' order the build's sort changed
+ * is put back, so a twin never interrupted runs on bit-identically. */
+START_TEST(interrupt_request_stops_long_loops)
+{
+    const int dim = _i;
+    sx_model *m[2];
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.06}, g[3] = {0, -9.81, 0};
+    for (int k = 0; k < 2; k++) {
+        m[k] = scene_model(dim, g, 1e-5, 1e6, 0.5, 1000);
+        scene_box_walls(m[k], lo, hi, 1e6, 0.5);
+        /* packed enough that many balls touch from the start */
+        scene_random_balls(m[k], dim == 3 ? 150 : 50, lo, hi, 0.004, 0.006, 1.0, 0.1, 3, NULL);
+        ck_assert_cycle(m[k], 1000);
+        /* a ball set where it is: the next cycle starts with a build */
+        double x[3];
+        const int64_t id = sx_ball_id_at(m[k], 0);
+        ck_assert_int_eq(sx_ball_get_vec(m[k], id, SX_BALL_POS, x), SX_OK);
+        ck_assert_int_eq(sx_ball_set_vec(m[k], id, SX_BALL_POS, x), SX_OK);
+    }
+    ck_assert_int_gt(sx_contact_count(m[0]), 0); /* a history to carry over */
+    const uint64_t h = sx_model_state_hash(m[0]);
+    sx_interrupt_request();
+    ck_assert_int_eq(sx_model_cycle(m[0], 10), SX_EINTERRUPT);
+    ck_assert_msg_has(m[0], "interrupted in the broad phase");
+    ck_assert_int_eq(sx_model_step_count(m[0]), 1000);
+    sx_bond_def b = sx_bond_default_def();
+    b.kind = SX_BOND_CONTACT;
+    b.gap = 1e-3;
+    b.normal_strength = b.shear_strength = 1;
+    int64_t count = -1;
+    ck_assert_int_eq(sx_bond_install(m[0], &b, &count), SX_EINTERRUPT);
+    ck_assert_int_eq(sx_bond_count(m[0]), 0);
+    /* two overlapping pebbles */
+    const double pos2[4] = {0, 0, 0.008, 0}, pos3[6] = {0, 0, 0, 0.008, 0, 0}, rad[2] = {0.005, 0.005};
+    const sx_clump_template_def t = {dim == 3 ? pos3 : pos2, rad, 2, 0};
+    ck_assert_int_eq(sx_clump_template_add(m[0], "pair", &t, NULL), SX_EINTERRUPT);
+    ck_assert_msg_has(m[0], "interrupted (no template added)");
+    ck_assert_int_eq(sx_clump_template_count(m[0]), 0);
+    /* the request stays until answered */
+    ck_assert(sx_interrupt_pending());
+    sx_interrupt_clear();
+    ck_assert(!sx_interrupt_pending());
+    ck_assert_uint_eq(sx_model_state_hash(m[0]), h);
+    int64_t moved = 0;
+    for (int64_t i = 0; i < sx_ball_count(m[0]); i++) moved += sx_ball_id_at(m[0], i) != sx_ball_id_at(m[1], i);
+    ck_assert_int_eq(moved, 0);
+    for (int k = 0; k < 2; k++) ck_assert_cycle(m[k], 300);
+    ck_assert_uint_eq(sx_model_state_hash(m[0]), sx_model_state_hash(m[1]));
+    ck_assert_int_eq(sx_clump_template_add(m[0], "pair", &t, NULL), SX_OK);
+    sx_model_destroy(m[0]);
+    sx_model_destroy(m[1]);
+}
+END_TEST
+
 /* --------------------------------------------------------------- memory */
 
 START_TEST(bytes_grow_with_balls)
@@ -780,6 +837,7 @@ int main(void)
     tcase_set_timeout(tq, 20);
     tcase_add_loop_test(tq, interrupt_from_thread, 2, 4);
     tcase_add_test(tq, interrupt_before_cycle_is_cleared);
+    tcase_add_loop_test(tq, interrupt_request_stops_long_loops, 2, 4);
     tcase_add_loop_test(tq, cycle_without_balls, 2, 4);
     suite_add_tcase(s, tq);
     SRunner *sr = srunner_create(s);

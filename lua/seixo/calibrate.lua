@@ -589,6 +589,20 @@ local function check_options(lab, opts)
   o.tolerance = opts.tolerance or 0.02
   o.guesses = opts.guesses or 3
   o.penalty = opts.penalty or 10
+  -- numbers, checked here rather than compared deep in the search (a string
+  -- for maxeval once failed there with Lua's own message)
+  for _, k in ipairs({"maxeval", "guesses"}) do
+    local v = o[k]
+    if math.type(v) == nil or v ~= math.floor(v) or v < 0 or v == math.huge then
+      fail("%s must be a whole number >= 0 (got %s)", k, tostring(v))
+    end
+  end
+  for _, k in ipairs({"xtol", "tolerance", "penalty"}) do
+    local v = o[k]
+    if type(v) ~= "number" or not (v >= 0) or v == math.huge then
+      fail("%s must be a finite number >= 0 (got %s)", k, tostring(v))
+    end
+  end
   o.algorithm = opts.algorithm or "bobyqa"
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")

@@ -68,9 +68,10 @@ end
 --- file for a file terminal, rewritten at each refresh), title, x = "step"
 --- (default) or "time", log = true for a logarithmic y axis.
 function plot.live(m, names, opts)
-  local ok, method = pcall(function() return m.histories end)
-  if getmetatable(m) == nil or type(m) ~= "userdata" or not ok or type(method) ~= "function" then
-    fail("plot.live: a model expected, got %s", type(m))
+  -- a model answers m:histories(); another userdata (a file handle) may index to nil
+  local hok, histories = pcall(function() return m:histories() end)
+  if type(m) ~= "userdata" or not hok or type(histories) ~= "table" then
+    fail("plot.live: a model expected, got %s", io.type(m) or type(m))
   end
   opts = opts or {}
   if type(opts) ~= "table" then fail("plot.live: an options table expected, got %s", type(opts)) end
@@ -85,7 +86,7 @@ function plot.live(m, names, opts)
     if not keys[k] then fail("plot.live: unknown key '%s' (valid keys: every, log, output, terminal, title, x)", tostring(k)) end
   end
   local have = {}
-  for _, name in ipairs(m:histories()) do have[name] = true end
+  for _, name in ipairs(histories) do have[name] = true end
   for _, name in ipairs(names) do
     if not have[name] then fail("plot.live: no history named '%s' (add it with m:history)", tostring(name)) end
   end

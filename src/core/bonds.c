@@ -384,7 +384,11 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
     const int d = m->dim;
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
+    /* every pair checked before any is bonded: a Ctrl-C stops the scan with no bond installed (the
+     * installing pass that follows is as long as this one) */
     for (int64_t c = 0; c < p->n; c++) {
+        if (c % 4096 == 0 && sx__interrupted(m))
+            return sx__fail(m, SX_EINTERRUPT, "bond: interrupted (no bond installed)");
         const int ma = B->mat[p->a[c]], mb = B->mat[p->b[c]];
         double n[3];
         if (!pair_selected(def, ma, mb) || pair_gap(m, c, n) >= def->gap) continue;

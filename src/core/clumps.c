@@ -403,17 +403,18 @@ static void span_moments(double a, double b, double w, double *m0, double *m1, d
  * to x across [lo, hi] (3D: in y and z, 2D: in y), about the point c: the
  * moments of sum over pebbles of their chords minus the chords' union.
  * Only the pebbles flagged in `in` (those overlapping another) take part. */
-static bool overlap_correction(int d, const double *pos, const double *rad, const uint8_t *in, int64_t np,
-                               const double *lo, const double *hi, int64_t n, double offset, const double *c,
-                               moments *out)
+static sx_status overlap_correction(const sx_model *m, const double *pos, const double *rad, const uint8_t *in,
+                                    int64_t np, const double *lo, const double *hi, int64_t n, double offset,
+                                    const double *c, moments *out)
 {
+    const int d = m->dim;
     memset(out, 0, sizeof *out);
     span *sp = malloc((size_t)np * sizeof *sp);
     int64_t *row = malloc((size_t)np * sizeof *row);
     if (!sp || !row) {
         free(sp);
         free(row);
-        return false;
+        return SX_ENOMEM;
     }
     const double hy = (hi[1] - lo[1]) / (double)n, hz = d == 3 ? (hi[2] - lo[2]) / (double)n : 1;
     const int64_t nz = d == 3 ? n : 1;
@@ -426,6 +427,12 @@ static bool overlap_correction(int d, const double *pos, const double *rad, cons
             if (in[i] && fabs(y - pos[i * d + 1]) < rad[i]) row[nr++] = i;
         if (nr < 2) continue;
         for (int64_t iz = 0; iz < nz; iz++) {
+            /* up to 2048^2 lines across up to a million pebbles */
+            if (sx__interrupted(m)) {
+                free(sp);
+                free(row);
+                return SX_EINTERRUPT;
+            }
             const double z = d == 3 ? lo[2] + ((double)iz + offset) * hz : 0;
             int64_t ns = 0;
             for (int64_t k = 0; k < nr; k++) {
@@ -471,7 +478,7 @@ static bool overlap_correction(int d, const double *pos, const double *rad, cons
     out->j[3] = out->j[1], out->j[6] = out->j[2], out->j[7] = out->j[5];
     free(sp);
     free(row);
-    return true;
+    return SX_OK;
 }
 
 /* Volume, centroid and inertia per unit density (about the centroid, in
@@ -559,7 +566,12 @@ static sx_status template_props(sx_model *m, sx_clump_tpl *t, int64_t lines)
     if (!in) return SX_ENOMEM;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     bool overlaps = false;
-    for (int64_t i = 0; i < n; i++)
+    for (int64_t i = 0; i < n; i++) {
+        /* a million pebbles make 5e11 pairs */
+        if (i % 256 == 0 && sx__interrupted(m)) {
+            free(in);
+            return SX_EINTERRUPT;
+        }
         for (int64_t j = i + 1; j < n; j++) {
             double d2 = 0;
             for (int k = 0; k < d; k++) d2 += (pos[j * d + k] - pos[i * d + k]) * (pos[j * d + k] - pos[i * d + k]);
@@ -573,6 +585,7 @@ static sx_status template_props(sx_model *m, sx_clump_tpl *t, int64_t lines)
                 hi[k] = fmax(hi[k], fmin(pos[i * d + k] + rad[i], pos[j * d + k] + rad[j]));
             }
         }
+    }
     moments corr;
     memset(&corr, 0, sizeof corr);
     t->error = 0;
@@ -580,11 +593,12 @@ static sx_status template_props(sx_model *m, sx_clump_tpl *t, int64_t lines)
     if (overlaps) {
         if (lines == 0) lines = d == 3 ? LINES_3D : LINES_2D;
         moments half[2];
-        if (!overlap_correction(d, pos, rad, in, n, lo, hi, lines, 0.5, c0, &corr) ||
-            !overlap_correction(d, pos, rad, in, n, lo, hi, lines / 2, 0.5, c0, &half[0]) ||
-            !overlap_correction(d, pos, rad, in, n, lo, hi, lines / 2, 0.25, c0, &half[1])) {
+        sx_status st = overlap_correction(m, pos, rad, in, n, lo, hi, lines, 0.5, c0, &corr);
+        if (!st) st = overlap_correction(m, pos, rad, in, n, lo, hi, lines / 2, 0.5, c0, &half[0]);
+        if (!st) st = overlap_correction(m, pos, rad, in, n, lo, hi, lines / 2, 0.25, c0, &half[1]);
+        if (st) {
             free(in);
-            return SX_ENOMEM;
+            return st;
         }
         finish_props(d, &e, &corr, c0, &t->volume, t->centroid, t->inertia);
         double spread = 0;
@@ -663,6 +677,7 @@ sx_status sx_clump_template_add(sx_model *m, const char *name, const sx_clump_te
     memcpy(C->tp_rad + t->first, def->radius, (size_t)def->count * sizeof(double));
     const sx_status st = template_props(m, t, def->lines);
     if (st == SX_ENOMEM) return sx__fail(m, SX_ENOMEM, "clump_template '%s': out of memory", name);
+    if (st == SX_EINTERRUPT) return sx__fail(m, st, "clump_template '%s': interrupted (no template added)", name);
     if (st) return sx__fail(m, SX_EINVAL, "clump_template '%s': its mass properties are degenerate", name);
     C->tp_n += def->count;
     if (out) *out = C->ntpl;
@@ -1542,21 +1557,51 @@ double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double 
     return best;
 }
 
+/* What a restart restores of the clumps (the snapshot's /clumps): every
+ * template, then every clump in id order (its pebbles as ball ids), each
+ * double with -0 as +0, as the state hash takes the rest (state.c). */
 uint64_t sx__clumps_hash(const sx_model *m, uint64_t h)
 {
     const sx_clumps *C = m->clumps;
-    const size_t n = (size_t)C->n, d = (size_t)m->dim, r = (size_t)m->rdim;
-    h = sx__fnv(h, C->id, n * sizeof *C->id);
-    h = sx__fnv(h, C->tpl_of, n * sizeof *C->tpl_of);
-    h = sx__fnv(h, C->scale, n * sizeof(double));
-    h = sx__fnv(h, C->x, n * d * sizeof(double));
-    h = sx__fnv(h, C->v, n * d * sizeof(double));
-    h = sx__fnv(h, C->q, n * (size_t)qdim(m) * sizeof(double));
-    if (C->L) h = sx__fnv(h, C->L, n * 3 * sizeof(double));
-    h = sx__fnv(h, C->w, n * r * sizeof(double));
-    h = sx__fnv(h, C->f, n * d * sizeof(double));
-    h = sx__fnv(h, C->t, n * r * sizeof(double));
-    h = sx__fnv(h, C->pebble, (size_t)C->pn * sizeof *C->pebble);
+    const int d = m->dim, r = m->rdim;
+    h = sx__fnv(h, &C->ntpl, sizeof C->ntpl);
+    for (int i = 0; i < C->ntpl; i++) {
+        const sx_clump_tpl *t = &C->tpl[i];
+        h = sx__fnv(h, t->name, strnlen(t->name, sizeof t->name));
+        h = sx__fnv(h, &t->n, sizeof t->n);
+        h = sx__fnv(h, &t->lines, sizeof t->lines);
+        const double props[] = {t->volume, t->error, t->power_sum};
+        h = sx__fnv_doubles(h, props, 3, 1);
+        h = sx__fnv_doubles(h, t->centroid, 3, 1);
+        h = sx__fnv_doubles(h, t->inertia, 9, 1);
+        h = sx__fnv_doubles(h, t->principal, 3, 1);
+        h = sx__fnv_doubles(h, t->frame, 4, 1);
+        h = sx__fnv_doubles(h, C->tp_pos + t->first * d, t->n * d, 1);
+        h = sx__fnv_doubles(h, C->tp_rad + t->first, t->n, 1);
+        h = sx__fnv_doubles(h, C->tp_body + t->first * d, t->n * d, 1);
+    }
+    h = sx__fnv(h, &C->n, sizeof C->n);
+    h = sx__fnv(h, &C->next_id, sizeof C->next_id);
+    for (int64_t id = 1; id < C->next_id && id < C->index_cap; id++) {
+        const int64_t c = C->index_of[id];
+        if (c < 0) continue;
+        h = sx__fnv(h, C->id + c, sizeof *C->id); /* = id, in a consistent state */
+        h = sx__fnv(h, C->tpl_of + c, sizeof *C->tpl_of);
+        h = sx__fnv(h, C->mat + c, sizeof *C->mat);
+        h = sx__fnv(h, C->fix + c, sizeof *C->fix);
+        const double scalars[] = {C->scale[c], C->alpha[c], C->mass[c]};
+        h = sx__fnv_doubles(h, scalars, 3, 1);
+        h = sx__fnv_doubles(h, C->inertia + c * r, r, 1);
+        h = sx__fnv_doubles(h, C->x + c * d, d, 1);
+        h = sx__fnv_doubles(h, C->v + c * d, d, 1);
+        h = sx__fnv_doubles(h, C->q + c * qdim(m), qdim(m), 1);
+        if (C->L) h = sx__fnv_doubles(h, C->L + c * 3, 3, 1);
+        h = sx__fnv_doubles(h, C->w + c * r, r, 1);
+        h = sx__fnv_doubles(h, C->f + c * d, d, 1);
+        h = sx__fnv_doubles(h, C->t + c * r, r, 1);
+        const int64_t np = C->tpl[C->tpl_of[c]].n;
+        h = sx__fnv(h, C->pebble + C->first[c], (size_t)np * sizeof *C->pebble);
+    }
     return h;
 }
 
@@ -1694,6 +1739,12 @@ sx_status sx__clumps_finish(sx_model *m)
             !finite_n(C->q + c * qd, qd) || (C->L && !finite_n(C->L + c * 3, 3)) || !isfinite(C->mass[c]) ||
             !isfinite(C->scale[c]))
             return sx__fail(m, SX_EINVAL, "state: clump %lld has a non-finite or out-of-range state", (long long)id);
+        if (qd == 4) { /* a unit quaternion as saved (a zero one made a NaN orientation) */
+            const double *q = C->q + c * 4;
+            if (!(fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) - 1) < 1e-6))
+                return sx__fail(m, SX_EINVAL, "state: clump %lld has an orientation that is not a unit quaternion",
+                                (long long)id);
+        }
         for (int k = 0; k < r; k++)
             if (!(C->inertia[c * r + k] > 0) || !isfinite(C->inertia[c * r + k]))
                 return sx__fail(m, SX_EINVAL, "state: clump %lld has an inertia <= 0", (long long)id);

@@ -8,6 +8,7 @@
 #include "model_internal.h"
 
 #include <float.h>
+#include <stdatomic.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdarg.h>
@@ -135,6 +136,18 @@ sx_memory sx_model_memory(const sx_model *m)
     return r;
 }
 void sx_model_interrupt(sx_model *m) { m->interrupt = 1; }
+
+/* A signal handler sets it, the core's long loops read it: lock-free */
+static atomic_int interrupt_requested;
+
+void sx_interrupt_request(void) { atomic_store(&interrupt_requested, 1); }
+
+int sx_interrupt_pending(void) { return atomic_load(&interrupt_requested); }
+
+void sx_interrupt_clear(void) { atomic_store(&interrupt_requested, 0); }
+
+/* a model's own flag only while it cycles: it stays set after the cycle it stopped */
+bool sx__interrupted(const sx_model *m) { return (m->locked && m->interrupt) || atomic_load(&interrupt_requested); }
 
 sx_status sx_model_set_threads(sx_model *m, int threads)
 {
@@ -447,6 +460,14 @@ static sx_status check_skin(sx_model *m)
     return SX_OK;
 }
 
+/* A build that did not finish left the model as it was before it. */
+static sx_status build_failed(sx_model *m, sx_status st)
+{
+    if (st == SX_EINTERRUPT)
+        return sx__fail(m, st, "interrupted in the broad phase at step %lld (the model is as it was)", (long long)m->step);
+    return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
+}
+
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
 sx_status sx__prepare(sx_model *m)
 {
@@ -456,7 +477,7 @@ sx_status sx__prepare(sx_model *m)
     if (!st && m->build_needed) st = check_skin(m);
     if (st) return st;
     if (m->build_needed && m->cell && (st = sx__cell_check(m))) return st;
-    if (m->build_needed && !kernels(m)->build(m)) return sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
+    if (m->build_needed && (st = kernels(m)->build(m))) return build_failed(m, st);
     return SX_OK;
 }
 
@@ -655,7 +676,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
     double other = now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
         t = now();
-        if (m->interrupt) {
+        if (sx__interrupted(m)) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
         }
@@ -665,11 +686,11 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
                 st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
                 break;
             }
-            const bool ok = k->build(m);
-            if (ok && dd) sx__dd_plan(m); /* the new slabs: balls migrate */
+            st = k->build(m);
+            if (!st && dd) sx__dd_plan(m); /* the new slabs: balls migrate */
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
-            if (!ok) {
-                st = sx__fail(m, SX_ENOMEM, "broad phase: out of memory");
+            if (st) {
+                st = build_failed(m, st);
                 break;
             }
         }
@@ -797,6 +818,16 @@ uint64_t sx__fnv(uint64_t h, const void *data, size_t n)
 {
     const unsigned char *p = data;
     for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+uint64_t sx__fnv_doubles(uint64_t h, const double *v, int64_t n, double sign)
+{
+    for (int64_t i = 0; i < n; i++) {
+        const double x = v ? sign * v[i] : 0;
+        const double c = x == 0 ? 0.0 : x; /* -0 as +0: the states continue alike */
+        h = sx__fnv(h, &c, sizeof c);
+    }
     return h;
 }
 

@@ -422,9 +422,13 @@ const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len
 sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* A Ctrl-C for the core's long loops to stop at (sx_interrupt_request, or
+ * the model's sx_model_interrupt while it cycles) (model.c). */
+bool sx__interrupted(const sx_model *m);
+
 /* Dimension kernels (kernels.c, one instance per dimension). */
 typedef struct sx_kernels {
-    bool (*build)(sx_model *m);                  /* broad phase + history transfer; false: out of memory */
+    sx_status (*build)(sx_model *m);             /* broad phase + history transfer: SX_ENOMEM, SX_EINTERRUPT */
     sx_status (*contacts)(sx_model *m);          /* ball-ball forces (the balls' forces start here) */
     sx_status (*walls)(sx_model *m);             /* ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
@@ -523,6 +527,8 @@ const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
 void sx__material_derive(sx_material *t);
 /* FNV-1a over n bytes, continuing h (the state hash). */
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
+/* The same over n doubles times sign (zeros when v is NULL), -0 hashed as +0. */
+uint64_t sx__fnv_doubles(uint64_t h, const double *v, int64_t n, double sign);
 
 /* Periodic space (periodic.c): hooks of the other stages; callers test
  * m->cell, so a scene without periodic space pays nothing. */

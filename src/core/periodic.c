@@ -452,9 +452,19 @@ sx_status sx__cell_finish(sx_model *m)
 uint64_t sx__cell_hash(const sx_model *m, uint64_t h)
 {
     const sx_cell *c = m->cell;
-    h = sx__fnv(h, c->lo, sizeof c->lo);
-    h = sx__fnv(h, c->h, sizeof c->h);
-    h = sx__fnv(h, c->hdot, sizeof c->hdot);
+    for (int k = 0; k < 3; k++) h = sx__fnv(h, &c->axis[k], sizeof c->axis[k]);
+    h = sx__fnv_doubles(h, c->lo, 3, 1);
+    h = sx__fnv_doubles(h, &c->h[0][0], 9, 1);
+    h = sx__fnv_doubles(h, &c->hdot[0][0], 9, 1);
+    /* the control (the snapshot's /periodic) */
+    for (int k = 0; k < SX_CELL_COMPONENTS; k++) h = sx__fnv(h, &c->ctl.mode[k], sizeof c->ctl.mode[k]);
+    h = sx__fnv_doubles(h, c->ctl.rate, SX_CELL_COMPONENTS, 1);
+    h = sx__fnv_doubles(h, c->ctl.target, SX_CELL_COMPONENTS, 1);
+    h = sx__fnv_doubles(h, &c->ctl.alpha, 1, 1);
+    h = sx__fnv_doubles(h, &c->ctl.max_rate, 1, 1);
+    /* a pending build counts as done (state.c) */
+    const double moved = m->build_needed ? 0 : c->moved;
+    h = sx__fnv_doubles(h, &moved, 1, 1);
     h = sx__fnv(h, &c->n, sizeof c->n);
     for (int64_t g = 0; g < c->n; g++) { /* owners by id: the hash does not depend on the balls' row order */
         const int32_t id = c->owner[g] >= 0 ? m->balls.id[c->owner[g]] : -1;

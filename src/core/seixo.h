@@ -30,7 +30,7 @@ typedef enum sx_status {
     SX_ENOMEM,      ///< an allocation failed
     SX_ENOTFOUND,   ///< no ball, wall or material with that id/name
     SX_EUNSTABLE,   ///< the stability guard stopped the run
-    SX_EINTERRUPT,  ///< the run was interrupted (sx_model_interrupt)
+    SX_EINTERRUPT,  ///< interrupted (sx_model_interrupt, sx_interrupt_request)
     SX_ELOCKED,     ///< the model is stepping; the change is not allowed now
 } sx_status;
 
@@ -80,6 +80,16 @@ SX_API int sx_model_threads(const sx_model *m);
 
 /// Asks a running cycle to stop at the next step boundary (async-signal-safe).
 SX_API void sx_model_interrupt(sx_model *m);
+
+/// A process-wide interrupt request (a Ctrl-C; async-signal-safe): a
+/// cycle stops at the next step boundary, as for sx_model_interrupt, and
+/// every long loop of the core outside the steps (the broad phase of a
+/// build, sx_bond_install's pair scan, a clump template's mass properties)
+/// stops with SX_EINTERRUPT, leaving the model as it was before the call.
+/// It stays pending until the code that reports the interruption clears it.
+SX_API void sx_interrupt_request(void);
+SX_API int sx_interrupt_pending(void);
+SX_API void sx_interrupt_clear(void);
 
 /// PFC's mean unbalanced-force ratio: the mean over bodies (free balls and clumps) of |F + m g| (free
 /// components) over the mean contact force magnitude; 0 when at rest with no

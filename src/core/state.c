@@ -471,14 +471,7 @@ typedef struct hasher {
 
 static void put(hasher *s, const void *data, size_t n) { s->h = sx__fnv(s->h, data, n); }
 
-static void put_doubles(hasher *s, const double *v, int64_t n, double sign)
-{
-    for (int64_t i = 0; i < n; i++) {
-        const double x = v ? sign * v[i] : 0;
-        const double c = x == 0 ? 0.0 : x; /* -0 as +0 */
-        put(s, &c, sizeof c);
-    }
-}
+static void put_doubles(hasher *s, const double *v, int64_t n, double sign) { s->h = sx__fnv_doubles(s->h, v, n, sign); }
 
 static void put_double(hasher *s, double v) { put_doubles(s, &v, 1, 1); }
 
@@ -721,7 +714,8 @@ uint64_t sx_model_state_hash(const sx_model *m)
     hash_pairs(&s, m, &m->bb, false);
     hash_pairs(&s, m, &m->bw, true);
     hash_bonds(&s, m);
-    if (m->clumps) s.h = sx__clumps_hash(m, s.h);
+    /* an empty clump store (a template that was refused) is no clumps */
+    if (m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0)) s.h = sx__clumps_hash(m, s.h);
     if (m->cell) s.h = sx__cell_hash(m, s.h);
     if (m->njoint) s.h = sx__joints_hash(m, s.h);
     return s.h;

@@ -869,6 +869,11 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     int64_t clumps = 0;
     sx_h5_get_i64(h, g, name, "clumps", &clumps, 1, false); /* absent before clumps, and without them */
     s->clumps = clumps != 0;
+    /* a damaged count (INT64_MIN) overflowed the points below and went into the XDMF text */
+    if (!h->failed && (s->walls < 0 || s->walls >= ((int64_t)1 << 40))) {
+        sx_h5_close(g);
+        return sx_h5_fail(h, "damaged: %s has %lld walls", name, (long long)s->walls);
+    }
     /* format 1 drew one cell per wall, of 4 (3D) or 2 (2D) points */
     s->wall_cells = s->walls;
     s->wall_points = s->walls * (dim == 3 ? 4 : 2);
@@ -878,6 +883,11 @@ static bool read_snap(sx_h5 *h, hid_t file, int dim, int64_t k, snap *s)
     sx_h5_get_i64(h, g, name, "mesh_cells", &s->mesh_cells, 1, false); /* absent without meshes */
     sx_h5_get_i64(h, g, name, "mesh_points", &s->mesh_points, 1, false);
     sx_h5_close(g);
+    const int64_t counts[] = {s->balls, s->contacts, s->wall_contacts, s->bonds, s->wall_cells, s->wall_points,
+                              s->cracks, s->mesh_cells, s->mesh_points};
+    for (size_t i = 0; i < sizeof counts / sizeof *counts && !h->failed; i++)
+        if (counts[i] < 0 || counts[i] >= ((int64_t)1 << 40))
+            return sx_h5_fail(h, "damaged: %s has a step or count out of range (%lld)", name, (long long)counts[i]);
     return !h->failed;
 }
 

@@ -161,16 +161,16 @@ typedef sx_lua_run run;
 
 static _Atomic(run *) runs[MAX_RUNS];
 static atomic_int nruns;
-/* a Ctrl-C no code has answered yet: long C work outside any run polls it */
-static atomic_int pending;
 
-int sx_lua_interrupt_pending(void) { return atomic_load(&pending); }
+/* A Ctrl-C no code has answered yet is the core's process-wide request:
+ * long C work outside any run, the core's included, polls it. */
+int sx_lua_interrupt_pending(void) { return sx_interrupt_pending(); }
 
-void sx_lua_interrupt_clear(void) { atomic_store(&pending, 0); }
+void sx_lua_interrupt_clear(void) { sx_interrupt_clear(); }
 
 int sx_lua_interrupt_all(void)
 {
-    atomic_store(&pending, 1);
+    sx_interrupt_request();
     const int n = atomic_load(&nruns);
     for (int i = 0; i < n; i++) {
         run *r = atomic_load(&runs[i]);
@@ -243,14 +243,14 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
 /* The Ctrl-C is answered: by the error raised now. */
 static void interrupted(lua_State *L, sx_lua_run *r)
 {
-    atomic_store(&pending, 0);
+    sx_interrupt_clear();
     if (r) luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
     luaL_error(L, "interrupted");
 }
 
 void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 {
-    if ((r && atomic_load(&r->interrupted)) || atomic_load(&pending)) interrupted(L, r);
+    if ((r && atomic_load(&r->interrupted)) || sx_interrupt_pending()) interrupted(L, r);
 }
 
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
@@ -305,7 +305,7 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
     if (status != LUA_OK) {
         /* a Ctrl-C that stopped the callback reads like one that stopped the cycle */
         if (mine && atomic_load(&r->interrupted)) {
-            atomic_store(&pending, 0);
+            sx_interrupt_clear();
             luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
         }
         if (lua_type(L, -1) == LUA_TSTRING && ud->m) {

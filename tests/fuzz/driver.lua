@@ -100,12 +100,23 @@ local function report(b)
   ran[kind] = ran[kind] + b.count
 end
 
--- every batch, at most `jobs` at a time
-local queue = {}
-for first = 1, api_cases, batch do queue[#queue + 1] = {"api.lua", first, math.min(batch, api_cases - first + 1)} end
+-- every batch, at most `jobs` at a time; the API and file batches in
+-- proportion, so that a long run stopped early has done some of both
+local queue, apis, files = {}, {}, {}
+for first = 1, api_cases, batch do apis[#apis + 1] = {"api.lua", first, math.min(batch, api_cases - first + 1)} end
 if mutator then
   for first = 1, file_cases, file_batch do
-    queue[#queue + 1] = {"files.lua", first, math.min(file_batch, file_cases - first + 1)}
+    files[#files + 1] = {"files.lua", first, math.min(file_batch, file_cases - first + 1)}
+  end
+end
+local ia, jf = 1, 1
+while ia <= #apis or jf <= #files do
+  if jf > #files or (ia <= #apis and (ia - 1) * #files <= (jf - 1) * #apis) then
+    queue[#queue + 1] = apis[ia]
+    ia = ia + 1
+  else
+    queue[#queue + 1] = files[jf]
+    jf = jf + 1
   end
 end
 local t0 = seixo.clock()

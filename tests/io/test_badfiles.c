@@ -91,6 +91,12 @@ START_TEST(missing_and_not_hdf5)
     fputs("-- a Lua script, not a snapshot\nlocal m = seixo.model{}\n", f);
     fclose(f);
     expect_error(p, 0, "not an HDF5 file");
+    /* a FIFO is refused before it is opened (issue 18: the load waited for a
+     * writer until Ctrl-C, then called it an empty file) */
+    io_path(p, sizeof p, "fifo.h5");
+    ck_assert_int_eq(mkfifo(p, 0600), 0);
+    expect_error(p, 0, "is not a regular file (a pipe, socket or device)");
+    ck_assert_int_eq(unlink(p), 0);
 }
 END_TEST
 
@@ -192,6 +198,25 @@ START_TEST(not_seixo)
     H5Sclose(s);
     H5Fclose(f);
     expect_error(p, 0, "not a seixo file");
+    /* seixo's root attribute 'format' rewritten as a variable-length string,
+     * as h5py writes one: named as such (issue 18: "not a seixo file") */
+    make_good();
+    io_path(p, sizeof p, "vlen.h5");
+    copy_file(good2, p);
+    f = H5Fopen(p, H5F_ACC_RDWR, H5P_DEFAULT);
+    ck_assert(f >= 0);
+    ck_assert(H5Adelete(f, "format") >= 0);
+    hid_t t = H5Tcopy(H5T_C_S1);
+    ck_assert(H5Tset_size(t, H5T_VARIABLE) >= 0);
+    s = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(f, "format", t, s, H5P_DEFAULT, H5P_DEFAULT);
+    const char *text = "seixo";
+    ck_assert(a >= 0 && H5Awrite(a, t, &text) >= 0);
+    H5Aclose(a);
+    H5Sclose(s);
+    H5Tclose(t);
+    H5Fclose(f);
+    expect_error(p, 0, "its 'format' attribute is a variable-length string (as h5py writes one by default)");
 }
 END_TEST
 
@@ -480,6 +505,22 @@ START_TEST(meaningless_values)
         H5Fclose(f);
         expect_error(p, 0, cases[k].error);
     }
+    /* found by the file fuzzer: a clump's orientation of zeros (the dataset
+     * retyped to integers) was loaded, and normalised into NaN */
+    sx_model *m = io_scene_bonded(3);
+    const double pos[6] = {0, 0, 0, 0.006, 0, 0}, rad[2] = {0.005, 0.004};
+    const sx_clump_template_def t = {pos, rad, 2, 0};
+    ck_assert_int_eq(sx_clump_template_add(m, "pair", &t, NULL), SX_OK);
+    sx_clump_def c = sx_clump_default_def();
+    c.pos[0] = c.pos[1] = c.pos[2] = 1; /* away from the bonded balls */
+    ck_assert_int_eq(sx_clump_add(m, &c, NULL), SX_OK);
+    char q[512];
+    io_save(m, io_path(q, sizeof q, "clump.h5"));
+    sx_model_destroy(m);
+    hid_t f = edit(q, p, sizeof p, "clump_q0.h5");
+    for (hsize_t k = 0; k < 4; k++) poke_at(f, "/clumps/orientation", k, 0);
+    H5Fclose(f);
+    expect_error(p, 3, "clump 1 has an orientation that is not a unit quaternion");
 }
 END_TEST
 

@@ -7,6 +7,7 @@
  * so none is missed through the public API's reach. */
 #include "io_scenes.h"
 
+#include "clumps.h"
 #include "model_internal.h"
 
 #include <math.h>
@@ -219,6 +220,112 @@ static void poke_all(sx_model *a, sx_model *b)
         POKE(cracks.ev[0].mn, F64);
         POKE(cracks.ev[0].ms, F64);
     }
+    /* flat joints: a joint's face and its elements */
+    for (int64_t s = 0; s < b->bonds.n && b->fjel.n > 0; s++) {
+        if (!(b->bonds.kind[s] & SX_BOND_FLATJOINT)) continue;
+        POKE(bonds.fj_mu[s], F64);
+        POKE(bonds.fj_tanphi[s], F64);
+        POKE(bonds.fj_d0[s], F64);
+        POKE(bonds.fj_rot[s * (d - 1)], F64);
+        if (d == 3) POKE(bonds.fj_axis[s * 3 + 1], F64);
+        const int64_t e = b->bonds.fj_first[s];
+        POKE(fjel.state[e], U8);
+        POKE(fjel.sigma_c[e], F64);
+        POKE(fjel.coh[e], F64);
+        POKE(fjel.gap0[e], F64);
+        POKE(fjel.fn[e], F64);
+        POKE(fjel.fs[e * (d - 1)], F64);
+        break;
+    }
+    /* clumps: a template and a clump */
+    if (b->clumps && b->clumps->n > 0) {
+        const int64_t k = b->clumps->n - 1, qd = d == 3 ? 4 : 1;
+        POKE(clumps->tpl[0].name[0], CHAR);
+        POKE(clumps->tpl[0].lines, I64);
+        POKE(clumps->tpl[0].volume, F64);
+        POKE(clumps->tpl[0].centroid[0], F64);
+        POKE(clumps->tpl[0].inertia[0], F64);
+        POKE(clumps->tpl[0].principal[0], F64);
+        POKE(clumps->tpl[0].frame[0], F64);
+        POKE(clumps->tpl[0].error, F64);
+        POKE(clumps->tpl[0].power_sum, F64);
+        POKE(clumps->tp_pos[d - 1], F64);
+        POKE(clumps->tp_rad[1], F64);
+        POKE(clumps->tp_body[0], F64);
+        POKE(clumps->next_id, I64);
+        POKE(clumps->id[k], I32);
+        POKE(clumps->mat[k], U16);
+        POKE(clumps->fix[k], U8);
+        POKE(clumps->scale[k], F64);
+        POKE(clumps->alpha[k], F64);
+        POKE(clumps->mass[k], F64);
+        POKE(clumps->inertia[k * r + r - 1], F64);
+        POKE(clumps->x[k * d + d - 1], F64);
+        POKE(clumps->v[k * d], F64);
+        POKE(clumps->q[k * qd + qd - 1], F64);
+        if (d == 3) POKE(clumps->L[k * 3 + 2], F64);
+        POKE(clumps->w[k * r], F64);
+        POKE(clumps->f[k * d], F64);
+        POKE(clumps->t[k * r], F64);
+        POKE(clumps->pebble[b->clumps->first[k] + 1], I32);
+    }
+    /* periodic space: the cell, its control and its ghosts */
+    if (b->cell) {
+        POKE(cell->axis[d - 1], BOOL);
+        POKE(cell->lo[0], F64);
+        POKE(cell->h[1][1], F64);
+        POKE(cell->hdot[0][0], F64);
+        POKE(cell->ctl.mode[SX_CELL_YY], INT);
+        POKE(cell->ctl.rate[SX_CELL_XX], F64);
+        POKE(cell->ctl.target[SX_CELL_XY], F64);
+        POKE(cell->ctl.alpha, F64);
+        POKE(cell->ctl.max_rate, F64);
+        if (!b->build_needed) POKE(cell->moved, F64);
+        if (b->cell->n > 0) {
+            POKE(cell->owner[0], I32);
+            POKE(cell->image[0], U8);
+        }
+    }
+}
+
+/* Clumps of two overlapping pebbles above a granular bed, falling onto it. */
+static sx_model *clumped(int dim)
+{
+    const int up = dim - 1;
+    double g[3] = {0, 0, 0};
+    g[up] = -9.81;
+    sx_model *m = scene_model(dim, g, 0, 1e5, 0.5, 2650);
+    double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1}, top[3] = {0.1, 0.1, 0.1};
+    top[up] = 0.2;
+    scene_box_walls(m, lo, top, 1e5, 0.5);
+    scene_random_balls(m, 30, lo, hi, 0.004, 0.007, 0.05, 0.02, 77, NULL);
+    const double pos[6] = {0, 0, 0, 0.006, 0, 0}, pos2[4] = {0, 0, 0.006, 0}, rad[2] = {0.005, 0.004};
+    const sx_clump_template_def t = {dim == 3 ? pos : pos2, rad, 2, 0};
+    ck_assert_int_eq(sx_clump_template_add(m, "pair", &t, NULL), SX_OK);
+    for (int k = 0; k < 3; k++) {
+        sx_clump_def c = sx_clump_default_def();
+        c.pos[0] = 0.025 * (k + 1);
+        if (dim == 3) c.pos[1] = 0.05;
+        c.pos[up] = 0.15;
+        c.spin[0] = 3.0 * (k - 1);
+        ck_assert_int_eq(sx_clump_add(m, &c, NULL), SX_OK);
+    }
+    return m;
+}
+
+/* Balls in a periodic box whose cell shrinks along x at a strain rate. */
+static sx_model *periodic(int dim)
+{
+    sx_model *m = scene_model(dim, NULL, 0, 1e5, 0.5, 2650);
+    sx_periodic_def pd = {{true, true, dim == 3}, {0, 0, 0}, {0.1, 0.1, 0.1}, {0, 0, 0}};
+    ck_assert_int_eq(sx_model_set_periodic(m, &pd), SX_OK);
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+    scene_random_balls(m, dim == 3 ? 60 : 40, lo, hi, 0.004, 0.007, 0.2, 0.02, 91, NULL);
+    sx_cell_control c = sx_cell_default_control();
+    c.mode[SX_CELL_XX] = SX_CELL_RATE;
+    c.rate[SX_CELL_XX] = -0.5;
+    ck_assert_int_eq(sx_cell_set_control(m, &c), SX_OK);
+    return m;
 }
 
 typedef sx_model *(*scene_fn)(int dim);
@@ -233,7 +340,8 @@ static sx_model *granular_table(int dim)
     ck_assert_int_eq(sx_cmodel_add(m, "stiffer", &row, NULL), SX_OK);
     return m;
 }
-static const scene_fn scenes[] = {granular, io_scene_bonded, io_scene_servo, io_scene_hertz, granular_table};
+static const scene_fn scenes[] = {granular, io_scene_bonded, io_scene_servo, io_scene_hertz, io_scene_flatjoint,
+                                  clumped, periodic, granular_table};
 enum { NSCENES = sizeof scenes / sizeof *scenes };
 
 static void cycled_pair(int scene, int dim, sx_model **a, sx_model **b)
@@ -259,7 +367,9 @@ START_TEST(every_restored_field)
     static const char *const must[] = {"balls.fapp[i * d]", "balls.group[i]", "balls.alpha[i]", "walls[w].servo.target",
                                        "bonds.fs[s * d]", "bonds.ms[s * r]", "cracks.ev[0].fs", "bw.un[cw]",
                                        "bb.fs[c * d]", "dt", "balls.x_build[i * d]", "walls[w].moved",
-                                       "cmodel[0].mat.def.kn", "bb.cmodel[c]"};
+                                       "cmodel[0].mat.def.kn", "bb.cmodel[c]",
+                                       "fjel.fs[e * (d - 1)]", "clumps->pebble[b->clumps->first[k] + 1]",
+                                       "clumps->tpl[0].power_sum", "cell->ctl.alpha", "cell->owner[0]"};
     for (size_t k = 0; k < sizeof must / sizeof *must; k++) {
         bool found = false;
         for (int i = 0; i < nseen; i++) found |= strcmp(seen[i], must[k]) == 0;

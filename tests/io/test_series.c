@@ -419,6 +419,39 @@ START_TEST(append_to_format1)
 }
 END_TEST
 
+/* A snapshot's count attribute damaged to INT64_MIN (found by the file
+ * fuzzer: UBSan's overflow in the XDMF writer's wall points) or to -1 is
+ * an error naming the snapshot, not an XDMF with negative sizes. */
+START_TEST(damaged_counts)
+{
+    static const char *const attrs[] = {"walls", "balls", "contacts"};
+    static const int64_t bad[] = {INT64_MIN, -1, INT64_MAX};
+    for (int a = 0; a < 3; a++) {
+        sx_model *m = io_scene_bonded(3);
+        char path[512], err[1024];
+        io_path(path, sizeof path, "counts.h5");
+        sx_series_opts o;
+        memset(&o, 0, sizeof o);
+        o.fields = SX_OUT_DEFAULT;
+        sx_series *s = sx_series_open(path, 3, &o, err, sizeof err);
+        ck_assert_msg(s, "%s", err);
+        ck_assert_msg(sx_series_write(s, m, NULL, 0, err, sizeof err) == SX_OK, "%s", err);
+        ck_assert_int_eq(sx_series_close(s, err, sizeof err), SX_OK);
+        sx_model_destroy(m);
+        hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT), g = H5Gopen2(f, "/snapshots/000000", H5P_DEFAULT);
+        hid_t at = H5Aopen(g, attrs[a], H5P_DEFAULT);
+        ck_assert(f >= 0 && g >= 0 && at >= 0);
+        ck_assert(H5Awrite(at, H5T_NATIVE_INT64, &bad[a]) >= 0);
+        H5Aclose(at);
+        H5Gclose(g);
+        H5Fclose(f);
+        ck_assert_int_ne(sx_series_write_xdmf(path, err, sizeof err), SX_OK);
+        ck_assert_msg(strstr(err, "damaged: /snapshots/000000 has") != NULL, "%s", err);
+        io_assert_no_handles();
+    }
+}
+END_TEST
+
 START_TEST(field_names)
 {
     for (unsigned bit = 1; bit <= SX_OUT_WALLS; bit <<= 1) {
@@ -438,6 +471,7 @@ int main(void)
     tcase_add_loop_test(tc, contents, 2, 4);
     tcase_add_test(tc, fields_append_errors);
     tcase_add_test(tc, field_names);
+    tcase_add_test(tc, damaged_counts);
     tcase_add_test(tc, cylinder_surface);
     tcase_add_test(tc, histories_grow);
     tcase_add_test(tc, append_to_format1);

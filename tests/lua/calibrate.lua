@@ -243,6 +243,13 @@ test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for th
 end)
 
 test("bad options are clear errors at the caller", function()
+  -- issue 18's fuzzer: a string for maxeval failed deep in the search with Lua's own message
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    maxeval = "zz"} end, "lab.calibrate: maxeval must be a whole number >= 0 (got zz)")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    tolerance = 0 / 0} end, "lab.calibrate: tolerance must be a finite number >= 0")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    print = math.mininteger} end, "lab.calibrate: print must be a function or false (got number)")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {2e9, 1e9}}, evaluate = synthetic} end,
            "parameters.modulus must be {lower, upper}")
   T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,

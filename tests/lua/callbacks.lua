@@ -95,6 +95,26 @@ end)
 
 ---------------------------------------------------------------- histories
 
+-- issue 18: a run deeper than the interrupt registry's 16 could not be
+-- stopped by Ctrl-C; the 17th model cycling inside the others' callbacks
+-- is refused, and every model stays usable
+test("more than 16 models cycling inside each other's callbacks are refused", function()
+  local models, ids = {}, {}
+  for i = 1, 17 do models[i] = falling(2) end
+  for i = 1, 16 do ids[i] = models[i]:on("cycle", function() models[i + 1]:cycle(1) end) end
+  local ok, err = pcall(models[1].cycle, models[1], 1)
+  check(not ok, "the 17th nested run started")
+  check(tostring(err):find("m:cycle: more than 16 models cycling inside each other's callbacks", 1, true), err)
+  -- 16 deep is allowed
+  models[16]:off(ids[16])
+  local s16 = models[16]:step()
+  models[1]:cycle(1)
+  eq(models[16]:step(), s16 + 1)
+  for i = 1, 15 do models[i]:off(ids[i]) end
+  for i = 1, 17 do models[i]:cycle(1) end
+  eq(models[17]:step(), 1)
+end)
+
 test("builtin histories record exact values at multiples of every", function()
   local m = falling()
   m:history("t", "time", {every = 10})

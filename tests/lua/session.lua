@@ -179,6 +179,9 @@ test("a live plot of histories is redrawn while the model cycles, and changes no
   check(text:find("kinetic energy", 1, true) and text:find("step", 1, true), text)
   raises(function() plot.live(seixo.model{dim = 2}, "nope") end, "no history named 'nope'")
   raises(function() plot.live(seixo.model{dim = 2}, {}) end, "names of histories expected")
+  -- issue 18's fuzzer: a file handle (userdata indexing to nil) is no model
+  raises(function() plot.live(io.stdout, "kinetic energy") end, "plot.live: a model expected, got file")
+  raises(function() plot.live(42, "kinetic energy") end, "plot.live: a model expected, got number")
 end)
 
 test("a ball placed behind a wall or overlapping one is an error naming the wall", function()

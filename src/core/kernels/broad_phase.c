@@ -32,6 +32,10 @@ typedef struct transfer {
     int8_t *gimage;
     bool facets;              /* the store being listed carries facets */
     int32_t *near;            /* one ball's candidate facets of one mesh (room for the largest mesh) */
+    /* a Ctrl-C stops the ball-ball listing (poll: not in periodic space,
+     * where the balls were wrapped too and cannot be put back) */
+    bool poll, stopped;
+    bool replaced;            /* the old ball-ball store was given up for the new one */
 } transfer;
 
 /* periodic space (kernels/ghosts.c) */
@@ -408,8 +412,30 @@ static bool sort_balls(sx_model *m, transfer *tr)
     g->start[0] = 0;
     sx__balls_permute(m, order, scratch);
     sx__scratch_release(m); /* not kept between builds: the pairs come next */
-    if (tr->history) tr->order = order; /* the transfer's */
-    else sx_alloc_free(&m->alloc, order, (size_t)n, sizeof *order);
+    tr->order = order; /* the transfer's, and the way back (unsort_balls) */
+    return true;
+}
+
+/* A build that stopped before the old ball-ball store was given up (a
+ * Ctrl-C, out of memory): the balls go back to their order before the
+ * sort, so that the old stores' ends name them again and the model is as
+ * it was. The listing's memory goes first, to make room for the scratch. */
+static bool unsort_balls(sx_model *m, transfer *tr)
+{
+    sx_alloc_free(&m->alloc, tr->a, (size_t)tr->cap, sizeof *tr->a);
+    sx_alloc_free(&m->alloc, tr->b, (size_t)tr->cap, sizeof *tr->b);
+    sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
+    sx_alloc_free(&m->alloc, tr->f, (size_t)tr->cap, sizeof *tr->f);
+    tr->a = tr->b = tr->src = tr->f = NULL;
+    tr->n = tr->cap = 0;
+    const int64_t n = m->balls.n;
+    /* the permutation's gathers use n x D doubles; the inverse order follows them */
+    double *scratch = sx__scratch(m, n * D + (n + 1) / 2);
+    if (!scratch) return false;
+    int32_t *inverse = (int32_t *)(scratch + n * D);
+    for (int64_t i = 0; i < n; i++) inverse[tr->order[i]] = (int32_t)i;
+    sx__balls_permute(m, inverse, scratch);
+    sx__scratch_release(m);
     return true;
 }
 
@@ -466,6 +492,11 @@ static void build_ball_pairs(sx_model *m, transfer *tr, int64_t *count)
             for (int64_t cx = 0; cx < g->nc[0]; cx++) {
                 const int64_t cell = cx + g->nc[0] * (cy + g->nc[1] * cz);
                 for (int32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
+                    /* a wide skin can make this the longest loop of seixo */
+                    if (tr->poll && i % 64 == 0 && sx__interrupted(m)) {
+                        tr->stopped = true;
+                        return;
+                    }
                     const double *xi = b->x + (int64_t)i * D;
                     const double ri = b->rad[i] + m->skin;
                     /* own cell: later balls only */
@@ -565,16 +596,18 @@ static bool build_store(sx_model *m, transfer *tr, bool walls)
     if (walls) build_wall_pairs(m, tr, &count);
     else build_ball_pairs(m, tr, &count);
     if (!walls && m->cell) build_ghost_pairs(m, tr, &count);
-    if (!transfer_list(m, tr, count, true)) return false;
+    if (tr->stopped || !transfer_list(m, tr, count, true)) return false;
     if (walls) build_wall_pairs(m, tr, NULL);
     else build_ball_pairs(m, tr, NULL);
     if (!walls && m->cell) build_ghost_pairs(m, tr, NULL);
-    return (walls || keep_bonded_pairs(m, tr)) && transfer_store(m, walls ? &m->bw : &m->bb, tr);
+    if (tr->stopped || (!walls && !keep_bonded_pairs(m, tr))) return false;
+    if (!walls) tr->replaced = true;
+    return transfer_store(m, walls ? &m->bw : &m->bb, tr);
 }
 
 static bool plan_chunks(sx_model *m);
 
-static bool KERNEL(build)(sx_model *m)
+static sx_status KERNEL(build)(sx_model *m)
 {
     if (m->balls.n == 0) { /* nothing to pair; a grid would have no extent */
         m->bb.n = m->bw.n = 0;
@@ -583,8 +616,9 @@ static bool KERNEL(build)(sx_model *m)
         m->builds++;
         m->build_needed = false;
         m->dt_stale = true;
-        return true;
+        return SX_OK;
     }
+    const double skin = m->skin; /* the last build's, kept by a build that stops */
     /* the automatic skin: a fifth of the mean radius */
     if (m->skin_user > 0) {
         m->skin = m->skin_user;
@@ -597,15 +631,27 @@ static bool KERNEL(build)(sx_model *m)
      * them and never grows while it is filled */
     transfer tr;
     bool ok = transfer_begin(m, &tr);
+    tr.poll = !m->cell;
     if (ok && m->cell) wrap_balls(m, tr.wrap); /* periodic space: balls into the cell, then their ghosts */
     ok = ok && grid_setup(m) && sort_balls(m, &tr) && (!m->cell || make_ghosts(m)) && build_store(m, &tr, false) &&
          build_store(m, &tr, true);
+    bool undone = false;
+    if (!ok && tr.order && !tr.replaced && !m->cell) {
+        undone = unsort_balls(m, &tr);
+        m->skin = skin;
+        /* no memory to put the balls back: the old stores are dropped (the
+         * history is lost), as when a store runs out of memory while filled */
+        if (!undone) m->bb.n = m->bw.n = 0;
+    } else if (!ok && tr.replaced) {
+        m->bw.n = 0; /* its ends name the balls in their order before the sort */
+    }
     transfer_end(m, &tr);
-    if (!ok || !plan_chunks(m)) return false;
+    if (tr.stopped && undone) return SX_EINTERRUPT;
+    if (!ok || !plan_chunks(m)) return SX_ENOMEM;
     memcpy(m->balls.x_build, m->balls.x, (size_t)(m->balls.n * D) * sizeof(double));
     for (int64_t w = 0; w < m->nwall; w++) m->walls[w].moved = 0;
     m->builds++;
     m->build_needed = false;
     m->dt_stale = true; /* new contacts: a new automatic timestep, wherever the build happens */
-    return true;
+    return SX_OK;
 }
