@@ -116,8 +116,9 @@ int sx_lua_material_arg(lua_State *L, const sx_model *m, int arg, const char *ke
 /// Reads the material keys model (a law's name), every law's parameters, modulus,
 /// stiffness_ratio into d and the `bond` sub-table into bpm (*has_bpm).
 void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm);
-/// bonds.c: pushes the `bond` table (the bond kinds' micro-parameters, from their registry) of material index `material`.
-void sx_lua_push_bpm(lua_State *L, const sx_model *m, int material);
+/// bonds.c: pushes the `bond` table (the bond kinds' micro-parameters, from their registry) of material index
+/// `material` and returns true, or pushes nothing and returns false when they are all zero.
+bool sx_lua_push_bpm(lua_State *L, const sx_model *m, int material);
 /// Appends the registry's law parameter keys (each once) to keys[0..n), up to cap;
 /// returns the new count.
 int sx_lua_law_keys(const char **keys, int n, int cap);

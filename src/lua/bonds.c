@@ -35,12 +35,16 @@ static void read_bpm(lua_State *L, int arg, sx_bpm_def *b)
     for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_optnumfield(L, arg, sx_bond_key(k, NULL), sx_bond_key_material(b, k));
 }
 
-void sx_lua_push_bpm(lua_State *L, const sx_model *m, int material)
+bool sx_lua_push_bpm(lua_State *L, const sx_model *m, int material)
 {
     sx_bpm_def b;
     sx_lua_check(L, m, sx_material_get_bpm(m, material, &b), "m:materials");
+    bool any = false;
+    for (int k = 0; k < sx_bond_key_count(); k++) any |= *sx_bond_key_material(&b, k) != 0;
+    if (!any) return false; /* a material without bond parameters lists none */
     lua_createtable(L, 0, sx_bond_key_count());
     for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_setnum(L, sx_bond_key(k, NULL), *sx_bond_key_material(&b, k));
+    return true;
 }
 
 int sx_lua_law_keys(const char **keys, int n, int cap)

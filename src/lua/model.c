@@ -470,8 +470,7 @@ static int model_materials(lua_State *L)
         sx_lua_check(L, m, sx_material_get(m, i, &d), "m:materials");
         lua_createtable(L, 0, 12);
         push_material(L, &d);
-        sx_lua_push_bpm(L, m, i);
-        lua_setfield(L, -2, "bond");
+        if (sx_lua_push_bpm(L, m, i)) lua_setfield(L, -2, "bond");
         lua_setfield(L, -2, sx_material_name(m, i));
     }
     return 1;
