@@ -451,8 +451,9 @@ typedef struct sx_kernels {
     sx_status (*walls)(sx_model *m);             /* ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
     double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
-    /* the clumps after the balls' law of motion: each body moves its pebbles
-     * (kernels/clump_motion.c); max_disp as integrate's */
+    /* the clumps after the balls' law of motion (kernels/clump_motion.c): sums
+     * the pebbles' forces, integrates (4-42 ... 4-48), places the pebbles;
+     * raises *max_disp to the largest pebble move since the last build */
     sx_status (*clumps_step)(sx_model *m, double *max_disp);
     /* clump c's pebbles placed from its body at rotation R; their largest squared move since the build */
     double (*place_pebbles)(sx_model *m, int64_t c, const double *R);
@@ -588,9 +589,6 @@ sx_status sx__cell_finish(sx_model *m);
 
 /* Clumps (clumps.c): the hooks of the other stages, all no-ops while
  * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */
-/* The step of the bodies, after the balls': sums the pebbles' forces,
- * integrates (4-42 ... 4-48), places the pebbles; raises *max_disp to the
- * largest pebble displacement since the last build. */
 /* Adds the clumps' kinetic (once per body) and gravitational energy. */
 void sx__clumps_energy(const sx_model *m, sx_energy *e);
 /* The smallest critical timestep of the clumps, from their pebbles' sums of
