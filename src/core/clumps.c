@@ -19,7 +19,7 @@
  * pairs of every depth of overlap. Principal axes come from a cyclic
  * Jacobi eigen-solver of the symmetric 3x3 tensor.
  *
- * The step (sx__clumps_step, after the balls'). Translation is 4-46/4-48
+ * The step (kernels/clump_motion.c, once per dimension, after the balls'). Translation is 4-46/4-48
  * with the resultant of the pebbles' forces and the clump's weight, as for
  * a ball. Rotation integrates Euler's equations (4-42) written as
  *     dL/dt = M (space),   dL_b/dt = L_b x w_b + M_b (body, w_b,i = L_b,i / I_i),
@@ -54,7 +54,7 @@
  * the rotation is about z with the scalar moment and Izz: 4-47 exactly.
  * After the step every pebble is placed from its body: x + R b, v + w x r,
  * spin w, so pebbles never drift from their clump. */
-#include "clumps.h"
+#include "clump_math.h"
 
 #include <float.h>
 #include <math.h>
@@ -63,55 +63,6 @@
 #include <string.h>
 
 /* ------------------------------------------------------------ vectors */
-
-static void cross3(const double *a, const double *b, double *out)
-{
-    const double o0 = a[1] * b[2] - a[2] * b[1], o1 = a[2] * b[0] - a[0] * b[2], o2 = a[0] * b[1] - a[1] * b[0];
-    out[0] = o0, out[1] = o1, out[2] = o2;
-}
-
-/* a x b for dim-vectors: 3D the vector, 2D the scalar about z in out[0]. */
-static void moment_arm(int d, const double *a, const double *b, double *out)
-{
-    if (d == 3) cross3(a, b, out);
-    else out[0] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* w x r: 2D w is the scalar spin about z. */
-static void spin_arm(int d, const double *w, const double *r, double *out)
-{
-    if (d == 3) {
-        cross3(w, r, out);
-    } else {
-        out[0] = -w[0] * r[1];
-        out[1] = w[0] * r[0];
-    }
-}
-
-/* Hamilton product a b of quaternions (w, x, y, z). */
-static void qmul(const double *a, const double *b, double *out)
-{
-    const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
-    const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
-    const double y = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
-    const double z = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
-    out[0] = w, out[1] = x, out[2] = y, out[3] = z;
-}
-
-static void qnormalize(double *q)
-{
-    const double s = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (int k = 0; k < 4; k++) q[k] *= s;
-}
-
-/* The rotation matrix (row-major) of a unit quaternion. */
-static inline void qmatrix(const double *q, double *R)
-{
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - w * z), R[2] = 2 * (x * z + w * y);
-    R[3] = 2 * (x * y + w * z), R[4] = 1 - 2 * (x * x + z * z), R[5] = 2 * (y * z - w * x);
-    R[6] = 2 * (x * z - w * y), R[7] = 2 * (y * z + w * x), R[8] = 1 - 2 * (x * x + y * y);
-}
 
 /* The unit quaternion of a rotation matrix (largest-component branch, so
  * the division is always by the largest of |w|, |x|, |y|, |z|). */
@@ -134,16 +85,6 @@ static void matrix_quat(const double *R, double *q)
     if (q[0] < 0)
         for (int k = 0; k < 4; k++) q[k] = -q[k];
     qnormalize(q);
-}
-
-static void mat_vec(const double *R, const double *v, double *out)
-{
-    for (int i = 0; i < 3; i++) out[i] = R[3 * i] * v[0] + R[3 * i + 1] * v[1] + R[3 * i + 2] * v[2];
-}
-
-static void mat_tvec(const double *R, const double *v, double *out)
-{
-    for (int i = 0; i < 3; i++) out[i] = R[i] * v[0] + R[3 + i] * v[1] + R[6 + i] * v[2];
 }
 
 /* Eigen-decomposition of a symmetric 3x3 matrix A (row-major) by cyclic
@@ -767,71 +708,10 @@ static int64_t lookup(const sx_model *m, int64_t id, const char *fn)
     return c;
 }
 
-/* The rotation (row-major 3x3) from the body frame to space. 2D: about z by the angle. */
-static void body_rotation(const sx_model *m, int64_t c, double *R)
-{
-    const sx_clumps *C = m->clumps;
-    if (m->dim == 3) {
-        qmatrix(C->q + c * 4, R);
-    } else {
-        const double a = C->q[c], cs = cos(a), sn = sin(a);
-        R[0] = cs, R[1] = -sn, R[2] = 0, R[3] = sn, R[4] = cs, R[5] = 0, R[6] = 0, R[7] = 0, R[8] = 1;
-    }
-}
-
-/* 3D: the spin in space of angular momentum L, w = R I^-1 R^T L (principal moments I). */
-static void spin_of(const double *R, const double *I, const double *L, double *w)
-{
-    double b[3];
-    mat_tvec(R, L, b);
-    for (int k = 0; k < 3; k++) b[k] /= I[k];
-    mat_vec(R, b, w);
-}
-
-/* 3D: the angular momentum of spin w, L = R I R^T w. */
-static void momentum_of(const double *R, const double *I, const double *w, double *L)
-{
-    double b[3];
-    mat_tvec(R, w, b);
-    for (int k = 0; k < 3; k++) b[k] *= I[k];
-    mat_vec(R, b, L);
-}
-
-/* Sets every pebble of clump c from its body: position x + R s b,
- * velocity v + w x r, spin w. Returns the largest squared displacement of
- * a pebble since the last broad-phase build. */
-static inline __attribute__((always_inline)) double place_pebbles_dim(sx_model *m, int64_t c, const double *R,
-                                                                      const int d, const int r)
-{
-    sx_clumps *C = m->clumps;
-    sx_balls *B = &m->balls;
-    const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
-    const double s = C->scale[c], *xc = C->x + c * d, *vc = C->v + c * d, *wc = C->w + c * r;
-    const double *body = C->tp_body + t->first * d;
-    const int32_t *peb = C->pebble + C->first[c];
-    double worst = 0;
-    for (int64_t k = 0; k < t->n; k++) {
-        const int64_t i = B->index_of[peb[k]];
-        double b[3] = {0, 0, 0}, arm[3] = {0, 0, 0}, u[3];
-        for (int j = 0; j < d; j++) b[j] = s * body[k * d + j];
-        mat_vec(R, b, arm);
-        spin_arm(d, wc, arm, u);
-        double *x = B->x + i * d, *v = B->v + i * d, disp2 = 0;
-        for (int j = 0; j < d; j++) {
-            x[j] = xc[j] + arm[j];
-            v[j] = vc[j] + u[j];
-            const double e = x[j] - B->x_build[i * d + j];
-            disp2 += e * e;
-        }
-        for (int j = 0; j < r; j++) B->w[i * r + j] = wc[j];
-        if (disp2 > worst) worst = disp2;
-    }
-    return worst;
-}
-
+/* Clump c's pebbles from its body (the dimension's kernel, kernels/clump_motion.c). */
 static double place_pebbles(sx_model *m, int64_t c, const double *R)
 {
-    return m->dim == 3 ? place_pebbles_dim(m, c, R, 3, 3) : place_pebbles_dim(m, c, R, 2, 1);
+    return (m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d)->place_pebbles(m, c, R);
 }
 
 /* Mass and principal moments of clump c from its template, scale and
@@ -1254,232 +1134,6 @@ sx_status sx_clump_set_fixity(sx_model *m, int64_t id, unsigned mask)
 
 /* ------------------------------------------------------------ the step */
 
-
-/* sin and cos of x. The drift's half-angles are w dt / 4 or w dt / 2,
- * small in any stable DEM run (w dt << 1, typically 1e-4 or less), where a
- * short Taylor series is exact to round-off and far cheaper than libm:
- * below 1e-3 the terms after x^5 (x^6) are under 1e-21 relative, below 0.1
- * those after x^9 (x^10) under 3e-19; larger angles go to libm. */
-static inline void sin_cos(double x, double *s, double *c)
-{
-    const double x2 = x * x;
-    if (x2 < 1e-6) {
-        *s = x * (1 - x2 * (1.0 / 6) * (1 - x2 * (1.0 / 20)));
-        *c = 1 - x2 * 0.5 * (1 - x2 * (1.0 / 12) * (1 - x2 * (1.0 / 30)));
-    } else if (x2 < 1e-2) {
-        *s = x * (1 - x2 * (1.0 / 6) * (1 - x2 * (1.0 / 20) * (1 - x2 * (1.0 / 42) * (1 - x2 * (1.0 / 72)))));
-        *c = 1 - x2 * 0.5 * (1 - x2 * (1.0 / 12) * (1 - x2 * (1.0 / 30) * (1 - x2 * (1.0 / 56) * (1 - x2 * (1.0 / 90)))));
-    } else {
-        *s = sin(x);
-        *c = cos(x);
-    }
-}
-
-/* The drift of a torque-free body over dt (4-42 with M = 0): the symmetric
- * splitting of T = sum L_b,i^2 / (2 I_i) into rotations about the principal
- * axes (see the note at the top). Under the part T_a alone w_a = L_b,a / I_a
- * is constant and the body turns about its axis a by phi = w_a tau: the
- * orientation gains the body-axis rotation (cos phi/2, sin phi/2 e_a) on the
- * right, and L, fixed in space, turns by -phi in body coordinates. R is the
- * rotation of q at the start (the kick's). */
-/* One part of the splitting: the rotation about principal axis a (j, k the
- * two after it, cyclically) by the share `part` of dt. */
-static inline __attribute__((always_inline)) void rotor_part(double *Lb, double *w, double *v, const double *h, int a,
-                                                             int j, int k, double part)
-{
-    double sh, ch;
-    sin_cos(Lb[a] * h[a] * part, &sh, &ch);
-    const double c = ch * ch - sh * sh, sn = 2 * sh * ch; /* cos phi, sin phi */
-    const double lj = Lb[j], lk = Lb[k];
-    Lb[j] = c * lj + sn * lk;
-    Lb[k] = c * lk - sn * lj;
-    /* q (ch, sh e_a): the Hamilton product with a rotation about one axis */
-    const double w0 = *w, va = v[a], vj = v[j], vk = v[k];
-    *w = w0 * ch - va * sh;
-    v[a] = va * ch + w0 * sh;
-    v[j] = vj * ch + vk * sh;
-    v[k] = vk * ch - vj * sh;
-}
-
-static void free_rotor(double *q, const double *R, const double *L, const double *I, double dt)
-{
-    const double h[3] = {dt / I[0], dt / I[1], dt / I[2]};
-    double Lb[3];
-    mat_tvec(R, L, Lb);
-    double w = q[0], v[3] = {q[1], q[2], q[3]};
-    /* axes 0, 1, 2, 1, 0 by dt/4, dt/4, dt/2, dt/4, dt/4 (the axes spelled
-     * out so that the parts' arithmetic stays in registers) */
-    rotor_part(Lb, &w, v, h, 0, 1, 2, 0.25);
-    rotor_part(Lb, &w, v, h, 1, 2, 0, 0.25);
-    rotor_part(Lb, &w, v, h, 2, 0, 1, 0.5);
-    rotor_part(Lb, &w, v, h, 1, 2, 0, 0.25);
-    rotor_part(Lb, &w, v, h, 0, 1, 2, 0.25);
-    q[0] = w, q[1] = v[0], q[2] = v[1], q[3] = v[2];
-    qnormalize(q);
-}
-
-/* A spin imposed in space (every spin component fixed): the body turns by
- * |w| dt about w, a rotation on the left of the orientation. */
-static void imposed_rotation(double *q, const double *w, double dt)
-{
-    const double n = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    if (n == 0) return;
-    const double half = 0.5 * n * dt, s = sin(half) / n;
-    const double p[4] = {cos(half), s * w[0], s * w[1], s * w[2]};
-    qmul(p, q, q);
-    qnormalize(q);
-}
-
-/* The step of clumps [c0, c1): partial sums of one block. Each clump
- * writes only itself and its own pebbles, so blocks run in parallel. */
-typedef struct clump_block {
-    double worst, damp_work, load_work; /* largest squared pebble displacement; energy terms */
-    int64_t bad;                        /* first clump with a non-finite state, or -1 */
-} clump_block;
-
-static inline __attribute__((always_inline)) void step_block_dim(sx_model *m, int64_t c0, int64_t c1, clump_block *o,
-                                                                 const int d, const int r)
-{
-    sx_clumps *C = m->clumps;
-    sx_balls *B = &m->balls;
-    const double dt = m->dt;
-    /* the kick spans the time between the half-step velocities, as for balls */
-    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
-    const double *g = m->gravity;
-    const bool track = m->track_energy;
-    double worst = 0, damp_work = 0, load_work = 0;
-    o->bad = -1;
-    for (int64_t c = c0; c < c1; c++) {
-        const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
-        const int32_t *peb = C->pebble + C->first[c];
-        double *x = C->x + c * d, *v = C->v + c * d, *w = C->w + c * r;
-        /* the resultant of the pebbles' forces, and its moment about the centroid:
-         * each pebble's own moment plus (x_pebble - x) x F (4-21 carried to the body) */
-        double F[3] = {0, 0, 0}, T[3] = {0, 0, 0}, Fa[3] = {0, 0, 0}, Ta[3] = {0, 0, 0};
-        for (int64_t k = 0; k < t->n; k++) {
-            const int64_t i = B->index_of[peb[k]];
-            double arm[3] = {0, 0, 0}, mo[3];
-            for (int j = 0; j < d; j++) arm[j] = B->x[i * d + j] - x[j];
-            moment_arm(d, arm, B->f + i * d, mo);
-            for (int j = 0; j < d; j++) F[j] += B->f[i * d + j];
-            for (int j = 0; j < r; j++) T[j] += B->t[i * r + j] + mo[j];
-            if (track && B->fapp) {
-                moment_arm(d, arm, B->fapp + i * d, mo);
-                for (int j = 0; j < d; j++) Fa[j] += B->fapp[i * d + j];
-                for (int j = 0; j < r; j++) Ta[j] += B->tapp[i * r + j] + mo[j];
-            }
-        }
-        memcpy(C->f + c * d, F, (size_t)d * sizeof(double));
-        memcpy(C->t + c * r, T, (size_t)r * sizeof(double));
-        const double mass = C->mass[c], a = C->alpha[c], *I = C->inertia + c * r;
-        const unsigned fix = C->fix[c];
-        /* translation: 4-46, 4-48 */
-        for (int k = 0; k < d; k++) {
-            if (!(fix & (SX_FIX_VX << k))) {
-                const double force = F[k] + g[k] * mass; /* 4-40: the weight acts at the centroid */
-                const double fd = sx__damped(force, v[k], a);
-                const double vold = v[k];
-                v[k] += fd / mass * dtv;
-                if (track) {
-                    damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
-                    load_work += Fa[k] * 0.5 * (vold + v[k]) * dt;
-                }
-            }
-            x[k] += v[k] * dt;
-        }
-        /* rotation: 4-42 */
-        if (d == 3) {
-            double *q = C->q + c * 4, *L = C->L + c * 3, R[9];
-            qmatrix(q, R);
-            if ((fix & SX_FIX_SPIN) == SX_FIX_SPIN) {
-                imposed_rotation(q, w, dt);
-                qmatrix(q, R);
-                momentum_of(R, I, w, L);
-            } else {
-                /* the kick, with local damping per principal component */
-                double Tb[3], Lb[3], Md[3], dL[3];
-                mat_tvec(R, T, Tb);
-                mat_tvec(R, L, Lb);
-                for (int k = 0; k < 3; k++) Md[k] = sx__damped(Tb[k], Lb[k] / I[k], a);
-                mat_vec(R, Md, dL);
-                for (int k = 0; k < 3; k++) L[k] += dL[k] * dtv;
-                if (track) { /* work at the mean of the old and new spins, as for balls */
-                    double Ln[3], wm[3];
-                    mat_tvec(R, L, Ln);
-                    for (int k = 0; k < 3; k++) {
-                        const double wold = Lb[k] / I[k], wnew = Ln[k] / I[k];
-                        damp_work += (Md[k] - Tb[k]) * 0.5 * (wold + wnew) * dt;
-                        wm[k] = 0.5 * (wold + wnew);
-                    }
-                    double ws[3];
-                    mat_vec(R, wm, ws);
-                    load_work += (Ta[0] * ws[0] + Ta[1] * ws[1] + Ta[2] * ws[2]) * dt;
-                }
-                free_rotor(q, R, L, I, dt); /* the drift */
-                qmatrix(q, R);
-                spin_of(R, I, L, w);
-            }
-            worst = fmax(worst, place_pebbles_dim(m, c, R, d, r));
-        } else {
-            if (!(fix & SX_FIX_WX)) {
-                const double md = sx__damped(T[0], w[0], a), wold = w[0];
-                w[0] += md / I[0] * dtv; /* 4-47 about z */
-                if (track) {
-                    damp_work += (md - T[0]) * 0.5 * (wold + w[0]) * dt;
-                    load_work += Ta[0] * 0.5 * (wold + w[0]) * dt;
-                }
-            }
-            C->q[c] += w[0] * dt;
-            double R[9];
-            body_rotation(m, c, R);
-            worst = fmax(worst, place_pebbles_dim(m, c, R, d, r));
-        }
-        bool ok = isfinite(C->q[c * (d == 3 ? 4 : 1)]);
-        for (int k = 0; k < d; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
-        for (int k = 0; k < r; k++) ok &= isfinite(w[k]);
-        if (!ok && o->bad < 0) o->bad = c;
-    }
-    o->worst = worst, o->damp_work = damp_work, o->load_work = load_work;
-}
-
-/* (the dimension a constant in each form, so that the small loops unroll) */
-static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
-{
-    if (m->dim == 3) step_block_dim(m, c0, c1, o, 3, 3);
-    else step_block_dim(m, c0, c1, o, 2, 1);
-}
-
-/* In fixed blocks of clumps whose partial sums are added in block order:
- * the same bits for any thread count (as the balls' law of motion). */
-enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
-
-sx_status sx__clumps_step(sx_model *m, double *max_disp)
-{
-    const sx_clumps *C = m->clumps;
-    const int64_t n = C->n;
-    clump_block part[CLUMP_BLOCKS];
-    int64_t size = (n + CLUMP_BLOCKS - 1) / CLUMP_BLOCKS;
-    if (size < CLUMP_BLOCK) size = CLUMP_BLOCK;
-    const int64_t nblk = (n + size - 1) / size;
-#pragma omp parallel for schedule(static) num_threads(m->threads) if (nblk > 1)
-    for (int64_t k = 0; k < nblk; k++) step_block(m, k * size, (k + 1) * size < n ? (k + 1) * size : n, &part[k]);
-    double worst = *max_disp * *max_disp;
-    for (int64_t k = 0; k < nblk; k++) {
-        if (part[k].bad >= 0)
-            return sx__fail(m, SX_EUNSTABLE,
-                            "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
-                            "the timestep %g s is likely too large (critical estimate %g s)",
-                            (long long)m->step, (long long)C->id[part[k].bad], m->dt,
-                            (m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d)->critical_dt(m));
-        worst = fmax(worst, part[k].worst);
-        if (m->track_energy) {
-            m->acc.local_damping -= part[k].damp_work;
-            m->acc.boundary_work += part[k].load_work;
-        }
-    }
-    *max_disp = sqrt(worst);
-    return SX_OK;
-}
 
 /* ------------------------------------------------- energies and queries */
 

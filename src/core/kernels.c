@@ -50,6 +50,7 @@
 #include "kernels/wall_contacts.c"
 #include "kernels/motion.c"
 #include "kernels/timestep.c"
+#include "kernels/clump_motion.c"
 #include "kernels/queries.c"
 
 const sx_kernels KERNEL(sx_kernels) = {
@@ -58,6 +59,8 @@ const sx_kernels KERNEL(sx_kernels) = {
     .walls = KERNEL(walls),
     .integrate = KERNEL(integrate),
     .critical_dt = KERNEL(critical_dt),
+    .clumps_step = KERNEL(clumps_step),
+    .place_pebbles = KERNEL(place_pebbles),
     .energy = KERNEL(energy),
     .each_contact = KERNEL(each_contact),
     .count_contacts = KERNEL(count_contacts),

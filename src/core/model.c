@@ -315,15 +315,19 @@ static sx_pair_law combine(const sx_material_def *a, double kn, double ks, doubl
  * (the ball's kn, ks; for Hertz, laws/hertz.h's rigid plane). */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
 {
-    const sx_material_def *a = &m->mats[mat].def;
-    const sx_material *wm = w->def.material >= 0 ? &m->mats[w->def.material] : NULL;
+    return sx__wall_law_of(&m->mats[mat], w->def.material >= 0 ? &m->mats[w->def.material] : NULL, &w->def);
+}
+
+sx_pair_law sx__wall_law_of(const sx_material *ball, const sx_material *wm, const sx_wall_def *w)
+{
+    const sx_material_def *a = &ball->def;
     sx_pair_law l;
     if (wm)
         l = combine(a, wm->def.kn, wm->def.ks, 0, 1, wm->def.friction, 0.5 * (a->viscous_normal + wm->def.viscous_normal),
                     0.5 * (a->viscous_shear + wm->def.viscous_shear));
     else
-        l = combine(a, w->def.kn, w->def.ks, 0, 1, w->def.friction, a->viscous_normal, a->viscous_shear);
-    const bool rigid = w->def.material == SX_WALL_RIGID;
+        l = combine(a, w->kn, w->ks, 0, 1, w->friction, a->viscous_normal, a->viscous_shear);
+    const bool rigid = w->material == SX_WALL_RIGID;
     if (rigid) { /* springs in series with an infinite one: the ball's alone */
         l.kn = a->kn, l.ks = a->ks;
         l.dash_n = 4 * l.beta_n * l.beta_n * l.kn;
@@ -331,8 +335,8 @@ sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w)
     l.wall = true;
     l.rigid = rigid;
     l.law = (uint8_t)a->model;
-    sx__law(l.law)->mix(&l, &m->mats[mat], wm, l.law);
-    sx__law_parts_mix(&l, &m->mats[mat], wm);
+    sx__law(l.law)->mix(&l, ball, wm, l.law);
+    sx__law_parts_mix(&l, ball, wm);
     return l;
 }
 
@@ -712,7 +716,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         st = k->integrate(m, &max_disp);
         if (!st && dd && !dd->x.max(dd->x.ud, &max_disp)) /* every rank decides the same rebuild */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
-        if (!st && m->clumps) st = sx__clumps_step(m, &max_disp); /* clumps.c: the bodies move their pebbles */
+        if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
         sx__walls_servo(m);

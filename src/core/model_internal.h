@@ -154,7 +154,7 @@ typedef struct sx_pairs {
     double *us;            /* accumulated tangential displacement of b (dim, laws/total_shear.h); NULL
                             * while no material asks for the total form */
     int32_t *facet;        /* m->bw: a mesh wall's facet (0 for other walls); NULL until the model has a mesh */
-    int32_t *cmodel;       /* m->bb: the contact-model row the contact took (from 1; 0: its materials'
+    int32_t *cmodel;       /* m->bb, m->bw: the contact-model row the contact took (from 1; 0: its materials'
                             * law), cmodel.c; NULL while the table is empty */
     /* m->bb, smooth joints (laws/smoothjoint.h): NULL until the model has a joint */
     int32_t *joint;        /* the joint this contact crosses + 1 (0: none) */
@@ -265,7 +265,8 @@ typedef struct sx_pair_law {
 typedef struct sx_cmodel_row {
     sx_cmodel_def def;
     sx_material mat;
-    sx_pair_law law;
+    sx_pair_law law;   /* a ball-ball row's: two balls of its material */
+    sx_pair_law wlaw;  /* a wall row's: a ball and a wall of its material */
 } sx_cmodel_row;
 
 /* Periodic space (periodic.c; kernels/ghosts.c). The cell is lo + H f,
@@ -400,10 +401,37 @@ static inline const sx_pair_law *sx__bb_step_law(const sx_model *m, int64_t c, i
     const int32_t r = m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
     return r ? &m->cmodel[r - 1].law : l;
 }
+/* The row (from 1) a contact between dense ball i and wall index w takes
+ * if created now, 0 for none (the WALL kinds of rows alone). */
+int32_t sx__cmodel_pick_wall(const sx_model *m, int64_t i, int64_t w);
+/* The row of ball-wall pair c for the step: the one it took (touching) or
+ * would take now; 0 for its ball's and wall's law (m->wlaw). */
+static inline int32_t sx__bw_row(const sx_model *m, int64_t c)
+{
+    if (!m->bw.cmodel) return 0;
+    return m->bw.touching[c] ? m->bw.cmodel[c] : sx__cmodel_pick_wall(m, m->bw.a[c], m->bw.b[c]);
+}
+/* Law of a ball of material `mat` against a wall (wall stiffness in series;
+ * model.c), and of a ball of material ball against a wall of definition w
+ * and material wm (NULL: none), the same rules. */
+sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
+sx_pair_law sx__wall_law_of(const sx_material *ball, const sx_material *wm, const sx_wall_def *w);
+/* The law of ball-wall pair c for queries: its row's, or its ball's and wall's. */
+static inline sx_pair_law sx__bw_law(const sx_model *m, int64_t c)
+{
+    const int32_t r = sx__bw_row(m, c);
+    return r ? m->cmodel[r - 1].wlaw : sx__wall_law(m, m->balls.mat[m->bw.a[c]], &m->walls[m->bw.b[c]]);
+}
 /* Rows' laws that need history the stores lack (rolling, total form):
  * expands the stores; and bonded contacts under a row whose law takes no
  * bonds are refused (seed 4.3.3). */
 sx_status sx__cmodel_prepare(sx_model *m);
+/* Why def cannot be a row of m (written into why[len]), or NULL. */
+const char *sx__cmodel_invalid(const sx_model *m, const sx_cmodel_def *def, char *why, size_t len);
+/* Gives store p its array of rows (zeroed), false when out of memory. */
+bool sx__cmodel_store(sx_model *m, sx_pairs *p);
+/* Whether a row of the table matches ball-wall contacts (walls), or ball-ball ones. */
+bool sx__cmodel_any(const sx_model *m, bool walls);
 /* A row's derived constants and its contact's law (on adding it, on a restore). */
 void sx__cmodel_derive(sx_cmodel_row *r);
 /* The mixed pair law of two materials (model.c). */
@@ -433,6 +461,12 @@ typedef struct sx_kernels {
     sx_status (*walls)(sx_model *m);             /* ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
     double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
+    /* the clumps after the balls' law of motion (kernels/clump_motion.c): sums
+     * the pebbles' forces, integrates (4-42 ... 4-48), places the pebbles;
+     * raises *max_disp to the largest pebble move since the last build */
+    sx_status (*clumps_step)(sx_model *m, double *max_disp);
+    /* clump c's pebbles placed from its body at rotation R; their largest squared move since the build */
+    double (*place_pebbles)(sx_model *m, int64_t c, const double *R);
     void (*energy)(const sx_model *m, sx_energy *e);
     bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
     int64_t (*count_contacts)(const sx_model *m);
@@ -518,8 +552,6 @@ sx_status sx__prepare(sx_model *m);
 /* Law of a contact of materials ma and mb, from the materials as they are
  * (the step reads the table m->law, refreshed before each cycle). */
 sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb);
-/* Law of a ball of material `mat` against a wall (wall stiffness in series). */
-sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
 /* NULL when material d's law and its parameters are valid, else why not
  * (written into why[len]; laws.c). */
 const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
@@ -569,10 +601,6 @@ sx_status sx__cell_finish(sx_model *m);
 
 /* Clumps (clumps.c): the hooks of the other stages, all no-ops while
  * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */
-/* The step of the bodies, after the balls': sums the pebbles' forces,
- * integrates (4-42 ... 4-48), places the pebbles; raises *max_disp to the
- * largest pebble displacement since the last build. */
-sx_status sx__clumps_step(sx_model *m, double *max_disp);
 /* Adds the clumps' kinetic (once per body) and gravitational energy. */
 void sx__clumps_energy(const sx_model *m, sx_energy *e);
 /* The smallest critical timestep of the clumps, from their pebbles' sums of

@@ -264,16 +264,23 @@ SX_API sx_status sx_material_get(const sx_model *m, int index, sx_material_def *
 /// material: the contact is the one two balls of that material would make
 /// (linear springs in series, 4-22/4-23). Rows are never removed: a newer
 /// row for the same match replaces the older one for new contacts only.
-/// Ball-wall contacts keep the laws of their ball and wall.
+/// Ball-wall contacts are matched by the rows of a wall (the WALL kinds)
+/// alone, by the same rules (a ball group's row, else a ball material's,
+/// else any ball's, newest first; else the laws of ball and wall); a
+/// wall row's law is read as a ball and a wall of its material would make
+/// (as a wall of a material, walls.c).
 typedef enum sx_cmodel_match {
-    SX_CMODEL_DEFAULT = 0,   ///< any pair no other row matches
-    SX_CMODEL_GROUPS = 1,    ///< balls of groups a and b (0: no group)
-    SX_CMODEL_MATERIALS = 2, ///< balls of materials a and b
+    SX_CMODEL_DEFAULT = 0,        ///< any ball-ball pair no other row matches
+    SX_CMODEL_GROUPS = 1,         ///< balls of groups a and b (0: no group)
+    SX_CMODEL_MATERIALS = 2,      ///< balls of materials a and b
+    SX_CMODEL_WALL_GROUP = 3,     ///< a ball of group a with wall id b
+    SX_CMODEL_WALL_MATERIAL = 4,  ///< a ball of material a with wall id b
+    SX_CMODEL_WALL = 5,           ///< any ball with wall id b (a unused, 0)
 } sx_cmodel_match;
 
 typedef struct sx_cmodel_def {
     sx_cmodel_match match;
-    int32_t a, b;            ///< group numbers (>= 0) or material indices; unordered
+    int32_t a, b;            ///< group numbers (>= 0) or material indices, unordered; for the WALL kinds a ball's and a wall id
     sx_material_def law;     ///< the law (its `model`) and its parameters, as a material's
 } sx_cmodel_def;
 

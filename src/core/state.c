@@ -31,6 +31,8 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
     out->walls = m->nwall;
     out->materials = m->nmat;
     out->cmodels = m->ncmodel;
+    out->bb_cmodel = m->bb.cmodel != NULL;
+    out->bw_cmodel = m->bw.cmodel != NULL;
 }
 
 /* An array of n elements of `size` bytes, zeroed; false when out of memory. */
@@ -125,9 +127,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     m->nmat = m->cap_mat = s->materials;
     if (!alloc_array(m, (void **)&m->cmodel, s->cmodels, sizeof(sx_cmodel_row))) goto nomem;
     m->ncmodel = m->cap_cmodel = s->cmodels;
-    if (s->cmodels > 0 && (sx__pairs_reserve(m, &m->bb, 1) || /* a store with room, so the array exists */
-                           !alloc_array(m, (void **)&m->bb.cmodel, m->bb.cap, sizeof(int32_t))))
-        goto nomem;
+    if ((s->bb_cmodel && !sx__cmodel_store(m, &m->bb)) || (s->bw_cmodel && !sx__cmodel_store(m, &m->bw))) goto nomem;
     return SX_OK;
 nomem:
     return sx__fail(m, SX_ENOMEM, "state: out of memory for %lld balls, %lld pairs, %lld bonds", (long long)s->balls,
@@ -194,20 +194,21 @@ static sx_status check_cmodels(sx_model *m)
         char why[256];
         if (!memchr(t->mat.name, 0, sizeof t->mat.name) || !t->mat.name[0])
             return sx__fail(m, SX_EINVAL, "state: contact-model row %d has no valid name", r + 1);
-        if ((d->match != SX_CMODEL_DEFAULT && d->match != SX_CMODEL_GROUPS && d->match != SX_CMODEL_MATERIALS) ||
-            (d->match != SX_CMODEL_DEFAULT && (d->a < 0 || d->b < 0)) ||
-            (d->match == SX_CMODEL_MATERIALS && (d->a >= m->nmat || d->b >= m->nmat)))
-            return sx__fail(m, SX_EINVAL, "state: contact-model row '%s' has a bad match (%d: %d, %d)", t->mat.name,
-                            (int)d->match, (int)d->a, (int)d->b);
         t->def.law = t->mat.def; /* a file stores the row's law as a material */
-        if (sx__material_invalid(&t->mat.def, why, sizeof why))
+        if (sx__cmodel_invalid(m, d, why, sizeof why))
             return sx__fail(m, SX_EINVAL, "state: contact-model row '%s': %s", t->mat.name, why);
         sx__cmodel_derive(t);
     }
-    for (int64_t c = 0; m->bb.cmodel && c < m->bb.n; c++)
-        if (m->bb.cmodel[c] < 0 || m->bb.cmodel[c] > m->ncmodel)
-            return sx__fail(m, SX_EINVAL, "state: ball-ball pair %lld has contact-model row %d, there are %d",
-                            (long long)c, (int)m->bb.cmodel[c], m->ncmodel);
+    const sx_pairs *ps[2] = {&m->bb, &m->bw};
+    for (int k = 0; k < 2; k++)
+        for (int64_t c = 0; ps[k]->cmodel && c < ps[k]->n; c++)
+            if (ps[k]->cmodel[c] < 0 || ps[k]->cmodel[c] > m->ncmodel)
+                return sx__fail(m, SX_EINVAL, "state: %s pair %lld has contact-model row %d, there are %d",
+                                k ? "ball-wall" : "ball-ball", (long long)c, (int)ps[k]->cmodel[c], m->ncmodel);
+    for (int k = 0; k < 2; k++)
+        if (sx__cmodel_any(m, k) && !ps[k]->cmodel)
+            return sx__fail(m, SX_EINVAL, "state: a contact-model row matches %s contacts but their pairs carry no row",
+                            k ? "ball-wall" : "ball-ball");
     return SX_OK;
 }
 

@@ -47,8 +47,9 @@ typedef struct sx_state_sizes {
     int64_t cracks;       ///< entries of the crack log
     int64_t walls;
     int materials;
-    int cmodels;          ///< rows of the contact-model table (cmodel.c); the ball-ball store carries
-                          ///< each contact's row when there are any
+    int cmodels;          ///< rows of the contact-model table (cmodel.c)
+    bool bb_cmodel;       ///< the ball-ball store carries each contact's row (a ball-ball row exists)
+    bool bw_cmodel;       ///< the ball-wall store carries each contact's row (a wall row exists)
 } sx_state_sizes;
 
 /// The sizes of m's stores now.

@@ -1292,10 +1292,12 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     s->bb_bonds = g >= 0 && H5Lexists(g, "bond", H5P_DEFAULT) > 0;
     s->rolling = g >= 0 && H5Lexists(g, "rolling_moment", H5P_DEFAULT) > 0;
     s->total_shear = g >= 0 && H5Lexists(g, "shear_displacement", H5P_DEFAULT) > 0;
+    s->bb_cmodel = g >= 0 && H5Lexists(g, "contact_model", H5P_DEFAULT) > 0;
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/contacts/ball_wall", true);
     s->bw = sx_h5_rows(h, g, "/contacts/ball_wall", "a", 1, true);
     s->bw_facets = g >= 0 && H5Lexists(g, "facet", H5P_DEFAULT) > 0;
+    s->bw_cmodel = g >= 0 && H5Lexists(g, "contact_model", H5P_DEFAULT) > 0;
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/bonds", true);
     s->bonds = sx_h5_rows(h, g, "/bonds", "kind", 1, true);

@@ -382,8 +382,8 @@ static int model_contact_model(lua_State *L)
 {
     const char *keys[56] = {"kn",      "ks",      "friction", "density",  "damping",    "viscous_normal",
                             "viscous_shear", "model", "modulus", "stiffness_ratio", "groups", "materials",
-                            "default", "material", "name"};
-    keys[sx_lua_law_keys(keys, 15, 55)] = NULL; /* and the laws' parameters */
+                            "default", "material", "name", "wall"};
+    keys[sx_lua_law_keys(keys, 16, 55)] = NULL; /* and the laws' parameters */
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
@@ -393,10 +393,30 @@ static int model_contact_model(lua_State *L)
                dflt = lua_getfield(L, 2, "default") != LUA_TNIL;
     if (dflt && !lua_toboolean(L, -1)) luaL_argerror(L, 2, "field 'default': true expected (or leave it out)");
     lua_pop(L, 3);
-    if (groups + materials + dflt != 1)
-        luaL_argerror(L, 2, "exactly one of groups = {a, b}, materials = {a, b} or default = true expected");
-    d.match = groups ? SX_CMODEL_GROUPS : materials ? SX_CMODEL_MATERIALS : SX_CMODEL_DEFAULT;
-    if (!dflt) pair_field(L, 2, groups ? "groups" : "materials", groups, &d.a, &d.b);
+    if (lua_getfield(L, 2, "wall") != LUA_TNIL) { /* a row of a wall's contacts: one ball group or material, or any */
+        int64_t wid;
+        const char *bad = sx_lua_toid(L, lua_gettop(L), 1, &sx_lua_wall_kind, &wid);
+        if (bad) sx_lua_fielderror(L, 2, "wall", bad);
+        if (!sx_wall_exists(m, wid)) sx_lua_fielderror(L, 2, "wall", lua_pushfstring(L, "no wall with id %I", (lua_Integer)wid));
+        lua_pop(L, 1);
+        if (dflt) luaL_argerror(L, 2, "with wall = ..., leave out default (a row of the wall's contacts with any ball)");
+        if (groups && materials) luaL_argerror(L, 2, "with wall = ..., one of groups = a or materials = a (or neither)");
+        const char *key = groups ? "groups" : "materials";
+        if ((groups || materials) && lua_getfield(L, 2, key) == LUA_TTABLE && lua_rawlen(L, -1) != 1)
+            sx_lua_fielderror(L, 2, key, "with wall = ..., one name (the ball's) expected");
+        if (groups || materials) lua_pop(L, 1);
+        if (wid > INT32_MAX) luaL_argerror(L, 2, "field 'wall': its id is beyond the table's range");
+        d.match = groups ? SX_CMODEL_WALL_GROUP : materials ? SX_CMODEL_WALL_MATERIAL : SX_CMODEL_WALL;
+        d.b = (int32_t)wid;
+        if (groups || materials) pair_field(L, 2, key, groups, &d.a, &(int32_t){0});
+    } else {
+        lua_pop(L, 1);
+        if (groups + materials + dflt != 1)
+            luaL_argerror(L, 2, "exactly one of groups = {a, b}, materials = {a, b}, default = true or wall = w expected");
+        d.match = groups ? SX_CMODEL_GROUPS : materials ? SX_CMODEL_MATERIALS : SX_CMODEL_DEFAULT;
+        if (!dflt) pair_field(L, 2, groups ? "groups" : "materials", groups, &d.a, &d.b);
+    }
+    const bool wall_row = d.match >= SX_CMODEL_WALL_GROUP;
     d.law = sx_material_default_def();
     const char *base = sx_lua_optstrfield(L, 2, "material");
     if (base) sx_lua_check(L, m, sx_material_get(m, sx_lua_material_arg(L, m, 2, "material", base), &d.law),
@@ -407,12 +427,14 @@ static int model_contact_model(lua_State *L)
     const char *name = sx_lua_optstrfield(L, 2, "name");
     char auto_name[64];
     if (!name && dflt) name = "default";
-    if (!name) { /* its match, for reports: "a-b" */
+    if (!name) { /* its match, for reports: "a-b" ("a-wall 3", "any-wall 3") */
         const sx_cmodel_def *p = &d;
         char both[2][64];
         for (int k = 0; k < 2; k++) {
             const int32_t v = k ? p->b : p->a;
-            if (groups) sx_lua_push_group_name(L, 1, v);
+            if (wall_row && k) lua_pushfstring(L, "wall %d", (int)v);
+            else if (d.match == SX_CMODEL_WALL) lua_pushliteral(L, "any");
+            else if (groups) sx_lua_push_group_name(L, 1, v);
             else lua_pushstring(L, sx_material_name(m, v));
             snprintf(both[k], sizeof both[k], "%s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "none");
             lua_pop(L, 1);
@@ -443,6 +465,13 @@ static int model_contact_models(lua_State *L)
         if (d.match == SX_CMODEL_DEFAULT) {
             lua_pushboolean(L, 1);
             lua_setfield(L, -2, "default");
+        } else if (d.match >= SX_CMODEL_WALL_GROUP) { /* the wall (its id once removed) and the ball's match */
+            if (sx_wall_exists(m, d.b)) sx_lua_pushhandle(L, 1, &sx_lua_wall_kind, d.b);
+            else lua_pushinteger(L, d.b);
+            lua_setfield(L, -2, "wall");
+            if (d.match == SX_CMODEL_WALL_GROUP) sx_lua_push_group_name(L, 1, d.a);
+            if (d.match == SX_CMODEL_WALL_MATERIAL) lua_pushstring(L, sx_material_name(m, d.a));
+            if (d.match != SX_CMODEL_WALL) lua_setfield(L, -2, d.match == SX_CMODEL_WALL_GROUP ? "groups" : "materials");
         } else {
             lua_createtable(L, 2, 0);
             for (int k = 0; k < 2; k++) {

@@ -107,6 +107,10 @@ E("m:contact_model", function(c)
   return method(c.m, "contact_model", {groups = {"top", "g"}, model = "linear", kn = 1e7, ks = 1e7, friction = 0.3,
                 name = "top-g", material = "rock"})
 end)
+E("m:contact_model{wall}", function(c)
+  return method(c.m, "contact_model", {wall = c.w, groups = "top", model = "linear", kn = 1e7, ks = 1e7, friction = 0.3,
+                material = "rock"})
+end)
 E("m:contact_models", function(c) return method(c.m, "contact_models") end)
 E("m:summary", function(c) return method(c.m, "summary") end)
 E("m:close", function(c) return method(c.m, "close") end)

@@ -80,7 +80,7 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const sx_wall *wl = &m->walls[m->bw.b[c]];
         /* a mesh's contacts as the last step kept them (a shadowed facet stores nothing) */
         const double un = wl->mesh ? (m->bw.touching[c] ? m->bw.un[c] : 0) : B->rad[i] - wall_distance(wl, B->x + i * D, n);
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], wl);
+        const sx_pair_law law = sx__bw_law(m, c);
         const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
         if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
         if (un > 0) e->strain += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
@@ -108,8 +108,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     }
     sx_contact_info ci;
     memset(&ci, 0, sizeof ci);
-    const sx_pair_law law = is_wall ? sx__wall_law(m, B->mat[i], &m->walls[p->b[c]])
-                                    : sx__bb_law(m, c, i, p->b[c]);
+    const sx_pair_law law = is_wall ? sx__bw_law(m, c) : sx__bb_law(m, c, i, p->b[c]);
     const double rj = is_wall ? B->rad[i] : B->rad[p->b[c]];
     stiffness(&law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
     /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
@@ -124,7 +123,7 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     ci.a = B->id[i];
     ci.b = is_wall ? m->walls[p->b[c]].id : B->id[p->b[c]];
     ci.is_wall = is_wall;
-    ci.cmodel = !is_wall && p->cmodel && p->touching[c] ? p->cmodel[c] : 0;
+    ci.cmodel = p->cmodel && p->touching[c] ? p->cmodel[c] : 0;
     if (!is_wall && m->cell) sx__cell_owner(m, p->b[c], ci.shift); /* through the boundary */
     if (!is_wall && p->joint && p->joint[c]) { /* a smooth joint: its normal and stiffnesses */
         const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;

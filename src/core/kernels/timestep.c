@@ -87,7 +87,7 @@ static double KERNEL(critical_dt)(sx_model *m)
         const double un = mesh ? (p->touching[c] ? p->un[c] : 0)
                                : B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
         if (un <= 0) continue;
-        const sx_pair_law law = sx__wall_law(m, B->mat[i], &m->walls[p->b[c]]);
+        const sx_pair_law law = sx__bw_law(m, c); /* its contact-model row's, or its ball's and wall's */
         double kn, ks;
         stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
         if (law.beta_n > 0 || law.beta_s > 0) {

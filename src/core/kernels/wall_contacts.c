@@ -19,7 +19,8 @@ static void wall_release(sx_model *m, sx_block *o, int64_t c)
     sx_pairs *p = &m->bw;
     const int64_t i = p->a[c];
     if (p->touching[c] && m->track_energy) { /* a Hertz spring holds nothing at zero overlap: ks = 0 */
-        const sx_pair_law *law = &m->wlaw[m->balls.mat[i] * m->nwall + p->b[c]];
+        const int32_t row = sx__bw_row(m, c);
+        const sx_pair_law *law = row ? &m->cmodel[row - 1].wlaw : &m->wlaw[m->balls.mat[i] * m->nwall + p->b[c]];
         const double r = m->balls.rad[i];
         double kn, ks;
         stiffness(law, r, 0, r, 0, &kn, &ks);
@@ -44,7 +45,9 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     sx_wall_acc *wa = &acc[p->b[c]];
     const double *xi = B->x + i * D, r = B->rad[i];
     double *fs = p->fs + c * D;
-    const sx_pair_law *law = &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
+    /* the contact-model row it took, or takes if new (cmodel.c); else its ball's and wall's law */
+    const int32_t row = sx__bw_row(m, c);
+    const sx_pair_law *law = row ? &m->cmodel[row - 1].wlaw : &m->wlaw[B->mat[i] * m->nwall + p->b[c]];
     const double un = r - dist; /* 4-3 */
     if (un > r) {
         o->st = SX_EUNSTABLE;
@@ -113,6 +116,7 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
         for (int k = 0; k < RD; k++) mroll[k] = mr[k];
     }
     for (int k = 0; k < D; k++) p->geo[c * D + k] = n[k];
+    if (p->cmodel) p->cmodel[c] = row;
     p->touching[c] = 1;
 
     double fd = fn, dsh[D], F[D];
@@ -441,7 +445,8 @@ SX_VECTOR_CLONES static void wall_block(sx_model *m, sx_block *o, sx_wall_acc *a
             continue;
         }
 #endif
-        bool lanes = !m->track_energy && c + LANES <= o->w1;
+        /* a contact-model row's law is read per contact (wall_force): lanes only without wall rows */
+        bool lanes = !m->track_energy && !m->bw.cmodel && c + LANES <= o->w1;
         for (int q = 0; q < LANES && lanes; q++) lanes = plain_wall_contact(m, c + q);
         if (lanes) {
             if (!wall_lanes(m, o, acc, c, &memo)) return;

@@ -1,0 +1,180 @@
+/* The clumps' step (clumps.c has the scheme: 4-46/4-48 for the centroid,
+ * Euler's equations 4-42 by a kick and a split free-rotor drift), one form
+ * per dimension as every kernel: d and r below are the unit's D and RD. */
+#include "clump_math.h"
+
+/* Sets every pebble of clump c from its body: position x + R s b,
+ * velocity v + w x r, spin w. Returns the largest squared displacement of
+ * a pebble since the last broad-phase build. */
+static double KERNEL(place_pebbles)(sx_model *m, int64_t c, const double *R)
+{
+    const int d = D, r = RD;
+    sx_clumps *C = m->clumps;
+    sx_balls *B = &m->balls;
+    const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
+    const double s = C->scale[c], *xc = C->x + c * d, *vc = C->v + c * d, *wc = C->w + c * r;
+    const double *body = C->tp_body + t->first * d;
+    const int32_t *peb = C->pebble + C->first[c];
+    double worst = 0;
+    for (int64_t k = 0; k < t->n; k++) {
+        const int64_t i = B->index_of[peb[k]];
+        double b[3] = {0, 0, 0}, arm[3] = {0, 0, 0}, u[3];
+        for (int j = 0; j < d; j++) b[j] = s * body[k * d + j];
+        mat_vec(R, b, arm);
+        spin_arm(d, wc, arm, u);
+        double *x = B->x + i * d, *v = B->v + i * d, disp2 = 0;
+        for (int j = 0; j < d; j++) {
+            x[j] = xc[j] + arm[j];
+            v[j] = vc[j] + u[j];
+            const double e = x[j] - B->x_build[i * d + j];
+            disp2 += e * e;
+        }
+        for (int j = 0; j < r; j++) B->w[i * r + j] = wc[j];
+        if (disp2 > worst) worst = disp2;
+    }
+    return worst;
+}
+
+/* The step of clumps [c0, c1): partial sums of one block. Each clump
+ * writes only itself and its own pebbles, so blocks run in parallel. */
+typedef struct clump_block {
+    double worst, damp_work, load_work; /* largest squared pebble displacement; energy terms */
+    int64_t bad;                        /* first clump with a non-finite state, or -1 */
+} clump_block;
+
+static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
+{
+    const int d = D, r = RD;
+    sx_clumps *C = m->clumps;
+    sx_balls *B = &m->balls;
+    const double dt = m->dt;
+    /* the kick spans the time between the half-step velocities, as for balls */
+    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
+    const double *g = m->gravity;
+    const bool track = m->track_energy;
+    double worst = 0, damp_work = 0, load_work = 0;
+    o->bad = -1;
+    for (int64_t c = c0; c < c1; c++) {
+        const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
+        const int32_t *peb = C->pebble + C->first[c];
+        double *x = C->x + c * d, *v = C->v + c * d, *w = C->w + c * r;
+        /* the resultant of the pebbles' forces, and its moment about the centroid:
+         * each pebble's own moment plus (x_pebble - x) x F (4-21 carried to the body) */
+        double F[3] = {0, 0, 0}, T[3] = {0, 0, 0}, Fa[3] = {0, 0, 0}, Ta[3] = {0, 0, 0};
+        for (int64_t k = 0; k < t->n; k++) {
+            const int64_t i = B->index_of[peb[k]];
+            double arm[3] = {0, 0, 0}, mo[3];
+            for (int j = 0; j < d; j++) arm[j] = B->x[i * d + j] - x[j];
+            moment_arm(d, arm, B->f + i * d, mo);
+            for (int j = 0; j < d; j++) F[j] += B->f[i * d + j];
+            for (int j = 0; j < r; j++) T[j] += B->t[i * r + j] + mo[j];
+            if (track && B->fapp) {
+                moment_arm(d, arm, B->fapp + i * d, mo);
+                for (int j = 0; j < d; j++) Fa[j] += B->fapp[i * d + j];
+                for (int j = 0; j < r; j++) Ta[j] += B->tapp[i * r + j] + mo[j];
+            }
+        }
+        memcpy(C->f + c * d, F, (size_t)d * sizeof(double));
+        memcpy(C->t + c * r, T, (size_t)r * sizeof(double));
+        const double mass = C->mass[c], a = C->alpha[c], *I = C->inertia + c * r;
+        const unsigned fix = C->fix[c];
+        /* translation: 4-46, 4-48 */
+        for (int k = 0; k < d; k++) {
+            if (!(fix & (SX_FIX_VX << k))) {
+                const double force = F[k] + g[k] * mass; /* 4-40: the weight acts at the centroid */
+                const double fd = sx__damped(force, v[k], a);
+                const double vold = v[k];
+                v[k] += fd / mass * dtv;
+                if (track) {
+                    damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
+                    load_work += Fa[k] * 0.5 * (vold + v[k]) * dt;
+                }
+            }
+            x[k] += v[k] * dt;
+        }
+        /* rotation: 4-42 */
+        if (d == 3) {
+            double *q = C->q + c * 4, *L = C->L + c * 3, R[9];
+            qmatrix(q, R);
+            if ((fix & SX_FIX_SPIN) == SX_FIX_SPIN) {
+                imposed_rotation(q, w, dt);
+                qmatrix(q, R);
+                momentum_of(R, I, w, L);
+            } else {
+                /* the kick, with local damping per principal component */
+                double Tb[3], Lb[3], Md[3], dL[3];
+                mat_tvec(R, T, Tb);
+                mat_tvec(R, L, Lb);
+                for (int k = 0; k < 3; k++) Md[k] = sx__damped(Tb[k], Lb[k] / I[k], a);
+                mat_vec(R, Md, dL);
+                for (int k = 0; k < 3; k++) L[k] += dL[k] * dtv;
+                if (track) { /* work at the mean of the old and new spins, as for balls */
+                    double Ln[3], wm[3];
+                    mat_tvec(R, L, Ln);
+                    for (int k = 0; k < 3; k++) {
+                        const double wold = Lb[k] / I[k], wnew = Ln[k] / I[k];
+                        damp_work += (Md[k] - Tb[k]) * 0.5 * (wold + wnew) * dt;
+                        wm[k] = 0.5 * (wold + wnew);
+                    }
+                    double ws[3];
+                    mat_vec(R, wm, ws);
+                    load_work += (Ta[0] * ws[0] + Ta[1] * ws[1] + Ta[2] * ws[2]) * dt;
+                }
+                free_rotor(q, R, L, I, dt); /* the drift */
+                qmatrix(q, R);
+                spin_of(R, I, L, w);
+            }
+            worst = fmax(worst, KERNEL(place_pebbles)(m, c, R));
+        } else {
+            if (!(fix & SX_FIX_WX)) {
+                const double md = sx__damped(T[0], w[0], a), wold = w[0];
+                w[0] += md / I[0] * dtv; /* 4-47 about z */
+                if (track) {
+                    damp_work += (md - T[0]) * 0.5 * (wold + w[0]) * dt;
+                    load_work += Ta[0] * 0.5 * (wold + w[0]) * dt;
+                }
+            }
+            C->q[c] += w[0] * dt;
+            double R[9];
+            body_rotation(m, c, R);
+            worst = fmax(worst, KERNEL(place_pebbles)(m, c, R));
+        }
+        bool ok = isfinite(C->q[c * (d == 3 ? 4 : 1)]);
+        for (int k = 0; k < d; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
+        for (int k = 0; k < r; k++) ok &= isfinite(w[k]);
+        if (!ok && o->bad < 0) o->bad = c;
+    }
+    o->worst = worst, o->damp_work = damp_work, o->load_work = load_work;
+}
+
+/* In fixed blocks of clumps whose partial sums are added in block order:
+ * the same bits for any thread count (as the balls' law of motion). */
+enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
+
+static sx_status KERNEL(clumps_step)(sx_model *m, double *max_disp)
+{
+    const sx_clumps *C = m->clumps;
+    const int64_t n = C->n;
+    clump_block part[CLUMP_BLOCKS];
+    int64_t size = (n + CLUMP_BLOCKS - 1) / CLUMP_BLOCKS;
+    if (size < CLUMP_BLOCK) size = CLUMP_BLOCK;
+    const int64_t nblk = (n + size - 1) / size;
+#pragma omp parallel for schedule(static) num_threads(m->threads) if (nblk > 1)
+    for (int64_t k = 0; k < nblk; k++) step_block(m, k * size, (k + 1) * size < n ? (k + 1) * size : n, &part[k]);
+    double worst = *max_disp * *max_disp;
+    for (int64_t k = 0; k < nblk; k++) {
+        if (part[k].bad >= 0)
+            return sx__fail(m, SX_EUNSTABLE,
+                            "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
+                            "the timestep %g s is likely too large (critical estimate %g s)",
+                            (long long)m->step, (long long)C->id[part[k].bad], m->dt,
+                            KERNEL(critical_dt)(m));
+        worst = fmax(worst, part[k].worst);
+        if (m->track_energy) {
+            m->acc.local_damping -= part[k].damp_work;
+            m->acc.boundary_work += part[k].load_work;
+        }
+    }
+    *max_disp = sqrt(worst);
+    return SX_OK;
+}
