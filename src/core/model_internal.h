@@ -436,11 +436,20 @@ bool sx__cmodel_any(const sx_model *m, bool walls);
 void sx__cmodel_derive(sx_cmodel_row *r);
 /* The mixed pair law of two materials (model.c). */
 sx_pair_law sx__pair_law_of(const sx_material *ma, const sx_material *mb);
-/* The law of ball-ball pair c for queries: its row's, or mixed from the materials as they are. */
-static inline sx_pair_law sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j)
+/* The law of ball-ball pair c for queries: its row's, or mixed from the
+ * materials as they are (into *buf); a pointer, as queries run it for every
+ * contact and the law is a few hundred bytes. */
+static inline const sx_pair_law *sx__bb_law(const sx_model *m, int64_t c, int64_t i, int64_t j, sx_pair_law *buf)
 {
     const int32_t r = !m->bb.cmodel ? 0 : m->bb.touching[c] ? m->bb.cmodel[c] : sx__cmodel_pick(m, i, j);
-    return r ? m->cmodel[r - 1].law : sx__pair_law_of(&m->mats[m->balls.mat[i]], &m->mats[m->balls.mat[j]]);
+    if (r) return &m->cmodel[r - 1].law;
+    const int a = m->balls.mat[i], b = m->balls.mat[j];
+    /* While the model steps (the energy guard), the step's table is the same
+     * mix (refresh_laws, before the cycle; materials cannot change while it
+     * steps): read it rather than mix the two materials for every contact. */
+    if (m->locked && m->law_n == m->nmat) return &m->law[a * m->law_n + b];
+    *buf = sx__pair_law_of(&m->mats[a], &m->mats[b]);
+    return buf;
 }
 
 /* The first rule d breaks (its value in *bad), or NULL (model.c). */

@@ -19,12 +19,13 @@ static double pair_force(const sx_model *m, int64_t c, double un, double *kn, do
 {
     const sx_balls *B = &m->balls;
     const int64_t i = m->bb.a[c], j = m->bb.b[c];
-    const sx_pair_law law = sx__bb_law(m, c, i, j);
+    sx_pair_law buf;
+    const sx_pair_law *law = sx__bb_law(m, c, i, j, &buf);
     const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
     const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
     const bool active = !(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT));
     const double rsum = B->rad[i] + B->rad[j];
-    const double fn = stiffness(&law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, kn, ks);
+    const double fn = stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, kn, ks);
     return active ? fn : 0;
 }
 
@@ -56,7 +57,8 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
         const double fn = pair_force(m, c, un, &kn, &ks);
-        const sx_pair_law law = sx__bb_law(m, c, i, j);
+        sx_pair_law buf;
+        const sx_pair_law *law = sx__bb_law(m, c, i, j, &buf);
         if (m->bb.joint && m->bb.joint[c] && m->bb.touching[c]) { /* a smooth joint (laws/smoothjoint.h) */
             const sx_law_sj *L = &m->joints[m->bb.joint[c] - 1].law;
             const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
@@ -67,24 +69,32 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
             else e->strain += s;
             continue;
         }
-        e->strain += contact_strain(&law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
-        e->strain += rolling_strain(&law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
+        e->strain += contact_strain(law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
+        e->strain += rolling_strain(law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += sx_bond_parallel_strain(D, &m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
             e->bond_strain += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
     }
+    /* the law of each material against each wall, mixed once here rather
+     * than for every contact (the energy guard runs this every 64 steps);
+     * a model with contact-model rows for walls asks each contact its row */
+    const int64_t nw = m->nwall, nlaw = m->bw.cmodel ? 0 : m->nmat * nw;
+    sx_pair_law *wall_laws = nlaw > 0 && nlaw <= 4096 ? malloc((size_t)nlaw * sizeof *wall_laws) : NULL;
+    for (int64_t k = 0; wall_laws && k < nlaw; k++) wall_laws[k] = sx__wall_law(m, (int)(k / nw), &m->walls[k % nw]);
     for (int64_t c = 0; c < m->bw.n; c++) {
         double n[D], kn, ks;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
         /* a mesh's contacts as the last step kept them (a shadowed facet stores nothing) */
         const double un = wl->mesh ? (m->bw.touching[c] ? m->bw.un[c] : 0) : B->rad[i] - wall_distance(wl, B->x + i * D, n);
-        const sx_pair_law law = sx__bw_law(m, c);
-        const double fn = un > 0 ? stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks) : 0;
-        if (un > 0) e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
-        if (un > 0) e->strain += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
+        if (un <= 0) continue;
+        const sx_pair_law law = wall_laws ? wall_laws[B->mat[i] * nw + m->bw.b[c]] : sx__bw_law(m, c);
+        const double fn = stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
+        e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
+        e->strain += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
     }
+    free(wall_laws);
 }
 
 /* Contacts are reported as the last force evaluation left them (the forces
@@ -108,9 +118,10 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     }
     sx_contact_info ci;
     memset(&ci, 0, sizeof ci);
-    const sx_pair_law law = is_wall ? sx__bw_law(m, c) : sx__bb_law(m, c, i, p->b[c]);
+    sx_pair_law buf;
+    const sx_pair_law *law = is_wall ? (buf = sx__bw_law(m, c), &buf) : sx__bb_law(m, c, i, p->b[c], &buf);
     const double rj = is_wall ? B->rad[i] : B->rad[p->b[c]];
-    stiffness(&law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
+    stiffness(law, B->rad[i], rj, is_wall ? B->rad[i] : 2 * B->rad[i] * rj / (B->rad[i] + rj), un, &ci.kn, &ci.ks);
     /* ball-wall normals point from the wall to the ball, so the point lies behind the centre */
     const double arm = is_wall ? -(B->rad[i] - 0.5 * un) : B->rad[i] - 0.5 * un;
     for (int k = 0; k < D; k++) {
