@@ -76,18 +76,6 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
 
 int sx_model_ranks(const sx_model *m) { return m->dd ? m->dd->x.ranks : 1; }
 
-/* First index c of sorted a[0..n) with a[c] >= key. */
-static int64_t first_at(const int32_t *a, int64_t n, int64_t key)
-{
-    int64_t lo = 0, hi = n;
-    while (lo < hi) {
-        const int64_t mid = lo + (hi - lo) / 2;
-        if (a[mid] < key) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
-}
-
 /* The rank owning ball i (own[] cut as in sx__dd_plan). */
 static int owner_of(const sx_dd *d, int64_t i, int64_t n)
 {
@@ -118,8 +106,8 @@ void sx__dd_plan(sx_model *m)
     for (int r = 0; r < R; r++) {
         sx_span *own = &d->own[r], *pr = &d->pairs[r], *wb = &d->wblk[r];
         const int64_t lo_a = pr->lo;
-        pr->lo = first_at(p->a, p->n, lo_a);
-        pr->hi = first_at(p->a, p->n, own->hi);
+        pr->lo = sx__first_at(p->a, p->n, lo_a);
+        pr->hi = sx__first_at(p->a, p->n, own->hi);
         int64_t hi = own->hi;
         for (int64_t c = pr->lo; c < pr->hi; c++)
             if (p->b[c] + 1 > hi) hi = p->b[c] + 1;
@@ -137,8 +125,8 @@ void sx__dd_plan(sx_model *m)
         if (own->hi == own->lo) lo = hi = own->lo; /* a rank without balls needs none */
         d->need[2 * r] = (sx_span){lo, own->lo};
         d->need[2 * r + 1] = (sx_span){own->hi, hi};
-        d->bb_own[r] = (sx_span){first_at(p->a, p->n, own->lo), first_at(p->a, p->n, own->hi)};
-        d->bw_own[r] = (sx_span){first_at(m->bw.a, m->bw.n, own->lo), first_at(m->bw.a, m->bw.n, own->hi)};
+        d->bb_own[r] = (sx_span){sx__first_at(p->a, p->n, own->lo), sx__first_at(p->a, p->n, own->hi)};
+        d->bw_own[r] = (sx_span){sx__first_at(m->bw.a, m->bw.n, own->lo), sx__first_at(m->bw.a, m->bw.n, own->hi)};
     }
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
      * they clear, to its own and its ghosts */

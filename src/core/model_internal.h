@@ -452,6 +452,19 @@ static inline const sx_pair_law *sx__bb_law(const sx_model *m, int64_t c, int64_
     return buf;
 }
 
+/* First index c of the sorted a[0..n) with a[c] >= key (a pair store's
+ * column a is sorted after a build). */
+static inline int64_t sx__first_at(const int32_t *a, int64_t n, int64_t key)
+{
+    int64_t lo = 0, hi = n;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 /* The first rule d breaks (its value in *bad), or NULL (model.c). */
 const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len);
 

@@ -837,18 +837,6 @@ static void ball_chunk(sx_model *m, sx_chunk *o)
  * passes. */
 enum { CHUNK_PAIRS = 1024, MAX_CHUNKS = 16, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
 
-/* First index c of sorted a[0..n) with a[c] >= key. */
-static int64_t lower_bound(const int32_t *a, int64_t n, int64_t key)
-{
-    int64_t lo = 0, hi = n;
-    while (lo < hi) {
-        const int64_t mid = lo + (hi - lo) / 2;
-        if (a[mid] < key) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
-}
-
 static bool plan_chunks(sx_model *m)
 {
     /* ownership needs the pairs grouped by a: bonded pairs appended by a
@@ -882,7 +870,7 @@ static bool plan_chunks(sx_model *m)
         if (c > 0 && lo[c] < lo[c - 1]) lo[c] = lo[c - 1];
         sx_chunk *o = &m->chunks[c];
         o->own_lo = lo[c];
-        o->first = lower_bound(p->a, p->n, lo[c]);
+        o->first = sx__first_at(p->a, p->n, lo[c]);
         if (c >= 2) { /* chunk c - 2 is complete once chunk c - 1 starts */
             const sx_chunk *e = &m->chunks[c - 2];
             int64_t reach = lo[c - 1];
@@ -891,7 +879,7 @@ static bool plan_chunks(sx_model *m)
             if (reach > lo[c]) {
                 lo[c] = reach;
                 o->own_lo = reach;
-                o->first = lower_bound(p->a, p->n, reach);
+                o->first = sx__first_at(p->a, p->n, reach);
             }
         }
     }
@@ -918,8 +906,8 @@ static bool plan_chunks(sx_model *m)
         sx_block *o = &m->blocks[b];
         o->b0 = b * size;
         o->b1 = (b + 1) * size < n ? (b + 1) * size : n;
-        o->w0 = lower_bound(m->bw.a, m->bw.n, o->b0);
-        o->w1 = lower_bound(m->bw.a, m->bw.n, o->b1);
+        o->w0 = sx__first_at(m->bw.a, m->bw.n, o->b0);
+        o->w1 = sx__first_at(m->bw.a, m->bw.n, o->b1);
     }
     return true;
 }
