@@ -42,6 +42,14 @@ typedef struct sx_bond_law {
     int nparams;
 } sx_bond_law;
 
+/* The cement face's micro-parameters, the parallel bond's (4-35, 4-38) and
+ * the flat joint's alike: one list for both kinds' tables. */
+#define SX_BOND_FACE_PARAMS                                                                                            \
+    SX_BOND_PARAM(radius_multiplier, "1", INFINITY, false), SX_BOND_PARAM(modulus, "Pa", INFINITY, false),             \
+        SX_BOND_PARAM(stiffness_ratio, "1", INFINITY, false), SX_BOND_PARAM(tensile_strength, "Pa", INFINITY, false), \
+        SX_BOND_PARAM(tensile_strength_sd, "Pa", INFINITY, false), SX_BOND_PARAM(cohesion, "Pa", INFINITY, false),    \
+        SX_BOND_PARAM(cohesion_sd, "Pa", INFINITY, false)
+
 /* The sum of a[k] b[k] from zero, as the passes' dot() (the same bits). */
 static inline double sx_bond_dot(int dim, const double *a, const double *b)
 {

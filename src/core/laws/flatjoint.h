@@ -200,13 +200,7 @@ static inline sx_law_fj_load sx_law_fj_load_of(int dim, const sx_law_fj_geom *g,
 static inline const sx_bond_law *sx_bond_flatjoint(void)
 {
     static const sx_bond_param params[] = {
-        SX_BOND_PARAM(radius_multiplier, "1", INFINITY, false),
-        SX_BOND_PARAM(modulus, "Pa", INFINITY, false),
-        SX_BOND_PARAM(stiffness_ratio, "1", INFINITY, false),
-        SX_BOND_PARAM(tensile_strength, "Pa", INFINITY, false),
-        SX_BOND_PARAM(tensile_strength_sd, "Pa", INFINITY, false),
-        SX_BOND_PARAM(cohesion, "Pa", INFINITY, false),
-        SX_BOND_PARAM(cohesion_sd, "Pa", INFINITY, false),
+        SX_BOND_FACE_PARAMS,
         SX_BOND_PARAM(friction_angle, "deg", 90, false),
         SX_BOND_PARAM(friction, "1", INFINITY, false),
         SX_BOND_COUNT(elements, 64), /* a joint's uint8 holds them */

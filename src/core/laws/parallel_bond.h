@@ -120,13 +120,7 @@ static inline void sx_bond_parallel_stiffness(int dim, const sx_bonds *b, int64_
 static inline const sx_bond_law *sx_bond_parallel_bond(void)
 {
     static const sx_bond_param params[] = {
-        SX_BOND_PARAM(radius_multiplier, "1", INFINITY, false),
-        SX_BOND_PARAM(modulus, "Pa", INFINITY, false),
-        SX_BOND_PARAM(stiffness_ratio, "1", INFINITY, false),
-        SX_BOND_PARAM(tensile_strength, "Pa", INFINITY, false),
-        SX_BOND_PARAM(tensile_strength_sd, "Pa", INFINITY, false),
-        SX_BOND_PARAM(cohesion, "Pa", INFINITY, false),
-        SX_BOND_PARAM(cohesion_sd, "Pa", INFINITY, false),
+        SX_BOND_FACE_PARAMS,
     };
     static const sx_bond_law law = {
         .name = "parallel",
