@@ -938,10 +938,40 @@ local function finish(m, r, opts, plot)
 end
 
 local test_keys = {"confining", "intermediate", "strain_rate", "max_strain", "post_peak", "every", "out", "plot", "log",
-                   "lateral", "max_steps", "confine_tol", "name"}
+                   "lateral", "max_steps", "confine_tol", "name", "target_ratio", "max_rate"}
 
 local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_strain", "axial_stress",
-                 "lateral_stress", "deviator", "cracks_tension", "cracks_shear", "ratio", "inertial"}
+                 "lateral_stress", "deviator", "cracks_tension", "cracks_shear", "ratio", "inertial", "strain_rate"}
+
+-- The loading-rate control's options: the unbalanced-force ratio it keeps
+-- the loading under (false: a constant strain rate) and the fastest rate.
+local function rate_control(opts, rate, fn)
+  local target = opts.target_ratio
+  if target == nil then target = 4e-3 end
+  if target == false then return nil, rate end
+  if type(target) ~= "number" or not (target > 0 and target < 1) then
+    fail("lab.%s: target_ratio must be a ratio in (0, 1) or false (got %s)", fn, tostring(opts.target_ratio))
+  end
+  local max_rate = opts.max_rate or 8 * rate
+  if type(max_rate) ~= "number" or not (max_rate >= rate and max_rate < math.huge) then
+    fail("lab.%s: max_rate must be a strain rate >= strain_rate = %g 1/s (got %s)", fn, rate, tostring(opts.max_rate))
+  end
+  return target, max_rate
+end
+
+-- PFC's loading-rate control by the mean unbalanced-force ratio: while the
+-- ratio stays below half its target the platens speed up by a fifth a
+-- sample, up to max_factor times strain_rate; above the target they halve
+-- their speed, down to strain_rate. A bonded specimen's ratio under a
+-- steady load falls as its stress grows (the unbalanced forces the platens'
+-- motion causes stay, the contact forces grow), and each burst of cracks
+-- raises it tenfold for hundreds of steps: the loading is fast while the
+-- specimen is elastic and at strain_rate while it cracks.
+local function rate_factor(factor, ratio, cracked, target, max_factor)
+  if ratio > target or cracked then return math.max(1, 0.5 * factor) end
+  if ratio < 0.5 * target then return math.min(max_factor, 1.15 * factor) end
+  return factor
+end
 
 -- A triaxial (confining > 0) or unconfined compression test.
 local function compression(spec, opts, fn)
@@ -972,6 +1002,7 @@ local function compression(spec, opts, fn)
 
   local m, lo, hi, centre, bottom, top = open_test(spec)
   local rate = opts.strain_rate or default_rate(m)
+  local control, max_rate = rate_control(opts, rate, fn)
   local kn, fr, kind = spec.wall_kn, 0, dim == 3 and "plane" or "line"
 
   -- lateral confinement: a cylinder or planes (lines), servo-controlled
@@ -1083,8 +1114,12 @@ local function compression(spec, opts, fn)
   -- 2D), a confinement the test no longer controls. Ten times the platens'
   -- speed leaves room for that dilation on specimens up to twice as wide as
   -- high; before the peak the walls move far slower than either limit.
-  lateral_limit = math.max(0.05, 10 * speed)
+  -- the rate control: the platens speed up to max_rate while the ratio is
+  -- low and slow down to strain_rate when it is high (see rate_factor)
+  local top_speed = control and 0.5 * max_rate * h0 or speed
+  lateral_limit = math.max(0.05, 10 * top_speed)
   drive(top, bottom, dim, speed)
+  local factor = 1
   local lateral_strain
   if #lateral == 0 then
     lateral_strain = affine_strain(m, ax)
@@ -1111,21 +1146,32 @@ local function compression(spec, opts, fn)
   local why = "max_strain"
   while true do
     if #lateral > 0 then servo_lateral() end
-    m:cycle(every)
+    -- the ratio: the mean of four readings over the interval (one reading
+    -- swings by a factor of 3 with the specimen's vibrations)
+    local ratio = 0
+    for i = 1, 4 do
+      m:cycle(every // 4 + (i <= every % 4 and 1 or 0))
+      ratio = ratio + 0.25 * m:ratio()
+    end
     local ea = (h0 - height()) / h0
     local el = lateral_strain()
     local sa, sl = axial_stress(), lateral_stress()
     local q = sa - sl
-    local ratio = m:ratio()
     local p = (sa + (dim - 1) * sl) / dim
-    local inertial = inertial_number(rate, spec, p)
+    local inertial = inertial_number(rate * factor, spec, p)
     if m:step() - start > 10 * every then -- past the first contact transients
       ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
       if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
     end
     local row = {m:step(), m:time() - t_start, ea, el, ea + (dim - 1) * el, sa, sl, q,
-                 m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial}
+                 m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial,
+                 rate * factor}
     rows[#rows + 1] = row
+    if control then
+      local cracked = row[9] + row[10] > (rows[#rows - 1] and rows[#rows - 1][9] + rows[#rows - 1][10] or 0)
+      local f = rate_factor(factor, ratio, cracked, control, max_rate / rate)
+      if f ~= factor then factor = f; drive(top, bottom, dim, speed * factor) end
+    end
     if q > peak then peak, peak_row = q, #rows end
     -- past the peak: a bonded specimen loses strength only by cracking, so
     -- a drop without cracks is a transient (the platens seating)
