@@ -24,7 +24,11 @@ local spec = lab.specimen{dim = 3, shape = "cylinder", diameter = diameter, heig
 
 local series = lab.series(spec, {confining = confining, strain_rate = rate, out = out .. "/series"})
 local ucs = series.tests[1]
-local slow = lab.ucs(spec, {strain_rate = ucs.strain_rate / 2, out = out .. "/ucs_half_rate", plot = false})
+-- half the rate: every speed of the loading-rate control halved, and the
+-- unbalanced-force ratio it allows too (the ratio grows with the speed)
+local slow = lab.ucs(spec, {strain_rate = ucs.strain_rate / 2, max_rate = ucs.max_rate / 2,
+                            target_ratio = ucs.target_ratio and ucs.target_ratio / 2, out = out .. "/ucs_half_rate",
+                            plot = false})
 
 local fit = series.fit
 local g = spec.genesis

@@ -887,18 +887,26 @@ local function default_rate(m) return 7e-8 / m:timestep() end
 
 -- The inertial number I = strain rate x mean diameter x sqrt(density / p):
 -- below about 1e-3 the loading is quasi-static (GDR MiDi 2004).
-local function inertial_number(rate, spec, p)
+local function inertial_number(rate, spec, p, scale)
   if not (p > 0) then return math.huge end
-  return rate * (spec.radius[1] + spec.radius[2]) * math.sqrt(spec.material.density / p)
+  return rate * (spec.radius[1] + spec.radius[2]) * math.sqrt(scale * spec.material.density / p)
 end
 
 -- A test's start: the specimen loaded from its file, its extents and
 -- centre, and the platens -- frictionless planes (lines) touching its ends
 -- along the loading axis.
-local function open_test(spec)
+local function open_test(spec, opts, fn)
   if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
   local dim, ax = spec.dim, axis_of(spec.dim)
+  local scale = opts.density_scale or 1
+  if type(scale) ~= "number" or not (scale >= 1 and scale <= 1e6) then
+    fail("lab.%s: density_scale must be a factor in [1, 1e6] (got %s)", fn, tostring(opts.density_scale))
+  end
   local m = seixo.load(spec.path)
+  -- density scaling: the balls' density (so mass and inertia) times scale,
+  -- the automatic timestep sqrt(m / k) times sqrt(scale); a quasi-static
+  -- test's stresses do not depend on the mass, only its dynamics do
+  if scale ~= 1 then m:material("rock", merge(spec.material, {density = scale * spec.material.density})) end
   local lo, hi = extents(m)
   local centre = {}
   for k = 1, dim do centre[k] = 0.5 * (lo[k] + hi[k]) end
@@ -938,7 +946,7 @@ local function finish(m, r, opts, plot)
 end
 
 local test_keys = {"confining", "intermediate", "strain_rate", "max_strain", "post_peak", "every", "out", "plot", "log",
-                   "lateral", "max_steps", "confine_tol", "name", "target_ratio", "max_rate"}
+                   "lateral", "max_steps", "confine_tol", "name", "target_ratio", "max_rate", "density_scale"}
 
 local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_strain", "axial_stress",
                  "lateral_stress", "deviator", "cracks_tension", "cracks_shear", "ratio", "inertial", "strain_rate"}
@@ -1000,7 +1008,7 @@ local function compression(spec, opts, fn)
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", fn) end
   local t0 = seixo.clock()
 
-  local m, lo, hi, centre, bottom, top = open_test(spec)
+  local m, lo, hi, centre, bottom, top = open_test(spec, opts, fn)
   local rate = opts.strain_rate or default_rate(m)
   local control, max_rate = rate_control(opts, rate, fn)
   local kn, fr, kind = spec.wall_kn, 0, dim == 3 and "plane" or "line"
@@ -1158,7 +1166,7 @@ local function compression(spec, opts, fn)
     local sa, sl = axial_stress(), lateral_stress()
     local q = sa - sl
     local p = (sa + (dim - 1) * sl) / dim
-    local inertial = inertial_number(rate * factor, spec, p)
+    local inertial = inertial_number(rate * factor, spec, p, opts.density_scale or 1)
     if m:step() - start > 10 * every then -- past the first contact transients
       ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
       if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
@@ -1187,7 +1195,8 @@ local function compression(spec, opts, fn)
   local r = {kind = sigma3 > 0 and "triaxial" or "ucs", confining = sigma3, intermediate = sigma2, dim = dim,
              rows = rows,
              columns = columns, stopped = why, steps = m:step() - start, confine_steps = confine_steps,
-             strain_rate = rate, platen_speed = speed}
+             strain_rate = rate, platen_speed = speed, target_ratio = control or false, max_rate = max_rate,
+             density_scale = opts.density_scale or 1, timestep = m:timestep()}
   local pr = rows[peak_row]
   r.peak_deviator = peak
   r.peak = peak + sigma3            -- sigma1 at failure
@@ -1248,7 +1257,8 @@ end
 function lab.brazilian(spec, opts)
   opts = opts or {}
   check_spec(spec, "brazilian")
-  check_keys(opts, "brazilian", {"strain_rate", "post_peak", "every", "out", "plot", "log", "max_steps", "max_strain"})
+  check_keys(opts, "brazilian", {"strain_rate", "post_peak", "every", "out", "plot", "log", "max_steps", "max_strain",
+                                 "density_scale"})
   local dim, ax = spec.dim, axis_of(spec.dim)
   if spec.shape ~= "disc" and spec.shape ~= "disk" then
     fail("lab.brazilian: the specimen must be a %s (got a %s)", dim == 3 and "disc" or "disk", spec.shape)
@@ -1258,7 +1268,7 @@ function lab.brazilian(spec, opts)
   local every = steps(opts.every or 100, "every", "brazilian")
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", "brazilian") end
   local t0 = seixo.clock()
-  local m, lo, hi, _, bottom, top = open_test(spec)
+  local m, lo, hi, _, bottom, top = open_test(spec, opts, "brazilian")
   local rate = opts.strain_rate or default_rate(m)
   local d = hi[ax] - lo[ax]
   local t = dim == 3 and hi[2] - lo[2] or 1
