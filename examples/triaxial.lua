@@ -28,7 +28,7 @@ local series = lab.series(spec, {confining = confining, strain_rate = rate, out 
 local ucs = series.tests[1]
 -- half the rate: every speed of the loading-rate control halved, and the
 -- unbalanced-force ratio it allows too (the ratio grows with the speed)
-local slow = lab.ucs(spec, {strain_rate = ucs.strain_rate / 2, max_rate = ucs.max_rate / 2,
+local slow = lab.ucs(spec, {strain_rate = ucs.strain_rate / 2, max_rate = ucs.target_ratio and ucs.max_rate / 2,
                             target_ratio = ucs.target_ratio and ucs.target_ratio / 2, out = out .. "/ucs_half_rate",
                             plot = false})
 

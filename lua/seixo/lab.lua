@@ -956,7 +956,10 @@ local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_s
 local function rate_control(opts, rate, fn)
   local target = opts.target_ratio
   if target == nil then target = 4e-3 end
-  if target == false then return nil, rate end
+  if target == false then
+    if opts.max_rate then fail("lab.%s: max_rate is the rate control's; target_ratio = false turns it off", fn) end
+    return nil, rate
+  end
   if type(target) ~= "number" or not (target > 0 and target < 1) then
     fail("lab.%s: target_ratio must be a ratio in (0, 1) or false (got %s)", fn, tostring(opts.target_ratio))
   end
