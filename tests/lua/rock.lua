@@ -1,0 +1,66 @@
+-- lab.rock's micro-parameter sets (docs/potyondy-cundall.md): Potyondy &
+-- Cundall's PFC2D set, the set calibrated in 3D, and the BPM scaling the
+-- 3D set rests on (E proportional to Ec = Ec-bar at fixed stiffness ratios).
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
+local lab = require "seixo.lab"
+
+test("lab.rock() is P&C's PFC2D set, and lab.rock{dim = 2} the same", function()
+  for _, r in ipairs{lab.rock(), lab.rock{dim = 2}} do
+    eq(r.density, 2630)
+    eq(r.modulus, 62e9)
+    eq(r.stiffness_ratio, 2.5)
+    eq(r.friction, 0.5)
+    eq(r.bond.radius_multiplier, 1)
+    eq(r.bond.modulus, 62e9)
+    eq(r.bond.stiffness_ratio, 2.5)
+    eq(r.bond.tensile_strength, 157e6)
+    eq(r.bond.tensile_strength_sd, 36e6)
+    eq(r.bond.cohesion, 157e6)
+    eq(r.bond.cohesion_sd, 36e6)
+    eq(r.dim, nil, "dim chooses the set and is not a material field")
+  end
+end)
+
+test("lab.rock{dim = 3}: the 3D calibration, P&C's ratios and coefficient of variation kept", function()
+  local r, p = lab.rock{dim = 3}, lab.rock()
+  eq(r.modulus, 84e9)
+  eq(r.bond.modulus, r.modulus)
+  eq(r.bond.tensile_strength, 205e6)
+  eq(r.bond.cohesion, r.bond.tensile_strength)
+  eq(r.dim, nil)
+  for _, k in ipairs{"density", "stiffness_ratio", "friction", "damping"} do eq(r[k], p[k], k) end
+  eq(r.bond.stiffness_ratio, p.bond.stiffness_ratio)
+  eq(r.bond.radius_multiplier, p.bond.radius_multiplier)
+  near(r.bond.tensile_strength_sd / r.bond.tensile_strength, p.bond.tensile_strength_sd / p.bond.tensile_strength, 0.02)
+  eq(r.bond.cohesion_sd, r.bond.tensile_strength_sd)
+  -- overrides apply on top of the chosen set
+  local o = lab.rock{dim = 3, friction = 0.3, bond = {cohesion = 1e8}}
+  eq(o.friction, 0.3)
+  eq(o.bond.cohesion, 1e8)
+  eq(o.bond.tensile_strength, 205e6)
+  eq(o.modulus, 84e9)
+  raises(function() lab.rock{dim = 4} end, "dim must be 2 or 3")
+  raises(function() lab.rock("pfc3d") end, "a table of overrides expected")
+end)
+
+test("E scales with Ec = Ec-bar at fixed ratios (the 3D set's calibration step), nu does not move", function()
+  local dir = os.tmpname()
+  os.remove(dir)
+  os.execute("mkdir -p '" .. dir .. "'")
+  local res = {}
+  for i, ec in ipairs{62e9, 84e9} do
+    local spec = lab.specimen{dim = 3, shape = "cylinder", diameter = 0.01, height = 0.02, radius = {0.8e-3, 1.33e-3},
+                              seed = 2, material = lab.rock{dim = 3, modulus = ec, bond = {modulus = ec}},
+                              path = dir .. "/e" .. i .. ".h5", log = false}
+    -- elastic only: to an axial strain of 3e-4, a third of the way to the peak
+    res[i] = lab.ucs(spec, {max_strain = 3e-4, log = false})
+    check(res[i].cracks.tension + res[i].cracks.shear == 0, "elastic: no bond broke")
+  end
+  os.execute("rm -rf '" .. dir .. "'")
+  local ratio = res[2].young / res[1].young
+  near(ratio, 84 / 62, 0.05)
+  near(res[2].poisson, res[1].poisson, 0.1)
+end)
+
+T.done()
