@@ -19,7 +19,7 @@ local radius = {rmin, 1.66 * rmin}
 local tag = string.format("%s_d%d_r%g_s%d_%s", csv:gsub("%.csv$", ""), dim, rmin * 1e3, seed, kind)
 local t0 = seixo.clock()
 local spec, r, values
-local common = {dim = dim, radius = radius, seed = seed, material = material, path = tag .. ".h5"}
+local common = {dim = dim, radius = radius, seed = seed, material = material, path = tag .. "_specimen.h5"}
 local function with(t)
   for k, v in pairs(common) do t[k] = v end
   return t
