@@ -145,11 +145,10 @@ local granite2d = {
 -- with Ec = Ec-bar, the UCS with sigma-bar_c = tau-bar_c, the ratios and
 -- the coefficient of variation kept): seixo's calibration, measured in
 -- docs/potyondy-cundall.md, not P&C's PFC3D table.
-local granite3d = {
-  density = 2630, modulus = 87e9, stiffness_ratio = 2.5, friction = 0.5, damping = 0.7,
-  bond = {radius_multiplier = 1, modulus = 87e9, stiffness_ratio = 2.5,
-          tensile_strength = 227e6, tensile_strength_sd = 52e6, cohesion = 227e6, cohesion_sd = 52e6},
-}
+local granite3d = merge(granite2d, {
+  modulus = 87e9,
+  bond = {modulus = 87e9, tensile_strength = 227e6, tensile_strength_sd = 52e6, cohesion = 227e6, cohesion_sd = 52e6},
+})
 
 --- Bonded-particle micro-parameters (4-49 ... 4-53) of a granite-like rock
 --- after Potyondy & Cundall (2004, Lac du Bonnet granite), with overrides.
