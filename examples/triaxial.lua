@@ -18,10 +18,12 @@ local tolerance = 0.02                                 -- quasi-static: the peak
 os.execute("mkdir -p '" .. out .. "'")
 local t0 = seixo.clock()
 
--- Potyondy & Cundall's (2004) micro-parameters of Lac du Bonnet granite,
--- on a coarse specimen (about 1,300 balls) so the series runs in minutes
+-- Lac du Bonnet granite: Potyondy & Cundall's (2004) micro-parameters with
+-- the moduli and bond strengths of seixo's 3D calibration (lab.rock{dim = 3};
+-- docs/potyondy-cundall.md), on a coarse specimen (about 1,500 balls) so the
+-- series runs in minutes
 local spec = lab.specimen{dim = 3, shape = "cylinder", diameter = diameter, height = 2 * diameter,
-                          radius = {0.04 * diameter, 0.0667 * diameter}, material = lab.rock(),
+                          radius = {0.04 * diameter, 0.0667 * diameter}, material = lab.rock{dim = 3},
                           sigma0 = 0.1e6, seed = 1, path = out .. "/specimen.h5"}
 
 local series = lab.series(spec, {confining = confining, strain_rate = rate, out = out .. "/series"})
