@@ -130,6 +130,46 @@ static haddr_t chunk_address(const char *path, const char *dataset)
     return addr;
 }
 
+/* The file offset of the size of the first chunk of an object's header
+ * (a version-2 header: "OHDR", version, flags, optional times and
+ * attribute phase change values, then the size, 1 to 8 bytes). */
+static long header_size_offset(const char *path, const char *object)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    H5O_info_t oi;
+    ck_assert(f >= 0 && H5Oget_info_by_name(f, object, &oi, H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    unsigned char b[6];
+    FILE *fp = fopen(path, "rb");
+    ck_assert(fp && fseek(fp, (long)oi.addr, SEEK_SET) == 0 && fread(b, 1, sizeof b, fp) == sizeof b);
+    fclose(fp);
+    ck_assert_msg(memcmp(b, "OHDR", 4) == 0 && b[4] == 2, "%s: not a version-2 object header", object);
+    return (long)oi.addr + 6 + (b[5] & 0x20 ? 16 : 0) + (b[5] & 0x10 ? 4 : 0);
+}
+
+/* A dataset's object header whose chunk size is damaged (issue 18, 6b):
+ * HDF5 decodes the header's prefix, then its checksum, taken over the
+ * wrong length, fails; seixo names the dataset. HDF5 1.10 drops the
+ * header it had begun to build (424 bytes, under H5O_protect): the one
+ * leak tests/io/lsan.supp and valgrind.supp allow on this path; any block
+ * of seixo's lost here would still be reported. In the main test case so
+ * that the valgrind setup checks its suppression too. */
+START_TEST(damaged_header_size)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "header.h5");
+    const char *objects[] = {"/balls/position", "/contacts/ball_ball/shear_force"};
+    for (size_t k = 0; k < sizeof objects / sizeof *objects; k++) {
+        copy_file(good3, p);
+        flip(p, header_size_offset(p, objects[k]));
+        char what[128];
+        snprintf(what, sizeof what, "damaged: cannot open the dataset %s", objects[k]);
+        expect_error(p, 0, what);
+    }
+}
+END_TEST
+
 START_TEST(corrupted)
 {
     make_good();
@@ -561,6 +601,7 @@ int main(void)
     tcase_add_test(tc, write_fails);
     tcase_add_test(tc, meaningless_values);
     tcase_add_test(tc, format2_parts);
+    tcase_add_test(tc, damaged_header_size);
     suite_add_tcase(s, tc);
     /* flipped bytes: HDF5 1.10 itself leaks a little on some damaged
      * metadata (its error paths), so these have their own case */
