@@ -1040,6 +1040,62 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
     return s;
 }
 
+/* ------------------------------------------------------------ recovery */
+
+/* Links every link of a group but one into another group. */
+typedef struct relink {
+    hid_t to;
+    const char *skip;
+} relink;
+
+static herr_t relink_one(hid_t g, const char *name, const H5L_info_t *info, void *ud)
+{
+    (void)info;
+    const relink *r = ud;
+    /* an object that cannot be read cannot be linked again: it stays
+     * behind, with the group set aside */
+    if (strcmp(name, r->skip) != 0) H5Lcreate_hard(g, name, r->to, name, H5P_DEFAULT, H5P_DEFAULT);
+    return 0;
+}
+
+/* Removes the link `name` of the group `parent` (an absolute path of the
+ * root), left by a write that failed or was killed. HDF5 deletes a link
+ * only by reading its object (to lower the object's link count), which a
+ * killed write may have left unreadable: its link reached the disk, its
+ * header did not (the cache evicts a group's header, with its new link,
+ * whenever it likes). Then the group is rebuilt without that link: a new
+ * group links every other object (each readable, so nothing complete is
+ * lost), is flushed, and takes the group's name; the old group is set
+ * aside as <parent>-damaged-<n>, which no reader looks at. */
+static bool drop_link(sx_h5 *h, hid_t file, const char *parent, const char *name)
+{
+    if (h->failed) return false;
+    hid_t pg = H5Gopen2(file, parent, H5P_DEFAULT);
+    if (pg < 0) return sx_h5_fail_h5(h, "damaged: cannot open the group %s", parent);
+    bool ok = H5Lexists(pg, name, H5P_DEFAULT) <= 0 || H5Ldelete(pg, name, H5P_DEFAULT) >= 0;
+    H5Eclear2(H5E_DEFAULT);
+    if (!ok) {
+        char aside[128];
+        for (int n = 1; n < 1000 && (snprintf(aside, sizeof aside, "%s-damaged-%d", parent, n), true); n++)
+            if (H5Lexists(file, aside, H5P_DEFAULT) <= 0) break;
+        hid_t ng = H5Gcreate_anon(file, H5P_DEFAULT, H5P_DEFAULT);
+        relink r = {ng, name};
+        /* the new group on disk before any link to it */
+        ok = ng >= 0 && H5Literate(pg, H5_INDEX_NAME, H5_ITER_INC, NULL, relink_one, &r) >= 0 && sync_file(file);
+        H5Eclear2(H5E_DEFAULT);
+        ok = ok && H5Lexists(file, aside, H5P_DEFAULT) <= 0 &&
+             H5Lmove(file, parent, file, aside, H5P_DEFAULT, H5P_DEFAULT) >= 0;
+        if (ok && H5Olink(ng, file, parent, H5P_DEFAULT, H5P_DEFAULT) < 0) {
+            H5Lmove(file, aside, file, parent, H5P_DEFAULT, H5P_DEFAULT);
+            ok = false;
+        }
+        if (!ok) sx_h5_fail_h5(h, "damaged: cannot remove %s/%s, left by an incomplete write", parent, name);
+        sx_h5_close(ng);
+    }
+    sx_h5_close(pg);
+    return ok;
+}
+
 /* ------------------------------------------------------ history rows */
 
 /* A history being appended: its group, its entry in s->held and the rows
@@ -1093,6 +1149,16 @@ static void hist_stage(sx_h5 *h, sx_series *s, const sx_io_history *x, int nh, p
             }
     }
     hid_t hg = sx_h5_group(h, s->file, "histories");
+    /* a history whose group a killed write left unreadable (its link
+     * reached the disk, its header did not) starts again: its rows went
+     * with the header, and the model holds them all */
+    for (int i = 0; i < nh && !h->failed; i++) {
+        H5O_info_t oi;
+        if (H5Lexists(hg, x[i].name, H5P_DEFAULT) > 0 && H5Oget_info_by_name(hg, x[i].name, &oi, H5P_DEFAULT) < 0) {
+            sx_h5_close(hg);
+            hg = drop_link(h, s->file, "/histories", x[i].name) ? sx_h5_group(h, s->file, "histories") : -1;
+        }
+    }
     for (int i = 0; i < nh && !h->failed; i++) {
         const sx_io_history *q = &x[i];
         const bool fresh = H5Lexists(hg, q->name, H5P_DEFAULT) <= 0;
@@ -1157,15 +1223,10 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         if (m) {
             char name[48];
             snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
-            /* a group left by a write that failed or was killed is dropped; if
-             * its object cannot be read to delete it, its link is moved aside */
-            if (H5Lexists(s->file, name, H5P_DEFAULT) > 0 && H5Ldelete(s->file, name, H5P_DEFAULT) < 0) {
-                char aside[80];
-                snprintf(aside, sizeof aside, "/snapshots/incomplete-%06lld-%ld", (long long)s->count, (long)getpid());
-                H5Lmove(s->file, name, s->file, aside, H5P_DEFAULT, H5P_DEFAULT);
-            }
-            H5Eclear2(H5E_DEFAULT);
-            hid_t g = H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+            /* a group left by a write that failed or was killed is dropped */
+            hid_t g = drop_link(&h, s->file, "/snapshots", name + strlen("/snapshots/"))
+                          ? H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)
+                          : -1;
             if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
             else write_snapshot(&h, g, m, s->fields, &sn);
             sx_h5_close(g);
