@@ -11,6 +11,27 @@
 
 /* -------------------------------------------------------------- cracks */
 
+/* A column of a part kept as an array of structs (the crack log, the clump
+ * templates): gathered into (or scattered from) arrays of its own, read or
+ * written with its memory and file types. */
+typedef struct column {
+    const char *name;
+    hid_t mem, file;
+    void *data;
+    int per;
+    const char *units;
+} column;
+
+/* Reads (write = false) or writes nc columns of `rows` rows each (`where`:
+ * the group's path in messages). */
+static void columns_io(sx_h5 *h, hid_t g, const char *where, const column *c, size_t nc, int64_t rows, bool write)
+{
+    for (size_t k = 0; k < nc; k++) {
+        if (write) sx_h5_write(h, g, c[k].name, c[k].mem, c[k].file, c[k].data, rows, c[k].per, c[k].units);
+        else sx_h5_read(h, g, where, c[k].name, c[k].mem, c[k].data, rows, c[k].per, true);
+    }
+}
+
 static const char *const mode_names[] = {"tension", "shear"};
 static const int mode_values[] = {SX_CRACK_TENSION, SX_CRACK_SHEAR};
 static const char *const bond_kind_names[] = {"contact", "parallel", "flatjoint", "smoothjoint"};
@@ -73,13 +94,7 @@ void sx_io_cracks(sx_h5 *h, hid_t g, sx_model *m, bool write)
             c.mode[i] = (int)e->mode, c.kind[i] = (int)e->kind, c.element[i] = e->element;
             for (int k = 0; k < d; k++) c.pos[i * d + k] = e->pos[k];
         }
-    struct {
-        const char *name;
-        hid_t mem, file;
-        void *data;
-        int per;
-        const char *units;
-    } cols[] = {
+    const column cols[] = {
         {"time", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.time, 1, "s"},
         {"step", H5T_NATIVE_INT64, H5T_STD_I64LE, c.step, 1, NULL},
         {"position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, c.pos, d, "m"},
@@ -94,10 +109,7 @@ void sx_io_cracks(sx_h5 *h, hid_t g, sx_model *m, bool write)
         {"element", H5T_NATIVE_INT, H5T_STD_I32LE, c.element, 1, NULL},
     };
     const size_t ncols = sizeof cols / sizeof *cols - (fj ? 0 : 1);
-    for (size_t k = 0; k < ncols; k++) {
-        if (write) sx_h5_write(h, g, cols[k].name, cols[k].mem, cols[k].file, cols[k].data, n, cols[k].per, cols[k].units);
-        else sx_h5_read(h, g, "/cracks", cols[k].name, cols[k].mem, cols[k].data, n, cols[k].per, true);
-    }
+    columns_io(h, g, "/cracks", cols, ncols, n, write);
     if (!write && !h->failed)
         for (int64_t i = 0; i < n; i++) {
             sx_crack *e = &m->cracks.ev[i];
@@ -236,13 +248,7 @@ static void templates_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
     }
     if (write)
         for (int64_t i = 0; i < n; i++) tpl_copy(&C->tpl[i], &c, i, true);
-    struct {
-        const char *name;
-        hid_t mem, file;
-        void *data;
-        int per;
-        const char *units;
-    } cols[] = {
+    const column cols[] = {
         {"first_pebble", H5T_NATIVE_INT64, H5T_STD_I64LE, c.first, 1, NULL},
         {"pebble_count", H5T_NATIVE_INT64, H5T_STD_I64LE, c.count, 1, NULL},
         {"lines", H5T_NATIVE_INT64, H5T_STD_I64LE, c.lines, 1, NULL},
@@ -256,10 +262,7 @@ static void templates_io(sx_h5 *h, hid_t g, sx_model *m, bool write)
     };
     if (write) sx_io_write_strings(h, g, "name", c.name, w, n);
     else sx_io_read_strings(h, g, "/clumps/templates", "name", c.name, w, n);
-    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) {
-        if (write) sx_h5_write(h, g, cols[k].name, cols[k].mem, cols[k].file, cols[k].data, n, cols[k].per, cols[k].units);
-        else sx_h5_read(h, g, "/clumps/templates", cols[k].name, cols[k].mem, cols[k].data, n, cols[k].per, true);
-    }
+    columns_io(h, g, "/clumps/templates", cols, sizeof cols / sizeof *cols, n, write);
     if (!write && !h->failed)
         for (int64_t i = 0; i < n; i++) tpl_copy(&C->tpl[i], &c, i, false);
     tpl_cols_free(&c);
