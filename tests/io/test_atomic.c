@@ -405,11 +405,5 @@ int main(void)
     tcase_set_timeout(recovery, 120);
     tcase_add_test(recovery, killed_add_recovers);
     suite_add_tcase(s, recovery);
-    io_tmpdir();
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    io_rmdir();
-    return failed ? 1 : 0;
+    return io_run_suite(s);
 }
