@@ -147,6 +147,68 @@ static long header_size_offset(const char *path, const char *object)
     return (long)oi.addr + 6 + (b[5] & 0x20 ? 16 : 0) + (b[5] & 0x10 ? 4 : 0);
 }
 
+/* HDF5's checksum of metadata (Jenkins' lookup3), exported by libhdf5
+ * though not declared in its public headers: a test that damages a message
+ * of an object header recomputes it, so that HDF5 decodes the damage (as
+ * from a file a faulty or hostile writer made) instead of refusing the
+ * header. */
+uint32_t H5_checksum_metadata(const void *data, size_t len, uint32_t initval);
+
+/* A copy of `from` at `to` in which bytes [at, at + n) of the data of the
+ * first message of `type` in the first chunk of `object`'s header (a
+ * version-2 header) are v, the chunk's checksum recomputed. */
+static void damage_message(const char *from, const char *to, const char *object, int type, int at,
+                           const unsigned char *v, int n)
+{
+    copy_file(from, to);
+    hid_t f = H5Fopen(to, H5F_ACC_RDONLY, H5P_DEFAULT);
+    H5O_info_t oi;
+    ck_assert(f >= 0 && H5Oget_info_by_name(f, object, &oi, H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    unsigned char b[4096];
+    FILE *fp = fopen(to, "r+b");
+    ck_assert(fp && fseek(fp, (long)oi.addr, SEEK_SET) == 0);
+    const size_t got = fread(b, 1, sizeof b, fp);
+    ck_assert(got > 16 && memcmp(b, "OHDR", 4) == 0 && b[4] == 2);
+    const unsigned flags = b[5];
+    size_t p = 6 + (flags & 0x20 ? 16 : 0) + (flags & 0x10 ? 4 : 0), size = 0;
+    for (int k = 0; k < 1 << (flags & 3); k++) size |= (size_t)b[p + (size_t)k] << (8 * k);
+    p += (size_t)1 << (flags & 3);
+    const size_t end = p + size; /* the checksum follows */
+    ck_assert(end + 4 <= got);
+    bool found = false;
+    while (!found && p + 4 <= end) {
+        const int mtype = b[p];
+        const size_t msize = (size_t)b[p + 1] | (size_t)b[p + 2] << 8;
+        p += 4 + (flags & 0x04 ? 2 : 0);
+        if (mtype == type) found = true;
+        else p += msize;
+    }
+    ck_assert_msg(found, "%s: no message of type %d", object, type);
+    memcpy(b + p + at, v, (size_t)n);
+    const uint32_t sum = H5_checksum_metadata(b, end, 0);
+    for (int k = 0; k < 4; k++) b[end + (size_t)k] = (unsigned char)(sum >> (8 * k));
+    ck_assert(fseek(fp, (long)oi.addr, SEEK_SET) == 0 && fwrite(b, 1, end + 4, fp) == end + 4);
+    fclose(fp);
+}
+
+/* A dataset's datatype message says its numbers have 32776 bytes each
+ * (their precision still 64 bits): HDF5 1.10 takes each chunk to hold rows
+ * times 32776 bytes and reads far past the end of the chunk it decoded
+ * (found by damaging the bytes of a snapshot's object headers with their
+ * checksums recomputed; ASan reported a heap-buffer-overflow in H5Dread).
+ * The load refuses the dataset before reading it. */
+START_TEST(damaged_type_size)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "typesize.h5");
+    const unsigned char huge[2] = {0x08, 0x80}; /* the size field (bytes 4-7 of the message), little-endian 32776 */
+    damage_message(good3, p, "/balls/radius", 0x03, 4, huge, 2);
+    expect_error(p, 0, "damaged: the dataset /balls/radius has numbers of 32776 bytes");
+}
+END_TEST
+
 /* A dataset's object header whose chunk size is damaged (issue 18, 6b):
  * HDF5 decodes the header's prefix, then its checksum, taken over the
  * wrong length, fails; seixo names the dataset. HDF5 1.10 drops the
@@ -602,6 +664,7 @@ int main(void)
     tcase_add_test(tc, meaningless_values);
     tcase_add_test(tc, format2_parts);
     tcase_add_test(tc, damaged_header_size);
+    tcase_add_test(tc, damaged_type_size);
     suite_add_tcase(s, tc);
     /* flipped bytes: HDF5 1.10 itself leaks a little on some damaged
      * metadata (its error paths), so these have their own case */
