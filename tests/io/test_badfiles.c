@@ -192,6 +192,21 @@ static void damage_message(const char *from, const char *to, const char *object,
     fclose(fp);
 }
 
+/* A dataset's layout message that does not decode (its bytes per chunk
+ * dimension 254), after its filter pipeline message did: HDF5 1.10 drops
+ * the pipeline it had read (64 bytes, under H5D__layout_oh_read), the
+ * leak lsan.supp and valgrind.supp allow there. */
+START_TEST(damaged_layout)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "layout.h5");
+    const unsigned char bad[1] = {0xfe};
+    damage_message(good3, p, "/balls/radius", 0x08, 4, bad, 1);
+    expect_error(p, 0, "damaged: cannot open the dataset /balls/radius");
+}
+END_TEST
+
 /* A dataset's datatype message says its numbers have 32776 bytes each
  * (their precision still 64 bits): HDF5 1.10 takes each chunk to hold rows
  * times 32776 bytes and reads far past the end of the chunk it decoded
@@ -665,6 +680,7 @@ int main(void)
     tcase_add_test(tc, format2_parts);
     tcase_add_test(tc, damaged_header_size);
     tcase_add_test(tc, damaged_type_size);
+    tcase_add_test(tc, damaged_layout);
     suite_add_tcase(s, tc);
     /* flipped bytes: HDF5 1.10 itself leaks a little on some damaged
      * metadata (its error paths), so these have their own case */
