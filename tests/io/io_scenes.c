@@ -385,18 +385,31 @@ void io_first_ball_contact(const sx_model *m, sx_contact_info *ci)
     ck_assert_msg(ci->a >= 0, "no ball-ball contact");
 }
 
-static int run_one(const char *name, const TTest *test, bool fork, enum print_output print)
+static int run_suite(Suite *s, bool fork, enum print_output print)
 {
-    Suite *s = suite_create(name);
-    TCase *tc = tcase_create(name);
-    tcase_add_test(tc, test);
-    suite_add_tcase(s, tc);
     SRunner *r = srunner_create(s);
     if (!fork) srunner_set_fork_status(r, CK_NOFORK);
     srunner_run_all(r, print);
     const int failed = srunner_ntests_failed(r);
     srunner_free(r);
     return failed ? 1 : 0;
+}
+
+static int run_one(const char *name, const TTest *test, bool fork, enum print_output print)
+{
+    Suite *s = suite_create(name);
+    TCase *tc = tcase_create(name);
+    tcase_add_test(tc, test);
+    suite_add_tcase(s, tc);
+    return run_suite(s, fork, print);
+}
+
+int io_run_suite(Suite *s)
+{
+    io_tmpdir(); /* one folder for every test (they run in child processes), removed at the end */
+    const int failed = run_suite(s, true, CK_NORMAL);
+    io_rmdir();
+    return failed;
 }
 
 int io_run_test(const char *name, const TTest *test) { return run_one(name, test, true, CK_NORMAL); }

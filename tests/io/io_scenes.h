@@ -57,6 +57,9 @@ sx_model *io_load_sample(const char *dir, int version, sx_snapshot_info *info);
 void io_first_ball_contact(const sx_model *m, sx_contact_info *ci);
 /// main() of a program of one Check test named name: 0 when it passes.
 int io_run_test(const char *name, const TTest *test);
+/// main() of a program of a suite: runs it with a fresh temporary folder
+/// (io_tmpdir, removed at the end); 0 when every test passes.
+int io_run_suite(Suite *s);
 /// main() of a sample writer (`prog out.h5`, run once to make a committed
 /// file of an old format): *out_path = argv[1], then the writer test runs
 /// in this process; 2 on a bad command line, 1 when the writer fails.

@@ -130,6 +130,123 @@ static haddr_t chunk_address(const char *path, const char *dataset)
     return addr;
 }
 
+/* The file offset of the size of the first chunk of an object's header
+ * (a version-2 header: "OHDR", version, flags, optional times and
+ * attribute phase change values, then the size, 1 to 8 bytes). */
+static long header_size_offset(const char *path, const char *object)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    H5O_info_t oi;
+    ck_assert(f >= 0 && H5Oget_info_by_name(f, object, &oi, H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    unsigned char b[6];
+    FILE *fp = fopen(path, "rb");
+    ck_assert(fp && fseek(fp, (long)oi.addr, SEEK_SET) == 0 && fread(b, 1, sizeof b, fp) == sizeof b);
+    fclose(fp);
+    ck_assert_msg(memcmp(b, "OHDR", 4) == 0 && b[4] == 2, "%s: not a version-2 object header", object);
+    return (long)oi.addr + 6 + (b[5] & 0x20 ? 16 : 0) + (b[5] & 0x10 ? 4 : 0);
+}
+
+/* HDF5's checksum of metadata (Jenkins' lookup3), exported by libhdf5
+ * though not declared in its public headers: a test that damages a message
+ * of an object header recomputes it, so that HDF5 decodes the damage (as
+ * from a file a faulty or hostile writer made) instead of refusing the
+ * header. */
+uint32_t H5_checksum_metadata(const void *data, size_t len, uint32_t initval);
+
+/* A copy of `from` at `to` in which bytes [at, at + n) of the data of the
+ * first message of `type` in the first chunk of `object`'s header (a
+ * version-2 header) are v, the chunk's checksum recomputed. */
+static void damage_message(const char *from, const char *to, const char *object, int type, int at,
+                           const unsigned char *v, int n)
+{
+    copy_file(from, to);
+    hid_t f = H5Fopen(to, H5F_ACC_RDONLY, H5P_DEFAULT);
+    H5O_info_t oi;
+    ck_assert(f >= 0 && H5Oget_info_by_name(f, object, &oi, H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    unsigned char b[4096];
+    FILE *fp = fopen(to, "r+b");
+    ck_assert(fp && fseek(fp, (long)oi.addr, SEEK_SET) == 0);
+    const size_t got = fread(b, 1, sizeof b, fp);
+    ck_assert(got > 16 && memcmp(b, "OHDR", 4) == 0 && b[4] == 2);
+    const unsigned flags = b[5];
+    size_t p = 6 + (flags & 0x20 ? 16 : 0) + (flags & 0x10 ? 4 : 0), size = 0;
+    for (int k = 0; k < 1 << (flags & 3); k++) size |= (size_t)b[p + (size_t)k] << (8 * k);
+    p += (size_t)1 << (flags & 3);
+    const size_t end = p + size; /* the checksum follows */
+    ck_assert(end + 4 <= got);
+    bool found = false;
+    while (!found && p + 4 <= end) {
+        const int mtype = b[p];
+        const size_t msize = (size_t)b[p + 1] | (size_t)b[p + 2] << 8;
+        p += 4 + (flags & 0x04 ? 2 : 0);
+        if (mtype == type) found = true;
+        else p += msize;
+    }
+    ck_assert_msg(found, "%s: no message of type %d", object, type);
+    memcpy(b + p + at, v, (size_t)n);
+    const uint32_t sum = H5_checksum_metadata(b, end, 0);
+    for (int k = 0; k < 4; k++) b[end + (size_t)k] = (unsigned char)(sum >> (8 * k));
+    ck_assert(fseek(fp, (long)oi.addr, SEEK_SET) == 0 && fwrite(b, 1, end + 4, fp) == end + 4);
+    fclose(fp);
+}
+
+/* A dataset's layout message that does not decode (its bytes per chunk
+ * dimension 254), after its filter pipeline message did: HDF5 1.10 drops
+ * the pipeline it had read (64 bytes, under H5D__layout_oh_read), the
+ * leak lsan.supp and valgrind.supp allow there. */
+START_TEST(damaged_layout)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "layout.h5");
+    const unsigned char bad[1] = {0xfe};
+    damage_message(good3, p, "/balls/radius", 0x08, 4, bad, 1);
+    expect_error(p, 0, "damaged: cannot open the dataset /balls/radius");
+}
+END_TEST
+
+/* A dataset's datatype message says its numbers have 32776 bytes each
+ * (their precision still 64 bits): HDF5 1.10 takes each chunk to hold rows
+ * times 32776 bytes and reads far past the end of the chunk it decoded
+ * (found by damaging the bytes of a snapshot's object headers with their
+ * checksums recomputed; ASan reported a heap-buffer-overflow in H5Dread).
+ * The load refuses the dataset before reading it. */
+START_TEST(damaged_type_size)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "typesize.h5");
+    const unsigned char huge[2] = {0x08, 0x80}; /* the size field (bytes 4-7 of the message), little-endian 32776 */
+    damage_message(good3, p, "/balls/radius", 0x03, 4, huge, 2);
+    expect_error(p, 0, "damaged: the dataset /balls/radius has numbers of 32776 bytes");
+}
+END_TEST
+
+/* A dataset's object header whose chunk size is damaged (issue 18, 6b):
+ * HDF5 decodes the header's prefix, then its checksum, taken over the
+ * wrong length, fails; seixo names the dataset. HDF5 1.10 drops the
+ * header it had begun to build (424 bytes, under H5O_protect): the one
+ * leak tests/io/lsan.supp and valgrind.supp allow on this path; any block
+ * of seixo's lost here would still be reported. In the main test case so
+ * that the valgrind setup checks its suppression too. */
+START_TEST(damaged_header_size)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "header.h5");
+    const char *objects[] = {"/balls/position", "/contacts/ball_ball/shear_force"};
+    for (size_t k = 0; k < sizeof objects / sizeof *objects; k++) {
+        copy_file(good3, p);
+        flip(p, header_size_offset(p, objects[k]));
+        char what[128];
+        snprintf(what, sizeof what, "damaged: cannot open the dataset %s", objects[k]);
+        expect_error(p, 0, what);
+    }
+}
+END_TEST
+
 START_TEST(corrupted)
 {
     make_good();
@@ -561,6 +678,9 @@ int main(void)
     tcase_add_test(tc, write_fails);
     tcase_add_test(tc, meaningless_values);
     tcase_add_test(tc, format2_parts);
+    tcase_add_test(tc, damaged_header_size);
+    tcase_add_test(tc, damaged_type_size);
+    tcase_add_test(tc, damaged_layout);
     suite_add_tcase(s, tc);
     /* flipped bytes: HDF5 1.10 itself leaks a little on some damaged
      * metadata (its error paths), so these have their own case */
@@ -569,11 +689,5 @@ int main(void)
     tcase_add_test(damaged, corrupted);
     tcase_add_loop_test(damaged, random_flips, 0, 2);
     suite_add_tcase(s, damaged);
-    io_tmpdir(); /* one folder for every test (they run in child processes), removed at the end */
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    io_rmdir();
-    return failed ? 1 : 0;
+    return io_run_suite(s);
 }

@@ -198,11 +198,5 @@ int main(void)
     tcase_add_test(tc, provenance);
     tcase_add_test(tc, trees);
     suite_add_tcase(s, tc);
-    io_tmpdir();
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    io_rmdir();
-    return failed ? 1 : 0;
+    return io_run_suite(s);
 }

@@ -342,11 +342,5 @@ int main(void)
     tcase_add_test(tc, threads_kept);
     tcase_add_test(tc, histories_saved);
     suite_add_tcase(s, tc);
-    io_tmpdir(); /* one folder for every test (they run in child processes), removed at the end */
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    io_rmdir();
-    return failed ? 1 : 0;
+    return io_run_suite(s);
 }

@@ -476,11 +476,5 @@ int main(void)
     tcase_add_test(tc, histories_grow);
     tcase_add_test(tc, append_to_format1);
     suite_add_tcase(s, tc);
-    io_tmpdir();
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    io_rmdir();
-    return failed ? 1 : 0;
+    return io_run_suite(s);
 }

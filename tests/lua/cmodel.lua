@@ -2,9 +2,8 @@
 -- assignment table): rows that give the ball-ball contacts of a pair of
 -- groups, of a pair of materials, or any other, their own law; each
 -- contact keeps the row it took when it was created.
-local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
-
-local function vec(dim, x, y) if dim == 3 then return {x, y or 0, 0} else return {x, y or 0} end end
+local C = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "cmodel_common.lua")
+local T, G, NU, KN, R, hertz, vec = C.T, C.G, C.NU, C.KN, C.R, C.hertz, C.vec
 
 -- The contact of balls a and b (ids), or nil.
 local function contact(m, a, b)
@@ -13,18 +12,12 @@ local function contact(m, a, b)
   end
 end
 
-local G, NU, KN, R = 5e8, 0.25, 2e6, 0.01
--- Hertz (4-25, R-bar = 2 Ra Rb / (Ra + Rb) = R for equal balls)
-local function hertz(un) return 2 * G * math.sqrt(2 * R) / (3 * (1 - NU)) * un ^ 1.5 end
-
 -- Four pairs far apart, each overlapping by un and at rest, no gravity:
 -- rock-rock (the materials' linear law: two springs KN in series),
 -- rock-platen (a Hertz row), steel-steel (a linear material row, kn = 4 KN)
 -- and a pair of ungrouped sand balls (no row).
 local function scene(dim, un)
-  local m = seixo.model{dim = dim, timestep = 1e-7}
-  m:material("sand", {kn = KN, ks = KN, friction = 0.5, density = 2650})
-  m:material("steel", {kn = KN, ks = KN, friction = 0.5, density = 7800})
+  local m = C.model(dim)
   local ids = {}
   local function pair(x, ga, gb, mat)
     local a = m:ball{pos = vec(dim, x), radius = R, group = ga, material = mat}
@@ -48,13 +41,8 @@ for _, dim in ipairs{3, 2} do
     local want = {KN / 2 * un, hertz(un), 2 * KN * un, KN / 2 * un}
     local rows = {nil, 1, 2, nil}
     for k, p in ipairs(ids) do
-      local c = contact(m, p[1], p[2])
-      T.check(c, "pair " .. k .. " touches")
-      T.eq(c.contact_model, rows[k], "pair " .. k .. "'s row")
-      -- the overlap after one step from rest is un to rounding; the force is the law's at it
-      T.check(math.abs(c.overlap - un) < 1e-12, "overlap " .. c.overlap)
-      local exact = k == 2 and hertz(c.overlap) or want[k] / un * c.overlap
-      T.check(math.abs(c.fn - exact) <= 1e-12 * exact, string.format("pair %d: fn %.17g, law %.17g", k, c.fn, exact))
+      C.check_force(contact(m, p[1], p[2]), "pair " .. k, rows[k], un,
+                    k == 2 and hertz or function(o) return want[k] / un * o end)
     end
     -- the Hertz force is not the linear one: the table did change the law
     T.check(math.abs(hertz(un) - KN / 2 * un) > 0.1 * hertz(un), "the two laws differ at this overlap")
@@ -175,43 +163,18 @@ end)
 
 -- A bed under gravity in two groups, a Hertz row between them: enough
 -- pairs (> 4096) for the ball-ball pass to run in several chunks.
-local function bed(threads)
-  local was = seixo.threads
-  seixo.threads = threads
-  local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
-  seixo.threads = was
-  m:material("sand", {kn = 1e5, ks = 1e5, friction = 0.4, density = 2650, damping = 0.1})
-  m:generate{region = {box = {{0, 0, 0}, {0.045, 0.045, 0.045}}}, radius = 0.0015, packing = "cubic"}
-  for bl in m:balls() do bl.group = bl.pos[3] < 0.0225 and "rock" or "platen" end
-  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
-  m:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = 2e7, poisson = 0.2}
-  m:contact_model{groups = {"platen", "platen"}, kn = 2e5, ks = 1e5, friction = 0.2, rolling_friction = 0.1}
-  m:cycle(400)
-  return m
-end
-
 T.test("1 and 2 threads give the same bits; a restart continues bit for bit", function()
-  local one, two = bed(1), bed(2)
+  local one = C.threads_and_restart({0, 0, -9.81}, function(m)
+    for bl in m:balls() do bl.group = bl.pos[3] < 0.0225 and "rock" or "platen" end
+    m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
+    m:contact_model{groups = {"rock", "platen"}, model = "hertz", shear_modulus = 2e7, poisson = 0.2}
+    m:contact_model{groups = {"platen", "platen"}, kn = 2e5, ks = 1e5, friction = 0.2, rolling_friction = 0.1}
+  end, "ball-ball", "cmodel_restart.h5", function(l, one)
+    -- a row added after the load governs new contacts only, in both alike
+    l:contact_model{default = true, kn = 3e5, ks = 3e5}
+    one:contact_model{default = true, kn = 3e5, ks = 3e5}
+  end)
   T.check(one:contact_count() > 1000, "contacts " .. one:contact_count())
-  T.eq(one:hash(), two:hash(), "threads")
-  local rows = {0, 0, 0}
-  for c in one:contacts() do
-    if c.kind == "ball-ball" then rows[(c.contact_model or 0) + 1] = rows[(c.contact_model or 0) + 1] + 1 end
-  end
-  T.check(rows[1] > 0 and rows[2] > 0 and rows[3] > 0, string.format("contacts by row: %d, %d, %d", rows[1], rows[2], rows[3]))
-  local path = "cmodel_restart.h5"
-  one:save(path)
-  local l = seixo.load(path)
-  T.eq(l:hash(), one:hash(), "loaded")
-  T.eq(#l:contact_models(), 2)
-  T.eq(l:contact_models()[2].rolling_friction, 0.1)
-  -- a row added after the load governs new contacts only, in both alike
-  l:contact_model{default = true, kn = 3e5, ks = 3e5}
-  one:contact_model{default = true, kn = 3e5, ks = 3e5}
-  l:cycle(300)
-  one:cycle(300)
-  T.eq(l:hash(), one:hash(), "continued")
-  os.remove(path)
 end)
 
 T.done()

@@ -2,14 +2,8 @@
 -- a specimen and its platens -- walls in seixo.lab -- under different
 -- laws): a row matches a wall with a ball group, a ball material or any
 -- ball; a contact takes its row when created and keeps it.
-local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
-
-local function vec(dim, x, y) if dim == 3 then return {x, y, 0} else return {x, y} end end
-
-local G, NU, KN, R = 5e8, 0.25, 2e6, 0.01
--- Hertz against a wall of the row's material, the seed's wall (4-28):
--- R-bar = R, G and nu the row's (the means of equal values, 4-27)
-local function hertz(un) return 2 * G * math.sqrt(2 * R) / (3 * (1 - NU)) * un ^ 1.5 end
+local C = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "cmodel_common.lua")
+local T, G, NU, KN, R, hertz, vec = C.T, C.G, C.NU, C.KN, C.R, C.hertz, C.vec
 
 -- The contact of ball id a with a wall, or nil.
 local function wall_contact(m, a)
@@ -20,9 +14,7 @@ end
 -- no gravity: a rock ball (sand), a steel ball, an ungrouped sand ball; and
 -- one on a second wall x = 1 (normal -x).
 local function scene(dim, un)
-  local m = seixo.model{dim = dim, timestep = 1e-7}
-  m:material("sand", {kn = KN, ks = KN, friction = 0.5, density = 2650})
-  m:material("steel", {kn = KN, ks = KN, friction = 0.5, density = 7800})
+  local m = C.model(dim)
   local floor = m:wall{kind = dim == 3 and "plane" or "line", point = vec(dim, 0, 0), normal = vec(dim, 0, 1), kn = KN, ks = KN}
   local side = m:wall{kind = dim == 3 and "plane" or "line", point = vec(dim, 1, 0), normal = vec(dim, -1, 0), kn = KN, ks = KN}
   local ids = {}
@@ -51,12 +43,7 @@ for _, dim in ipairs{3, 2} do
     local slope = {nil, 2 * KN, KN / 2, 4 * KN}
     local rows = {1, 2, nil, 3}
     for k, id in ipairs(ids) do
-      local c = wall_contact(m, id)
-      T.check(c, "ball " .. k .. " touches its wall")
-      T.eq(c.contact_model, rows[k], "ball " .. k .. "'s row")
-      T.check(math.abs(c.overlap - un) < 1e-12, "overlap " .. c.overlap)
-      local exact = k == 1 and hertz(c.overlap) or slope[k] * c.overlap
-      T.check(math.abs(c.fn - exact) <= 1e-12 * exact, string.format("ball %d: fn %.17g, law %.17g", k, c.fn, exact))
+      C.check_force(wall_contact(m, id), "ball " .. k, rows[k], un, k == 1 and hertz or function(o) return slope[k] * o end)
     end
     T.check(math.abs(hertz(un) - KN / 2 * un) > 0.1 * hertz(un), "the laws differ at this overlap")
   end)
@@ -114,38 +101,14 @@ end)
 -- A bed under gravity on a floor and between side walls: a Hertz row for
 -- the floor's rock balls, a linear row for any ball on one side wall
 -- (gravity tilted towards it).
-local function bed(threads)
-  local was = seixo.threads
-  seixo.threads = threads
-  local m = seixo.model{dim = 3, gravity = {-4, 0, -9.81}}
-  seixo.threads = was
-  m:material("sand", {kn = 1e5, ks = 1e5, friction = 0.4, density = 2650, damping = 0.1})
-  m:generate{region = {box = {{0, 0, 0}, {0.045, 0.045, 0.045}}}, radius = 0.0015, packing = "cubic"}
-  for bl in m:balls() do bl.group = (bl.id % 2 == 0) and "rock" or "platen" end
-  local floor = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
-  local side = m:wall{kind = "plane", point = {0, 0, 0}, normal = {1, 0, 0}, kn = 1e6, ks = 1e6}
-  m:contact_model{wall = floor, groups = "rock", model = "hertz", shear_modulus = 2e7, poisson = 0.2}
-  m:contact_model{wall = side, kn = 2e5, ks = 1e5, friction = 0.2, rolling_friction = 0.1}
-  m:cycle(400)
-  return m
-end
-
 T.test("1 and 2 threads give the same bits; a restart continues bit for bit", function()
-  local one, two = bed(1), bed(2)
-  T.eq(one:hash(), two:hash(), "threads")
-  local rows = {0, 0, 0}
-  for c in one:contacts{kind = "ball-wall"} do rows[(c.contact_model or 0) + 1] = rows[(c.contact_model or 0) + 1] + 1 end
-  T.check(rows[1] > 0 and rows[2] > 0 and rows[3] > 0, string.format("wall contacts by row: %d, %d, %d", rows[1], rows[2], rows[3]))
-  local path = "cmodel_walls_restart.h5"
-  one:save(path)
-  local l = seixo.load(path)
-  T.eq(l:hash(), one:hash(), "loaded")
-  T.eq(#l:contact_models(), 2)
-  T.eq(l:contact_models()[2].rolling_friction, 0.1)
-  l:cycle(300)
-  one:cycle(300)
-  T.eq(l:hash(), one:hash(), "continued")
-  os.remove(path)
+  C.threads_and_restart({-4, 0, -9.81}, function(m)
+    for bl in m:balls() do bl.group = (bl.id % 2 == 0) and "rock" or "platen" end
+    local floor = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1e6, ks = 1e6}
+    local side = m:wall{kind = "plane", point = {0, 0, 0}, normal = {1, 0, 0}, kn = 1e6, ks = 1e6}
+    m:contact_model{wall = floor, groups = "rock", model = "hertz", shear_modulus = 2e7, poisson = 0.2}
+    m:contact_model{wall = side, kn = 2e5, ks = 1e5, friction = 0.2, rolling_friction = 0.1}
+  end, "ball-wall", "cmodel_walls_restart.h5")
 end)
 
 T.done()
