@@ -136,6 +136,39 @@ for _, dim in ipairs{2, 3} do
         string.format("%s sigma %s tau %s want %s", tostring(mode2), tostring(s2), tostring(tau), tostring(want)))
 end
 
+-- A face installed on overlapping balls (overlap u0 = 0.01) and broken in
+-- tension opens before the balls part: it stays, carrying nothing, until
+-- they part, and only then does the contact law take over (at zero
+-- overlap). Removing it at the first opening handed the pair to the
+-- contact law with an overlap, a force kn u0 out of nowhere.
+for _, dim in ipairs{2, 3} do
+  local m = seixo.model{dim = dim}
+  m:material("r", {density = 1000, kn = 1e9, ks = 1e9, friction = 0.5,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 10e6, friction = 0.6, elements = 4, sectors = 3}})
+  local function v(x) return dim == 3 and {x, 0, 0} or {x, 0} end
+  local a = m:ball{pos = v(0), radius = 1}
+  local b = m:ball{pos = v(2 - 0.01), radius = 1}
+  m:bond{kind = "flatjoint", gap = 1e-6, seed = 2}
+  a.fix, b.fix = "all", "all"
+  local dt = m:timestep()
+  b.vel = v(0.005 / (1000 * dt)) -- opened by 0.005: broken (at 0.002), the balls still overlap by 0.005
+  m:cycle(1000)
+  b.vel = v(0)
+  m:cycle(1)
+  local f = b.force
+  check(dim .. "D broken face open, balls overlapping: kept", m:crack_count() > 0 and m:bond_count() == 1,
+        m:crack_count() .. " cracks, " .. m:bond_count() .. " joints")
+  check(dim .. "D ... and no force (no contact law on the overlap)", math.abs(f[1]) < 1e-9, f[1])
+  b.vel = v(0.006 / (1000 * dt)) -- apart by 0.001
+  m:cycle(1000)
+  b.vel = v(0)
+  m:cycle(1)
+  check(dim .. "D gone once the balls part", m:bond_count() == 0 and math.abs(b.force[1]) < 1e-9,
+        m:bond_count() .. " " .. b.force[1])
+  m:close()
+end
+
 -- a removed ball takes its joints with it (the broad phase must not list them again)
 for _, dim in ipairs{2, 3} do
   local m, a, b = pair(dim)

@@ -287,6 +287,11 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
      * waits for its balls to close while they have not opened by more than
      * its gap again */
     if (!alive && gapped) alive = delta < E->gap0[b->fj_first[s]];
+    /* a face installed on overlapping balls opens (delta > 0) before they
+     * part: it stays, carrying nothing, until they part, so the contact
+     * law takes over at zero overlap rather than with a force kn u0 out
+     * of nowhere (an energy jump) */
+    if (!alive && !gapped) alive = d < m->balls.rad[i] + m->balls.rad[j];
     /* resultants, turned to the pair's orientation (sg) */
     double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
     b->fn[s] = fn_sum;
