@@ -19,16 +19,23 @@ plot "docs/data/joints_angle.csv" every ::1 using 1:2 with linespoints pt 7 lw 2
      cap(jaeger(x, c_eff, mu_eff)) with lines lw 2 title sprintf("Jaeger, the joint's measured peak envelope c = %.2f MPa, mu = %.3f", c_eff, mu_eff), \
      intact with lines dt 3 title "intact UCS (183.4 MPa)"
 set output "docs/img/ucs-bts.png"
-set title "UCS / BTS of 2D specimens (10 x 20 mm, 10 mm disk, radii 0.4-0.66 mm, seed 3)"
+# docs/data/ucs_bts.lua writes ucs_bts.csv (seeds 1-3; 3D one seed) and ucs_bts_sweep.csv (seeds 1-2)
+set terminal pngcairo size 1200,820 font "sans,10"
+set title "UCS / BTS, mean and sample sd over the seeds: left, the laws at the same UCS (2D: 10 x 20 mm rectangle, 10 mm disk, radii 0.2-0.33 mm;\n3D: cylinder and disc, radii 0.5-0.83 mm); right, joints.rock's sweep (2D, seeds 1-2)"
 set style data histograms
+set style histogram errorbars gap 1 lw 1
 set style fill solid 0.6 border -1
 set boxwidth 0.8
 set key off
 set xlabel ""
 set ylabel "UCS / BTS"
-set yrange [0:*]
+set yrange [0:16]
 set xrange [*:*]
-set xtics rotate by -30
-set bmargin 13
-set rmargin 26
-plot "docs/data/ucs_bts.csv" every ::1 using 4:xtic(1) title "UCS/BTS", 15 with lines dt 2 lw 2, 8 with lines dt 3 lw 2
+set xtics rotate by -35 font "sans,9" noenhanced
+set bmargin 20
+set rmargin 18
+set label 1 "target >= 15 (flat joint)" at graph 0.01, first 15.4
+set label 2 "parallel bond < 8" at graph 0.01, first 8.4
+plot newhistogram "", "docs/data/ucs_bts.csv" every ::1 using 8:9:xtic(1), \
+     newhistogram "", "docs/data/ucs_bts_sweep.csv" every ::1 using 8:9:xtic(1), \
+     15 with lines dt 2 lw 2, 8 with lines dt 3 lw 2

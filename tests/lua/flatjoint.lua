@@ -100,6 +100,75 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D energy closes within 1 %", math.abs(balance) < 0.01 * e.boundary_work, balance)
 end
 
+-- Elements much stronger in shear than in tension (c = 10 sigma_c, the
+-- flat-jointed rock's choice): pulled apart, the face breaks in tension at
+-- sigma_c; pressed by sigma and sheared, it breaks in shear at
+-- tau = c + sigma tan(phi) (Coulomb with cohesion), the pressure adding
+-- 2.7 c at phi = 60 deg. Both balls move at set velocities (fix = "all").
+for _, dim in ipairs{2, 3} do
+  local function load(sn, phi)
+    local m, a, b = pair(dim, {kind = "flatjoint", gap = 1e-6, seed = 1},
+                         {tensile_strength_sd = 0, cohesion = 10e6, cohesion_sd = 0, friction_angle = phi})
+    a.fix, b.fix = "all", "all"
+    local els = m:flatjoint(a.id, b.id)
+    local dt = m:timestep()
+    local function v(x, y) return dim == 3 and {x, y, 0} or {x, y} end
+    b.vel = v(-sn / 0.5e9 / (1000 * dt), 0) -- kn = modulus / (RA + RB) = 0.5e9 Pa/m
+    m:cycle(1000)
+    local n = 0
+    while m:crack_count() == 0 and n < 40000 do
+      b.vel = v(0, sn > 0 and 0.2 / (20000 * dt) or 0)
+      m:cycle(10)
+      n = n + 10
+    end
+    local c = m:cracks()[1]
+    local area = c and els[c.element].area or 1
+    m:close()
+    return c and c.mode, c and c.fn / area, c and c.fs / area
+  end
+  local mode, sigma = load(-2e6, 60)
+  check(dim .. "D c >> sigma_c: tension break at sigma_c", mode == "tension" and math.abs(sigma + 1e6) < 1e-6 * 1e6,
+        tostring(mode) .. " " .. tostring(sigma))
+  local mode2, s2, tau = load(20e6, 60)
+  local want = s2 and 10e6 + s2 * math.tan(math.rad(60))
+  check(dim .. "D pressed and sheared: shear break at c + sigma tan(phi)",
+        mode2 == "shear" and s2 > 10e6 and math.abs(tau - want) < 1e-3 * want,
+        string.format("%s sigma %s tau %s want %s", tostring(mode2), tostring(s2), tostring(tau), tostring(want)))
+end
+
+-- A face installed on overlapping balls (overlap u0 = 0.01) and broken in
+-- tension opens before the balls part: it stays, carrying nothing, until
+-- they part, and only then does the contact law take over (at zero
+-- overlap). Removing it at the first opening handed the pair to the
+-- contact law with an overlap, a force kn u0 out of nowhere.
+for _, dim in ipairs{2, 3} do
+  local m = seixo.model{dim = dim}
+  m:material("r", {density = 1000, kn = 1e9, ks = 1e9, friction = 0.5,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 10e6, friction = 0.6, elements = 4, sectors = 3}})
+  local function v(x) return dim == 3 and {x, 0, 0} or {x, 0} end
+  local a = m:ball{pos = v(0), radius = 1}
+  local b = m:ball{pos = v(2 - 0.01), radius = 1}
+  m:bond{kind = "flatjoint", gap = 1e-6, seed = 2}
+  a.fix, b.fix = "all", "all"
+  local dt = m:timestep()
+  b.vel = v(0.005 / (1000 * dt)) -- opened by 0.005: broken (at 0.002), the balls still overlap by 0.005
+  m:cycle(1000)
+  b.vel = v(0)
+  m:cycle(1)
+  local f = b.force
+  check(dim .. "D broken face open, balls overlapping: kept", m:crack_count() > 0 and m:bond_count() == 1,
+        m:crack_count() .. " cracks, " .. m:bond_count() .. " joints")
+  check(dim .. "D ... and no force (no contact law on the overlap)", math.abs(f[1]) < 1e-9, f[1])
+  b.vel = v(0.006 / (1000 * dt)) -- apart by 0.001
+  m:cycle(1000)
+  b.vel = v(0)
+  m:cycle(1)
+  check(dim .. "D gone once the balls part", m:bond_count() == 0 and math.abs(b.force[1]) < 1e-9,
+        m:bond_count() .. " " .. b.force[1])
+  m:close()
+end
+
 -- a removed ball takes its joints with it (the broad phase must not list them again)
 for _, dim in ipairs{2, 3} do
   local m, a, b = pair(dim)

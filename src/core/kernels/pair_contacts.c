@@ -191,7 +191,8 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
  * the force on j added to F, its moment about the contact point to mb, and
  * both kept in the bond's fn, fs, mn, ms (as the parallel bond's). Returns
  * false when the joint is gone: no element bonded and none in contact (a
- * gapped face: and its balls apart by more than twice its gap). */
+ * gapped face: and its balls apart by more than twice its gap; a face on
+ * overlapping balls: and the balls apart). */
 static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *np, double d,
                        const double *vsp, const double *dthp, const double *xc, int64_t i, int64_t j, double *F,
                        double *mb)
@@ -287,6 +288,11 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
      * waits for its balls to close while they have not opened by more than
      * its gap again */
     if (!alive && gapped) alive = delta < E->gap0[b->fj_first[s]];
+    /* a face installed on overlapping balls opens (delta > 0) before they
+     * part: it stays, carrying nothing, until they part, so the contact
+     * law takes over at zero overlap rather than with a force kn u0 out
+     * of nowhere (an energy jump) */
+    if (!alive && !gapped) alive = d < m->balls.rad[i] + m->balls.rad[j];
     /* resultants, turned to the pair's orientation (sg) */
     double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
     b->fn[s] = fn_sum;
