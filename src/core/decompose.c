@@ -33,7 +33,7 @@
 
 static const char *not_decomposed(const sx_model *m)
 {
-    if (m->bonds.n) return "bonds";
+    if (m->fjel.n) return "flat joints";
     if (m->clumps) return "clumps";
     if (m->cell) return "periodic space";
     if (m->njoint) return "smooth joints";
@@ -48,6 +48,7 @@ void sx__dd_free(sx_model *m)
     sx_dd *d = m->dd;
     if (!d) return;
     free(d->own);
+    free(d->bslot);
     free(d);
     m->dd = NULL;
 }
@@ -61,8 +62,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all: 9 spans per rank */
-    sx_span *s = d ? calloc(9 * r, sizeof *s) : NULL;
+    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch: 11 spans per rank */
+    sx_span *s = d ? calloc(11 * r, sizeof *s) : NULL;
     if (!s) {
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
@@ -70,6 +71,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->x = *x;
     d->own = s, d->need = s + r, d->pairs = s + 3 * r, d->wblk = s + 4 * r;
     d->wrun = s + 5 * r, d->bb_own = s + 6 * r, d->bw_own = s + 7 * r, d->all = s + 8 * r;
+    d->bs_own = s + 9 * r, d->scratch = s + 10 * r;
     m->dd = d;
     return SX_OK;
 }
@@ -87,9 +89,34 @@ static int owner_of(const sx_dd *d, int64_t i, int64_t n)
     return r;
 }
 
+/* The bond slots of the bonded pairs in pair order, each rank's own
+ * pairs' a contiguous run (bs_own): what a gather takes from each owner.
+ * A pair keeps its slot until the next plan, broken or not. */
+static bool plan_bonds(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_pairs *p = &m->bb;
+    d->nbslot = 0;
+    for (int r = 0; r < d->x.ranks; r++) {
+        d->bs_own[r] = (sx_span){0, 0};
+        if (!p->bond) continue;
+        if (d->cap_bslot < p->n) {
+            int32_t *q = realloc(d->bslot, (size_t)p->n * sizeof *q);
+            if (!q) return false;
+            d->bslot = q, d->cap_bslot = p->n;
+        }
+        d->bs_own[r].lo = d->nbslot;
+        for (int64_t c = d->bb_own[r].lo; c < d->bb_own[r].hi; c++)
+            if (p->bond[c]) d->bslot[d->nbslot++] = p->bond[c] - 1;
+        d->bs_own[r].hi = d->nbslot;
+    }
+    return true;
+}
+
 /* The spans of every rank from the whole, current pair stores (after a
- * build, or when a cycle starts), and this rank's clipped chunks. */
-void sx__dd_plan(sx_model *m)
+ * build, or when a cycle starts), and this rank's clipped chunks. False:
+ * out of memory. */
+bool sx__dd_plan(sx_model *m)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks, me = d->x.rank;
@@ -139,6 +166,7 @@ void sx__dd_plan(sx_model *m)
         if (o->clear_hi > hi.hi) o->clear_hi = hi.hi;
         if (o->clear_hi < o->clear_lo) o->clear_hi = o->clear_lo;
     }
+    return plan_bonds(m);
 }
 
 /* [0, count) for every rank: what a gather needs. */
@@ -173,6 +201,89 @@ static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
     return true;
 }
 
+/* The bonds' state the step changes (kind, fn, mn, fs, ms), each bond
+ * from the owner of its pair's first ball; packed as doubles in the
+ * plan's order (a kind is a small integer: exact). The intact count is
+ * counted again: each rank took off the bonds it saw break, its ghost
+ * pairs' included. */
+static bool gather_bonds(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_bonds *b = &m->bonds;
+    const int D = m->dim, RD = m->rdim, w = 3 + D + RD;
+    const int64_t nb = d->nbslot;
+    double *buf = nb ? malloc((size_t)(nb * w) * sizeof *buf) : NULL;
+    if (nb && !buf) return false;
+    const sx_span mine = d->bs_own[d->x.rank];
+    for (int64_t e = mine.lo; e < mine.hi; e++) {
+        const int32_t s = d->bslot[e];
+        double *q = buf + e * w;
+        q[0] = b->kind[s], q[1] = b->fn[s], q[2] = b->mn[s];
+        memcpy(q + 3, b->fs + s * D, (size_t)D * sizeof *q);
+        memcpy(q + 3 + D, b->ms + s * RD, (size_t)RD * sizeof *q);
+    }
+    const bool ok = !nb || share(d, buf, (size_t)w * sizeof *buf, d->bs_own, everything(d, nb), 1);
+    for (int64_t e = 0; ok && e < nb; e++) {
+        const int32_t s = d->bslot[e];
+        const double *q = buf + e * w;
+        b->kind[s] = (uint8_t)q[0], b->fn[s] = q[1], b->mn[s] = q[2];
+        memcpy(b->fs + s * D, q + 3, (size_t)D * sizeof *q);
+        memcpy(b->ms + s * RD, q + 3 + D, (size_t)RD * sizeof *q);
+    }
+    free(buf);
+    b->intact = 0;
+    for (int64_t s = 0; s < b->n; s++) b->intact += b->kind[s] != 0;
+    return ok;
+}
+
+/* The cracks logged since the last gather, made one log in the serial
+ * order. Every rank evaluates its own pairs and some of its neighbours'
+ * (between its ghosts): it keeps the cracks of its own pairs (a pair is
+ * its first ball's), which, the pairs being sorted by that ball, are the
+ * serial log's of its pair range. A step's cracks are thus rank 0's, then
+ * rank 1's, ...; the ranks' lists are merged by step in that order. */
+static bool gather_cracks(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_cracks *k = &m->cracks;
+    const int R = d->x.ranks, me = d->x.rank;
+    const sx_span own = d->own[me];
+    int64_t mine = d->crack0;
+    for (int64_t e = d->crack0; e < k->n; e++) {
+        const int64_t a = sx__ball_index(m, k->ev[e].a);
+        if (a >= own.lo && a < own.hi) k->ev[mine++] = k->ev[e];
+    }
+    int64_t *at = calloc((size_t)(2 * R), sizeof *at), *count = at + R; /* count[r]: rank r's; at[r]: its next */
+    if (!at) return false;
+    count[me] = mine - d->crack0;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    bool ok = share(d, count, sizeof *count, d->scratch, everything(d, R), 1);
+    int64_t total = 0;
+    for (int r = 0; ok && r < R; r++) {
+        d->scratch[r] = (sx_span){total, total + count[r]};
+        at[r] = total;
+        total += count[r];
+    }
+    sx_crack *all = ok && total ? malloc((size_t)total * sizeof *all) : NULL;
+    ok = ok && (!total || all);
+    if (ok && total) {
+        if (count[me]) memcpy(all + at[me], k->ev + d->crack0, (size_t)count[me] * sizeof *all);
+        ok = share(d, all, sizeof *all, d->scratch, everything(d, total), 1);
+    }
+    k->n = d->crack0;
+    for (;;) {
+        int pick = -1;
+        for (int r = 0; ok && r < R; r++) /* the earliest step; on a tie the lower rank */
+            if (at[r] < d->scratch[r].hi && (pick < 0 || all[at[r]].step < all[at[pick]].step)) pick = r;
+        if (pick < 0) break;
+        ok = sx__crack_log(m, &all[at[pick]++]);
+    }
+    d->crack0 = k->n;
+    free(all);
+    free(at);
+    return ok;
+}
+
 bool sx__dd_gather(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -182,7 +293,7 @@ bool sx__dd_gather(sx_model *m)
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
-           gather_pairs(m, &m->bw, d->bw_own);
+           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m)));
 }
 
 bool sx__dd_walls(sx_model *m)
@@ -197,15 +308,16 @@ sx_status sx__dd_begin(sx_model *m)
     sx_dd *d = m->dd;
     const char *what = not_decomposed(m);
     if (what)
-        return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16's first milestone: "
-                                      "unbonded balls and walls); run it serially",
+        return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
+                                      "walls, contact and parallel bonds); run it serially",
                         what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
         return sx__fail(m, SX_EINVAL,
                         "cycle: the model differs between the %d ranks (every rank must make the same calls: "
                         "random numbers without a fixed seed, or a branch on seixo.rank()?)",
                         d->x.ranks);
-    sx__dd_plan(m);
+    if (!sx__dd_plan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    d->crack0 = m->cracks.n;
     d->active = true;
     return SX_OK;
 }

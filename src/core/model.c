@@ -691,7 +691,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
                 break;
             }
             st = k->build(m);
-            if (!st && dd) sx__dd_plan(m); /* the new slabs: balls migrate */
+            if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs: balls migrate */
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (st) {
                 st = build_failed(m, st);
