@@ -34,7 +34,6 @@
 static const char *not_decomposed(const sx_model *m)
 {
     if (m->fjel.n) return "flat joints";
-    if (m->clumps) return "clumps";
     if (m->cell) return "periodic space";
     if (m->njoint) return "smooth joints";
     if (m->track_energy) return "energy tracking";
@@ -49,6 +48,7 @@ void sx__dd_free(sx_model *m)
     if (!d) return;
     free(d->own);
     free(d->bslot);
+    free(d->peb);
     free(d);
     m->dd = NULL;
 }
@@ -62,8 +62,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch: 11 spans per rank */
-    sx_span *s = d ? calloc(11 * r, sizeof *s) : NULL;
+    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own: 12 spans per rank */
+    sx_span *s = d ? calloc(12 * r, sizeof *s) : NULL;
     if (!s) {
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
@@ -71,7 +71,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->x = *x;
     d->own = s, d->need = s + r, d->pairs = s + 3 * r, d->wblk = s + 4 * r;
     d->wrun = s + 5 * r, d->bb_own = s + 6 * r, d->bw_own = s + 7 * r, d->all = s + 8 * r;
-    d->bs_own = s + 9 * r, d->scratch = s + 10 * r;
+    d->bs_own = s + 9 * r, d->scratch = s + 10 * r, d->peb_own = s + 11 * r;
     m->dd = d;
     return SX_OK;
 }
@@ -109,6 +109,30 @@ static bool plan_bonds(sx_model *m)
         for (int64_t c = d->bb_own[r].lo; c < d->bb_own[r].hi; c++)
             if (p->bond[c]) d->bslot[d->nbslot++] = p->bond[c] - 1;
         d->bs_own[r].hi = d->nbslot;
+    }
+    return true;
+}
+
+/* The clumps' pebbles in dense order, each rank's own a contiguous run
+ * (peb_own): every rank steps every clump (kernels/clump_motion.c, the
+ * serial step), from its pebbles' forces shared by their owners. */
+static bool plan_pebbles(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_balls *B = &m->balls;
+    d->npeb = 0;
+    for (int r = 0; r < d->x.ranks; r++) {
+        d->peb_own[r] = (sx_span){0, 0};
+        if (!B->clump) continue;
+        if (d->cap_peb < B->n) {
+            int32_t *q = realloc(d->peb, (size_t)B->n * sizeof *q);
+            if (!q) return false;
+            d->peb = q, d->cap_peb = B->n;
+        }
+        d->peb_own[r].lo = d->npeb;
+        for (int64_t i = d->own[r].lo; i < d->own[r].hi; i++)
+            if (B->clump[i]) d->peb[d->npeb++] = (int32_t)i;
+        d->peb_own[r].hi = d->npeb;
     }
     return true;
 }
@@ -166,7 +190,7 @@ bool sx__dd_plan(sx_model *m)
         if (o->clear_hi > hi.hi) o->clear_hi = hi.hi;
         if (o->clear_hi < o->clear_lo) o->clear_hi = o->clear_lo;
     }
-    return plan_bonds(m);
+    return plan_bonds(m) && plan_pebbles(m);
 }
 
 /* [0, count) for every rank: what a gather needs. */
@@ -303,13 +327,45 @@ bool sx__dd_walls(sx_model *m)
     return share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1);
 }
 
+/* Every pebble's rows of some per-ball arrays from its owner, to every
+ * rank: with sums NULL its force and moment (before the clumps' step),
+ * else the timestep's four sums (kt, kr, ct, cr: n each, from sums). */
+bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
+{
+    sx_dd *d = m->dd;
+    sx_balls *B = &m->balls;
+    const int64_t np = d->npeb;
+    if (!np) return true;
+    const int D = m->dim, RD = m->rdim, w = sums ? 4 : D + RD;
+    double *buf = malloc((size_t)(np * w) * sizeof *buf);
+    if (!buf) return false;
+    for (int pass = 0; pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
+        const int64_t e0 = pass ? 0 : d->peb_own[d->x.rank].lo, e1 = pass ? np : d->peb_own[d->x.rank].hi;
+        for (int64_t e = e0; e < e1; e++) {
+            const int64_t i = d->peb[e];
+            double *q = buf + e * w;
+            for (int k = 0; k < w; k++) {
+                double *v = sums ? sums + k * n + i : k < D ? B->f + i * D + k : B->t + i * RD + k - D;
+                if (pass) *v = q[k];
+                else q[k] = *v;
+            }
+        }
+        if (!pass && !share(d, buf, (size_t)w * sizeof *buf, d->peb_own, everything(d, np), 1)) {
+            free(buf);
+            return false;
+        }
+    }
+    free(buf);
+    return true;
+}
+
 sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
     const char *what = not_decomposed(m);
     if (what)
         return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
-                                      "walls, contact and parallel bonds); run it serially",
+                                      "walls, contact and parallel bonds, clumps); run it serially",
                         what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
         return sx__fail(m, SX_EINVAL,

@@ -312,6 +312,10 @@ typedef struct sx_dd {
     int64_t nbslot, cap_bslot;
     sx_span *bs_own, *scratch;
     int64_t crack0;         /* the crack log's entries every rank holds alike */
+    /* clumps: the pebbles in dense order, as planned, and each rank's own */
+    int32_t *peb;
+    int64_t npeb, cap_peb;
+    sx_span *peb_own;
 } sx_dd;
 
 struct sx_model {
@@ -574,6 +578,7 @@ bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
 bool sx__dd_walls(sx_model *m);
+bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);

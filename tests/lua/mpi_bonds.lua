@@ -5,8 +5,8 @@
 --             parallel and contact bonds on every touching pair, crushed by a platen until bonds break: the state
 --             hash at mid-run and at the end, the bond and crack counts and
 --             the whole crack log, entry by entry, in its order.
---   refused W one of what is not decomposed yet (W: flatjoint, clump,
---             periodic), for mpi_pour.sh: refused under mpirun with an
+--   refused W one of what is not decomposed yet (W: flatjoint, periodic),
+--             for mpi_pour.sh: refused under mpirun with an
 --             error naming it, cycled serially.
 --   cross     a bonded triplet of disks (three parallel bonds, three contact
 --             bonds) dropped down a channel beside a column of 600 fixed
@@ -119,7 +119,7 @@ elseif scene == "cross" then
   if tri[1].pos[2] > 0.02 then error("the triplet did not fall through the column") end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "refused" then
-  -- one of what is not decomposed yet (arg 2: flatjoint, clump, periodic):
+  -- one of what is not decomposed yet (arg 2: flatjoint, periodic):
   -- a serial run cycles it, mpirun stops every rank at the first cycle with
   -- an error naming it (mpi_pour.sh checks both)
   local what = arg[2]
@@ -131,14 +131,11 @@ elseif scene == "refused" then
     m:ball{pos = {0, 0, 0}, radius = 1}
     m:ball{pos = {2, 0, 0}, radius = 1}
     m:bond{kind = "flatjoint", gap = 1e-6, seed = 5}
-  elseif what == "clump" then
-    m:clump_template("dumbbell", {{-0.015, 0, 0, 0.01}, {0.015, 0, 0, 0.01}})
-    m:clump{template = "dumbbell", pos = {0, 0, 0}}
   elseif what == "periodic" then
     m:periodic{min = {0, 0, 0}, max = {0.1, 0.1, 0.1}}
     m:ball{pos = {0.05, 0.05, 0.05}, radius = 0.01}
   else
-    error("mpi_bonds.lua refused: flatjoint, clump or periodic expected")
+    error("mpi_bonds.lua refused: flatjoint or periodic expected")
   end
   m:cycle(10)
   print(what .. " cycled on " .. m:ranks() .. " rank(s)")
