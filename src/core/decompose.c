@@ -24,8 +24,10 @@
  *     ranks (a maximum, exact in any order) for the rebuild criterion.
  * A build, the energy guard and the end of the cycle first gather the
  * whole state on every rank (each ball from its owner, each pair from the
- * owner of its first ball); the build itself is the serial one, on every
- * rank. */
+ * owner of its first ball, each bond from the owner of its pair, and the
+ * ranks' cracks merged in the serial order); the build itself is the
+ * serial one, on every rank. Clumps: every rank steps every clump, from
+ * its pebbles' forces shared by their owners at every step. */
 #include "model_internal.h"
 
 #include <stdlib.h>
