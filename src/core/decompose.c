@@ -91,52 +91,47 @@ static int owner_of(const sx_dd *d, int64_t i, int64_t n)
     return r;
 }
 
-/* The bond slots of the bonded pairs in pair order, each rank's own
- * pairs' a contiguous run (bs_own): what a gather takes from each owner.
- * A pair keeps its slot until the next plan, broken or not. */
-static bool plan_bonds(sx_model *m)
+/* Lists, rank by rank, the entries pick(m, k) >= 0 of the k in range[r]
+ * (at most `most` of them): each rank's a contiguous run, spans[r]. */
+static bool plan_list(sx_model *m, const sx_span *range, int64_t most, int32_t (*pick)(const sx_model *, int64_t),
+                      int32_t **list, int64_t *n, int64_t *cap, sx_span *spans)
 {
-    sx_dd *d = m->dd;
-    const sx_pairs *p = &m->bb;
-    d->nbslot = 0;
-    for (int r = 0; r < d->x.ranks; r++) {
-        d->bs_own[r] = (sx_span){0, 0};
-        if (!p->bond) continue;
-        if (d->cap_bslot < p->n) {
-            int32_t *q = realloc(d->bslot, (size_t)p->n * sizeof *q);
-            if (!q) return false;
-            d->bslot = q, d->cap_bslot = p->n;
+    *n = 0;
+    if (*cap < most) {
+        int32_t *q = realloc(*list, (size_t)most * sizeof *q);
+        if (!q) return false;
+        *list = q, *cap = most;
+    }
+    for (int r = 0; r < m->dd->x.ranks; r++) {
+        spans[r].lo = *n;
+        for (int64_t k = range[r].lo; k < range[r].hi; k++) {
+            const int32_t v = pick(m, k);
+            if (v >= 0) (*list)[(*n)++] = v;
         }
-        d->bs_own[r].lo = d->nbslot;
-        for (int64_t c = d->bb_own[r].lo; c < d->bb_own[r].hi; c++)
-            if (p->bond[c]) d->bslot[d->nbslot++] = p->bond[c] - 1;
-        d->bs_own[r].hi = d->nbslot;
+        spans[r].hi = *n;
     }
     return true;
 }
 
-/* The clumps' pebbles in dense order, each rank's own a contiguous run
- * (peb_own): every rank steps every clump (kernels/clump_motion.c, the
- * serial step), from its pebbles' forces shared by their owners. */
-static bool plan_pebbles(sx_model *m)
+static int32_t bond_slot(const sx_model *m, int64_t c) { return m->bb.bond[c] - 1; }
+
+static int32_t pebble(const sx_model *m, int64_t i) { return m->balls.clump[i] ? (int32_t)i : -1; }
+
+/* The bond slots of the bonded pairs in pair order, each rank's own
+ * pairs' a contiguous run (bs_own): what a gather takes from each owner
+ * (a pair keeps its slot until the next plan, broken or not); and the
+ * clumps' pebbles in dense order, each rank's own a run (peb_own): every
+ * rank steps every clump (kernels/clump_motion.c, the serial step), from
+ * its pebbles' forces shared by their owners. */
+static bool plan_lists(sx_model *m)
 {
     sx_dd *d = m->dd;
-    const sx_balls *B = &m->balls;
-    d->npeb = 0;
-    for (int r = 0; r < d->x.ranks; r++) {
-        d->peb_own[r] = (sx_span){0, 0};
-        if (!B->clump) continue;
-        if (d->cap_peb < B->n) {
-            int32_t *q = realloc(d->peb, (size_t)B->n * sizeof *q);
-            if (!q) return false;
-            d->peb = q, d->cap_peb = B->n;
-        }
-        d->peb_own[r].lo = d->npeb;
-        for (int64_t i = d->own[r].lo; i < d->own[r].hi; i++)
-            if (B->clump[i]) d->peb[d->npeb++] = (int32_t)i;
-        d->peb_own[r].hi = d->npeb;
-    }
-    return true;
+    d->nbslot = d->npeb = 0;
+    for (int r = 0; r < d->x.ranks; r++) d->bs_own[r] = d->peb_own[r] = (sx_span){0, 0};
+    return (!m->bb.bond ||
+            plan_list(m, d->bb_own, m->bb.n, bond_slot, &d->bslot, &d->nbslot, &d->cap_bslot, d->bs_own)) &&
+           (!m->balls.clump ||
+            plan_list(m, d->own, m->balls.n, pebble, &d->peb, &d->npeb, &d->cap_peb, d->peb_own));
 }
 
 /* The spans of every rank from the whole, current pair stores (after a
@@ -192,7 +187,7 @@ bool sx__dd_plan(sx_model *m)
         if (o->clear_hi > hi.hi) o->clear_hi = hi.hi;
         if (o->clear_hi < o->clear_lo) o->clear_hi = o->clear_lo;
     }
-    return plan_bonds(m) && plan_pebbles(m);
+    return plan_lists(m);
 }
 
 /* [0, count) for every rank: what a gather needs. */
