@@ -4,7 +4,8 @@
 # same state hashes, contact count, floor force, unbalanced-force ratio and
 # kinetic energy, to the bit; a 3D pour and a 2D one of 3,000 disks (several
 # chunks of the contact pass, twelve wall blocks). Then a pour saved with 3
-# ranks and loaded with 2 ranks, and serially, ends as the serial run does;
+# ranks and loaded with 2 ranks, and serially, ends as the serial run does
+# (and so does a bonded specimen breaking bonds across the save);
 # and a servo-controlled lid moves alike with 2 and 3 ranks; what is not
 # decomposed yet is refused with a clear error.
 # Skipped without mpirun. The pours run through mpi_same.sh (which
@@ -36,23 +37,27 @@ for np in 2 3; do
     echo "servo, -np $np differs or failed:"; cat "$dir/out" "$dir/err"; fail=1
   fi
 done
-# a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit
+# a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit:
+# a pour, and a bonded specimen breaking bonds before and after the save
 restart=$(dirname "$script")/mpi_restart.lua
-"$seixo" "$restart" save "$dir/serial.h5" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
-echo "restart, serial:"; cat "$dir/serial"
-# shellcheck disable=SC2086
-mpirun $root --oversubscribe -np 3 "$seixo" "$restart" save "$dir/three.h5" >"$dir/saved" 2>"$dir/err" &&
-  grep -q "^ranks 3$" "$dir/err" || { echo "the save with 3 ranks failed:"; cat "$dir/err"; exit 1; }
-# shellcheck disable=SC2086
-mpirun $root --oversubscribe -np 2 "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded" 2>"$dir/err" &&
-  grep -q "^ranks 2$" "$dir/err" || { echo "the load with 2 ranks failed:"; cat "$dir/err"; exit 1; }
-"$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded1" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
-for run in saved loaded loaded1; do
-  if cmp -s "$dir/serial" "$dir/$run"; then
-    echo "restart, $run: identical"
-  else
-    echo "restart, $run differs:"; diff "$dir/serial" "$dir/$run"; fail=1
-  fi
+for kind in pour bonded; do
+  # shellcheck disable=SC2086
+  "$seixo" "$restart" save "$dir/serial.h5" $kind >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+  echo "restart ($kind), serial:"; cat "$dir/serial"
+  # shellcheck disable=SC2086
+  mpirun $root --oversubscribe -np 3 "$seixo" "$restart" save "$dir/three.h5" $kind >"$dir/saved" 2>"$dir/err" &&
+    grep -q "^ranks 3$" "$dir/err" || { echo "the save with 3 ranks failed:"; cat "$dir/err"; exit 1; }
+  # shellcheck disable=SC2086
+  mpirun $root --oversubscribe -np 2 "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded" 2>"$dir/err" &&
+    grep -q "^ranks 2$" "$dir/err" || { echo "the load with 2 ranks failed:"; cat "$dir/err"; exit 1; }
+  "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded1" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+  for run in saved loaded loaded1; do
+    if cmp -s "$dir/serial" "$dir/$run"; then
+      echo "restart ($kind), $run: identical"
+    else
+      echo "restart ($kind), $run differs:"; diff "$dir/serial" "$dir/$run"; fail=1
+    fi
+  done
 done
 # what is not decomposed yet runs serially, and mpirun stops every rank at
 # the first cycle with an error naming it
