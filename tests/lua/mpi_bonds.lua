@@ -1,19 +1,20 @@
--- Bonds under the MPI decomposition (issue 16; run by mpi_pour.sh, test
--- lua_mpi_pour): serially and under mpirun -np 1 ... 4 each scene prints
+-- Bonds under the MPI decomposition (issue 16; test lua_mpi_bonds through
+-- mpi_same.sh): serially and under mpirun -np 1 ... 4 each scene prints
 -- the same lines, to the bit.
---   crush D   a bonded specimen (D = 2: 480 disks; 3: 576 spheres) with
---             parallel and contact bonds on every touching pair, crushed by a platen until bonds break: the state
---             hash at mid-run and at the end, the bond and crack counts and
---             the whole crack log, entry by entry, in its order.
---   refused W one of what is not decomposed yet (W: flatjoint, periodic),
---             for mpi_pour.sh: refused under mpirun with an
---             error naming it, cycled serially.
+--   crush D   a bonded specimen (D = 2: 480 disks; 3: 576 spheres), every
+--             touching pair with a parallel and a contact bond, crushed by
+--             a platen (3D: sheared too) until bonds break: the state hash
+--             at mid-run and at the end, the bond and crack counts and the
+--             whole crack log, entry by entry, in its order.
 --   cross     a bonded triplet of disks (three parallel bonds, three contact
 --             bonds) dropped down a channel beside a column of 600 fixed
 --             disks, so that its balls pass through the slab of every rank
 --             (the ranks cut the balls by count along y): its bonds and
 --             contacts must survive the migrations, and the state is the
 --             serial one.
+--   refused W one of what is not decomposed yet (W: flatjoint, periodic),
+--             for mpi_pour.sh: refused under mpirun with an error naming
+--             it, cycled serially.
 local scene = arg and arg[1] or "crush"
 local dim = tonumber(arg and arg[2]) or 2
 
