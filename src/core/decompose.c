@@ -24,8 +24,10 @@
  *     ranks (a maximum, exact in any order) for the rebuild criterion.
  * A build, the energy guard and the end of the cycle first gather the
  * whole state on every rank (each ball from its owner, each pair from the
- * owner of its first ball); the build itself is the serial one, on every
- * rank. */
+ * owner of its first ball, each bond from the owner of its pair, and the
+ * ranks' cracks merged in the serial order); the build itself is the
+ * serial one, on every rank. Clumps: every rank steps every clump, from
+ * its pebbles' forces shared by their owners at every step. */
 #include "model_internal.h"
 
 #include <stdlib.h>
@@ -33,8 +35,7 @@
 
 static const char *not_decomposed(const sx_model *m)
 {
-    if (m->bonds.n) return "bonds";
-    if (m->clumps) return "clumps";
+    if (m->fjel.n) return "flat joints";
     if (m->cell) return "periodic space";
     if (m->njoint) return "smooth joints";
     if (m->track_energy) return "energy tracking";
@@ -48,6 +49,8 @@ void sx__dd_free(sx_model *m)
     sx_dd *d = m->dd;
     if (!d) return;
     free(d->own);
+    free(d->bslot);
+    free(d->peb);
     free(d);
     m->dd = NULL;
 }
@@ -61,8 +64,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all: 9 spans per rank */
-    sx_span *s = d ? calloc(9 * r, sizeof *s) : NULL;
+    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own: 12 spans per rank */
+    sx_span *s = d ? calloc(12 * r, sizeof *s) : NULL;
     if (!s) {
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
@@ -70,6 +73,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->x = *x;
     d->own = s, d->need = s + r, d->pairs = s + 3 * r, d->wblk = s + 4 * r;
     d->wrun = s + 5 * r, d->bb_own = s + 6 * r, d->bw_own = s + 7 * r, d->all = s + 8 * r;
+    d->bs_own = s + 9 * r, d->scratch = s + 10 * r, d->peb_own = s + 11 * r;
     m->dd = d;
     return SX_OK;
 }
@@ -87,9 +91,53 @@ static int owner_of(const sx_dd *d, int64_t i, int64_t n)
     return r;
 }
 
+/* Lists, rank by rank, the entries pick(m, k) >= 0 of the k in range[r]
+ * (at most `most` of them): each rank's a contiguous run, spans[r]. */
+static bool plan_list(sx_model *m, const sx_span *range, int64_t most, int32_t (*pick)(const sx_model *, int64_t),
+                      int32_t **list, int64_t *n, int64_t *cap, sx_span *spans)
+{
+    *n = 0;
+    if (*cap < most) {
+        int32_t *q = realloc(*list, (size_t)most * sizeof *q);
+        if (!q) return false;
+        *list = q, *cap = most;
+    }
+    for (int r = 0; r < m->dd->x.ranks; r++) {
+        spans[r].lo = *n;
+        for (int64_t k = range[r].lo; k < range[r].hi; k++) {
+            const int32_t v = pick(m, k);
+            if (v >= 0) (*list)[(*n)++] = v;
+        }
+        spans[r].hi = *n;
+    }
+    return true;
+}
+
+static int32_t bond_slot(const sx_model *m, int64_t c) { return m->bb.bond[c] - 1; }
+
+static int32_t pebble(const sx_model *m, int64_t i) { return m->balls.clump[i] ? (int32_t)i : -1; }
+
+/* The bond slots of the bonded pairs in pair order, each rank's own
+ * pairs' a contiguous run (bs_own): what a gather takes from each owner
+ * (a pair keeps its slot until the next plan, broken or not); and the
+ * clumps' pebbles in dense order, each rank's own a run (peb_own): every
+ * rank steps every clump (kernels/clump_motion.c, the serial step), from
+ * its pebbles' forces shared by their owners. */
+static bool plan_lists(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    d->nbslot = d->npeb = 0;
+    for (int r = 0; r < d->x.ranks; r++) d->bs_own[r] = d->peb_own[r] = (sx_span){0, 0};
+    return (!m->bb.bond ||
+            plan_list(m, d->bb_own, m->bb.n, bond_slot, &d->bslot, &d->nbslot, &d->cap_bslot, d->bs_own)) &&
+           (!m->balls.clump ||
+            plan_list(m, d->own, m->balls.n, pebble, &d->peb, &d->npeb, &d->cap_peb, d->peb_own));
+}
+
 /* The spans of every rank from the whole, current pair stores (after a
- * build, or when a cycle starts), and this rank's clipped chunks. */
-void sx__dd_plan(sx_model *m)
+ * build, or when a cycle starts), and this rank's clipped chunks. False:
+ * out of memory. */
+bool sx__dd_plan(sx_model *m)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks, me = d->x.rank;
@@ -139,6 +187,7 @@ void sx__dd_plan(sx_model *m)
         if (o->clear_hi > hi.hi) o->clear_hi = hi.hi;
         if (o->clear_hi < o->clear_lo) o->clear_hi = o->clear_lo;
     }
+    return plan_lists(m);
 }
 
 /* [0, count) for every rank: what a gather needs. */
@@ -173,6 +222,89 @@ static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
     return true;
 }
 
+/* The bonds' state the step changes (kind, fn, mn, fs, ms), each bond
+ * from the owner of its pair's first ball; packed as doubles in the
+ * plan's order (a kind is a small integer: exact). The intact count is
+ * counted again: each rank took off the bonds it saw break, its ghost
+ * pairs' included. */
+static bool gather_bonds(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_bonds *b = &m->bonds;
+    const int D = m->dim, RD = m->rdim, w = 3 + D + RD;
+    const int64_t nb = d->nbslot;
+    double *buf = nb ? malloc((size_t)(nb * w) * sizeof *buf) : NULL;
+    if (nb && !buf) return false;
+    const sx_span mine = d->bs_own[d->x.rank];
+    for (int64_t e = mine.lo; e < mine.hi; e++) {
+        const int32_t s = d->bslot[e];
+        double *q = buf + e * w;
+        q[0] = b->kind[s], q[1] = b->fn[s], q[2] = b->mn[s];
+        memcpy(q + 3, b->fs + s * D, (size_t)D * sizeof *q);
+        memcpy(q + 3 + D, b->ms + s * RD, (size_t)RD * sizeof *q);
+    }
+    const bool ok = !nb || share(d, buf, (size_t)w * sizeof *buf, d->bs_own, everything(d, nb), 1);
+    for (int64_t e = 0; ok && e < nb; e++) {
+        const int32_t s = d->bslot[e];
+        const double *q = buf + e * w;
+        b->kind[s] = (uint8_t)q[0], b->fn[s] = q[1], b->mn[s] = q[2];
+        memcpy(b->fs + s * D, q + 3, (size_t)D * sizeof *q);
+        memcpy(b->ms + s * RD, q + 3 + D, (size_t)RD * sizeof *q);
+    }
+    free(buf);
+    b->intact = 0;
+    for (int64_t s = 0; s < b->n; s++) b->intact += b->kind[s] != 0;
+    return ok;
+}
+
+/* The cracks logged since the last gather, made one log in the serial
+ * order. Every rank evaluates its own pairs and some of its neighbours'
+ * (between its ghosts): it keeps the cracks of its own pairs (a pair is
+ * its first ball's), which, the pairs being sorted by that ball, are the
+ * serial log's of its pair range. A step's cracks are thus rank 0's, then
+ * rank 1's, ...; the ranks' lists are merged by step in that order. */
+static bool gather_cracks(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_cracks *k = &m->cracks;
+    const int R = d->x.ranks, me = d->x.rank;
+    const sx_span own = d->own[me];
+    int64_t mine = d->crack0;
+    for (int64_t e = d->crack0; e < k->n; e++) {
+        const int64_t a = sx__ball_index(m, k->ev[e].a);
+        if (a >= own.lo && a < own.hi) k->ev[mine++] = k->ev[e];
+    }
+    int64_t *at = calloc((size_t)(2 * R), sizeof *at), *count = at + R; /* count[r]: rank r's; at[r]: its next */
+    if (!at) return false;
+    count[me] = mine - d->crack0;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    bool ok = share(d, count, sizeof *count, d->scratch, everything(d, R), 1);
+    int64_t total = 0;
+    for (int r = 0; ok && r < R; r++) {
+        d->scratch[r] = (sx_span){total, total + count[r]};
+        at[r] = total;
+        total += count[r];
+    }
+    sx_crack *all = ok && total ? malloc((size_t)total * sizeof *all) : NULL;
+    ok = ok && (!total || all);
+    if (ok && total) {
+        if (count[me]) memcpy(all + at[me], k->ev + d->crack0, (size_t)count[me] * sizeof *all);
+        ok = share(d, all, sizeof *all, d->scratch, everything(d, total), 1);
+    }
+    k->n = d->crack0;
+    for (;;) {
+        int pick = -1;
+        for (int r = 0; ok && r < R; r++) /* the earliest step; on a tie the lower rank */
+            if (at[r] < d->scratch[r].hi && (pick < 0 || all[at[r]].step < all[at[pick]].step)) pick = r;
+        if (pick < 0) break;
+        ok = sx__crack_log(m, &all[at[pick]++]);
+    }
+    d->crack0 = k->n;
+    free(all);
+    free(at);
+    return ok;
+}
+
 bool sx__dd_gather(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -182,7 +314,7 @@ bool sx__dd_gather(sx_model *m)
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
-           gather_pairs(m, &m->bw, d->bw_own);
+           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m)));
 }
 
 bool sx__dd_walls(sx_model *m)
@@ -192,20 +324,53 @@ bool sx__dd_walls(sx_model *m)
     return share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1);
 }
 
+/* Every pebble's rows of some per-ball arrays from its owner, to every
+ * rank: with sums NULL its force and moment (before the clumps' step),
+ * else the timestep's four sums (kt, kr, ct, cr: n each, from sums). */
+bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
+{
+    sx_dd *d = m->dd;
+    sx_balls *B = &m->balls;
+    const int64_t np = d->npeb;
+    if (!np) return true;
+    const int D = m->dim, RD = m->rdim, w = sums ? 4 : D + RD;
+    double *buf = malloc((size_t)(np * w) * sizeof *buf);
+    if (!buf) return false;
+    for (int pass = 0; pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
+        const int64_t e0 = pass ? 0 : d->peb_own[d->x.rank].lo, e1 = pass ? np : d->peb_own[d->x.rank].hi;
+        for (int64_t e = e0; e < e1; e++) {
+            const int64_t i = d->peb[e];
+            double *q = buf + e * w;
+            for (int k = 0; k < w; k++) {
+                double *v = sums ? sums + k * n + i : k < D ? B->f + i * D + k : B->t + i * RD + k - D;
+                if (pass) *v = q[k];
+                else q[k] = *v;
+            }
+        }
+        if (!pass && !share(d, buf, (size_t)w * sizeof *buf, d->peb_own, everything(d, np), 1)) {
+            free(buf);
+            return false;
+        }
+    }
+    free(buf);
+    return true;
+}
+
 sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
     const char *what = not_decomposed(m);
     if (what)
-        return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16's first milestone: "
-                                      "unbonded balls and walls); run it serially",
+        return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
+                                      "walls, contact and parallel bonds, clumps); run it serially",
                         what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
         return sx__fail(m, SX_EINVAL,
                         "cycle: the model differs between the %d ranks (every rank must make the same calls: "
                         "random numbers without a fixed seed, or a branch on seixo.rank()?)",
                         d->x.ranks);
-    sx__dd_plan(m);
+    if (!sx__dd_plan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    d->crack0 = m->cracks.n;
     d->active = true;
     return SX_OK;
 }

@@ -691,7 +691,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
                 break;
             }
             st = k->build(m);
-            if (!st && dd) sx__dd_plan(m); /* the new slabs: balls migrate */
+            if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs: balls migrate */
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (st) {
                 st = build_failed(m, st);
@@ -716,6 +716,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         st = k->integrate(m, &max_disp);
         if (!st && dd && !dd->x.max(dd->x.ud, &max_disp)) /* every rank decides the same rebuild */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
+        if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* every rank steps every clump */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
         if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;

@@ -306,6 +306,16 @@ typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: 2 per rank) */
+    /* bonds: the slots of the bonded pairs in pair order, as planned, and
+     * each rank's entries (its own pairs'); scratch spans for a gather */
+    int32_t *bslot;
+    int64_t nbslot, cap_bslot;
+    sx_span *bs_own, *scratch;
+    int64_t crack0;         /* the crack log's entries every rank holds alike */
+    /* clumps: the pebbles in dense order, as planned, and each rank's own */
+    int32_t *peb;
+    int64_t npeb, cap_peb;
+    sx_span *peb_own;
 } sx_dd;
 
 struct sx_model {
@@ -564,10 +574,11 @@ void sx__bonds_free(sx_model *m);
  * end of a cycle (the whole state, then replan: the serial chunk plan) */
 void sx__dd_free(sx_model *m);
 sx_status sx__dd_begin(sx_model *m);
-void sx__dd_plan(sx_model *m);
+bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
 bool sx__dd_walls(sx_model *m);
+bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);

@@ -4,9 +4,12 @@
 # same state hashes, contact count, floor force, unbalanced-force ratio and
 # kinetic energy, to the bit; a 3D pour and a 2D one of 3,000 disks (several
 # chunks of the contact pass, twelve wall blocks). Then a pour saved with 3
-# ranks and loaded with 2 ranks, and serially, ends as the serial run does;
-# and a servo-controlled lid moves alike with 2 and 3 ranks.
-# Skipped without mpirun.
+# ranks and loaded with 2 ranks, and serially, ends as the serial run does
+# (and so does a bonded specimen breaking bonds across the save);
+# and a servo-controlled lid moves alike with 2 and 3 ranks; what is not
+# decomposed yet is refused with a clear error.
+# Skipped without mpirun. The pours run through mpi_same.sh (which
+# checks 2 and 3 ranks only under AddressSanitizer).
 #   mpi_pour.sh SEIXO mpi_pour.lua
 set -u
 seixo=$1
@@ -17,38 +20,10 @@ if ! command -v mpirun >/dev/null 2>&1; then
 fi
 root=
 [ "$(id -u)" = 0 ] && root=--allow-run-as-root # Open MPI refuses root without it
-# Under AddressSanitizer (scripts/test --sanitize) the pours run on 2 and 3
-# ranks only (one even and one odd cut, the memory checks of every code
-# path): the plain suite checks every rank count, and CI's time stays short.
-ranks="1 2 3 4"
-if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="2 3"; fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 fail=0
-for scene in "600 6000 3" "3000 4000 2"; do
-  # shellcheck disable=SC2086 # the scene is three arguments
-  if ! "$seixo" "$script" $scene >"$dir/serial" 2>"$dir/err"; then
-    echo "serial run of '$scene' failed:"; cat "$dir/err"; exit 1
-  fi
-  grep -q "^ranks 1$" "$dir/err" || { echo "the serial run is not serial"; exit 1; }
-  [ "$(grep -c '^hash ' "$dir/serial")" = 1 ] || { echo "no hash from the serial run"; cat "$dir/serial"; exit 1; }
-  echo "scene '$scene', serial:"; cat "$dir/serial"
-  for np in $ranks; do
-    # shellcheck disable=SC2086
-    if ! mpirun $root --oversubscribe -np "$np" "$seixo" "$script" $scene >"$dir/out" 2>"$dir/err"; then
-      echo "-np $np failed:"; cat "$dir/err"; fail=1; continue
-    fi
-    want=$np; [ "$np" = 1 ] && want=1
-    if ! grep -q "^ranks $want$" "$dir/err"; then
-      echo "-np $np: the model was not decomposed over $want ranks:"; cat "$dir/err"; fail=1; continue
-    fi
-    if cmp -s "$dir/serial" "$dir/out"; then
-      echo "-np $np: identical"
-    else
-      echo "-np $np differs:"; diff "$dir/serial" "$dir/out"; fail=1
-    fi
-  done
-done
+sh "$(dirname "$0")/mpi_same.sh" "$seixo" "$script" "600 6000 3" "3000 4000 2" || fail=1
 # a servo-controlled lid (a wall force summed over the ranks' blocks drives it)
 servo=$(dirname "$script")/mpi_servo.lua
 "$seixo" "$servo" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
@@ -62,22 +37,41 @@ for np in 2 3; do
     echo "servo, -np $np differs or failed:"; cat "$dir/out" "$dir/err"; fail=1
   fi
 done
-# a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit
+# a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit:
+# a pour, and a bonded specimen breaking bonds before and after the save
 restart=$(dirname "$script")/mpi_restart.lua
-"$seixo" "$restart" save "$dir/serial.h5" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
-echo "restart, serial:"; cat "$dir/serial"
-# shellcheck disable=SC2086
-mpirun $root --oversubscribe -np 3 "$seixo" "$restart" save "$dir/three.h5" >"$dir/saved" 2>"$dir/err" &&
-  grep -q "^ranks 3$" "$dir/err" || { echo "the save with 3 ranks failed:"; cat "$dir/err"; exit 1; }
-# shellcheck disable=SC2086
-mpirun $root --oversubscribe -np 2 "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded" 2>"$dir/err" &&
-  grep -q "^ranks 2$" "$dir/err" || { echo "the load with 2 ranks failed:"; cat "$dir/err"; exit 1; }
-"$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded1" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
-for run in saved loaded loaded1; do
-  if cmp -s "$dir/serial" "$dir/$run"; then
-    echo "restart, $run: identical"
+for kind in pour bonded; do
+  # shellcheck disable=SC2086
+  "$seixo" "$restart" save "$dir/serial.h5" $kind >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+  echo "restart ($kind), serial:"; cat "$dir/serial"
+  # shellcheck disable=SC2086
+  mpirun $root --oversubscribe -np 3 "$seixo" "$restart" save "$dir/three.h5" $kind >"$dir/saved" 2>"$dir/err" &&
+    grep -q "^ranks 3$" "$dir/err" || { echo "the save with 3 ranks failed:"; cat "$dir/err"; exit 1; }
+  # shellcheck disable=SC2086
+  mpirun $root --oversubscribe -np 2 "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded" 2>"$dir/err" &&
+    grep -q "^ranks 2$" "$dir/err" || { echo "the load with 2 ranks failed:"; cat "$dir/err"; exit 1; }
+  "$seixo" "$restart" load "$dir/three.h5" >"$dir/loaded1" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+  for run in saved loaded loaded1; do
+    if cmp -s "$dir/serial" "$dir/$run"; then
+      echo "restart ($kind), $run: identical"
+    else
+      echo "restart ($kind), $run differs:"; diff "$dir/serial" "$dir/$run"; fail=1
+    fi
+  done
+done
+# what is not decomposed yet runs serially, and mpirun stops every rank at
+# the first cycle with an error naming it
+bonds=$(dirname "$script")/mpi_bonds.lua
+for what in "flatjoint:flat joints" "periodic:periodic space"; do
+  arg=${what%%:*} name=${what#*:}
+  "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err" || { echo "$arg, serial:"; cat "$dir/err"; fail=1; }
+  # shellcheck disable=SC2086
+  if mpirun $root --oversubscribe -np 2 "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err"; then
+    echo "$arg: not refused with 2 ranks"; cat "$dir/out"; fail=1
+  elif grep -q "m:cycle: $name cannot yet run decomposed over 2 ranks" "$dir/err"; then
+    echo "$arg: refused with 2 ranks, naming it"
   else
-    echo "restart, $run differs:"; diff "$dir/serial" "$dir/$run"; fail=1
+    echo "$arg: failed with 2 ranks without naming it:"; cat "$dir/err"; fail=1
   fi
 done
 exit $fail

@@ -1,0 +1,145 @@
+-- Bonds under the MPI decomposition (issue 16; test lua_mpi_bonds through
+-- mpi_same.sh): serially and under mpirun -np 1 ... 4 each scene prints
+-- the same lines, to the bit.
+--   crush D   a bonded specimen (D = 2: 480 disks; 3: 576 spheres), every
+--             touching pair with a parallel and a contact bond, crushed by
+--             a platen (3D: sheared too) until bonds break: the state hash
+--             at mid-run and at the end, the bond and crack counts and the
+--             whole crack log, entry by entry, in its order.
+--   cross     a bonded triplet of disks (three parallel bonds, three contact
+--             bonds) dropped down a channel beside a column of 600 fixed
+--             disks, so that its balls pass through the slab of every rank
+--             (the ranks cut the balls by count along y): its bonds and
+--             contacts must survive the migrations, and the state is the
+--             serial one.
+--   refused W one of what is not decomposed yet (W: flatjoint, periodic),
+--             for mpi_pour.sh: refused under mpirun with an error naming
+--             it, cycled serially.
+local scene = arg and arg[1] or "crush"
+local dim = tonumber(arg and arg[2]) or 2
+
+local function log_cracks(m)
+  for i, c in ipairs(m:cracks()) do
+    print(string.format("crack %d step %d %s %s balls %d %d fn %.17g fs %.17g mn %.17g ms %.17g at %.17g %.17g", i,
+                        c.step, c.kind, c.mode, c.a, c.b, c.fn, c.fs, c.mn, c.ms, c.pos[1], c.pos[2]))
+  end
+end
+
+local function report(m, tag)
+  print(string.format("%s step %d bonds %d cracks %d (tension %d) contacts %d hash %s", tag, m:step(), m:bond_count(),
+                      m:crack_count(), m:crack_count("tension"), m:contact_count(), m:hash()))
+end
+
+local function material(m)
+  m:material("rock", {density = 2650, friction = 0.5, damping = 0.7, modulus = 1e9, stiffness_ratio = 2.5,
+                      bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5,
+                              tensile_strength = 2e5, tensile_strength_sd = 4e4, cohesion = 4e5, cohesion_sd = 8e4,
+                              normal_strength = 1000, normal_strength_sd = 200, shear_strength = 1000,
+                              shear_strength_sd = 200}})
+end
+
+if scene == "crush" then
+  local g = dim == 3 and {0, 0, -9.81} or {0, -9.81}
+  local m = seixo.model{dim = dim, gravity = g}
+  material(m)
+  local r = 1e-3
+  local height
+  if dim == 2 then -- a hexagonal packing, 20 x 24
+    for j = 0, 23 do
+      for i = 0, 19 do m:ball{pos = {(2 * i + (j % 2) + 1) * r, (1 + j * math.sqrt(3)) * r}, radius = r} end
+    end
+    height = (2 + 23 * math.sqrt(3)) * r
+    m:wall{kind = "line", point = {0, 0}, normal = {0, 1}, kn = 2e9, ks = 2e9}
+  else -- a simple cubic block, 6 x 6 x 16
+    for k = 0, 15 do
+      for j = 0, 5 do
+        for i = 0, 5 do m:ball{pos = {(2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r}, radius = r} end
+      end
+    end
+    height = 32 * r
+    m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, kn = 2e9, ks = 2e9}
+  end
+  local n = m:bond{kind = "parallel", gap = 1e-6, seed = 42}
+  local nc = m:bond{kind = "contact", gap = 1e-6, seed = 43}
+  print(string.format("%d balls, %d parallel bonds, %d contact bonds", m:ball_count(), n, nc))
+  local function along(v) -- a vector along the last axis
+    return dim == 3 and {0, 0, v} or {0, v}
+  end
+  local down, up, top = along(-0.04), along(-1), along(height)
+  if dim == 3 then down = {0.1, 0, -0.1} end -- (a simple cubic block is crushed without tension: shear it)
+  m:wall{kind = dim == 3 and "plane" or "line", point = top, normal = up, kn = 2e9, ks = 2e9, vel = down}
+  m:cycle(1500)
+  report(m, "mid")
+  m:cycle(1500)
+  report(m, "end")
+  log_cracks(m)
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "cross" then
+  -- soft disks and a fixed timestep, so that the fall takes few steps
+  local m = seixo.model{dim = 2, gravity = {0, -9.81}, timestep = 4e-6}
+  m:material("soft", {density = 2650, friction = 0.5, modulus = 1e7, stiffness_ratio = 2.5,
+                      bond = {radius_multiplier = 1, modulus = 1e7, stiffness_ratio = 2.5, tensile_strength = 1e12,
+                              cohesion = 1e12, normal_strength = 1e9, shear_strength = 1e9}})
+  m:material("column", {density = 2650, modulus = 1e7})
+  local r = 1e-3
+  -- a column of fixed disks, 6 wide and 100 tall, on the right; the channel on the left
+  for j = 0, 99 do
+    for i = 0, 5 do
+      m:ball{pos = {0.02 + (2 * i + 1) * r, (2 * j + 1) * r}, radius = r, material = "column"}.fix = "all"
+    end
+  end
+  m:wall{kind = "line", point = {0, 0}, normal = {0, 1}, kn = 2e7, ks = 2e7}
+  local x0, y0 = 0.008, 0.19
+  local tri = {}
+  for k, p in ipairs{{x0, y0}, {x0 + 2 * r, y0}, {x0 + r, y0 + math.sqrt(3) * r}} do
+    tri[k] = m:ball{pos = p, radius = r, material = "soft", vel = {0, -4}, spin = 30}
+  end
+  local n = m:bond{kind = "parallel", gap = 1e-6, seed = 42, materials = "soft"}
+  local nc = m:bond{kind = "contact", gap = 1e-6, seed = 43, materials = "soft"}
+  print(string.format("triplet: %d parallel and %d contact bonds", n, nc))
+  for _ = 1, 10 do
+    m:cycle(1200)
+    -- the triplet's contacts among its balls, with their forces, and its bonds
+    local own, fn, seen = 0, {}, {}
+    local mine = {[tri[1].id] = true, [tri[2].id] = true, [tri[3].id] = true}
+    for k = 1, 3 do
+      for c in m:contacts{ball = tri[k], kind = "ball-ball"} do
+        local key = math.min(c.a.id, c.b.id) .. "-" .. math.max(c.a.id, c.b.id)
+        if mine[c.a.id] and mine[c.b.id] and not seen[key] then
+          seen[key] = true
+          own = own + 1
+          fn[#fn + 1] = string.format("%.17g", c.fn)
+        end
+      end
+    end
+    print(string.format("step %d y %.17g %.17g %.17g bonds %d triplet contacts %d (fn %s) hash %s", m:step(),
+                        tri[1].pos[2], tri[2].pos[2], tri[3].pos[2], m:bond_count(), own, table.concat(fn, " "),
+                        m:hash()))
+    if m:bond_count() ~= 3 or own ~= 3 then error("the triplet lost a bond or a contact") end
+  end
+  if tri[1].pos[2] > 0.02 then error("the triplet did not fall through the column") end
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "refused" then
+  -- one of what is not decomposed yet (arg 2: flatjoint, periodic):
+  -- a serial run cycles it, mpirun stops every rank at the first cycle with
+  -- an error naming it (mpi_pour.sh checks both)
+  local what = arg[2]
+  local m = seixo.model{dim = 3}
+  m:material("r", {density = 1000, kn = 1e7, ks = 1e7, friction = 0.5,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 2e6, friction_angle = 30, friction = 0.6, elements = 4, sectors = 3}})
+  if what == "flatjoint" then
+    m:ball{pos = {0, 0, 0}, radius = 1}
+    m:ball{pos = {2, 0, 0}, radius = 1}
+    m:bond{kind = "flatjoint", gap = 1e-6, seed = 5}
+  elseif what == "periodic" then
+    m:periodic{min = {0, 0, 0}, max = {0.1, 0.1, 0.1}}
+    m:ball{pos = {0.05, 0.05, 0.05}, radius = 0.01}
+  else
+    error("mpi_bonds.lua refused: flatjoint or periodic expected")
+  end
+  m:cycle(10)
+  print(what .. " cycled on " .. m:ranks() .. " rank(s)")
+else
+  error("mpi_bonds.lua: scene 'crush' or 'cross' expected, got " .. tostring(scene))
+end
