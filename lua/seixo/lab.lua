@@ -976,7 +976,7 @@ local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_s
 -- the loading under (false: a constant strain rate) and the fastest rate.
 local function rate_control(opts, rate, fn)
   local target = opts.target_ratio
-  if target == nil then target = 4e-3 end
+  if target == nil then target = 2e-3 end
   if target == false then
     if opts.max_rate then fail("lab.%s: max_rate is the rate control's; target_ratio = false turns it off", fn) end
     return nil, rate
@@ -1004,8 +1004,10 @@ end
 -- ratio alone, noisy (a factor of 2 to 3 between records) and lifted by
 -- each change of speed, cannot tell that phase apart without a target so
 -- low that it never speeds up (docs/performance.md, Lab throughput). The
--- target 4e-3: at 8e-3 the main job took 15 % fewer steps but its UCS at
--- half the rate (target 4e-3) peaked 2.1 % above it, past the tolerance.
+-- target 2e-3: on the main job's specimen with lab.rock{dim = 3} the UCS
+-- peaked at 209.3 MPa at 4e-3, 3.8 % below the constant half rate's 217.7
+-- (at 2e-3: 215.6, and 217.7 at half the rate and target); on lab.rock()'s
+-- specimen 8e-3 already failed the quasi-static check (docs/performance.md).
 local function rate_factor(factor, ratio, cracked, target, max_factor)
   if ratio > target or cracked then return math.max(1, 0.5 * factor) end
   if ratio < 0.5 * target then return math.min(max_factor, 1.15 * factor) end

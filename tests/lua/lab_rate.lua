@@ -23,7 +23,7 @@ local col = {}
 for i, name in ipairs(controlled.columns) do col[name] = i end
 
 test("the rate control speeds the loading up within its bounds and keeps the ratio under its target", function()
-  check(controlled.target_ratio == 4e-3, controlled.target_ratio)
+  check(controlled.target_ratio == 2e-3, controlled.target_ratio)
   near(controlled.max_rate, 8 * controlled.strain_rate, 1e-12)
   local base, top, fastest, rows = controlled.strain_rate, controlled.max_rate, 0, controlled.rows
   local fast_ratio, fast_n = 0, 0
