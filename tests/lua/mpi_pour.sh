@@ -9,7 +9,7 @@
 # and a servo-controlled lid moves alike with 2 and 3 ranks; what is not
 # decomposed yet is refused with a clear error.
 # Skipped without mpirun. The pours run through mpi_same.sh (which
-# checks 2 and 3 ranks only under AddressSanitizer).
+# checks 3 ranks only under AddressSanitizer).
 #   mpi_pour.sh SEIXO mpi_pour.lua
 set -u
 seixo=$1
