@@ -550,7 +550,13 @@ local function check_options(lab, opts)
     fail("parameters = {name = {lower, upper}, ...} expected (names: modulus, stiffness_ratio, strength, ...)")
   end
   o.names, o.lower, o.upper, o.x0, o.groups = {}, {}, {}, {}, {}
-  for name in pairs(opts.parameters) do o.names[#o.names + 1] = name end
+  for name in pairs(opts.parameters) do
+    if type(name) ~= "string" then
+      fail("parameters must be keyed by name, {modulus = {lower, upper}, ...} (got a %s key: %s)", type(name),
+           tostring(name))
+    end
+    o.names[#o.names + 1] = name
+  end
   table.sort(o.names)
   for i, name in ipairs(o.names) do
     local b = opts.parameters[name]
@@ -604,6 +610,11 @@ local function check_options(lab, opts)
     end
   end
   o.algorithm = opts.algorithm or "bobyqa"
+  for _, k in ipairs({"out", "log"}) do
+    if opts[k] ~= nil and type(opts[k]) ~= "string" then
+      fail("%s must be a path (a string; got %s)", k, type(opts[k]))
+    end
+  end
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")
   o.plot = opts.plot

@@ -54,7 +54,7 @@ function checks.nan_in(m)
   local cok, it = pcall(m.contacts, m) -- (a model that cannot be prepared has none to show)
   for c in cok and it or function() end do
     for _, f in ipairs(fields.contact) do
-      if not finite(c[f]) then return "contact " .. c.a .. "-" .. c.b .. " " .. f end
+      if not finite(c[f]) then return "contact " .. tostring(c.a.id) .. "-" .. tostring(c.b.id) .. " " .. f end
     end
   end
   for _, cr in ipairs(m:cracks()) do

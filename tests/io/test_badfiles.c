@@ -600,6 +600,8 @@ START_TEST(meaningless_values)
         {"/bonds/kn", SX_BOND_PARALLEL, NAN, "radius or stiffness <= 0 or not finite"},
         {"/balls/force", 0, NAN, "non-finite force, moment or applied load"},
         {"/contacts/ball_ball/relative_position", 0, NAN, "ball-ball pair 0 has a non-finite history"},
+        /* found by the long fuzz run: 1e300 is finite, the length it gives is not (an infinite overlap) */
+        {"/contacts/ball_ball/relative_position", 0, 1e300, "ball-ball pair 0 has a non-finite history"},
         {"/contacts/ball_ball/shear_force", 0, -INFINITY, "ball-ball pair 0 has a non-finite history"},
         {"/walls/normal", 0, 5, "a normal of length other than 1"},
         {"/walls/kn", 0, NAN, "has a stiffness, friction or move out of range"},

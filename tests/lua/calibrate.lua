@@ -252,6 +252,13 @@ test("bad options are clear errors at the caller", function()
                                     print = math.mininteger} end, "lab.calibrate: print must be a function or false (got number)")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {2e9, 1e9}}, evaluate = synthetic} end,
            "parameters.modulus must be {lower, upper}")
+  -- the long fuzz run (issue 18): a list for parameters and a function for out failed inside calibrate.lua
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {1, 2, 3, 4}, evaluate = synthetic} end,
+           "lab.calibrate: parameters must be keyed by name, {modulus = {lower, upper}, ...} (got a number key: 1)")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {{}}, evaluate = synthetic} end,
+           "parameters must be keyed by name")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    out = print} end, "lab.calibrate: out must be a path (a string; got function)")
   T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
            "unknown target 'G'")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {nothing = {1, 2}}, evaluate = synthetic} end,
