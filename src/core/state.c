@@ -315,15 +315,16 @@ static sx_status check_walls(sx_model *m)
 }
 
 /* The history of pair c of store p is finite (a NaN shear force or
- * relative position would spread through the step unseen), the length of
- * its relative position (or normal) too: a component of 1e300 is finite,
- * its square is not, and the contact's overlap would come out infinite. */
+ * relative position would spread through the step unseen). The relative
+ * position (or normal) is checked by its squared length, which is finite
+ * only if every component is and none is so large (1e300) that the
+ * contact's overlap would come out infinite. */
 static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
 {
     const int d = m->dim;
     double len2 = 0;
     for (int k = 0; k < d; k++) len2 += p->geo[c * d + k] * p->geo[c * d + k];
-    return finite_all(p->fs + c * d, d) && finite_all(p->geo + c * d, d) && isfinite(len2) && isfinite(p->fn[c]) &&
+    return finite_all(p->fs + c * d, d) && isfinite(len2) && isfinite(p->fn[c]) &&
            (!p->un || isfinite(p->un[c])) &&
            (!p->jun || (isfinite(p->jun[c]) && finite_all(p->jnormal + c * d, d)));
 }
