@@ -18,7 +18,16 @@
  * Nothing is lost on a crash: the file is created under a temporary name
  * and renamed; each snapshot and the history rows are written, flushed and
  * synced before the `count`s of complete snapshots and rows are raised
- * (readers ignore what lies beyond them). The XDMF is never patched in
+ * (readers ignore what lies beyond them). HDF5 rewrites some metadata in
+ * place (a group's header when a link is added to it, a growing dataset's
+ * index) and its cache writes dirty metadata in any order, so a kill could
+ * leave /snapshots' header pointing at a new header chunk not yet on disk,
+ * and every snapshot with it. A snapshot is therefore written as an
+ * unlinked group and synced first; only then is it linked and are the
+ * history rows appended, so the long write never touches what complete
+ * snapshots are reached by, and only a kill inside the short flush of the
+ * link and the rows could (HDF5 orders its writes only under SWMR, which
+ * cannot create groups). The XDMF is never patched in
  * place: the new one (kept in memory, so no snapshot is read back) is
  * written and synced under a temporary name before the counts are raised,
  * and renamed over the old one right after, so it is always a complete
@@ -400,24 +409,30 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         if (m) {
             char name[48];
             snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
-            /* a group left by a write that failed or was killed is dropped */
-            hid_t g = drop_link(&h, s->file, "/snapshots", name + strlen("/snapshots/"))
-                          ? H5Gcreate2(s->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)
-                          : -1;
+            /* 1. the snapshot written unlinked and synced: the long write
+             * dirties no object that a complete snapshot is reached by */
+            hid_t g = H5Gcreate_anon(s->file, H5P_DEFAULT, H5P_DEFAULT);
             if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
             else sx_io_frame_write(&h, g, m, s->fields, &sn);
+            if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
+            /* then linked, in place of a group left by a write that failed
+             * or was killed */
+            if (!h.failed && drop_link(&h, s->file, "/snapshots", name + strlen("/snapshots/")) &&
+                H5Olink(g, s->file, name, H5P_DEFAULT, H5P_DEFAULT) < 0)
+                sx_h5_fail_h5(&h, "cannot add a snapshot");
             sx_h5_close(g);
         }
         hist_stage(&h, s, x, nh, p);
-        /* 1. the data on disk before anything says it is complete */
+        /* 2. the link and the rows on disk before anything says they are
+         * complete */
         if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
-        /* 2. the XDMF that lists it, on disk under a temporary name */
+        /* 3. the XDMF that lists it, on disk under a temporary name */
         if (m && !h.failed) {
             sx_io_xmf_step(&s->x, s->base, s->count, &sn);
             if (!sx_io_xmf_compose(&s->x)) sx_h5_fail(&h, "out of memory");
             else have_tmp = sx_h5_write_temp(&h, s->xmf, s->x.out.p, s->x.out.n, tmp, sizeof tmp);
         }
-        /* 3. the counts, and at once 4. the XDMF renamed into place */
+        /* 4. the counts, and at once 5. the XDMF renamed into place */
         if (!h.failed) {
             if (m) sx_h5_attr_int(&h, s->file, "count", s->count + 1);
             hist_raise(&h, p, nh);
@@ -427,7 +442,7 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
             s->count += m ? 1 : 0;
             hist_commit(s, p, nh);
             if (have_tmp && sx_h5_rename(&h, tmp, s->xmf)) have_tmp = false;
-            /* 5. the counts durable too */
+            /* 6. the counts durable too */
             if (!sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the counts");
         } else {
             for (int k = 0; k < NKINDS; k++) s->x.kind[k].n = xat[k];
