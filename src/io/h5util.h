@@ -44,6 +44,13 @@ bool sx_h5_temp_name(const char *path, char *out, size_t len);
 hid_t sx_h5_fapl(bool latest);
 /// The file creation list of every seixo file (small chunk-index nodes).
 hid_t sx_h5_fcpl(void);
+/// The file driver that makes each flush of a file appended in place atomic
+/// (journal.c); opening a file through it first completes a killed flush.
+hid_t sx_h5_journal_driver(void);
+/// Flushes a file; with `sync` on disk too (a power failure keeps it),
+/// else only as far as a killed process keeps it (the journal's steps are
+/// not synced one by one: the flush returns in microseconds).
+bool sx_h5_flush(hid_t file, bool sync);
 /// Flushes `tmp` to disk and renames it over `path`, then syncs the folder.
 bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path);
 /// The second half of sx_h5_commit, for a `tmp` already on disk: the

@@ -18,17 +18,14 @@
  * Nothing is lost on a crash: the file is created under a temporary name
  * and renamed; each snapshot and the history rows are written, flushed and
  * synced before the `count`s of complete snapshots and rows are raised
- * (readers ignore what lies beyond them). HDF5 rewrites some metadata in
- * place (a group's header when a link is added to it, a growing dataset's
- * index) and its cache writes dirty metadata in any order, so a kill could
- * leave /snapshots' header pointing at a new header chunk not yet on disk,
- * and every snapshot with it. A snapshot is therefore written as an
- * unlinked group and synced first; only then is it linked and are the
- * history rows appended, so the long write never touches what complete
- * snapshots are reached by, and only a kill inside the short flush of the
- * link and the rows could (HDF5 orders its writes only under SWMR, which
- * cannot create groups). The XDMF is never patched in
- * place: the new one (kept in memory, so no snapshot is read back) is
+ * (readers ignore what lies beyond them). HDF5 rewrites metadata in place
+ * (a group's header when a link is added, a growing dataset's chunk
+ * index) and writes a flush's pieces in address order, a parent before
+ * its new child, so the file is written through a journal (journal.c)
+ * that makes each flush atomic: a kill leaves the file as the last
+ * completed flush left it. A snapshot is written as an unlinked group and
+ * linked once it is complete, so a failed write leaves no link behind.
+ * The XDMF is never patched in place: the new one (kept in memory, so no snapshot is read back) is
  * written and synced under a temporary name before the counts are raised,
  * and renamed over the old one right after, so it is always a complete
  * document and lists the snapshots the counts say are complete; only a
@@ -45,7 +42,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 /* A history the file holds: its complete rows and their last step. */
@@ -106,38 +102,10 @@ static char *dup_str(const char *s)
     return p;
 }
 
-/* The file's descriptor (sec2 driver), or -1. */
-static int file_fd(hid_t file)
-{
-    void *handle = NULL;
-    return H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle ? *(int *)handle : -1;
-}
-
-/* H5Fflush writes a superblock recording the end of the space allocated so
- * far, while some of that space (metadata the same flush writes later, the
- * unused end of an aggregator block) is not yet on disk: a writer killed
- * during the flush would leave a file shorter than its superblock says,
- * which HDF5 refuses to open ("truncated file"). The file is first grown to
- * that end, so it is never shorter than any superblock a flush writes (the
- * flush trims it back to what is allocated when it completes). */
-static bool flush_file(hid_t file)
-{
-    const int fd = file_fd(file);
-    hsize_t size = 0;
-    struct stat st;
-    if (fd >= 0 && H5Fget_filesize(file, &size) >= 0 && fstat(fd, &st) == 0 && (hsize_t)st.st_size < size &&
-        ftruncate(fd, (off_t)size) != 0)
-        return false;
-    return H5Fflush(file, H5F_SCOPE_LOCAL) >= 0;
-}
-
-static bool sync_file(hid_t file)
-{
-    if (!flush_file(file)) return false;
-    const int fd = file_fd(file);
-    if (fd >= 0) fsync(fd);
-    return true;
-}
+/* The file flushed as far as a killed writer keeps it (microseconds), or
+ * synced to the disk too (journal.c makes either atomic). */
+static bool flush_file(hid_t file) { return sx_h5_flush(file, false); }
+static bool sync_file(hid_t file) { return sx_h5_flush(file, true); }
 
 static void fields_text(unsigned f, char *out, size_t len)
 {

@@ -4,6 +4,7 @@
  * identically from the file, that h5dump reads the file, field selection,
  * appending (to a format-1 series too), histories growing as extendable
  * datasets, and errors. */
+#include "h5util.h"
 #include "io_scenes.h"
 
 #include <hdf5.h>
@@ -272,9 +273,9 @@ static void hset(hbuf *b, const char *name, int64_t k)
 /* The rows of /histories/<name> up to its count (asserting the layout). */
 static int64_t read_history(const char *path, const char *name, int64_t *st, double *v)
 {
-    /* the series may hold the file open: the same close degree as its writer */
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fclose_degree(fapl, H5F_CLOSE_SEMI);
+    /* the series may hold the file open: opened as its writer opens it
+     * (close degree, file driver), HDF5 shares the open file */
+    hid_t fapl = sx_h5_fapl(false);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     H5Pclose(fapl);
     ck_assert(f >= 0);
