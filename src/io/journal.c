@@ -304,7 +304,10 @@ static herr_t j_write(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, s
 static herr_t j_flush(H5FD_t *file, hid_t dxpl, hbool_t closing)
 {
     jfile *f = (jfile *)file;
-    return commit(f) < 0 || H5FDflush(f->inner, dxpl, closing) < 0 ? -1 : 0;
+    const bool synced = durable && (f->np > 0 || f->shrink);
+    if (commit(f) < 0 || H5FDflush(f->inner, dxpl, closing) < 0) return -1;
+    /* a durable flush with nothing to journal still syncs what it wrote */
+    return durable && !synced && fsync(f->fd) != 0 ? -1 : 0;
 }
 
 static herr_t j_truncate(H5FD_t *file, hid_t dxpl, hbool_t closing)
@@ -353,7 +356,5 @@ bool sx_h5_flush(hid_t file, bool sync)
     durable = sync;
     const bool ok = H5Fflush(file, H5F_SCOPE_LOCAL) >= 0;
     durable = true;
-    void *handle = NULL;
-    if (ok && sync && H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) >= 0 && handle) fsync(*(int *)handle);
     return ok;
 }

@@ -377,22 +377,20 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         if (m) {
             char name[48];
             snprintf(name, sizeof name, "/snapshots/%06lld", (long long)s->count);
-            /* 1. the snapshot written unlinked and synced: the long write
-             * dirties no object that a complete snapshot is reached by */
+            /* 1. the snapshot written unlinked, then linked (in place of a
+             * group left by a write that failed or was killed), so that a
+             * failed write leaves no link behind */
             hid_t g = H5Gcreate_anon(s->file, H5P_DEFAULT, H5P_DEFAULT);
             if (g < 0) sx_h5_fail_h5(&h, "cannot add a snapshot");
             else sx_io_frame_write(&h, g, m, s->fields, &sn);
-            if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
-            /* then linked, in place of a group left by a write that failed
-             * or was killed */
             if (!h.failed && drop_link(&h, s->file, "/snapshots", name + strlen("/snapshots/")) &&
                 H5Olink(g, s->file, name, H5P_DEFAULT, H5P_DEFAULT) < 0)
                 sx_h5_fail_h5(&h, "cannot add a snapshot");
             sx_h5_close(g);
         }
         hist_stage(&h, s, x, nh, p);
-        /* 2. the link and the rows on disk before anything says they are
-         * complete */
+        /* 2. the snapshot and the rows on disk before anything says they
+         * are complete */
         if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
         /* 3. the XDMF that lists it, on disk under a temporary name */
         if (m && !h.failed) {

@@ -624,7 +624,8 @@ int main(void)
     tcase_add_test(tc, killed_series_keeps_snapshots);
     suite_add_tcase(s, tc);
     TCase *recovery = tcase_create("recovery");
-    tcase_set_timeout(recovery, 120);
+    /* the replay's time is mostly its writer's syncs: the disk's, not the CPU's */
+    tcase_set_timeout(recovery, 900);
     tcase_add_test(recovery, killed_add_recovers);
     tcase_add_test(recovery, kill_after_every_write);
     suite_add_tcase(s, recovery);
