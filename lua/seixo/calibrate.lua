@@ -170,6 +170,8 @@ local function lab_evaluate(lab, o, material, seed)
       local r
       if t.c or t.phi then
         test.confining = o.confining
+        -- the runs already fill the cores: the series' tests in turn
+        if o.workers > 1 then test.jobs = test.jobs or 1 end
         local s = lab.series(spec, test)
         for i, x in ipairs(s.tests) do
           peaked(x, string.format("the test at confining %g Pa", o.confining[i]))
@@ -619,13 +621,18 @@ local function calibrate(lab, helpers, opts)
     if #jobs > 0 and replay then
       fail("this worker replays the calibration logged in %s, which is not finished", o.log)
     end
+    -- the log lists a batch's runs in their order (candidate, seed) whatever
+    -- order they end in, the same order on every run
+    local base, rows = #log_rows, {}
     local function record(i, rec)
       local j = jobs[i]
       cache[key_of(j.x, j.seed)] = rec
       local row = {j.candidate, j.seed, rec.status, rec.time}
       for _, v in ipairs(j.x) do row[#row + 1] = v end
       for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
-      log_rows[#log_rows + 1] = row
+      rows[i] = row
+      for k = #log_rows, base + 1, -1 do log_rows[k] = nil end
+      for k = 1, #jobs do if rows[k] then log_rows[#log_rows + 1] = rows[k] end end
       lab.write_csv(o.log, log_header(o), log_rows)
       if rec.status ~= 1 then o.print(string.format("calibrate: run failed (seed %s): %s", tostring(j.seed), rec.error)) end
     end

@@ -88,7 +88,7 @@ function pool.run(o)
   local function start(i)
     local s = stem(i)
     pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out"}))
-    running[i] = io.popen(string.format("{ %s > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"), q(s .. ".txt"),
+    running[i] = io.popen(string.format("{ ( %s ) > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"), q(s .. ".txt"),
                                         i, q(fifo)))
     count = count + 1
   end
@@ -112,7 +112,10 @@ function pool.run(o)
     end
   end)
   -- on an error (a done callback's): the jobs still running are waited for
-  for _, h in pairs(running) do h:close() end
+  for i, h in pairs(running) do
+    h:close()
+    for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(stem(i) .. ext) end
+  end
   events:close()
   os.remove(fifo)
   if not ok then error(err, 0) end
