@@ -78,7 +78,9 @@ end
 --- exit code. The job files are removed.
 function pool.run(o)
   local q = pool.quote
-  local fifo = o.prefix .. ".fifo"
+  -- the FIFO in the temporary directory, where a FIFO can be made (the
+  -- prefix may be on a file system that has none)
+  local fifo = os.tmpname()
   os.remove(fifo)
   local made = os.execute("mkfifo " .. q(fifo))
   local events = (made == true or made == 0) and io.open(fifo, "r+")
@@ -88,9 +90,10 @@ function pool.run(o)
   local function start(i)
     local s = stem(i)
     pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out"}))
-    running[i] = io.popen(string.format("{ ( %s ) > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"), q(s .. ".txt"),
-                                        i, q(fifo)))
-    count = count + 1
+    local h, why = io.popen(string.format("{ ( %s ) > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"),
+                                          q(s .. ".txt"), i, q(fifo)))
+    if not h then error("seixo.pool: cannot start a process: " .. tostring(why), 0) end
+    running[i], count = h, count + 1
   end
   local ok, err = pcall(function()
     while next_job <= #o.jobs or count > 0 do
@@ -99,7 +102,8 @@ function pool.run(o)
         next_job = next_job + 1
       end
       local line = events:read("l")
-      if not line then error("seixo.pool: the FIFO " .. fifo .. " was closed", 0) end
+      -- (a SIGINT interrupts the read: the workers, in our process group, stop too)
+      if not line then error("seixo.pool: interrupted while waiting for the jobs", 0) end
       local i, code = line:match("^(%d+) (%d+)$")
       i, code = tonumber(i), tonumber(code)
       running[i]:close()
