@@ -1372,7 +1372,8 @@ local function run_tests(spec, tests, jobs, opts)
   local calls, results = {}, {}
   for k, i in ipairs(order) do
     local o = copy(tests[i].opts)
-    o.log = opts.log == false and false or nil -- a function stays here: the worker prints, we pass it on
+    -- a log function stays here: the worker prints, and its lines are passed on
+    if opts.log == false then o.log = false else o.log = nil end
     calls[k] = {module = "seixo.lab", call = tests[i].call, args = {spec, o}}
   end
   local prefix = os.tmpname()
@@ -1381,8 +1382,8 @@ local function run_tests(spec, tests, jobs, opts)
       local t = tests[order[k]]
       for line in output:gmatch("[^\n]+") do say(opts, "%s", line) end
       if type(answer) ~= "table" then
-        error(string.format("lab.series: the test at confining %g Pa ended without a result (exit code %s)",
-                            t.opts.confining, tostring(code)), 0)
+        error(string.format("lab.series: the test at confining %g Pa ended without a result (exit code %s): %s",
+                            t.opts.confining, tostring(code), (output:sub(-300):gsub("%s+$", ""))), 0)
       end
       if not answer.ok then error(answer.error, 0) end
       results[order[k]] = answer.value
@@ -1418,6 +1419,9 @@ function lab.series(spec, opts)
   local out = opts.out
   local tests = {}
   for i, s3 in ipairs(list) do
+    if type(s3) ~= "number" or not (s3 >= 0 and s3 < math.huge) then
+      fail("lab.series: confining[%d] must be a stress >= 0 Pa (got %s)", i, tostring(s3))
+    end
     local o = copy(opts)
     o.confining = s3
     o.out = out and string.format("%s_%s%g", out, s3 > 0 and "triaxial_" or "ucs", s3 > 0 and s3 / 1e6 or 0):gsub("ucs0$", "ucs")
