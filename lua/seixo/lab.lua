@@ -1409,8 +1409,9 @@ function lab.series(spec, opts)
   if math.type(jobs) == nil or jobs ~= math.floor(jobs) or jobs < 1 or jobs == math.huge then
     fail("lab.series: jobs must be a whole number of processes >= 1 (got %s)", tostring(opts.jobs))
   end
-  -- under mpirun the ranks share each model: the tests run here, in turn
-  if seixo.ranks() > 1 then jobs = 1 end
+  -- under mpirun the ranks share each model, and under a stock lua5.4 there
+  -- is no seixo program to start: the tests run here, in turn
+  if seixo.ranks() > 1 or (jobs > 1 and not pool.can_serve()) then jobs = 1 end
   local tolerance = opts.quasi_static == true and 0.02 or opts.quasi_static
   if tolerance and (type(tolerance) ~= "number" or not (tolerance > 0 and tolerance < 1)) then
     fail("lab.series: quasi_static must be true, false or a tolerance in (0, 1) (got %s)", tostring(opts.quasi_static))

@@ -145,6 +145,19 @@ function pool.serve()
   pool.answer(e, ok and {ok = true, value = value} or {ok = false, error = tostring(value)})
 end
 
+-- Whether the running program is seixo (its `-v` says so), which the
+-- workers of pool.serve_command need: a stock lua5.4 that loaded the
+-- module is not. Asked once.
+local is_seixo
+function pool.can_serve()
+  if is_seixo == nil then
+    local h = io.popen(pool.quote(seixo.executable()) .. " -v 2>/dev/null")
+    is_seixo = h ~= nil and (h:read("a") or ""):match("^seixo ") ~= nil
+    if h then h:close() end
+  end
+  return is_seixo
+end
+
 --- The shell command of a pool.serve worker for a job file.
 function pool.serve_command(job_file)
   return string.format("SEIXO_POOL_JOB=%s %s --threads 1 -e %s", pool.quote(job_file), pool.quote(seixo.executable()),

@@ -106,6 +106,7 @@ test("seixo.pool: jobs in processes, the next started as soon as any ends; answe
   eq(back[7].x[1], 1e300)
   check(back[8] ~= back[8] and back[9] == math.huge)
   raises(function() pool.serialize({print}) end, "cannot pass between processes")
+  eq(pool.can_serve(), true) -- this is the seixo program
   local prefix = os.tmpname()
   -- two workers: job 1 long, 2 and 3 short: 3 starts when 2 ends and ends before 1
   local order, codes = {}, {}
