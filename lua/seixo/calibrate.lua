@@ -39,6 +39,7 @@
 -- in the log and only runs what the log lacks.
 
 local util = require("seixo.util")
+local pool = require("seixo.pool")
 
 local M = {}
 
@@ -118,43 +119,8 @@ end
 -- keeps, so a run read back from the log is the same run.
 local function quantize(v) return tonumber(string.format("%.10g", v)) end
 
--- --------------------------------------------------- messages and files
-
--- Tables of numbers, strings and booleans to text and back, for job files,
--- result files and MPI messages; numbers in hexadecimal, exactly.
-local function serialize(v)
-  local t = type(v)
-  if t == "number" then
-    if v ~= v then return "(0/0)" end
-    if v == math.huge then return "math.huge" end
-    if v == -math.huge then return "(-math.huge)" end
-    return math.type(v) == "integer" and string.format("%d", v) or string.format("%a", v)
-  elseif t == "string" then
-    return string.format("%q", v)
-  elseif t == "boolean" then
-    return tostring(v)
-  elseif t == "table" then
-    local parts = {}
-    for k, x in pairs(v) do parts[#parts + 1] = "[" .. serialize(k) .. "]=" .. serialize(x) end
-    return "{" .. table.concat(parts, ",") .. "}"
-  end
-  error("lab.calibrate: a " .. t .. " cannot pass between processes", 2)
-end
-
-local function deserialize(text)
-  local chunk = load("return " .. text, "=message", "t", {math = math})
-  return chunk and chunk() or nil
-end
-
-local function read_all(path)
-  local f = io.open(path, "r")
-  if not f then return nil end
-  local text = f:read("a")
-  f:close()
-  return text
-end
-
-local function quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
+-- messages and files between processes (seixo.pool)
+local serialize, deserialize, quote = pool.serialize, pool.deserialize, pool.quote
 
 -- ------------------------------------------------------ the evaluation
 
@@ -204,6 +170,8 @@ local function lab_evaluate(lab, o, material, seed)
       local r
       if t.c or t.phi then
         test.confining = o.confining
+        -- the runs already fill the cores: the series' tests in turn
+        if o.workers > 1 then test.jobs = test.jobs or 1 end
         local s = lab.series(spec, test)
         for i, x in ipairs(s.tests) do
           peaked(x, string.format("the test at confining %g Pa", o.confining[i]))
@@ -271,34 +239,23 @@ local function script_command()
   return table.concat(parts, " ")
 end
 
--- Runs jobs {x =, seed =} in processes, `workers` at a time; each writes
--- its record to a file. A process that dies without writing one is a
--- failed run.
+-- Runs jobs {x =, seed =} in processes, `workers` at a time (seixo.pool),
+-- each the script started again with SEIXO_CALIBRATE_JOB naming its job.
+-- A process that dies without answering is a failed run.
 local function run_processes(o, jobs, record)
   local command = script_command()
-  local running, next_job = {}, 1
-  local function start(i)
-    local stem = string.format("%s.job%d", o.log, i)
-    o.write_file(stem .. ".lua", serialize({log = o.log, x = jobs[i].x, seed = jobs[i].seed, result = stem .. ".out"}))
-    local h = io.popen(string.format("SEIXO_CALIBRATE_JOB=%s %s > %s 2>&1", quote(stem .. ".lua"), command,
-                                     quote(stem .. ".txt")))
-    running[#running + 1] = {i = i, h = h, stem = stem}
-  end
-  while next_job <= #jobs or #running > 0 do
-    while #running < o.workers and next_job <= #jobs do
-      start(next_job)
-      next_job = next_job + 1
-    end
-    local w = table.remove(running, 1)
-    local _, _, code = w.h:close()
-    local rec = deserialize(read_all(w.stem .. ".out") or "")
-    if type(rec) ~= "table" then
-      local tail = (read_all(w.stem .. ".txt") or ""):sub(-300):gsub("%s+$", "")
-      rec = {status = 0, time = 0, error = string.format("the worker exited with code %s: %s", tostring(code), tail)}
-    end
-    for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(w.stem .. ext) end
-    record(w.i, rec)
-  end
+  local files = {}
+  for i, j in ipairs(jobs) do files[i] = {log = o.log, x = j.x, seed = j.seed} end
+  pool.run{jobs = files, workers = o.workers, prefix = o.log,
+           command = function(job_file) return string.format("SEIXO_CALIBRATE_JOB=%s %s", quote(job_file), command) end,
+           done = function(i, rec, output, code)
+             if type(rec) ~= "table" then
+               local tail = output:sub(-300):gsub("%s+$", "")
+               rec = {status = 0, time = 0, error = string.format("the worker exited with code %s: %s", tostring(code),
+                                                                  tail)}
+             end
+             record(i, rec)
+           end}
 end
 
 -- Runs jobs over the MPI ranks: rank 0 hands each idle rank a job, runs
@@ -629,17 +586,17 @@ end
 
 local function calibrate(lab, helpers, opts)
   local o = check_options(lab, opts)
-  o.gnuplot, o.write_file = helpers.gnuplot, helpers.write_file
+  o.gnuplot = helpers.gnuplot
   -- over MPI ranks every rank runs specimens of its own, not one model
   -- decomposed: the models made from here on are each rank's (seixo.decompose)
   if seixo.ranks() > 1 then seixo.decompose(false) end
   if seixo.rank() > 0 then return serve_rank(o) end
 
   -- a worker process started for one run of this calibration
-  local job_file = os.getenv("SEIXO_CALIBRATE_JOB")
-  local job = job_file and deserialize(read_all(job_file) or "") or nil
+  local taken = pool.take(os.getenv("SEIXO_CALIBRATE_JOB"))
+  local job = taken and taken.job
   if job and job.log == o.log then
-    o.write_file(job.result, serialize(run_job(o, job.x, job.seed)))
+    pool.answer(taken, run_job(o, job.x, job.seed))
     os.exit(0, true)
   end
   -- (a worker for a later calibration of the script replays this one from its log)
@@ -664,13 +621,18 @@ local function calibrate(lab, helpers, opts)
     if #jobs > 0 and replay then
       fail("this worker replays the calibration logged in %s, which is not finished", o.log)
     end
+    -- the log lists a batch's runs in their order (candidate, seed) whatever
+    -- order they end in, the same order on every run
+    local base, rows = #log_rows, {}
     local function record(i, rec)
       local j = jobs[i]
       cache[key_of(j.x, j.seed)] = rec
       local row = {j.candidate, j.seed, rec.status, rec.time}
       for _, v in ipairs(j.x) do row[#row + 1] = v end
       for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
-      log_rows[#log_rows + 1] = row
+      rows[i] = row
+      for k = #log_rows, base + 1, -1 do log_rows[k] = nil end
+      for k = 1, #jobs do if rows[k] then log_rows[#log_rows + 1] = rows[k] end end
       lab.write_csv(o.log, log_header(o), log_rows)
       if rec.status ~= 1 then o.print(string.format("calibrate: run failed (seed %s): %s", tostring(j.seed), rec.error)) end
     end
@@ -807,9 +769,8 @@ local function calibrate(lab, helpers, opts)
   return result
 end
 
---- Installs lab.calibrate; lab.lua hands over its gnuplot runner, its
---- atomic file writer (the figures and files of the lab look the same) and
---- its deep copy.
+--- Installs lab.calibrate; lab.lua hands over its gnuplot runner (the
+--- figures of the lab look the same) and its deep copy.
 function M.install(lab, helpers)
   copy = helpers.copy
   lab.calibrate = function(opts) return calibrate(lab, helpers, opts) end

@@ -25,6 +25,7 @@
 -- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
 
 local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
+local pool = require "seixo.pool"
 local lab = {}
 
 local pi = math.pi
@@ -105,17 +106,8 @@ local function extents(m)
   return lo, hi
 end
 
--- Writes text to path through a temporary name in the same folder, renamed
--- when complete: an interrupted write never leaves a truncated file.
-local function write_file(path, text)
-  local tmp = string.format("%s.tmp%d", path, math.random(1, 1 << 30))
-  local f = assert(io.open(tmp, "w"))
-  local ok, err = f:write(text)
-  f:close()
-  if not ok then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(err), 2) end
-  local done, why = os.rename(tmp, path)
-  if not done then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(why), 2) end
-end
+-- Files written whole or not at all (a temporary name, renamed when complete)
+local write_file = pool.write_file
 
 --- Writes rows (arrays of numbers) under a header to a CSV file, atomically.
 function lab.write_csv(path, header, rows)
@@ -1362,29 +1354,117 @@ function lab.mohr_coulomb(points)
   return fit
 end
 
+-- The tests of a series in processes (seixo.pool), `jobs` at a time: each
+-- loads the specimen's file as it would here, so its results are the same
+-- bit for bit. The longest first (the half-rate test, then the highest
+-- confinement down: the greater the confinement, the more steps), so that
+-- the last to start is the shortest and both cores end together. Each
+-- test's log is passed on as it ends.
+local function run_tests(spec, tests, jobs, opts)
+  local order = {}
+  for i = 1, #tests do order[i] = i end
+  table.sort(order, function(a, b)
+    local ta, tb = tests[a], tests[b]
+    if ta.slow ~= tb.slow then return ta.slow == true end
+    if ta.opts.confining ~= tb.opts.confining then return ta.opts.confining > tb.opts.confining end
+    return a < b
+  end)
+  local calls, results = {}, {}
+  for k, i in ipairs(order) do
+    local o = copy(tests[i].opts)
+    -- a log function stays here: the worker prints, and its lines are passed on
+    if opts.log == false then o.log = false else o.log = nil end
+    calls[k] = {module = "seixo.lab", call = tests[i].call, args = {spec, o}}
+  end
+  local prefix = os.tmpname()
+  local ok, err = pcall(pool.run, {jobs = calls, workers = jobs, prefix = prefix, command = pool.serve_command,
+    done = function(k, answer, output, code)
+      local t = tests[order[k]]
+      for line in output:gmatch("[^\n]+") do say(opts, "%s", line) end
+      if type(answer) ~= "table" then
+        error(string.format("lab.series: the test at confining %g Pa ended without a result (exit code %s): %s",
+                            t.opts.confining, tostring(code), (output:sub(-300):gsub("%s+$", ""))), 0)
+      end
+      if not answer.ok then error(answer.error, 0) end
+      results[order[k]] = answer.value
+    end})
+  os.remove(prefix)
+  if not ok then error(err, 0) end
+  return results
+end
+
 --- A triaxial series: the tests at each confining stress (0 is a UCS), then
 --- the Mohr-Coulomb fit of their peaks, and the plots. opts as for
 --- lab.triaxial, with confining = {sigma3, ...}; opts.out is a prefix.
+--- quasi_static = true (tolerance 0.02) or a tolerance: the first test
+--- again at half the strain rate. jobs: the tests run in that many
+--- processes at once (default: the machine's cores; 1: one after another
+--- in this process), with the same results bit for bit.
 function lab.series(spec, opts)
   check_spec(spec, "series")
   opts = copy(opts or {})
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
-  local results, points = {}, {}
+  local jobs = opts.jobs or seixo.cores()
+  if math.type(jobs) == nil or jobs ~= math.floor(jobs) or jobs < 1 or jobs == math.huge then
+    fail("lab.series: jobs must be a whole number of processes >= 1 (got %s)", tostring(opts.jobs))
+  end
+  -- under mpirun the ranks share each model, and under a stock lua5.4 there
+  -- is no seixo program to start: the tests run here, in turn
+  if seixo.ranks() > 1 or (jobs > 1 and not pool.can_serve()) then jobs = 1 end
+  local tolerance = opts.quasi_static == true and 0.02 or opts.quasi_static
+  if tolerance and (type(tolerance) ~= "number" or not (tolerance > 0 and tolerance < 1)) then
+    fail("lab.series: quasi_static must be true, false or a tolerance in (0, 1) (got %s)", tostring(opts.quasi_static))
+  end
+  opts.jobs, opts.quasi_static = nil, nil
   local out = opts.out
+  local tests = {}
   for i, s3 in ipairs(list) do
+    if type(s3) ~= "number" or not (s3 >= 0 and s3 < math.huge) then
+      fail("lab.series: confining[%d] must be a stress >= 0 Pa (got %s)", i, tostring(s3))
+    end
     local o = copy(opts)
     o.confining = s3
     o.out = out and string.format("%s_%s%g", out, s3 > 0 and "triaxial_" or "ucs", s3 > 0 and s3 / 1e6 or 0):gsub("ucs0$", "ucs")
     o.plot = false
-    local r = s3 > 0 and lab.triaxial(spec, o) or lab.ucs(spec, o)
-    results[i] = r
-    points[i] = {sigma3 = s3, sigma1 = r.peak}
+    tests[i] = {call = s3 > 0 and "triaxial" or "ucs", opts = o}
   end
+  if tolerance then
+    -- the first test at half the rate: every speed of the loading-rate
+    -- control halved, and the unbalanced-force ratio it allows too (the
+    -- ratio grows with the speed); its rate as that test will take it
+    local first = tests[1]
+    local m = open_test(spec, first.opts, "series")
+    local rate = first.opts.strain_rate or default_rate(m)
+    m:close()
+    local target, max_rate = rate_control(first.opts, rate, "series")
+    local o = copy(first.opts)
+    o.strain_rate, o.max_rate, o.target_ratio = rate / 2, target and max_rate / 2 or nil, target and target / 2
+    o.out = o.out and o.out .. "_half_rate"
+    tests[#tests + 1] = {call = first.call, opts = o, slow = true}
+  end
+  jobs = math.min(jobs, #tests)
+  local results
+  if jobs > 1 then
+    results = run_tests(spec, tests, jobs, opts)
+  else
+    results = {}
+    for i, t in ipairs(tests) do results[i] = lab[t.call](spec, t.opts) end
+  end
+  local points = {}
+  for i, s3 in ipairs(list) do points[i] = {sigma3 = s3, sigma1 = results[i].peak} end
   local fit = lab.mohr_coulomb(points)
   say(opts, "lab.series: Mohr-Coulomb c %.4g MPa, phi %.2f deg (UCS of the fit %.4g MPa, R^2 %.4f, rms %.3g MPa)",
       fit.c / 1e6, fit.phi, fit.intercept / 1e6, fit.r2, fit.rms / 1e6)
-  local s = {tests = results, fit = fit}
+  local s = {tests = {table.unpack(results, 1, #list)}, fit = fit, jobs = jobs}
+  if tolerance then
+    local slow, fast = results[#tests], results[1]
+    local change = math.abs(slow.peak / fast.peak - 1)
+    s.quasi_static = {test = slow, change = change, tolerance = tolerance, ok = change <= tolerance}
+    say(opts, "lab.series: quasi-static check: peak %.4g MPa, %.4g MPa at half the rate: %.2f %% apart (tolerance "
+        .. "%.3g %%)%s", fast.peak / 1e6, slow.peak / 1e6, 100 * change, 100 * tolerance,
+        change <= tolerance and "" or ": too fast, lower the strain rate")
+  end
   if out and opts.plot ~= false then plot_series(s, out) end
   return s
 end
@@ -1514,8 +1594,8 @@ set yrange [0:%.6g]
                           {key = "c", path = out .. "_cracks.png"}, {key = "m", path = out .. "_mohr.png"}})
 end
 
--- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures and atomic writes
-require("seixo.calibrate").install(lab, {gnuplot = gnuplot, write_file = write_file, copy = copy})
+-- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures
+require("seixo.calibrate").install(lab, {gnuplot = gnuplot, copy = copy})
 
 -- periodic cells, without walls (lua/seixo/periodic.lua)
 lab.periodic = require "seixo.periodic"

@@ -81,6 +81,48 @@ test("UCS and biaxial tests give finite peaks, moduli and a Mohr-Coulomb envelop
   end
 end)
 
+test("a series in processes gives the series run in turn, bit for bit, with its quasi-static check", function()
+  local lines = {}
+  local function log(line) lines[#lines + 1] = line end
+  local serial = lab.series(spec, {confining = {0, 2e6}, quasi_static = true, jobs = 1, log = false})
+  local parallel = lab.series(spec, {confining = {0, 2e6}, quasi_static = 0.5, jobs = 2, log = log})
+  eq(serial.jobs, 1)
+  eq(parallel.jobs, 2)
+  local a, b = serial.tests, parallel.tests
+  a[3], b[3] = serial.quasi_static.test, parallel.quasi_static.test
+  for i, r in ipairs(a) do
+    for _, k in ipairs({"peak", "young", "poisson", "steps", "stopped", "strain_rate", "max_rate", "target_ratio"}) do
+      eq(b[i][k], r[k], string.format("test %d: %s", i, k))
+    end
+    eq(#b[i].rows, #r.rows)
+    for j, row in ipairs(r.rows) do
+      for c, v in ipairs(row) do eq(b[i].rows[j][c], v, string.format("test %d row %d column %d", i, j, c)) end
+    end
+  end
+  eq(parallel.fit.c, serial.fit.c)
+  eq(parallel.fit.phi, serial.fit.phi)
+  eq(parallel.quasi_static.change, serial.quasi_static.change)
+  eq(serial.quasi_static.tolerance, 0.02)
+  eq(parallel.quasi_static.tolerance, 0.5)
+  -- the check: the first test (the UCS) at half its rate, and half the rate control's speeds and target
+  local ucs, slow = serial.tests[1], serial.quasi_static.test
+  eq(slow.kind, "ucs")
+  eq(slow.strain_rate, ucs.strain_rate / 2)
+  eq(slow.max_rate, ucs.max_rate / 2)
+  eq(slow.target_ratio, ucs.target_ratio / 2)
+  near(serial.quasi_static.change, math.abs(slow.peak / ucs.peak - 1), 1e-15)
+  eq(serial.quasi_static.ok, serial.quasi_static.change <= 0.02)
+  -- the workers' logs come through the log function: each test's last line and the series'
+  local text = table.concat(lines, "\n")
+  check(text:find("lab.ucs: sigma3 0 MPa", 1, true) and text:find("lab.triaxial: sigma3 2 MPa", 1, true)
+        and text:find("lab.series: quasi-static check", 1, true), text)
+  -- a test that fails in its process fails the series with its message
+  raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 2, max_strain = -1, log = false}) end, "max_strain")
+  raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 0}) end, "jobs must be")
+  raises(function() lab.series(spec, {confining = {0, "2e6"}}) end, "confining[2] must be a stress")
+  raises(function() lab.series(spec, {confining = {0, 2e6}, quasi_static = 2}) end, "quasi_static must be")
+end)
+
 test("a loading far too fast is reported as not quasi-static", function()
   local r = lab.ucs(spec, {strain_rate = 400, log = false})
   check(#r.warnings > 0 and r.warnings[1]:find("quasi-static") or (r.warnings[1] or ""):find("equilibrium"),

@@ -96,4 +96,51 @@ test("read_csv reads what history_csv writes", function()
   raises(function() util.read_csv(3) end, HERE, "string expected")
 end)
 
+test("seixo.pool: jobs in processes, the next started as soon as any ends; answers, deaths and errors", function()
+  local pool = require("seixo.pool")
+  -- exact numbers both ways
+  local v = {1 / 3, -0.0, 2 ^ -1074, 7, "a'b\n", true, {x = {1e300}}, 0 / 0, math.huge}
+  local back = pool.deserialize(pool.serialize(v))
+  for i = 1, 7 do if i ~= 7 then eq(back[i], v[i]) end end
+  eq(1 / back[2], -math.huge)
+  eq(back[7].x[1], 1e300)
+  check(back[8] ~= back[8] and back[9] == math.huge)
+  raises(function() pool.serialize({print}) end, "cannot pass between processes")
+  eq(pool.can_serve(), true) -- this is the seixo program
+  local prefix = os.tmpname()
+  -- two workers: job 1 long, 2 and 3 short: 3 starts when 2 ends and ends before 1
+  local order, codes = {}, {}
+  pool.run{jobs = {{s = 1.5}, {s = 0.05}, {s = 0.05}, {s = 0, code = 3}}, workers = 2, prefix = prefix,
+           command = function(job_file)
+             local e = pool.take(job_file)
+             return string.format("sleep %g; exit %d", e.job.s, e.job.code or 0)
+           end,
+           done = function(i, answer, output, code)
+             order[#order + 1], codes[i] = i, code
+             eq(answer, nil) -- these commands answer nothing
+             eq(output, "")
+           end}
+  eq(table.concat(order, " "), "2 3 4 1")
+  eq(codes[4], 3)
+  eq(codes[1], 0)
+  -- seixo workers calling a module's function: the value, or the error, comes back
+  local got = {}
+  pool.run{jobs = {{module = "seixo.util", call = "add", args = {{1, 2}, {0.5, 4}}},
+                   {module = "seixo.util", call = "add", args = {{1, 2}, "x"}}},
+           workers = 2, prefix = prefix, command = pool.serve_command,
+           done = function(i, answer) got[i] = answer end}
+  eq(got[1].ok, true)
+  T.vec_eq(got[1].value, {1.5, 6})
+  eq(got[2].ok, false)
+  check(got[2].error:find("util.add", 1, true), got[2].error)
+  -- a done callback's error comes through, after the jobs still running end; no file is left
+  raises(function()
+    pool.run{jobs = {{s = 0}, {s = 0.2}}, workers = 2, prefix = prefix, command = function() return "sleep 0" end,
+             done = function() error("stop here") end}
+  end, "stop here")
+  os.remove(prefix)
+  local left = io.popen("ls " .. pool.quote(prefix) .. ".* 2>/dev/null"):read("a")
+  eq(left, "")
+end)
+
 T.done()

@@ -1,0 +1,167 @@
+-- seixo.pool: jobs run in separate processes, a few at a time, to spread
+-- independent work over the machine's cores (lab.series's tests,
+-- lab.calibrate's runs). A process, not a thread: every job owns its
+-- models, and its results are bit for bit those it gives run in the
+-- calling process (the same file in, the same steps; numbers pass between
+-- processes exactly, in hexadecimal).
+--
+-- The parent writes each job to a file and starts a shell command that
+-- runs a seixo process on it; the worker writes its answer to the file the
+-- job names, atomically. The parent waits for whichever job ends first: each
+-- command ends by writing its job's number and exit code to a FIFO that the
+-- parent holds open for reading and writing (so it never sees its end), a
+-- plain blocking read with no polling; the next job starts at once in the
+-- freed slot, so jobs of unequal lengths keep every core busy.
+--   pool.run{jobs = {...}, workers = n, prefix = path, command = function(job_file) ... end,
+--            done = function(i, answer, output, code) ... end}
+--   -- in the worker: local e = pool.take(job_file) ... pool.answer(e, value)
+--   -- or, for a call of a module's function: seixo -e "require('seixo.pool').serve()"
+
+local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
+local pool = {}
+
+-- Tables of numbers, strings and booleans to text and back; numbers in
+-- hexadecimal, exactly.
+function pool.serialize(v)
+  local t = type(v)
+  if t == "number" then
+    if v ~= v then return "(0/0)" end
+    if v == math.huge then return "math.huge" end
+    if v == -math.huge then return "(-math.huge)" end
+    return math.type(v) == "integer" and string.format("%d", v) or string.format("%a", v)
+  elseif t == "string" then
+    return string.format("%q", v)
+  elseif t == "boolean" then
+    return tostring(v)
+  elseif t == "table" then
+    local parts = {}
+    for k, x in pairs(v) do parts[#parts + 1] = "[" .. pool.serialize(k) .. "]=" .. pool.serialize(x) end
+    return "{" .. table.concat(parts, ",") .. "}"
+  end
+  error("a " .. t .. " cannot pass between processes", 2)
+end
+
+function pool.deserialize(text)
+  local chunk = load("return " .. text, "=message", "t", {math = math})
+  return chunk and chunk() or nil
+end
+
+function pool.read_all(path)
+  local f = io.open(path, "r")
+  if not f then return nil end
+  local text = f:read("a")
+  f:close()
+  return text
+end
+
+--- A word for the shell.
+function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
+
+--- Writes text to path through a temporary name in the same folder,
+--- renamed when complete: an interrupted write never leaves a truncated
+--- file.
+function pool.write_file(path, text)
+  local tmp = string.format("%s.tmp%d", path, math.random(1, 1 << 30))
+  local f = assert(io.open(tmp, "w"))
+  local ok, err = f:write(text)
+  f:close()
+  if not ok then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(err), 2) end
+  local done, why = os.rename(tmp, path)
+  if not done then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(why), 2) end
+end
+
+--- Runs o.jobs (serializable tables) in processes, o.workers at a time:
+--- job i is written to <prefix>.job<i>.lua and o.command(that file) is a
+--- shell command running the worker (its output goes to a file). As each
+--- job ends, in the order they end, o.done(i, answer, output, code) gets
+--- what the worker answered (nil if it died first), its output and its
+--- exit code. The job files are removed.
+function pool.run(o)
+  local q = pool.quote
+  -- the FIFO in the temporary directory, where a FIFO can be made (the
+  -- prefix may be on a file system that has none)
+  local fifo = os.tmpname()
+  os.remove(fifo)
+  local made = os.execute("mkfifo " .. q(fifo))
+  local events = (made == true or made == 0) and io.open(fifo, "r+")
+  if not events then error("seixo.pool: cannot make the FIFO " .. fifo .. " (mkfifo)", 2) end
+  local running, count, next_job = {}, 0, 1
+  local function stem(i) return string.format("%s.job%d", o.prefix, i) end
+  local function start(i)
+    local s = stem(i)
+    pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out"}))
+    local h, why = io.popen(string.format("{ ( %s ) > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"),
+                                          q(s .. ".txt"), i, q(fifo)))
+    if not h then error("seixo.pool: cannot start a process: " .. tostring(why), 0) end
+    running[i], count = h, count + 1
+  end
+  local ok, err = pcall(function()
+    while next_job <= #o.jobs or count > 0 do
+      while count < o.workers and next_job <= #o.jobs do
+        start(next_job)
+        next_job = next_job + 1
+      end
+      local line = events:read("l")
+      -- (a SIGINT interrupts the read: the workers, in our process group, stop too)
+      if not line then error("seixo.pool: interrupted while waiting for the jobs", 0) end
+      local i, code = line:match("^(%d+) (%d+)$")
+      i, code = tonumber(i), tonumber(code)
+      running[i]:close()
+      running[i], count = nil, count - 1
+      local s = stem(i)
+      local answer = pool.deserialize(pool.read_all(s .. ".out") or "")
+      local output = pool.read_all(s .. ".txt") or ""
+      for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(s .. ext) end
+      o.done(i, answer, output, code)
+    end
+  end)
+  -- on an error (a done callback's): the jobs still running are waited for
+  for i, h in pairs(running) do
+    h:close()
+    for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(stem(i) .. ext) end
+  end
+  events:close()
+  os.remove(fifo)
+  if not ok then error(err, 0) end
+end
+
+--- In a worker: the job in the file (nil if none), to pass to pool.answer.
+function pool.take(path)
+  local e = path and pool.deserialize(pool.read_all(path) or "")
+  return type(e) == "table" and e or nil
+end
+
+--- In a worker: the answer to the job taken.
+function pool.answer(e, value) pool.write_file(e.answer, pool.serialize(value)) end
+
+--- A worker for a call: the job in $SEIXO_POOL_JOB is {module =, call =,
+--- args = {...}}; answers {ok = true, value = require(module)[call](args...)}
+--- or {ok = false, error = message}.
+function pool.serve()
+  local e = pool.take(os.getenv("SEIXO_POOL_JOB"))
+  if not e then error("seixo.pool: no job in $SEIXO_POOL_JOB", 0) end
+  local j = e.job
+  local ok, value = pcall(function() return require(j.module)[j.call](table.unpack(j.args)) end)
+  pool.answer(e, ok and {ok = true, value = value} or {ok = false, error = tostring(value)})
+end
+
+-- Whether the running program is seixo (its `-v` says so), which the
+-- workers of pool.serve_command need: a stock lua5.4 that loaded the
+-- module is not. Asked once.
+local is_seixo
+function pool.can_serve()
+  if is_seixo == nil then
+    local h = io.popen(pool.quote(seixo.executable()) .. " -v 2>/dev/null")
+    is_seixo = h ~= nil and (h:read("a") or ""):match("^seixo ") ~= nil
+    if h then h:close() end
+  end
+  return is_seixo
+end
+
+--- The shell command of a pool.serve worker for a job file.
+function pool.serve_command(job_file)
+  return string.format("SEIXO_POOL_JOB=%s %s --threads 1 -e %s", pool.quote(job_file), pool.quote(seixo.executable()),
+                       pool.quote("require('seixo.pool').serve()"))
+end
+
+return pool
