@@ -1,6 +1,7 @@
 /* What the clumps' files share, inside the core (clumps.h describes the
  * store; clump_math.h has the rotations):
  *   clump_store.c           the store's memory; a restore's sizes and checks; the hash
+ *   clump_mass.c            a template's mass properties
  *   clumps.c                the bodies: add, remove, read and set
  * and the step, once per dimension, in kernels/clump_motion.c. */
 #pragma once
@@ -16,3 +17,15 @@ sx_status sx__clump_template_reserve(sx_model *m, int64_t n);
 /* Room for one more clump of n pebbles: its row, its pebbles, its id, and
  * n more balls with their clump ids (SX_ENOMEM). The store exists. */
 sx_status sx__clump_reserve(sx_model *m, int64_t n);
+
+/* Lines per axis of a template's overlap integration (clump_mass.c): the
+ * defaults, and the range a template may ask for. At most 16 times the
+ * default's work in 3D (lines^2), 16 times its lines in 2D. */
+enum { LINES_3D = 512, LINES_2D = 65536, LINES_MIN = 16, LINES_MAX_3D = 2048, LINES_MAX_2D = 1 << 20 };
+
+/* The mass properties of template t from its pebbles (tp_pos, tp_rad) and
+ * its body-frame pebbles (tp_body), integrating the overlaps on `lines`
+ * lines per axis (0: the default); fills everything but the name and the
+ * pebble range. SX_ENOMEM, SX_EINTERRUPT (nothing kept), SX_EINVAL when
+ * the properties are degenerate. */
+sx_status sx__clump_mass_props(sx_model *m, sx_clump_tpl *t, int64_t lines);
