@@ -2,6 +2,7 @@
  * store; clump_math.h has the rotations):
  *   clump_store.c           the store's memory; a restore's sizes and checks; the hash
  *   clump_mass.c            a template's mass properties
+ *   clump_templates.c       the templates' API
  *   clumps.c                the bodies: add, remove, read and set
  * and the step, once per dimension, in kernels/clump_motion.c. */
 #pragma once
@@ -29,3 +30,6 @@ enum { LINES_3D = 512, LINES_2D = 65536, LINES_MIN = 16, LINES_MAX_3D = 2048, LI
  * pebble range. SX_ENOMEM, SX_EINTERRUPT (nothing kept), SX_EINVAL when
  * the properties are degenerate. */
 sx_status sx__clump_mass_props(sx_model *m, sx_clump_tpl *t, int64_t lines);
+
+/* Template t, or NULL with a message naming fn (SX_ENOTFOUND). */
+const sx_clump_tpl *sx__clump_template_at(const sx_model *m, int t, const char *fn);
