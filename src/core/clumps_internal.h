@@ -4,6 +4,7 @@
  *   clump_mass.c            a template's mass properties
  *   clump_templates.c       the templates' API
  *   clumps.c                the bodies: add, remove, read and set
+ *   clump_queries.c         what the other stages ask: energy, timestep, balance
  * and the step, once per dimension, in kernels/clump_motion.c. */
 #pragma once
 
