@@ -83,14 +83,7 @@ static sx_status pebbles_reserve(sx_model *m, int64_t n)
 static sx_status index_reserve(sx_model *m, int64_t need)
 {
     sx_clumps *C = m->clumps;
-    if (need <= C->index_cap) return SX_OK;
-    int64_t cap = C->index_cap * 2 > need ? C->index_cap * 2 : need + 64;
-    if (cap > INT32_MAX) return SX_ENOMEM;
-    int32_t *q = sx_alloc_resize(&m->alloc, C->index_of, (size_t)C->index_cap, (size_t)cap, sizeof *q);
-    if (!q) return SX_ENOMEM;
-    C->index_of = q;
-    C->index_cap = cap;
-    return SX_OK;
+    return sx_alloc_reserve_index(&m->alloc, &C->index_of, &C->index_cap, need) ? SX_OK : SX_ENOMEM;
 }
 
 /* The template pebble arrays to exactly cap pebbles. All three are made
