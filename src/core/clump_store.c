@@ -6,6 +6,7 @@
  * sx_clump_remove's shift of the rows, clumps.c, and the snapshot's
  * /clumps, src/io/snapshot_parts.c). */
 #include "clumps_internal.h"
+#include "state.h"
 
 #include <math.h>
 #include <string.h>
@@ -250,11 +251,8 @@ sx_status sx__clumps_finish(sx_model *m)
     next = 0;
     for (int64_t c = 0; c < C->n; c++) {
         const int64_t id = C->id[c];
-        if (id < 1 || id >= C->next_id)
-            return sx__fail(m, SX_EINVAL, "state: clump %lld has id %lld outside 1..%lld", (long long)c, (long long)id,
-                            (long long)(C->next_id - 1));
-        if (C->index_of[id] >= 0) return sx__fail(m, SX_EINVAL, "state: clump id %lld appears twice", (long long)id);
-        C->index_of[id] = (int32_t)c;
+        const sx_status st = sx__state_map_id(m, "clump", C->index_of, C->next_id, c, id);
+        if (st) return st;
         if (C->tpl_of[c] < 0 || C->tpl_of[c] >= C->ntpl || C->mat[c] >= m->nmat)
             return sx__fail(m, SX_EINVAL, "state: clump %lld has a bad template or material", (long long)id);
         const unsigned valid = d == 3 ? (SX_FIX_VEL | SX_FIX_SPIN) : (SX_FIX_VX | SX_FIX_VY | SX_FIX_WX);
