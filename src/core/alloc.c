@@ -25,3 +25,15 @@ void sx_alloc_free(sx_alloc *a, void *p, size_t n, size_t size)
     free(p);
     a->bytes -= n * size;
 }
+
+bool sx_alloc_reserve_index(sx_alloc *a, int32_t **map, int64_t *cap, int64_t need)
+{
+    if (need <= *cap) return true;
+    const int64_t n = *cap * 2 > need ? *cap * 2 : need + 64;
+    if (n > INT32_MAX) return false;
+    int32_t *q = sx_alloc_resize(a, *map, (size_t)*cap, (size_t)n, sizeof *q);
+    if (!q) return false;
+    *map = q;
+    *cap = n;
+    return true;
+}

@@ -148,14 +148,7 @@ static bool pebble(sx_model *m, int64_t i, const char *fn, const char *what)
 static sx_status grow_index(sx_model *m, int64_t need)
 {
     sx_balls *b = &m->balls;
-    if (need <= b->index_cap) return SX_OK;
-    int64_t cap = b->index_cap * 2 > need ? b->index_cap * 2 : need + 64;
-    if (cap > INT32_MAX) return SX_ENOMEM;
-    int32_t *q = sx_alloc_resize(&m->alloc, b->index_of, (size_t)b->index_cap, (size_t)cap, sizeof *q);
-    if (!q) return SX_ENOMEM;
-    b->index_of = q;
-    b->index_cap = cap;
-    return SX_OK;
+    return sx_alloc_reserve_index(&m->alloc, &b->index_of, &b->index_cap, need) ? SX_OK : SX_ENOMEM;
 }
 
 /* Finite and below 1e100 in magnitude: the step squares differences of

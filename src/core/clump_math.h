@@ -1,6 +1,6 @@
-/* Small vectors, quaternions and rotations of the clumps (clumps.c), shared
- * with their per-dimension step (kernels/clump_motion.c): static inline, so
- * each unit keeps its own copy as when they were static in clumps.c. */
+/* Small vectors, quaternions and rotations of the clumps (clumps.c and the
+ * clump_*.c files), shared with their per-dimension step
+ * (kernels/clump_motion.c): static inline, so each unit keeps its own copy. */
 #ifndef SX_CLUMP_MATH_H
 #define SX_CLUMP_MATH_H
 
@@ -120,11 +120,12 @@ static inline void sin_cos(double x, double *s, double *c)
 
 /* The drift of a torque-free body over dt (4-42 with M = 0): the symmetric
  * splitting of T = sum L_b,i^2 / (2 I_i) into rotations about the principal
- * axes (see the note at the top). Under the part T_a alone w_a = L_b,a / I_a
- * is constant and the body turns about its axis a by phi = w_a tau: the
- * orientation gains the body-axis rotation (cos phi/2, sin phi/2 e_a) on the
- * right, and L, fixed in space, turns by -phi in body coordinates. R is the
- * rotation of q at the start (the kick's). */
+ * axes (see the note atop kernels/clump_motion.c). Under the part T_a
+ * alone w_a = L_b,a / I_a is constant and the body turns about its axis a
+ * by phi = w_a tau: the orientation gains the body-axis rotation
+ * (cos phi/2, sin phi/2 e_a) on the right, and L, fixed in space, turns by
+ * -phi in body coordinates. R is the rotation of q at the start (the
+ * kick's). */
 /* One part of the splitting: the rotation about principal axis a (j, k the
  * two after it, cyclically) by the share `part` of dt. */
 static inline __attribute__((always_inline)) void rotor_part(double *Lb, double *w, double *v, const double *h, int a,

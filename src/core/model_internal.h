@@ -378,7 +378,7 @@ struct sx_model {
 
     sx_cmodel_row *cmodel;   /* the contact-model table (cmodel.c); NULL while it is empty */
     int ncmodel, cap_cmodel;
-    struct sx_clumps *clumps; /* templates and clumps (clumps.c); NULL while the model has none */
+    struct sx_clumps *clumps; /* templates and clumps (clumps.h); NULL while the model has none */
     sx_cell *cell;            /* periodic space (periodic.c); NULL while the space is not periodic */
     sx_dd *dd;                /* domain decomposition (decompose.c); NULL in a serial run */
     struct sx_joint *joints;  /* smooth joints (joints.c), in the order added */
@@ -392,7 +392,7 @@ static inline double sx__ball_damping(const sx_model *m, int64_t i)
 }
 
 /* Local (non-viscous) damping, -alpha |F| sign(v) per component (DESIGN 1):
- * the balls' law of motion (kernels.c) and the clumps' (clumps.c). */
+ * the balls' law of motion (kernels.c) and the clumps' (kernels/clump_motion.c). */
 static inline double sx__damped(double force, double vel, double alpha)
 {
     if (alpha == 0 || vel == 0) return force;
@@ -632,8 +632,9 @@ void sx__cell_free(sx_model *m);
 sx_status sx__cell_restore(sx_model *m, const sx_cell *saved);
 sx_status sx__cell_finish(sx_model *m);
 
-/* Clumps (clumps.c): the hooks of the other stages, all no-ops while
- * m->clumps is NULL (callers test it, so an unclumped scene pays nothing). */
+/* Clumps (clump_queries.c, clump_store.c, clumps.c): the hooks of the
+ * other stages, all no-ops while m->clumps is NULL (callers test it, so an
+ * unclumped scene pays nothing). */
 /* Adds the clumps' kinetic (once per body) and gravitational energy. */
 void sx__clumps_energy(const sx_model *m, sx_energy *e);
 /* The smallest critical timestep of the clumps, from their pebbles' sums of

@@ -212,6 +212,16 @@ static sx_status check_cmodels(sx_model *m)
     return SX_OK;
 }
 
+sx_status sx__state_map_id(sx_model *m, const char *kind, int32_t *index_of, int64_t next_id, int64_t i, int64_t id)
+{
+    if (id < 1 || id >= next_id)
+        return sx__fail(m, SX_EINVAL, "state: %s %lld has id %lld outside 1..%lld", kind, (long long)i, (long long)id,
+                        (long long)(next_id - 1));
+    if (index_of[id] >= 0) return sx__fail(m, SX_EINVAL, "state: %s id %lld appears twice", kind, (long long)id);
+    index_of[id] = (int32_t)i;
+    return SX_OK;
+}
+
 static sx_status check_balls(sx_model *m)
 {
     sx_balls *b = &m->balls;
@@ -220,11 +230,8 @@ static sx_status check_balls(sx_model *m)
     for (int64_t id = 0; id < b->index_cap; id++) b->index_of[id] = -1;
     for (int64_t i = 0; i < b->n; i++) {
         const int64_t id = b->id[i];
-        if (id < 1 || id >= b->next_id)
-            return sx__fail(m, SX_EINVAL, "state: ball %lld has id %lld outside 1..%lld", (long long)i, (long long)id,
-                            (long long)(b->next_id - 1));
-        if (b->index_of[id] >= 0) return sx__fail(m, SX_EINVAL, "state: ball id %lld appears twice", (long long)id);
-        b->index_of[id] = (int32_t)i;
+        const sx_status st = sx__state_map_id(m, "ball", b->index_of, b->next_id, i, id);
+        if (st) return st;
         if (b->mat[i] >= m->nmat)
             return sx__fail(m, SX_EINVAL, "state: ball %lld has material %d, there are %d", (long long)id,
                             (int)b->mat[i], m->nmat);

@@ -69,3 +69,7 @@ sx_mesh *sx__mesh_alloc(sx_model *m, int64_t nv, int64_t nt);
 /// intact-bond count and checks every index, id, kind and material
 /// reference. SX_EINVAL with a message naming the first inconsistency.
 sx_status sx__state_finish(sx_model *m);
+/// A restore's check of dense row i's stable id in a store (`kind` names
+/// it in the message: "ball", "clump"): within 1 .. next_id - 1 and not met
+/// before in index_of (every entry -1 at the start); then mapped to i.
+sx_status sx__state_map_id(sx_model *m, const char *kind, int32_t *index_of, int64_t next_id, int64_t i, int64_t id);

@@ -135,7 +135,7 @@ done:
  * pebbles in /clumps/template_pebbles), every per-clump array, and the
  * clumps' pebbles as ball ids (/clumps/pebbles; clump c owns the rows
  * first_pebble[c] .. first_pebble[c] + its template's count). The balls'
- * clump ids are derived from it on load (clumps.c). */
+ * clump ids are derived from it on load (clump_store.c). */
 
 static int clump_fields(const sx_model *m, field *f)
 {

@@ -7,7 +7,7 @@
  * over double round-off).
  *
  * Overlapping pairs are integrated numerically (line integration; see
- * clumps.c). Their reference is exact: the union of two spheres (disks)
+ * clump_mass.c). Their reference is exact: the union of two spheres (disks)
  * is symmetric about the line of centres, so every moment is a 1D
  * integral along it of the cross-section of the union, which is that of
  * one pebble on either side of the plane of the intersection circle. In

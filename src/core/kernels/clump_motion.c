@@ -1,6 +1,41 @@
-/* The clumps' step (clumps.c has the scheme: 4-46/4-48 for the centroid,
- * Euler's equations 4-42 by a kick and a split free-rotor drift), one form
- * per dimension as every kernel: d and r below are the unit's D and RD. */
+/* The clumps' step, one form per dimension as every kernel: d and r below
+ * are the unit's D and RD.
+ *
+ * After the balls' step. Translation is 4-46/4-48 with the resultant of
+ * the pebbles' forces and the clump's weight, as for a ball. Rotation
+ * integrates Euler's equations (4-42) written as
+ *     dL/dt = M (space),   dL_b/dt = L_b x w_b + M_b (body, w_b,i = L_b,i / I_i),
+ * which are 4-42 component by component in the principal frame. It is
+ * leapfrog in the same arrangement as 4-46/4-47: L at half steps, the
+ * orientation at whole steps.
+ *   kick:  L(t + dt/2) = L(t - dt/2) + M(t) dt    (4-47 for L; exact for a
+ *          moment held over the step, and in space the moment adds to L
+ *          directly, whatever the inertia);
+ *   drift: the torque-free body (4-42 with M = 0) over dt, split into its
+ *          three principal parts T = sum L_b,i^2 / (2 I_i). The part T_i
+ *          alone keeps L_b,i, so w_i, constant: its flow is the rotation of
+ *          the body about its principal axis i by w_i dt, exact. The
+ *          symmetric composition  i = 1 (dt/2), 2 (dt/2), 3 (dt), 2 (dt/2),
+ *          1 (dt/2)  is second order, time-reversible and symplectic
+ *          (Dullweber, Leimkuhler & McLachlan 1997). Axes ascend in I, so
+ *          the major axis takes the middle, whole step: of the orders tried
+ *          on a free asymmetric body this one had the smallest energy error
+ *          (9 times below the reverse order), which scales as (w dt)^2
+ *          (3e-5 at w dt = 0.1, 1.3e-6 at 0.02).
+ * Why this scheme: each sub-rotation turns the body about a body axis and
+ * so leaves L in space unchanged, so a torque-free clump keeps L (and |L|)
+ * to round-off over any number of steps; as a symplectic map its energy
+ * error stays bounded, O((w dt)^2), and does not drift, which is what long
+ * DEM runs need. Fincham's leapfrog extrapolates the half-step orientation
+ * and is not symplectic (its energy drifts slowly); Omelyan's leapfrog is
+ * stable too but needs an implicit iteration per step. Here everything is
+ * explicit: five rotations of a quaternion.
+ * Local damping acts per component of the force (space axes, as for balls)
+ * and of the moment in the principal frame, where each component drives
+ * one w_i (4-42), opposing the sign of that component of the spin. In 2D
+ * the rotation is about z with the scalar moment and Izz: 4-47 exactly.
+ * After the step every pebble is placed from its body: x + R b, v + w x r,
+ * spin w, so pebbles never drift from their clump. */
 #include "clump_math.h"
 
 /* Sets every pebble of clump c from its body: position x + R s b,

@@ -19,8 +19,8 @@ static inline void image_shift(const double (*h)[3], const int8_t *s, double *ou
 
 /* Brings every free ball into the cell (sx__cell_wrap); wrap (3 per
  * ball) records how many cell vectors each moved by, for the history of
- * the pairs. Pebbles move with their clump (clumps.c places them from
- * its centroid), so a clump is wrapped as a body. */
+ * the pairs. Pebbles move with their clump (clump_motion.c places them
+ * from its centroid), so a clump is wrapped as a body. */
 static void wrap_balls(sx_model *m, int32_t *wrap)
 {
     sx_balls *B = &m->balls;

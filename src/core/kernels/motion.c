@@ -49,7 +49,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
      * the squares overflow; the search below tells) */
     double check = 0;
     for (int64_t i = o->b0; i < o->b1; i++) {
-        if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clumps.c) */
+        if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clump_motion.c) */
         const unsigned fix = plain ? 0 : fixa[i];
         const double a = plain ? 0 : sx__ball_damping(m, i), im = ima[i], ii = iia[i];
         double *v = va + i * D, *x = xa + i * D;

@@ -119,7 +119,7 @@ static double KERNEL(critical_dt)(sx_model *m)
         }
         const double ktr = kt[i] > kn + ks ? kt[i] : kn + ks;
         const double krot = kr[i] > ks * r * r ? kr[i] : ks * r * r;
-        if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clumps.c) */
+        if (B->clump && B->clump[i]) { /* clumps: the body is rated from its pebbles' sums (clump_queries.c) */
             kt[i] = ktr, kr[i] = krot;
             continue;
         }
