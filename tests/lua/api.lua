@@ -2,54 +2,8 @@
 --   build/seixo tests/lua/api.lua
 -- Prints "N passed, M failed" and exits non-zero on any failure.
 
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = pcall(fn)
-  if ok then
-    passed = passed + 1
-  else
-    failed = failed + 1
-    io.stderr:write("FAIL ", name, ": ", tostring(err), "\n")
-  end
-end
-
-local function check(cond, msg)
-  if not cond then error(msg or "check failed", 2) end
-end
-
-local function eq(a, b, context)
-  if a ~= b then
-    error(string.format("expected %s, got %s%s", tostring(b), tostring(a), context and " (" .. context .. ")" or ""), 2)
-  end
-end
-
--- |a - b| <= rel * |b| (or <= rel when b is 0)
-local function near(a, b, rel)
-  local tol = rel * (b == 0 and 1 or math.abs(b))
-  if not (math.abs(a - b) <= tol) then
-    error(string.format("expected %.17g, got %.17g (tolerance %g)", b, a, tol), 2)
-  end
-end
-
-local function vec_eq(v, w)
-  check(type(v) == "table", "expected a vector, got " .. type(v))
-  eq(#v, #w)
-  for k = 1, #w do eq(v[k], w[k]) end
-end
-
--- fn must fail with a message containing every given fragment
-local function raises(fn, ...)
-  local ok, err = pcall(fn)
-  if ok then error("expected an error", 2) end
-  err = tostring(err)
-  for _, fragment in ipairs({...}) do
-    if not err:find(fragment, 1, true) then
-      error(string.format("error %q lacks %q", err, fragment), 2)
-    end
-  end
-  return err
-end
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, vec_eq, raises = T.test, T.check, T.eq, T.near, T.vec_eq, T.raises
 
 local HERE = "api.lua:"  -- errors must carry the script position
 
@@ -786,5 +740,4 @@ test("an empty model gives errors, not crashes", function()
   eq(status, 0, out)
 end)
 
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.done()
