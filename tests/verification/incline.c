@@ -37,19 +37,11 @@ typedef struct incline_result {
 static incline_result run_incline(int dim, double tan_theta, int expect_roll)
 {
     const double theta = atan(tan_theta), phi = 0.7;
+    const double kb = dim == 3 ? 1e6 : 1e8, kw = 4 * kb;
+    int mat;
+    sx_model *m = v_ball_model(dim, G, RHO, kb, MU_BALL, &mat);
     double g[3] = {0, 0, 0};
     g[dim - 1] = -G;
-    sx_model_def def = sx_model_default_def();
-    def.dim = dim;
-    for (int k = 0; k < 3; k++) def.gravity[k] = g[k];
-    char err[256];
-    sx_model *m = sx_model_create(&def, err, sizeof err);
-    ck_assert_msg(m != NULL, "%s", err);
-    const double kb = dim == 3 ? 1e6 : 1e8, kw = 4 * kb;
-    sx_material_def md = sx_material_default_def();
-    md.density = RHO, md.kn = md.ks = kb, md.friction = MU_BALL;
-    md.viscous_normal = 0.3, md.viscous_shear = 0.3;
-    const int mat = scene_material_def(m, "ball", &md);
     double n[3] = {0, 0, 0};
     if (dim == 3)
         n[0] = sin(theta) * cos(phi), n[1] = sin(theta) * sin(phi), n[2] = cos(theta);

@@ -34,21 +34,11 @@ static const double R = 0.01, RHO = 2650, G = 9.81, MU_BALL = 0.3, MU_WALL = 0.5
 
 static void check_rolling(int dim)
 {
-    double g[3] = {0, 0, 0};
-    g[dim - 1] = -G;
-    sx_model_def def = sx_model_default_def();
-    def.dim = dim;
-    for (int k = 0; k < 3; k++) def.gravity[k] = g[k];
-    char err[256];
-    sx_model *m = sx_model_create(&def, err, sizeof err);
-    ck_assert_msg(m != NULL, "%s", err);
     /* 2D disks are ~75 times heavier than 3D spheres of the same radius: scale
      * the stiffness so that the overlap stays ~1e-5 R in both */
     const double kb = dim == 3 ? 1e6 : 1e8, kw = 4 * kb;
-    sx_material_def md = sx_material_default_def();
-    md.density = RHO, md.kn = md.ks = kb, md.friction = MU_BALL;
-    md.viscous_normal = 0.3, md.viscous_shear = 0.3;
-    const int mat = scene_material_def(m, "ball", &md);
+    int mat;
+    sx_model *m = v_ball_model(dim, G, RHO, kb, MU_BALL, &mat);
     double p0[3] = {0, 0, 0}, n[3] = {0, 0, 0};
     n[dim - 1] = 1;
     scene_halfspace(m, p0, n, kw, kw, MU_WALL);

@@ -34,6 +34,25 @@ static inline void v_unit(double *a, int d)
         if (!(cond)) ck_abort_msg(__VA_ARGS__);                                                                        \
     } while (0)
 
+/* A model of dimension dim under gravity g along -axis dim, with the
+ * damped material "ball" (density rho, normal and shear stiffness kb,
+ * friction mu) whose index goes to *mat: the start of the ball-on-a-wall
+ * scenes. */
+static inline sx_model *v_ball_model(int dim, double g, double rho, double kb, double mu, int *mat)
+{
+    sx_model_def def = sx_model_default_def();
+    def.dim = dim;
+    for (int k = 0; k < 3; k++) def.gravity[k] = k == dim - 1 ? -g : 0;
+    char err[256];
+    sx_model *m = sx_model_create(&def, err, sizeof err);
+    ck_assert_msg(m != NULL, "%s", err);
+    sx_material_def md = sx_material_default_def();
+    md.density = rho, md.kn = md.ks = kb, md.friction = mu;
+    md.viscous_normal = 0.3, md.viscous_shear = 0.3;
+    *mat = scene_material_def(m, "ball", &md);
+    return m;
+}
+
 /* A ball vector field (asserts success). */
 static inline void v_get(const sx_model *m, int64_t id, sx_ball_vec which, double out[3])
 {
