@@ -1603,7 +1603,9 @@ lab.periodic = require "seixo.periodic"
 -- Errors point at the caller's line, not into this file: what fails inside
 -- an exported function is raised again from its caller's position (the
 -- helpers above raise at a fixed level, which is the caller's only for
--- some call paths). One wrapper here keeps every function honest.
+-- some call paths). One wrapper here keeps every function honest; an
+-- error raised in another of seixo's modules that lab calls counts as lab's.
+local own = {lab = true, pool = true, calibrate = true, periodic = true, plot = true, util = true}
 local function at_caller(f)
   return function(...)
     local r = table.pack(pcall(f, ...))
@@ -1613,8 +1615,8 @@ local function at_caller(f)
     local caller = debug.getinfo(2, "Sl")
     local here = caller and caller.currentline > 0 and (caller.short_src .. ":" .. caller.currentline .. ": ")
     if here and e:sub(1, #here) == here then error(e, 0) end -- already the caller's
-    local inner = e:match("^[^\n]-lab%.lua:%d+: (.*)$")
-    if inner then error(inner, 2) end
+    local module, inner = e:match("^[^\n]-seixo/([%w_]+)%.lua:%d+: (.*)$")
+    if inner and own[module] then error(inner, 2) end
     if e:match("^[^\n:]+:%d+: ") then error(e, 0) end -- another file's (a user's callback)
     error(e, 2) -- no position (a helper's level fell on a tail call)
   end

@@ -61,13 +61,15 @@ function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
 --- renamed when complete: an interrupted write never leaves a truncated
 --- file.
 function pool.write_file(path, text)
+  if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
   local tmp = string.format("%s.tmp%d", path, math.random(1, 1 << 30))
-  local f = assert(io.open(tmp, "w"))
+  local f, opened = io.open(tmp, "w")
+  if not f then error("cannot write " .. path .. ": " .. tostring(opened), 2) end
   local ok, err = f:write(text)
   f:close()
-  if not ok then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(err), 2) end
+  if not ok then os.remove(tmp); error("cannot write " .. path .. ": " .. tostring(err), 2) end
   local done, why = os.rename(tmp, path)
-  if not done then os.remove(tmp); error("lab: cannot write " .. path .. ": " .. tostring(why), 2) end
+  if not done then os.remove(tmp); error("cannot write " .. path .. ": " .. tostring(why), 2) end
 end
 
 --- Runs o.jobs (serializable tables) in processes, o.workers at a time:
