@@ -8,10 +8,14 @@
 -- joints.direct_tension of the rectangle, lab.brazilian of both disks (its
 -- peak and joints.split_strength). Appends each run to
 -- outdir/fj_ratio_runs.csv; "table" writes the means and sample standard
--- deviations of the runs in that file to outdir/fj_ratio.csv.
+-- deviations of the runs in that file to outdir/fj_ratio.csv. With
+-- FJR_QUICK set in the environment, the UCS and direct tension only, to
+-- fj_ratio_quick_runs.csv (table: fj_ratio_quick.csv).
 local lab = require("seixo.lab")
 local joints = require("seixo.joints")
 local dir = (arg and arg[1] or ".") .. "/"
+local quick = os.getenv("FJR_QUICK") ~= nil
+local file = quick and "fj_ratio_quick" or "fj_ratio"
 local RMIN = 0.2e-3
 
 -- name -> {label, model, bond (joints.rock's overrides), gap (installation gap / rmin)}
@@ -35,6 +39,7 @@ local header = {"kind", "seed", "balls_rect", "faces_per_ball", "ucs_MPa", "dire
                 "ucs_over_bts10_peak", "cracks_tension_at_ucs"}
 
 local function stats(xs)
+  if #xs == 0 then return nil, nil end
   local s, n = 0, #xs
   for _, x in ipairs(xs) do s = s + x end
   local mean, v = s / n, 0
@@ -44,9 +49,9 @@ end
 
 if arg[2] == "table" then
   local by, order = {}, {}
-  for line in io.lines(dir .. "fj_ratio_runs.csv") do
+  for line in io.lines(dir .. file .. "_runs.csv") do
     local f = {}
-    for x in line:gmatch("[^,]+") do f[#f + 1] = x end
+    for x in (line .. ","):gmatch("([^,]*),") do f[#f + 1] = x end
     if f[1] ~= "kind" then
       if not by[f[1]] then by[f[1]] = {}; order[#order + 1] = f[1] end
       local row = {}
@@ -60,21 +65,20 @@ if arg[2] == "table" then
     local row = {kinds[name] and kinds[name].label or name, #runs}
     for k = 4, 13 do
       local xs = {}
-      for _, r in ipairs(runs) do xs[#xs + 1] = r[k] end
-      local m, s = stats(xs)
-      row[#row + 1], row[#row + 2] = m, s
+      for _, r in ipairs(runs) do xs[#xs + 1] = r[k] end -- (nil where a quick run has none)
+      row[2 * k - 5], row[2 * k - 4] = stats(xs)
     end
     rows[#rows + 1] = row
   end
   local h = {"specimen", "seeds"}
   for k = 4, 13 do h[#h + 1] = header[k]; h[#h + 1] = header[k] .. "_sd" end
-  lab.write_csv(dir .. "fj_ratio.csv", h, rows)
+  lab.write_csv(dir .. file .. ".csv", h, rows)
   return
 end
 
 local seeds = {}
 for s in (arg[2] or "1"):gmatch("%d+") do seeds[#seeds + 1] = tonumber(s) end
-local path = dir .. "fj_ratio_runs.csv"
+local path = dir .. file .. "_runs.csv"
 local fresh = io.open(path, "r") == nil
 local runs = io.open(path, "a")
 if fresh then runs:write(table.concat(header, ",") .. "\n") end
@@ -93,17 +97,18 @@ for i = 3, #arg do
     local ru = lab.ucs(spec, {log = false})
     local dt = joints.direct_tension(spec).peak
     local bts = {}
-    for _, d in ipairs{0.01, 0.02} do
+    for _, d in ipairs(quick and {} or {0.01, 0.02}) do
       local disk = specimen{shape = "disk", diameter = d, path = tag .. "_disk.h5"}
       local r = lab.brazilian(disk, {log = false})
       bts[#bts + 1] = r.tensile_strength
       bts[#bts + 1] = joints.split_strength(r)
       os.remove(tag .. "_disk.h5")
     end
-    local row = {name, seed, spec.balls, 2 * spec.bonds / spec.balls, ru.peak / 1e6, dt / 1e6, bts[1] / 1e6,
-                 bts[2] / 1e6, bts[3] / 1e6, bts[4] / 1e6, ru.peak / dt, ru.peak / bts[4], ru.peak / bts[1],
-                 ru.cracks.tension}
-    for j = 3, #row do row[j] = string.format("%.5g", row[j]) end
+    local function mpa(x) return x and x / 1e6 end
+    local function over(x) return x and ru.peak / x end
+    local row = {name, seed, spec.balls, 2 * spec.bonds / spec.balls, ru.peak / 1e6, dt / 1e6, mpa(bts[1]),
+                 mpa(bts[2]), mpa(bts[3]), mpa(bts[4]), ru.peak / dt, over(bts[4]), over(bts[1]), ru.cracks.tension}
+    for j = 3, #header do row[j] = row[j] and string.format("%.5g", row[j]) or "" end
     runs:write(table.concat(row, ",") .. "\n")
     runs:flush()
     print(table.concat(row, ","))
