@@ -29,7 +29,7 @@ local kinds = {
 for _, g in ipairs{0.3, 0.5, 1.0} do
   for _, phib in ipairs{1.0, 0.7, 0.5, 0.3} do
     kinds[string.format("g%g_b%g", g, phib)] = {
-      label = string.format("flat joint, installation gap %g rmin, %g %% bonded", g, 100 * phib),
+      label = string.format("flat joint, gap %g rmin, phiB %g", g, phib),
       model = "flatjoint", bond = {unbonded_fraction = 1 - phib}, gap = g}
   end
 end
@@ -40,21 +40,14 @@ local cal = {unbonded_fraction = 0.5}
 for _, key in ipairs{"tensile_strength", "tensile_strength_sd", "cohesion", "cohesion_sd"} do
   cal[key] = 1.2 * joints.rock().bond[key]
 end
-kinds.g05_b05_cal = {label = "flat joint, installation gap 0.5 rmin, 50 % bonded, strengths x 1.2",
+kinds.g05_b05_cal = {label = "flat joint, gap 0.5 rmin, phiB 0.5, strengths x 1.2",
                      model = "flatjoint", bond = cal, gap = 0.5}
 
 local header = {"kind", "seed", "balls_rect", "faces_per_ball", "ucs_MPa", "direct_tension_MPa", "bts10_peak_MPa",
                 "bts10_split_MPa", "bts20_peak_MPa", "bts20_split_MPa", "ucs_over_dt", "ucs_over_bts20_split",
                 "ucs_over_bts10_peak", "cracks_tension_at_ucs"}
 
-local function stats(xs)
-  if #xs == 0 then return nil, nil end
-  local s, n = 0, #xs
-  for _, x in ipairs(xs) do s = s + x end
-  local mean, v = s / n, 0
-  for _, x in ipairs(xs) do v = v + (x - mean) ^ 2 end
-  return mean, n > 1 and math.sqrt(v / (n - 1)) or 0
-end
+local stats = require("seixo.util").mean_sd
 
 if arg[2] == "table" then
   local by, order = {}, {}
@@ -81,7 +74,15 @@ if arg[2] == "table" then
   end
   local h = {"specimen", "seeds"}
   for k = 4, 13 do h[#h + 1] = header[k]; h[#h + 1] = header[k] .. "_sd" end
-  lab.write_csv(dir .. file .. ".csv", h, rows)
+  -- (lab.write_csv writes numbers only: the labels are quoted here)
+  local out = io.open(dir .. file .. ".csv", "w")
+  out:write(table.concat(h, ",") .. "\n")
+  for _, row in ipairs(rows) do
+    local cells = {string.format("%q", row[1])}
+    for k = 2, #h do cells[k] = row[k] and string.format("%.4g", row[k]) or "" end
+    out:write(table.concat(cells, ",") .. "\n")
+  end
+  out:close()
   return
 end
 

@@ -47,7 +47,8 @@ set style histogram errorbars gap 2 lw 1
 set key top left noenhanced
 set ylabel "UCS / tensile strength"
 set yrange [0:40]
-set bmargin 12
+set bmargin 6
+set xtics rotate by 0
 set rmargin 4
 unset label 1
 unset label 2
