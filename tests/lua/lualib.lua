@@ -32,6 +32,7 @@ test("vector arithmetic in 2D and 3D", function()
   eq(sd, math.sqrt((9 + 1 + 16) / 2))
   eq(select(2, util.mean_sd({7})), 0)
   eq(util.mean_sd({}), nil)
+  raises(function() util.mean_sd({1, "2"}) end, HERE, "element 2 is a string")
   -- arguments are never changed
   local a, b = {1, 2, 3}, {1, 1, 1}
   util.add(a, b)
