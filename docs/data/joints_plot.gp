@@ -39,3 +39,22 @@ set label 2 "parallel bond < 8" at graph 0.01, first 8.4
 plot newhistogram "", "docs/data/ucs_bts.csv" every ::1 using 8:9:xtic(1), \
      newhistogram "", "docs/data/ucs_bts_sweep.csv" every ::1 using 8:9:xtic(1), \
      15 with lines dt 2 lw 2, 8 with lines dt 3 lw 2
+set output "docs/img/fj-ratio.png"
+# docs/data/fj_ratio.lua writes fj_ratio.csv (seeds 1-3)
+set terminal pngcairo size 1200,760 font "sans,10"
+set title "UCS over tensile strength, mean and sample sd over seeds 1-3 (2D: 10 x 20 mm rectangle; disks of 10 and 20 mm; radii 0.2-0.33 mm)"
+set style histogram errorbars gap 2 lw 1
+set key top left noenhanced
+set ylabel "UCS / tensile strength"
+set yrange [0:40]
+set bmargin 6
+set xtics rotate by 0
+set rmargin 4
+unset label 1
+unset label 2
+set label 3 "target >= 15 (flat joint)" at graph 0.6, first 15.8
+set label 4 "parallel bond < 8" at graph 0.6, first 8.8
+plot "docs/data/fj_ratio.csv" every ::1 using 21:22:xtic(1) title "UCS / BTS, 10 mm disk, peak load (lab.brazilian)", \
+     "" every ::1 using 19:20 title "UCS / BTS, 20 mm disk, load at the split (joints.split_strength)", \
+     "" every ::1 using 17:18 title "UCS / direct tension (joints.direct_tension, the UCS rectangle)", \
+     15 with lines dt 2 lw 2 notitle, 8 with lines dt 3 lw 2 notitle

@@ -76,13 +76,7 @@ if only.sweep then
 end
 if not next(only) then for _, k in ipairs(kinds) do only[k.name] = k.dim ~= 3 end end
 
-local function stats(xs)
-  local s, n = 0, #xs
-  for _, x in ipairs(xs) do s = s + x end
-  local mean, v = s / n, 0
-  for _, x in ipairs(xs) do v = v + (x - mean) ^ 2 end
-  return mean, n > 1 and math.sqrt(v / (n - 1)) or 0
-end
+local stats = require("seixo.util").mean_sd
 
 local runs = io.open(dir .. "ucs_bts_runs.csv", "a")
 local measured = {} -- mean UCS (MPa) of each kind run

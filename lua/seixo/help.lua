@@ -250,6 +250,7 @@ local entries = {
   ["util.dist"] = {"util.dist(a, b)", "|a - b|"},
   ["util.normalize"] = {"util.normalize(a)", "a / |a|"},
   ["util.lerp"] = {"util.lerp(a, b, t)", "a + t (b - a)"},
+  ["util.mean_sd"] = {"util.mean_sd(xs) -> mean, sd", "the mean and sample standard deviation of a list of numbers"},
   ["util.show"] = {"util.show(v[, depth[, limit]]) -> text", "A readable text of any value: tables to depth levels (4), each cut after limit entries (none); the REPL prints tables with it."},
   ["util.print"] = {"util.print(...)", "Prints values with util.show."},
   ["util.read_csv"] = {"util.read_csv(path) -> {header, columns, rows}", "Reads a CSV written by m:history_csv."},

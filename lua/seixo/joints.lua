@@ -19,6 +19,12 @@ local function merge(base, over)
   return t
 end
 
+local function check_keys(fn, opts, keys)
+  for k in pairs(opts) do
+    if not keys[k] then error(string.format("joints.%s: unknown option '%s'", fn, tostring(k)), 3) end
+  end
+end
+
 --- Flat-joint micro-parameters of a granite-like rock, with overrides: the
 --- grains' stiffness of lab.rock, faces of radius min(RA, RB) cut into 4
 --- segments (2D) or 2 rings x 4 sectors (3D), elements much stronger in
@@ -71,16 +77,101 @@ function joints.compare(opts)
   return res
 end
 
+-- ------------------------------------------------------ tensile strength
+
+--- The direct tension test of a bonded specimen (a 2D rect, a 3D cylinder
+--- or prism, loading axis y in 2D and z in 3D): the balls within an eighth
+--- of the height of either end are grips, fixed and pulled apart at
+--- `strain_rate` (default lab's, 7e-8 of strain a step); the stress is the
+--- pull of the specimen on the top grip over its section (2D: width x 1).
+--- Stops when the stress falls below `post_peak` (default 0.5) times its
+--- peak after a bond broke, or at max_steps (default 400,000). opts:
+--- strain_rate, post_peak, every (steps a record, default 50), max_steps,
+--- log. Returns {peak (Pa), strain_at_peak, cracks = {tension, shear} at
+--- the peak, rows = {{strain, stress, pull of the bottom grip over the
+--- section}, ...}, stopped}.
+function joints.direct_tension(spec, opts)
+  opts = opts or {}
+  check_keys("direct_tension", opts, {strain_rate = true, post_peak = true, every = true, max_steps = true, log = true})
+  local dim = spec.dim
+  if not (dim == 2 and spec.shape == "rect" or dim == 3 and (spec.shape == "cylinder" or spec.shape == "prism")) then
+    error("joints.direct_tension: a 2D rect or a 3D cylinder or prism specimen", 2)
+  end
+  local m = seixo.load(spec.path)
+  local ax = dim
+  local lo, hi = spec.lo[ax], spec.hi[ax]
+  local h = hi - lo
+  local area = spec.hi[1] - spec.lo[1]
+  if dim == 3 then
+    area = spec.shape == "cylinder" and math.pi / 4 * area ^ 2 or area * (spec.hi[2] - spec.lo[2])
+  end
+  local rate = opts.strain_rate or 7e-8 / m:timestep()
+  local top, bottom = {}, {}
+  for b in m:balls() do
+    local y = b.pos[ax]
+    if y > hi - h / 8 then top[#top + 1] = b elseif y < lo + h / 8 then bottom[#bottom + 1] = b end
+  end
+  local function pull(grip, v)
+    for _, b in ipairs(grip) do
+      b.fix = "all"
+      local vel = dim == 3 and {0, 0, 0} or {0, 0}
+      vel[ax] = v
+      b.vel = vel
+    end
+  end
+  pull(top, 0.5 * rate * h)
+  pull(bottom, -0.5 * rate * h)
+  local every, post_peak, max_steps = opts.every or 50, opts.post_peak or 0.5, opts.max_steps or 400000
+  local y0 = top[1].pos[ax] - bottom[1].pos[ax]
+  local t0, s0 = m:crack_count("tension"), m:crack_count("shear")
+  local rows, peak, at, stopped = {}, 0, nil, "max_steps"
+  local steps = 0
+  while steps < max_steps do
+    m:cycle(every)
+    steps = steps + every
+    local ft, fb = 0, 0
+    for _, b in ipairs(top) do ft = ft - b.force[ax] end
+    for _, b in ipairs(bottom) do fb = fb + b.force[ax] end
+    local strain = (top[1].pos[ax] - bottom[1].pos[ax] - y0) / h
+    rows[#rows + 1] = {strain, ft / area, fb / area}
+    if ft / area > peak then
+      peak, at = ft / area, #rows
+      rows[at].cracks = {tension = m:crack_count("tension") - t0, shear = m:crack_count("shear") - s0}
+    end
+    if ft / area < post_peak * peak and m:crack_count() > t0 + s0 then stopped = "post_peak"; break end
+  end
+  m:close()
+  if not at then error("joints.direct_tension: the specimen never carried a pull", 2) end
+  if opts.log then
+    opts.log(string.format("joints.direct_tension: peak %.4g MPa at strain %.3g, cracks %d tension / %d shear (%s)",
+                           peak / 1e6, rows[at][1], rows[at].cracks.tension, rows[at].cracks.shear, stopped))
+  end
+  return {peak = peak, strain_at_peak = rows[at][1], cracks = rows[at].cracks, rows = rows, stopped = stopped}
+end
+
+--- The splitting strength of a Brazilian test (lab.brazilian's result r):
+--- the tensile stress 2 F / (pi D t) at the first fall of the load by
+--- `drop` (default 0.1) of its running maximum -- the disk's split, the
+--- load a laboratory records -- or r's peak when the load never fell so.
+--- A flat-jointed disk split in two goes on carrying load, its halves in
+--- compression, to a later peak well above the split (docs/joints.md).
+function joints.split_strength(r, drop)
+  drop = drop or 0.1
+  local col
+  for k, name in ipairs(r.columns) do if name == "tensile_stress" then col = k end end
+  local best = -math.huge
+  for _, row in ipairs(r.rows) do
+    local s = row[col]
+    if s < (1 - drop) * best then return best end
+    if s > best then best = s end
+  end
+  return r.tensile_strength
+end
+
 -- ------------------------------------------------------ jointed rock
 
 local joint_keys = {angle = true, path = true, point = true, kn = true, ks = true, friction = true, dilation = true,
                     tension = true, cohesion = true, friction_angle = true, radius_multiplier = true}
-
-local function check_keys(fn, opts, keys)
-  for k in pairs(opts) do
-    if not keys[k] then error(string.format("joints.%s: unknown option '%s'", fn, tostring(k)), 3) end
-  end
-end
 
 -- The joint's parameters from opts, its stiffnesses by default the
 -- specimen's bonds' (4-51, 4-52 at the mean pair: kn = Ec / (rmin + rmax)).

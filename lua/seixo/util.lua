@@ -120,6 +120,23 @@ function util.lerp(a, b, t)
   return r
 end
 
+--- The mean and the sample standard deviation of the numbers in xs (sd 0
+--- for one number; nil, nil for none).
+function util.mean_sd(xs)
+  if type(xs) ~= "table" then error("bad argument 'xs' to 'util.mean_sd' (a list of numbers expected)", 2) end
+  local n, s = #xs, 0
+  if n == 0 then return nil, nil end
+  for i = 1, n do
+    if type(xs[i]) ~= "number" then
+      error(string.format("bad argument 'xs' to 'util.mean_sd' (element %d is a %s, not a number)", i, type(xs[i])), 2)
+    end
+    s = s + xs[i]
+  end
+  local mean, ss = s / n, 0
+  for _, x in ipairs(xs) do ss = ss + (x - mean) ^ 2 end
+  return mean, n > 1 and math.sqrt(ss / (n - 1)) or 0
+end
+
 ---------------------------------------------------------------- printing
 
 -- (raw access throughout: printing never runs a table's metamethods)

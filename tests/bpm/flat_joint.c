@@ -36,6 +36,7 @@
  * nothing and the joint is gone.
  */
 #include "bpm.h"
+#include "laws/flatjoint.h"
 
 enum load { TENSION, SHEAR, BENDING, HALF_TENSION, HALF_CLOSE, HALF_OPEN };
 static const char *const load_name[] = {"tension", "shear", "bending", "half slit: tension",
@@ -259,12 +260,113 @@ END_TEST
 START_TEST(face_2d) { run_load(2, (enum load)_i); }
 END_TEST
 
+/* The 3D closed part of an unbonded element (sx_law_fj_closed), exactly:
+ * a full disk of radius 1 cut by the line u.p = h against the circular
+ * segment's closed forms; the elements of a face (2 x 4 and 3 x 6) cut by
+ * one line adding up to the disk's part to rounding; a closed element's
+ * load equal to the bonded (whole) one; the load the derivative of the
+ * energy (fn = -dE/dgc, m2 = dE/day, m1 = -dE/daz). */
+static sx_law_fj_geom disk_geom(void)
+{
+    sx_law_fj_geom g;
+    sx_law_fj_element(3, 1.0, 1, 1, 0, &g);
+    return g;
+}
+
+/* gc that puts the line u.p = h (u at angle beta) through element g's gap field of slope a */
+static double gc_for(const sx_law_fj_geom *g, double a, double beta, double h)
+{
+    return a * cos(beta) * g->y + a * sin(beta) * g->z - h * a;
+}
+
+static void near(double got, double want, double tol, const char *what, double beta, double h)
+{
+    ck_assert_msg(fabs(got - want) <= tol, "%s at beta %g, h %g: %.17g, expected %.17g", what, beta, h, got, want);
+}
+
+START_TEST(closed_part_3d)
+{
+    const double pi = BPM_PI;
+    const sx_law_fj_geom disk = disk_geom();
+    int cuts = 0;
+    for (int ib = 0; ib < 13; ib++)
+        for (int ih = 0; ih < 11; ih++) {
+            const double beta = -pi + 2 * pi * ib / 13 + 0.1, h = -1.25 + 0.25 * ih + 0.01 * ib, a = 0.7;
+            const double ay = a * cos(beta), az = a * sin(beta);
+            const sx_law_fj_moments q = sx_law_fj_closed(&disk, gc_for(&disk, a, beta, h), ay, az);
+            /* the segment beyond the line, s = u.p in (h, 1): area, first and second moments */
+            double sa = 0, sm = 0, sss = 0, stt = 0;
+            if (h < 1) {
+                const double hh = h > -1 ? h : -1, w = sqrt(1 - hh * hh);
+                sa = acos(hh) - hh * w;
+                sm = 2.0 / 3.0 * w * w * w;
+                /* int s^2 2 sqrt(1 - s^2) ds and int (2/3)(1 - s^2)^(3/2) ds from hh to 1 */
+                sss = 2 * (pi / 16 - (hh * (2 * hh * hh - 1) * w / 8 + asin(hh) / 8));
+                stt = 2.0 / 3.0 * (3 * pi / 16 - (hh * (5 - 2 * hh * hh) * w / 8 + 3 * asin(hh) / 8));
+            }
+            const double ca = pi - sa, cm = -sm, css = pi / 4 - sss, ctt = pi / 4 - stt; /* the closed side */
+            const double c = cos(beta), s = sin(beta), tol = 1e-13;
+            near(q.a, ca, tol, "area", beta, h);
+            near(q.y, c * cm, tol, "y moment", beta, h);
+            near(q.z, s * cm, tol, "z moment", beta, h);
+            near(q.yy, c * c * css + s * s * ctt, tol, "yy", beta, h);
+            near(q.zz, s * s * css + c * c * ctt, tol, "zz", beta, h);
+            near(q.yz, s * c * (css - ctt), tol, "yz", beta, h);
+            cuts += h > -1 && h < 1;
+            /* the elements of faces cut by the same line add up to the disk's part */
+            const int nrs[2] = {2, 3}, nas[2] = {4, 6};
+            for (int f = 0; f < 2; f++) {
+                sx_law_fj_moments sum = {0, 0, 0, 0, 0, 0};
+                for (int e = 0; e < nrs[f] * nas[f]; e++) {
+                    sx_law_fj_geom g;
+                    sx_law_fj_element(3, 1.0, nrs[f], nas[f], e, &g);
+                    const sx_law_fj_moments p = sx_law_fj_closed(&g, gc_for(&g, a, beta, h), ay, az);
+                    sx_law_fj_add(&sum, 1, &p);
+                }
+                near(sum.a, q.a, tol, "elements' area", beta, h);
+                near(sum.y, q.y, tol, "elements' y moment", beta, h);
+                near(sum.z, q.z, tol, "elements' z moment", beta, h);
+                near(sum.yy, q.yy, tol, "elements' yy", beta, h);
+                near(sum.yz, q.yz, tol, "elements' yz", beta, h);
+                near(sum.zz, q.zz, tol, "elements' zz", beta, h);
+            }
+        }
+    ck_assert_int_ge(cuts, 80);
+    /* a closed element carries what it carries bonded; the load is the energy's derivative */
+    const double kn = 3e12;
+    for (int e = 0; e < 8; e++) {
+        sx_law_fj_geom g;
+        sx_law_fj_element(3, 1e-3, 2, 4, e, &g);
+        const double ay = 2e-3, az = -1.3e-3, closed = -5e-6; /* |a| r < 2.4e-6: closed everywhere */
+        const sx_law_fj_load w = sx_law_fj_whole(&g, kn, closed, ay, az), l = sx_law_fj_contact(3, &g, kn, closed, ay, az);
+        near(l.fn, w.fn, 1e-12 * fabs(w.fn), "closed fn", e, 0);
+        near(l.m1, w.m1, 1e-12 * fabs(w.fn) * 1e-3, "closed m1", e, 0);
+        near(l.m2, w.m2, 1e-12 * fabs(w.fn) * 1e-3, "closed m2", e, 0);
+        near(l.energy, w.energy, 1e-12 * w.energy, "closed energy", e, 0);
+        const double gc = 2e-7, d = 1e-13, dd = 1e-9; /* partly closed: the gap varies by +- 0.6e-6 over an element */
+        const sx_law_fj_load p = sx_law_fj_contact(3, &g, kn, gc, ay, az);
+        ck_assert_msg(p.fn > 0 && p.fn < sx_law_fj_contact(3, &g, kn, gc - 1e-7, ay, az).fn &&
+                          p.fn < sx_law_fj_whole(&g, kn, gc - 1e-5, ay, az).fn, "partly closed");
+        const double e_gc = (sx_law_fj_contact(3, &g, kn, gc + d, ay, az).energy -
+                             sx_law_fj_contact(3, &g, kn, gc - d, ay, az).energy) / (2 * d);
+        const double e_ay = (sx_law_fj_contact(3, &g, kn, gc, ay + dd, az).energy -
+                             sx_law_fj_contact(3, &g, kn, gc, ay - dd, az).energy) / (2 * dd);
+        const double e_az = (sx_law_fj_contact(3, &g, kn, gc, ay, az + dd).energy -
+                             sx_law_fj_contact(3, &g, kn, gc, ay, az - dd).energy) / (2 * dd);
+        near(-e_gc, p.fn, 1e-6 * p.fn, "fn = -dE/dgc", e, gc);
+        near(e_ay, p.m2, 1e-6 * fabs(p.fn) * 1e-3, "m2 = dE/day", e, gc);
+        near(-e_az, p.m1, 1e-6 * fabs(p.fn) * 1e-3, "m1 = -dE/daz", e, gc);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("flat_joint");
     TCase *tc = tcase_create("loads");
     tcase_add_loop_test(tc, face_2d, TENSION, HALF_OPEN + 1);
     tcase_add_loop_test(tc, face_3d, TENSION, HALF_OPEN + 1);
+    tcase_add_test(tc, closed_part_3d);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

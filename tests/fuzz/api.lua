@@ -275,6 +275,7 @@ E("util.cross", function() return fn(util.cross, {1, 0, 0}, {0, 1, 0}) end)
 E("util.norm", function(c) return fn(util.norm, V(c, 3, 4, 0)) end)
 E("util.normalize", function(c) return fn(util.normalize, V(c, 3, 4, 0)) end)
 E("util.lerp", function(c) return fn(util.lerp, V(c, 0, 0, 0), V(c, 1, 1, 1), 0.5) end)
+E("util.mean_sd", function() return fn(util.mean_sd, {1, 2, 4}) end)
 E("util.show", function() return fn(util.show, {1, {2, x = "y"}}, 3) end)
 E("util.print", function() return fn(util.show, {1, 2}) end) -- print's text is show's: no output flood
 E("util.read_csv", function(c)

@@ -54,5 +54,28 @@ T.test("direct shear of an unbonded joint: residual mu sigma_n", function()
   T.check(r.peak >= r.residual, "peak " .. r.peak)
 end)
 
+T.test("direct tension: the grips pull equally before the peak, the specimen breaks", function()
+  local r = joints.direct_tension(spec)
+  T.eq(r.stopped, "post_peak")
+  T.check(r.peak > 1e6, "peak " .. r.peak)
+  T.check(r.cracks.tension > 0, "tensile cracks at the peak: " .. r.cracks.tension)
+  -- quasi-static below the peak: the bottom grip's pull is the top's
+  local half
+  for _, row in ipairs(r.rows) do if not half and row[2] > 0.5 * r.peak then half = row end end
+  T.near(half[3], half[2], 0.01)
+  T.check(r.rows[#r.rows][2] < 0.5 * r.peak, "broken")
+  T.raises(function() joints.direct_tension(spec, {rate = 1}) end, "rate")
+end)
+
+T.test("the splitting strength: the load at the first fall of a tenth", function()
+  local rows = {}
+  for _, s in ipairs{1, 5, 10, 20, 17, 25, 30, 10} do rows[#rows + 1] = {0, s} end
+  local r = {columns = {"step", "tensile_stress"}, rows = rows, tensile_strength = 30}
+  T.eq(joints.split_strength(r), 20, "split at 20 (a fall of 15 %)")
+  T.eq(joints.split_strength(r, 0.2), 30, "no fall of 20 % before the peak")
+  rows[5][2] = 18.5 -- a fall of 7.5 %: not a split
+  T.eq(joints.split_strength(r), 30)
+end)
+
 os.execute("rm -rf " .. T.quote(dir))
 T.done()

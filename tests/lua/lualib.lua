@@ -27,6 +27,12 @@ test("vector arithmetic in 2D and 3D", function()
   eq(util.dist({1, 1, 1}, {3, 4, 7}), 7)
   T.vec_eq(util.normalize({0, 3, 4}), {0, 0.6, 0.8})
   T.vec_eq(util.lerp({0, 0}, {10, 20}, 0.25), {2.5, 5})
+  local mean, sd = util.mean_sd({2, 4, 9})
+  eq(mean, 5)
+  eq(sd, math.sqrt((9 + 1 + 16) / 2))
+  eq(select(2, util.mean_sd({7})), 0)
+  eq(util.mean_sd({}), nil)
+  raises(function() util.mean_sd({1, "2"}) end, HERE, "element 2 is a string")
   -- arguments are never changed
   local a, b = {1, 2, 3}, {1, 1, 1}
   util.add(a, b)

@@ -20,10 +20,9 @@
  *   normal stress  sigma(r) = -kn g(r) where bonded, or where g < 0
  *                  (unbonded: compression only), so
  *                  Fn_e = integral of sigma, the element's moment about its
- *                  centroid integral of (r - re) x n sigma (exact for a
- *                  bonded element and, in 2D, over an unbonded one's closed
- *                  part; an unbonded 3D element by Gauss points, 2 x 2 in
- *                  each of 4 x 4 sub-sectors);
+ *                  centroid integral of (r - re) x n sigma, exactly (an
+ *                  unbonded element over its closed part: 2D a segment, 3D
+ *                  an annular sector cut by a straight line);
  *   shear force    incremental, Fs_e -= ks Ae (dUs + dtheta_n n x re),
  *                  dUs the contact point's shear displacement (4-17 ...
  *                  4-20) and dtheta_n the relative twist increment (3D), so
@@ -47,7 +46,6 @@
 #include <stdbool.h>
 
 #define SX_FJ_PI 3.14159265358979323846
-#define SX_FJ_SUB 4 /* sub-sectors per direction of an unbonded 3D element */
 
 /* An element's (or sub-sector's) area, centroid and central second moments
  * in the face's axes (2D: y along the face, z = 0). */
@@ -143,6 +141,135 @@ static inline void sx_law_fj_range(int dim, const sx_law_fj_geom *g, double ay, 
         }
 }
 
+/* Raw moments of a plane region about the face's centre: its area and
+ * the integrals of y, z, y^2, yz, z^2. */
+typedef struct sx_law_fj_moments {
+    double a, y, z, yy, yz, zz;
+} sx_law_fj_moments;
+
+static inline void sx_law_fj_add(sx_law_fj_moments *q, double s, const sx_law_fj_moments *p)
+{
+    q->a += s * p->a, q->y += s * p->y, q->z += s * p->z;
+    q->yy += s * p->yy, q->yz += s * p->yz, q->zz += s * p->zz;
+}
+
+/* The circular sector 0 <= r <= R, b0 <= alpha <= b1. */
+static inline sx_law_fj_moments sx_law_fj_disk_sector(double R, double b0, double b1)
+{
+    const double r2 = R * R / 2, r3 = R * R * R / 3, r4 = R * R * R * R / 4, db = b1 - b0;
+    const double s0 = sin(b0), s1 = sin(b1), c0 = cos(b0), c1 = cos(b1), s2 = (sin(2 * b1) - sin(2 * b0)) / 4;
+    return (sx_law_fj_moments){r2 * db, r3 * (s1 - s0), r3 * (c0 - c1), r4 * (db / 2 + s2), r4 * (s1 * s1 - s0 * s0) / 2,
+                               r4 * (db / 2 - s2)};
+}
+
+/* The triangle of the centre and the points p, q (counterclockwise). */
+static inline sx_law_fj_moments sx_law_fj_triangle(double py, double pz, double qy, double qz)
+{
+    const double a = 0.5 * (py * qz - qy * pz);
+    return (sx_law_fj_moments){a, a * (py + qy) / 3, a * (pz + qz) / 3, a / 6 * (py * py + qy * qy + py * qy),
+                               a / 12 * (py * pz + qy * qz + (py + qy) * (pz + qz)), a / 6 * (pz * pz + qz * qz + pz * qz)};
+}
+
+/* The closed part of an annular sector (g->r0 <= r <= g->r1, g->a0 <= alpha
+ * <= g->a1) where the gap gc + ay (y - yc) + az (z - zc) < 0, exactly: it is
+ * the half-plane u.p < h (u the gradient's direction), in polar r cos(alpha
+ * - beta) < h, so between the angles where the line r = h / cos(alpha -
+ * beta) crosses the rings (or turns parallel to the rays) each radial
+ * stretch runs between two of r0, r1 and the line; a stretch [lo, hi] is
+ * the sector out to hi less the one out to lo, out to the line the triangle
+ * of the centre and the line's points. */
+static inline sx_law_fj_moments sx_law_fj_closed(const sx_law_fj_geom *g, double gc, double ay, double az)
+{
+    sx_law_fj_moments q = {0, 0, 0, 0, 0, 0};
+    const double amod = hypot(ay, az);
+    if (!(amod > 0)) {
+        if (gc < 0) sx_law_fj_add(&q, 1, &(sx_law_fj_moments){g->area, g->area * g->y, g->area * g->z,
+                                                            g->jyy + g->area * g->y * g->y, g->jyz + g->area * g->y * g->z,
+                                                            g->jzz + g->area * g->z * g->z});
+        return q;
+    }
+    const double h = (ay * g->y + az * g->z - gc) / amod, beta = atan2(az, ay);
+    /* the breaks: where the line meets r0 and r1, and beta +- 90 deg */
+    double br[16];
+    int nb = 0;
+    br[nb++] = g->a0;
+    const double ang[2] = {SX_FJ_PI / 2, -SX_FJ_PI / 2};
+    double cand[6];
+    int nc = 0;
+    cand[nc++] = beta + ang[0], cand[nc++] = beta + ang[1];
+    const double rr[2] = {g->r0, g->r1};
+    for (int i = 0; i < 2; i++)
+        if (rr[i] > 0 && fabs(h) < rr[i]) {
+            const double phi = acos(h / rr[i]);
+            cand[nc++] = beta + phi, cand[nc++] = beta - phi;
+        }
+    for (int i = 0; i < nc; i++)
+        for (int k = -2; k <= 2; k++) {
+            const double a = cand[i] + 2 * SX_FJ_PI * k;
+            if (a > g->a0 && a < g->a1 && nb < 15) br[nb++] = a;
+        }
+    br[nb++] = g->a1;
+    for (int i = 1; i < nb; i++) /* insertion sort: a dozen at most */
+        for (int k = i; k > 0 && br[k] < br[k - 1]; k--) {
+            const double t = br[k];
+            br[k] = br[k - 1], br[k - 1] = t;
+        }
+    for (int i = 0; i + 1 < nb; i++) {
+        const double b0 = br[i], b1 = br[i + 1];
+        if (!(b1 > b0)) continue;
+        const double w = cos(0.5 * (b0 + b1) - beta);
+        /* the closed stretch of the ray: r < h/w for w > 0, r > h/w for w < 0,
+         * within [r0, r1]; its ends r0, r1 or the line */
+        bool lo_line = false, hi_line = false;
+        if (w > 0) {
+            const double L = h / w;
+            if (L <= g->r0) continue;
+            hi_line = L < g->r1;
+        } else if (h < 0) {
+            const double L = h / w;
+            if (L >= g->r1) continue;
+            lo_line = L > g->r0;
+        }
+        sx_law_fj_moments part;
+        if (hi_line || lo_line) { /* the line's points at the stretch's ends */
+            const double l0 = h / cos(b0 - beta), l1 = h / cos(b1 - beta);
+            part = sx_law_fj_triangle(l0 * cos(b0), l0 * sin(b0), l1 * cos(b1), l1 * sin(b1));
+        }
+        if (hi_line) {
+            sx_law_fj_add(&q, 1, &part);
+        } else {
+            const sx_law_fj_moments s = sx_law_fj_disk_sector(g->r1, b0, b1);
+            sx_law_fj_add(&q, 1, &s);
+        }
+        if (lo_line) {
+            sx_law_fj_add(&q, -1, &part);
+        } else if (g->r0 > 0) {
+            const sx_law_fj_moments s = sx_law_fj_disk_sector(g->r0, b0, b1);
+            sx_law_fj_add(&q, -1, &s);
+        }
+    }
+    return q;
+}
+
+/* The load of the closed region q (raw moments) under the gap field gc +
+ * ay dy + az dz, (dy, dz) from the element's centroid (y, z): the moments
+ * moved to the centroid, then Fn = -kn int g, m1 = -kn int g dz,
+ * m2 = kn int g dy, energy (1/2) kn int g^2. */
+static inline sx_law_fj_load sx_law_fj_integrate_at(const sx_law_fj_moments *q, double yc, double zc, double kn,
+                                                   double gc, double ay, double az)
+{
+    const double j1 = q->a, jy = q->y - yc * q->a, jz = q->z - zc * q->a;
+    const double jyy = q->yy - 2 * yc * q->y + yc * yc * q->a, jzz = q->zz - 2 * zc * q->z + zc * zc * q->a;
+    const double jyz = q->yz - yc * q->z - zc * q->y + yc * zc * q->a;
+    const double ig = gc * j1 + ay * jy + az * jz;
+    sx_law_fj_load l;
+    l.fn = -kn * ig;
+    l.m1 = -kn * (gc * jz + ay * jyz + az * jzz);
+    l.m2 = kn * (gc * jy + ay * jyy + az * jyz);
+    l.energy = 0.5 * kn * (gc * gc * j1 + 2 * gc * (ay * jy + az * jz) + ay * ay * jyy + 2 * ay * az * jyz + az * az * jzz);
+    return l;
+}
+
 /* An unbonded region: compression only, where g < 0. */
 static inline sx_law_fj_load sx_law_fj_contact(int dim, const sx_law_fj_geom *g, double kn, double gc, double ay, double az)
 {
@@ -150,8 +277,8 @@ static inline sx_law_fj_load sx_law_fj_contact(int dim, const sx_law_fj_geom *g,
     double lo, hi;
     sx_law_fj_range(dim, g, ay, az, &lo, &hi);
     if (gc + lo >= 0) return l;
+    if (gc + hi <= 0) return sx_law_fj_whole(g, kn, gc, ay, az);
     if (dim == 2) {
-        if (gc + hi <= 0) return sx_law_fj_whole(g, kn, gc, ay, az);
         /* exactly over the closed part [p, q] of the segment (centroid at 0) */
         const double h = 0.5 * g->area, root = -gc / ay;
         const double p = ay > 0 ? -h : root, q = ay > 0 ? root : h;
@@ -161,29 +288,9 @@ static inline sx_law_fj_load sx_law_fj_contact(int dim, const sx_law_fj_geom *g,
         l.energy = 0.5 * kn * (gc * gc * d1 + 2 * gc * ay * d2 + ay * ay * d3);
         return l;
     }
-    /* 3D: Gauss points, 2 x 2 in each of SUB x SUB sub-sectors (exact in r
-     * for the integrands here, r^3 at most; smooth in alpha), each a
-     * compression-only spring: the forces are the exact derivatives of the
-     * energy summed, so an unbonded element conserves energy as it opens
-     * and closes (a closed element by this rule differs from the exact one
-     * only by the rule's error in alpha) */
-    static const double gp[2] = {-0.57735026918962576, 0.57735026918962576};
-    const double dr = (g->r1 - g->r0) / SX_FJ_SUB, da = (g->a1 - g->a0) / SX_FJ_SUB;
-    for (int i = 0; i < SX_FJ_SUB; i++)
-        for (int k = 0; k < SX_FJ_SUB; k++)
-            for (int u = 0; u < 2; u++)
-                for (int v = 0; v < 2; v++) {
-                    const double r = g->r0 + dr * (i + 0.5 + 0.5 * gp[u]), a = g->a0 + da * (k + 0.5 + 0.5 * gp[v]);
-                    const double dy = r * cos(a) - g->y, dz = r * sin(a) - g->z, gq = gc + ay * dy + az * dz;
-                    if (gq >= 0) continue;
-                    const double w = 0.25 * dr * da * r, f = -kn * w * gq;
-                    /* moved to the element's centroid: + (dy t1 + dz t2) x n f */
-                    l.fn += f;
-                    l.m1 += f * dz;
-                    l.m2 -= f * dy;
-                    l.energy += 0.5 * kn * w * gq * gq;
-                }
-    return l;
+    /* 3D: the annular sector cut by the line g = 0 (sx_law_fj_closed) */
+    const sx_law_fj_moments q = sx_law_fj_closed(g, gc, ay, az);
+    return sx_law_fj_integrate_at(&q, g->y, g->z, kn, gc, ay, az);
 }
 
 /* The normal load of element e: bonded, or compression only. */
