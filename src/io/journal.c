@@ -211,15 +211,16 @@ static H5FD_t *j_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxa
     memcpy(f->journal, name, len);
     memcpy(f->journal + len, ".journal", sizeof ".journal");
     void *handle = NULL;
-    /* a new or emptied file: a journal beside its name is an older file's.
-     * Recovery runs before any call into HDF5's API, which would clear the
-     * error it reports. */
+    /* a file created or emptied: a journal beside its name is an older
+     * file's, dropped once the open succeeded (a failed one leaves the old
+     * file and its journal). Recovery runs before any call into HDF5's API,
+     * which would clear the error it reports. */
     const bool fresh = (flags & (H5F_ACC_TRUNC | H5F_ACC_EXCL)) != 0;
-    if (fresh) sx_h5_journal_drop(name);
     if (fresh || journal_recover(name, f->journal)) {
         const hid_t inner_fapl = sec2_fapl();
         if (inner_fapl >= 0) f->inner = H5FDopen(name, flags, inner_fapl, maxaddr);
         if (inner_fapl >= 0) H5Pclose(inner_fapl);
+        if (f->inner && fresh) sx_h5_journal_drop(name);
     }
     if (!f->inner || H5FDget_vfd_handle(f->inner, H5P_DEFAULT, &handle) < 0 || !handle) {
         if (f->inner) H5FDclose(f->inner);

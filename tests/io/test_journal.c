@@ -144,6 +144,17 @@ START_TEST(stale_journal_not_applied)
     char journal[600];
     snprintf(journal, sizeof journal, "%s.journal", path);
     ck_assert_int_ne(access(journal, F_OK), 0);
+    /* an exclusive create that fails (the file exists) leaves its journal */
+    write_journal(path);
+    H5FD_t *f = open_driver(path, H5F_ACC_RDWR | H5F_ACC_CREAT | H5F_ACC_EXCL);
+    ck_assert_ptr_null(f);
+    H5Eclear2(H5E_DEFAULT);
+    ck_assert_int_eq(access(journal, F_OK), 0);
+    /* a truncating create drops it */
+    f = open_driver(path, H5F_ACC_RDWR | H5F_ACC_CREAT | H5F_ACC_TRUNC);
+    ck_assert_ptr_nonnull(f);
+    ck_assert_int_ne(access(journal, F_OK), 0);
+    ck_assert_int_ge(H5FDclose(f), 0);
     io_assert_no_handles();
 }
 END_TEST
