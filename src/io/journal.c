@@ -121,9 +121,9 @@ static bool journal_apply(const char *path, const char *journal, size_t n)
     const int jfd = open(journal, O_RDONLY);
     unsigned char *b = jfd >= 0 ? malloc(n ? n : 1) : NULL;
     /* a journal that cannot be read may be complete: never drop it unread */
-    const bool read = b && (n == 0 || pread(jfd, b, n, 0) == (ssize_t)n);
+    const bool got = b && (n == 0 || pread(jfd, b, n, 0) == (ssize_t)n);
     if (jfd >= 0) close(jfd);
-    if (!read) {
+    if (!got) {
         free(b);
         push_error("%s: the journal of its last flush cannot be read", path);
         return false;
@@ -401,7 +401,11 @@ bool sx_h5_journal_drop(const char *path)
 {
     char journal[4096];
     const int n = snprintf(journal, sizeof journal, "%s.journal", path);
-    return n > 0 && (size_t)n < sizeof journal && (unlink(journal) == 0 || errno == ENOENT);
+    if (n < 0 || (size_t)n >= sizeof journal) {
+        errno = ENAMETOOLONG;
+        return false;
+    }
+    return unlink(journal) == 0 || errno == ENOENT;
 }
 
 hid_t sx_h5_journal_driver(void)
