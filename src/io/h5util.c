@@ -179,6 +179,12 @@ bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path)
         sx_h5_fail(h, "cannot flush the temporary file '%s' to disk: %s", tmp, strerror(errno));
         return false;
     }
+    /* the file replaced may have left a journal (its writer killed in a
+     * flush): applied to the new file it would damage it */
+    if (!sx_h5_journal_drop(path)) {
+        sx_h5_fail(h, "cannot remove the journal of the file '%s' replaces: %s", path, strerror(errno));
+        return false;
+    }
     return sx_h5_rename(h, tmp, path);
 }
 

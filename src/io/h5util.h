@@ -47,6 +47,9 @@ hid_t sx_h5_fcpl(void);
 /// The file driver that makes each flush of a file appended in place atomic
 /// (journal.c); opening a file through it first completes a killed flush.
 hid_t sx_h5_journal_driver(void);
+/// Removes the journal beside `path` (a file about to take that name is a
+/// new file: an older one's journal must never be applied to it).
+bool sx_h5_journal_drop(const char *path);
 /// Flushes a file; with `sync` on disk too (a power failure keeps it),
 /// else only as far as a killed process keeps it (the journal's steps are
 /// not synced one by one: the flush returns in microseconds).

@@ -20,11 +20,13 @@
  * The file itself stays a plain HDF5 file. */
 #include "h5util.h"
 
+#include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -53,6 +55,7 @@ typedef struct jfile {
     pending *p;
     size_t np, cap;
     bool shrink; /* a truncation below `committed` waits for the journal */
+    bool broken; /* a commit failed after its journal was complete */
 } jfile;
 
 /* ------------------------------------------------------------- errors */
@@ -109,21 +112,24 @@ static bool journal_write(const jfile *f, uint64_t truncate_to)
     return ok;
 }
 
-/* Applies the complete journal of `path` to it and removes the journal; an
- * incomplete one (its writer was killed while writing it: the file was not
- * touched yet) is removed. False, with HDF5's error stack told why, when
- * a complete journal cannot be applied. */
-static bool journal_recover(const char *path, const char *journal)
+/* Applies the complete journal `journal` (n bytes) to `path`, then
+ * removes it; an incomplete one (its writer was killed while writing it:
+ * the file was not touched yet) is removed. False, with HDF5's error stack
+ * told why, when a journal cannot be read or a complete one applied. */
+static bool journal_apply(const char *path, const char *journal, size_t n)
 {
-    struct stat st;
-    if (stat(journal, &st) != 0) return true;
     const int jfd = open(journal, O_RDONLY);
-    unsigned char *b = jfd >= 0 && st.st_size > 0 ? malloc((size_t)st.st_size) : NULL;
-    const size_t n = (size_t)st.st_size;
-    bool whole = b && pread(jfd, b, n, 0) == (ssize_t)n;
+    unsigned char *b = jfd >= 0 ? malloc(n ? n : 1) : NULL;
+    /* a journal that cannot be read may be complete: never drop it unread */
+    const bool got = b && (n == 0 || pread(jfd, b, n, 0) == (ssize_t)n);
     if (jfd >= 0) close(jfd);
+    if (!got) {
+        free(b);
+        push_error("%s: the journal of its last flush cannot be read", path);
+        return false;
+    }
     const size_t fixed = sizeof journal_magic + 3 * sizeof(uint64_t) + sizeof journal_end;
-    whole = whole && n >= fixed && memcmp(b, journal_magic, sizeof journal_magic) == 0 &&
+    bool whole = n >= fixed && memcmp(b, journal_magic, sizeof journal_magic) == 0 &&
             memcmp(b + n - sizeof journal_end, journal_end, sizeof journal_end) == 0;
     uint64_t h = 0, stored = 0, count = 0, truncate_to = UINT64_MAX;
     if (whole) {
@@ -162,6 +168,25 @@ static bool journal_recover(const char *path, const char *journal)
     return ok;
 }
 
+/* Completes a flush of `path` that its writer was killed in (journal.c's
+ * opening comment), unless the file is open elsewhere. */
+static bool journal_recover(const char *path, const char *journal)
+{
+    struct stat st;
+    if (stat(journal, &st) != 0) return true;
+    /* HDF5 locks a file it opens (flock, kept until it closes the file):
+     * locked, the file is open elsewhere, its journal perhaps being written
+     * by its live writer, and is left alone (HDF5 then refuses the open) */
+    const int lock = open(path, O_RDONLY);
+    if (lock >= 0 && flock(lock, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+        close(lock);
+        return true;
+    }
+    const bool ok = journal_apply(path, journal, (size_t)st.st_size);
+    if (lock >= 0) close(lock);
+    return ok;
+}
+
 /* ---------------------------------------------------------- the driver */
 
 static hid_t sec2_fapl(void)
@@ -185,11 +210,18 @@ static H5FD_t *j_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxa
     }
     memcpy(f->journal, name, len);
     memcpy(f->journal + len, ".journal", sizeof ".journal");
-    hid_t inner_fapl = sec2_fapl();
     void *handle = NULL;
-    if (journal_recover(name, f->journal) && inner_fapl >= 0)
-        f->inner = H5FDopen(name, flags, inner_fapl, maxaddr);
-    if (inner_fapl >= 0) H5Pclose(inner_fapl);
+    /* a file created or emptied: a journal beside its name is an older
+     * file's, dropped once the open succeeded (a failed one leaves the old
+     * file and its journal). Recovery runs before any call into HDF5's API,
+     * which would clear the error it reports. */
+    const bool fresh = (flags & (H5F_ACC_TRUNC | H5F_ACC_EXCL)) != 0;
+    if (fresh || journal_recover(name, f->journal)) {
+        const hid_t inner_fapl = sec2_fapl();
+        if (inner_fapl >= 0) f->inner = H5FDopen(name, flags, inner_fapl, maxaddr);
+        if (inner_fapl >= 0) H5Pclose(inner_fapl);
+        if (f->inner && fresh) sx_h5_journal_drop(name);
+    }
     if (!f->inner || H5FDget_vfd_handle(f->inner, H5P_DEFAULT, &handle) < 0 || !handle) {
         if (f->inner) H5FDclose(f->inner);
         free(f->journal);
@@ -212,16 +244,31 @@ static void drop_pending(jfile *f)
  * synced before the next only when the flush is to be durable. */
 static herr_t commit(jfile *f)
 {
-    if (f->np == 0 && !f->shrink) return 0;
+    /* the file may hold part of the journal's overwrites: only the journal
+     * on disk, applied at the next open, completes it; rewriting it now
+     * would leave a window with neither */
+    if (f->broken) {
+        push_error("%s: a flush failed half-way; the journal beside the file completes it when the file is next "
+                   "opened", f->journal);
+        return -1;
+    }
+    /* what this flush appended is the last completed flush's from now on:
+     * a later overwrite of it must be journaled too */
+    if (f->np == 0 && !f->shrink) {
+        f->committed = H5FDget_eof(f->inner, H5FD_MEM_DEFAULT);
+        return 0;
+    }
     const haddr_t eoa = H5FDget_eoa(f->inner, H5FD_MEM_DEFAULT);
     const uint64_t truncate_to = f->shrink ? (uint64_t)eoa : UINT64_MAX;
     if ((durable && fsync(f->fd) != 0) || !journal_write(f, truncate_to)) return -1;
+    f->broken = true;
     for (size_t i = 0; i < f->np; i++) {
         off_t at = (off_t)f->p[i].at;
         if (!put_all(f->fd, f->p[i].bytes, f->p[i].n, &at)) return -1;
     }
     if (f->shrink && H5FDtruncate(f->inner, H5P_DEFAULT, false) < 0) return -1;
     if ((durable && fsync(f->fd) != 0) || unlink(f->journal) != 0) return -1;
+    f->broken = false;
     drop_pending(f);
     f->shrink = false;
     f->committed = H5FDget_eof(f->inner, H5FD_MEM_DEFAULT);
@@ -244,13 +291,12 @@ static int j_cmp(const H5FD_t *a, const H5FD_t *b) { return H5FDcmp(((const jfil
 
 static herr_t j_query(const H5FD_t *file, unsigned long *flags)
 {
-    /* called without a file to learn the driver's features: sec2's */
-    if (!file) {
-        *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA | H5FD_FEAT_DATA_SIEVE |
-                 H5FD_FEAT_AGGREGATE_SMALLDATA | H5FD_FEAT_POSIX_COMPAT_HANDLE;
-        return 0;
-    }
-    return H5FDquery(((const jfile *)file)->inner, flags) < 0 ? -1 : 0;
+    (void)file;
+    /* sec2's, less SWMR: a reader in SWMR mode would read the file while
+     * its overwrites wait here */
+    *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA | H5FD_FEAT_DATA_SIEVE |
+             H5FD_FEAT_AGGREGATE_SMALLDATA | H5FD_FEAT_POSIX_COMPAT_HANDLE | H5FD_FEAT_DEFAULT_VFD_COMPATIBLE;
+    return 0;
 }
 
 static haddr_t j_get_eoa(const H5FD_t *file, H5FD_mem_t type) { return H5FDget_eoa(((const jfile *)file)->inner, type); }
@@ -288,6 +334,13 @@ static herr_t j_write(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, s
 {
     jfile *f = (jfile *)file;
     if (addr >= f->committed) return H5FDwrite(f->inner, type, dxpl, addr, size, buf);
+    /* the part beyond the committed end goes to the file now, as any write
+     * there: kept pending, it would later cover newer writes to those bytes */
+    if (size > f->committed - addr) {
+        const size_t below = (size_t)(f->committed - addr);
+        if (H5FDwrite(f->inner, type, dxpl, f->committed, size - below, (const char *)buf + below) < 0) return -1;
+        size = below;
+    }
     if (f->np == f->cap) {
         const size_t cap = f->cap ? 2 * f->cap : 64;
         pending *q = realloc(f->p, cap * sizeof *q);
@@ -343,6 +396,17 @@ static const H5FD_class_t journal_class = {
     .unlock = j_unlock,
     .fl_map = H5FD_FLMAP_DICHOTOMY,
 };
+
+bool sx_h5_journal_drop(const char *path)
+{
+    char journal[4096];
+    const int n = snprintf(journal, sizeof journal, "%s.journal", path);
+    if (n < 0 || (size_t)n >= sizeof journal) {
+        errno = ENAMETOOLONG;
+        return false;
+    }
+    return unlink(journal) == 0 || errno == ENOENT;
+}
 
 hid_t sx_h5_journal_driver(void)
 {
