@@ -51,6 +51,7 @@ void sx__dd_free(sx_model *m)
     free(d->bslot);
     free(d->peb);
     free(d->xpair);
+    free(d->gho);
     free(d->xchunk.cracks);
     free(d);
     m->dd = NULL;
@@ -65,8 +66,9 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own */
-    enum { SPANS = 10 + SX_DD_NEED };
+    /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own,
+     * gho_own */
+    enum { SPANS = 11 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL;
     if (!s) {
         free(d);
@@ -77,6 +79,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     s += (1 + SX_DD_NEED) * r;
     d->pairs = s, d->wblk = s + r, d->wrun = s + 2 * r, d->bb_own = s + 3 * r, d->bw_own = s + 4 * r;
     d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->peb_own = s + 8 * r;
+    d->gho_own = s + 9 * r;
     m->dd = d;
     return SX_OK;
 }
@@ -150,6 +153,32 @@ static void reach(sx_dd *d, int r, int64_t e)
     if (e + 1 > f->hi) f->hi = e + 1;
 }
 
+/* Periodic space: the ghosts by their owner's rank, whose copies (the
+ * state the last pass left in them: the owner's, shifted, and the force
+ * folded onto it) are the serial run's; a ghost whose owner was removed
+ * is no rank's. False: out of memory. */
+static bool plan_ghosts(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_cell *cell = m->cell;
+    const int R = d->x.ranks;
+    d->ngho = 0;
+    if (d->cap_gho < cell->n) {
+        int32_t *q = realloc(d->gho, (size_t)cell->n * sizeof *q);
+        if (!q) return false;
+        d->gho = q, d->cap_gho = cell->n;
+    }
+    for (int r = 0; r < R; r++) {
+        d->gho_own[r].lo = d->ngho;
+        for (int64_t g = 0; g < cell->n; g++) {
+            const int64_t o = cell->owner[g];
+            if (o >= d->own[r].lo && o < d->own[r].hi) d->gho[d->ngho++] = (int32_t)g;
+        }
+        d->gho_own[r].hi = d->ngho;
+    }
+    return true;
+}
+
 /* Periodic space: a ghost's force is added to its owner after the pass
  * (kernels/ghosts.c, fold_ghosts), so the rank of a ball evaluates every
  * pair whose b is an image of it: those outside its pairs[] are its xpair.
@@ -188,7 +217,7 @@ static bool plan_far(sx_model *m)
         if (s[2].hi > s[2].lo && s[2].hi >= s[0].lo) s[0].lo = s[2].lo, s[2] = (sx_span){0, 0};
         if (s[3].hi > s[3].lo && s[3].lo <= s[1].hi) s[1].hi = s[3].hi, s[3] = (sx_span){0, 0};
     }
-    return true;
+    return plan_ghosts(m);
 }
 
 /* The spans of every rank from the whole, current pair stores (after a
@@ -237,7 +266,7 @@ bool sx__dd_plan(sx_model *m)
         d->bb_own[r] = (sx_span){sx__first_at(p->a, p->n, own->lo), sx__first_at(p->a, p->n, own->hi)};
         d->bw_own[r] = (sx_span){sx__first_at(m->bw.a, m->bw.n, own->lo), sx__first_at(m->bw.a, m->bw.n, own->hi)};
     }
-    d->nxpair = d->nxlow = 0;
+    d->nxpair = d->nxlow = d->ngho = 0;
     if (m->cell && m->cell->n && !plan_far(m)) return false;
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
      * they clear, to its own and its near ghosts */
@@ -368,6 +397,38 @@ static bool gather_cracks(sx_model *m)
     return ok;
 }
 
+/* Periodic space: every ghost's slot (position, velocity, spin, force,
+ * moment) from the rank of its owner, packed as doubles in the plan's
+ * order. */
+static bool gather_ghosts(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_balls *B = &m->balls;
+    const int D = m->dim, RD = m->rdim, w = 3 * D + 2 * RD;
+    const int64_t ng = d->ngho, base = m->cell->base;
+    if (!ng) return true;
+    double *buf = malloc((size_t)(ng * w) * sizeof *buf);
+    if (!buf) return false;
+    double *const field[5] = {B->x, B->v, B->f, B->w, B->t};
+    bool ok = true;
+    for (int pass = 0; ok && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
+        const int64_t e0 = pass ? 0 : d->gho_own[d->x.rank].lo, e1 = pass ? ng : d->gho_own[d->x.rank].hi;
+        for (int64_t e = e0; e < e1; e++) {
+            double *q = buf + e * w;
+            for (int k = 0; k < 5; k++) {
+                const int per = k < 3 ? D : RD;
+                double *v = field[k] + (base + d->gho[e]) * per;
+                if (pass) memcpy(v, q, (size_t)per * sizeof *q);
+                else memcpy(q, v, (size_t)per * sizeof *q);
+                q += per;
+            }
+        }
+        if (!pass) ok = share(d, buf, (size_t)w * sizeof *buf, d->gho_own, everything(d, ng), 1);
+    }
+    free(buf);
+    return ok;
+}
+
 bool sx__dd_gather(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -377,7 +438,8 @@ bool sx__dd_gather(sx_model *m)
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
-           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m)));
+           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m))) &&
+           (!m->cell || !m->cell->n || gather_ghosts(m));
 }
 
 bool sx__dd_walls(sx_model *m)

@@ -316,6 +316,11 @@ typedef struct sx_dd {
     int32_t *xpair;
     int64_t nxpair, nxlow, cap_xpair;
     sx_chunk xchunk;
+    /* periodic space: the ghosts grouped by their owner's rank (each
+     * rank's a run, gho_own), what a gather takes from each */
+    int32_t *gho;
+    int64_t ngho, cap_gho;
+    sx_span *gho_own;
     /* bonds: the slots of the bonded pairs in pair order, as planned, and
      * each rank's entries (its own pairs'); scratch spans for a gather */
     int32_t *bslot;

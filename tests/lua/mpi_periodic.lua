@@ -12,7 +12,7 @@
 --   drift D   a bonded triplet thrown along the last axis beside a column
 --             of fixed balls, in a cell periodic along that axis only: it
 --             goes round the cell (through every rank's slab and the
---             boundary) twice, keeping its bonds and contacts
+--             boundary) keeping its bonds and contacts
 -- Arguments: scene (cell), dim (3).
 local scene = arg and arg[1] or "cell"
 local dim = tonumber(arg and arg[2]) or 3
@@ -35,16 +35,16 @@ if scene == "cell" then
   m:periodic{min = zero, max = size}
   m:generate{count = dim == 3 and 700 or 900, radius = {2.2e-3, 3.3e-3}, region = {box = {zero, size}}, seed = 7}
   local target = dim == 3 and 2e5 or 4e3
-  local servo = {xx = {stress = target}, yy = {stress = target}, max_rate = 30}
+  local servo = {xx = {stress = target}, yy = {stress = target}, max_rate = dim == 3 and 80 or 30}
   if dim == 3 then servo.zz = {stress = target} end
   m:cell_control(servo)
-  m:cycle(dim == 3 and 2500 or 3000)
+  m:cycle(2000)
   report(m, "compressed")
   m:bond{gap = 1e-4}
   -- simple shear at a rate, the normal stresses held by the servo
   servo.xy = {rate = 4}
   m:cell_control(servo)
-  m:cycle(dim == 3 and 1500 or 2000)
+  m:cycle(dim == 3 and 1000 or 1500)
   report(m, "sheared")
   local s = m:cell_stress()
   print(string.format("stress xx %.17g yy %.17g xy %.17g", s[1][1], s[2][2], s[1][2]))
@@ -54,7 +54,7 @@ if scene == "cell" then
   if m:crack_count() == 0 or m:bond_count() == 0 then error("mpi_periodic.lua cell: no crack or no bond left") end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "drift" then
-  local m = seixo.model{dim = dim, timestep = 1e-5}
+  local m = seixo.model{dim = dim, timestep = 2e-5, skin = 4e-3}
   m:material("soft", {density = 2000, kn = 1e6, ks = 1e6, friction = 0.3,
                       bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e12,
                               cohesion = 1e12}})
@@ -72,8 +72,8 @@ elseif scene == "drift" then
   end
   print(string.format("triplet: %d bonds", m:bond{gap = 1e-4, materials = "soft"}))
   local mine = {[tri[1].id] = true, [tri[2].id] = true, [tri[3].id] = true}
-  for step = 1, 6 do
-    m:cycle(1000)
+  for step = 1, 4 do
+    m:cycle(400)
     local own = 0
     for c in m:contacts{kind = "ball-ball"} do
       if mine[c.a.id] and mine[c.b.id] then own = own + 1 end
