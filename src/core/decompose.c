@@ -9,8 +9,9 @@
  * by cell with the last axis slowest, so a range is a slab across that
  * axis, cut to balance the ball count (and cut again at every build, which
  * is where balls migrate). Each step it
- *   - refreshes its ghosts, the balls need[2r] below and need[2r + 1]
- *     above its own, from their owners (positions, velocities, spins);
+ *   - refreshes its ghosts, the balls need[4r] below and need[4r + 1]
+ *     above its own (and the far ends of a periodic cell), from their
+ *     owners (positions, velocities, spins);
  *   - evaluates the ball-ball pairs pairs[r]: every pair of its balls, in
  *     the serial chunks, clipped (a ball's contributions thus arrive in the
  *     serial order, whatever the cut; pairs between ghosts come along and
@@ -27,7 +28,11 @@
  * owner of its first ball, each bond from the owner of its pair, and the
  * ranks' cracks merged in the serial order); the build itself is the
  * serial one, on every rank. Clumps: every rank steps every clump, from
- * its pebbles' forces shared by their owners at every step. */
+ * its pebbles' forces shared by their owners at every step. Periodic
+ * space: a ghost's force is folded onto its owner after the pass, so the
+ * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
+ * (xpair), keeping current the far end of the cell they reach; the cell's
+ * stress (its servo) is summed over the ranks in a chain, in pair order. */
 #include "model_internal.h"
 
 #include <stdlib.h>
