@@ -226,8 +226,9 @@ static void fold_ghosts(sx_model *m)
  * of F (x) l over the ball-ball pairs that carry a force (acc[3 i + j]),
  * F the force on b and l = x_b - x_a the branch vector of the last
  * evaluation (through the boundary for a ghost), and the servo's K per
- * component (acc[9 + k], sx_cell_control). */
-static void KERNEL(stress_terms)(const sx_model *m, int64_t c0, int64_t c1, double *acc)
+ * component (acc[9 + k], sx_cell_control) with stiff (the step's laws:
+ * the servo's, inside a cycle). */
+static void stress_terms(const sx_model *m, int64_t c0, int64_t c1, double *acc, bool stiff)
 {
     const sx_pairs *p = &m->bb;
     const sx_balls *B = &m->balls;
@@ -243,6 +244,7 @@ static void KERNEL(stress_terms)(const sx_model *m, int64_t c0, int64_t c1, doub
             for (int k = 0; k < D; k++) F[k] += bs->fn[slot] * n[k] + bs->fs[slot * D + k];
         for (int i = 0; i < D; i++)
             for (int j = 0; j < D; j++) acc[3 * i + j] += F[i] * l[j];
+        if (!stiff) continue;
         const int64_t a = p->a[c], b = p->b[c];
         const double ra = B->rad[a], rb = B->rad[b];
         const sx_pair_law *law = sx__bb_step_law(m, c, a, b);
@@ -257,6 +259,12 @@ static void KERNEL(stress_terms)(const sx_model *m, int64_t c0, int64_t c1, doub
     }
 }
 
+/* stress_terms with the servo's K, for a sum over the ranks. */
+static void KERNEL(stress_terms_stiff)(const sx_model *m, int64_t c0, int64_t c1, double *acc)
+{
+    stress_terms(m, c0, c1, acc, true);
+}
+
 /* The cell's average stress, (1/V) sum F (x) l (stress_terms), compression
  * positive; with stiff, the servo's K per component. Decomposed, the sum
  * runs over the ranks in pair order (sx__dd_pair_sum). False: the ranks
@@ -264,10 +272,10 @@ static void KERNEL(stress_terms)(const sx_model *m, int64_t c0, int64_t c1, doub
 static bool KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double stiff[6])
 {
     double acc[9 + 6] = {0};
-    if (m->dd && m->dd->active) {
-        if (!sx__dd_pair_sum(m, acc, 9 + 6, KERNEL(stress_terms))) return false;
+    if (m->dd && m->dd->active) { /* inside a cycle: the servo's */
+        if (!stiff || !sx__dd_pair_sum(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
     } else {
-        KERNEL(stress_terms)(m, 0, m->bb.n, acc);
+        stress_terms(m, 0, m->bb.n, acc, stiff != NULL);
     }
     double vol = 1;
     for (int k = 0; k < D; k++) vol *= m->cell->h[k][k];
