@@ -9,8 +9,9 @@
  * by cell with the last axis slowest, so a range is a slab across that
  * axis, cut to balance the ball count (and cut again at every build, which
  * is where balls migrate). Each step it
- *   - refreshes its ghosts, the balls need[2r] below and need[2r + 1]
- *     above its own, from their owners (positions, velocities, spins);
+ *   - refreshes its ghosts, the balls need[4r] below and need[4r + 1]
+ *     above its own (and the far ends of a periodic cell), from their
+ *     owners (positions, velocities, spins);
  *   - evaluates the ball-ball pairs pairs[r]: every pair of its balls, in
  *     the serial chunks, clipped (a ball's contributions thus arrive in the
  *     serial order, whatever the cut; pairs between ghosts come along and
@@ -27,7 +28,11 @@
  * owner of its first ball, each bond from the owner of its pair, and the
  * ranks' cracks merged in the serial order); the build itself is the
  * serial one, on every rank. Clumps: every rank steps every clump, from
- * its pebbles' forces shared by their owners at every step. */
+ * its pebbles' forces shared by their owners at every step. Periodic
+ * space: a ghost's force is folded onto its owner after the pass, so the
+ * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
+ * (xpair), keeping current the far end of the cell they reach; the cell's
+ * stress (its servo) is summed over the ranks in a chain, in pair order. */
 #include "model_internal.h"
 
 #include <stdlib.h>
@@ -36,7 +41,6 @@
 static const char *not_decomposed(const sx_model *m)
 {
     if (m->fjel.n) return "flat joints";
-    if (m->cell) return "periodic space";
     if (m->njoint) return "smooth joints";
     if (m->track_energy) return "energy tracking";
     for (int64_t w = 0; w < m->nwall; w++)
@@ -51,6 +55,9 @@ void sx__dd_free(sx_model *m)
     free(d->own);
     free(d->bslot);
     free(d->peb);
+    free(d->xpair);
+    free(d->gho);
+    free(d->xchunk.cracks);
     free(d);
     m->dd = NULL;
 }
@@ -64,16 +71,20 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (2 per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own: 12 spans per rank */
-    sx_span *s = d ? calloc(12 * r, sizeof *s) : NULL;
+    /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own,
+     * gho_own */
+    enum { SPANS = 11 + SX_DD_NEED };
+    sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL;
     if (!s) {
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
     }
     d->x = *x;
-    d->own = s, d->need = s + r, d->pairs = s + 3 * r, d->wblk = s + 4 * r;
-    d->wrun = s + 5 * r, d->bb_own = s + 6 * r, d->bw_own = s + 7 * r, d->all = s + 8 * r;
-    d->bs_own = s + 9 * r, d->scratch = s + 10 * r, d->peb_own = s + 11 * r;
+    d->own = s, d->need = s + r;
+    s += (1 + SX_DD_NEED) * r;
+    d->pairs = s, d->wblk = s + r, d->wrun = s + 2 * r, d->bb_own = s + 3 * r, d->bw_own = s + 4 * r;
+    d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->peb_own = s + 8 * r;
+    d->gho_own = s + 9 * r;
     m->dd = d;
     return SX_OK;
 }
@@ -134,6 +145,86 @@ static bool plan_lists(sx_model *m)
             plan_list(m, d->own, m->balls.n, pebble, &d->peb, &d->npeb, &d->cap_peb, d->peb_own));
 }
 
+/* Widens rank r's ghosts to ball e: in its near spans already, or in the
+ * far span on e's side. */
+static void reach(sx_dd *d, int r, int64_t e)
+{
+    const sx_span own = d->own[r];
+    sx_span *s = d->need + SX_DD_NEED * r;
+    if ((e >= own.lo && e < own.hi) || (e < own.lo && e >= s[0].lo) || (e >= own.hi && e < s[1].hi)) return;
+    sx_span *f = e < own.lo ? &s[2] : &s[3];
+    if (f->hi == f->lo) *f = (sx_span){e, e + 1};
+    if (e < f->lo) f->lo = e;
+    if (e + 1 > f->hi) f->hi = e + 1;
+}
+
+/* Periodic space: the ghosts by their owner's rank, whose copies (the
+ * state the last pass left in them: the owner's, shifted, and the force
+ * folded onto it) are the serial run's; a ghost whose owner was removed
+ * is no rank's. False: out of memory. */
+static bool plan_ghosts(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_cell *cell = m->cell;
+    const int R = d->x.ranks;
+    d->ngho = 0;
+    if (d->cap_gho < cell->n) {
+        int32_t *q = realloc(d->gho, (size_t)cell->n * sizeof *q);
+        if (!q) return false;
+        d->gho = q, d->cap_gho = cell->n;
+    }
+    for (int r = 0; r < R; r++) {
+        d->gho_own[r].lo = d->ngho;
+        for (int64_t g = 0; g < cell->n; g++) {
+            const int64_t o = cell->owner[g];
+            if (o >= d->own[r].lo && o < d->own[r].hi) d->gho[d->ngho++] = (int32_t)g;
+        }
+        d->gho_own[r].hi = d->ngho;
+    }
+    return true;
+}
+
+/* Periodic space: a ghost's force is added to its owner after the pass
+ * (kernels/ghosts.c, fold_ghosts), so the rank of a ball evaluates every
+ * pair whose b is an image of it: those outside its pairs[] are its xpair.
+ * Each rank keeps current, besides its near ghosts, the balls imaged by
+ * the ghosts of its pairs and the first balls of its xpair: the far ends
+ * of the cell (need[4r + 2] below its balls, need[4r + 3] above them;
+ * merged into the near spans when they meet). False: out of memory. */
+static bool plan_far(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_pairs *p = &m->bb;
+    const sx_cell *cell = m->cell;
+    const int R = d->x.ranks, me = d->x.rank;
+    const int64_t n = m->balls.n;
+    for (int r = 0; r < R; r++)
+        for (int64_t c = d->pairs[r].lo; c < d->pairs[r].hi; c++)
+            if (p->b[c] >= n && cell->owner[p->b[c] - cell->base] >= 0) reach(d, r, cell->owner[p->b[c] - cell->base]);
+    for (int64_t c = 0; c < p->n; c++) {
+        const int64_t o = p->b[c] >= n ? cell->owner[p->b[c] - cell->base] : -1;
+        if (o < 0) continue;
+        const int r = owner_of(d, o, n);
+        if (c >= d->pairs[r].lo && c < d->pairs[r].hi) continue;
+        reach(d, r, p->a[c]);
+        if (r != me) continue;
+        if (d->nxpair == d->cap_xpair) {
+            const int64_t cap = d->cap_xpair ? 2 * d->cap_xpair : 64;
+            int32_t *q = realloc(d->xpair, (size_t)cap * sizeof *q);
+            if (!q) return false;
+            d->xpair = q, d->cap_xpair = cap;
+        }
+        d->xpair[d->nxpair++] = (int32_t)c;
+        d->nxlow += c < d->pairs[me].lo;
+    }
+    for (int r = 0; r < R; r++) {
+        sx_span *s = d->need + SX_DD_NEED * r;
+        if (s[2].hi > s[2].lo && s[2].hi >= s[0].lo) s[0].lo = s[2].lo, s[2] = (sx_span){0, 0};
+        if (s[3].hi > s[3].lo && s[3].lo <= s[1].hi) s[1].hi = s[3].hi, s[3] = (sx_span){0, 0};
+    }
+    return plan_ghosts(m);
+}
+
 /* The spans of every rank from the whole, current pair stores (after a
  * build, or when a cycle starts), and this rank's clipped chunks. False:
  * out of memory. */
@@ -144,9 +235,11 @@ bool sx__dd_plan(sx_model *m)
     const int64_t n = m->balls.n;
     const sx_pairs *p = &m->bb;
     for (int r = 0; r < R; r++) d->own[r] = (sx_span){n * r / R, n * (r + 1) / R};
-    /* the lowest first ball of a pair whose second ball each rank owns */
+    /* the lowest first ball of a pair whose second ball each rank owns (a
+     * ghost's pairs reach its owner through the fold: plan_far) */
     for (int r = 0; r < R; r++) d->pairs[r].lo = d->own[r].lo; /* lo: a ball index until made a pair index */
     for (int64_t c = 0; c < p->n; c++) {
+        if (p->b[c] >= n) continue;
         sx_span *q = &d->pairs[owner_of(d, p->b[c], n)];
         if (p->a[c] < q->lo) q->lo = p->a[c];
     }
@@ -158,7 +251,7 @@ bool sx__dd_plan(sx_model *m)
         pr->hi = sx__first_at(p->a, p->n, own->hi);
         int64_t hi = own->hi;
         for (int64_t c = pr->lo; c < pr->hi; c++)
-            if (p->b[c] + 1 > hi) hi = p->b[c] + 1;
+            if (p->b[c] < n && p->b[c] + 1 > hi) hi = p->b[c] + 1;
         while (bl < m->nblock && m->blocks[bl].b1 - 1 < own->lo) bl++;
         wb->lo = wb->hi = bl;
         while (wb->hi < m->nblock && m->blocks[wb->hi].b1 - 1 < own->hi) wb->hi++;
@@ -171,14 +264,18 @@ bool sx__dd_plan(sx_model *m)
         if (run->hi > run->lo && m->blocks[run->lo].b0 < lo) lo = m->blocks[run->lo].b0;
         if (run->hi > run->lo && m->blocks[run->hi - 1].b1 > hi) hi = m->blocks[run->hi - 1].b1;
         if (own->hi == own->lo) lo = hi = own->lo; /* a rank without balls needs none */
-        d->need[2 * r] = (sx_span){lo, own->lo};
-        d->need[2 * r + 1] = (sx_span){own->hi, hi};
+        sx_span *need = d->need + SX_DD_NEED * r;
+        need[0] = (sx_span){lo, own->lo};
+        need[1] = (sx_span){own->hi, hi};
+        need[2] = need[3] = (sx_span){0, 0};
         d->bb_own[r] = (sx_span){sx__first_at(p->a, p->n, own->lo), sx__first_at(p->a, p->n, own->hi)};
         d->bw_own[r] = (sx_span){sx__first_at(m->bw.a, m->bw.n, own->lo), sx__first_at(m->bw.a, m->bw.n, own->hi)};
     }
+    d->nxpair = d->nxlow = d->ngho = 0;
+    if (m->cell && m->cell->n && !plan_far(m)) return false;
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
-     * they clear, to its own and its ghosts */
-    const sx_span pr = d->pairs[me], lo = d->need[2 * me], hi = d->need[2 * me + 1];
+     * they clear, to its own and its near ghosts */
+    const sx_span pr = d->pairs[me], lo = d->need[SX_DD_NEED * me], hi = d->need[SX_DD_NEED * me + 1];
     for (int64_t c = 0; c < m->nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         o->first = o->first < pr.lo ? pr.lo : o->first > pr.hi ? pr.hi : o->first;
@@ -207,8 +304,8 @@ bool sx__dd_halo(sx_model *m)
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
     const size_t v = (size_t)m->dim * sizeof(double), w = (size_t)m->rdim * sizeof(double);
-    return share(d, B->x, v, d->own, d->need, 2) && share(d, B->v, v, d->own, d->need, 2) &&
-           share(d, B->w, w, d->own, d->need, 2);
+    return share(d, B->x, v, d->own, d->need, SX_DD_NEED) && share(d, B->v, v, d->own, d->need, SX_DD_NEED) &&
+           share(d, B->w, w, d->own, d->need, SX_DD_NEED);
 }
 
 static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
@@ -305,6 +402,38 @@ static bool gather_cracks(sx_model *m)
     return ok;
 }
 
+/* Periodic space: every ghost's slot (position, velocity, spin, force,
+ * moment) from the rank of its owner, packed as doubles in the plan's
+ * order. */
+static bool gather_ghosts(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_balls *B = &m->balls;
+    const int D = m->dim, RD = m->rdim, w = 3 * D + 2 * RD;
+    const int64_t ng = d->ngho, base = m->cell->base;
+    if (!ng) return true;
+    double *buf = malloc((size_t)(ng * w) * sizeof *buf);
+    if (!buf) return false;
+    double *const field[5] = {B->x, B->v, B->f, B->w, B->t};
+    bool ok = true;
+    for (int pass = 0; ok && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
+        const int64_t e0 = pass ? 0 : d->gho_own[d->x.rank].lo, e1 = pass ? ng : d->gho_own[d->x.rank].hi;
+        for (int64_t e = e0; e < e1; e++) {
+            double *q = buf + e * w;
+            for (int k = 0; k < 5; k++) {
+                const int per = k < 3 ? D : RD;
+                double *v = field[k] + (base + d->gho[e]) * per;
+                if (pass) memcpy(v, q, (size_t)per * sizeof *q);
+                else memcpy(q, v, (size_t)per * sizeof *q);
+                q += per;
+            }
+        }
+        if (!pass) ok = share(d, buf, (size_t)w * sizeof *buf, d->gho_own, everything(d, ng), 1);
+    }
+    free(buf);
+    return ok;
+}
+
 bool sx__dd_gather(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -314,7 +443,8 @@ bool sx__dd_gather(sx_model *m)
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
-           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m)));
+           gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m))) &&
+           (!m->cell || !m->cell->n || gather_ghosts(m));
 }
 
 bool sx__dd_walls(sx_model *m)
@@ -356,13 +486,45 @@ bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
     return true;
 }
 
+/* A sum over the ball-ball pairs in the serial order (the periodic cell's
+ * stress): each rank adds its own pairs' terms (bb_own, pairs of its
+ * balls: the ranks' runs follow each other in pair order) to the running
+ * sum of the ranks before it, in a chain from rank 0, and the last rank's
+ * total goes to every rank: the serial sum's every rounding, in R steps
+ * of one message. part(m, c0, c1, acc) adds the terms of pairs [c0, c1)
+ * to acc (len doubles, zero on entry). False: the ranks could not
+ * exchange. */
+bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
+                     void (*part)(const sx_model *m, int64_t c0, int64_t c1, double *acc))
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks, me = d->x.rank;
+    double *buf = calloc((size_t)R * (size_t)len, sizeof *buf);
+    if (!buf) return false;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1}; /* rank r's running sum: entry r */
+    bool ok = true;
+    for (int k = 0; ok && k < R; k++) {
+        if (k == me) {
+            if (k) memcpy(acc, buf + (k - 1) * len, (size_t)len * sizeof *acc);
+            part(m, d->bb_own[k].lo, d->bb_own[k].hi, acc);
+            memcpy(buf + k * len, acc, (size_t)len * sizeof *acc);
+        }
+        for (int r = 0; r < R; r++) /* the next rank takes rank k's sum; the total goes to all */
+            d->all[r] = k + 1 == R || r == k + 1 ? (sx_span){k, k + 1} : (sx_span){0, 0};
+        ok = share(d, buf, (size_t)len * sizeof *buf, d->scratch, d->all, 1);
+    }
+    if (ok) memcpy(acc, buf + (R - 1) * len, (size_t)len * sizeof *acc);
+    free(buf);
+    return ok;
+}
+
 sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
     const char *what = not_decomposed(m);
     if (what)
         return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
-                                      "walls, contact and parallel bonds, clumps); run it serially",
+                                      "walls, contact and parallel bonds, clumps, periodic space); run it serially",
                         what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
         return sx__fail(m, SX_EINVAL,

@@ -493,6 +493,9 @@ static sx_status next_timestep(sx_model *m, double *dt)
     if (m->dt_user > 0) {
         *dt = m->dt_user;
     } else if (m->dt_stale || m->step % DT_REFRESH_STEPS == 0 || !(m->dt > 0)) {
+        /* decomposed: the ghosts where the last step left them, as the serial run reads them */
+        if (m->dd && m->dd->active && !sx__dd_halo(m))
+            return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange ghosts");
         double crit = kernels(m)->critical_dt(m);
         if (m->dd && m->dd->active) { /* each rank rates its own balls: the smallest of all (exact) */
             crit = -crit;
@@ -723,7 +726,10 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         sx__walls_servo(m);
         move_walls(m, &max_wall);
-        if (m->cell) sx__cell_step(m); /* periodic space: the cell deforms */
+        if (m->cell && !sx__cell_step(m)) { /* periodic space: the cell deforms */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the cell's stress");
+            break;
+        }
         m->time += m->dt;
         m->dt_prev = m->dt;
         m->step++;

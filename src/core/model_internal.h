@@ -298,14 +298,29 @@ typedef struct sx_cell {
 /* Domain decomposition (decompose.c; docs/developer.md). Between cycles
  * every rank holds the whole model, identical; inside a cycle rank r
  * integrates the balls own[r] (dense indices: slabs of the cell order),
- * keeps the balls need[2r], need[2r + 1] below and above them current as
- * ghosts, evaluates the ball-ball pairs pairs[r] (those of its balls and
- * of its ghosts, in the serial order) and completes the wall blocks
- * wblk[r]. Every ball's sums thus run in the serial run's order. */
+ * keeps the balls need[4r ... 4r + 3] current as ghosts (below and above
+ * them, and in periodic space the far ends of the cell), evaluates the
+ * ball-ball pairs pairs[r] (those of its balls and of its ghosts, in the
+ * serial order; in periodic space also xpair, those through the boundary
+ * whose image of the far end is of its own balls) and completes the wall
+ * blocks wblk[r]. Every ball's sums thus run in the serial run's order. */
+/* The spans of ghosts a rank keeps: near below, near above, far below, far above. */
+enum { SX_DD_NEED = 4 };
 typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
-    sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: 2 per rank) */
+    sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
+    /* periodic space: this rank's pairs outside pairs[rank] whose b is a
+     * ghost of one of its balls, in pair order (the first nxlow below
+     * pairs[rank], the rest above it), and the chunk that runs them */
+    int32_t *xpair;
+    int64_t nxpair, nxlow, cap_xpair;
+    sx_chunk xchunk;
+    /* periodic space: the ghosts grouped by their owner's rank (each
+     * rank's a run, gho_own), what a gather takes from each */
+    int32_t *gho;
+    int64_t ngho, cap_gho;
+    sx_span *gho_own;
     /* bonds: the slots of the bonded pairs in pair order, as planned, and
      * each rank's entries (its own pairs'); scratch spans for a gather */
     int32_t *bslot;
@@ -507,7 +522,7 @@ typedef struct sx_kernels {
     void (*ghosts_refresh)(sx_model *m, bool all);
     /* the cell's average stress (compression positive) and the servo's
      * stiffnesses K per component (sx_cell_control) from the pair store */
-    void (*cell_stress)(const sx_model *m, double stress[3][3], double stiff[6]);
+    bool (*cell_stress)(const sx_model *m, double stress[3][3], double stiff[6]);
 } sx_kernels;
 
 extern const sx_kernels sx_kernels_2d, sx_kernels_3d;
@@ -579,6 +594,8 @@ bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
 bool sx__dd_walls(sx_model *m);
 bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
+bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
+                     void (*part)(const sx_model *m, int64_t c0, int64_t c1, double *acc));
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
@@ -620,7 +637,7 @@ double sx__cell_thickness(const sx_cell *c, int dim, int k);
 sx_status sx__cell_check(sx_model *m);
 /* After the step's motion: sets the cell's rates (a servo from the
  * stress) and moves the cell. */
-void sx__cell_step(sx_model *m);
+bool sx__cell_step(sx_model *m);
 uint64_t sx__cell_hash(const sx_model *m, uint64_t h);
 size_t sx__cell_bytes(const sx_model *m);
 /* Room for n ghosts in the table and in the ball slots past base; SX_ENOMEM. */

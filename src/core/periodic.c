@@ -304,19 +304,20 @@ static void gradient(const sx_model *m, const double stress[3][3], const double 
     }
 }
 
-void sx__cell_step(sx_model *m)
+bool sx__cell_step(sx_model *m)
 {
     sx_cell *c = m->cell;
-    if (!c->controlled) return;
+    if (!c->controlled) return true;
     bool servo = false;
     for (int k = 0; k < SX_CELL_COMPONENTS; k++) servo |= c->ctl.mode[k] == SX_CELL_STRESS;
     double stress[3][3], stiff[SX_CELL_COMPONENTS], g[3][3];
-    if (servo) kernels_of(m)->cell_stress(m, stress, stiff);
+    if (servo && !kernels_of(m)->cell_stress(m, stress, stiff)) return false; /* decomposed: the ranks failed */
     gradient(m, servo ? stress : NULL, stiff, g);
     c->moved += set_rates(m, g);
     /* the cell moves by H' dt, as the balls did (leapfrog: H' at the half step) */
     for (int k = 0; k < m->dim; k++)
         for (int i = 0; i < m->dim; i++) c->h[k][i] += c->hdot[k][i] * m->dt;
+    return true;
 }
 
 /* ------------------------------------------------------- ghost bookkeeping */

@@ -5,7 +5,8 @@
 # kinetic energy, to the bit; a 3D pour and a 2D one of 3,000 disks (several
 # chunks of the contact pass, twelve wall blocks). Then a pour saved with 3
 # ranks and loaded with 2 ranks, and serially, ends as the serial run does
-# (and so does a bonded specimen breaking bonds across the save);
+# (and so do a bonded specimen and a bonded periodic cell breaking bonds
+# across the save);
 # and a servo-controlled lid moves alike with 2 and 3 ranks; what is not
 # decomposed yet is refused with a clear error.
 # Skipped without mpirun. The pours run through mpi_same.sh (which
@@ -38,9 +39,10 @@ for np in 2 3; do
   fi
 done
 # a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit:
-# a pour, and a bonded specimen breaking bonds before and after the save
+# a pour, a bonded specimen and a bonded periodic cell breaking bonds before
+# and after the save
 restart=$(dirname "$script")/mpi_restart.lua
-for kind in pour bonded; do
+for kind in pour bonded periodic; do
   # shellcheck disable=SC2086
   "$seixo" "$restart" save "$dir/serial.h5" $kind >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
   echo "restart ($kind), serial:"; cat "$dir/serial"
@@ -62,7 +64,7 @@ done
 # what is not decomposed yet runs serially, and mpirun stops every rank at
 # the first cycle with an error naming it
 bonds=$(dirname "$script")/mpi_bonds.lua
-for what in "flatjoint:flat joints" "periodic:periodic space"; do
+for what in "flatjoint:flat joints" "energy:energy tracking"; do
   arg=${what%%:*} name=${what#*:}
   "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err" || { echo "$arg, serial:"; cat "$dir/err"; fail=1; }
   # shellcheck disable=SC2086

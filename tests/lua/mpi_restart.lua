@@ -4,9 +4,11 @@
 -- prints the final state hash: a file saved with N ranks, loaded with M ranks
 -- (or serially), continues bit-for-bit. `save FILE bonded`: a bonded 2D
 -- specimen crushed by a platen instead, breaking bonds before and after the
--- save (the hash covers the bonds and the crack log).
+-- save (the hash covers the bonds and the crack log). `save FILE periodic`:
+-- a 2D cell periodic on both axes, compressed by its servo, bonded and
+-- sheared at a rate, breaking bonds before and after the save.
 local mode, file, kind = arg[1], arg[2], arg[3]
-assert(mode == "save" or mode == "load", "usage: mpi_restart.lua save|load FILE [bonded]")
+assert(mode == "save" or mode == "load", "usage: mpi_restart.lua save|load FILE [bonded|periodic]")
 local m
 if mode == "save" and kind == "bonded" then
   m = seixo.model{dim = 2, gravity = {0, -9.81}}
@@ -23,6 +25,21 @@ if mode == "save" and kind == "bonded" then
   m:bond{kind = "parallel", gap = 1e-6, seed = 42}
   m:bond{kind = "contact", gap = 1e-6, seed = 43}
   m:cycle(1500)
+  m:save(file)
+elseif mode == "save" and kind == "periodic" then
+  m = seixo.model{dim = 2}
+  m:material("rock", {density = 2000, kn = 1e7, ks = 5e6, friction = 0.5, damping = 0.7,
+                      bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 3e5,
+                              tensile_strength_sd = 5e4, cohesion = 6e5, cohesion_sd = 1e5}})
+  m:periodic{min = {0, 0}, max = {0.2, 0.2}}
+  m:generate{count = 900, radius = {2.2e-3, 3.3e-3}, region = {box = {{0, 0}, {0.2, 0.2}}}, seed = 7}
+  local servo = {xx = {stress = 4e3}, yy = {stress = 4e3}, max_rate = 30}
+  m:cell_control(servo)
+  m:cycle(1100)
+  m:bond{gap = 1e-4}
+  servo.xy = {rate = 4}
+  m:cell_control(servo)
+  m:cycle(400)
   m:save(file)
 elseif mode == "save" then
   m = seixo.model{dim = 2, gravity = {0, -9.81}}

@@ -222,17 +222,19 @@ static void fold_ghosts(sx_model *m)
 
 /* -------------------------------------------------------------- stress */
 
-/* The cell's average stress, (1/V) sum F (x) l over the ball-ball pairs
- * that carry a force, F the force on b and l = x_b - x_a the branch vector
- * of the last evaluation (through the boundary for a ghost), compression
- * positive; with stiff, the servo's K per component (sx_cell_control). */
-static void KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double stiff[6])
+/* The terms of the cell's stress of pairs [c0, c1), added to acc: the sum
+ * of F (x) l over the ball-ball pairs that carry a force (acc[3 i + j]),
+ * F the force on b and l = x_b - x_a the branch vector of the last
+ * evaluation (through the boundary for a ghost), and the servo's K per
+ * component (acc[9 + k], sx_cell_control) with stiff (the step's laws:
+ * the servo's, inside a cycle). */
+static void stress_terms(const sx_model *m, int64_t c0, int64_t c1, double *acc, bool stiff)
 {
     const sx_pairs *p = &m->bb;
     const sx_balls *B = &m->balls;
     const sx_bonds *bs = &m->bonds;
-    double s[D][D] = {{0}}, k6[6] = {0};
-    for (int64_t c = 0; c < p->n; c++) {
+    double *k6 = acc + 9;
+    for (int64_t c = c0; c < c1; c++) {
         if (!p->touching[c]) continue;
         const double *l = p->geo + c * D, d = sqrt(dot(l, l));
         double n[D], F[D];
@@ -241,7 +243,7 @@ static void KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double s
         if (slot >= 0 && (bs->kind[slot] & SX_BOND_PARALLEL))
             for (int k = 0; k < D; k++) F[k] += bs->fn[slot] * n[k] + bs->fs[slot * D + k];
         for (int i = 0; i < D; i++)
-            for (int j = 0; j < D; j++) s[i][j] += F[i] * l[j];
+            for (int j = 0; j < D; j++) acc[3 * i + j] += F[i] * l[j];
         if (!stiff) continue;
         const int64_t a = p->a[c], b = p->b[c];
         const double ra = B->rad[a], rb = B->rad[b];
@@ -255,10 +257,31 @@ static void KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double s
         k6[SX_CELL_YZ] += ks * l[2] * l[2];
 #endif
     }
+}
+
+/* stress_terms with the servo's K, for a sum over the ranks. */
+static void KERNEL(stress_terms_stiff)(const sx_model *m, int64_t c0, int64_t c1, double *acc)
+{
+    stress_terms(m, c0, c1, acc, true);
+}
+
+/* The cell's average stress, (1/V) sum F (x) l (stress_terms), compression
+ * positive; with stiff, the servo's K per component. Decomposed, the sum
+ * runs over the ranks in pair order (sx__dd_pair_sum). False: the ranks
+ * could not exchange. */
+static bool KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double stiff[6])
+{
+    double acc[9 + 6] = {0};
+    if (m->dd && m->dd->active) { /* inside a cycle: the servo's */
+        if (!stiff || !sx__dd_pair_sum(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
+    } else {
+        stress_terms(m, 0, m->bb.n, acc, stiff != NULL);
+    }
     double vol = 1;
     for (int k = 0; k < D; k++) vol *= m->cell->h[k][k];
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) stress[i][j] = i < D && j < D ? s[i][j] / vol : 0;
+        for (int j = 0; j < 3; j++) stress[i][j] = i < D && j < D ? acc[3 * i + j] / vol : 0;
     if (stiff)
-        for (int k = 0; k < 6; k++) stiff[k] = k6[k] / vol;
+        for (int k = 0; k < 6; k++) stiff[k] = acc[9 + k] / vol;
+    return true;
 }

@@ -918,6 +918,25 @@ static bool plan_chunks(sx_model *m)
     return true;
 }
 
+/* Decomposed in periodic space: the pairs xpair[e0, e1) (decompose.c,
+ * plan_far), in runs of consecutive pairs, for their ghosts' forces (the
+ * forces on their first balls, another rank's, and their cracks are that
+ * rank's to keep). Non-zero: an overlap error. */
+static sx_status far_pairs(sx_model *m, int64_t e0, int64_t e1)
+{
+    sx_dd *d = m->dd;
+    sx_chunk *o = &d->xchunk;
+    o->clear_lo = o->clear_hi = 0;
+    for (int64_t e = e0; e < e1;) {
+        o->first = d->xpair[e];
+        while (++e < e1 && d->xpair[e] == d->xpair[e - 1] + 1) {}
+        o->last = d->xpair[e - 1] + 1;
+        ball_chunk(m, o);
+        if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+    }
+    return SX_OK;
+}
+
 /* Runs the even chunks, then the odd ones (each phase in parallel), then
  * merges energies, cracks and errors in chunk order. */
 static void KERNEL(ghosts_refresh)(sx_model *m, bool all);
@@ -926,12 +945,19 @@ static void fold_ghosts(sx_model *m);
 static sx_status KERNEL(contacts)(sx_model *m)
 {
     const int64_t nchunk = m->nchunk;
+    /* decomposed in periodic space: the ghosts' pairs outside this rank's
+     * chunk, before and after it, so that each ghost's force adds up in
+     * pair order (a ghost is only ever a pair's b; one chunk) */
+    sx_dd *dd = m->dd && m->dd->active && m->dd->nxpair ? m->dd : NULL;
     if (m->cell) KERNEL(ghosts_refresh)(m, false); /* the ghosts where their owners are now */
+    sx_status st;
+    if (dd && (st = far_pairs(m, 0, dd->nxlow))) return st;
 #pragma omp parallel num_threads(m->threads) if (nchunk > 2)
     for (int64_t phase = 0; phase < 2; phase++) {
 #pragma omp for schedule(static)
         for (int64_t c = phase; c < nchunk; c += 2) ball_chunk(m, &m->chunks[c]);
     }
+    if (dd && (st = far_pairs(m, dd->nxlow, dd->nxpair))) return st;
     if (m->cell) fold_ghosts(m);
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];

@@ -31,11 +31,16 @@ static double KERNEL(critical_dt)(sx_model *m)
     if (!kt) return INFINITY;
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
     memset(kt, 0, (size_t)(4 * n) * sizeof(double));
-    /* decomposed: this rank's balls, summed over their pairs in the serial order (decompose.c) */
+    /* decomposed: this rank's balls, summed over their pairs in the serial
+     * order (decompose.c): pairs[rank], and in periodic space the pairs
+     * through the boundary that reach its balls from elsewhere (xpair: the
+     * first nxlow before pairs[rank], the rest after it) */
     const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
-    const int64_t c0 = dd ? dd->pairs[dd->x.rank].lo : 0, c1 = dd ? dd->pairs[dd->x.rank].hi : p->n;
-    for (int64_t c = c0; c < c1; c++) {
+    const int64_t c0 = dd ? dd->pairs[dd->x.rank].lo : 0, nc = (dd ? dd->pairs[dd->x.rank].hi : p->n) - c0;
+    const int64_t nx = dd ? dd->nxpair : 0, nlow = dd ? dd->nxlow : 0;
+    for (int64_t e = 0; e < nc + nx; e++) {
+        const int64_t c = e < nlow ? dd->xpair[e] : e < nlow + nc ? c0 + e - nlow : dd->xpair[e - nc];
         const int64_t i = p->a[c], j = p->b[c];
         const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
         double dx[D];

@@ -1,0 +1,89 @@
+-- Periodic space under the MPI decomposition (issue 16; test lua_mpi_periodic
+-- through mpi_same.sh): run serially and under mpirun -np 1 ... 4, each
+-- scene prints the same hashes, cell and crack log, to the bit. The slabs
+-- are cut across the last axis (z in 3D, y in 2D), the cell is periodic
+-- along it too: the first and the last rank meet through the boundary,
+-- where a ghost's force is folded onto its owner on another rank.
+--   cell D    a granular gas in a cell periodic on every axis, compressed
+--             by the cell's servo (the stress summed over the ranks in
+--             pair order) with the automatic timestep, then bonded (bonds
+--             through the boundary included) and sheared at a rate with
+--             the lateral stress held by the servo until bonds break
+--   drift D   a bonded triplet thrown along the last axis beside a column
+--             of fixed balls, in a cell periodic along that axis only: it
+--             goes round the cell (through every rank's slab and the
+--             boundary) keeping its bonds and contacts
+-- Arguments: scene (cell), dim (3).
+local scene = arg and arg[1] or "cell"
+local dim = tonumber(arg and arg[2]) or 3
+
+local function report(m, tag)
+  local c = m:periodic()
+  print(string.format("%s step %d balls %d bonds %d cracks %d contacts %d dt %.17g tilt %.17g size %.17g %.17g hash %s",
+                      tag, m:step(), m:ball_count(), m:bond_count(), m:crack_count(), m:contact_count(), m:timestep(),
+                      c.tilt.xy, c.size[1], c.size[dim], m:hash()))
+end
+
+if scene == "cell" then
+  local m = seixo.model{dim = dim}
+  m:material("rock", {density = 2000, kn = 1e7, ks = 5e6, friction = 0.5, damping = 0.7,
+                      bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 3e5,
+                              tensile_strength_sd = 5e4, cohesion = 6e5, cohesion_sd = 1e5}})
+  local L = dim == 3 and 0.06 or 0.2
+  local zero = dim == 3 and {0, 0, 0} or {0, 0}
+  local size = dim == 3 and {L, L, L} or {L, L}
+  m:periodic{min = zero, max = size}
+  m:generate{count = dim == 3 and 700 or 900, radius = {2.2e-3, 3.3e-3}, region = {box = {zero, size}}, seed = 7}
+  local target = dim == 3 and 2e5 or 4e3
+  local servo = {xx = {stress = target}, yy = {stress = target}, max_rate = dim == 3 and 80 or 30}
+  if dim == 3 then servo.zz = {stress = target} end
+  m:cell_control(servo)
+  m:cycle(2000)
+  report(m, "compressed")
+  m:bond{gap = 1e-4}
+  -- simple shear at a rate, the normal stresses held by the servo
+  servo.xy = {rate = 4}
+  m:cell_control(servo)
+  m:cycle(dim == 3 and 1000 or 1500)
+  report(m, "sheared")
+  local s = m:cell_stress()
+  print(string.format("stress xx %.17g yy %.17g xy %.17g", s[1][1], s[2][2], s[1][2]))
+  for i, c in ipairs(m:cracks()) do
+    print(string.format("crack %d step %d %s balls %d %d", i, c.step, c.kind, c.a, c.b))
+  end
+  if m:crack_count() == 0 or m:bond_count() == 0 then error("mpi_periodic.lua cell: no crack or no bond left") end
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "drift" then
+  local m = seixo.model{dim = dim, timestep = 2e-5, skin = 4e-3}
+  m:material("soft", {density = 2000, kn = 1e6, ks = 1e6, friction = 0.3,
+                      bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 2, tensile_strength = 1e12,
+                              cohesion = 1e12}})
+  m:material("column", {density = 2000, kn = 1e6, ks = 1e6, friction = 0.3})
+  local r, H = 0.01, 0.8
+  local function at(x, y, z) return dim == 3 and {x, y, z} or {x, z} end
+  m:periodic{min = at(-0.1, -0.1, 0), max = at(0.1, 0.1, H), axes = dim == 3 and "z" or "y"}
+  -- the column: fixed balls along the last axis, so that every rank has balls
+  for k = 0, 38 do m:ball{pos = at(0, 0, (k + 0.5) * H / 39), radius = r, material = "column"}.fix = "all" end
+  -- the triplet (sides s) straddles the boundary, grazing the column
+  local s, x0, v = 1.99 * r, 1.99 * r, at(0.1, 0, 30)
+  local tri = {}
+  for k, p in ipairs{at(x0, 0, H - 0.25 * s), at(x0, 0, 0.75 * s), at(x0 + math.sqrt(3) / 2 * s, 0, 0.25 * s)} do
+    tri[k] = m:ball{pos = p, radius = r, material = "soft", vel = v}
+  end
+  print(string.format("triplet: %d bonds", m:bond{gap = 1e-4, materials = "soft"}))
+  local mine = {[tri[1].id] = true, [tri[2].id] = true, [tri[3].id] = true}
+  for step = 1, 4 do
+    m:cycle(400)
+    local own = 0
+    for c in m:contacts{kind = "ball-ball"} do
+      if mine[c.a.id] and mine[c.b.id] then own = own + 1 end
+    end
+    report(m, "drift " .. step)
+    print(string.format("triplet contacts %d at %.17g %.17g %.17g", own, tri[1].pos[dim], tri[2].pos[dim],
+                        tri[3].pos[dim]))
+    if m:bond_count() ~= 3 or own ~= 3 then error("mpi_periodic.lua drift: the triplet lost a bond or a contact") end
+  end
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+else
+  error("mpi_periodic.lua: scene cell or drift expected")
+end
