@@ -541,6 +541,11 @@ local function check_options(lab, opts)
     o.seeds = {}
     for i = 1, seeds do o.seeds[i] = i end
   elseif type(seeds) == "table" and #seeds > 0 then
+    for i, seed in ipairs(seeds) do
+      if type(seed) ~= "number" or seed ~= math.floor(seed) or math.abs(seed) >= 2 ^ 53 then
+        fail("seeds[%d] must be a whole number, not %s", i, type(seed) == "number" and tostring(seed) or "a " .. type(seed))
+      end
+    end
     o.seeds = seeds
   else
     fail("seeds must be a count >= 1 or a list of seeds")

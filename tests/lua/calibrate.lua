@@ -259,6 +259,11 @@ test("bad options are clear errors at the caller", function()
            "parameters must be keyed by name")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
                                     out = print} end, "lab.calibrate: out must be a path (a string; got function)")
+  -- and a list of seeds holding a table failed writing its log
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    seeds = {{}}} end, "lab.calibrate: seeds[1] must be a whole number, not a table")
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    seeds = {1, 0.5}} end, "seeds[2] must be a whole number, not 0.5")
   T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
            "unknown target 'G'")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {nothing = {1, 2}}, evaluate = synthetic} end,
