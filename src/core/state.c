@@ -141,6 +141,15 @@ static bool finite_all(const double *v, int64_t n)
     return true;
 }
 
+/* The vector's squared length is finite: every component is, and none is
+ * so large (1e300) that a length, or a product of two, overflows. */
+static bool length_finite(const double *v, int64_t n)
+{
+    double len2 = 0;
+    for (int64_t i = 0; i < n; i++) len2 += v[i] * v[i];
+    return isfinite(len2);
+}
+
 static sx_status check_scalars(sx_model *m)
 {
     const char *why = NULL;
@@ -329,9 +338,7 @@ static sx_status check_walls(sx_model *m)
 static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
 {
     const int d = m->dim;
-    double len2 = 0;
-    for (int k = 0; k < d; k++) len2 += p->geo[c * d + k] * p->geo[c * d + k];
-    return finite_all(p->fs + c * d, d) && isfinite(len2) && isfinite(p->fn[c]) &&
+    return finite_all(p->fs + c * d, d) && length_finite(p->geo + c * d, d) && isfinite(p->fn[c]) &&
            (!p->un || isfinite(p->un[c])) &&
            (!p->jun || (isfinite(p->jun[c]) && finite_all(p->jnormal + c * d, d)));
 }
@@ -421,8 +428,9 @@ static sx_status check_bonds(sx_model *m)
         if ((k->kind[s] & SX_BOND_CONTACT) && !(k->cb_n[s] > 0 && isfinite(k->cb_n[s]) && k->cb_s[s] > 0 &&
                                                 isfinite(k->cb_s[s])))
             return sx__fail(m, SX_EINVAL, "state: contact bond %lld has a strength <= 0 or not finite", (long long)s);
-        if (!isfinite(k->fn[s]) || !finite_all(k->fs + s * m->dim, m->dim) || !isfinite(k->mn[s]) ||
-            !finite_all(k->ms + s * m->rdim, m->rdim))
+        /* by their squared lengths: a finite 1e300 breaks the bond into a NaN crack */
+        if (!length_finite(k->fn + s, 1) || !length_finite(k->fs + s * m->dim, m->dim) ||
+            !length_finite(k->mn + s, 1) || !length_finite(k->ms + s * m->rdim, m->rdim))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has a non-finite force or moment", (long long)s);
         if (k->kind[s] & SX_BOND_FLATJOINT) {
             const int64_t nel = (int64_t)k->fj_nr[s] * k->fj_na[s];

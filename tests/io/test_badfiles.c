@@ -603,6 +603,8 @@ START_TEST(meaningless_values)
         /* found by the long fuzz run: 1e300 is finite, the length it gives is not (an infinite overlap) */
         {"/contacts/ball_ball/relative_position", 0, 1e300, "ball-ball pair 0 has a non-finite history"},
         {"/contacts/ball_ball/shear_force", 0, -INFINITY, "ball-ball pair 0 has a non-finite history"},
+        /* found by the second long fuzz run: a finite 1e300 broke the bond into a NaN crack */
+        {"/bonds/bending_moment", SX_BOND_PARALLEL, 1e300, "has a non-finite force or moment"},
         {"/walls/normal", 0, 5, "a normal of length other than 1"},
         {"/walls/kn", 0, NAN, "has a stiffness, friction or move out of range"},
         {"/materials/kn", 0, NAN, "kn must be > 0 N/m"},

@@ -112,7 +112,8 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
         for (int k = 0; k < D; k++) n[k] = p->geo[c * D + k];
         un = p->un[c];
     } else { /* the normal and overlap of the relative position, as the step computed them */
-        const double *rel = p->geo + c * D, d = sqrt(dot(rel, rel)), inv_d = 1.0 / d;
+        /* coincident centres (only a damaged file's) have no normal, as in pair_geometry */
+        const double *rel = p->geo + c * D, d = sqrt(dot(rel, rel)), inv_d = d > 0 ? 1.0 / d : 0;
         for (int k = 0; k < D; k++) n[k] = rel[k] * inv_d;
         un = B->rad[i] + B->rad[p->b[c]] - d;
     }
