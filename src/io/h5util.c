@@ -139,8 +139,9 @@ hid_t sx_h5_fapl(bool latest)
      * every other piece of metadata. Otherwise (series, appended in place)
      * the 1.8 format: checksummed object headers, and no "open for
      * writing" flag that would leave a file whose writer was killed
-     * unopenable; and each flush made atomic by a journal (journal.c). SEMI: closing a file with objects still open is an
-     * error, never a file left half-written behind a successful close. */
+     * unopenable; and each flush made atomic by a journal (journal.c).
+     * SEMI: closing a file with objects still open is an error, never a
+     * file left half-written behind a successful close. */
     const H5F_libver_t v = latest ? H5F_LIBVER_LATEST : H5F_LIBVER_V18;
     if (H5Pset_libver_bounds(fapl, v, v) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_SEMI) < 0 ||
         (!latest && H5Pset_driver(fapl, sx_h5_journal_driver(), NULL) < 0)) {

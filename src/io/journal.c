@@ -71,6 +71,9 @@ static void push_error(const char *fmt, const char *path)
 
 /* --------------------------------------------------- the journal file */
 
+/* FNV-1a, 64 bits: its offset basis starts a checksum */
+static const uint64_t fnv_basis = 1469598103934665603ULL;
+
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
 {
     const unsigned char *b = p;
@@ -97,7 +100,7 @@ static bool journal_write(const jfile *f, uint64_t truncate_to)
     const int fd = open(f->journal, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd < 0) return false;
     off_t at = 0;
-    uint64_t h = fnv(1469598103934665603ULL, journal_magic, sizeof journal_magic);
+    uint64_t h = fnv(fnv_basis, journal_magic, sizeof journal_magic);
     bool ok = put_all(fd, journal_magic, sizeof journal_magic, &at);
     for (size_t i = 0; ok && i < f->np; i++) {
         const uint64_t head[2] = {f->p[i].at, f->p[i].n};
@@ -134,7 +137,7 @@ static bool journal_apply(const char *path, const char *journal, size_t n)
     uint64_t h = 0, stored = 0, count = 0, truncate_to = UINT64_MAX;
     if (whole) {
         memcpy(&stored, b + n - sizeof journal_end - sizeof stored, sizeof stored);
-        h = fnv(1469598103934665603ULL, b, n - sizeof journal_end - sizeof stored);
+        h = fnv(fnv_basis, b, n - sizeof journal_end - sizeof stored);
         memcpy(&count, b + n - sizeof journal_end - 3 * sizeof(uint64_t), sizeof count);
         memcpy(&truncate_to, b + n - sizeof journal_end - 2 * sizeof(uint64_t), sizeof truncate_to);
         whole = h == stored;
@@ -156,7 +159,8 @@ static bool journal_apply(const char *path, const char *journal, size_t n)
             ok = ok && put_all(fd, b + at, (size_t)head[1], &where);
             at += (size_t)head[1];
         }
-        if (ok && truncate_to != UINT64_MAX) ok = truncate_to <= (uint64_t)INT64_MAX && ftruncate(fd, (off_t)truncate_to) == 0;
+        if (ok && truncate_to != UINT64_MAX)
+            ok = truncate_to <= (uint64_t)INT64_MAX && ftruncate(fd, (off_t)truncate_to) == 0;
         ok = ok && fsync(fd) == 0;
         if (fd >= 0) close(fd);
         if (!ok)
@@ -187,6 +191,15 @@ static bool journal_recover(const char *path, const char *journal)
     return ok;
 }
 
+/* <path>.journal, allocated (NULL when out of memory). */
+static char *journal_name(const char *path)
+{
+    const size_t len = strlen(path);
+    char *j = malloc(len + sizeof ".journal");
+    if (j) memcpy(j, path, len), memcpy(j + len, ".journal", sizeof ".journal");
+    return j;
+}
+
 /* ---------------------------------------------------------- the driver */
 
 static hid_t sec2_fapl(void)
@@ -203,13 +216,10 @@ static H5FD_t *j_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxa
 {
     (void)fapl;
     jfile *f = calloc(1, sizeof *f);
-    const size_t len = strlen(name);
-    if (!f || !(f->journal = malloc(len + sizeof ".journal"))) {
+    if (!f || !(f->journal = journal_name(name))) {
         free(f);
         return NULL;
     }
-    memcpy(f->journal, name, len);
-    memcpy(f->journal + len, ".journal", sizeof ".journal");
     void *handle = NULL;
     /* a file created or emptied: a journal beside its name is an older
      * file's, dropped once the open succeeded (a failed one leaves the old
@@ -399,13 +409,14 @@ static const H5FD_class_t journal_class = {
 
 bool sx_h5_journal_drop(const char *path)
 {
-    char journal[4096];
-    const int n = snprintf(journal, sizeof journal, "%s.journal", path);
-    if (n < 0 || (size_t)n >= sizeof journal) {
-        errno = ENAMETOOLONG;
+    char *journal = journal_name(path);
+    if (!journal) {
+        errno = ENOMEM;
         return false;
     }
-    return unlink(journal) == 0 || errno == ENOENT;
+    const bool gone = unlink(journal) == 0 || errno == ENOENT;
+    free(journal);
+    return gone;
 }
 
 hid_t sx_h5_journal_driver(void)

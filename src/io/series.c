@@ -25,13 +25,14 @@
  * that makes each flush atomic: a kill leaves the file as the last
  * completed flush left it. A snapshot is written as an unlinked group and
  * linked once it is complete, so a failed write leaves no link behind.
- * The XDMF is never patched in place: the new one (kept in memory, so no snapshot is read back) is
- * written and synced under a temporary name before the counts are raised,
- * and renamed over the old one right after, so it is always a complete
- * document and lists the snapshots the counts say are complete; only a
- * kill in the microseconds between the counts' write and the rename leaves
- * it one snapshot behind (seixo.xdmf and append mode rebuild it). The 1.8
- * file format keeps a file whose writer was killed openable.
+ * The XDMF is never patched in place: the new one (kept in memory, so no
+ * snapshot is read back) is written and synced under a temporary name
+ * before the counts are raised, and renamed over the old one right after,
+ * so it is always a complete document and lists the snapshots the counts
+ * say are complete; only a kill in the microseconds between the counts'
+ * write and the rename leaves it one snapshot behind (seixo.xdmf and
+ * append mode rebuild it). The 1.8 file format keeps a file whose writer
+ * was killed openable.
  *
  * This file keeps the series file (open, append, recovery of what a killed
  * write left, close); series_frame.c writes one snapshot's groups and
