@@ -339,14 +339,6 @@ end
 
 -- ------------------------------------------------------------- summary
 
-local function mean_sd(list)
-  local n, s = #list, 0
-  for _, v in ipairs(list) do s = s + v end
-  local mean, ss = s / n, 0
-  for _, v in ipairs(list) do ss = ss + (v - mean) ^ 2 end
-  return mean, n > 1 and math.sqrt(ss / (n - 1)) or 0
-end
-
 -- A candidate from its runs: every macro-property's mean, scatter and
 -- count, and the objective: the weighted sum of squared relative errors of
 -- the means (a curve's misfit is already relative), or the penalty when a
@@ -362,7 +354,7 @@ local function summarize(o, x, recs)
   end
   local c = {x = x, achieved = {}, failed = failed, runs = #recs}
   for k, l in pairs(lists) do
-    local mean, sd = mean_sd(l)
+    local mean, sd = util.mean_sd(l)
     c.achieved[k] = {mean = mean, sd = sd, n = #l}
   end
   local f, within = 0, true
