@@ -57,9 +57,18 @@ extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, exec
 bool sx_lua_parallel_decompose(sx_model *m);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);
-/// parallel.c: this process's MPI rank (0 without MPI); every rank waits for all.
+/// parallel.c: this process's MPI rank (0 without MPI).
 int sx_lua_parallel_rank(void);
-void sx_lua_parallel_barrier(void);
+/// parallel.c: whether this process writes the files of a model, `shared`
+/// if it is decomposed over MPI ranks (sx_model_ranks > 1): then rank 0
+/// writes for all (every rank holds the whole model between cycles).
+bool sx_lua_parallel_writes(bool shared);
+/// parallel.c: the outcome of a file's work, which rank 0 alone does for a
+/// `shared` model, made every rank's: err (empty: it succeeded; every rank
+/// passes the same size) and *count (if not NULL) go from rank 0 to all
+/// ranks, which wait for it. True if the work failed. Not shared: only
+/// reads err. A collective call: never from __gc, whose time differs between ranks.
+bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count);
 /// parallel.c: on ranks other than 0, print does nothing.
 void sx_lua_parallel_open(lua_State *L);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress

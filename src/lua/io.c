@@ -324,15 +324,14 @@ static int model_save(lua_State *L)
         }
     o.provenance.script = script_path(L);
     o.provenance.seeds = seeds_of(L, 1, &o.provenance.nseeds);
-    char err[1024];
+    char err[1024] = "";
     /* decomposed over ranks, every rank holds the same whole model between
-     * cycles: rank 0 writes it, and the others wait until the file is there */
-    const bool decomposed = sx_model_ranks(m) > 1;
-    if ((!decomposed || sx_lua_parallel_rank() == 0) && sx_snapshot_save(m, path, &o, err, sizeof err)) {
-        if (decomposed) sx_lua_parallel_fail(err); /* the other ranks wait at the barrier */
-        return luaL_error(L, "%s", err);
-    }
-    if (decomposed) sx_lua_parallel_barrier();
+     * cycles: rank 0 writes it, and the others wait for the outcome (the
+     * file is there, or every rank raises rank 0's error) */
+    const bool shared = sx_model_ranks(m) > 1;
+    if (sx_lua_parallel_writes(shared) && sx_snapshot_save(m, path, &o, err, sizeof err) && !err[0])
+        snprintf(err, sizeof err, "m:save: '%s' could not be written", path);
+    if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     lua_pushvalue(L, 5);
     return 1;
 }
@@ -411,17 +410,23 @@ static int model_vars(lua_State *L)
 /* -------------------------------------------------------------- outputs */
 
 typedef struct output {
-    sx_series *s;
+    sx_series *s;  // the open series; NULL when closed, and on ranks other than 0 of a decomposed model
     int64_t every;
+    bool open;     // not closed yet
+    bool shared;   // of a model decomposed over MPI ranks: rank 0 writes, every rank learns the outcome
+    int64_t count; // the series' snapshots (rank 0's count, on every rank)
 } output;
 
 /* The output's uservalues: 1 the model, 2 its callback id, 3 the step of
- * the last sample of each history handed to the series (name -> step). */
+ * the last sample of each history handed to the series (name -> step),
+ * 4 its path. */
 static output *check_output(lua_State *L, int idx) { return luaL_checkudata(L, idx, SX_LUA_OUTPUT); }
 
 /* A snapshot of m (NULL: none) and the histories' new samples, of the
- * output at idx whose model userdata is at `model`. */
-static void write_now(lua_State *L, int idx, int model, const sx_model *m)
+ * output at idx whose model userdata is at `model`. `collective`: every
+ * rank of a decomposed model makes this call and raises rank 0's error
+ * (not from __gc, which comes at different times on different ranks). */
+static void write_now(lua_State *L, int idx, int model, const sx_model *m, bool collective)
 {
     idx = lua_absindex(L, idx);
     model = lua_absindex(L, model);
@@ -430,10 +435,15 @@ static void write_now(lua_State *L, int idx, int model, const sx_model *m)
     const int passed = lua_gettop(L);
     int n;
     const sx_io_history *h = sx_lua_histories_push(L, model, 0, passed, &n);
-    char err[1024];
-    const sx_status st = m ? sx_series_write(o->s, m, h, n, err, sizeof err)
-                           : sx_series_write_histories(o->s, h, n, err, sizeof err);
-    if (st) luaL_error(L, "%s", err);
+    char err[1024] = "";
+    if (o->s) {
+        const sx_status st = m ? sx_series_write(o->s, m, h, n, err, sizeof err)
+                               : sx_series_write_histories(o->s, h, n, err, sizeof err);
+        if (st && !err[0]) snprintf(err, sizeof err, "'%s': the series could not be written", sx_series_path(o->s));
+        o->count = sx_series_count(o->s);
+    }
+    if (collective ? sx_lua_parallel_outcome(o->shared, err, sizeof err, &o->count) : err[0] != '\0')
+        luaL_error(L, "%s", err);
     for (int k = 0; k < n; k++)
         if (h[k].n > 0) {
             lua_pushinteger(L, (lua_Integer)h[k].steps[h[k].n - 1]);
@@ -443,17 +453,12 @@ static void write_now(lua_State *L, int idx, int model, const sx_model *m)
 }
 
 /* The histories' samples since the last snapshot, before the output closes;
- * a model already closed has its state still. */
-static void flush_histories(lua_State *L, int idx)
+ * a model already closed has its state still. Upvalue 1: whether the call
+ * is collective (write_now). */
+static int flush_histories(lua_State *L)
 {
-    idx = lua_absindex(L, idx);
-    if (lua_getiuservalue(L, idx, 1) == LUA_TUSERDATA) write_now(L, idx, -1, NULL);
-    lua_pop(L, 1);
-}
-
-static int flush_protected(lua_State *L)
-{
-    flush_histories(L, 1);
+    if (lua_getiuservalue(L, 1, 1) == LUA_TUSERDATA)
+        write_now(L, 1, -1, NULL, lua_toboolean(L, lua_upvalueindex(1)));
     return 0;
 }
 
@@ -461,22 +466,40 @@ static int flush_protected(lua_State *L)
 static int output_callback(lua_State *L)
 {
     output *o = check_output(L, lua_upvalueindex(1));
-    if (o->s) write_now(L, lua_upvalueindex(1), 1, sx_lua_checkmodel(L, 1));
+    if (o->open) write_now(L, lua_upvalueindex(1), 1, sx_lua_checkmodel(L, 1), true);
     return 0;
+}
+
+/* Writes the last samples and closes the file: `collective` as write_now;
+ * err gets the first failure (empty: none). */
+static void close_series(lua_State *L, int idx, bool collective, char *err, size_t size)
+{
+    output *o = check_output(L, idx);
+    lua_pushboolean(L, collective);
+    lua_pushcclosure(L, flush_histories, 1);
+    lua_pushvalue(L, idx);
+    if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
+        const char *why = lua_tostring(L, -1);
+        snprintf(err, size, "%s", why ? why : "the series' last samples could not be written");
+        lua_pop(L, 1);
+    }
+    /* a failure to write the last samples still closes the file */
+    char closing[1024] = "";
+    if (o->s && sx_series_close(o->s, closing, sizeof closing) && !closing[0])
+        snprintf(closing, sizeof closing, "'%s': the series could not be closed", sx_series_path(o->s));
+    o->s = NULL;
+    o->open = false;
+    if (collective) sx_lua_parallel_outcome(o->shared, closing, sizeof closing, NULL);
+    if (!err[0]) snprintf(err, size, "%s", closing);
 }
 
 static int output_close(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (!o->s) return 0;
-    /* a failure to write the last samples still closes the file */
-    lua_pushcfunction(L, flush_protected);
-    lua_pushvalue(L, 1);
-    const int fst = lua_pcall(L, 1, 0, 0);
-    const int failure = lua_gettop(L); /* the flush's error, if any */
-    char err[1024];
-    const sx_status st = sx_series_close(o->s, err, sizeof err);
-    o->s = NULL;
+    if (!o->open) return 0;
+    lua_settop(L, 1);
+    char err[1024] = "";
+    close_series(L, 1, true, err, sizeof err);
     /* stop the callback: m:off(id), if the model is still open */
     if (lua_getiuservalue(L, 1, 1) == LUA_TUSERDATA && sx_lua_tomodel(L, -1)) {
         lua_getfield(L, -1, "off");
@@ -484,12 +507,7 @@ static int output_close(lua_State *L)
         lua_getiuservalue(L, 1, 2);
         lua_call(L, 2, 0);
     }
-    lua_pop(L, 1);
-    if (fst != LUA_OK) {
-        lua_settop(L, failure);
-        return lua_error(L);
-    }
-    if (st) return luaL_error(L, "%s", err);
+    if (err[0]) return luaL_error(L, "%s", err);
     return 0;
 }
 
@@ -499,47 +517,47 @@ static int output_close(lua_State *L)
 static int output_gc(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (!o->s) return 0;
-    lua_pushcfunction(L, flush_protected);
-    lua_pushvalue(L, 1);
-    lua_pcall(L, 1, 0, 0);
-    sx_series_close(o->s, NULL, 0);
-    o->s = NULL;
+    if (!o->open) return 0;
+    lua_settop(L, 1);
+    char err[1024] = "";
+    close_series(L, 1, false, err, sizeof err);
     return 0;
 }
 
 static int output_write(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (!o->s) return luaL_error(L, "the output has been closed");
+    if (!o->open) return luaL_error(L, "the output has been closed");
     lua_getiuservalue(L, 1, 1);
-    write_now(L, 1, -1, sx_lua_checkmodel(L, -1));
+    write_now(L, 1, -1, sx_lua_checkmodel(L, -1), true);
     return 0;
 }
 
 static int output_count(lua_State *L)
 {
     output *o = check_output(L, 1);
-    lua_pushinteger(L, o->s ? (lua_Integer)sx_series_count(o->s) : 0);
+    lua_pushinteger(L, o->open ? (lua_Integer)o->count : 0);
     return 1;
 }
 
 static int output_path(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (!o->s) return luaL_error(L, "the output has been closed");
-    lua_pushstring(L, sx_series_path(o->s));
+    if (!o->open) return luaL_error(L, "the output has been closed");
+    lua_getiuservalue(L, 1, 4);
     return 1;
 }
 
 static int output_tostring(lua_State *L)
 {
     output *o = check_output(L, 1);
-    if (o->s)
-        lua_pushfstring(L, "seixo.output %s (every %I steps, %I snapshots)", sx_series_path(o->s), (lua_Integer)o->every,
-                        (lua_Integer)sx_series_count(o->s));
-    else
+    if (o->open) {
+        lua_getiuservalue(L, 1, 4);
+        lua_pushfstring(L, "seixo.output %s (every %I steps, %I snapshots)", lua_tostring(L, -1), (lua_Integer)o->every,
+                        (lua_Integer)o->count);
+    } else {
         lua_pushliteral(L, "seixo.output (closed)");
+    }
     return 1;
 }
 
@@ -581,10 +599,6 @@ static int model_output(lua_State *L)
     sx_lua_checkkeys(L, 2, keys);
     const char *path = sx_lua_optstrfield(L, 2, "path");
     if (!path) return sx_lua_fielderror(L, 2, "path", "a file name (.h5) is required");
-    if (sx_model_ranks(m) > 1)
-        return luaL_error(L, "m:output: a model decomposed over %d MPI ranks cannot write series yet (issue 16); "
-                             "use m:save, or seixo.decompose(false) before seixo.model",
-                          sx_model_ranks(m));
     int64_t every = 1000, level = 0;
     sx_lua_optintfield(L, 2, "every", 1, INT64_MAX / 2, &every);
     sx_lua_optintfield(L, 2, "compression", 0, 9, &level);
@@ -594,9 +608,10 @@ static int model_output(lua_State *L)
     const bool append = lua_toboolean(L, -1);
     lua_settop(L, 2);
 
-    output *o = lua_newuserdatauv(L, sizeof *o, 3); /* 3 */
+    output *o = lua_newuserdatauv(L, sizeof *o, 4); /* 3 */
     memset(o, 0, sizeof *o);
     o->every = every;
+    o->shared = sx_model_ranks(m) > 1;
     luaL_setmetatable(L, SX_LUA_OUTPUT);
     lua_pushvalue(L, 1);
     lua_setiuservalue(L, 3, 1);
@@ -609,11 +624,18 @@ static int model_output(lua_State *L)
     so.append = append;
     so.provenance.script = script_path(L);
     so.provenance.seeds = seeds_of(L, 1, &so.provenance.nseeds);
-    char err[1024];
-    o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
-    if (!o->s) return luaL_error(L, "%s", err);
+    char err[1024] = "";
+    if (sx_lua_parallel_writes(o->shared)) {
+        o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
+        if (o->s) o->count = sx_series_count(o->s);
+        else if (!err[0]) snprintf(err, sizeof err, "'%s': the series could not be opened", path);
+    }
+    if (sx_lua_parallel_outcome(o->shared, err, sizeof err, &o->count)) return luaL_error(L, "%s", err);
+    o->open = true;
+    lua_pushstring(L, o->s ? sx_series_path(o->s) : path);
+    lua_setiuservalue(L, 3, 4);
     lua_settop(L, 3);
-    write_now(L, 3, 1, m);
+    write_now(L, 3, 1, m, true);
     /* m:on("after", callback, {every = every}) */
     lua_getfield(L, 1, "on");
     lua_pushvalue(L, 1);

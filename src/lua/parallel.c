@@ -233,11 +233,25 @@ void sx_lua_parallel_fail(const char *message)
 
 int sx_lua_parallel_rank(void) { return world_rank; }
 
-void sx_lua_parallel_barrier(void)
+bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
+
+bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count)
 {
 #ifdef SX_HAVE_MPI
-    if (mpi_started) MPI_Barrier(MPI_COMM_WORLD);
+    /* every rank passes the same size; a failed broadcast is a failure too */
+    if (shared && mpi_started && size > 0 && size <= INT_MAX) {
+        int64_t n = count ? *count : 0;
+        if (MPI_Bcast(err, (int)size, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS ||
+            MPI_Bcast(&n, 1, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+            snprintf(err, size, "rank %d of %d: the ranks failed to exchange a file's outcome", world_rank, world_size);
+        err[size - 1] = '\0';
+        if (count) *count = n;
+    }
+#else
+    (void)shared;
+    (void)count;
 #endif
+    return size > 0 && err[0] != '\0';
 }
 
 /* seixo.decompose([on]) -> whether models made from now on are decomposed */
