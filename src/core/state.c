@@ -252,13 +252,16 @@ static sx_status check_balls(sx_model *m)
             !isfinite(1 / b->inv_inertia[i]) || !(alpha >= 0 && alpha < 1))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a radius, mass, inertia or damping out of range",
                             (long long)id);
-        if (!finite_all(b->x + i * d, d) || !finite_all(b->x_build + i * d, d) || !finite_all(b->v + i * d, d) ||
-            !finite_all(b->w + i * r, r))
-            return sx__fail(m, SX_EINVAL, "state: ball %lld has a non-finite position, velocity or spin",
+        /* (a spin of 1e300, finite, turns a bond's moment into inf - inf at the next step) */
+        if (!length_finite(b->x + i * d, d) || !length_finite(b->x_build + i * d, d) ||
+            !length_finite(b->v + i * d, d) || !length_finite(b->w + i * r, r))
+            return sx__fail(m, SX_EINVAL, "state: ball %lld has a position, velocity or spin that is not finite or "
+                                          "too large (its square overflows)",
                             (long long)id);
-        if (!finite_all(b->f + i * d, d) || !finite_all(b->t + i * r, r) ||
-            (b->fapp && (!finite_all(b->fapp + i * d, d) || !finite_all(b->tapp + i * r, r))))
-            return sx__fail(m, SX_EINVAL, "state: ball %lld has a non-finite force, moment or applied load",
+        if (!length_finite(b->f + i * d, d) || !length_finite(b->t + i * r, r) ||
+            (b->fapp && (!length_finite(b->fapp + i * d, d) || !length_finite(b->tapp + i * r, r))))
+            return sx__fail(m, SX_EINVAL, "state: ball %lld has a force, moment or applied load that is not finite or "
+                                          "too large (its square overflows)",
                             (long long)id);
     }
     return SX_OK;
@@ -269,7 +272,9 @@ static sx_status check_mesh(sx_model *m, sx_wall *w)
 {
     sx_mesh *s = w->mesh;
     const double *q = s->q, qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    if (!finite_all(s->body, 3 * s->nv) || !finite_all(w->def.spin, 3) || !finite_all(q, 4) || !(fabs(qq - 1) < 1e-9))
+    bool vertices = true;
+    for (int64_t v = 0; v < s->nv; v++) vertices = vertices && length_finite(s->body + 3 * v, 3);
+    if (!vertices || !length_finite(w->def.spin, 3) || !finite_all(q, 4) || !(fabs(qq - 1) < 1e-9))
         return sx__fail(m, SX_EINVAL, "state: mesh wall %lld has a non-finite vertex or spin, or an orientation that "
                                       "is not a unit quaternion", (long long)w->id);
     for (int64_t t = 0; t < 3 * s->nt; t++)
@@ -296,11 +301,11 @@ static sx_status check_walls(sx_model *m)
                             (long long)m->next_wall_id);
         for (int64_t j = 0; j < i; j++)
             if (m->walls[j].id == w->id) return sx__fail(m, SX_EINVAL, "state: wall id %lld appears twice", (long long)w->id);
-        if (!finite_all(w->def.point, 3) || !finite_all(w->def.normal, 3) || !finite_all(w->def.vel, 3) ||
-            !finite_all(w->def.edge1, 3) || !finite_all(w->def.edge2, 3) || !finite_all(w->force, 3) ||
-            !finite_all(w->moment, 3))
-            return sx__fail(m, SX_EINVAL, "state: wall %lld has a non-finite point, normal, edge, velocity, force or "
-                                          "moment", (long long)w->id);
+        if (!length_finite(w->def.point, 3) || !length_finite(w->def.normal, 3) || !length_finite(w->def.vel, 3) ||
+            !length_finite(w->def.edge1, 3) || !length_finite(w->def.edge2, 3) || !length_finite(w->force, 3) ||
+            !length_finite(w->moment, 3))
+            return sx__fail(m, SX_EINVAL, "state: wall %lld has a point, normal, edge, velocity, force or moment that "
+                                          "is not finite or too large (its square overflows)", (long long)w->id);
         /* a unit normal (walls are stored normalised) */
         const double *nv = w->def.normal;
         if (!(fabs(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2] - 1) < 1e-6))

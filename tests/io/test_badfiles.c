@@ -598,7 +598,10 @@ START_TEST(meaningless_values)
         {"/bonds/contact_shear_strength", SX_BOND_CONTACT, INFINITY, "has a strength <= 0 or not finite"},
         {"/bonds/normal_force", SX_BOND_PARALLEL, INFINITY, "has a non-finite force or moment"},
         {"/bonds/kn", SX_BOND_PARALLEL, NAN, "radius or stiffness <= 0 or not finite"},
-        {"/balls/force", 0, NAN, "non-finite force, moment or applied load"},
+        {"/balls/force", 0, NAN, "has a force, moment or applied load that is not finite or too large"},
+        /* found by the third long fuzz run: a spin of 1e300 broke a bond into a NaN crack */
+        {"/balls/spin", 0, 1e300, "has a position, velocity or spin that is not finite or too large"},
+        {"/walls/velocity", 0, -1e300, "is not finite or too large (its square overflows)"},
         {"/contacts/ball_ball/relative_position", 0, NAN, "ball-ball pair 0 has a non-finite history"},
         /* found by the long fuzz run: 1e300 is finite, the length it gives is not (an infinite overlap) */
         {"/contacts/ball_ball/relative_position", 0, 1e300, "ball-ball pair 0 has a non-finite history"},
