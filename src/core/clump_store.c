@@ -214,13 +214,6 @@ nomem:
     return sx__fail(m, SX_ENOMEM, "state: out of memory for %lld clumps", (long long)s->clumps);
 }
 
-static bool finite_n(const double *v, int n)
-{
-    for (int k = 0; k < n; k++)
-        if (!isfinite(v[k])) return false;
-    return true;
-}
-
 sx_status sx__clumps_finish(sx_model *m)
 {
     sx_clumps *C = m->clumps;
@@ -237,11 +230,11 @@ sx_status sx__clumps_finish(sx_model *m)
         if (t->first != next || t->n < 1 || t->n > C->tp_n - next)
             return sx__fail(m, SX_EINVAL, "state: clump template '%s' has a bad pebble range", t->name);
         next += t->n;
-        if (!(t->volume > 0) || !(t->principal[0] > 0) || !(t->power_sum > 0) || !finite_n(t->principal, 3) ||
-            !finite_n(t->frame, 4) || !isfinite(t->volume) || !isfinite(t->power_sum))
+        if (!(t->volume > 0) || !(t->principal[0] > 0) || !(t->power_sum > 0) || !sx__state_finite(t->principal, 3) ||
+            !sx__state_finite(t->frame, 4) || !isfinite(t->volume) || !isfinite(t->power_sum))
             return sx__fail(m, SX_EINVAL, "state: clump template '%s' has bad mass properties", t->name);
         for (int64_t k = t->first; k < t->first + t->n; k++)
-            if (!(C->tp_rad[k] > 0) || !finite_n(C->tp_body + k * d, d))
+            if (!(C->tp_rad[k] > 0) || !sx__state_length_finite(C->tp_body + k * d, d))
                 return sx__fail(m, SX_EINVAL, "state: clump template '%s' has a bad pebble", t->name);
     }
     if (next != C->tp_n) return sx__fail(m, SX_EINVAL, "state: the clump templates do not cover their pebbles");
@@ -262,8 +255,9 @@ sx_status sx__clumps_finish(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: clump %lld has a bad pebble range", (long long)id);
         next += np;
         if (!(C->scale[c] > 0) || !(C->mass[c] > 0) || !(C->alpha[c] >= 0 && C->alpha[c] < 1) ||
-            !finite_n(C->x + c * d, d) || !finite_n(C->v + c * d, d) || !finite_n(C->w + c * r, r) ||
-            !finite_n(C->q + c * qd, qd) || (C->L && !finite_n(C->L + c * 3, 3)) || !isfinite(C->mass[c]) ||
+            !sx__state_length_finite(C->x + c * d, d) || !sx__state_length_finite(C->v + c * d, d) ||
+            !sx__state_length_finite(C->w + c * r, r) || !sx__state_finite(C->q + c * qd, qd) ||
+            (C->L && !sx__state_length_finite(C->L + c * 3, 3)) || !isfinite(C->mass[c]) ||
             !isfinite(C->scale[c]))
             return sx__fail(m, SX_EINVAL, "state: clump %lld has a non-finite or out-of-range state", (long long)id);
         if (qd == 4) { /* a unit quaternion as saved (a zero one made a NaN orientation) */

@@ -134,16 +134,14 @@ nomem:
                     (long long)(s->bb + s->bw), (long long)s->bonds);
 }
 
-static bool finite_all(const double *v, int64_t n)
+bool sx__state_finite(const double *v, int64_t n)
 {
     for (int64_t i = 0; i < n; i++)
         if (!isfinite(v[i])) return false;
     return true;
 }
 
-/* The vector's squared length is finite: every component is, and none is
- * so large (1e300) that a length, or a product of two, overflows. */
-static bool length_finite(const double *v, int64_t n)
+bool sx__state_length_finite(const double *v, int64_t n)
 {
     double len2 = 0;
     for (int64_t i = 0; i < n; i++) len2 += v[i] * v[i];
@@ -153,7 +151,7 @@ static bool length_finite(const double *v, int64_t n)
 static sx_status check_scalars(sx_model *m)
 {
     const char *why = NULL;
-    if (!finite_all(m->gravity, 3)) why = "gravity is not finite";
+    if (!sx__state_finite(m->gravity, 3)) why = "gravity is not finite";
     else if (!(m->dt_user >= 0) || !isfinite(m->dt_user)) why = "the user timestep is not >= 0";
     else if (!(m->dt >= 0) || !isfinite(m->dt) || !(m->dt_prev >= 0) || !isfinite(m->dt_prev))
         why = "the timestep is not >= 0";
@@ -253,13 +251,13 @@ static sx_status check_balls(sx_model *m)
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a radius, mass, inertia or damping out of range",
                             (long long)id);
         /* (a spin of 1e300, finite, turns a bond's moment into inf - inf at the next step) */
-        if (!length_finite(b->x + i * d, d) || !length_finite(b->x_build + i * d, d) ||
-            !length_finite(b->v + i * d, d) || !length_finite(b->w + i * r, r))
+        if (!sx__state_length_finite(b->x + i * d, d) || !sx__state_length_finite(b->x_build + i * d, d) ||
+            !sx__state_length_finite(b->v + i * d, d) || !sx__state_length_finite(b->w + i * r, r))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a position, velocity or spin that is not finite or "
                                           "too large (its square overflows)",
                             (long long)id);
-        if (!length_finite(b->f + i * d, d) || !length_finite(b->t + i * r, r) ||
-            (b->fapp && (!length_finite(b->fapp + i * d, d) || !length_finite(b->tapp + i * r, r))))
+        if (!sx__state_length_finite(b->f + i * d, d) || !sx__state_length_finite(b->t + i * r, r) ||
+            (b->fapp && (!sx__state_length_finite(b->fapp + i * d, d) || !sx__state_length_finite(b->tapp + i * r, r))))
             return sx__fail(m, SX_EINVAL, "state: ball %lld has a force, moment or applied load that is not finite or "
                                           "too large (its square overflows)",
                             (long long)id);
@@ -273,8 +271,8 @@ static sx_status check_mesh(sx_model *m, sx_wall *w)
     sx_mesh *s = w->mesh;
     const double *q = s->q, qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     bool vertices = true;
-    for (int64_t v = 0; v < s->nv; v++) vertices = vertices && length_finite(s->body + 3 * v, 3);
-    if (!vertices || !length_finite(w->def.spin, 3) || !finite_all(q, 4) || !(fabs(qq - 1) < 1e-9))
+    for (int64_t v = 0; v < s->nv; v++) vertices = vertices && sx__state_length_finite(s->body + 3 * v, 3);
+    if (!vertices || !sx__state_length_finite(w->def.spin, 3) || !sx__state_finite(q, 4) || !(fabs(qq - 1) < 1e-9))
         return sx__fail(m, SX_EINVAL, "state: mesh wall %lld has a non-finite vertex or spin, or an orientation that "
                                       "is not a unit quaternion", (long long)w->id);
     for (int64_t t = 0; t < 3 * s->nt; t++)
@@ -301,9 +299,9 @@ static sx_status check_walls(sx_model *m)
                             (long long)m->next_wall_id);
         for (int64_t j = 0; j < i; j++)
             if (m->walls[j].id == w->id) return sx__fail(m, SX_EINVAL, "state: wall id %lld appears twice", (long long)w->id);
-        if (!length_finite(w->def.point, 3) || !length_finite(w->def.normal, 3) || !length_finite(w->def.vel, 3) ||
-            !length_finite(w->def.edge1, 3) || !length_finite(w->def.edge2, 3) || !length_finite(w->force, 3) ||
-            !length_finite(w->moment, 3))
+        if (!sx__state_length_finite(w->def.point, 3) || !sx__state_length_finite(w->def.normal, 3) || !sx__state_length_finite(w->def.vel, 3) ||
+            !sx__state_length_finite(w->def.edge1, 3) || !sx__state_length_finite(w->def.edge2, 3) || !sx__state_length_finite(w->force, 3) ||
+            !sx__state_length_finite(w->moment, 3))
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a point, normal, edge, velocity, force or moment that "
                                           "is not finite or too large (its square overflows)", (long long)w->id);
         /* a unit normal (walls are stored normalised) */
@@ -343,9 +341,9 @@ static sx_status check_walls(sx_model *m)
 static bool pair_finite(const sx_model *m, const sx_pairs *p, int64_t c)
 {
     const int d = m->dim;
-    return finite_all(p->fs + c * d, d) && length_finite(p->geo + c * d, d) && isfinite(p->fn[c]) &&
+    return sx__state_finite(p->fs + c * d, d) && sx__state_length_finite(p->geo + c * d, d) && isfinite(p->fn[c]) &&
            (!p->un || isfinite(p->un[c])) &&
-           (!p->jun || (isfinite(p->jun[c]) && finite_all(p->jnormal + c * d, d)));
+           (!p->jun || (isfinite(p->jun[c]) && sx__state_finite(p->jnormal + c * d, d)));
 }
 
 static sx_status check_pairs(sx_model *m)
@@ -402,7 +400,7 @@ static sx_status check_cracks(sx_model *m)
     for (int64_t i = 0; i < m->cracks.n; i++) {
         const sx_crack *c = &m->cracks.ev[i];
         const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
-        if (!finite_all(v, (int64_t)(sizeof v / sizeof *v)))
+        if (!sx__state_finite(v, (int64_t)(sizeof v / sizeof *v)))
             return sx__fail(m, SX_EINVAL, "state: crack %lld has a non-finite time, position, force or moment",
                             (long long)i);
     }
@@ -434,8 +432,8 @@ static sx_status check_bonds(sx_model *m)
                                                 isfinite(k->cb_s[s])))
             return sx__fail(m, SX_EINVAL, "state: contact bond %lld has a strength <= 0 or not finite", (long long)s);
         /* by their squared lengths: a finite 1e300 breaks the bond into a NaN crack */
-        if (!length_finite(k->fn + s, 1) || !length_finite(k->fs + s * m->dim, m->dim) ||
-            !length_finite(k->mn + s, 1) || !length_finite(k->ms + s * m->rdim, m->rdim))
+        if (!sx__state_length_finite(k->fn + s, 1) || !sx__state_length_finite(k->fs + s * m->dim, m->dim) ||
+            !sx__state_length_finite(k->mn + s, 1) || !sx__state_length_finite(k->ms + s * m->rdim, m->rdim))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has a non-finite force or moment", (long long)s);
         if (k->kind[s] & SX_BOND_FLATJOINT) {
             const int64_t nel = (int64_t)k->fj_nr[s] * k->fj_na[s];

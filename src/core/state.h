@@ -55,6 +55,13 @@ typedef struct sx_state_sizes {
 /// The sizes of m's stores now.
 void sx__state_sizes(const sx_model *m, sx_state_sizes *out);
 
+/// Every one of the n values is finite (a restored array's check).
+bool sx__state_finite(const double *v, int64_t n);
+/// The vector's squared length is finite: every component is, and none is
+/// so large (1e300) that a length, or a product of two, overflows (a
+/// restored vector's check: a finite spin of 1e300 broke a bond into NaN).
+bool sx__state_length_finite(const double *v, int64_t n);
+
 /// Sizes every store of m, a model just made by sx_model_create and never
 /// used, to hold exactly s (arrays zeroed, counts set). SX_EINVAL when m is
 /// not empty or a size is out of range, SX_ENOMEM; the message is in m.

@@ -645,6 +645,11 @@ START_TEST(meaningless_values)
     for (hsize_t k = 0; k < 4; k++) poke_at(f, "/clumps/orientation", k, 0);
     H5Fclose(f);
     expect_error(p, 3, "clump 1 has an orientation that is not a unit quaternion");
+    /* a clump's spin of 1e300, finite, as a ball's (above) */
+    f = edit(q, p, sizeof p, "clump_w.h5");
+    poke_at(f, "/clumps/spin", 0, 1e300);
+    H5Fclose(f);
+    expect_error(p, 3, "clump 1 has a non-finite or out-of-range state");
 }
 END_TEST
 
