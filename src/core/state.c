@@ -441,13 +441,33 @@ static sx_status check_bonds(sx_model *m)
                 k->fj_first[s] + nel > m->fjel.n)
                 return sx__fail(m, SX_EINVAL, "state: flat joint %lld has bad elements (%d x %d from %d of %lld)",
                                 (long long)s, k->fj_nr[s], k->fj_na[s], k->fj_first[s], (long long)m->fjel.n);
+            if (!(k->fj_mu[s] >= 0) || !(k->fj_tanphi[s] >= 0) || !sx__state_length_finite(k->fj_mu + s, 1) ||
+                !sx__state_length_finite(k->fj_tanphi + s, 1) || !sx__state_length_finite(k->fj_d0 + s, 1) ||
+                !sx__state_length_finite(k->fj_rot + s * (m->dim - 1), m->dim - 1) ||
+                (m->dim == 3 && !sx__state_length_finite(k->fj_axis + s * 3, 3)))
+                return sx__fail(m, SX_EINVAL, "state: flat joint %lld has a friction, gap or rotation that is negative, "
+                                              "not finite or too large",
+                                (long long)s);
         }
         k->intact++;
     }
-    for (int64_t e = 0; e < m->fjel.n; e++)
-        if (m->fjel.state[e] > SX_FJ_SHEAR)
+    const sx_fjels *E = &m->fjel;
+    const int fsd = m->dim - 1;
+    for (int64_t e = 0; e < E->n; e++) {
+        if (E->state[e] > SX_FJ_SHEAR)
             return sx__fail(m, SX_EINVAL, "state: flat-joint element %lld has an unknown state %d", (long long)e,
-                            m->fjel.state[e]);
+                            E->state[e]);
+        /* as a bond's: NaN or infinite strengths never break, zero or negative ones break at once */
+        if (E->state[e] == SX_FJ_BONDED &&
+            !(E->sigma_c[e] > 0 && isfinite(E->sigma_c[e]) && E->coh[e] > 0 && isfinite(E->coh[e])))
+            return sx__fail(m, SX_EINVAL, "state: flat-joint element %lld is bonded with a strength <= 0 or not finite",
+                            (long long)e);
+        if (!sx__state_length_finite(E->gap0 + e, 1) || !sx__state_length_finite(E->fn + e, 1) ||
+            !sx__state_length_finite(E->fs + e * fsd, fsd))
+            return sx__fail(m, SX_EINVAL, "state: flat-joint element %lld has a gap or force that is not finite or "
+                                          "too large (its square overflows)",
+                            (long long)e);
+    }
     return SX_OK;
 }
 

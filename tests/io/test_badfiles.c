@@ -645,6 +645,30 @@ START_TEST(meaningless_values)
     for (hsize_t k = 0; k < 4; k++) poke_at(f, "/clumps/orientation", k, 0);
     H5Fclose(f);
     expect_error(p, 3, "clump 1 has an orientation that is not a unit quaternion");
+    /* a flat joint's elements and its own fields, as a bond's (issue 18) */
+    m = io_scene_flatjoint(3);
+    char fj[512];
+    io_save(m, io_path(fj, sizeof fj, "flatjoint.h5"));
+    sx_model_destroy(m);
+    static const struct {
+        const char *dataset;
+        double value;
+        const char *error;
+    } fjcases[] = {
+        {"/flatjoints/elements/tensile_strength", NAN, "flat-joint element 0 is bonded with a strength <= 0"},
+        {"/flatjoints/elements/cohesion", -1, "flat-joint element 0 is bonded with a strength <= 0"},
+        {"/flatjoints/elements/normal_force", 1e300, "flat-joint element 0 has a gap or force that is not finite"},
+        {"/flatjoints/friction", -0.5, "flat joint 0 has a friction, gap or rotation that is negative"},
+        {"/flatjoints/bend_rotation", INFINITY, "flat joint 0 has a friction, gap or rotation that is negative"},
+    };
+    for (size_t k = 0; k < sizeof fjcases / sizeof *fjcases; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "fj%zu.h5", k);
+        f = edit(fj, p, sizeof p, name);
+        poke_at(f, fjcases[k].dataset, 0, fjcases[k].value);
+        H5Fclose(f);
+        expect_error(p, 3, fjcases[k].error);
+    }
     /* a clump's spin of 1e300, finite, as a ball's (above) */
     f = edit(q, p, sizeof p, "clump_w.h5");
     poke_at(f, "/clumps/spin", 0, 1e300);
