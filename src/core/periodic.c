@@ -14,6 +14,7 @@
  * the cell measures so that one step removes a fraction alpha of it. */
 #include "clumps.h"
 #include "model_internal.h"
+#include "state.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -428,10 +429,16 @@ sx_status sx__cell_finish(sx_model *m)
         if (k >= d || !(c->h[k][k] > 0) || !isfinite(c->h[k][k]) || !isfinite(c->lo[k]))
             return sx__fail(m, SX_EINVAL, "state: the periodic cell's axis %c is out of range", "xyz"[k]);
     }
-    for (int k = 0; k < 3; k++)
-        for (int i = 0; i < 3; i++)
-            if (!isfinite(c->h[k][i]) || !isfinite(c->hdot[k][i]) || (i > k && c->h[k][i] != 0))
-                return sx__fail(m, SX_EINVAL, "state: the periodic cell's vectors are not upper triangular and finite");
+    /* by rows' squared lengths and the volume: a finite 1e300 overflows the cell's products */
+    double volume = 1;
+    for (int k = 0; k < 3; k++) {
+        if (c->axis[k]) volume *= c->h[k][k];
+        if (!sx__state_length_finite(c->h[k], 3) || !sx__state_length_finite(c->hdot[k], 3) || !isfinite(volume))
+            return sx__fail(m, SX_EINVAL, "state: the periodic cell's vectors or rates are not finite or too large");
+        for (int i = k + 1; i < 3; i++)
+            if (c->h[k][i] != 0)
+                return sx__fail(m, SX_EINVAL, "state: the periodic cell's vectors are not upper triangular");
+    }
     if (!any) return sx__fail(m, SX_EINVAL, "state: a periodic cell without a periodic axis");
     char why[160];
     if (control_problem(m, &c->ctl, &c->controlled, why, sizeof why))

@@ -669,6 +669,25 @@ START_TEST(meaningless_values)
         H5Fclose(f);
         expect_error(p, 3, fjcases[k].error);
     }
+    /* a periodic cell whose vector or rate is a finite 1e300: its volume and products overflow */
+    m = io_scene_granular(3, 50);
+    const sx_periodic_def pd = {{true, true, true}, {-1, -1, -1}, {2, 2, 2}, {0, 0, 0}};
+    ck_assert_int_eq(sx_model_set_periodic(m, &pd), SX_OK);
+    char cell[512];
+    io_save(m, io_path(cell, sizeof cell, "cell.h5"));
+    sx_model_destroy(m);
+    for (int k = 0; k < 2; k++) {
+        const double big_h[9] = {1e200, 0, 0, 0, 1e200, 0, 0, 0, 1e200}; /* each finite, the volume not */
+        const double big_hdot[9] = {0, 1e300, 0, 0, 0, 0, 0, 0, 0};
+        const double *h = k ? big_hdot : big_h;
+        f = edit(cell, p, sizeof p, k ? "cell_hdot.h5" : "cell_h.h5");
+        hid_t g = H5Gopen2(f, "/periodic", H5P_DEFAULT), a = H5Aopen(g, k ? "hdot" : "h", H5P_DEFAULT);
+        ck_assert(a >= 0 && H5Awrite(a, H5T_NATIVE_DOUBLE, h) >= 0);
+        H5Aclose(a);
+        H5Gclose(g);
+        H5Fclose(f);
+        expect_error(p, 3, "the periodic cell's vectors or rates are not finite or too large");
+    }
     /* a clump's spin of 1e300, finite, as a ball's (above) */
     f = edit(q, p, sizeof p, "clump_w.h5");
     poke_at(f, "/clumps/spin", 0, 1e300);
