@@ -101,7 +101,7 @@ local entries = {
   -- model: bonds
   ["model:bond"] = {"m:bond{kind = 'parallel' | 'contact' | 'flatjoint', gap =, seed =, materials =, ...} -> n", "Installs bonds between balls closer than gap [m]."},
   ["model:flatjoint"] = {"m:flatjoint(a, b) -> {{state, area, centroid, gap, fn, fs, tensile_strength, cohesion}, ...} | nil", "The elements of the flat joint between balls a and b."},
-  ["model:joint"] = {"m:joint{point =, normal = | dip = [, dip_direction =], kn =, ks =, friction =, dilation =, tension =, cohesion =, friction_angle =, radius_multiplier =} -> number, bonds, contacts", "Adds a smooth joint: contacts and bonds across the plane take the smooth-joint law."},
+  ["model:joint"] = {"m:joint{point =, normal = | dip = [, dip_direction =], kn =, ks =, friction =, dilation =, tension =, cohesion =, friction_angle =, radius_multiplier =, radius =} -> number, bonds, contacts", "Adds a smooth joint: contacts and bonds across the plane (or, with radius, across its disk about point) take the smooth-joint law."},
   ["model:joints"] = {"m:joints() -> {{point, normal, kn, ks, ...}, ...}", "The model's smooth joints as given."},
   ["model:flatjoint_unbond"] = {"m:flatjoint_unbond(a, b, e)", "Makes element e of the flat joint between a and b a slit (compression and friction only)."},
   ["model:bond_count"] = {"m:bond_count() -> n", "Intact bonds."},

@@ -45,6 +45,7 @@ static const char *joint_invalid(int dim, const sx_joint_def *d, char *why, size
         {"cohesion (Pa)", d->cohesion, 0, INFINITY, false, true},
         {"friction_angle (degrees)", d->friction_angle, 0, 90, false, true},
         {"radius_multiplier", d->radius_multiplier, 0, INFINITY, true, true},
+        {"radius (m)", d->radius, 0, INFINITY, false, true},
     };
     for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
         const double v = rules[k].v;

@@ -11,9 +11,10 @@ typedef struct sx_joint {
 } sx_joint;
 
 /* The first joint (in order) whose plane separates the centres xa and xb
- * (dim components): its number + 1, and its unit normal from a's side to
- * b's in nrm; 0 when none does. A centre on the plane counts as on the
- * normal's side. */
+ * (dim components) and, for a joint of finite radius, whose disk (2D:
+ * segment) the centre line crosses: its number + 1, and its unit normal
+ * from a's side to b's in nrm; 0 when none does. A centre on the plane
+ * counts as on the normal's side. */
 static inline int32_t sx__joint_crossed(const sx_model *m, int dim, const double *xa, const double *xb, double *nrm)
 {
     for (int64_t k = 0; k < m->njoint; k++) {
@@ -24,6 +25,15 @@ static inline int32_t sx__joint_crossed(const sx_model *m, int dim, const double
             sb += (xb[q] - j->point[q]) * j->normal[q];
         }
         if ((sa >= 0) == (sb >= 0)) continue;
+        if (j->radius > 0) { /* where the centre line meets the plane, against the disk */
+            const double t = sa / (sa - sb);
+            double r2 = 0;
+            for (int q = 0; q < dim; q++) {
+                const double c = xa[q] + t * (xb[q] - xa[q]) - j->point[q];
+                r2 += c * c;
+            }
+            if (r2 > j->radius * j->radius) continue;
+        }
         const double s = sb >= 0 ? 1 : -1;
         for (int q = 0; q < dim; q++) nrm[q] = s * j->normal[q];
         return (int32_t)(k + 1);

@@ -650,9 +650,11 @@ SX_API sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out);
 /* --------------------------------------------------------- smooth joints */
 
 /// A smooth joint (Mas Ivars et al. 2011; src/core/laws/smoothjoint.h): a
-/// plane through the model. A contact or bond between two balls whose
-/// centres lie on opposite sides takes the smooth-joint law: its normal is
-/// the plane's, its shear lies in the plane.
+/// plane through the model, or a disk of it (3D; a segment in 2D) about
+/// its point, as the fractures of a discrete fracture network are. A
+/// contact or bond between two balls whose centre line crosses it takes
+/// the smooth-joint law: its normal is the plane's, its shear lies in the
+/// plane.
 typedef struct sx_joint_def {
     double point[3];          ///< m, a point of the plane
     double normal[3];         ///< its normal (any length > 0; 2D: z ignored)
@@ -663,13 +665,15 @@ typedef struct sx_joint_def {
     double cohesion;          ///< Pa, bond's shear strength at zero normal stress
     double friction_angle;    ///< degrees, the bond's phi_b in [0, 90): c + sigma_n tan(phi_b)
     double radius_multiplier; ///< lambda > 0: the interface radius is lambda min(RA, RB)
+    double radius;            ///< m, the joint's extent about point (a disk; 2D a segment); 0: the whole plane
 } sx_joint_def;
 
 /// Plane through the origin with normal +y, kn = ks = 0 (to be given), friction 0.5, no
-/// dilation, unbonded, lambda 1.
+/// dilation, unbonded, lambda 1, the whole plane (radius 0).
 SX_API sx_joint_def sx_joint_default_def(void);
 /// Adds a joint (number sx_joint_count - 1 afterwards) and installs it on the
-/// pairs it crosses: each bond between balls on opposite sides is removed,
+/// pairs it crosses (their centre line crosses the plane, within radius of
+/// point when radius > 0): each bond between balls on opposite sides is removed,
 /// and a bonded joint takes its place, stress free (*bonds counts them);
 /// each other overlapping pair takes the joint's law as an unbonded contact
 /// (*contacts counts these). Later contacts across the plane take it as

@@ -11,7 +11,7 @@
 #include "seixo.h"
 
 /// The newest file format this build writes; it reads every format up to it.
-#define SX_IO_FORMAT_VERSION 3
+#define SX_IO_FORMAT_VERSION 4
 
 /* ---------------------------------------------------------- STL files */
 

@@ -389,8 +389,9 @@ void sx_io_load_periodic(sx_h5 *h, hid_t f, sx_model *m)
 /* The smooth joints' definitions (core sx_joint_def) in their own group
  * /joints, one row per joint, written only when the model has joints; the
  * contacts' joint fields are the ball-ball store's (joint, joint_normal,
- * joint_overlap). */
-enum { JOINT_COLS = 14 };
+ * joint_overlap). The last column, radius, came with format 4: a file
+ * without it has joints of radius 0 (whole planes). */
+enum { JOINT_COLS = 15 };
 
 static int joint_fields(field *f, double *cols, int64_t n)
 {
@@ -398,9 +399,9 @@ static int joint_fields(field *f, double *cols, int64_t n)
     f[k++] = F("point", T_F64, cols, 3, "m");
     f[k++] = F("normal", T_F64, cols + 3 * n, 3, "1");
     static const char *const names[] = {"kn", "ks", "friction", "dilation", "tension", "cohesion", "friction_angle",
-                                        "radius_multiplier"};
-    static const char *const units[] = {"Pa/m", "Pa/m", "1", "degree", "Pa", "Pa", "degree", "1"};
-    for (int q = 0; q < 8; q++) f[k++] = F(names[q], T_F64, cols + (6 + q) * n, 1, units[q]);
+                                        "radius_multiplier", "radius"};
+    static const char *const units[] = {"Pa/m", "Pa/m", "1", "degree", "Pa", "Pa", "degree", "1", "m"};
+    for (int q = 0; q < 9; q++) f[k++] = F(names[q], T_F64, cols + (6 + q) * n, 1, units[q]);
     return k;
 }
 
@@ -411,7 +412,7 @@ static void joint_columns(sx_joint_def *defs, double *cols, int64_t n, bool to_c
         sx_joint_def *d = &defs[i];
         double *v[JOINT_COLS] = {&d->point[0], &d->point[1], &d->point[2], &d->normal[0], &d->normal[1],
                                  &d->normal[2], &d->kn, &d->ks, &d->friction, &d->dilation, &d->tension,
-                                 &d->cohesion, &d->friction_angle, &d->radius_multiplier};
+                                 &d->cohesion, &d->friction_angle, &d->radius_multiplier, &d->radius};
         for (int q = 0; q < JOINT_COLS; q++) {
             double *c = q < 6 ? cols + (q / 3) * 3 * n + i * 3 + q % 3 : cols + (int64_t)q * n + i;
             if (to_cols) *c = *v[q];
@@ -448,7 +449,11 @@ void sx_io_load_joints(sx_h5 *h, hid_t f, sx_model *m, int64_t n)
     if (!defs || !cols) sx_h5_fail(h, "out of memory");
     else {
         field fl[MAX_FIELDS];
-        sx_io_load_group(h, f, "/joints", fl, joint_fields(fl, cols, n), n);
+        const int nf = joint_fields(fl, cols, n);
+        hid_t g = sx_h5_open_group(h, f, "/joints", true);
+        if (g >= 0 && sx_io_read_fields(h, g, "/joints", fl, nf - 1, n, true))
+            sx_io_read_fields(h, g, "/joints", fl + nf - 1, 1, n, false); /* radius: format 4 on */
+        sx_h5_close(g);
         joint_columns(defs, cols, n, false);
         if (!h->failed && sx__joints_restore(m, defs, n)) sx_h5_fail(h, "damaged: %s", sx_model_error(m));
     }

@@ -1,7 +1,7 @@
 /* Smooth joints (core sx_joint_add; law src/core/laws/smoothjoint.h):
  *   m:joint{point=, normal= | dip= [, dip_direction=], kn=, ks=, friction=,
  *           dilation=, tension=, cohesion=, friction_angle=,
- *           radius_multiplier=}     -> number, bonds cut or replaced, contacts taken
+ *           radius_multiplier=, radius=}  -> number, bonds cut or replaced, contacts taken
  *   m:joints()                      -> the joints as given, numbered from 1 */
 #include "bindings.h"
 
@@ -9,7 +9,8 @@
 
 static const char *const joint_keys[] = {"point",    "normal",   "dip",      "dip_direction",  "kn",
                                          "ks",       "friction", "dilation", "tension",        "cohesion",
-                                         "friction_angle",       "radius_multiplier",          NULL};
+                                         "friction_angle",       "radius_multiplier",          "radius",
+                                         NULL};
 
 /* The plane's normal from dip angles: 3D, dip d below the horizontal
  * towards the dip direction a (clockwise from +y, north, with x east and
@@ -46,6 +47,7 @@ static int model_joint(lua_State *L)
     sx_lua_optnumfield(L, 2, "cohesion", &def.cohesion);
     sx_lua_optnumfield(L, 2, "friction_angle", &def.friction_angle);
     sx_lua_optnumfield(L, 2, "radius_multiplier", &def.radius_multiplier);
+    sx_lua_optnumfield(L, 2, "radius", &def.radius);
     int64_t bonds = 0, contacts = 0;
     sx_lua_check(L, m, sx_joint_add(m, &def, &bonds, &contacts), "m:joint");
     lua_pushinteger(L, (lua_Integer)sx_joint_count(m));
@@ -63,7 +65,7 @@ static int model_joints(lua_State *L)
     for (int64_t k = 0; k < n; k++) {
         sx_joint_def d;
         sx_joint_get(m, k, &d);
-        lua_createtable(L, 0, 10);
+        lua_createtable(L, 0, 11);
         sx_lua_pushvec(L, d.point, dim);
         lua_setfield(L, -2, "point");
         sx_lua_pushvec(L, d.normal, dim);
@@ -76,6 +78,7 @@ static int model_joints(lua_State *L)
         sx_lua_setnum(L, "cohesion", d.cohesion);
         sx_lua_setnum(L, "friction_angle", d.friction_angle);
         sx_lua_setnum(L, "radius_multiplier", d.radius_multiplier);
+        sx_lua_setnum(L, "radius", d.radius);
         lua_rawseti(L, -2, (lua_Integer)(k + 1));
     }
     return 1;

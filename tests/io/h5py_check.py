@@ -12,7 +12,7 @@ d = sys.argv[1]
 with h5py.File(d + "/snapshot.h5", "r") as f:
     a = f.attrs
     assert a["format"] == b"seixo", a["format"]
-    assert a["format_version"] == 3 and a["kind"] == b"snapshot" and a["dim"] == 3
+    assert a["format_version"] == 4 and a["kind"] == b"snapshot" and a["dim"] == 3
     assert list(a["seeds"]) == [11], list(a["seeds"])
     x = f["balls/position"][:]
     assert x.shape == (60, 3) and np.all(np.isfinite(x))
@@ -48,7 +48,7 @@ with h5py.File(d + "/snapshot.h5", "r") as f:
     assert abs(radius[-1] - w["radius"][0]) < 0.05 * w["radius"][0]
 
 with h5py.File(d + "/series.h5", "r") as f:
-    assert f.attrs["kind"] == b"series" and f.attrs["format_version"] == 3
+    assert f.attrs["kind"] == b"series" and f.attrs["format_version"] == 4
     count = f.attrs["count"]
     assert count == 7, count
     last = f["snapshots/%06d" % (count - 1)]

@@ -268,6 +268,70 @@ for _, dim in ipairs{2, 3} do
   end)
 end
 
+-- A joint of finite radius (a disk about its point; a fracture of a DFN):
+-- only the pairs whose centre line meets the plane inside it take the law.
+T.test("a joint of finite radius: the bonds its disk cuts, and no others", function()
+  local m = seixo.model{dim = 3}
+  m:material("r", {density = 2600, damping = 0.7, kn = 1e8, ks = 1e8, friction = 0.5,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2, tensile_strength = 1e6,
+                           cohesion = 1e6}})
+  local R = 0.01
+  for i = 0, 9 do
+    for j = 0, 9 do
+      for k = 0, 3 do m:ball{pos = {2 * R * i, 2 * R * j, 2 * R * k}, radius = R} end
+    end
+  end
+  T.eq(m:bond{kind = "parallel", gap = 1e-6}, 2 * 9 * 10 * 4 + 10 * 10 * 3, "bonded lattice")
+  -- the plane z = 3R between layers 1 and 2, a disk of radius 4R about (9R, 9R)
+  local expected = 0
+  for i = 0, 9 do
+    for j = 0, 9 do
+      if (2 * i - 9) ^ 2 + (2 * j - 9) ^ 2 <= 16 then expected = expected + 1 end
+    end
+  end
+  local n, cut = m:joint{point = {9 * R, 9 * R, 3 * R}, normal = {0, 0, 1}, kn = 1e10, ks = 1e10, radius = 4 * R}
+  T.eq(n, 1)
+  T.eq(cut, expected, "bonds cut by the disk")
+  T.check(expected > 0 and expected < 100, "the disk cuts some of the layer's 100 bonds")
+  T.eq(m:bond_count(), 1020 - expected)
+  T.eq(m:joints()[1].radius, 4 * R)
+  -- a save keeps the extent (format 4) and the bits
+  local path = os.tmpname()
+  m:save(path)
+  local r = seixo.load(path)
+  os.remove(path)
+  T.eq(r:joints()[1].radius, 4 * R)
+  T.eq(r:hash(), m:hash(), "as saved")
+  m:close(); r:close()
+end)
+
+T.test("a joint of finite radius: contacts that form later take it only inside", function()
+  for _, dim in ipairs({2, 3}) do
+    local m = seixo.model{dim = dim}
+    m:material("r", {density = 2600, damping = 0.7, kn = 1e8, ks = 1e8, friction = 0.5})
+    local R = 0.01
+    -- two pairs pressed together across y = 0: one at x = 0 (inside the
+    -- joint's radius 3R about the origin), one at x = 10R (outside)
+    local pairs_ = {}
+    for _, x in ipairs({0, 10 * R}) do
+      local a = m:ball{pos = v(dim, x, -1.2 * R), radius = R}
+      local b = m:ball{pos = v(dim, x, 1.2 * R), radius = R}
+      a.fix = "all"
+      b.fix = "spin"
+      b.applied_force = v(dim, 0, -100)
+      pairs_[#pairs_ + 1] = {a = a.id, b = b.id}
+    end
+    m:joint{point = v(dim, 0, 0), normal = v(dim, 0, 1), kn = 1e10, ks = 1e10, radius = 3 * R}
+    m:cycle(2000)
+    local joint_of = {}
+    for c in m:contacts() do joint_of[c.a.id * 1000 + c.b.id] = c.joint or false end
+    local inside, outside = pairs_[1], pairs_[2]
+    T.eq(joint_of[inside.a * 1000 + inside.b], 1, dim .. "D: inside, the joint's law")
+    T.eq(joint_of[outside.a * 1000 + outside.b], false, dim .. "D: outside, the contact law")
+    m:close()
+  end
+end)
+
 T.test("bad joints are named", function()
   local m = seixo.model{dim = 3}
   T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 0}, kn = 1, ks = 1} end, "normal")
@@ -277,6 +341,8 @@ T.test("bad joints are named", function()
   T.raises(function() m:joint{point = {0, 0, 0}, kn = 1, ks = 1} end, "normal or dip")
   T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, dip = 30, kn = 1, ks = 1} end, "normal or dip")
   T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, glue = 1} end, "glue")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, radius = -1} end, "radius")
+  T.raises(function() m:joint{point = {0, 0, 0}, normal = {0, 0, 1}, kn = 1, ks = 1, radius = 0 / 0} end, "radius")
   m:joint{point = {0, 0, 0}, dip = 30, dip_direction = 90, kn = 1, ks = 1}
   local n = m:joints()[1].normal
   T.near(n[1], 0.5, 1e-12); T.near(n[3], math.cos(math.rad(30)), 1e-12)
