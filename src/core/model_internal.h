@@ -218,6 +218,7 @@ typedef struct sx_chunk {
     sx_status st;
     int64_t err_a, err_b;
     double err_un, err_r;
+    bool err_break;        /* st is a bond broken with a non-finite force, not an overlap */
 } sx_chunk;
 
 /* The per-ball passes (wall contacts, then the law of motion) run in

@@ -135,6 +135,19 @@ static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64
                     KERNEL(critical_dt)(m));
 }
 
+/* A chunk's error: an overlap deeper than a radius, or a bond broken with
+ * a non-finite force. */
+static sx_status chunk_error(sx_model *m, const sx_chunk *o)
+{
+    if (o->err_break)
+        return sx__fail(m, SX_EUNSTABLE,
+                        "unstable at step %lld: the bond of balls %lld and %lld broke with a force or moment that is "
+                        "not finite; the timestep %g s is too large for its stiffness (critical estimate %g s): "
+                        "lower the timestep or use the automatic one",
+                        (long long)m->step, (long long)o->err_a, (long long)o->err_b, m->dt, KERNEL(critical_dt)(m));
+    return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+}
+
 static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int element,
                       int64_t i, int64_t j, double fn, double fs, double mn, double ms)
 {
@@ -149,6 +162,12 @@ static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode 
     c.b = m->balls.id[j];
     c.fn = fn, c.fs = fs, c.mn = mn, c.ms = ms;
     c.element = element;
+    /* a force no finite stiffness and step can make: the step is unstable
+     * (a stiffness far above what the timestep was computed for), not a crack */
+    if (!isfinite(fn) || !isfinite(fs) || !isfinite(mn) || !isfinite(ms)) {
+        if (!o->st) o->st = SX_EUNSTABLE, o->err_break = true, o->err_a = c.a, o->err_b = c.b;
+        return;
+    }
     /* kept with the chunk, merged into the model's log in chunk order */
     if (o->ncracks == o->capcracks) {
         const int64_t cap = o->capcracks ? 2 * o->capcracks : 16;
@@ -401,6 +420,7 @@ static void chunk_start(sx_model *m, sx_chunk *o)
     o->lost_bonds = 0;
     o->ncracks = 0;
     o->st = SX_OK;
+    o->err_break = false;
 }
 
 /* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
@@ -932,7 +952,7 @@ static sx_status far_pairs(sx_model *m, int64_t e0, int64_t e1)
         while (++e < e1 && d->xpair[e] == d->xpair[e - 1] + 1) {}
         o->last = d->xpair[e - 1] + 1;
         ball_chunk(m, o);
-        if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+        if (o->st) return chunk_error(m, o);
     }
     return SX_OK;
 }
@@ -961,7 +981,7 @@ static sx_status KERNEL(contacts)(sx_model *m)
     if (m->cell) fold_ghosts(m);
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
-        if (o->st) return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+        if (o->st) return chunk_error(m, o);
         m->acc.slip += o->slip;
         m->acc.viscous += o->viscous;
         m->acc.bond_released += o->released;
