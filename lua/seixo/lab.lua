@@ -1296,9 +1296,9 @@ end
 -- stress before the diametral crack runs through and the halves part. Until
 -- the first crack the halves' opening is elastic, c0 times the stress; it
 -- is taken as split once it exceeds twice the elastic opening at the
--- current stress: on docs/joints.md's 20 mm flat-jointed disks it jumps
--- from under 1.8 to over 3 times within a few hundred steps as the load
--- dips, and three times reads the same split, 1.5 times 2.5-5.5 % lower;
+-- current stress: on docs/joints.md's 20 mm flat-jointed disks it rises
+-- from 1.5-1.8 to 3 times within 600-1,000 steps while the load stays flat
+-- or dips, and three times reads the same split, 1.5 times 2.5-5.5 % lower;
 -- on 16 mm disks the halves part more gradually (1.5 and 3 times: -9 %
 -- to +11 %). nil when the halves never parted so before the test stopped.
 -- Rows {..., tensile_stress (5), cracks (6, 7), ..., opening (9)}.
