@@ -1593,8 +1593,8 @@ set xlabel 'platen displacement (mm)'
 set ylabel 'sigma_t = 2F/(pi D t) (MPa)'
 set y2label 'cracks'
 set y2tics
-plot '%s' using ($3*1e3):($5/1e6) with lines lw 2 title 'tensile stress', '' using ($3*1e3):($6+$7) axes x1y2 with lines dt 2 title 'cracks'
-]], csv)
+plot '%s' using ($3*1e3):($5/1e6) with lines lw 2 title 'tensile stress', '' using ($3*1e3):($6+$7) axes x1y2 with lines dt 2 title 'cracks'%s
+]], csv, r.split and string.format(", %.6g with lines dt 3 title 'the split'", r.split / 1e6) or "")
   return gnuplot(script, {{key = "s", path = out .. "_stress.png"}})
 end
 
