@@ -58,3 +58,23 @@ plot "docs/data/fj_ratio.csv" every ::1 using 21:22:xtic(1) title "UCS / BTS, 10
      "" every ::1 using 19:20 title "UCS / BTS, 20 mm disk, load at the split (joints.split_strength)", \
      "" every ::1 using 17:18 title "UCS / direct tension (joints.direct_tension, the UCS rectangle)", \
      15 with lines dt 2 lw 2 notitle, 8 with lines dt 3 lw 2 notitle
+set output "docs/img/fj-split.png"
+# docs/data/fj_split.lua writes fj_split.csv (seeds 1-3, 2D disks of 10-30 mm; the UCS of fj_ratio.lua's rectangle)
+set terminal pngcairo size 1100,700 font "sans,10"
+set title "UCS / Brazilian strength against the disk's size, mean and sample sd over seeds 1-3\n(2D; UCS of the 10 x 20 mm rectangle; disks of radii 0.2-0.33 mm)"
+unset label 3
+unset label 4
+set style data yerrorlines
+set key top left noenhanced
+set xlabel "disk diameter / mean grain diameter"
+set ylabel "UCS / BTS"
+set xrange [10:80]
+set yrange [0:30]
+set xtics auto
+set bmargin 4
+set label 5 "target >= 15 (flat joint)" at graph 0.7, first 15.6
+set label 6 "parallel bond < 8" at graph 0.7, first 8.6
+plot "docs/data/fj_split.csv" every ::1 using 4:(strcol(1) eq "cal" ? $18 : NaN):19 pt 7 lw 2 title "flat joint (calibrated), BTS at the split (lab.brazilian's split)", \
+     "" every ::1 using 4:(strcol(1) eq "cal" ? $20 : NaN):21 pt 6 lw 1 dt 2 title "flat joint (calibrated), BTS at the peak load", \
+     "" every ::1 using 4:(strcol(1) eq "pb" ? $18 : NaN):19 pt 5 lw 2 title "parallel bond, BTS at the split (= its peak)", \
+     15 with lines dt 2 lw 2 notitle, 8 with lines dt 3 lw 2 notitle

@@ -147,6 +147,18 @@ test("the Brazilian test splits a disk", function()
   check(r.tensile_strength > 0 and r.tensile_strength < math.huge, r.tensile_strength)
   near(r.tensile_strength, 2 * r.peak_force / (math.pi * r.diameter * r.thickness), 1e-12)
   check(r.cracks.tension > 0, "tensile cracks")
+  -- the halves' opening is elastic before the first crack: in proportion to
+  -- the load, at a quarter and at three quarters of the peak
+  eq(r.columns[9], "opening")
+  local function at(frac)
+    for _, row in ipairs(r.rows) do if row[5] >= frac * r.tensile_strength then return row end end
+  end
+  local q1, q3 = at(0.25), at(0.75)
+  eq(q3[6] + q3[7], 0, "no crack at three quarters of the peak")
+  near(q3[9] / q3[5], q1[9] / q1[5], 0.05)
+  check(q1[9] > 0, "the halves move apart")
+  -- a parallel-bonded disk splits at its peak
+  near(r.split, r.tensile_strength, 1e-12)
 end)
 
 test("3D: a tiny cylinder through UCS and triaxial tests in a servo-controlled cylindrical wall", function()
