@@ -299,9 +299,12 @@ static sx_status check_walls(sx_model *m)
                             (long long)m->next_wall_id);
         for (int64_t j = 0; j < i; j++)
             if (m->walls[j].id == w->id) return sx__fail(m, SX_EINVAL, "state: wall id %lld appears twice", (long long)w->id);
-        if (!sx__state_length_finite(w->def.point, 3) || !sx__state_length_finite(w->def.normal, 3) || !sx__state_length_finite(w->def.vel, 3) ||
-            !sx__state_length_finite(w->def.edge1, 3) || !sx__state_length_finite(w->def.edge2, 3) || !sx__state_length_finite(w->force, 3) ||
-            !sx__state_length_finite(w->moment, 3))
+        const double *vectors[] = {w->def.point, w->def.normal, w->def.vel, w->def.edge1, w->def.edge2, w->force,
+                                   w->moment};
+        bool finite = true;
+        for (size_t k = 0; k < sizeof vectors / sizeof *vectors; k++)
+            finite = finite && sx__state_length_finite(vectors[k], 3);
+        if (!finite)
             return sx__fail(m, SX_EINVAL, "state: wall %lld has a point, normal, edge, velocity, force or moment that "
                                           "is not finite or too large (its square overflows)", (long long)w->id);
         /* a unit normal (walls are stored normalised) */

@@ -327,10 +327,10 @@ static int model_save(lua_State *L)
     char err[1024] = "";
     /* decomposed over ranks, every rank holds the same whole model between
      * cycles: rank 0 writes it, and the others wait for the outcome (the
-     * file is there, or every rank raises rank 0's error) */
+     * file is there, or every rank raises rank 0's error: the I/O layer
+     * writes a message to err with every failure) */
     const bool shared = sx_model_ranks(m) > 1;
-    if (sx_lua_parallel_writes(shared) && sx_snapshot_save(m, path, &o, err, sizeof err) && !err[0])
-        snprintf(err, sizeof err, "m:save: '%s' could not be written", path);
+    if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     lua_pushvalue(L, 5);
     return 1;
@@ -437,13 +437,11 @@ static void write_now(lua_State *L, int idx, int model, const sx_model *m, bool 
     const sx_io_history *h = sx_lua_histories_push(L, model, 0, passed, &n);
     char err[1024] = "";
     if (o->s) {
-        const sx_status st = m ? sx_series_write(o->s, m, h, n, err, sizeof err)
-                               : sx_series_write_histories(o->s, h, n, err, sizeof err);
-        if (st && !err[0]) snprintf(err, sizeof err, "'%s': the series could not be written", sx_series_path(o->s));
+        if (m) sx_series_write(o->s, m, h, n, err, sizeof err);
+        else sx_series_write_histories(o->s, h, n, err, sizeof err);
         o->count = sx_series_count(o->s);
     }
-    if (collective ? sx_lua_parallel_outcome(o->shared, err, sizeof err, &o->count) : err[0] != '\0')
-        luaL_error(L, "%s", err);
+    if (sx_lua_parallel_outcome(collective && o->shared, err, sizeof err, &o->count)) luaL_error(L, "%s", err);
     for (int k = 0; k < n; k++)
         if (h[k].n > 0) {
             lua_pushinteger(L, (lua_Integer)h[k].steps[h[k].n - 1]);
@@ -485,11 +483,10 @@ static void close_series(lua_State *L, int idx, bool collective, char *err, size
     }
     /* a failure to write the last samples still closes the file */
     char closing[1024] = "";
-    if (o->s && sx_series_close(o->s, closing, sizeof closing) && !closing[0])
-        snprintf(closing, sizeof closing, "'%s': the series could not be closed", sx_series_path(o->s));
+    sx_series_close(o->s, closing, sizeof closing);
     o->s = NULL;
     o->open = false;
-    if (collective) sx_lua_parallel_outcome(o->shared, closing, sizeof closing, NULL);
+    sx_lua_parallel_outcome(collective && o->shared, closing, sizeof closing, NULL);
     if (!err[0]) snprintf(err, size, "%s", closing);
 }
 
@@ -628,7 +625,6 @@ static int model_output(lua_State *L)
     if (sx_lua_parallel_writes(o->shared)) {
         o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
         if (o->s) o->count = sx_series_count(o->s);
-        else if (!err[0]) snprintf(err, sizeof err, "'%s': the series could not be opened", path);
     }
     if (sx_lua_parallel_outcome(o->shared, err, sizeof err, &o->count)) return luaL_error(L, "%s", err);
     o->open = true;
