@@ -69,6 +69,9 @@ bool sx_lua_parallel_writes(bool shared);
 /// ranks, which wait for it. True if the work failed. Not shared: only
 /// reads err. A collective call: never from __gc, whose time differs between ranks.
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count);
+/// parallel.c: rank 0's v, on every rank (which all make the call and wait
+/// for it); v itself without MPI or with one rank.
+int64_t sx_lua_parallel_root_value(int64_t v);
 /// parallel.c: on ranks other than 0, print does nothing.
 void sx_lua_parallel_open(lua_State *L);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress

@@ -233,6 +233,15 @@ void sx_lua_parallel_fail(const char *message)
 
 int sx_lua_parallel_rank(void) { return world_rank; }
 
+int64_t sx_lua_parallel_root_value(int64_t v)
+{
+#ifdef SX_HAVE_MPI
+    if (mpi_started && world_size > 1 && MPI_Bcast(&v, 1, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("the ranks could not agree on where a cycle's chunk ends");
+#endif
+    return v;
+}
+
 bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count)

@@ -82,8 +82,16 @@ static double now(void)
  * every `every` seconds (10 by default), for runs that last that long. */
 enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250, PROGRESS_LOG_EVERY_S = 10 };
 
+/* A model decomposed over MPI ranks cuts its cycles into chunks that every
+ * rank takes alike (rank 0's, whose clock sets them), of a line's interval
+ * and at least PROGRESS_RANKS_S: each chunk's cycle starts by checking that
+ * the ranks' models agree (a hash of the whole state) and ends by gathering
+ * the state, a cost of a few steps. */
+enum { PROGRESS_RANKS_S = 1 };
+
 typedef struct progress {
     int mode;              // SX_PROGRESS_*
+    bool ranks;            // the model is decomposed over MPI ranks: chunks of rank 0, lines from rank 0
     bool shown;
     double start, last;    // wall-clock s
     double delay, every;   // s before the first line, s between lines
@@ -92,9 +100,10 @@ typedef struct progress {
     const char *what;      // the call, which a log line names
 } progress;
 
-static void progress_start(lua_State *L, progress *p, const sx_model *m, const char *what)
+static void progress_start(lua_State *L, progress *p, const sx_model *m, const char *what, bool ranks)
 {
     p->mode = sx_lua_progress_mode(L);
+    p->ranks = ranks;
     p->shown = false;
     p->start = p->last = now();
     p->step0 = sx_model_step_count(m);
@@ -115,10 +124,11 @@ static void progress_show(progress *p, const sx_model *m, int64_t total, double 
     const double t = now();
     const int64_t done = sx_model_step_count(m) - p->step0;
     const double rate = done / (t - p->start > 0 ? t - p->start : 1e-9);
-    /* aim the next chunk at 0.1 s of cycling */
-    const double want = rate * 0.1;
+    /* aim the next chunk at 0.1 s of cycling (over ranks, at a line's interval, and no less than PROGRESS_RANKS_S) */
+    const double want = rate * (p->ranks ? fmax(p->every, PROGRESS_RANKS_S) : 0.1);
     p->chunk = want < 1 ? 1 : want > 1e9 ? 1000000000 : (int64_t)want;
     if (!p->mode || t - p->start < p->delay || t - p->last < p->every) return;
+    if (p->ranks && sx_lua_parallel_rank() > 0) return; /* one line per chunk, not one per rank */
     p->last = t;
     p->shown = true;
     char line[256];
@@ -505,7 +515,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     const int64_t start = sx_model_step_count(m);
     const double t0 = sx_model_time(m);
     progress *p = &r->progress;
-    progress_start(L, p, m, what);
+    progress_start(L, p, m, what, r->ud->decomposed);
     sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
     *ratio = NAN;
     enum reason why = BY_STEPS;
@@ -546,8 +556,12 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = steps_to_time(m, lim->time, taken);
             if (k < n) n = k;
         }
-        /* (a chunk of 0.1 s of cycling differs between ranks, which must cut their cycles alike) */
-        if (p->mode && p->chunk < n && !r->ud->decomposed) n = p->chunk;
+        if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
+            const int64_t chunk = sx_lua_parallel_root_value(p->mode ? p->chunk : INT64_MAX);
+            if (chunk < n) n = chunk;
+        } else if (p->mode && p->chunk < n) {
+            n = p->chunk;
+        }
         /* a placement check follows the first step; contact and region events are per step */
         if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         sx_lua_run_cycle(L, r, n);

@@ -42,6 +42,21 @@ done
 # a file saved with 3 ranks, loaded with 2 (and serially), continues bit-for-bit:
 # a pour, a bonded specimen and a bonded periodic cell breaking bonds before
 # and after the save
+# the progress line under MPI: rank 0's chunks on every rank, its lines only
+# (steps strictly increasing: no line repeated by another rank), the same bits
+progress=$(dirname "$script")/mpi_progress.lua
+"$seixo" "$progress" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+if mpirun $root --oversubscribe -np 3 "$seixo" "$progress" >"$dir/out" 2>"$dir/err" &&
+   grep -q "^ranks 3$" "$dir/err" && cmp -s "$dir/serial" "$dir/out"; then
+  lines=$(grep -c "^seixo: m:cycle: step " "$dir/err")
+  if [ "$lines" -ge 2 ] && grep "^seixo: m:cycle: step " "$dir/err" | awk '{ if ($4 <= last) exit 1; last = $4 }'; then
+    echo "progress, -np 3: $lines lines from one rank, identical"
+  else
+    echo "progress, -np 3: $lines lines, or a step repeated:"; cat "$dir/err"; fail=1
+  fi
+else
+  echo "progress, -np 3 differs or failed:"; cat "$dir/out" "$dir/err"; fail=1
+fi
 restart=$(dirname "$script")/mpi_restart.lua
 for kind in pour bonded periodic; do
   # shellcheck disable=SC2086
