@@ -4,7 +4,7 @@
  *
  * The core makes no MPI call: the caller's sx_exchange moves bytes. Between
  * cycles every rank holds the whole model, the same on all ranks (checked
- * by its hash when a cycle starts). Inside a cycle rank r owns the balls
+ * by a digest of its bytes when a cycle starts, sx__state_digest). Inside a cycle rank r owns the balls
  * own[r], a contiguous range of dense indices: the broad phase sorts balls
  * by cell with the last axis slowest, so a range is a slab across that
  * axis, cut to balance the ball count (and cut again at every build, which
@@ -34,6 +34,7 @@
  * (xpair), keeping current the far end of the cell they reach; the cell's
  * stress (its servo) is summed over the ranks in a chain, in pair order. */
 #include "model_internal.h"
+#include "state.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -526,7 +527,7 @@ sx_status sx__dd_begin(sx_model *m)
         return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
                                       "walls, contact and parallel bonds, clumps, periodic space); run it serially",
                         what, d->x.ranks);
-    if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
+    if (!d->x.agree(d->x.ud, sx__state_digest(m)))
         return sx__fail(m, SX_EINVAL,
                         "cycle: the model differs between the %d ranks (every rank must make the same calls: "
                         "random numbers without a fixed seed, or a branch on seixo.rank()?)",

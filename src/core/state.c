@@ -709,6 +709,10 @@ static void hash_bonds(hasher *s, const sx_model *m)
             put_doubles(s, e->fs + i * t, t, 1);
         }
     }
+}
+
+static void hash_cracks(hasher *s, const sx_model *m)
+{
     put_int(s, m->cracks.n);
     for (int64_t i = 0; i < m->cracks.n; i++) {
         const sx_crack *c = &m->cracks.ev[i];
@@ -751,6 +755,15 @@ static void hash_walls(hasher *s, const sx_model *m)
     }
 }
 
+/* The clumps, the periodic cell and the smooth joints, each hashed by its module. */
+static void hash_stores(hasher *s, const sx_model *m)
+{
+    /* an empty clump store (a template that was refused) is no clumps */
+    if (m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0)) s->h = sx__clumps_hash(m, s->h);
+    if (m->cell) s->h = sx__cell_hash(m, s->h);
+    if (m->njoint) s->h = sx__joints_hash(m, s->h);
+}
+
 uint64_t sx_model_state_hash(const sx_model *m)
 {
     hasher s = {FNV_BASIS};
@@ -761,9 +774,128 @@ uint64_t sx_model_state_hash(const sx_model *m)
     hash_pairs(&s, m, &m->bb, false);
     hash_pairs(&s, m, &m->bw, true);
     hash_bonds(&s, m);
-    /* an empty clump store (a template that was refused) is no clumps */
-    if (m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0)) s.h = sx__clumps_hash(m, s.h);
-    if (m->cell) s.h = sx__cell_hash(m, s.h);
-    if (m->njoint) s.h = sx__joints_hash(m, s.h);
+    hash_cracks(&s, m);
+    hash_stores(&s, m);
     return s.h;
+}
+
+/* ---------------------------------------------------------------- digest */
+
+/* What the ranks of a decomposed model compare when a cycle starts
+ * (decompose.c): ranks that made the same calls hold the same bytes in
+ * the same dense order, so the big stores (balls, pairs, bonds) go raw, a
+ * word at a time in four independent lanes (xxHash's round), at about the
+ * speed of memory; the byte-at-a-time canonical hash costs some five steps
+ * of a 400,000-ball bed, at every cycle's start. The small parts and the
+ * crack log go through the canonical hash's functions. Not a state hash:
+ * it depends on the dense order and on the representation. */
+typedef struct digest {
+    uint64_t lane[4];
+} digest;
+
+static uint64_t digest_round(uint64_t acc, uint64_t w)
+{
+    acc += w * 0xc2b2ae3d27d4eb4fULL;
+    acc = acc << 31 | acc >> 33;
+    return acc * 0x9e3779b185ebca87ULL;
+}
+
+/* n entries of size bytes at data; a NULL array (an optional one not
+ * allocated) differs from any allocated one. */
+static void digest_array(digest *g, const void *data, int64_t n, size_t size)
+{
+    const size_t bytes = data ? (size_t)n * size : 0;
+    const unsigned char *p = data;
+    size_t i = 0;
+    for (; i + 32 <= bytes; i += 32)
+        for (int k = 0; k < 4; k++) {
+            uint64_t w;
+            memcpy(&w, p + i + 8 * k, sizeof w);
+            g->lane[k] = digest_round(g->lane[k], w);
+        }
+    for (; i < bytes; i++) g->lane[i & 3] = digest_round(g->lane[i & 3], p[i]);
+    g->lane[0] = digest_round(g->lane[0], data ? (uint64_t)bytes : UINT64_MAX);
+}
+
+static void digest_balls(digest *g, const sx_model *m)
+{
+    const sx_balls *b = &m->balls;
+    const int64_t n = b->n, nd = n * m->dim, nr = n * m->rdim;
+    const uint64_t counts[] = {(uint64_t)n, (uint64_t)b->next_id};
+    digest_array(g, counts, 2, sizeof *counts);
+    digest_array(g, b->x, nd, sizeof *b->x);
+    digest_array(g, b->v, nd, sizeof *b->v);
+    digest_array(g, b->w, nr, sizeof *b->w);
+    digest_array(g, b->f, nd, sizeof *b->f);
+    digest_array(g, b->t, nr, sizeof *b->t);
+    digest_array(g, b->x_build, nd, sizeof *b->x_build);
+    digest_array(g, b->rad, n, sizeof *b->rad);
+    digest_array(g, b->inv_mass, n, sizeof *b->inv_mass);
+    digest_array(g, b->inv_inertia, n, sizeof *b->inv_inertia);
+    digest_array(g, b->id, n, sizeof *b->id);
+    digest_array(g, b->mat, n, sizeof *b->mat);
+    digest_array(g, b->fix, n, sizeof *b->fix);
+    digest_array(g, b->alpha, n, sizeof *b->alpha);
+    digest_array(g, b->group, n, sizeof *b->group);
+    digest_array(g, b->clump, n, sizeof *b->clump);
+    digest_array(g, b->fapp, nd, sizeof *b->fapp);
+    digest_array(g, b->tapp, nr, sizeof *b->tapp);
+}
+
+/* Every field of the store's schema (the ends too: the build's lists). */
+static void digest_pairs(digest *g, const sx_model *m, const sx_pairs *p)
+{
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, (sx_pairs *)p, f);
+    digest_array(g, &p->n, 1, sizeof p->n);
+    for (int k = 0; k < nf; k++) digest_array(g, *f[k].data, p->n * f[k].per, sx__pair_size(&f[k]));
+}
+
+static void digest_bonds(digest *g, const sx_model *m)
+{
+    const sx_bonds *k = &m->bonds;
+    const sx_fjels *e = &m->fjel;
+    const int64_t n = k->n, t = m->dim - 1;
+    digest_array(g, &k->n, 1, sizeof k->n);
+    digest_array(g, k->kind, n, sizeof *k->kind);
+    digest_array(g, k->ida, n, sizeof *k->ida);
+    digest_array(g, k->idb, n, sizeof *k->idb);
+    const double *const scalars[] = {k->cb_n, k->cb_s, k->rbar, k->kn, k->ks, k->sigma_c, k->tau_c, k->fn, k->mn};
+    for (size_t j = 0; j < sizeof scalars / sizeof *scalars; j++) digest_array(g, scalars[j], n, sizeof(double));
+    digest_array(g, k->fs, n * m->dim, sizeof *k->fs);
+    digest_array(g, k->ms, n * m->rdim, sizeof *k->ms);
+    if (!e->n) return; /* flat joints (laws/flatjoint.h): each joint's face, its elements */
+    digest_array(g, k->fj_first, n, sizeof *k->fj_first);
+    digest_array(g, k->fj_nr, n, sizeof *k->fj_nr);
+    digest_array(g, k->fj_na, n, sizeof *k->fj_na);
+    digest_array(g, k->fj_mu, n, sizeof *k->fj_mu);
+    digest_array(g, k->fj_tanphi, n, sizeof *k->fj_tanphi);
+    digest_array(g, k->fj_d0, n, sizeof *k->fj_d0);
+    digest_array(g, k->fj_rot, n * t, sizeof *k->fj_rot);
+    digest_array(g, k->fj_axis, m->dim == 3 ? n * 3 : 0, sizeof *k->fj_axis);
+    digest_array(g, &e->n, 1, sizeof e->n);
+    digest_array(g, e->state, e->n, sizeof *e->state);
+    digest_array(g, e->sigma_c, e->n, sizeof *e->sigma_c);
+    digest_array(g, e->coh, e->n, sizeof *e->coh);
+    digest_array(g, e->gap0, e->n, sizeof *e->gap0);
+    digest_array(g, e->fn, e->n, sizeof *e->fn);
+    digest_array(g, e->fs, e->n * t, sizeof *e->fs);
+}
+
+uint64_t sx__state_digest(const sx_model *m)
+{
+    hasher s = {FNV_BASIS};
+    hash_scalars(&s, m);
+    hash_materials(&s, m);
+    hash_walls(&s, m);
+    hash_cracks(&s, m);
+    hash_stores(&s, m);
+    digest g = {{s.h, FNV_BASIS, ~FNV_BASIS, s.h ^ 0x9e3779b97f4a7c15ULL}};
+    digest_balls(&g, m);
+    digest_pairs(&g, m, &m->bb);
+    digest_pairs(&g, m, &m->bw);
+    digest_bonds(&g, m);
+    uint64_t h = 0;
+    for (int k = 0; k < 4; k++) h = mix(h ^ g.lane[k]);
+    return h;
 }

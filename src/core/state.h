@@ -57,6 +57,10 @@ void sx__state_sizes(const sx_model *m, sx_state_sizes *out);
 
 /// Every one of the n values is finite (a restored array's check).
 bool sx__state_finite(const double *v, int64_t n);
+/// A digest of the whole state in dense order, for ranks that must hold
+/// the same bytes (decompose.c): much faster than sx_model_state_hash, but
+/// not canonical (a re-sort changes it).
+uint64_t sx__state_digest(const sx_model *m);
 /// The vector's squared length is finite: every component is, and none is
 /// so large (1e300) that a length, or a product of two, overflows (a
 /// restored vector's check: a finite spin of 1e300 broke a bond into NaN).

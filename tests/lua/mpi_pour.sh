@@ -57,6 +57,15 @@ if mpirun $root --oversubscribe -np 3 "$seixo" "$progress" >"$dir/out" 2>"$dir/e
 else
   echo "progress, -np 3 differs or failed:"; cat "$dir/out" "$dir/err"; fail=1
 fi
+# ranks whose models differ by one bit of one velocity: stopped with the cause
+diverge=$(dirname "$script")/mpi_diverge.lua
+if mpirun $root --oversubscribe -np 3 "$seixo" "$diverge" >"$dir/out" 2>"$dir/err"; then
+  echo "diverging ranks, -np 3: not stopped"; cat "$dir/out"; fail=1
+elif grep -q "m:cycle: the model differs between the 3 ranks" "$dir/err" && ! grep -q "not stopped" "$dir/out"; then
+  echo "diverging ranks, -np 3: stopped, naming the cause"
+else
+  echo "diverging ranks, -np 3: failed without naming the cause:"; cat "$dir/out" "$dir/err"; fail=1
+fi
 restart=$(dirname "$script")/mpi_restart.lua
 for kind in pour bonded periodic; do
   # shellcheck disable=SC2086
