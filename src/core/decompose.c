@@ -22,9 +22,14 @@
  *     wblk[r], are its to share, and every rank adds all blocks' sums in
  *     block order;
  *   - integrates its own balls, and takes the largest displacement of all
- *     ranks (a maximum, exact in any order) for the rebuild criterion.
- * A build, the energy guard and the end of the cycle first gather the
- * whole state on every rank (each ball from its owner, each pair from the
+ *     ranks (a maximum, exact in any order) for the rebuild criterion;
+ *   - with energy tracking, chains the step's energy sums (a chunk's or a
+ *     block's, begun on one rank, may go on over the next: each rank keeps
+ *     the terms of such a sum on a tape and adds them onto the sum the
+ *     lower ranks pass it), and every rank adds them in the serial order.
+ * The energy guard sums its energy in chains over the ranks' own balls and
+ * pairs (sx__dd_chain), in the serial order. A build and the end of the
+ * cycle first gather the whole state on every rank (each ball from its owner, each pair from the
  * owner of its first ball, each bond from the owner of its pair, and the
  * ranks' cracks merged in the serial order); the build itself is the
  * serial one, on every rank. Clumps: every rank steps every clump, from
