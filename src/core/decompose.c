@@ -568,7 +568,8 @@ static void energy_part(const sx_model *m, int r, double *acc)
         if (o->part != SX_DD_PART_START) continue;
         acc[3 * c] = o->slip, acc[3 * c + 1] = o->viscous, acc[3 * c + 2] = o->released;
     }
-    for (int64_t b = d->wblk[r].lo; b < d->wblk[r].hi; b++) wall[2 * b] = m->blocks[b].slip, wall[2 * b + 1] = m->blocks[b].viscous;
+    for (int64_t b = d->wblk[r].lo; b < d->wblk[r].hi; b++)
+        wall[2 * b] = m->blocks[b].slip, wall[2 * b + 1] = m->blocks[b].viscous;
     const sx_span own = d->own[r];
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];

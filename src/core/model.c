@@ -509,7 +509,8 @@ static sx_status next_timestep(sx_model *m, double *dt)
         if (m->dd && m->dd->active && !sx__dd_halo(m))
             return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange ghosts");
         double crit;
-        if (!critical(m, &crit)) return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
+        if (!critical(m, &crit))
+            return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
         if (!isfinite(crit))
             return sx__fail(m, SX_EINVAL,
                             "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
@@ -628,7 +629,8 @@ static sx_status guard_check(sx_model *m)
     if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
     sx_energy e;
     /* decomposed: the ghosts where the step left their owners, for the pairs' strain */
-    if ((m->dd && m->dd->active && !sx__dd_halo(m)) || !kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    if ((m->dd && m->dd->active && !sx__dd_halo(m)) || !kernels(m)->energy(m, &e))
+        return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     const double gain = mechanical(&e) - m->guard_e0;
     if (!(gain > GUARD_ENERGY_FACTOR * m->guard_scale)) return SX_OK;
     int64_t fastest;

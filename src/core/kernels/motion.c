@@ -74,7 +74,8 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                     v[k] += fd * im * dtv; /* 4-46 */
                     if (track) motion_energy(m, o, 0, &damp_work, (fd - force) * 0.5 * (vold + v[k]) * dt);
                 }
-                if (track && B->fapp) motion_energy(m, o, 1, &load_work, B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt);
+                if (track && B->fapp)
+                    motion_energy(m, o, 1, &load_work, B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt);
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - xb[i * D + k];
@@ -93,7 +94,8 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                     w[k] += md * ii * dtv;
                     if (track) motion_energy(m, o, 0, &damp_work, (md - t[k]) * 0.5 * (wold + w[k]) * dt);
                 }
-                if (track && B->tapp) motion_energy(m, o, 1, &load_work, B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt);
+                if (track && B->tapp)
+                    motion_energy(m, o, 1, &load_work, B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt);
             }
             check += 0 * w[k];
         }

@@ -409,7 +409,8 @@ static void smooth_joint(sx_model *m, sx_chunk *o, int64_t c, int32_t slot, unsi
         double work[2] = {0, 0};
         fn = sx_law_sj_unbonded(D, L, area, un, fs, fs0, track && !before ? work : NULL);
         if (track) chunk_energy(m, o, E_SLIP, work[0]), chunk_energy(m, o, E_SLIP, work[1]);
-        if (track && before) chunk_energy(m, o, E_RELEASED, before - sx_law_sj_strain(D, L, area, *un > 0 ? *un : 0, fs));
+        if (track && before)
+            chunk_energy(m, o, E_RELEASED, before - sx_law_sj_strain(D, L, area, *un > 0 ? *un : 0, fs));
     }
     for (int k = 0; k < D; k++) F[k] = fn * N[k] + fs[k];
     p->fn[c] = fn;
@@ -479,7 +480,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                 double kn, ks;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
                 if (ks > 0) chunk_energy(m, o, E_SLIP, 0.5 * dot(fs, fs) / ks);
-                if (law->mu_r > 0) chunk_energy(m, o, E_SLIP, sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum));
+                if (law->mu_r > 0)
+                    chunk_energy(m, o, E_SLIP, sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum));
                 if (p->joint && p->joint[c]) { /* a smooth joint's springs instead */
                     const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
                     chunk_energy(m, o, E_SLIP,
@@ -594,7 +596,8 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (!(bonds & SX_BOND_CONTACT)) {
                 if (un <= 0) { /* unbonded and open: no contact force */
                     /* a contact bond that failed in shear while in tension releases both springs */
-                    if (track) chunk_energy(m, o, E_RELEASED, 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0));
+                    if (track)
+                        chunk_energy(m, o, E_RELEASED, 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0));
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                     if (us) sx_law_total_shear_slip(D, us, 0);
