@@ -5,9 +5,10 @@
 --             chunk of pairs over every rank; 3: 576 spheres, two chunks)
 --             with local damping, contact dashpots and friction, crushed
 --             (3D: sheared) by a moving platen until bonds break, balls
---             pushed by applied forces and moments, and clumps falling
---             beside it: every energy term in hexadecimal (%a) every 400
---             steps, and the state hash.
+--             pushed by applied forces and moments, a loose stack of grains
+--             collapsing beside it (friction: slip in every rank's slab),
+--             and clumps falling: every energy term in hexadecimal (%a)
+--             every 400 steps, and the state hash.
 --   guard D   an unforced bed (balls settled in a fixed box, no load) given
 --             a timestep far above the critical one: the energy guard stops
 --             the cycle; its message (mpi_guard.sh compares it) must name
@@ -70,9 +71,20 @@ if scene == "track" then
   local n = m:bond{kind = "parallel", gap = 1e-6, seed = 42, materials = "rock"}
   local nc = m:bond{kind = "contact", gap = 1e-6, seed = 43, materials = "rock"}
   print(string.format("%d balls, %d parallel bonds, %d contact bonds", m:ball_count(), n, nc))
-  -- clumps falling on the floor beside the specimen (its pebbles on the ranks of the low slabs)
+  -- a square stack of grains beside it, as tall as the specimen, pressed
+  -- a little together, its layers thrown sideways in turn: they slide on
+  -- each other (friction) in every rank's slab
+  local layers = dim == 3 and 14 or 19 -- below the platen
+  for j = 0, layers - 1 do
+    for i = 0, 2 do
+      local x, y, u = (44 + 1.99 * i) * r, (1 + 1.99 * j) * r, j % 2 == 0 and 0.3 or -0.3
+      m:ball{pos = dim == 3 and {x, 6 * r, y} or {x, y}, radius = r, material = "grain",
+             vel = dim == 3 and {u, 0.1 * u, 0} or {u, 0}}
+    end
+  end
+  -- clumps falling on the floor beside them (its pebbles on the ranks of the low slabs)
   for k = 0, 5 do
-    local x = (48 + 5 * k) * r
+    local x = (56 + 5 * k) * r
     m:clump{template = "pair", pos = dim == 3 and {x, 6 * r, 2 * r + k * r} or {x, 2 * r + k * r}, material = "grain",
             vel = along(-0.5)}
   end
