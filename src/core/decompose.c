@@ -22,9 +22,14 @@
  *     wblk[r], are its to share, and every rank adds all blocks' sums in
  *     block order;
  *   - integrates its own balls, and takes the largest displacement of all
- *     ranks (a maximum, exact in any order) for the rebuild criterion.
- * A build, the energy guard and the end of the cycle first gather the
- * whole state on every rank (each ball from its owner, each pair from the
+ *     ranks (a maximum, exact in any order) for the rebuild criterion;
+ *   - with energy tracking, chains the step's energy sums (a chunk's or a
+ *     block's, begun on one rank, may go on over the next: each rank keeps
+ *     the terms of such a sum on a tape and adds them onto the sum the
+ *     lower ranks pass it), and every rank adds them in the serial order.
+ * The energy guard sums its energy in chains over the ranks' own balls and
+ * pairs (sx__dd_chain), in the serial order. A build and the end of the
+ * cycle first gather the whole state on every rank (each ball from its owner, each pair from the
  * owner of its first ball, each bond from the owner of its pair, and the
  * ranks' cracks merged in the serial order); the build itself is the
  * serial one, on every rank. Clumps: every rank steps every clump, from
@@ -43,7 +48,6 @@ static const char *not_decomposed(const sx_model *m)
 {
     if (m->fjel.n) return "flat joints";
     if (m->njoint) return "smooth joints";
-    if (m->track_energy) return "energy tracking";
     for (int64_t w = 0; w < m->nwall; w++)
         if (m->walls[w].mesh) return "mesh walls";
     return NULL;
@@ -59,6 +63,7 @@ void sx__dd_free(sx_model *m)
     free(d->xpair);
     free(d->gho);
     free(d->xchunk.cracks);
+    free(d->tape.e);
     free(d);
     m->dd = NULL;
 }
@@ -226,6 +231,17 @@ static bool plan_far(sx_model *m)
     return plan_ghosts(m);
 }
 
+/* Energy tracking: what this rank gives chunk o's energy sums (its own
+ * pairs own, sx__dd_energy), from the serial chunk before it is clipped. */
+static void plan_energy(sx_chunk *o, sx_span own)
+{
+    o->tape_at = -1;
+    o->part = SX_DD_PART_NONE;
+    if (own.hi <= own.lo || o->last <= own.lo || o->first >= own.hi) return;
+    o->part = o->first >= own.lo ? SX_DD_PART_START : SX_DD_PART_TAPE;
+    if (o->part == SX_DD_PART_TAPE) o->tape_at = own.lo;
+}
+
 /* The spans of every rank from the whole, current pair stores (after a
  * build, or when a cycle starts), and this rank's clipped chunks. False:
  * out of memory. */
@@ -277,8 +293,11 @@ bool sx__dd_plan(sx_model *m)
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
      * they clear, to its own and its near ghosts */
     const sx_span pr = d->pairs[me], lo = d->need[SX_DD_NEED * me], hi = d->need[SX_DD_NEED * me + 1];
+    d->xchunk.tape_at = -1;
+    d->tape.n = 0;
     for (int64_t c = 0; c < m->nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
+        plan_energy(o, d->bb_own[me]);
         o->first = o->first < pr.lo ? pr.lo : o->first > pr.hi ? pr.hi : o->first;
         o->last = o->last < o->first ? o->first : o->last > pr.hi ? pr.hi : o->last;
         if (o->clear_lo < lo.lo) o->clear_lo = lo.lo;
@@ -487,16 +506,15 @@ bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
     return true;
 }
 
-/* A sum over the ball-ball pairs in the serial order (the periodic cell's
- * stress): each rank adds its own pairs' terms (bb_own, pairs of its
- * balls: the ranks' runs follow each other in pair order) to the running
- * sum of the ranks before it, in a chain from rank 0, and the last rank's
- * total goes to every rank: the serial sum's every rounding, in R steps
- * of one message. part(m, c0, c1, acc) adds the terms of pairs [c0, c1)
- * to acc (len doubles, zero on entry). False: the ranks could not
- * exchange. */
-bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
-                     void (*part)(const sx_model *m, int64_t c0, int64_t c1, double *acc))
+/* A sum in the serial order over what the ranks own in turn (the
+ * periodic cell's stress: each rank's own pairs, bb_own, whose runs follow
+ * each other in pair order; the energy guard's: each rank's own balls and
+ * pairs): each rank adds its own terms to the running sum of the ranks
+ * before it, in a chain from rank 0 (which starts from acc as given), and
+ * the last rank's total goes to every rank: the serial sum's every
+ * rounding, in R steps of one message. part(m, r, acc) adds rank r's
+ * terms to acc (len doubles). False: the ranks could not exchange. */
+bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc))
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks, me = d->x.rank;
@@ -507,7 +525,7 @@ bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
     for (int k = 0; ok && k < R; k++) {
         if (k == me) {
             if (k) memcpy(acc, buf + (k - 1) * len, (size_t)len * sizeof *acc);
-            part(m, d->bb_own[k].lo, d->bb_own[k].hi, acc);
+            part(m, k, acc);
             memcpy(buf + k * len, acc, (size_t)len * sizeof *acc);
         }
         for (int r = 0; r < R; r++) /* the next rank takes rank k's sum; the total goes to all */
@@ -516,6 +534,82 @@ bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
     }
     if (ok) memcpy(acc, buf + (R - 1) * len, (size_t)len * sizeof *acc);
     free(buf);
+    return ok;
+}
+
+void sx__tape_add(sx_tape *t, int64_t k, double v)
+{
+    if (t->n == t->cap) {
+        const int64_t cap = t->cap ? 2 * t->cap : 1024;
+        struct sx_tape_term *q = realloc(t->e, (size_t)cap * sizeof *q);
+        if (!q) {
+            t->lost = true;
+            return;
+        }
+        t->e = q, t->cap = cap;
+    }
+    t->e[t->n++] = (struct sx_tape_term){v, k};
+}
+
+/* Rank r's part of the step's energy sums (r is this rank: the chain asks
+ * only its own): the sums of the chunks and motion blocks that begin among
+ * its balls (each a sum from zero in the serial order, which the lower
+ * ranks' parts do not touch) and of the wall blocks it shares (wblk: run
+ * whole, their sums are the serial ones), then its tape's terms, in their
+ * order, onto the sums the lower ranks began. The sums: three per chunk
+ * (slip, viscous, released), two per wall block (slip, viscous), two per
+ * motion block (damping, loads). */
+static void energy_part(const sx_model *m, int r, double *acc)
+{
+    const sx_dd *d = m->dd;
+    const int64_t K = m->nchunk, nb = m->nblock;
+    double *wall = acc + 3 * K, *motion = wall + 2 * nb;
+    for (int64_t c = 0; c < K; c++) {
+        const sx_chunk *o = &m->chunks[c];
+        if (o->part != SX_DD_PART_START) continue;
+        acc[3 * c] = o->slip, acc[3 * c + 1] = o->viscous, acc[3 * c + 2] = o->released;
+    }
+    for (int64_t b = d->wblk[r].lo; b < d->wblk[r].hi; b++)
+        wall[2 * b] = m->blocks[b].slip, wall[2 * b + 1] = m->blocks[b].viscous;
+    const sx_span own = d->own[r];
+    for (int64_t b = 0; b < nb; b++) {
+        const sx_block *o = &m->blocks[b];
+        if (o->b0 >= own.lo && o->b0 < own.hi) motion[2 * b] = o->damp_work, motion[2 * b + 1] = o->load_work;
+    }
+    for (int64_t e = 0; e < d->tape.n; e++) acc[d->tape.e[e].k] += d->tape.e[e].v;
+}
+
+/* The serial step adds its chunks' energy sums to m->acc in chunk order,
+ * then its wall blocks', then its motion blocks', each sum from zero over
+ * its pairs or balls in order; decomposed, a chunk or block may begin on
+ * one rank and go on over the next ones. So, after the law of motion (the
+ * clumps' terms, the same on every rank, follow), the sums are chained
+ * over the ranks in rank order (energy_part: each rank starts the sums
+ * that begin among its own and continues, term by term from its tape,
+ * those begun below it), and every rank adds the totals in the serial
+ * order: the serial bits in R messages of a few hundred doubles a step.
+ * False: out of memory or the ranks could not exchange. */
+bool sx__dd_energy(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const int64_t K = m->nchunk, nb = m->nblock, len = 3 * K + 4 * nb;
+    double *s = calloc((size_t)len, sizeof *s);
+    const bool ok = s && !d->tape.lost && sx__dd_chain(m, s, (int)len, energy_part);
+    d->tape.n = 0;
+    for (int64_t c = 0; ok && c < K; c++) {
+        m->acc.slip += s[3 * c];
+        m->acc.viscous += s[3 * c + 1];
+        m->acc.bond_released += s[3 * c + 2];
+    }
+    for (int64_t b = 0; ok && b < nb; b++) {
+        m->acc.slip += s[3 * K + 2 * b];
+        m->acc.viscous += s[3 * K + 2 * b + 1];
+    }
+    for (int64_t b = 0; ok && b < nb; b++) {
+        m->acc.local_damping -= s[3 * K + 2 * nb + 2 * b];
+        m->acc.boundary_work += s[3 * K + 2 * nb + 2 * b + 1];
+    }
+    free(s);
     return ok;
 }
 

@@ -485,6 +485,18 @@ sx_status sx__prepare(sx_model *m)
     return SX_OK;
 }
 
+/* The critical timestep; decomposed, each rank rates its own balls: the
+ * smallest of all (exact). False: the ranks could not exchange. */
+static bool critical(sx_model *m, double *crit)
+{
+    *crit = kernels(m)->critical_dt(m);
+    if (!m->dd || !m->dd->active) return true;
+    *crit = -*crit;
+    if (!m->dd->x.max(m->dd->x.ud, crit)) return false;
+    *crit = -*crit;
+    return true;
+}
+
 /* The timestep the next step takes: the user's, the automatic one in use,
  * or, when that is stale or due for a refresh, safety x critical. */
 static sx_status next_timestep(sx_model *m, double *dt)
@@ -496,13 +508,9 @@ static sx_status next_timestep(sx_model *m, double *dt)
         /* decomposed: the ghosts where the last step left them, as the serial run reads them */
         if (m->dd && m->dd->active && !sx__dd_halo(m))
             return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange ghosts");
-        double crit = kernels(m)->critical_dt(m);
-        if (m->dd && m->dd->active) { /* each rank rates its own balls: the smallest of all (exact) */
-            crit = -crit;
-            if (!m->dd->x.max(m->dd->x.ud, &crit))
-                return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
-            crit = -crit;
-        }
+        double crit;
+        if (!critical(m, &crit))
+            return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
         if (!isfinite(crit))
             return sx__fail(m, SX_EINVAL,
                             "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
@@ -569,19 +577,14 @@ static bool unforced(const sx_model *m)
  * specimen under load holds much of its energy in the bonds. */
 static double mechanical(const sx_energy *e) { return e->kinetic + e->gravitational + e->strain + e->bond_strain; }
 
-static double mechanical_energy(const sx_model *m)
-{
-    sx_energy e;
-    kernels(m)->energy(m, &e);
-    return mechanical(&e);
-}
+static const char *const NO_EXCHANGE = "cycle: the ranks could not exchange the state";
 
-static void guard_start(sx_model *m)
+static sx_status guard_start(sx_model *m)
 {
     m->guard_on = unforced(m);
-    if (!m->guard_on) return;
+    if (!m->guard_on) return SX_OK;
     sx_energy e;
-    kernels(m)->energy(m, &e);
+    if (!kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     m->guard_e0 = mechanical(&e);
     /* the scale: the energy in play, with a floor of each ball's weight over its radius */
     double floor_e = 0, g = 0;
@@ -589,35 +592,56 @@ static void guard_start(sx_model *m)
     g = sqrt(g);
     for (int64_t i = 0; i < m->balls.n; i++) floor_e += g * m->balls.rad[i] / m->balls.inv_mass[i];
     m->guard_scale = e.kinetic + e.strain + e.bond_strain + floor_e;
+    return SX_OK;
 }
 
-/* The ball with the largest translational kinetic energy: the one to name. */
-static int64_t most_energetic_ball(const sx_model *m)
+/* The ball with the largest translational kinetic energy, the first in
+ * dense order on a tie: the one to name (-1: none). Decomposed, each rank
+ * its own balls', then the largest of all and, among the ranks that hold
+ * it, the lowest index (maxima: exact). False: the ranks could not
+ * exchange. */
+static bool most_energetic_ball(const sx_model *m, int64_t *id)
 {
     const sx_balls *b = &m->balls;
+    const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
+    const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : b->n;
     int64_t best = -1;
     double top = -1;
-    for (int64_t i = 0; i < b->n; i++) {
+    for (int64_t i = i0; i < i1; i++) {
         double v2 = 0;
         for (int k = 0; k < m->dim; k++) v2 += b->v[i * m->dim + k] * b->v[i * m->dim + k];
         const double ke = 0.5 * v2 / b->inv_mass[i];
-        if (ke > top) top = ke, best = b->id[i];
+        if (ke > top) top = ke, best = i;
     }
-    return best;
+    if (dd) {
+        double all = top;
+        if (!dd->x.max(dd->x.ud, &all)) return false;
+        double lowest = best >= 0 && top == all ? -(double)best : -INFINITY; /* an index is exact in a double */
+        if (!dd->x.max(dd->x.ud, &lowest)) return false;
+        best = all >= 0 ? (int64_t)-lowest : -1;
+    }
+    *id = best >= 0 ? b->id[best] : -1;
+    return true;
 }
 
 static sx_status guard_check(sx_model *m)
 {
     if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
-    const double gain = mechanical_energy(m) - m->guard_e0;
-    if (gain > GUARD_ENERGY_FACTOR * m->guard_scale)
-        return sx__fail(m, SX_EUNSTABLE,
-                        "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
-                        "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is too large "
-                        "(critical estimate %g s)",
-                        (long long)m->step, gain, gain / m->guard_scale, m->guard_scale,
-                        (long long)most_energetic_ball(m), m->dt, kernels(m)->critical_dt(m));
-    return SX_OK;
+    sx_energy e;
+    /* decomposed: the ghosts where the step left their owners, for the pairs' strain */
+    if ((m->dd && m->dd->active && !sx__dd_halo(m)) || !kernels(m)->energy(m, &e))
+        return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    const double gain = mechanical(&e) - m->guard_e0;
+    if (!(gain > GUARD_ENERGY_FACTOR * m->guard_scale)) return SX_OK;
+    int64_t fastest;
+    double crit;
+    if (!most_energetic_ball(m, &fastest) || !critical(m, &crit)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    return sx__fail(m, SX_EUNSTABLE,
+                    "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
+                    "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is too large "
+                    "(critical estimate %g s)",
+                    (long long)m->step, gain, gain / m->guard_scale, m->guard_scale, (long long)fastest, m->dt,
+                    crit);
 }
 
 /* ---------------------------------------------------------------- cycle */
@@ -676,10 +700,12 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
     m->locked = true;
     /* the energy baseline is taken when the user has changed the system, not
      * at every call: a script cycling one step at a time is guarded too */
-    if (m->guard_dirty) {
-        guard_start(m);
-        m->guard_dirty = false;
+    if (m->guard_dirty && (st = guard_start(m))) {
+        m->locked = false;
+        if (dd) dd->active = false;
+        return st;
     }
+    m->guard_dirty = false;
     double other = now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
         t = now();
@@ -719,6 +745,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         st = k->integrate(m, &max_disp);
         if (!st && dd && !dd->x.max(dd->x.ud, &max_disp)) /* every rank decides the same rebuild */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
+        if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
         if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* every rank steps every clump */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
         if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
@@ -740,11 +768,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
         /* a ghost moves with its owner and with the cell vectors that shift it */
         if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
-        if (m->step % GUARD_STEPS == 0) {
-            if (dd && m->guard_on && !sx__dd_gather(m)) /* the guard's energy is the whole model's */
-                st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
-            if (!st) st = guard_check(m);
-        }
+        if (m->step % GUARD_STEPS == 0) st = guard_check(m); /* decomposed: chained sums (kernels/queries.c) */
         other += now() - t;
         if (st) break;
     }
@@ -854,7 +878,7 @@ sx_energy sx_model_energy(sx_model *m)
         for (size_t k = 0; k < sizeof e / sizeof(double); k++) t[k] = NAN;
         return e;
     }
-    kernels(m)->energy(m, &e);
+    kernels(m)->energy(m, &e); /* between cycles: the serial sums, which cannot fail */
     return e;
 }
 

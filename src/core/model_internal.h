@@ -210,6 +210,13 @@ typedef struct sx_chunk {
     int64_t first, last;   /* pair range [first, last) */
     int64_t own_lo, own_hi;/* balls [own_lo, own_hi): the a's of its pairs */
     int64_t clear_lo, clear_hi; /* balls whose forces it starts from the applied loads (or zero) */
+    /* decomposed with energy tracking (decompose.c, sx__dd_energy): from
+     * pair tape_at on (-1: never) the chunk's energy terms are this rank's
+     * part of a chunk begun on a lower rank, and go to its tape (taping);
+     * part: what this rank gives the chunk's energy sums (SX_DD_PART_*) */
+    int64_t tape_at;
+    bool taping;
+    int8_t part;
     /* results of the last pass */
     double slip, viscous, released;
     int64_t lost_bonds;
@@ -235,6 +242,10 @@ typedef struct sx_block {
     int64_t b0, b1;        /* balls [b0, b1) */
     int64_t w0, w1;        /* their ball-wall pairs [w0, w1) */
     double worst, damp_work, load_work, slip, viscous;
+    /* decomposed with energy tracking: this rank's part of a block begun on
+     * a lower rank puts its law of motion's energy terms on its tape at
+     * tape_k (damping) and tape_k + 1 (loads) (decompose.c); -1: in the sums */
+    int64_t tape_k;
     int64_t bad;           /* first ball with a non-finite state, or -1 */
     sx_status st;          /* a wall contact's overlap error */
     int64_t err_ball, err_wall;
@@ -307,6 +318,23 @@ typedef struct sx_cell {
  * blocks wblk[r]. Every ball's sums thus run in the serial run's order. */
 /* The spans of ghosts a rank keeps: near below, near above, far below, far above. */
 enum { SX_DD_NEED = 4 };
+/* Decomposed with energy tracking: the energy terms of a rank's part of
+ * a chunk or block begun on a lower rank, in the order the step makes
+ * them, each with the index of its sum (decompose.c, sx__dd_energy). */
+typedef struct sx_tape {
+    struct sx_tape_term {
+        double v;
+        int64_t k;
+    } *e;
+    int64_t n, cap;
+    bool lost; /* out of memory */
+} sx_tape;
+
+/* What a rank gives a chunk's energy sums: nothing (none of its pairs),
+ * the sums of the chunk's first pairs (the chunk begins among its own), or
+ * its tape's terms, folded into the lower ranks' sums. */
+enum { SX_DD_PART_NONE, SX_DD_PART_START, SX_DD_PART_TAPE };
+
 typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
@@ -332,6 +360,7 @@ typedef struct sx_dd {
     int32_t *peb;
     int64_t npeb, cap_peb;
     sx_span *peb_own;
+    sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
 } sx_dd;
 
 struct sx_model {
@@ -515,7 +544,9 @@ typedef struct sx_kernels {
     sx_status (*clumps_step)(sx_model *m, double *max_disp);
     /* clump c's pebbles placed from its body at rotation R; their largest squared move since the build */
     double (*place_pebbles)(sx_model *m, int64_t c, const double *R);
-    void (*energy)(const sx_model *m, sx_energy *e);
+    /* decomposed inside a cycle: own balls and pairs summed in a chain (the
+     * ghosts current); false: the ranks could not exchange */
+    bool (*energy)(const sx_model *m, sx_energy *e);
     bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
     int64_t (*count_contacts)(const sx_model *m);
     bool (*plan)(sx_model *m);                  /* chunks of the ball-ball pass for the pair store as it is (a restore) */
@@ -595,9 +626,13 @@ bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
 bool sx__dd_walls(sx_model *m);
 bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
-bool sx__dd_pair_sum(const sx_model *m, double *acc, int len,
-                     void (*part)(const sx_model *m, int64_t c0, int64_t c1, double *acc));
+bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc));
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
+/* Energy tracking: term v of the sum k on the rank's tape; after the law
+ * of motion, every chunk's and block's energy sums of the step, the serial
+ * ones, added to m->acc in the serial order. */
+void sx__tape_add(sx_tape *t, int64_t k, double v);
+bool sx__dd_energy(sx_model *m);
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
 /* Law of a contact of materials ma and mb, from the materials as they are

@@ -128,7 +128,7 @@ typedef struct sx_exchange {
 /// copies of its neighbours' balls; every cycle ends with the whole state
 /// on every rank, bit-identical to a serial run's. SX_EINVAL (with the
 /// reason) for what is not decomposed yet: flat and smooth joints,
-/// meshes, energy tracking.
+/// meshes.
 SX_API sx_status sx_model_decompose(sx_model *m, const sx_exchange *x);
 /// The number of ranks m's cycles are decomposed over (1: not decomposed).
 SX_API int sx_model_ranks(const sx_model *m);

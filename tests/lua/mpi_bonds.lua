@@ -12,7 +12,7 @@
 --             (the ranks cut the balls by count along y): its bonds and
 --             contacts must survive the migrations, and the state is the
 --             serial one.
---   refused W one of what is not decomposed yet (W: flatjoint, energy),
+--   refused W one of what is not decomposed yet (W: flatjoint),
 --             for mpi_pour.sh: refused under mpirun with an error naming
 --             it, cycled serially.
 local scene = arg and arg[1] or "crush"
@@ -120,7 +120,7 @@ elseif scene == "cross" then
   if tri[1].pos[2] > 0.02 then error("the triplet did not fall through the column") end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "refused" then
-  -- one of what is not decomposed yet (arg 2: flatjoint, energy):
+  -- one of what is not decomposed yet (arg 2: flatjoint):
   -- a serial run cycles it, mpirun stops every rank at the first cycle with
   -- an error naming it (mpi_pour.sh checks both)
   local what = arg[2]
@@ -132,11 +132,8 @@ elseif scene == "refused" then
     m:ball{pos = {0, 0, 0}, radius = 1}
     m:ball{pos = {2, 0, 0}, radius = 1}
     m:bond{kind = "flatjoint", gap = 1e-6, seed = 5}
-  elseif what == "energy" then
-    m:ball{pos = {0.05, 0.05, 0.05}, radius = 0.01}
-    m:track_energy(true)
   else
-    error("mpi_bonds.lua refused: flatjoint or energy expected")
+    error("mpi_bonds.lua refused: flatjoint expected")
   end
   m:cycle(10)
   print(what .. " cycled on " .. m:ranks() .. " rank(s)")

@@ -259,21 +259,21 @@ static void stress_terms(const sx_model *m, int64_t c0, int64_t c1, double *acc,
     }
 }
 
-/* stress_terms with the servo's K, for a sum over the ranks. */
-static void KERNEL(stress_terms_stiff)(const sx_model *m, int64_t c0, int64_t c1, double *acc)
+/* stress_terms with the servo's K of rank r's own pairs, for a sum over the ranks. */
+static void KERNEL(stress_terms_stiff)(const sx_model *m, int r, double *acc)
 {
-    stress_terms(m, c0, c1, acc, true);
+    stress_terms(m, m->dd->bb_own[r].lo, m->dd->bb_own[r].hi, acc, true);
 }
 
 /* The cell's average stress, (1/V) sum F (x) l (stress_terms), compression
  * positive; with stiff, the servo's K per component. Decomposed, the sum
- * runs over the ranks in pair order (sx__dd_pair_sum). False: the ranks
+ * runs over the ranks in pair order (sx__dd_chain). False: the ranks
  * could not exchange. */
 static bool KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double stiff[6])
 {
     double acc[9 + 6] = {0};
     if (m->dd && m->dd->active) { /* inside a cycle: the servo's */
-        if (!stiff || !sx__dd_pair_sum(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
+        if (!stiff || !sx__dd_chain(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
     } else {
         stress_terms(m, 0, m->bb.n, acc, stiff != NULL);
     }

@@ -20,6 +20,14 @@ static void blame_non_finite(const sx_model *m, sx_block *o, double check)
     }
 }
 
+/* An energy term of the block's sum (k: 0 damping, 1 loads), or, decomposed
+ * in a block begun on a lower rank, of the rank's tape (decompose.c). */
+static inline void motion_energy(sx_model *m, const sx_block *o, int k, double *sum, double x)
+{
+    if (o->tape_k >= 0) sx__tape_add(&m->dd->tape, o->tape_k + k, x);
+    else *sum += x;
+}
+
 /* 4-46 ... 4-48: central differences, velocities at half steps, for the
  * balls of one block; partial sums go to the block. With energy tracking,
  * the damping's and applied loads' work use the mean of the old and new
@@ -64,9 +72,10 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                     const double force = f[k] + g[k] / im; /* 4-40: the unbalanced force includes the weight */
                     const double fd = sx__damped(force, v[k], a);
                     v[k] += fd * im * dtv; /* 4-46 */
-                    if (track) damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
+                    if (track) motion_energy(m, o, 0, &damp_work, (fd - force) * 0.5 * (vold + v[k]) * dt);
                 }
-                if (track && B->fapp) load_work += B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt;
+                if (track && B->fapp)
+                    motion_energy(m, o, 1, &load_work, B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt);
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - xb[i * D + k];
@@ -83,9 +92,10 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 } else {
                     const double md = sx__damped(t[k], w[k], a);
                     w[k] += md * ii * dtv;
-                    if (track) damp_work += (md - t[k]) * 0.5 * (wold + w[k]) * dt;
+                    if (track) motion_energy(m, o, 0, &damp_work, (md - t[k]) * 0.5 * (wold + w[k]) * dt);
                 }
-                if (track && B->tapp) load_work += B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt;
+                if (track && B->tapp)
+                    motion_energy(m, o, 1, &load_work, B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt);
             }
             check += 0 * w[k];
         }
@@ -190,16 +200,21 @@ SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     const int64_t nb = m->nblock;
-    if (m->dd && m->dd->active) { /* decomposed: this rank's own balls of each block */
+    const bool dd = m->dd && m->dd->active;
+    if (dd) { /* decomposed: this rank's own balls of each block */
         const sx_span own = m->dd->own[m->dd->x.rank];
+        /* energy tracking: the terms of a block begun on a lower rank go to
+         * the tape, after the chunks' sums (3 a chunk) and the wall blocks' (2 a block) */
+        const int64_t tape0 = 3 * m->nchunk + 2 * nb;
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
         for (int64_t b = 0; b < nb; b++) {
             sx_block *o = &m->blocks[b], part = *o;
             part.b0 = o->b0 > own.lo ? o->b0 : own.lo;
             part.b1 = o->b1 < own.hi ? o->b1 : own.hi;
-            part.worst = 0, part.bad = -1;
+            part.worst = 0, part.bad = -1, part.damp_work = part.load_work = 0;
+            part.tape_k = o->b0 < own.lo ? tape0 + 2 * b : -1;
             if (part.b1 > part.b0) integrate_block(m, &part);
-            o->worst = part.worst, o->bad = part.bad;
+            o->worst = part.worst, o->bad = part.bad, o->damp_work = part.damp_work, o->load_work = part.load_work;
         }
     } else {
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
@@ -214,7 +229,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
                             "the timestep %g s is likely too large (critical estimate %g s)",
                             (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(critical_dt)(m));
         if (o->worst > worst) worst = o->worst;
-        if (m->track_energy) {
+        if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (decompose.c, sx__dd_energy) */
             m->acc.local_damping -= o->damp_work;
             m->acc.boundary_work += o->load_work;
         }

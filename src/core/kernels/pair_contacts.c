@@ -179,6 +179,19 @@ static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode 
     o->cracks[o->ncracks++] = c;
 }
 
+/* An energy term of the chunk's current pair: to the chunk's sum k, or,
+ * decomposed past its tape_at, to the rank's tape (decompose.c). A zero
+ * changes no sum (a sum from +0 never reaches -0), so it is not kept. */
+enum { E_SLIP, E_VISCOUS, E_RELEASED };
+static inline void chunk_energy(sx_model *m, sx_chunk *o, int k, double x)
+{
+    if (x == 0) return;
+    if (o->taping) sx__tape_add(&m->dd->tape, 3 * (o - m->chunks) + k, x);
+    else if (k == E_SLIP) o->slip += x;
+    else if (k == E_VISCOUS) o->viscous += x;
+    else o->released += x;
+}
+
 /* The parallel bond of pair (i, j) (laws/parallel_bond.h): carried with
  * the contact (4-13 ... 4-15), then stepped and tested by its law. Adds its
  * force to F (on j) and its moment to mb (on j). Returns false when it
@@ -194,7 +207,7 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     sx_bond_break br;
     if (sx_bond_parallel_step(D, b, s, n, vn, vs, dtheta, motion_dt(m), &br)) {
         log_crack(m, o, xc, br.mode, SX_BOND_PARALLEL, -1, i, j, b->fn[s], br.fsn, br.mnn, br.msn);
-        if (m->track_energy) o->released += sx_bond_parallel_strain(D, b, s);
+        if (m->track_energy) chunk_energy(m, o, E_RELEASED, sx_bond_parallel_strain(D, b, s));
         return false;
     }
     sx_bond_parallel_add(D, b, s, n, F, mb);
@@ -284,12 +297,13 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
             }
         }
         if (!bonded) { /* compression and Coulomb friction only; a break's drop is released, not slip */
-            double sc;
-            sx__law_cap(D - 1, fs, f0, fsn * fsn, mu * (l.fn > 0 ? l.fn : 0), ksa, track && !released ? &o->slip : NULL,
+            double sc, work = 0;
+            sx__law_cap(D - 1, fs, f0, fsn * fsn, mu * (l.fn > 0 ? l.fn : 0), ksa, track && !released ? &work : NULL,
                         &sc);
+            if (track) chunk_energy(m, o, E_SLIP, work);
             if (released) released -= l.energy + fj_shear_energy(fs, ks, g.area);
         }
-        if (track) o->released += released;
+        if (track) chunk_energy(m, o, E_RELEASED, released);
         E->fn[x] = l.fn;
         alive = alive || bonded || l.fn > 0;
         gapped = gapped && E->gap0[x] > 0;
@@ -391,9 +405,12 @@ static void smooth_joint(sx_model *m, sx_chunk *o, int64_t c, int32_t slot, unsi
     }
     if (!bonded) {
         if (track && *un <= 0 && !before) /* opening releases the shear spring */
-            o->slip += sx_law_sj_strain(D, L, area, 0, fs);
-        fn = sx_law_sj_unbonded(D, L, area, un, fs, fs0, track && !before ? &o->slip : NULL);
-        if (track && before) o->released += before - sx_law_sj_strain(D, L, area, *un > 0 ? *un : 0, fs);
+            chunk_energy(m, o, E_SLIP, sx_law_sj_strain(D, L, area, 0, fs));
+        double work[2] = {0, 0};
+        fn = sx_law_sj_unbonded(D, L, area, un, fs, fs0, track && !before ? work : NULL);
+        if (track) chunk_energy(m, o, E_SLIP, work[0]), chunk_energy(m, o, E_SLIP, work[1]);
+        if (track && before)
+            chunk_energy(m, o, E_RELEASED, before - sx_law_sj_strain(D, L, area, *un > 0 ? *un : 0, fs));
     }
     for (int k = 0; k < D; k++) F[k] = fn * N[k] + fs[k];
     p->fn[c] = fn;
@@ -417,6 +434,7 @@ static void chunk_start(sx_model *m, sx_chunk *o)
         memset(B->t + o->clear_lo * RD, 0, nt * sizeof(double));
     }
     o->slip = o->viscous = o->released = 0;
+    o->taping = false;
     o->lost_bonds = 0;
     o->ncracks = 0;
     o->st = SX_OK;
@@ -447,6 +465,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     for (int64_t c = o->first; c < o->last; c++) {
         const int64_t i = pa[c], j = pb[c];
         const int32_t slot = bond ? bond[c] - 1 : -1;
+        if (c == o->tape_at) o->taping = true; /* decomposed: the rank's own pairs of a chunk begun below them */
         double dx[D];
         for (int k = 0; k < D; k++) dx[k] = x[j * D + k] - x[i * D + k];
         const double d2 = dot(dx, dx), ri = rad[i], rj = rad[j], rsum = ri + rj;
@@ -460,12 +479,14 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (track && touching[c]) { /* the shear spring's energy is released as the contact opens */
                 double kn, ks;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn, &ks);
-                if (ks > 0) o->slip += 0.5 * dot(fs, fs) / ks;
-                if (law->mu_r > 0) o->slip += sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum);
+                if (ks > 0) chunk_energy(m, o, E_SLIP, 0.5 * dot(fs, fs) / ks);
+                if (law->mu_r > 0)
+                    chunk_energy(m, o, E_SLIP, sx_law_rolling_strain(D, p->mr + c * RD, ks, ri * rj / rsum));
                 if (p->joint && p->joint[c]) { /* a smooth joint's springs instead */
                     const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
-                    o->slip += sx_law_sj_strain(D, L, sx_law_sj_area(D, L, ri, rj), fmax(p->jun[c], 0), fs) -
-                               (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+                    chunk_energy(m, o, E_SLIP,
+                                 sx_law_sj_strain(D, L, sx_law_sj_area(D, L, ri, rj), fmax(p->jun[c], 0), fs) -
+                                     (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0));
                 }
             }
             touching[c] = 0;
@@ -566,7 +587,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     bonds &= ~(unsigned)SX_BOND_CONTACT;
                 }
                 if (mode == SX_CRACK_TENSION) { /* both components vanish; in shear, slip takes over */
-                    if (track) o->released += sx_bond_contact_released(fn, un, fsn, ks);
+                    if (track) chunk_energy(m, o, E_RELEASED, sx_bond_contact_released(fn, un, fsn, ks));
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                     if (us) sx_law_total_shear_slip(D, us, 0);
@@ -575,15 +596,17 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (!(bonds & SX_BOND_CONTACT)) {
                 if (un <= 0) { /* unbonded and open: no contact force */
                     /* a contact bond that failed in shear while in tension releases both springs */
-                    if (track) o->released += 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0);
+                    if (track)
+                        chunk_energy(m, o, E_RELEASED, 0.5 * fn * un + (ks > 0 ? 0.5 * dot(fs, fs) / ks : 0));
                     fn = 0;
                     for (int k = 0; k < D; k++) fs[k] = 0;
                     if (us) sx_law_total_shear_slip(D, us, 0);
                 }
                 /* 4-30/4-31: Coulomb slip with the smaller friction */
                 const double fmax = law->mu * (fn > 0 ? fn : 0);
-                double sc;
-                slip = sx__law_cap(D, fs, f0, dot(fs, fs), fmax, ks, track ? &o->slip : NULL, &sc);
+                double sc, work = 0;
+                slip = sx__law_cap(D, fs, f0, dot(fs, fs), fmax, ks, track ? &work : NULL, &sc);
+                if (track) chunk_energy(m, o, E_SLIP, work);
                 if (slip && us) sx_law_total_shear_slip(D, us, sc);
             }
             if (law->mu_r > 0) { /* rolling resistance (laws/rolling.h) */
@@ -595,7 +618,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 #endif
                 for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
                 const double e = sx_law_rolling_moment(law, D, mr, dtheta, n, ks, ri * rj / rsum, un > 0 ? fn : 0);
-                if (track) o->slip += e;
+                if (track) chunk_energy(m, o, E_SLIP, e);
                 for (int k = 0; k < RD; k++) mroll[k] = mr[k];
             }
             double fd = fn, dsh[D] = {0}; /* set when shear_dashpot; zeroed for the compiler's flow analysis */
@@ -615,7 +638,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
                     work += dot(dsh, vs);
                     shear_dashpot = true;
                 }
-                if (track) o->viscous -= work * dt;
+                if (track) chunk_energy(m, o, E_VISCOUS, -(work * dt));
             }
             for (int k = 0; k < D; k++) F[k] = fd * n[k] + fs[k]; /* 4-5 */
             if (shear_dashpot)
@@ -625,7 +648,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if (track && touching[c]) { /* a parallel-bonded pair's contact opened: its shear spring is released */
                 double kn0, ks0;
                 stiffness(law, ri, rj, 2 * ri * rj / rsum, 0, &kn0, &ks0);
-                if (ks0 > 0) o->slip += 0.5 * dot(fs, fs) / ks0;
+                if (ks0 > 0) chunk_energy(m, o, E_SLIP, 0.5 * dot(fs, fs) / ks0);
             }
             for (int k = 0; k < D; k++) F[k] = fs[k] = 0;
             fn_all[c] = 0;
@@ -897,6 +920,7 @@ static bool plan_chunks(sx_model *m)
         sx_chunk *o = &m->chunks[c];
         o->own_lo = lo[c];
         o->first = sx__first_at(p->a, p->n, lo[c]);
+        o->tape_at = -1; /* decomposed: decompose.c plans its energy's part */
         if (c >= 2) { /* chunk c - 2 is complete once chunk c - 1 starts */
             const sx_chunk *e = &m->chunks[c - 2];
             int64_t reach = lo[c - 1];
@@ -934,6 +958,7 @@ static bool plan_chunks(sx_model *m)
         o->b1 = (b + 1) * size < n ? (b + 1) * size : n;
         o->w0 = sx__first_at(m->bw.a, m->bw.n, o->b0);
         o->w1 = sx__first_at(m->bw.a, m->bw.n, o->b1);
+        o->tape_k = -1;
     }
     return true;
 }
@@ -979,12 +1004,16 @@ static sx_status KERNEL(contacts)(sx_model *m)
     }
     if (dd && (st = far_pairs(m, dd->nxlow, dd->nxpair))) return st;
     if (m->cell) fold_ghosts(m);
+    /* decomposed: the energy sums are the ranks' to chain (decompose.c, sx__dd_energy) */
+    const bool sums = !m->dd || !m->dd->active;
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         if (o->st) return chunk_error(m, o);
-        m->acc.slip += o->slip;
-        m->acc.viscous += o->viscous;
-        m->acc.bond_released += o->released;
+        if (sums) {
+            m->acc.slip += o->slip;
+            m->acc.viscous += o->viscous;
+            m->acc.bond_released += o->released;
+        }
         m->bonds.intact -= o->lost_bonds;
         for (int64_t e = 0; e < o->ncracks; e++) sx__crack_log(m, &o->cracks[e]);
     }

@@ -35,24 +35,28 @@ static double rolling_strain(const sx_pair_law *l, const sx_pairs *p, int64_t c,
     return l->mu_r > 0 && p->touching[c] ? sx_law_rolling_strain(D, p->mr + c * RD, ks, rbar) : 0;
 }
 
-static void KERNEL(energy)(const sx_model *m, sx_energy *e)
+/* The kinetic and gravitational energy of balls [i0, i1) added to e[0], e[1]. */
+static void energy_balls(const sx_model *m, int64_t i0, int64_t i1, double *e)
 {
     const sx_balls *B = &m->balls;
-    *e = m->acc;
-    e->kinetic = e->gravitational = e->strain = e->bond_strain = 0;
-    for (int64_t i = 0; i < B->n; i++) {
-        if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once, below */
+    for (int64_t i = i0; i < i1; i++) {
+        if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once (clump_queries.c) */
         const double *v = B->v + i * D, *w = B->w + i * RD;
         double ww = 0;
         for (int k = 0; k < RD; k++) ww += w[k] * w[k];
-        e->kinetic += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
-        e->gravitational -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
+        e[0] += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
+        e[1] -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
     }
-    if (m->clumps) sx__clumps_energy(m, e);
+}
+
+/* The strain of ball-ball pairs [c0, c1) added to e[0], their bonds' to e[1]. */
+static void energy_pairs(const sx_model *m, int64_t c0, int64_t c1, double *e)
+{
+    const sx_balls *B = &m->balls;
     /* every overlap stores normal strain, even one no step has seen yet;
      * the shear spring only once the contact has history */
     const double zero[D] = {0};
-    for (int64_t c = 0; c < m->bb.n; c++) {
+    for (int64_t c = c0; c < c1; c++) {
         double n[D], kn, ks;
         const int64_t i = m->bb.a[c], j = m->bb.b[c];
         const double un = pair_geometry(m, i, j, n);
@@ -65,24 +69,31 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
             const bool bonded = slot >= 0 && (m->bonds.kind[slot] & SX_BOND_SMOOTHJOINT);
             const double ju = bonded || m->bb.jun[c] > 0 ? m->bb.jun[c] : 0;
             const double s = sx_law_sj_strain(D, L, sx_law_sj_area(D, L, B->rad[i], B->rad[j]), ju, m->bb.fs + c * D);
-            if (bonded) e->bond_strain += s;
-            else e->strain += s;
+            if (bonded) e[1] += s;
+            else e[0] += s;
             continue;
         }
-        e->strain += contact_strain(law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
-        e->strain += rolling_strain(law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
+        e[0] += contact_strain(law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
+        e[0] += rolling_strain(law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
-        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e->bond_strain += sx_bond_parallel_strain(D, &m->bonds, slot);
+        if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e[1] += sx_bond_parallel_strain(D, &m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
-            e->bond_strain += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
+            e[1] += fj_strain(m, slot, sqrt(dot(m->bb.geo + c * D, m->bb.geo + c * D)));
     }
+}
+
+/* The strain of ball-wall pairs [c0, c1) added to *e. */
+static void energy_walls(const sx_model *m, int64_t c0, int64_t c1, double *e)
+{
+    const sx_balls *B = &m->balls;
+    const double zero[D] = {0};
     /* the law of each material against each wall, mixed once here rather
      * than for every contact (the energy guard runs this every 64 steps);
      * a model with contact-model rows for walls asks each contact its row */
-    const int64_t nw = m->nwall, nlaw = m->bw.cmodel ? 0 : m->nmat * nw;
+    const int64_t nw = m->nwall, nlaw = m->bw.cmodel || c1 <= c0 ? 0 : m->nmat * nw;
     sx_pair_law *wall_laws = nlaw > 0 && nlaw <= 4096 ? malloc((size_t)nlaw * sizeof *wall_laws) : NULL;
     for (int64_t k = 0; wall_laws && k < nlaw; k++) wall_laws[k] = sx__wall_law(m, (int)(k / nw), &m->walls[k % nw]);
-    for (int64_t c = 0; c < m->bw.n; c++) {
+    for (int64_t c = c0; c < c1; c++) {
         double n[D], kn, ks;
         const int64_t i = m->bw.a[c];
         const sx_wall *wl = &m->walls[m->bw.b[c]];
@@ -91,10 +102,47 @@ static void KERNEL(energy)(const sx_model *m, sx_energy *e)
         if (un <= 0) continue;
         const sx_pair_law law = wall_laws ? wall_laws[B->mat[i] * nw + m->bw.b[c]] : sx__bw_law(m, c);
         const double fn = stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
-        e->strain += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
-        e->strain += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
+        *e += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
+        *e += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
     }
     free(wall_laws);
+}
+
+/* Rank r's terms of the energy's chained sums (decompose.c, sx__dd_chain):
+ * its own balls' kinetic and gravitational energy and its own pairs'
+ * strains (acc: kinetic, gravitational, strain, bond strain); then, the
+ * pairs' strain summed, its own ball-wall pairs' (acc: strain). */
+static void energy_own(const sx_model *m, int r, double *acc)
+{
+    energy_balls(m, m->dd->own[r].lo, m->dd->own[r].hi, acc);
+    energy_pairs(m, m->dd->bb_own[r].lo, m->dd->bb_own[r].hi, acc + 2);
+}
+
+static void energy_own_walls(const sx_model *m, int r, double *acc)
+{
+    energy_walls(m, m->dd->bw_own[r].lo, m->dd->bw_own[r].hi, acc);
+}
+
+/* The serial sums: balls in dense order (then the clumps), pairs in pair
+ * order, then ball-wall pairs in order. Decomposed inside a cycle (the
+ * energy guard), the same sums run as chains over the ranks' own balls and
+ * pairs (the ghosts current: model.c refreshes them), each rank stepping
+ * every clump and so adding the clumps alike. */
+static bool KERNEL(energy)(const sx_model *m, sx_energy *e)
+{
+    *e = m->acc;
+    double s[4] = {0, 0, 0, 0}; /* kinetic, gravitational, strain, bond strain */
+    const bool dd = m->dd && m->dd->active;
+    if (dd && !sx__dd_chain(m, s, 4, energy_own)) return false;
+    if (!dd) {
+        energy_balls(m, 0, m->balls.n, s);
+        energy_pairs(m, 0, m->bb.n, s + 2);
+    }
+    e->kinetic = s[0], e->gravitational = s[1], e->strain = s[2], e->bond_strain = s[3];
+    if (m->clumps) sx__clumps_energy(m, e);
+    if (dd) return sx__dd_chain(m, &e->strain, 1, energy_own_walls);
+    energy_walls(m, 0, m->bw.n, &e->strain);
+    return true;
 }
 
 /* Contacts are reported as the last force evaluation left them (the forces

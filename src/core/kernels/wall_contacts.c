@@ -503,8 +503,10 @@ static sx_status KERNEL(walls)(sx_model *m)
                             "a ball of radius %g m (coarsen it)",
                             (long long)o->err_ball, o->err_un, (long long)o->err_wall, MESH_ROWS_MAX, o->err_r);
         if (o->st) return overlap_error(m, "ball and wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
-        m->acc.slip += o->slip;
-        m->acc.viscous += o->viscous;
+        if (!dd) { /* decomposed: the energy sums are the ranks' to chain (decompose.c, sx__dd_energy) */
+            m->acc.slip += o->slip;
+            m->acc.viscous += o->viscous;
+        }
         for (int64_t w = 0; w < nw; w++) {
             const sx_wall_acc *a = &m->wall_acc[b * nw + w];
             sx_wall *wl = &m->walls[w];

@@ -81,8 +81,9 @@ static inline int sx_law_sj_breaks(const sx_law_sj *j, double area, double fn, d
 
 /* The unbonded law after the elastic increments: open (no force), or
  * Coulomb slip with dilation. un and fs (n components, fs0 before this
- * step's increment) are updated in place; the slip's plastic work less the
- * dilation's strain energy goes to *work (may be NULL). Returns Fn. */
+ * step's increment) are updated in place; the slip's plastic work is added
+ * to work[0] and the dilation's strain energy taken from work[1] (two
+ * terms of the caller's sum, in that order; work may be NULL). Returns Fn. */
 static inline double sx_law_sj_unbonded(int n, const sx_law_sj *j, double area, double *un, double *fs,
                                         const double *fs0, double *work)
 {
@@ -100,6 +101,6 @@ static inline double sx_law_sj_unbonded(int n, const sx_law_sj *j, double area, 
     const double slip = (trial - j->mu * fn) / ksa;
     *un += slip * j->tanpsi;
     const double fn1 = kna * *un;
-    if (work) *work -= 0.5 * (fn1 * fn1 - fn * fn) / kna;
+    if (work) work[1] -= 0.5 * (fn1 * fn1 - fn * fn) / kna;
     return fn1;
 }
