@@ -119,6 +119,111 @@ elseif scene == "cross" then
   end
   if tri[1].pos[2] > 0.02 then error("the triplet did not fall through the column") end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "flat" then
+  -- a flat-jointed specimen (D = 2: 16 x 20 disks, 4 elements a joint; 3:
+  -- 4 x 4 x 12 spheres, 2 rings of 3 sectors), a fifth of the elements
+  -- unbonded, crushed (3D: sheared) by a platen until elements break and
+  -- whole joints go: the elements' state travels with the joints
+  local g = dim == 3 and {0, 0, -9.81} or {0, -9.81}
+  local m = seixo.model{dim = dim, gravity = g}
+  m:material("rock", {density = 2650, friction = 0.5, damping = 0.7, modulus = 1e9, stiffness_ratio = 2.5,
+                      bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 4e5,
+                              tensile_strength_sd = 8e4, cohesion = 8e5, cohesion_sd = 1.6e5, friction_angle = 30,
+                              friction = 0.6, elements = dim == 3 and 2 or 4, sectors = 3,
+                              unbonded_fraction = 0.2, initial_gap = 1e-6}})
+  local r = 1e-3
+  local height
+  if dim == 2 then -- a hexagonal packing, 16 x 20
+    for j = 0, 19 do
+      for i = 0, 15 do m:ball{pos = {(2 * i + (j % 2) + 1) * r, (1 + j * math.sqrt(3)) * r}, radius = r} end
+    end
+    height = (2 + 19 * math.sqrt(3)) * r
+  else -- a simple cubic block, 4 x 4 x 12
+    for k = 0, 11 do
+      for j = 0, 3 do
+        for i = 0, 3 do m:ball{pos = {(2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r}, radius = r} end
+      end
+    end
+    height = 24 * r
+  end
+  local up = dim == 3 and {0, 0, 1} or {0, 1}
+  m:wall{kind = dim == 3 and "plane" or "line", point = dim == 3 and {0, 0, 0} or {0, 0}, normal = up, kn = 2e9,
+         ks = 2e9}
+  local n = m:bond{kind = "flatjoint", gap = 1e-6, seed = 42}
+  print(string.format("%d balls, %d flat joints", m:ball_count(), n))
+  local down = dim == 3 and {0.1, 0, -0.1} or {0, -0.05}
+  local platen = m:wall{kind = dim == 3 and "plane" or "line", point = dim == 3 and {0, 0, height} or {0, height},
+                        normal = dim == 3 and {0, 0, -1} or {0, -1}, kn = 2e9, ks = 2e9, vel = down}
+  -- the elements of every joint still listed, by state (m:flatjoint of each bonded pair)
+  local function elements()
+    local count = {}
+    for c in m:contacts{kind = "ball-ball"} do
+      for _, e in ipairs(m:flatjoint(c.a.id, c.b.id) or {}) do count[e.state] = (count[e.state] or 0) + 1 end
+    end
+    return string.format("bonded %d unbonded %d tension %d shear %d", count.bonded or 0, count.unbonded or 0,
+                         count.tension or 0, count.shear or 0)
+  end
+  for k = 1, 4 do
+    m:cycle(dim == 3 and 500 or 800)
+    report(m, "at " .. k)
+    print(string.format("  platen %.17g %.17g %s", platen.force[1], platen.force[dim], elements()))
+  end
+  if m:crack_count() == 0 or m:bond_count() == n then error("no element or joint broke") end
+  log_cracks(m)
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "smooth" then
+  -- a bonded 2D column of 12 x 30 soft disks cut by a bonded smooth joint
+  -- at 60 degrees across the whole column (through every rank's slab), its
+  -- upper part pressed onto the joint and pushed down it, the lower part
+  -- fixed: the joint's bonds
+  -- break and the part slides along the joint by more than a ball, its
+  -- balls meeting new balls across it (contacts that take the joint's law
+  -- as they form)
+  local m = seixo.model{dim = 2, gravity = {0, -9.81}, timestep = 4e-6}
+  m:material("soft", {density = 2650, friction = 0.5, modulus = 1e7, stiffness_ratio = 2.5,
+                      bond = {radius_multiplier = 1, modulus = 1e7, stiffness_ratio = 2.5, tensile_strength = 1e12,
+                              cohesion = 1e12}})
+  local r = 1e-3
+  local nx, ny = 12, 30
+  local dip = math.rad(60)
+  local point = {nx * r, ny * r}
+  local upper = {}
+  for j = 0, ny - 1 do
+    for i = 0, nx - 1 do
+      local x, y = (2 * i + 1) * r, (2 * j + 1) * r
+      local b = m:ball{pos = {x, y}, radius = r}
+      -- above the joint (its normal (-sin, cos)): pressed onto it by 5 N a
+      -- ball, and pushed down it by 2.5 N (more than its friction)
+      if -math.sin(dip) * (x - point[1]) + math.cos(dip) * (y - point[2]) > 0 then
+        b.applied_force = {5 * math.sin(dip) - 2.5 * math.cos(dip), -5 * math.cos(dip) - 2.5 * math.sin(dip)}
+        upper[#upper + 1] = b
+      else -- the lower part: a fixed base
+        b.fix = "all"
+      end
+    end
+  end
+  m:wall{kind = "line", point = {0, 0}, normal = {0, 1}, kn = 2e7, ks = 2e7}
+  local n = m:bond{kind = "parallel", gap = 1e-6, seed = 42}
+  local _, cut, took = m:joint{point = point, dip = 60, kn = 1e10, ks = 1e10, friction = 0.3, dilation = 5,
+                               tension = 5e3, cohesion = 5e3, friction_angle = 20}
+  print(string.format("%d balls (%d above the joint), %d parallel bonds, the joint took %d bonds and %d contacts",
+                      m:ball_count(), #upper, n, cut, took))
+  local x0 = upper[1].pos[1]
+  for k = 1, 5 do
+    m:cycle(800)
+    local joint, broke = 0, 0
+    for c in m:contacts{kind = "ball-ball"} do
+      if c.joint then joint = joint + 1 end
+    end
+    for _, c in ipairs(m:cracks()) do
+      if c.kind == "smoothjoint" then broke = broke + 1 end
+    end
+    report(m, "at " .. k)
+    print(string.format("  joint contacts %d joint bonds broken %d slid %.17g", joint, broke, upper[1].pos[1] - x0))
+  end
+  if upper[1].pos[1] - x0 > -2 * r then error("the upper part did not slide by a ball along the joint") end
+  log_cracks(m)
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "refused" then
   -- one of what is not decomposed yet (arg 2: flatjoint, energy):
   -- a serial run cycles it, mpirun stops every rank at the first cycle with
