@@ -25,9 +25,12 @@
  *     ranks (a maximum, exact in any order) for the rebuild criterion.
  * A build, the energy guard and the end of the cycle first gather the
  * whole state on every rank (each ball from its owner, each pair from the
- * owner of its first ball, each bond from the owner of its pair, and the
- * ranks' cracks merged in the serial order); the build itself is the
- * serial one, on every rank. Clumps: every rank steps every clump, from
+ * owner of its first ball, each bond, and a flat joint's face and
+ * elements, from the owner of its pair, and the ranks' cracks merged in
+ * the serial order); the build itself is the serial one, on every rank.
+ * A smooth joint's state is its pair's and its bond's; a mesh wall is a
+ * wall (its rows of a ball lie in the ball's block), moved and turned
+ * alike by every rank. Clumps: every rank steps every clump, from
  * its pebbles' forces shared by their owners at every step. Periodic
  * space: a ghost's force is folded onto its owner after the pass, so the
  * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
@@ -582,7 +585,8 @@ sx_status sx__dd_begin(sx_model *m)
     const char *what = not_decomposed(m);
     if (what)
         return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
-                                      "walls, contact and parallel bonds, clumps, periodic space); run it serially",
+                                      "walls, mesh walls, contact and parallel bonds, flat and smooth joints, "
+                                      "clumps, periodic space); run it serially",
                         what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx_model_state_hash(m)))
         return sx__fail(m, SX_EINVAL,

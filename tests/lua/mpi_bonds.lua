@@ -12,9 +12,19 @@
 --             (the ranks cut the balls by count along y): its bonds and
 --             contacts must survive the migrations, and the state is the
 --             serial one.
---   refused W one of what is not decomposed yet (W: flatjoint, energy),
---             for mpi_pour.sh: refused under mpirun with an error naming
---             it, cycled serially.
+--   flat D    a flat-jointed specimen (D = 2 or 3), a fifth of its
+--             elements unbonded, crushed (3D: sheared) until elements and
+--             whole joints break: the state hash (which covers every
+--             element's state and forces), the platen's force, the elements
+--             by state and the crack log at several points.
+--   smooth    a bonded 2D column cut by a bonded smooth joint at 60 degrees
+--             through every rank's slab, its upper part pushed down the
+--             joint: the joint's bonds break, the part slides by more than
+--             a ball, making new contacts across the joint; the hash, the
+--             joint contacts and the crack log.
+--   refused W one of what is not decomposed yet (W: energy), for
+--             mpi_pour.sh: refused under mpirun with an error naming it,
+--             cycled serially.
 local scene = arg and arg[1] or "crush"
 local dim = tonumber(arg and arg[2]) or 2
 
@@ -225,26 +235,20 @@ elseif scene == "smooth" then
   log_cracks(m)
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "refused" then
-  -- one of what is not decomposed yet (arg 2: flatjoint, energy):
+  -- one of what is not decomposed yet (arg 2: energy):
   -- a serial run cycles it, mpirun stops every rank at the first cycle with
   -- an error naming it (mpi_pour.sh checks both)
   local what = arg[2]
   local m = seixo.model{dim = 3}
-  m:material("r", {density = 1000, kn = 1e7, ks = 1e7, friction = 0.5,
-                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
-                           cohesion = 2e6, friction_angle = 30, friction = 0.6, elements = 4, sectors = 3}})
-  if what == "flatjoint" then
-    m:ball{pos = {0, 0, 0}, radius = 1}
-    m:ball{pos = {2, 0, 0}, radius = 1}
-    m:bond{kind = "flatjoint", gap = 1e-6, seed = 5}
-  elseif what == "energy" then
+  m:material("r", {density = 1000, kn = 1e7, ks = 1e7, friction = 0.5})
+  if what == "energy" then
     m:ball{pos = {0.05, 0.05, 0.05}, radius = 0.01}
     m:track_energy(true)
   else
-    error("mpi_bonds.lua refused: flatjoint or energy expected")
+    error("mpi_bonds.lua refused: energy expected")
   end
   m:cycle(10)
   print(what .. " cycled on " .. m:ranks() .. " rank(s)")
 else
-  error("mpi_bonds.lua: scene 'crush' or 'cross' expected, got " .. tostring(scene))
+  error("mpi_bonds.lua: scene 'crush', 'cross', 'flat' or 'smooth' expected, got " .. tostring(scene))
 end

@@ -87,7 +87,7 @@ fi
 # what is not decomposed yet runs serially, and mpirun stops every rank at
 # the first cycle with an error naming it
 bonds=$(dirname "$script")/mpi_bonds.lua
-for what in "flatjoint:flat joints" "energy:energy tracking"; do
+for what in "energy:energy tracking"; do
   arg=${what%%:*} name=${what#*:}
   "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err" || { echo "$arg, serial:"; cat "$dir/err"; fail=1; }
   # shellcheck disable=SC2086
