@@ -17,8 +17,8 @@
 --             whole joints break: the state hash (which covers every
 --             element's state and forces), the platen's force, the elements
 --             by state and the crack log at several points.
---   smooth    a bonded 2D column cut by a bonded smooth joint at 60 degrees
---             through every rank's slab, its upper part pushed down the
+--   smooth D  a bonded column (D = 2 or 3) cut by a bonded smooth joint at
+--             60 degrees through every rank's slab, its upper part pushed down the
 --             joint: the joint's bonds break, the part slides by more than
 --             a ball, making new contacts across the joint; the hash, the
 --             joint contacts and the crack log.
@@ -38,6 +38,29 @@ end
 local function report(m, tag)
   print(string.format("%s step %d bonds %d cracks %d (tension %d) contacts %d hash %s", tag, m:step(), m:bond_count(),
                       m:crack_count(), m:crack_count("tension"), m:contact_count(), m:hash()))
+end
+
+-- The ball-ball contacts keep(c) holds in each quarter of the balls by
+-- height (the ranks' slabs cut the balls by count along the last axis:
+-- with 4 ranks, about these quarters), as "a b c d"; an error unless each
+-- has some, so that they meet the slab of every rank.
+local function quarters(m, keep)
+  local z = {}
+  for b in m:balls() do z[#z + 1] = b.pos[dim] end
+  table.sort(z)
+  local cut = {z[#z // 4], z[#z // 2], z[3 * #z // 4]}
+  local count = {0, 0, 0, 0}
+  for c in m:contacts{kind = "ball-ball"} do
+    if keep(c) then
+      local q = 1
+      while q <= 3 and c.a.pos[dim] > cut[q] do q = q + 1 end
+      count[q] = count[q] + 1
+    end
+  end
+  for q = 1, 4 do
+    if count[q] == 0 then error(string.format("no contact in quarter %d of the balls", q)) end
+  end
+  return table.concat(count, " ")
 end
 
 local function material(m)
@@ -182,44 +205,53 @@ elseif scene == "flat" then
   log_cracks(m)
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "smooth" then
-  -- a bonded 2D column of 12 x 30 soft disks cut by a bonded smooth joint
-  -- at 60 degrees across the whole column (through every rank's slab), its
-  -- upper part pressed onto the joint and pushed down it, the lower part
-  -- fixed: the joint's bonds
+  -- a bonded column of soft balls (D = 2: 12 x 30 disks; 3: 8 x 3 x 20
+  -- spheres) cut by a bonded smooth joint at 60 degrees across the whole
+  -- column (through every rank's slab), its upper part pressed onto the
+  -- joint and pushed down it, the lower part fixed: the joint's bonds
   -- break and the part slides along the joint by more than a ball, its
   -- balls meeting new balls across it (contacts that take the joint's law
   -- as they form)
-  local m = seixo.model{dim = 2, gravity = {0, -9.81}, timestep = 4e-6}
+  local function v(x, z) -- x along the dip, z up (the slabs' axis)
+    return dim == 3 and {x, 0, z} or {x, z}
+  end
+  local m = seixo.model{dim = dim, gravity = v(0, -9.81), timestep = 4e-6}
   m:material("soft", {density = 2650, friction = 0.5, modulus = 1e7, stiffness_ratio = 2.5,
                       bond = {radius_multiplier = 1, modulus = 1e7, stiffness_ratio = 2.5, tensile_strength = 1e12,
                               cohesion = 1e12}})
   local r = 1e-3
-  local nx, ny = 12, 30
+  local nx, ny, nz = 12, 1, 30
+  if dim == 3 then nx, ny, nz = 8, 3, 20 end
   local dip = math.rad(60)
-  local point = {nx * r, ny * r}
+  local px, pz = nx * r, nz * r
+  -- a ball's weight times 600 (2D: 5 N a disk of unit thickness): the load pressing the joint
+  local P = 600 * 2650 * (dim == 3 and 4 / 3 * math.pi * r ^ 3 or math.pi * r ^ 2)
   local upper = {}
-  for j = 0, ny - 1 do
-    for i = 0, nx - 1 do
-      local x, y = (2 * i + 1) * r, (2 * j + 1) * r
-      local b = m:ball{pos = {x, y}, radius = r}
-      -- above the joint (its normal (-sin, cos)): pressed onto it by 5 N a
-      -- ball, and pushed down it by 2.5 N (more than its friction)
-      if -math.sin(dip) * (x - point[1]) + math.cos(dip) * (y - point[2]) > 0 then
-        b.applied_force = {5 * math.sin(dip) - 2.5 * math.cos(dip), -5 * math.cos(dip) - 2.5 * math.sin(dip)}
-        upper[#upper + 1] = b
-      else -- the lower part: a fixed base
-        b.fix = "all"
+  for k = 0, nz - 1 do
+    for j = 0, ny - 1 do
+      for i = 0, nx - 1 do
+        local x, z = (2 * i + 1) * r, (2 * k + 1) * r
+        local pos = v(x, z)
+        if dim == 3 then pos[2] = (2 * j + 1) * r end
+        local b = m:ball{pos = pos, radius = r}
+        -- above the joint (its normal (-sin, cos) in x, z): pressed onto it
+        -- by P, and pushed down it by P / 2 (more than its friction)
+        if -math.sin(dip) * (x - px) + math.cos(dip) * (z - pz) > 0 then
+          b.applied_force = v(P * math.sin(dip) - P / 2 * math.cos(dip), -P * math.cos(dip) - P / 2 * math.sin(dip))
+          upper[#upper + 1] = b
+        else -- the lower part: a fixed base
+          b.fix = "all"
+        end
       end
     end
   end
-  m:wall{kind = "line", point = {0, 0}, normal = {0, 1}, kn = 2e7, ks = 2e7}
   local n = m:bond{kind = "parallel", gap = 1e-6, seed = 42}
-  local _, cut, took = m:joint{point = point, dip = 60, kn = 1e10, ks = 1e10, friction = 0.3, dilation = 5,
-                               tension = 5e3, cohesion = 5e3, friction_angle = 20}
+  local _, cut, took = m:joint{point = v(px, pz), normal = v(-math.sin(dip), math.cos(dip)), kn = 1e10, ks = 1e10,
+                               friction = 0.3, dilation = 5, tension = 5e3, cohesion = 5e3, friction_angle = 20}
   print(string.format("%d balls (%d above the joint), %d parallel bonds, the joint took %d bonds and %d contacts",
                       m:ball_count(), #upper, n, cut, took))
   local x0 = upper[1].pos[1]
-  for k = 1, 5 do
+  for k = 1, 4 do
     m:cycle(800)
     local joint, broke = 0, 0
     for c in m:contacts{kind = "ball-ball"} do
@@ -230,6 +262,7 @@ elseif scene == "smooth" then
     end
     report(m, "at " .. k)
     print(string.format("  joint contacts %d joint bonds broken %d slid %.17g", joint, broke, upper[1].pos[1] - x0))
+    if k == 1 then print("  joint contacts by quarter of height " .. quarters(m, function(c) return c.joint end)) end
   end
   if upper[1].pos[1] - x0 > -2 * r then error("the upper part did not slide by a ball along the joint") end
   log_cracks(m)
