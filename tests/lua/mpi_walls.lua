@@ -2,16 +2,17 @@
 -- through mpi_same.sh): serially and under mpirun -np 1 ... 4 each scene
 -- prints the same lines, to the bit. The ranks cut the balls by count
 -- along z, so every mesh below meets the slab of every rank.
---   plough   a bed of 700 balls settled on a floor read from an STL file
---            (tests/data/square.stl) between four planes, ploughed by a
---            mesh wedge taller than the bed, moving along x and turning
---            about its vertical axis: the state hash, the plough's force
---            and moment (the balls' resultant about its point, summed over
---            the wall blocks of every rank), the floor's force and the
---            contact count at several points.
---   drum     700 balls tumbling in a mesh box turning about x (and drifting
---            along it), with rolling resistance: they are carried up one
---            side and fall back across every slab; the box's force and
+--   plough   a bed of 675 balls (an fcc lattice) settled on a floor read
+--            from an STL file (tests/data/square.stl) between four planes,
+--            ploughed by a 96-facet mesh wedge taller than the bed, moving
+--            along x and turning about its vertical axis, the automatic
+--            timestep: the state hash, the plough's and the floor's force
+--            and moment (the balls' resultants, summed over the wall
+--            blocks of every rank) and the contact count at four points;
+--            the plough's contacts in every quarter of the bed's height.
+--   drum     700 balls in a 108-facet mesh box turning about x (and
+--            drifting along it), with rolling resistance: the turning
+--            sides drag the balls across the slabs; the box's force and
 --            moment and the state hash as above.
 local scene = arg and arg[1] or "plough"
 local dir = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
@@ -86,7 +87,6 @@ if scene == "plough" then
              material = "sand"}
   local plough = m:wall{kind = "mesh", triangles = t, point = {x0 + len / 3, y0, 0}, kn = 1e5, ks = 1e5}
   m:cycle(500)
-  io.stderr:write(string.format("timestep %g\n", m:timestep()))
   plough.vel = {1.5, 0, 0}
   plough.spin = {0, 0, 2}
   print(string.format("%d balls, plough of %d facets", m:ball_count(), plough.facet_count))
@@ -120,7 +120,6 @@ elseif scene == "drum" then
   m:generate{count = 700, radius = 3.5e-3, packing = "fcc",
              region = {box = {{0.002, 0.002, 0.002}, {S - 0.002, S - 0.002, 0.04}}},
              material = "grain"}
-  io.stderr:write(string.format("timestep %g\n", m:timestep()))
   print(string.format("%d balls in a drum of %d facets", m:ball_count(), drum.facet_count))
   local walls = {{name = "drum", wall = drum}}
   for k = 1, 4 do
