@@ -29,10 +29,13 @@
  *     lower ranks pass it), and every rank adds them in the serial order.
  * The energy guard sums its energy in chains over the ranks' own balls and
  * pairs (sx__dd_chain), in the serial order. A build and the end of the
- * cycle first gather the whole state on every rank (each ball from its owner, each pair from the
- * owner of its first ball, each bond from the owner of its pair, and the
- * ranks' cracks merged in the serial order); the build itself is the
- * serial one, on every rank. Clumps: every rank steps every clump, from
+ * cycle first gather the whole state on every rank (each ball from its
+ * owner, each pair from the owner of its first ball, each bond, and a flat
+ * joint's face and elements, from the owner of its pair, and the ranks'
+ * cracks merged in the serial order); the build itself is the serial one,
+ * on every rank. A smooth joint's state is its pair's and its bond's; a
+ * mesh wall is a wall (its rows of a ball lie in the ball's block), moved
+ * and turned alike by every rank. Clumps: every rank steps every clump, from
  * its pebbles' forces shared by their owners at every step. Periodic
  * space: a ghost's force is folded onto its owner after the pass, so the
  * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
@@ -43,15 +46,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-
-static const char *not_decomposed(const sx_model *m)
-{
-    if (m->fjel.n) return "flat joints";
-    if (m->njoint) return "smooth joints";
-    for (int64_t w = 0; w < m->nwall; w++)
-        if (m->walls[w].mesh) return "mesh walls";
-    return NULL;
-}
 
 void sx__dd_free(sx_model *m)
 {
@@ -374,6 +368,67 @@ static bool gather_bonds(sx_model *m)
     return ok;
 }
 
+/* The flat joints' state the step changes beyond the bond's (laws/
+ * flatjoint.h): the face's bend rotation and (3D) its carried axis, and
+ * each element's state, normal force and shear force; each joint from the
+ * owner of its pair, as gather_bonds takes the bond. The joints of the
+ * plan's bonded pairs (bslot: every slot with elements, a joint broken in
+ * this cycle included; a slot a smooth joint took keeps its elements
+ * unchanged, and the owner's copy is everyone's) are packed as doubles in
+ * plan order, each rank's a contiguous run (a state is a small integer:
+ * exact). */
+static bool gather_fjoints(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_bonds *b = &m->bonds;
+    sx_fjels *E = &m->fjel;
+    const int D = m->dim, T = D - 1, face = T + (D == 3 ? 3 : 0), el = 2 + T;
+    const int64_t nb = d->nbslot;
+    int64_t *at = malloc((size_t)(nb + 1) * sizeof *at); /* entry e's first double */
+    if (!at) return false;
+    at[0] = 0;
+    for (int64_t e = 0; e < nb; e++) {
+        const int32_t s = d->bslot[e];
+        const int nel = b->fj_nr[s] * b->fj_na[s];
+        at[e + 1] = at[e] + (nel ? face + nel * el : 0);
+    }
+    const int64_t total = at[nb];
+    double *buf = total ? malloc((size_t)total * sizeof *buf) : NULL;
+    bool ok = !total || buf;
+    for (int r = 0; ok && r < d->x.ranks; r++) d->scratch[r] = (sx_span){at[d->bs_own[r].lo], at[d->bs_own[r].hi]};
+    for (int pass = 0; ok && total && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
+        const sx_span mine = d->bs_own[d->x.rank];
+        const int64_t e0 = pass ? 0 : mine.lo, e1 = pass ? nb : mine.hi;
+        for (int64_t e = e0; e < e1; e++) {
+            const int32_t s = d->bslot[e];
+            const int nel = b->fj_nr[s] * b->fj_na[s];
+            if (!nel) continue;
+            double *q = buf + at[e], *rot = b->fj_rot + s * T, *axis = D == 3 ? b->fj_axis + s * 3 : NULL;
+            if (pass) {
+                memcpy(rot, q, (size_t)T * sizeof *q);
+                if (axis) memcpy(axis, q + T, 3 * sizeof *q);
+            } else {
+                memcpy(q, rot, (size_t)T * sizeof *q);
+                if (axis) memcpy(q + T, axis, 3 * sizeof *q);
+            }
+            q += face;
+            for (int64_t x = b->fj_first[s]; x < b->fj_first[s] + nel; x++, q += el) {
+                if (pass) {
+                    E->state[x] = (uint8_t)q[0], E->fn[x] = q[1];
+                    memcpy(E->fs + x * T, q + 2, (size_t)T * sizeof *q);
+                } else {
+                    q[0] = E->state[x], q[1] = E->fn[x];
+                    memcpy(q + 2, E->fs + x * T, (size_t)T * sizeof *q);
+                }
+            }
+        }
+        if (!pass) ok = share(d, buf, sizeof *buf, d->scratch, everything(d, total), 1);
+    }
+    free(buf);
+    free(at);
+    return ok;
+}
+
 /* The cracks logged since the last gather, made one log in the serial
  * order. Every rank evaluates its own pairs and some of its neighbours'
  * (between its ghosts): it keeps the cracks of its own pairs (a pair is
@@ -464,6 +519,7 @@ bool sx__dd_gather(sx_model *m)
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
            gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m))) &&
+           (!m->fjel.n || gather_fjoints(m)) &&
            (!m->cell || !m->cell->n || gather_ghosts(m));
 }
 
@@ -616,11 +672,6 @@ bool sx__dd_energy(sx_model *m)
 sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
-    const char *what = not_decomposed(m);
-    if (what)
-        return sx__fail(m, SX_EINVAL, "cycle: %s cannot yet run decomposed over %d ranks (issue 16 so far: balls, "
-                                      "walls, contact and parallel bonds, clumps, periodic space); run it serially",
-                        what, d->x.ranks);
     if (!d->x.agree(d->x.ud, sx__state_digest(m)))
         return sx__fail(m, SX_EINVAL,
                         "cycle: the model differs between the %d ranks (every rank must make the same calls: "

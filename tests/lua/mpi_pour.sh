@@ -8,8 +8,9 @@
 # (and so do a bonded specimen and a bonded periodic cell breaking bonds
 # across the save);
 # and a servo-controlled lid moves alike with 2 and 3 ranks; an output
-# series written with 2 and 3 ranks is the serial one (mpi_output.lua); what is not
-# decomposed yet is refused with a clear error.
+# series written with 2 and 3 ranks is the serial one (mpi_output.lua); a
+# long cycle's progress lines come from rank 0 (mpi_progress.lua); ranks whose
+# models differ are stopped with the cause (mpi_diverge.lua).
 # Skipped without mpirun. The pours run through mpi_same.sh (which
 # checks 3 ranks only under AddressSanitizer).
 #   mpi_pour.sh SEIXO mpi_pour.lua
@@ -108,19 +109,4 @@ if command -v h5dump >/dev/null 2>&1; then
 else
   echo "h5dump not found: the series under MPI not checked"
 fi
-# what is not decomposed yet runs serially, and mpirun stops every rank at
-# the first cycle with an error naming it
-bonds=$(dirname "$script")/mpi_bonds.lua
-for what in "flatjoint:flat joints"; do
-  arg=${what%%:*} name=${what#*:}
-  "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err" || { echo "$arg, serial:"; cat "$dir/err"; fail=1; }
-  # shellcheck disable=SC2086
-  if mpirun $root --oversubscribe -np 2 "$seixo" "$bonds" refused "$arg" >"$dir/out" 2>"$dir/err"; then
-    echo "$arg: not refused with 2 ranks"; cat "$dir/out"; fail=1
-  elif grep -q "m:cycle: $name cannot yet run decomposed over 2 ranks" "$dir/err"; then
-    echo "$arg: refused with 2 ranks, naming it"
-  else
-    echo "$arg: failed with 2 ranks without naming it:"; cat "$dir/err"; fail=1
-  fi
-done
 exit $fail
