@@ -22,8 +22,11 @@
 --             joint: the joint's bonds break, the part slides by more than
 --             a ball, making new contacts across the joint; the hash, the
 --             joint contacts and the crack log.
+--   flat D energy, smooth D energy: the same with energy tracking on, every
+--             energy term printed (%a) with each report.
 local scene = arg and arg[1] or "crush"
 local dim = tonumber(arg and arg[2]) or 2
+local energy = arg and arg[3] == "energy"
 
 local function log_cracks(m)
   for i, c in ipairs(m:cracks()) do
@@ -35,6 +38,12 @@ end
 local function report(m, tag)
   print(string.format("%s step %d bonds %d cracks %d (tension %d) contacts %d hash %s", tag, m:step(), m:bond_count(),
                       m:crack_count(), m:crack_count("tension"), m:contact_count(), m:hash()))
+  if not energy then return end
+  local e, terms = m:energy(), {}
+  for k in pairs(e) do terms[#terms + 1] = k end
+  table.sort(terms)
+  for i, k in ipairs(terms) do terms[i] = k .. " " .. string.format("%a", e[k]) end
+  print("  energy " .. table.concat(terms, " "))
 end
 
 -- The ball-ball contacts keep(c) holds in each quarter of the balls by
@@ -156,6 +165,7 @@ elseif scene == "flat" then
   -- whole joints go: the elements' state travels with the joints
   local g = dim == 3 and {0, 0, -9.81} or {0, -9.81}
   local m = seixo.model{dim = dim, gravity = g}
+  m:track_energy(energy)
   m:material("rock", {density = 2650, friction = 0.5, damping = 0.7, modulus = 1e9, stiffness_ratio = 2.5,
                       bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 4e5,
                               tensile_strength_sd = 8e4, cohesion = 8e5, cohesion_sd = 1.6e5, friction_angle = 30,
@@ -213,6 +223,7 @@ elseif scene == "smooth" then
     return dim == 3 and {x, 0, z} or {x, z}
   end
   local m = seixo.model{dim = dim, gravity = v(0, -9.81), timestep = 4e-6}
+  m:track_energy(energy)
   m:material("soft", {density = 2650, friction = 0.5, modulus = 1e7, stiffness_ratio = 2.5,
                       bond = {radius_multiplier = 1, modulus = 1e7, stiffness_ratio = 2.5, tensile_strength = 1e12,
                               cohesion = 1e12}})
