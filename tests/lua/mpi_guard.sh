@@ -10,16 +10,7 @@ set -u
 seixo=$1
 script=$2
 scene=$3
-if ! command -v mpirun >/dev/null 2>&1; then
-  echo "mpirun not found: skipped"
-  exit 77
-fi
-root=
-[ "$(id -u)" = 0 ] && root=--allow-run-as-root # Open MPI refuses root without it
-ranks="1 2 3 4"
-if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; fi
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
 # the guard's message, once per rank that printed it
 messages() { grep -o "m:cycle: unstable at step .*" "$1" | sort -u; }
 # shellcheck disable=SC2086 # a scene is several arguments

@@ -17,14 +17,7 @@
 set -u
 seixo=$1
 script=$2
-if ! command -v mpirun >/dev/null 2>&1; then
-  echo "mpirun not found: skipped"
-  exit 77
-fi
-root=
-[ "$(id -u)" = 0 ] && root=--allow-run-as-root # Open MPI refuses root without it
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
 fail=0
 sh "$(dirname "$0")/mpi_same.sh" "$seixo" "$script" "600 6000 3" "3000 4000 2" || fail=1
 # a servo-controlled lid (a wall force summed over the ranks' blocks drives it)

@@ -9,20 +9,7 @@ set -u
 seixo=$1
 script=$2
 shift 2
-if ! command -v mpirun >/dev/null 2>&1; then
-  echo "mpirun not found: skipped"
-  exit 77
-fi
-root=
-[ "$(id -u)" = 0 ] && root=--allow-run-as-root # Open MPI refuses root without it
-# Under AddressSanitizer (scripts/test --sanitize) 3 ranks only (a middle
-# rank with a neighbour on each side and two end ranks: the memory checks of
-# every code path): the plain suite checks every rank count, and CI's time
-# stays short (three MPI tests under ASan).
-ranks="1 2 3 4"
-if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; fi
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
 fail=0
 for scene in "$@"; do
   # shellcheck disable=SC2086 # a scene is several arguments

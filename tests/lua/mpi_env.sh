@@ -1,0 +1,17 @@
+# Sourced by the MPI test scripts (mpi_same.sh, mpi_guard.sh, mpi_pour.sh)
+# once $seixo is set: exits 77 (skipped) without mpirun; sets root (Open
+# MPI refuses root without --allow-run-as-root), ranks and dir (a temporary
+# directory removed at exit). Under AddressSanitizer (scripts/test
+# --sanitize) ranks is 3 only (a middle rank with a neighbour on each side
+# and two end ranks: the memory checks of every code path): the plain
+# suite checks every rank count, and CI's time stays short.
+if ! command -v mpirun >/dev/null 2>&1; then
+  echo "mpirun not found: skipped"
+  exit 77
+fi
+root=
+[ "$(id -u)" = 0 ] && root=--allow-run-as-root
+ranks="1 2 3 4"
+if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; fi
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
