@@ -1,0 +1,174 @@
+/* Domain decomposition (issue 16) in one process: threads as ranks, each
+ * holding its own copy of the model and exchanging through memory (the
+ * sx_exchange an MPI launcher would fill), so that every rank count and
+ * every code path of decompose.c runs in the unit suite, under the
+ * sanitizers too, and the bits are compared in full: the state hash and
+ * every energy term of each rank against the serial run. */
+#include "scenes.h"
+
+#include <check.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+
+enum { MAX_RANKS = 5 };
+
+/* The ranks' meeting point: each posts its array (or value), all wait,
+ * each takes what it needs from the others, all wait again (so no rank
+ * writes an array another is still reading). */
+typedef struct world {
+    int ranks;
+    pthread_barrier_t bar;
+    void *data[MAX_RANKS];
+    double value[MAX_RANKS];
+    uint64_t key[MAX_RANKS];
+} world;
+
+typedef struct rank_ctx {
+    world *w;
+    int rank, dim;
+    uint64_t hash;
+    sx_energy energy;
+    sx_status st;
+} rank_ctx;
+
+static bool share(void *ud, void *data, size_t size, const sx_span *own, const sx_span *need, int per)
+{
+    rank_ctx *c = ud;
+    world *w = c->w;
+    w->data[c->rank] = data;
+    pthread_barrier_wait(&w->bar);
+    for (int r = 0; r < w->ranks; r++) {
+        if (r == c->rank) continue;
+        for (int k = 0; k < per; k++) { /* what rank r holds of this rank's need k */
+            const sx_span want = need[c->rank * per + k];
+            const int64_t lo = want.lo > own[r].lo ? want.lo : own[r].lo, hi = want.hi < own[r].hi ? want.hi : own[r].hi;
+            if (hi > lo)
+                memcpy((char *)data + (size_t)lo * size, (const char *)w->data[r] + (size_t)lo * size,
+                       (size_t)(hi - lo) * size);
+        }
+    }
+    pthread_barrier_wait(&w->bar);
+    return true;
+}
+
+static bool largest(void *ud, double *v)
+{
+    rank_ctx *c = ud;
+    world *w = c->w;
+    w->value[c->rank] = *v;
+    pthread_barrier_wait(&w->bar);
+    for (int r = 0; r < w->ranks; r++)
+        if (w->value[r] > *v) *v = w->value[r];
+    pthread_barrier_wait(&w->bar);
+    return true;
+}
+
+static bool agree(void *ud, uint64_t v)
+{
+    rank_ctx *c = ud;
+    world *w = c->w;
+    w->key[c->rank] = v;
+    pthread_barrier_wait(&w->bar);
+    bool same = true;
+    for (int r = 0; r < w->ranks; r++) same = same && w->key[r] == v;
+    pthread_barrier_wait(&w->bar);
+    return same;
+}
+
+/* A dense bed in a box with energy tracking on: several chunks of pairs
+ * and wall blocks, so that chunks and blocks begin on one rank and go on
+ * over the next; unforced, so the energy guard runs its chained sums. */
+static sx_model *bed(int dim)
+{
+    const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
+    sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
+    sx_material_def md = sx_material_default_def();
+    md.kn = md.ks = 2e5;
+    md.density = 2500;
+    md.friction = 0.3;
+    md.viscous_normal = 0.2;
+    md.viscous_shear = 0.1;
+    md.damping = 0.1;
+    scene_material_def(m, "m", &md);
+    sx_model_track_energy(m, true);
+    const double r = 0.01, s = 2 * r - 1e-5;
+    const int nx = dim == 3 ? 12 : 80, ny = dim == 3 ? 12 : 50, nz = dim == 3 ? 14 : 1;
+    uint64_t seed = 11;
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                double x[3] = {r + i * s + scene_rng_uniform(&seed, -2e-6, 2e-6), r + j * s, r + k * s};
+                if (dim == 3) x[1] += scene_rng_uniform(&seed, -2e-6, 2e-6);
+                const double v[3] = {scene_rng_uniform(&seed, -0.05, 0.05), scene_rng_uniform(&seed, -0.05, 0.05),
+                                     dim == 3 ? scene_rng_uniform(&seed, -0.05, 0.05) : 0};
+                scene_ball(m, x, v, r);
+            }
+    const double lo[3] = {0, 0, 0}, hi[3] = {nx * s + r, dim == 3 ? ny * s + r : 10, 10};
+    scene_box_walls(m, lo, hi, 2e5, 0.5);
+    return m;
+}
+
+enum { STEPS_A = 150, STEPS_B = 250 };
+
+static void *run_rank(void *arg)
+{
+    rank_ctx *c = arg;
+    sx_model *m = bed(c->dim);
+    const sx_exchange x = {c->rank, c->w->ranks, c, share, largest, agree};
+    c->st = sx_model_decompose(m, &x);
+    if (!c->st) c->st = sx_model_cycle(m, STEPS_A); /* two cycles: a cycle's end and start in between */
+    if (!c->st) c->st = sx_model_cycle(m, STEPS_B);
+    c->hash = sx_model_state_hash(m);
+    c->energy = sx_model_energy(m);
+    sx_model_destroy(m);
+    return NULL;
+}
+
+START_TEST(ranks_give_the_serial_bits)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        sx_model *serial = bed(dim);
+        ck_assert_int_eq(sx_model_cycle(serial, STEPS_A), SX_OK);
+        ck_assert_int_eq(sx_model_cycle(serial, STEPS_B), SX_OK);
+        ck_assert_msg(sx_contact_count(serial) > sx_ball_count(serial), "the bed must be dense");
+        const uint64_t hash = sx_model_state_hash(serial);
+        const sx_energy e = sx_model_energy(serial);
+        ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
+        sx_model_destroy(serial);
+        for (int ranks = 2; ranks <= MAX_RANKS; ranks++) {
+            world w = {.ranks = ranks};
+            pthread_barrier_init(&w.bar, NULL, (unsigned)ranks);
+            rank_ctx c[MAX_RANKS];
+            pthread_t t[MAX_RANKS];
+            for (int r = 0; r < ranks; r++) {
+                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim};
+                ck_assert_int_eq(pthread_create(&t[r], NULL, run_rank, &c[r]), 0);
+            }
+            for (int r = 0; r < ranks; r++) pthread_join(t[r], NULL);
+            pthread_barrier_destroy(&w.bar);
+            for (int r = 0; r < ranks; r++) {
+                ck_assert_msg(c[r].st == SX_OK, "%dD, %d ranks: rank %d failed (%d)", dim, ranks, r, c[r].st);
+                ck_assert_msg(c[r].hash == hash, "%dD, %d ranks: rank %d's state differs from the serial run's", dim,
+                              ranks, r);
+                ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
+                              "%dD, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
+            }
+        }
+    }
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("decompose");
+    TCase *tc = tcase_create("threads as ranks");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, ranks_give_the_serial_bits);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    const int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}
