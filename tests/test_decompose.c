@@ -27,6 +27,7 @@ typedef struct world {
 typedef struct rank_ctx {
     world *w;
     int rank, dim;
+    bool bonded;
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -78,8 +79,11 @@ static bool agree(void *ud, uint64_t v)
 
 /* A dense bed in a box with energy tracking on: several chunks of pairs
  * and wall blocks, so that chunks and blocks begin on one rank and go on
- * over the next; unforced, so the energy guard runs its chained sums. */
-static sx_model *bed(int dim)
+ * over the next; unforced, so the energy guard runs its chained sums.
+ * Bonded: every touching pair gets a weak parallel bond, and the balls'
+ * random velocities break many of them (the crack log merged from the
+ * ranks in the serial order, the released energy chained). */
+static sx_model *bed(int dim, bool bonded)
 {
     const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
     sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
@@ -106,6 +110,17 @@ static sx_model *bed(int dim)
             }
     const double lo[3] = {0, 0, 0}, hi[3] = {nx * s + r, dim == 3 ? ny * s + r : 10, 10};
     scene_box_walls(m, lo, hi, 2e5, 0.5);
+    if (bonded) {
+        sx_bond_def bd = sx_bond_default_def();
+        bd.gap = 1e-6;
+        bd.seed = 3;
+        bd.radius_multiplier = 1;
+        bd.modulus = 1e6;
+        bd.stiffness_ratio = 2.5;
+        bd.tensile_strength = 2e3, bd.tensile_strength_sd = 1e3;
+        bd.cohesion = 4e3, bd.cohesion_sd = 2e3;
+        ck_assert_int_eq(sx_bond_install(m, &bd, NULL), SX_OK);
+    }
     return m;
 }
 
@@ -114,7 +129,7 @@ enum { STEPS_A = 150, STEPS_B = 250 };
 static void *run_rank(void *arg)
 {
     rank_ctx *c = arg;
-    sx_model *m = bed(c->dim);
+    sx_model *m = bed(c->dim, c->bonded);
     const sx_exchange x = {c->rank, c->w->ranks, c, share, largest, agree};
     c->st = sx_model_decompose(m, &x);
     if (!c->st) c->st = sx_model_cycle(m, STEPS_A); /* two cycles: a cycle's end and start in between */
@@ -127,14 +142,22 @@ static void *run_rank(void *arg)
 
 START_TEST(ranks_give_the_serial_bits)
 {
-    for (int dim = 2; dim <= 3; dim++) {
-        sx_model *serial = bed(dim);
+    for (int scene = 0; scene < 4; scene++) {
+        const int dim = 2 + scene % 2;
+        const bool bonded = scene >= 2;
+        sx_model *serial = bed(dim, bonded);
         ck_assert_int_eq(sx_model_cycle(serial, STEPS_A), SX_OK);
         ck_assert_int_eq(sx_model_cycle(serial, STEPS_B), SX_OK);
         ck_assert_msg(sx_contact_count(serial) > sx_ball_count(serial), "the bed must be dense");
         const uint64_t hash = sx_model_state_hash(serial);
         const sx_energy e = sx_model_energy(serial);
         ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
+        if (bonded) {
+            const int64_t cracks = sx_crack_count(serial);
+            ck_assert_msg(cracks > 10 && sx_bond_count(serial) > 10 && e.bond_released > 0,
+                          "%dD: bonds must break, and not all (%lld cracks, %lld bonds left)", dim, (long long)cracks,
+                          (long long)sx_bond_count(serial));
+        }
         sx_model_destroy(serial);
         for (int ranks = 2; ranks <= MAX_RANKS; ranks++) {
             world w = {.ranks = ranks};
@@ -142,13 +165,13 @@ START_TEST(ranks_give_the_serial_bits)
             rank_ctx c[MAX_RANKS];
             pthread_t t[MAX_RANKS];
             for (int r = 0; r < ranks; r++) {
-                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim};
+                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim, .bonded = bonded};
                 ck_assert_int_eq(pthread_create(&t[r], NULL, run_rank, &c[r]), 0);
             }
             for (int r = 0; r < ranks; r++) pthread_join(t[r], NULL);
             pthread_barrier_destroy(&w.bar);
             for (int r = 0; r < ranks; r++) {
-                ck_assert_msg(c[r].st == SX_OK, "%dD, %d ranks: rank %d failed (%d)", dim, ranks, r, c[r].st);
+                ck_assert_msg(c[r].st == SX_OK, "%dD%s, %d ranks: rank %d failed (%d)", dim, bonded ? " bonded" : "", ranks, r, c[r].st);
                 ck_assert_msg(c[r].hash == hash, "%dD, %d ranks: rank %d's state differs from the serial run's", dim,
                               ranks, r);
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
