@@ -7,7 +7,7 @@
  * by a digest of its bytes when a cycle starts, sx__state_digest). Inside a cycle rank r owns the balls
  * own[r], a contiguous range of dense indices: the broad phase sorts balls
  * by cell with the last axis slowest, so a range is a slab across that
- * axis, cut to balance the ball count (and cut again at every build, which
+ * axis, cut to balance the ranks' work (and cut again at every build, which
  * is where balls migrate). Each step it
  *   - refreshes its ghosts, the balls need[4r] below and need[4r + 1]
  *     above its own (and the far ends of a periodic cell), from their
@@ -56,6 +56,8 @@ void sx__dd_free(sx_model *m)
     free(d->peb);
     free(d->xpair);
     free(d->gho);
+    free(d->low_a);
+    free(d->work);
     free(d->xchunk.cracks);
     free(d->tape.e);
     free(d);
@@ -236,6 +238,76 @@ static void plan_energy(sx_chunk *o, sx_span own)
     if (o->part == SX_DD_PART_TAPE) o->tape_at = own.lo;
 }
 
+/* The work of balls [low, e) (work[] is its prefix sum over balls). */
+static int64_t work_of(const sx_dd *d, int64_t low, int64_t e) { return d->work[e] - d->work[low]; }
+
+/* The ranks filled in turn with balls while each one's work stays within
+ * bound (a rank's work runs from the lowest first ball of a pair reaching
+ * its balls: it evaluates those pairs too); the first ball of each rank in
+ * first[] (R + 1 entries, the last n). True if they take every ball. */
+static bool fill(const sx_dd *d, int64_t n, int64_t bound, int64_t *first)
+{
+    const int R = d->x.ranks;
+    int64_t e = 0, low = 0;
+    for (int r = 0; r < R; r++) {
+        first[r] = low = e;
+        while (e < n) {
+            const int64_t l = d->low_a[e] < low ? d->low_a[e] : low;
+            if (r < R - 1 && work_of(d, l, e + 1) > bound) break;
+            low = l, e++;
+        }
+    }
+    first[R] = n;
+    return work_of(d, low, n) <= bound;
+}
+
+/* The ranks' ranges of balls, cut to even their work rather than their
+ * ball count: besides its balls' pairs a rank evaluates the pairs of the
+ * layer below that reach its balls, and the lowest rank has the floor's
+ * wall pairs. The largest rank's work is bisected down to the smallest
+ * bound whose ranks, filled in turn, take every ball. Any cut gives the
+ * same bits (every sum keeps the serial order, whatever rank makes it):
+ * this one evens the ranks' time. The weights are the SC-bed's costs per
+ * item (callgrind, 1 thread: about 220 instructions a ball-ball pair, 650
+ * a ball-wall pair, 110 a ball's integration and clearing). False: out of
+ * memory. */
+enum { WORK_PAIR = 2, WORK_WALL_PAIR = 6, WORK_BALL = 1 };
+
+static bool cut_by_work(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    const int64_t n = m->balls.n;
+    const sx_pairs *p = &m->bb;
+    if (d->cap_cut < n + 1) {
+        int32_t *low = realloc(d->low_a, (size_t)(n + 1) * sizeof *low);
+        if (low) d->low_a = low;
+        int64_t *work = realloc(d->work, (size_t)(n + 1) * sizeof *work);
+        if (work) d->work = work;
+        if (!low || !work) return false;
+        d->cap_cut = n + 1;
+    }
+    int64_t *first = malloc((size_t)(R + 1) * sizeof *first);
+    if (!first) return false;
+    for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->work[i] = 0;
+    for (int64_t c = 0; c < p->n; c++) {
+        if (p->b[c] < n && p->a[c] < d->low_a[p->b[c]]) d->low_a[p->b[c]] = p->a[c];
+        d->work[p->a[c] + 1] += WORK_PAIR;
+    }
+    for (int64_t c = 0; c < m->bw.n; c++) d->work[m->bw.a[c] + 1] += WORK_WALL_PAIR;
+    for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL;
+    int64_t lo = d->work[n] / R, hi = d->work[n]; /* hi: one rank could take all */
+    while (hi - lo > 1 + d->work[n] / 4096) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (fill(d, n, mid, first)) hi = mid;
+        else lo = mid;
+    }
+    fill(d, n, hi, first);
+    for (int r = 0; r < R; r++) d->own[r] = (sx_span){first[r], first[r + 1]};
+    free(first);
+    return true;
+}
+
 /* The spans of every rank from the whole, current pair stores (after a
  * build, or when a cycle starts), and this rank's clipped chunks. False:
  * out of memory. */
@@ -245,7 +317,7 @@ bool sx__dd_plan(sx_model *m)
     const int R = d->x.ranks, me = d->x.rank;
     const int64_t n = m->balls.n;
     const sx_pairs *p = &m->bb;
-    for (int r = 0; r < R; r++) d->own[r] = (sx_span){n * r / R, n * (r + 1) / R};
+    if (!cut_by_work(m)) return false;
     /* the lowest first ball of a pair whose second ball each rank owns (a
      * ghost's pairs reach its owner through the fold: plan_far) */
     for (int r = 0; r < R; r++) d->pairs[r].lo = d->own[r].lo; /* lo: a ball index until made a pair index */

@@ -361,6 +361,10 @@ typedef struct sx_dd {
     int64_t npeb, cap_peb;
     sx_span *peb_own;
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
+    /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
+     * a pair reaching it, and the work of the balls before it */
+    int32_t *low_a;
+    int64_t *work, cap_cut;
 } sx_dd;
 
 struct sx_model {
