@@ -318,13 +318,13 @@ bool sx__dd_plan(sx_model *m)
     const int64_t n = m->balls.n;
     const sx_pairs *p = &m->bb;
     if (!cut_by_work(m)) return false;
-    /* the lowest first ball of a pair whose second ball each rank owns (a
-     * ghost's pairs reach its owner through the fold: plan_far) */
-    for (int r = 0; r < R; r++) d->pairs[r].lo = d->own[r].lo; /* lo: a ball index until made a pair index */
-    for (int64_t c = 0; c < p->n; c++) {
-        if (p->b[c] >= n) continue;
-        sx_span *q = &d->pairs[owner_of(d, p->b[c], n)];
-        if (p->a[c] < q->lo) q->lo = p->a[c];
+    /* the lowest first ball of a pair whose second ball each rank owns,
+     * from the cut's low_a (a ghost's pairs reach its owner through the
+     * fold: plan_far) */
+    for (int r = 0; r < R; r++) {
+        d->pairs[r].lo = d->own[r].lo; /* lo: a ball index until made a pair index */
+        for (int64_t i = d->own[r].lo; i < d->own[r].hi; i++)
+            if (d->low_a[i] < d->pairs[r].lo) d->pairs[r].lo = d->low_a[i];
     }
     int64_t bl = 0; /* the blocks are in order: the first whose last ball reaches each rank */
     for (int r = 0; r < R; r++) {

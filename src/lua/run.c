@@ -85,7 +85,7 @@ enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250, PROGRESS_LOG_EVERY_S =
 /* A model decomposed over MPI ranks cuts its cycles into chunks that every
  * rank takes alike (rank 0's, whose clock sets them), of a line's interval
  * and at least PROGRESS_RANKS_S: each chunk's cycle starts by checking that
- * the ranks' models agree (a hash of the whole state) and ends by gathering
+ * the ranks' models agree (a digest of the whole state) and ends by gathering
  * the state, a cost of a few steps. */
 enum { PROGRESS_RANKS_S = 1 };
 
