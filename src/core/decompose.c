@@ -14,8 +14,8 @@
  *     owners (positions, velocities, spins);
  *   - evaluates the ball-ball pairs pairs[r]: every pair of its balls, in
  *     the serial chunks, clipped (a ball's contributions thus arrive in the
- *     serial order, whatever the cut; pairs between ghosts come along and
- *     are evaluated as their owners evaluate them);
+ *     serial order, whatever the cut), skipping those between two ghosts
+ *     (inpair: they add only to ghosts);
  *   - evaluates whole the wall blocks with a ball of its own, wrun[r]
  *     (their other balls are ghosts), so each block's partial wall
  *     resultant is the serial one; the blocks whose last ball it owns,
@@ -55,6 +55,7 @@ void sx__dd_free(sx_model *m)
     free(d->bslot);
     free(d->peb);
     free(d->xpair);
+    free(d->inpair);
     free(d->gho);
     free(d->low_a);
     free(d->work);
@@ -227,6 +228,36 @@ static bool plan_far(sx_model *m)
     return plan_ghosts(m);
 }
 
+/* The pairs of this rank's pairs[] below its own (their a a ghost) that
+ * reach its balls: b one of its own or, in periodic space, an image of
+ * one (whose force folds onto it), in pair order (inpair). The others lie
+ * between two ghosts and add only to ghosts, whose sums are their owners':
+ * the rank skips them (kernels/pair_contacts.c, timestep.c). Nothing else
+ * needs them on this rank: a gather takes their history, bonds, joints and
+ * cracks from their owner (the rank of their a), their energy terms are
+ * no sum's here (a chunk's sums begin on the rank of its first pair, and
+ * a rank's tape starts at its own pairs, tape_at), and the chained sums
+ * (the energy guard's, the cell's stress) run over each rank's own pairs.
+ * False: out of memory. */
+static bool plan_inpairs(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_pairs *p = &m->bb;
+    const sx_span own = d->own[d->x.rank];
+    const int64_t c0 = d->pairs[d->x.rank].lo, c1 = d->bb_own[d->x.rank].lo, n = m->balls.n;
+    d->ninpair = 0;
+    if (d->cap_inpair < c1 - c0) {
+        int32_t *q = realloc(d->inpair, (size_t)(c1 - c0) * sizeof *q);
+        if (!q) return false;
+        d->inpair = q, d->cap_inpair = c1 - c0;
+    }
+    for (int64_t c = c0; c < c1; c++) {
+        const int64_t b = p->b[c] < n ? p->b[c] : m->cell->owner[p->b[c] - m->cell->base];
+        if (b >= own.lo && b < own.hi) d->inpair[d->ninpair++] = (int32_t)c;
+    }
+    return true;
+}
+
 /* Energy tracking: what this rank gives chunk o's energy sums (its own
  * pairs own, sx__dd_energy), from the serial chunk before it is clipped. */
 static void plan_energy(sx_chunk *o, sx_span own)
@@ -355,7 +386,7 @@ bool sx__dd_plan(sx_model *m)
         d->bw_own[r] = (sx_span){sx__first_at(m->bw.a, m->bw.n, own->lo), sx__first_at(m->bw.a, m->bw.n, own->hi)};
     }
     d->nxpair = d->nxlow = d->ngho = 0;
-    if (m->cell && m->cell->n && !plan_far(m)) return false;
+    if ((m->cell && m->cell->n && !plan_far(m)) || !plan_inpairs(m)) return false;
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
      * they clear, to its own and its near ghosts */
     const sx_span pr = d->pairs[me], lo = d->need[SX_DD_NEED * me], hi = d->need[SX_DD_NEED * me + 1];

@@ -441,9 +441,10 @@ static void chunk_start(sx_model *m, sx_chunk *o)
     o->err_break = false;
 }
 
-/* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
- * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
- * a; energies, cracks and errors go to the chunk. */
+/* Ball-ball contacts of one chunk's pairs [first, last), every model:
+ * 4-1 ... 4-21 with the contact models of 4.3.3 - 4.3.5. The total force F
+ * acts on b and -F on a; energies, cracks and errors go to the chunk
+ * (started by chunk_start). */
 static void ball_chunk_pass(sx_model *m, sx_chunk *o)
 {
     sx_balls *B = &m->balls;
@@ -458,7 +459,6 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     uint8_t *restrict touching = p->touching;
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
-    chunk_start(m, o);
     const double dt = motion_dt(m);
     const int nlaw = m->law_n;
     const bool track = m->track_energy;
@@ -686,10 +686,13 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
  * out of contact or not slipping takes the same lanes, and multiplying by
  * a scale of exactly 1 changes nothing), and the results are scattered
  * in pair order. Each lane does the scalar pass's arithmetic in its
- * order, so both give the same bits. */
+ * order, so both give the same bits. The pairs are the chunk's [first,
+ * last), or with a list (decomposed: decompose.c, plan_inpairs) the pairs
+ * list[first, last), gathered into the lanes as a short batch is; the
+ * compiler makes one function of each (list NULL: the serial one). */
 #include "lanes.h"
 
-SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
+static inline __attribute__((always_inline)) void batched_pass(sx_model *m, sx_chunk *o, const int32_t *list)
 {
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
@@ -702,7 +705,6 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     double *restrict f = B->f, *restrict t = B->t;
     const sx_pair_law *laws = m->law;
     const int nlaw = m->law_n;
-    chunk_start(m, o);
     const double dt = motion_dt(m);
     /* the law's parameters per lane; with one material, the same in every lane */
     vd kn = VZERO + laws->kn, ks = VZERO + laws->ks, mu = VZERO + laws->mu, dash = VZERO + laws->dash_n,
@@ -715,7 +717,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         const int nb = o->last - c0 < LANES ? (int)(o->last - c0) : LANES;
         int64_t cc[LANES], i[LANES], j[LANES]; /* lanes past nb repeat the first pair */
         for (int q = 0; q < LANES; q++) {
-            cc[q] = c0 + (q < nb ? q : 0);
+            cc[q] = list ? list[c0 + (q < nb ? q : 0)] : c0 + (q < nb ? q : 0);
             i[q] = pa[cc[q]], j[q] = pb[cc[q]];
         }
         if (nlaw > 1)
@@ -724,8 +726,8 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
                 kn[q] = law->kn, ks[q] = law->ks, mu[q] = law->mu, dash[q] = law->dash_n, bn[q] = law->beta_n;
             }
         /* the history as stored, four consecutive pairs by shuffles (a short
-         * batch copied to four pairs first) */
-        const bool full = nb == LANES;
+         * batch, or listed pairs, copied to four pairs first) */
+        const bool full = nb == LANES && !list;
         double tail[2 * LANES * D];
         uint8_t tail_touching[LANES];
         const double *hfs = fs_all + c0 * D, *hrel = geo_all + c0 * D;
@@ -872,10 +874,61 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     }
 }
 
+SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o) { batched_pass(m, o, NULL); }
+
+SX_VECTOR_CLONES static void ball_chunk_listed(sx_model *m, sx_chunk *o, const int32_t *list)
+{
+    batched_pass(m, o, list);
+}
+
+static inline bool chunk_plain(const sx_model *m)
+{
+    return m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->bb.joint && !m->track_energy;
+}
+
 static void ball_chunk(sx_model *m, sx_chunk *o)
 {
-    if (m->law_plain && !m->bb.bond && !m->bb.cmodel && !m->bb.joint && !m->track_energy) ball_chunk_batched(m, o);
+    chunk_start(m, o);
+    if (chunk_plain(m)) ball_chunk_batched(m, o);
     else ball_chunk_pass(m, o);
+}
+
+/* Decomposed: the pairs list[e0, e1) (in pair order) into chunk o,
+ * started: the batched pass takes them four at a time, the scalar one in
+ * runs of consecutive pairs. Leaves o's pair range changed. */
+static void ball_chunk_list(sx_model *m, sx_chunk *o, const int32_t *list, int64_t e0, int64_t e1)
+{
+    if (chunk_plain(m) && e1 > e0) {
+        o->first = e0, o->last = e1;
+        ball_chunk_listed(m, o, list);
+        return;
+    }
+    for (int64_t e = e0; e < e1 && !o->st;) {
+        o->first = list[e];
+        while (++e < e1 && list[e] == list[e - 1] + 1) {}
+        o->last = list[e - 1] + 1;
+        ball_chunk_pass(m, o);
+    }
+}
+
+/* Decomposed: chunk o, whose first pairs lie below the rank's own (their
+ * a is a ghost). Of these it evaluates only those that reach its balls,
+ * the list inpair (decompose.c, plan_inpairs): the others add only to
+ * ghosts, whose sums are their owners'. Each ball's contributions keep
+ * their order, so its sums their bits. */
+static void ball_chunk_below(sx_model *m, sx_chunk *o)
+{
+    const sx_dd *d = m->dd;
+    const int64_t first = o->first, last = o->last, mine = d->bb_own[d->x.rank].lo, split = last < mine ? last : mine;
+    chunk_start(m, o);
+    ball_chunk_list(m, o, d->inpair, sx__first_at(d->inpair, d->ninpair, first),
+                    sx__first_at(d->inpair, d->ninpair, split));
+    o->first = split, o->last = last; /* its own pairs */
+    if (!o->st && last > split) {
+        if (chunk_plain(m)) ball_chunk_batched(m, o);
+        else ball_chunk_pass(m, o);
+    }
+    o->first = first;
 }
 
 /* Chunks of the ball-ball pass and blocks of the per-ball passes, planned
@@ -964,22 +1017,17 @@ static bool plan_chunks(sx_model *m)
 }
 
 /* Decomposed in periodic space: the pairs xpair[e0, e1) (decompose.c,
- * plan_far), in runs of consecutive pairs, for their ghosts' forces (the
- * forces on their first balls, another rank's, and their cracks are that
- * rank's to keep). Non-zero: an overlap error. */
+ * plan_far), for their ghosts' forces (the forces on their first balls,
+ * another rank's, and their cracks are that rank's to keep). Non-zero: an
+ * overlap error. */
 static sx_status far_pairs(sx_model *m, int64_t e0, int64_t e1)
 {
     sx_dd *d = m->dd;
     sx_chunk *o = &d->xchunk;
     o->clear_lo = o->clear_hi = 0;
-    for (int64_t e = e0; e < e1;) {
-        o->first = d->xpair[e];
-        while (++e < e1 && d->xpair[e] == d->xpair[e - 1] + 1) {}
-        o->last = d->xpair[e - 1] + 1;
-        ball_chunk(m, o);
-        if (o->st) return chunk_error(m, o);
-    }
-    return SX_OK;
+    chunk_start(m, o);
+    ball_chunk_list(m, o, d->xpair, e0, e1);
+    return o->st ? chunk_error(m, o) : SX_OK;
 }
 
 /* Runs the even chunks, then the odd ones (each phase in parallel), then
@@ -1000,7 +1048,11 @@ static sx_status KERNEL(contacts)(sx_model *m)
 #pragma omp parallel num_threads(m->threads) if (nchunk > 2)
     for (int64_t phase = 0; phase < 2; phase++) {
 #pragma omp for schedule(static)
-        for (int64_t c = phase; c < nchunk; c += 2) ball_chunk(m, &m->chunks[c]);
+        for (int64_t c = phase; c < nchunk; c += 2) {
+            sx_chunk *o = &m->chunks[c];
+            if (m->dd && m->dd->active && o->first < m->dd->bb_own[m->dd->x.rank].lo) ball_chunk_below(m, o);
+            else ball_chunk(m, o);
+        }
     }
     if (dd && (st = far_pairs(m, dd->nxlow, dd->nxpair))) return st;
     if (m->cell) fold_ghosts(m);
