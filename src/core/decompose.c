@@ -58,6 +58,7 @@ void sx__dd_free(sx_model *m)
     free(d->inpair);
     free(d->gho);
     free(d->low_a);
+    free(d->cross);
     free(d->work);
     free(d->xchunk.cracks);
     free(d->tape.e);
@@ -269,41 +270,39 @@ static void plan_energy(sx_chunk *o, sx_span own)
     if (o->part == SX_DD_PART_TAPE) o->tape_at = own.lo;
 }
 
+enum { WORK_PAIR = 4, WORK_WALL_PAIR = 5, WORK_BALL = 2 }; /* cut_by_work's weights */
+
 /* The work of balls [low, e) (work[] is its prefix sum over balls). */
 static int64_t work_of(const sx_dd *d, int64_t low, int64_t e) { return d->work[e] - d->work[low]; }
 
 /* The ranks filled in turn with balls while each one's work stays within
- * bound (a rank's work runs from the lowest first ball of a pair reaching
- * its balls: it evaluates those pairs too); the first ball of each rank in
+ * bound (a rank's work: its balls' and, from below, the pairs crossing its
+ * first ball, which it evaluates too); the first ball of each rank in
  * first[] (R + 1 entries, the last n). True if they take every ball. */
 static bool fill(const sx_dd *d, int64_t n, int64_t bound, int64_t *first)
 {
     const int R = d->x.ranks;
-    int64_t e = 0, low = 0;
+    int64_t e = 0;
     for (int r = 0; r < R; r++) {
-        first[r] = low = e;
-        while (e < n) {
-            const int64_t l = d->low_a[e] < low ? d->low_a[e] : low;
-            if (r < R - 1 && work_of(d, l, e + 1) > bound) break;
-            low = l, e++;
-        }
+        const int64_t lo = first[r] = e, below = WORK_PAIR * d->cross[lo];
+        while (e < n && (r == R - 1 || below + work_of(d, lo, e + 1) <= bound)) e++;
     }
     first[R] = n;
-    return work_of(d, low, n) <= bound;
+    return WORK_PAIR * d->cross[first[R - 1]] + work_of(d, first[R - 1], n) <= bound;
 }
 
 /* The ranks' ranges of balls, cut to even their work rather than their
- * ball count: besides its balls' pairs a rank evaluates the pairs of the
- * layer below that reach its balls, and the lowest rank has the floor's
- * wall pairs. The largest rank's work is bisected down to the smallest
- * bound whose ranks, filled in turn, take every ball. Any cut gives the
- * same bits (every sum keeps the serial order, whatever rank makes it):
- * this one evens the ranks' time. The weights are the SC-bed's costs per
- * item (callgrind, 1 thread: about 220 instructions a ball-ball pair, 650
- * a ball-wall pair, 110 a ball's integration and clearing). False: out of
- * memory. */
-enum { WORK_PAIR = 2, WORK_WALL_PAIR = 6, WORK_BALL = 1 };
-
+ * ball count: besides its balls' pairs a rank evaluates the pairs from
+ * the layer below that reach its balls (counted as those crossing its
+ * first ball, cross[]: with the few that span a rank thinner than a
+ * pair's reach, which it skips), and the lowest rank has the floor's wall
+ * pairs. The largest rank's work is bisected down to the smallest bound
+ * whose ranks, filled in turn, take every ball. Any cut gives the same
+ * bits (every sum keeps the serial order, whatever rank makes it): this
+ * one evens the ranks' time. The weights are the SC-bed's costs per item
+ * (WORK_*; callgrind, 1 thread: about 250 instructions a ball-ball pair,
+ * 320 a ball-wall pair, 120 a ball's integration and clearing). False:
+ * out of memory. */
 static bool cut_by_work(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -313,20 +312,23 @@ static bool cut_by_work(sx_model *m)
     if (d->cap_cut < n + 1) {
         int32_t *low = realloc(d->low_a, (size_t)(n + 1) * sizeof *low);
         if (low) d->low_a = low;
+        int32_t *cross = realloc(d->cross, (size_t)(n + 1) * sizeof *cross);
+        if (cross) d->cross = cross;
         int64_t *work = realloc(d->work, (size_t)(n + 1) * sizeof *work);
         if (work) d->work = work;
-        if (!low || !work) return false;
+        if (!low || !cross || !work) return false;
         d->cap_cut = n + 1;
     }
     int64_t *first = malloc((size_t)(R + 1) * sizeof *first);
     if (!first) return false;
-    for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->work[i] = 0;
+    for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->cross[i] = 0, d->work[i] = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->b[c] < n && p->a[c] < d->low_a[p->b[c]]) d->low_a[p->b[c]] = p->a[c];
+        if (p->b[c] < n) d->cross[p->a[c] + 1]++, d->cross[p->b[c] + 1]--; /* a < first ball <= b */
         d->work[p->a[c] + 1] += WORK_PAIR;
     }
     for (int64_t c = 0; c < m->bw.n; c++) d->work[m->bw.a[c] + 1] += WORK_WALL_PAIR;
-    for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL;
+    for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL, d->cross[i + 1] += d->cross[i];
     int64_t lo = d->work[n] / R, hi = d->work[n]; /* hi: one rank could take all */
     while (hi - lo > 1 + d->work[n] / 4096) {
         const int64_t mid = lo + (hi - lo) / 2;
@@ -534,7 +536,7 @@ static bool gather_fjoints(sx_model *m)
 
 /* The cracks logged since the last gather, made one log in the serial
  * order. Every rank evaluates its own pairs and some of its neighbours'
- * (between its ghosts): it keeps the cracks of its own pairs (a pair is
+ * (from a ghost to its balls): it keeps the cracks of its own pairs (a pair is
  * its first ball's), which, the pairs being sorted by that ball, are the
  * serial log's of its pair range. A step's cracks are thus rank 0's, then
  * rank 1's, ...; the ranks' lists are merged by step in that order. */

@@ -366,8 +366,9 @@ typedef struct sx_dd {
     sx_span *peb_own;
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
     /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
-     * a pair reaching it, and the work of the balls before it */
-    int32_t *low_a;
+     * a pair reaching it, the pairs crossing it (first ball below it,
+     * second ball it or above), and the work of the balls before it */
+    int32_t *low_a, *cross;
     int64_t *work, cap_cut;
 } sx_dd;
 
