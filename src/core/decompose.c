@@ -14,8 +14,8 @@
  *     owners (positions, velocities, spins);
  *   - evaluates the ball-ball pairs pairs[r]: every pair of its balls, in
  *     the serial chunks, clipped (a ball's contributions thus arrive in the
- *     serial order, whatever the cut; pairs between ghosts come along and
- *     are evaluated as their owners evaluate them);
+ *     serial order, whatever the cut), skipping those between two ghosts
+ *     (inpair: they add only to ghosts);
  *   - evaluates whole the wall blocks with a ball of its own, wrun[r]
  *     (their other balls are ghosts), so each block's partial wall
  *     resultant is the serial one; the blocks whose last ball it owns,
@@ -55,8 +55,10 @@ void sx__dd_free(sx_model *m)
     free(d->bslot);
     free(d->peb);
     free(d->xpair);
+    free(d->inpair);
     free(d->gho);
     free(d->low_a);
+    free(d->cross);
     free(d->work);
     free(d->xchunk.cracks);
     free(d->tape.e);
@@ -227,6 +229,36 @@ static bool plan_far(sx_model *m)
     return plan_ghosts(m);
 }
 
+/* The pairs of this rank's pairs[] below its own (their a a ghost) that
+ * reach its balls: b one of its own or, in periodic space, an image of
+ * one (whose force folds onto it), in pair order (inpair). The others lie
+ * between two ghosts and add only to ghosts, whose sums are their owners':
+ * the rank skips them (kernels/pair_contacts.c, timestep.c). Nothing else
+ * needs them on this rank: a gather takes their history, bonds, joints and
+ * cracks from their owner (the rank of their a), their energy terms are
+ * no sum's here (a chunk's sums begin on the rank of its first pair, and
+ * a rank's tape starts at its own pairs, tape_at), and the chained sums
+ * (the energy guard's, the cell's stress) run over each rank's own pairs.
+ * False: out of memory. */
+static bool plan_inpairs(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_pairs *p = &m->bb;
+    const sx_span own = d->own[d->x.rank];
+    const int64_t c0 = d->pairs[d->x.rank].lo, c1 = d->bb_own[d->x.rank].lo, n = m->balls.n;
+    d->ninpair = 0;
+    if (d->cap_inpair < c1 - c0) {
+        int32_t *q = realloc(d->inpair, (size_t)(c1 - c0) * sizeof *q);
+        if (!q) return false;
+        d->inpair = q, d->cap_inpair = c1 - c0;
+    }
+    for (int64_t c = c0; c < c1; c++) {
+        const int64_t b = p->b[c] < n ? p->b[c] : m->cell->owner[p->b[c] - m->cell->base];
+        if (b >= own.lo && b < own.hi) d->inpair[d->ninpair++] = (int32_t)c;
+    }
+    return true;
+}
+
 /* Energy tracking: what this rank gives chunk o's energy sums (its own
  * pairs own, sx__dd_energy), from the serial chunk before it is clipped. */
 static void plan_energy(sx_chunk *o, sx_span own)
@@ -238,41 +270,39 @@ static void plan_energy(sx_chunk *o, sx_span own)
     if (o->part == SX_DD_PART_TAPE) o->tape_at = own.lo;
 }
 
+enum { WORK_PAIR = 4, WORK_WALL_PAIR = 5, WORK_BALL = 2 }; /* cut_by_work's weights */
+
 /* The work of balls [low, e) (work[] is its prefix sum over balls). */
 static int64_t work_of(const sx_dd *d, int64_t low, int64_t e) { return d->work[e] - d->work[low]; }
 
 /* The ranks filled in turn with balls while each one's work stays within
- * bound (a rank's work runs from the lowest first ball of a pair reaching
- * its balls: it evaluates those pairs too); the first ball of each rank in
+ * bound (a rank's work: its balls' and, from below, the pairs crossing its
+ * first ball, which it evaluates too); the first ball of each rank in
  * first[] (R + 1 entries, the last n). True if they take every ball. */
 static bool fill(const sx_dd *d, int64_t n, int64_t bound, int64_t *first)
 {
     const int R = d->x.ranks;
-    int64_t e = 0, low = 0;
+    int64_t e = 0;
     for (int r = 0; r < R; r++) {
-        first[r] = low = e;
-        while (e < n) {
-            const int64_t l = d->low_a[e] < low ? d->low_a[e] : low;
-            if (r < R - 1 && work_of(d, l, e + 1) > bound) break;
-            low = l, e++;
-        }
+        const int64_t lo = first[r] = e, below = WORK_PAIR * d->cross[lo];
+        while (e < n && (r == R - 1 || below + work_of(d, lo, e + 1) <= bound)) e++;
     }
     first[R] = n;
-    return work_of(d, low, n) <= bound;
+    return WORK_PAIR * d->cross[first[R - 1]] + work_of(d, first[R - 1], n) <= bound;
 }
 
 /* The ranks' ranges of balls, cut to even their work rather than their
- * ball count: besides its balls' pairs a rank evaluates the pairs of the
- * layer below that reach its balls, and the lowest rank has the floor's
- * wall pairs. The largest rank's work is bisected down to the smallest
- * bound whose ranks, filled in turn, take every ball. Any cut gives the
- * same bits (every sum keeps the serial order, whatever rank makes it):
- * this one evens the ranks' time. The weights are the SC-bed's costs per
- * item (callgrind, 1 thread: about 220 instructions a ball-ball pair, 650
- * a ball-wall pair, 110 a ball's integration and clearing). False: out of
- * memory. */
-enum { WORK_PAIR = 2, WORK_WALL_PAIR = 6, WORK_BALL = 1 };
-
+ * ball count: besides its balls' pairs a rank evaluates the pairs from
+ * the layer below that reach its balls (counted as those crossing its
+ * first ball, cross[]: with the few that span a rank thinner than a
+ * pair's reach, which it skips), and the lowest rank has the floor's wall
+ * pairs. The largest rank's work is bisected down to the smallest bound
+ * whose ranks, filled in turn, take every ball. Any cut gives the same
+ * bits (every sum keeps the serial order, whatever rank makes it): this
+ * one evens the ranks' time. The weights are the SC-bed's costs per item
+ * (WORK_*; callgrind, 1 thread: about 250 instructions a ball-ball pair,
+ * 320 a ball-wall pair, 120 a ball's integration and clearing). False:
+ * out of memory. */
 static bool cut_by_work(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -282,20 +312,23 @@ static bool cut_by_work(sx_model *m)
     if (d->cap_cut < n + 1) {
         int32_t *low = realloc(d->low_a, (size_t)(n + 1) * sizeof *low);
         if (low) d->low_a = low;
+        int32_t *cross = realloc(d->cross, (size_t)(n + 1) * sizeof *cross);
+        if (cross) d->cross = cross;
         int64_t *work = realloc(d->work, (size_t)(n + 1) * sizeof *work);
         if (work) d->work = work;
-        if (!low || !work) return false;
+        if (!low || !cross || !work) return false;
         d->cap_cut = n + 1;
     }
     int64_t *first = malloc((size_t)(R + 1) * sizeof *first);
     if (!first) return false;
-    for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->work[i] = 0;
+    for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->cross[i] = 0, d->work[i] = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->b[c] < n && p->a[c] < d->low_a[p->b[c]]) d->low_a[p->b[c]] = p->a[c];
+        if (p->b[c] < n) d->cross[p->a[c] + 1]++, d->cross[p->b[c] + 1]--; /* a < first ball <= b */
         d->work[p->a[c] + 1] += WORK_PAIR;
     }
     for (int64_t c = 0; c < m->bw.n; c++) d->work[m->bw.a[c] + 1] += WORK_WALL_PAIR;
-    for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL;
+    for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL, d->cross[i + 1] += d->cross[i];
     int64_t lo = d->work[n] / R, hi = d->work[n]; /* hi: one rank could take all */
     while (hi - lo > 1 + d->work[n] / 4096) {
         const int64_t mid = lo + (hi - lo) / 2;
@@ -355,7 +388,7 @@ bool sx__dd_plan(sx_model *m)
         d->bw_own[r] = (sx_span){sx__first_at(m->bw.a, m->bw.n, own->lo), sx__first_at(m->bw.a, m->bw.n, own->hi)};
     }
     d->nxpair = d->nxlow = d->ngho = 0;
-    if (m->cell && m->cell->n && !plan_far(m)) return false;
+    if ((m->cell && m->cell->n && !plan_far(m)) || !plan_inpairs(m)) return false;
     /* this rank's chunks: the serial ones, clipped to its pairs; the balls
      * they clear, to its own and its near ghosts */
     const sx_span pr = d->pairs[me], lo = d->need[SX_DD_NEED * me], hi = d->need[SX_DD_NEED * me + 1];
@@ -503,7 +536,7 @@ static bool gather_fjoints(sx_model *m)
 
 /* The cracks logged since the last gather, made one log in the serial
  * order. Every rank evaluates its own pairs and some of its neighbours'
- * (between its ghosts): it keeps the cracks of its own pairs (a pair is
+ * (from a ghost to its balls): it keeps the cracks of its own pairs (a pair is
  * its first ball's), which, the pairs being sorted by that ball, are the
  * serial log's of its pair range. A step's cracks are thus rank 0's, then
  * rank 1's, ...; the ranks' lists are merged by step in that order. */

@@ -312,9 +312,9 @@ typedef struct sx_cell {
  * integrates the balls own[r] (dense indices: slabs of the cell order),
  * keeps the balls need[4r ... 4r + 3] current as ghosts (below and above
  * them, and in periodic space the far ends of the cell), evaluates the
- * ball-ball pairs pairs[r] (those of its balls and of its ghosts, in the
- * serial order; in periodic space also xpair, those through the boundary
- * whose image of the far end is of its own balls) and completes the wall
+ * ball-ball pairs pairs[r] that reach its balls (in the serial order;
+ * in periodic space also xpair, those through the boundary whose image
+ * of the far end is of its own balls) and completes the wall
  * blocks wblk[r]. Every ball's sums thus run in the serial run's order. */
 /* The spans of ghosts a rank keeps: near below, near above, far below, far above. */
 enum { SX_DD_NEED = 4 };
@@ -345,6 +345,10 @@ typedef struct sx_dd {
     int32_t *xpair;
     int64_t nxpair, nxlow, cap_xpair;
     sx_chunk xchunk;
+    /* the pairs of pairs[rank] below its own (their a a ghost) that reach
+     * its balls, in pair order: the others, between two ghosts, it skips */
+    int32_t *inpair;
+    int64_t ninpair, cap_inpair;
     /* periodic space: the ghosts grouped by their owner's rank (each
      * rank's a run, gho_own), what a gather takes from each */
     int32_t *gho;
@@ -362,8 +366,9 @@ typedef struct sx_dd {
     sx_span *peb_own;
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
     /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
-     * a pair reaching it, and the work of the balls before it */
-    int32_t *low_a;
+     * a pair reaching it, the pairs crossing it (first ball below it,
+     * second ball it or above), and the work of the balls before it */
+    int32_t *low_a, *cross;
     int64_t *work, cap_cut;
 } sx_dd;
 

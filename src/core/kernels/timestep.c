@@ -22,6 +22,56 @@ static void self_rating(const sx_pair_law *l, double r, double *kn, double *ks)
     if (own->series) *kn *= 2, *ks *= 2; /* undo the series combination with itself */
 }
 
+/* Adds ball-ball pair c's stiffness and dashpot to its balls' sums kt,
+ * kr, ct, cr (n each, from kt); a ghost's go to its owner. */
+static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
+{
+    const sx_balls *B = &m->balls;
+    const sx_pairs *p = &m->bb;
+    const int64_t n = B->n;
+    double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n;
+    const int64_t i = p->a[c], j = p->b[c];
+    const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
+    double dx[D];
+    for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
+    const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
+    const sx_pair_law *law = sx__bb_step_law(m, c, i, j);
+    double ktr = 0, krot_i = 0, krot_j = 0;
+    const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
+    if (p->joint && p->joint[c] && p->touching[c]) { /* a smooth joint's springs (laws/smoothjoint.h) */
+        const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
+        const double area = sx_law_sj_area(D, L, B->rad[i], B->rad[j]);
+        ktr = (L->kn + L->ks) * area;
+        krot_i = L->ks * area * B->rad[i] * B->rad[i];
+        krot_j = L->ks * area * B->rad[j] * B->rad[j];
+    } else if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
+        double kn, ks;
+        stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
+        if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
+            const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
+            const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
+            const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base];
+            ct[i] += cn + cs, ct[jo] += cn + cs;
+            cr[i] += cs * B->rad[i] * B->rad[i], cr[jo] += cs * B->rad[j] * B->rad[j];
+        }
+        kn *= sx__law(law->law)->tangent; /* 4-29 */
+        ktr = kn + ks;
+        krot_i = ks * B->rad[i] * B->rad[i];
+        krot_j = ks * B->rad[j] * B->rad[j];
+        if (law->mu_r > 0) { /* the rolling spring kr = ks R-bar^2 (laws/rolling.h) */
+            const double rbar = B->rad[i] * B->rad[j] / rsum;
+            krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
+        }
+    }
+    if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) /* a flat joint's face: the section of 4-35 */
+        sx_bond_parallel_stiffness(D, &m->bonds, slot, B->rad[i], B->rad[j], &ktr, &krot_i, &krot_j);
+    const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
+    kt[i] += ktr;
+    kt[jo] += ktr;
+    kr[i] += krot_i;
+    kr[jo] += krot_j;
+}
+
 static double KERNEL(critical_dt)(sx_model *m)
 {
     sx_balls *B = &m->balls;
@@ -32,55 +82,20 @@ static double KERNEL(critical_dt)(sx_model *m)
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
     memset(kt, 0, (size_t)(4 * n) * sizeof(double));
     /* decomposed: this rank's balls, summed over their pairs in the serial
-     * order (decompose.c): pairs[rank], and in periodic space the pairs
-     * through the boundary that reach its balls from elsewhere (xpair: the
-     * first nxlow before pairs[rank], the rest after it) */
+     * order (decompose.c): those of pairs[rank] that reach them (inpair,
+     * then its own), and in periodic space the pairs through the boundary
+     * that reach them from elsewhere (xpair: the first nxlow before
+     * pairs[rank], the rest after it); a ghost's sums are its owner's */
     const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
-    const int64_t c0 = dd ? dd->pairs[dd->x.rank].lo : 0, nc = (dd ? dd->pairs[dd->x.rank].hi : p->n) - c0;
-    const int64_t nx = dd ? dd->nxpair : 0, nlow = dd ? dd->nxlow : 0;
-    for (int64_t e = 0; e < nc + nx; e++) {
-        const int64_t c = e < nlow ? dd->xpair[e] : e < nlow + nc ? c0 + e - nlow : dd->xpair[e - nc];
-        const int64_t i = p->a[c], j = p->b[c];
-        const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
-        double dx[D];
-        for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
-        const double rsum = B->rad[i] + B->rad[j], d = sqrt(dot(dx, dx)), un = rsum - d;
-        const sx_pair_law *law = sx__bb_step_law(m, c, i, j);
-        double ktr = 0, krot_i = 0, krot_j = 0;
-        const unsigned bonds = slot >= 0 ? m->bonds.kind[slot] : 0;
-        if (p->joint && p->joint[c] && p->touching[c]) { /* a smooth joint's springs (laws/smoothjoint.h) */
-            const sx_law_sj *L = &m->joints[p->joint[c] - 1].law;
-            const double area = sx_law_sj_area(D, L, B->rad[i], B->rad[j]);
-            ktr = (L->kn + L->ks) * area;
-            krot_i = L->ks * area * B->rad[i] * B->rad[i];
-            krot_j = L->ks * area * B->rad[j] * B->rad[j];
-        } else if (!(bonds & SX_BOND_FLATJOINT) && (un > 0 || (bonds & SX_BOND_CONTACT))) {
-            double kn, ks;
-            stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
-            if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
-                const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
-                const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
-                const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base];
-                ct[i] += cn + cs, ct[jo] += cn + cs;
-                cr[i] += cs * B->rad[i] * B->rad[i], cr[jo] += cs * B->rad[j] * B->rad[j];
-            }
-            kn *= sx__law(law->law)->tangent; /* 4-29 */
-            ktr = kn + ks;
-            krot_i = ks * B->rad[i] * B->rad[i];
-            krot_j = ks * B->rad[j] * B->rad[j];
-            if (law->mu_r > 0) { /* the rolling spring kr = ks R-bar^2 (laws/rolling.h) */
-                const double rbar = B->rad[i] * B->rad[j] / rsum;
-                krot_i += ks * rbar * rbar, krot_j += ks * rbar * rbar;
-            }
-        }
-        if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) /* a flat joint's face: the section of 4-35 */
-            sx_bond_parallel_stiffness(D, &m->bonds, slot, B->rad[i], B->rad[j], &ktr, &krot_i, &krot_j);
-        const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
-        kt[i] += ktr;
-        kt[jo] += ktr;
-        kr[i] += krot_i;
-        kr[jo] += krot_j;
+    if (!dd) {
+        for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, kt);
+    } else {
+        const sx_span mine = dd->bb_own[dd->x.rank];
+        for (int64_t e = 0; e < dd->nxlow; e++) rate_pair(m, dd->xpair[e], kt);
+        for (int64_t e = 0; e < dd->ninpair; e++) rate_pair(m, dd->inpair[e], kt);
+        for (int64_t c = mine.lo; c < mine.hi; c++) rate_pair(m, c, kt);
+        for (int64_t e = dd->nxlow; e < dd->nxpair; e++) rate_pair(m, dd->xpair[e], kt);
     }
     p = &m->bw;
     const int64_t w0 = dd ? dd->bw_own[dd->x.rank].lo : 0, w1 = dd ? dd->bw_own[dd->x.rank].hi : p->n;
