@@ -80,22 +80,36 @@ static inline __attribute__((always_inline)) void energy_term(double *work, doub
     else *work += v;
 }
 
+/* What every clump's step reads of the model, read once per run of
+ * clumps (the stores through the clumps' arrays could alias it). */
+typedef struct step_env {
+    sx_clumps *C;
+    sx_balls *B;
+    double dt, dtv;
+    const double *g;
+    bool track;
+} step_env;
+
+static step_env step_env_of(sx_model *m)
+{
+    /* the kick spans the time between the half-step velocities, as for balls */
+    return (step_env){m->clumps, &m->balls, m->dt, m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt, m->gravity,
+                      m->track_energy};
+}
+
 /* Steps clump c: its resultant, translation, rotation, and its pebbles
  * placed. *worst takes the largest squared pebble displacement, work[0]
  * and work[1] the damping and load terms (or terms, decomposed: the
  * damping's d + r slots, then the loads' d + 1). False: a non-finite
  * state. */
-static inline __attribute__((always_inline)) bool step_clump(sx_model *m, int64_t c, double *worst, double *work,
-                                                             double *terms)
+static inline __attribute__((always_inline)) bool step_clump(sx_model *m, const step_env *env, int64_t c,
+                                                             double *worst, double *work, double *terms)
 {
     const int d = D, r = RD, nd = D + RD;
-    sx_clumps *C = m->clumps;
-    sx_balls *B = &m->balls;
-    const double dt = m->dt;
-    /* the kick spans the time between the half-step velocities, as for balls */
-    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
-    const double *g = m->gravity;
-    const bool track = m->track_energy;
+    sx_clumps *C = env->C;
+    sx_balls *B = env->B;
+    const double dt = env->dt, dtv = env->dtv, *g = env->g;
+    const bool track = env->track;
     const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
     const int32_t *peb = C->pebble + C->first[c];
     double *x = C->x + c * d, *v = C->v + c * d, *w = C->w + c * r;
@@ -195,10 +209,11 @@ typedef struct clump_block {
 
 static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
 {
+    const step_env env = step_env_of(m);
     double worst = 0, work[2] = {0, 0};
     o->bad = -1;
     for (int64_t c = c0; c < c1; c++)
-        if (!step_clump(m, c, &worst, work, NULL) && o->bad < 0) o->bad = c;
+        if (!step_clump(m, &env, c, &worst, work, NULL) && o->bad < 0) o->bad = c;
     o->worst = worst, o->damp_work = work[0], o->load_work = work[1];
 }
 
@@ -225,10 +240,11 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
     const sx_span own = d->cl_own[d->x.rank];
     double *terms = m->track_energy ? calloc((size_t)((own.hi - own.lo) * W + 1), sizeof *terms) : NULL;
     if (m->track_energy && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    const step_env env = step_env_of(m);
     double worst = *max_disp * *max_disp, work[2] = {0, 0};
     int64_t bad = -1;
     for (int64_t e = own.lo; e < own.hi; e++)
-        if (!step_clump(m, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
+        if (!step_clump(m, &env, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
     *max_disp = sqrt(worst);
     const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, terms, W, D + RD, size);
     free(terms);
