@@ -35,8 +35,9 @@
  * cracks merged in the serial order); the build itself is the serial one,
  * on every rank. A smooth joint's state is its pair's and its bond's; a
  * mesh wall is a wall (its rows of a ball lie in the ball's block), moved
- * and turned alike by every rank. Clumps: every rank steps every clump, from
- * its pebbles' forces shared by their owners at every step. Periodic
+ * and turned alike by every rank. Clumps: each is stepped by its owner
+ * (the owner of its pebble nearest its centroid), the pebbles of other
+ * ranks routed to it and back, point to point (plan_clumps). Periodic
  * space: a ghost's force is folded onto its owner after the pass, so the
  * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
  * (xpair), keeping current the far end of the cell they reach; the cell's
@@ -874,7 +875,7 @@ static void energy_part(const sx_model *m, int r, double *acc)
  * then its wall blocks', then its motion blocks', each sum from zero over
  * its pairs or balls in order; decomposed, a chunk or block may begin on
  * one rank and go on over the next ones. So, after the law of motion (the
- * clumps' terms, the same on every rank, follow), the sums are chained
+ * clumps' terms follow: sx__dd_clump_energy), the sums are chained
  * over the ranks in rank order (energy_part: each rank starts the sums
  * that begin among its own and continues, term by term from its tape,
  * those begun below it), and every rank adds the totals in the serial
