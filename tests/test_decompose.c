@@ -81,13 +81,10 @@ static bool agree(void *ud, uint64_t v)
     return same;
 }
 
-/* A dense bed in a box with energy tracking on: several chunks of pairs
- * and wall blocks, so that chunks and blocks begin on one rank and go on
- * over the next; unforced, so the energy guard runs its chained sums.
- * Bonded: every touching pair gets a weak parallel bond, and the balls'
- * random velocities break many of them (the crack log merged from the
- * ranks in the serial order, the released energy chained). */
-static sx_model *bed(int dim, bool bonded)
+/* A model under gravity with energy tracking and one material "m" (its
+ * index in *mat if not NULL): friction, dashpots and local damping, so
+ * that every dissipation acts. */
+static sx_model *tracked_model(int dim, int *mat)
 {
     const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
     sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
@@ -98,8 +95,21 @@ static sx_model *bed(int dim, bool bonded)
     md.viscous_normal = 0.2;
     md.viscous_shear = 0.1;
     md.damping = 0.1;
-    scene_material_def(m, "m", &md);
+    const int k = scene_material_def(m, "m", &md);
+    if (mat) *mat = k;
     sx_model_track_energy(m, true);
+    return m;
+}
+
+/* A dense bed in a box with energy tracking on: several chunks of pairs
+ * and wall blocks, so that chunks and blocks begin on one rank and go on
+ * over the next; unforced, so the energy guard runs its chained sums.
+ * Bonded: every touching pair gets a weak parallel bond, and the balls'
+ * random velocities break many of them (the crack log merged from the
+ * ranks in the serial order, the released energy chained). */
+static sx_model *bed(int dim, bool bonded)
+{
+    sx_model *m = tracked_model(dim, NULL);
     const double r = 0.01, s = 2 * r - 1e-5;
     const int nx = dim == 3 ? 12 : 80, ny = dim == 3 ? 12 : 50, nz = dim == 3 ? 14 : 1;
     uint64_t seed = 11;
@@ -136,16 +146,8 @@ static sx_model *bed(int dim, bool bonded)
  * energy blocks. */
 static sx_model *clump_bed(int dim)
 {
-    const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
-    sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
-    sx_material_def md = sx_material_default_def();
-    md.kn = md.ks = 2e5;
-    md.density = 2500;
-    md.friction = 0.3;
-    md.viscous_normal = 0.2;
-    md.damping = 0.1;
-    const int mat = scene_material_def(m, "m", &md);
-    sx_model_track_energy(m, true);
+    int mat;
+    sx_model *m = tracked_model(dim, &mat);
     const double r = 0.01, pos[6] = {-r, 0, 0, 0.7 * r, 0, 0}, rad[2] = {r, 0.7 * r};
     double p2[4] = {-r, 0, 0.7 * r, 0};
     const sx_clump_template_def td = {dim == 3 ? pos : p2, rad, 2, 0};
