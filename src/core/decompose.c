@@ -773,6 +773,7 @@ bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_
     sx_dd *d = m->dd;
     const int R = d->x.ranks;
     const int64_t nc = m->clumps->n, nblk = (nc + size - 1) / size;
+    if (!nc) return true; /* every clump removed: no block, on every rank */
     double *t = malloc((size_t)(d->ncl * w + 2 * nblk) * sizeof *t), *sum = t + d->ncl * w;
     if (!t) return false;
     memcpy(t + d->cl_own[d->x.rank].lo * w, terms,
