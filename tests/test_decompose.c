@@ -8,10 +8,10 @@
 #include "scenes.h"
 
 #include <check.h>
-#include <stdlib.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 enum { MAX_RANKS = 5 };
