@@ -4,11 +4,14 @@
  * every code path of decompose.c runs in the unit suite, under the
  * sanitizers too, and the bits are compared in full: the state hash and
  * every energy term of each rank against the serial run. */
+#include "model_internal.h" /* the clumps' owners and routes, to check the scene exercises them */
 #include "scenes.h"
 
 #include <check.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 enum { MAX_RANKS = 5 };
@@ -27,7 +30,8 @@ typedef struct world {
 typedef struct rank_ctx {
     world *w;
     int rank, dim;
-    bool bonded;
+    bool bonded, clumped;
+    int64_t crossing, moved; /* clumps: pebbles routed to another rank's clump; clumps whose owner changed */
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -77,13 +81,10 @@ static bool agree(void *ud, uint64_t v)
     return same;
 }
 
-/* A dense bed in a box with energy tracking on: several chunks of pairs
- * and wall blocks, so that chunks and blocks begin on one rank and go on
- * over the next; unforced, so the energy guard runs its chained sums.
- * Bonded: every touching pair gets a weak parallel bond, and the balls'
- * random velocities break many of them (the crack log merged from the
- * ranks in the serial order, the released energy chained). */
-static sx_model *bed(int dim, bool bonded)
+/* A model under gravity with energy tracking and one material "m" (its
+ * index in *mat if not NULL): friction, dashpots and local damping, so
+ * that every dissipation acts. */
+static sx_model *tracked_model(int dim, int *mat)
 {
     const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
     sx_model *m = scene_model(dim, g, 1e-5, 2e5, 0.5, 2500);
@@ -94,8 +95,21 @@ static sx_model *bed(int dim, bool bonded)
     md.viscous_normal = 0.2;
     md.viscous_shear = 0.1;
     md.damping = 0.1;
-    scene_material_def(m, "m", &md);
+    const int k = scene_material_def(m, "m", &md);
+    if (mat) *mat = k;
     sx_model_track_energy(m, true);
+    return m;
+}
+
+/* A dense bed in a box with energy tracking on: several chunks of pairs
+ * and wall blocks, so that chunks and blocks begin on one rank and go on
+ * over the next; unforced, so the energy guard runs its chained sums.
+ * Bonded: every touching pair gets a weak parallel bond, and the balls'
+ * random velocities break many of them (the crack log merged from the
+ * ranks in the serial order, the released energy chained). */
+static sx_model *bed(int dim, bool bonded)
+{
+    sx_model *m = tracked_model(dim, NULL);
     const double r = 0.01, s = 2 * r - 1e-5;
     const int nx = dim == 3 ? 12 : 80, ny = dim == 3 ? 12 : 50, nz = dim == 3 ? 14 : 1;
     uint64_t seed = 11;
@@ -124,16 +138,65 @@ static sx_model *bed(int dim, bool bonded)
     return m;
 }
 
+/* A bed of clumps with energy tracking: asymmetric dumbbells (two
+ * touching pebbles, radii r and 0.7 r) on a lattice at random angles,
+ * thrown about and spinning in a box under gravity: many lie across the
+ * ranks' slabs (their pebbles on two ranks), and the cut moves as they
+ * do, so clumps change owner; a load on some pebbles works on them. 2D: 720 clumps, two of the clump step's
+ * energy blocks. */
+static sx_model *clump_bed(int dim)
+{
+    int mat;
+    sx_model *m = tracked_model(dim, &mat);
+    const double r = 0.01, pos[6] = {-r, 0, 0, 0.7 * r, 0, 0}, rad[2] = {r, 0.7 * r};
+    double p2[4] = {-r, 0, 0.7 * r, 0};
+    const sx_clump_template_def td = {dim == 3 ? pos : p2, rad, 2, 0};
+    ck_assert_int_eq(sx_clump_template_add(m, "dumbbell", &td, NULL), SX_OK);
+    const double s = 4.1 * r; /* a dumbbell turns within 2 r of its centroid */
+    const int nx = dim == 3 ? 8 : 24, ny = dim == 3 ? 5 : 30, nz = dim == 3 ? 10 : 1;
+    uint64_t seed = 5;
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                sx_clump_def cd = sx_clump_default_def();
+                cd.material = mat;
+                const double a = scene_rng_uniform(&seed, -3.14, 3.14);
+                cd.pos[0] = 2.2 * r + i * s;
+                cd.pos[1] = dim == 3 ? 1.1 * r + j * 2.2 * r : 2.2 * r + j * s;
+                cd.pos[2] = dim == 3 ? 2.2 * r + k * s : 0;
+                /* about the axis normal to the lattice's layers of dumbbells (3D: y; 2D: z) */
+                cd.orientation[0] = cos(a / 2), cd.orientation[dim == 3 ? 2 : 3] = sin(a / 2);
+                for (int q = 0; q < dim; q++) cd.vel[q] = scene_rng_uniform(&seed, -2, 2);
+                cd.spin[dim == 3 ? 1 : 0] = scene_rng_uniform(&seed, -50, 50);
+                ck_assert_int_eq(sx_clump_add(m, &cd, NULL), SX_OK);
+            }
+    /* a load on some pebbles: the clumps' load work (energy tracking) */
+    const double push[3] = {0.02, 0.01, 0};
+    for (int64_t id = 1; id <= 2 * sx_clump_count(m); id += 7)
+        ck_assert_int_eq(sx_ball_set_vec(m, id, SX_BALL_APPLIED_FORCE, push), SX_OK);
+    const double lo[3] = {0, 0, 0}, hi[3] = {nx * s + r, dim == 3 ? ny * 2.2 * r + r : ny * s + 1, nz * s + 1};
+    scene_box_walls(m, lo, hi, 2e5, 0.5);
+    return m;
+}
+
 enum { STEPS_A = 150, STEPS_B = 250 };
 
 static void *run_rank(void *arg)
 {
     rank_ctx *c = arg;
-    sx_model *m = bed(c->dim, c->bonded);
+    sx_model *m = c->clumped ? clump_bed(c->dim) : bed(c->dim, c->bonded);
     const sx_exchange x = {c->rank, c->w->ranks, c, share, largest, agree};
     c->st = sx_model_decompose(m, &x);
     if (!c->st) c->st = sx_model_cycle(m, STEPS_A); /* two cycles: a cycle's end and start in between */
+    const sx_dd *d = m->dd;
+    int32_t *owner = c->clumped && !c->st ? malloc((size_t)d->ncl * sizeof *owner) : NULL; /* at A's last plan */
+    if (owner) memcpy(owner, d->cown, (size_t)d->ncl * sizeof *owner);
     if (!c->st) c->st = sx_model_cycle(m, STEPS_B);
+    if (owner) {
+        c->crossing = d->fwd.n;
+        for (int64_t k = 0; k < d->ncl; k++) c->moved += owner[k] != d->cown[k];
+        free(owner);
+    }
     c->hash = sx_model_state_hash(m);
     c->energy = sx_model_energy(m);
     sx_model_destroy(m);
@@ -142,16 +205,19 @@ static void *run_rank(void *arg)
 
 START_TEST(ranks_give_the_serial_bits)
 {
-    for (int scene = 0; scene < 4; scene++) {
+    for (int scene = 0; scene < 6; scene++) {
         const int dim = 2 + scene % 2;
-        const bool bonded = scene >= 2;
-        sx_model *serial = bed(dim, bonded);
+        const bool bonded = scene >= 2 && scene < 4, clumped = scene >= 4;
+        sx_model *serial = clumped ? clump_bed(dim) : bed(dim, bonded);
         ck_assert_int_eq(sx_model_cycle(serial, STEPS_A), SX_OK);
         ck_assert_int_eq(sx_model_cycle(serial, STEPS_B), SX_OK);
-        ck_assert_msg(sx_contact_count(serial) > sx_ball_count(serial), "the bed must be dense");
+        const int64_t contacts = sx_contact_count(serial);
+        ck_assert_msg(clumped ? contacts > 20 : contacts > sx_ball_count(serial),
+                      "%dD: the bed must be dense, or the clumps collide (%lld contacts)", dim, (long long)contacts);
         const uint64_t hash = sx_model_state_hash(serial);
         const sx_energy e = sx_model_energy(serial);
         ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
+        ck_assert_msg(!clumped || e.boundary_work != 0, "%dD: the loads must work on the clumps", dim);
         if (bonded) {
             const int64_t cracks = sx_crack_count(serial);
             ck_assert_msg(cracks > 10 && sx_bond_count(serial) > 10 && e.bond_released > 0,
@@ -159,13 +225,14 @@ START_TEST(ranks_give_the_serial_bits)
                           (long long)sx_bond_count(serial));
         }
         sx_model_destroy(serial);
+        int64_t crossing = 0, moved = 0; /* clumps: over the rank counts, at the cycles' last plans */
         for (int ranks = 2; ranks <= MAX_RANKS; ranks++) {
             world w = {.ranks = ranks};
             pthread_barrier_init(&w.bar, NULL, (unsigned)ranks);
             rank_ctx c[MAX_RANKS];
             pthread_t t[MAX_RANKS];
             for (int r = 0; r < ranks; r++) {
-                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim, .bonded = bonded};
+                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim, .bonded = bonded, .clumped = clumped};
                 ck_assert_int_eq(pthread_create(&t[r], NULL, run_rank, &c[r]), 0);
             }
             for (int r = 0; r < ranks; r++) pthread_join(t[r], NULL);
@@ -177,7 +244,15 @@ START_TEST(ranks_give_the_serial_bits)
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
             }
+            if (clumped) {
+                printf("%dD clumps, %d ranks: %lld pebbles routed to another rank's clump, %lld clumps changed owner\n",
+                       dim, ranks, (long long)c[0].crossing, (long long)c[0].moved);
+                crossing += c[0].crossing, moved += c[0].moved;
+            }
         }
+        ck_assert_msg(!clumped || (crossing > 0 && moved > 0),
+                      "%dD: clumps must lie across the slabs (%lld pebbles routed) and change owner (%lld)", dim,
+                      (long long)crossing, (long long)moved);
     }
 }
 END_TEST

@@ -145,7 +145,10 @@ static inline __attribute__((always_inline)) void rotor_part(double *Lb, double 
     v[k] = vk * ch - vj * sh;
 }
 
-static inline void free_rotor(double *q, const double *R, const double *L, const double *I, double dt)
+/* Always inlined: the clumps' step has two callers (serial, decomposed),
+ * and left to itself the compiler stops inlining it into either. */
+static inline __attribute__((always_inline)) void free_rotor(double *q, const double *R, const double *L,
+                                                             const double *I, double dt)
 {
     const double h[3] = {dt / I[0], dt / I[1], dt / I[2]};
     double Lb[3];

@@ -40,43 +40,56 @@ void sx__clumps_energy(const sx_model *m, sx_energy *e)
  * rotational frequency, the largest eigenvalue of I^-1 K, is at most its
  * trace, w^2 <= sum_i K_i / I_i (the body frame diagonalises I). The
  * dashpots enter likewise, with the largest damping ratio of the axes. */
-double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double *kr, const double *ct,
-                              const double *cr)
+static double clump_rating(const sx_model *m, int64_t c, const double *kt, const double *kr, const double *ct,
+                           const double *cr)
 {
     const sx_clumps *C = m->clumps;
     const sx_balls *B = &m->balls;
     const int d = m->dim, r = m->rdim;
     double best = INFINITY;
-    for (int64_t c = 0; c < C->n; c++) {
-        const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
-        const double s = C->scale[c], *body = C->tp_body + t->first * d, *I = C->inertia + c * r;
-        double Kt = 0, Ct = 0, Kr[3] = {0, 0, 0}, Cr[3] = {0, 0, 0};
-        for (int64_t k = 0; k < t->n; k++) {
-            const int64_t i = B->index_of[C->pebble[C->first[c] + k]];
-            Kt += kt[i];
-            Ct += ct[i];
-            for (int a = 0; a < r; a++) {
-                /* the pebble centre's distance from principal axis a (2D: from z) */
-                double h2 = 0;
-                for (int j = 0; j < d; j++)
-                    if (d == 2 || j != a) h2 += s * body[k * d + j] * s * body[k * d + j];
-                const double lever = 1 + 2 * sqrt(h2) / B->rad[i];
-                Kr[a] += kr[i] * lever + kt[i] * h2;
-                Cr[a] += cr[i] * lever + ct[i] * h2;
-            }
-        }
-        const double mass = C->mass[c], amp = 1 + C->alpha[c];
-        if (Kt > 0) {
-            const double z = amp * Ct / (2 * sqrt(Kt * mass));
-            best = fmin(best, sqrt(mass / Kt) * (sqrt(1 + z * z) - z));
-        }
-        double w2 = 0, z = 0;
+    const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
+    const double s = C->scale[c], *body = C->tp_body + t->first * d, *I = C->inertia + c * r;
+    double Kt = 0, Ct = 0, Kr[3] = {0, 0, 0}, Cr[3] = {0, 0, 0};
+    for (int64_t k = 0; k < t->n; k++) {
+        const int64_t i = B->index_of[C->pebble[C->first[c] + k]];
+        Kt += kt[i];
+        Ct += ct[i];
         for (int a = 0; a < r; a++) {
-            w2 += Kr[a] / I[a];
-            if (Kr[a] > 0) z = fmax(z, amp * Cr[a] / (2 * sqrt(Kr[a] * I[a])));
+            /* the pebble centre's distance from principal axis a (2D: from z) */
+            double h2 = 0;
+            for (int j = 0; j < d; j++)
+                if (d == 2 || j != a) h2 += s * body[k * d + j] * s * body[k * d + j];
+            const double lever = 1 + 2 * sqrt(h2) / B->rad[i];
+            Kr[a] += kr[i] * lever + kt[i] * h2;
+            Cr[a] += cr[i] * lever + ct[i] * h2;
         }
-        if (w2 > 0) best = fmin(best, (sqrt(1 + z * z) - z) / sqrt(w2));
     }
+    const double mass = C->mass[c], amp = 1 + C->alpha[c];
+    if (Kt > 0) {
+        const double z = amp * Ct / (2 * sqrt(Kt * mass));
+        best = fmin(best, sqrt(mass / Kt) * (sqrt(1 + z * z) - z));
+    }
+    double w2 = 0, z = 0;
+    for (int a = 0; a < r; a++) {
+        w2 += Kr[a] / I[a];
+        if (Kr[a] > 0) z = fmax(z, amp * Cr[a] / (2 * sqrt(Kr[a] * I[a])));
+    }
+    if (w2 > 0) best = fmin(best, (sqrt(1 + z * z) - z) / sqrt(w2));
+    return best;
+}
+
+/* Decomposed inside a cycle, a rank rates its own clumps (decompose.c):
+ * the ranks' minimum is the serial one. */
+double sx__clumps_critical_dt(const sx_model *m, const double *kt, const double *kr, const double *ct,
+                              const double *cr)
+{
+    const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
+    double best = INFINITY;
+    if (dd)
+        for (int64_t e = dd->cl_own[dd->x.rank].lo; e < dd->cl_own[dd->x.rank].hi; e++)
+            best = fmin(best, clump_rating(m, dd->cl[e], kt, kr, ct, cr));
+    else
+        for (int64_t c = 0; c < m->clumps->n; c++) best = fmin(best, clump_rating(m, c, kt, kr, ct, cr));
     return best;
 }
 

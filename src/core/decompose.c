@@ -35,12 +35,14 @@
  * cracks merged in the serial order); the build itself is the serial one,
  * on every rank. A smooth joint's state is its pair's and its bond's; a
  * mesh wall is a wall (its rows of a ball lie in the ball's block), moved
- * and turned alike by every rank. Clumps: every rank steps every clump, from
- * its pebbles' forces shared by their owners at every step. Periodic
+ * and turned alike by every rank. Clumps: each is stepped by its owner
+ * (the owner of its pebble nearest its centroid), the pebbles of other
+ * ranks routed to it and back, point to point (plan_clumps). Periodic
  * space: a ghost's force is folded onto its owner after the pass, so the
  * owner's rank also evaluates the ghost's pairs that lie outside pairs[r]
  * (xpair), keeping current the far end of the cell they reach; the cell's
  * stress (its servo) is summed over the ranks in a chain, in pair order. */
+#include "clumps.h"
 #include "model_internal.h"
 #include "state.h"
 
@@ -53,7 +55,12 @@ void sx__dd_free(sx_model *m)
     if (!d) return;
     free(d->own);
     free(d->bslot);
-    free(d->peb);
+    free(d->cown);
+    free(d->cl);
+    free(d->cl_at);
+    free(d->fwd.item);
+    free(d->back.item);
+    free(d->fwd.need);
     free(d->xpair);
     free(d->inpair);
     free(d->gho);
@@ -75,11 +82,12 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
         return sx__fail(m, SX_EINVAL, "decompose: an exchange needs share, max, agree and a rank below its ranks");
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
-    /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, peb_own,
-     * gho_own */
-    enum { SPANS = 11 + SX_DD_NEED };
-    sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL;
-    if (!s) {
+    /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, cl_own,
+     * gho_own, fwd.own, back.own; and the routes' needs (r per rank) */
+    enum { SPANS = 13 + SX_DD_NEED };
+    sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(2 * r * r, sizeof *routes) : NULL;
+    if (!routes) {
+        free(s);
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
     }
@@ -87,8 +95,9 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->own = s, d->need = s + r;
     s += (1 + SX_DD_NEED) * r;
     d->pairs = s, d->wblk = s + r, d->wrun = s + 2 * r, d->bb_own = s + 3 * r, d->bw_own = s + 4 * r;
-    d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->peb_own = s + 8 * r;
-    d->gho_own = s + 9 * r;
+    d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->cl_own = s + 8 * r;
+    d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
+    d->fwd.need = routes, d->back.need = routes + r * r;
     m->dd = d;
     return SX_OK;
 }
@@ -130,23 +139,113 @@ static bool plan_list(sx_model *m, const sx_span *range, int64_t most, int32_t (
 
 static int32_t bond_slot(const sx_model *m, int64_t c) { return m->bb.bond[c] - 1; }
 
-static int32_t pebble(const sx_model *m, int64_t i) { return m->balls.clump[i] ? (int32_t)i : -1; }
+/* Clump c's pebble k: its dense index. */
+static int64_t pebble_of(const sx_model *m, int64_t c, int64_t k)
+{
+    return m->balls.index_of[m->clumps->pebble[m->clumps->first[c] + k]];
+}
+
+static int64_t pebbles(const sx_model *m, int64_t c) { return m->clumps->tpl[m->clumps->tpl_of[c]].n; }
+
+/* The route of the pebbles whose owner is not their clump's: from their
+ * owners to their clumps' owners, or (back) the other way. Each source
+ * rank's entries a run, within it a span per destination, each in clump
+ * order then pebble order (a counting sort on source and destination);
+ * every rank plans every rank's alike. False: out of memory. */
+static bool plan_route(sx_model *m, sx_route *rt, bool back)
+{
+    sx_dd *d = m->dd;
+    const sx_clumps *C = m->clumps;
+    const int R = d->x.ranks;
+    const int64_t n = m->balls.n;
+    int64_t *at = calloc((size_t)(R * R + 1), sizeof *at); /* per (source, destination): its first entry */
+    if (!at) return false;
+    for (int pass = 0; pass < 2; pass++) { /* count, then place */
+        for (int64_t c = 0; c < C->n; c++)
+            for (int64_t k = 0; k < pebbles(m, c); k++) {
+                const int64_t i = pebble_of(m, c, k);
+                const int po = owner_of(d, i, n), co = d->cown[c];
+                if (po == co) continue;
+                const int key = back ? co * R + po : po * R + co;
+                if (pass) rt->item[at[key]++] = (int32_t)i;
+                else at[key + 1]++;
+            }
+        if (pass) break;
+        for (int key = 0; key < R * R; key++) at[key + 1] += at[key];
+        rt->n = at[R * R];
+        if (rt->cap < rt->n) {
+            int32_t *q = realloc(rt->item, (size_t)rt->n * sizeof *q);
+            if (!q) {
+                free(at);
+                return false;
+            }
+            rt->item = q, rt->cap = rt->n;
+        }
+        for (int src = 0; src < R; src++)
+            for (int dst = 0; dst < R; dst++) rt->need[dst * R + src] = (sx_span){at[src * R + dst], at[src * R + dst + 1]};
+    }
+    for (int src = 0; src < R; src++) rt->own[src] = (sx_span){rt->need[src].lo, rt->need[(R - 1) * R + src].hi};
+    free(at);
+    return true;
+}
+
+/* Clumps: each is stepped by one rank, its owner: the owner of its pebble
+ * nearest its centroid (the first on a tie). Its centroid lies in that
+ * pebble's slab or next to it (the slabs are runs of the cell order, not
+ * planes, so the pebble's owner is what places it), and the rank steps
+ * the pebble itself: the fewest pebbles cross. The clumps by owner (cl,
+ * each rank's a run cl_own in clump order; cl_at: a clump's entry), then
+ * the pebbles' routes. False: out of memory. */
+static bool plan_clumps(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const sx_clumps *C = m->clumps;
+    const sx_balls *B = &m->balls;
+    const int R = d->x.ranks, D = m->dim;
+    if (d->cap_cl < C->n) {
+        int32_t *own = realloc(d->cown, (size_t)C->n * sizeof *own);
+        if (own) d->cown = own;
+        int32_t *cl = realloc(d->cl, (size_t)C->n * sizeof *cl);
+        if (cl) d->cl = cl;
+        int32_t *at = realloc(d->cl_at, (size_t)C->n * sizeof *at);
+        if (at) d->cl_at = at;
+        if (!own || !cl || !at) return false;
+        d->cap_cl = C->n;
+    }
+    for (int64_t c = 0; c < C->n; c++) {
+        int64_t best = pebble_of(m, c, 0);
+        double near = INFINITY;
+        for (int64_t k = 0; k < pebbles(m, c); k++) {
+            const int64_t i = pebble_of(m, c, k);
+            double d2 = 0;
+            for (int j = 0; j < D; j++) d2 += (B->x[i * D + j] - C->x[c * D + j]) * (B->x[i * D + j] - C->x[c * D + j]);
+            if (d2 < near) near = d2, best = i;
+        }
+        d->cown[c] = (int32_t)owner_of(d, best, B->n);
+    }
+    d->ncl = 0;
+    for (int r = 0; r < R; r++) {
+        d->cl_own[r].lo = d->ncl;
+        for (int64_t c = 0; c < C->n; c++)
+            if (d->cown[c] == r) d->cl_at[c] = (int32_t)d->ncl, d->cl[d->ncl++] = (int32_t)c;
+        d->cl_own[r].hi = d->ncl;
+    }
+    return plan_route(m, &d->fwd, false) && plan_route(m, &d->back, true);
+}
 
 /* The bond slots of the bonded pairs in pair order, each rank's own
  * pairs' a contiguous run (bs_own): what a gather takes from each owner
  * (a pair keeps its slot until the next plan, broken or not); and the
- * clumps' pebbles in dense order, each rank's own a run (peb_own): every
- * rank steps every clump (kernels/clump_motion.c, the serial step), from
- * its pebbles' forces shared by their owners. */
+ * clumps' owners and routes (plan_clumps). */
 static bool plan_lists(sx_model *m)
 {
     sx_dd *d = m->dd;
-    d->nbslot = d->npeb = 0;
-    for (int r = 0; r < d->x.ranks; r++) d->bs_own[r] = d->peb_own[r] = (sx_span){0, 0};
+    d->nbslot = d->ncl = d->fwd.n = d->back.n = 0;
+    for (int r = 0; r < d->x.ranks; r++) d->bs_own[r] = d->cl_own[r] = d->fwd.own[r] = d->back.own[r] = (sx_span){0, 0};
+    memset(d->fwd.need, 0, 2 * (size_t)d->x.ranks * (size_t)d->x.ranks * sizeof *d->fwd.need);
     return (!m->bb.bond ||
             plan_list(m, d->bb_own, m->bb.n, bond_slot, &d->bslot, &d->nbslot, &d->cap_bslot, d->bs_own)) &&
-           (!m->balls.clump ||
-            plan_list(m, d->own, m->balls.n, pebble, &d->peb, &d->npeb, &d->cap_peb, d->peb_own));
+           (!m->clumps || !m->clumps->n || plan_clumps(m));
 }
 
 /* Widens rank r's ghosts to ball e: in its near spans already, or in the
@@ -582,36 +681,67 @@ static bool gather_cracks(sx_model *m)
     return ok;
 }
 
+/* Rows of per-entry arrays between ranks: field[k] has per[k] doubles an
+ * entry, and the rows moved are base + list[e] for the entries e < n of
+ * the buffer. Each rank packs the entries own[rank], they are shared
+ * (need: nper spans per rank), and each rank unpacks those it needs. */
+typedef struct sx_rows {
+    double *const *field;
+    const int *per;
+    int nf;
+} sx_rows;
+
+static bool move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t base, int64_t n, const sx_span *own,
+                      const sx_span *need, int nper)
+{
+    int w = 0;
+    for (int k = 0; k < f->nf; k++) w += f->per[k];
+    if (!n || !w) return true;
+    double *buf = malloc((size_t)(n * w) * sizeof *buf);
+    if (!buf) return false;
+    const int me = d->x.rank;
+    bool ok = true;
+    for (int pass = 0; ok && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
+        const sx_span s = pass ? need[me * nper + pass - 1] : own[me];
+        for (int64_t e = s.lo; e < s.hi; e++) {
+            double *q = buf + e * w;
+            for (int k = 0; k < f->nf; k++) {
+                double *v = f->field[k] + (base + list[e]) * f->per[k];
+                if (pass) memcpy(v, q, (size_t)f->per[k] * sizeof *q);
+                else memcpy(q, v, (size_t)f->per[k] * sizeof *q);
+                q += f->per[k];
+            }
+        }
+        if (!pass) ok = share(d, buf, (size_t)w * sizeof *buf, own, need, nper);
+    }
+    free(buf);
+    return ok;
+}
+
 /* Periodic space: every ghost's slot (position, velocity, spin, force,
- * moment) from the rank of its owner, packed as doubles in the plan's
- * order. */
+ * moment) from the rank of its owner, in the plan's order. */
 static bool gather_ghosts(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
-    const int D = m->dim, RD = m->rdim, w = 3 * D + 2 * RD;
-    const int64_t ng = d->ngho, base = m->cell->base;
-    if (!ng) return true;
-    double *buf = malloc((size_t)(ng * w) * sizeof *buf);
-    if (!buf) return false;
+    const int D = m->dim, RD = m->rdim;
     double *const field[5] = {B->x, B->v, B->f, B->w, B->t};
-    bool ok = true;
-    for (int pass = 0; ok && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
-        const int64_t e0 = pass ? 0 : d->gho_own[d->x.rank].lo, e1 = pass ? ng : d->gho_own[d->x.rank].hi;
-        for (int64_t e = e0; e < e1; e++) {
-            double *q = buf + e * w;
-            for (int k = 0; k < 5; k++) {
-                const int per = k < 3 ? D : RD;
-                double *v = field[k] + (base + d->gho[e]) * per;
-                if (pass) memcpy(v, q, (size_t)per * sizeof *q);
-                else memcpy(q, v, (size_t)per * sizeof *q);
-                q += per;
-            }
-        }
-        if (!pass) ok = share(d, buf, (size_t)w * sizeof *buf, d->gho_own, everything(d, ng), 1);
-    }
-    free(buf);
-    return ok;
+    const int per[5] = {D, D, D, RD, RD};
+    const sx_rows f = {field, per, 5};
+    return move_rows(d, &f, d->gho, m->cell->base, d->ngho, d->gho_own, everything(d, d->ngho), 1);
+}
+
+/* The clumps' state (centroid, velocity, spin, orientation, angular
+ * momentum, the last resultants) from their owners to every rank. */
+bool sx__dd_clumps(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_clumps *C = m->clumps;
+    const int D = m->dim, RD = m->rdim;
+    double *const field[7] = {C->x, C->v, C->w, C->f, C->t, C->q, C->L};
+    const int per[7] = {D, D, RD, D, RD, D == 3 ? 4 : 1, D == 3 ? 3 : 0};
+    const sx_rows f = {field, per, D == 3 ? 7 : 6};
+    return move_rows(d, &f, d->cl, 0, d->ncl, d->cl_own, everything(d, d->ncl), 1);
 }
 
 bool sx__dd_gather(sx_model *m)
@@ -625,7 +755,7 @@ bool sx__dd_gather(sx_model *m)
            share(d, B->t, w, d->own, all, 1) && gather_pairs(m, &m->bb, d->bb_own) &&
            gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m))) &&
            (!m->fjel.n || gather_fjoints(m)) &&
-           (!m->cell || !m->cell->n || gather_ghosts(m));
+           (!m->cell || !m->cell->n || gather_ghosts(m)) && (!m->clumps || !m->clumps->n || sx__dd_clumps(m));
 }
 
 bool sx__dd_walls(sx_model *m)
@@ -635,36 +765,71 @@ bool sx__dd_walls(sx_model *m)
     return share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1);
 }
 
-/* Every pebble's rows of some per-ball arrays from its owner, to every
- * rank: with sums NULL its force and moment (before the clumps' step),
- * else the timestep's four sums (kt, kr, ct, cr: n each, from sums). */
+/* The pebbles whose owner is not their clump's, from their owners to
+ * their clumps' owners: with sums NULL their forces and moments (before
+ * the clumps' step), else the timestep's four sums (kt, kr, ct, cr: n
+ * each, from sums). */
 bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
 {
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
-    const int64_t np = d->npeb;
-    if (!np) return true;
-    const int D = m->dim, RD = m->rdim, w = sums ? 4 : D + RD;
-    double *buf = malloc((size_t)(np * w) * sizeof *buf);
-    if (!buf) return false;
-    for (int pass = 0; pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
-        const int64_t e0 = pass ? 0 : d->peb_own[d->x.rank].lo, e1 = pass ? np : d->peb_own[d->x.rank].hi;
-        for (int64_t e = e0; e < e1; e++) {
-            const int64_t i = d->peb[e];
-            double *q = buf + e * w;
-            for (int k = 0; k < w; k++) {
-                double *v = sums ? sums + k * n + i : k < D ? B->f + i * D + k : B->t + i * RD + k - D;
-                if (pass) *v = q[k];
-                else q[k] = *v;
-            }
+    double *const field[4] = {sums ? sums : B->f, sums ? sums + n : B->t, sums ? sums + 2 * n : NULL,
+                              sums ? sums + 3 * n : NULL};
+    const int forces[2] = {m->dim, m->rdim}, rates[4] = {1, 1, 1, 1};
+    const sx_rows f = {field, sums ? rates : forces, sums ? 4 : 2};
+    return move_rows(d, &f, d->fwd.item, 0, d->fwd.n, d->fwd.own, d->fwd.need, d->x.ranks);
+}
+
+/* The pebbles the clumps' owners placed (position, velocity, spin), to
+ * the pebbles' owners, whose ghosts' ranks then take them as any ball's
+ * (sx__dd_halo). */
+bool sx__dd_placed(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    sx_balls *B = &m->balls;
+    double *const field[3] = {B->x, B->v, B->w};
+    const int per[3] = {m->dim, m->dim, m->rdim};
+    const sx_rows f = {field, per, 3};
+    return move_rows(d, &f, d->back.item, 0, d->back.n, d->back.own, d->back.need, d->x.ranks);
+}
+
+/* The serial step adds, after the balls' blocks, the clumps' blocks'
+ * energy sums (size clumps a block, each sum from zero over its clumps'
+ * terms in clump order) to m->acc in block order. The owners' terms
+ * (w a clump at its entry cl_at, the first nd its damping's, a term
+ * absent from the serial sum a zero: adding +0 to a sum from +0 changes
+ * no bit) go to rank 0, which folds them in the serial order; the block
+ * sums go to every rank, which adds them in block order: two messages a
+ * step per rank, only with energy tracking. */
+bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_t size)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    const int64_t nc = m->clumps->n, nblk = (nc + size - 1) / size;
+    if (!nc) return true; /* every clump removed: no block, on every rank */
+    double *t = malloc((size_t)(d->ncl * w + 2 * nblk) * sizeof *t), *sum = t + d->ncl * w;
+    if (!t) return false;
+    memcpy(t + d->cl_own[d->x.rank].lo * w, terms,
+           (size_t)(d->cl_own[d->x.rank].hi - d->cl_own[d->x.rank].lo) * (size_t)w * sizeof *t);
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){0, r ? 0 : d->ncl}; /* rank 0 needs them all */
+    bool ok = share(d, t, (size_t)w * sizeof *t, d->cl_own, d->scratch, 1);
+    for (int64_t k = 0; ok && !d->x.rank && k < nblk; k++) {
+        double damp = 0, load = 0;
+        for (int64_t c = k * size; c < (k + 1) * size && c < nc; c++) {
+            const double *q = t + (int64_t)d->cl_at[c] * w;
+            for (int j = 0; j < nd; j++) damp += q[j];
+            for (int j = nd; j < w; j++) load += q[j];
         }
-        if (!pass && !share(d, buf, (size_t)w * sizeof *buf, d->peb_own, everything(d, np), 1)) {
-            free(buf);
-            return false;
-        }
+        sum[2 * k] = damp, sum[2 * k + 1] = load;
     }
-    free(buf);
-    return true;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){0, r ? 0 : 2 * nblk}; /* rank 0's sums, to all */
+    ok = ok && share(d, sum, sizeof *sum, d->scratch, everything(d, 2 * nblk), 1);
+    for (int64_t k = 0; ok && k < nblk; k++) {
+        m->acc.local_damping -= sum[2 * k];
+        m->acc.boundary_work += sum[2 * k + 1];
+    }
+    free(t);
+    return ok;
 }
 
 /* A sum in the serial order over what the ranks own in turn (the
@@ -744,7 +909,7 @@ static void energy_part(const sx_model *m, int r, double *acc)
  * then its wall blocks', then its motion blocks', each sum from zero over
  * its pairs or balls in order; decomposed, a chunk or block may begin on
  * one rank and go on over the next ones. So, after the law of motion (the
- * clumps' terms, the same on every rank, follow), the sums are chained
+ * clumps' terms follow: sx__dd_clump_energy), the sums are chained
  * over the ranks in rank order (energy_part: each rank starts the sums
  * that begin among its own and continues, term by term from its tape,
  * those begun below it), and every rank adds the totals in the serial

@@ -629,7 +629,8 @@ static sx_status guard_check(sx_model *m)
     if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
     sx_energy e;
     /* decomposed: the ghosts where the step left their owners, for the pairs' strain */
-    if ((m->dd && m->dd->active && !sx__dd_halo(m)) || !kernels(m)->energy(m, &e))
+    if ((m->dd && m->dd->active && (!sx__dd_halo(m) || (m->clumps && !sx__dd_clumps(m)))) ||
+        !kernels(m)->energy(m, &e))
         return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     const double gain = mechanical(&e) - m->guard_e0;
     if (!(gain > GUARD_ENERGY_FACTOR * m->guard_scale)) return SX_OK;
@@ -743,13 +744,16 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
-        if (!st && dd && !dd->x.max(dd->x.ud, &max_disp)) /* every rank decides the same rebuild */
-            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
         if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
-        if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* every rank steps every clump */
+        if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
         if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
+        if (!st && m->clumps && dd && !sx__dd_placed(m)) /* the placed pebbles to their owners */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' places");
+        /* every rank decides the same rebuild (the largest of the ranks' own balls' and pebbles' moves) */
+        if (!st && dd && !dd->x.max(dd->x.ud, &max_disp))
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
         sx__walls_servo(m);

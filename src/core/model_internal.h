@@ -335,6 +335,15 @@ typedef struct sx_tape {
  * its tape's terms, folded into the lower ranks' sums. */
 enum { SX_DD_PART_NONE, SX_DD_PART_START, SX_DD_PART_TAPE };
 
+/* Entries (ball indices) moved between ranks, grouped by the rank they
+ * come from (a run each, own[src]) and within it by the rank they go to
+ * (need[dst * ranks + src]). */
+typedef struct sx_route {
+    int32_t *item;
+    int64_t n, cap;
+    sx_span *own, *need;
+} sx_route;
+
 typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
@@ -360,10 +369,15 @@ typedef struct sx_dd {
     int64_t nbslot, cap_bslot;
     sx_span *bs_own, *scratch;
     int64_t crack0;         /* the crack log's entries every rank holds alike */
-    /* clumps: the pebbles in dense order, as planned, and each rank's own */
-    int32_t *peb;
-    int64_t npeb, cap_peb;
-    sx_span *peb_own;
+    /* clumps: each clump's owner (cown: the rank owning its pebble
+     * nearest its centroid), the clumps by owner, each rank's in clump
+     * order a run (cl, cl_own; cl_at: a clump's entry), and the pebbles
+     * whose owner is not their clump's, routed to (fwd) and from (back)
+     * the clump's owner */
+    int32_t *cown, *cl, *cl_at;
+    int64_t ncl, cap_cl;
+    sx_span *cl_own;
+    sx_route fwd, back;
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
     /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
      * a pair reaching it, the pairs crossing it (first ball below it,
@@ -634,7 +648,18 @@ bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
 bool sx__dd_walls(sx_model *m);
+/* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
+ * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n
+ * each, from sums), from the pebbles' owners to their clumps' owners; the
+ * placed pebbles (position, velocity, spin) from the clumps' owners to the
+ * pebbles' owners; the clumps' energy terms (w a clump, the first nd its
+ * damping's, at the clump's entry cl_at), summed in blocks of `size`
+ * clumps in the serial order and added to m->acc. */
 bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
+bool sx__dd_placed(sx_model *m);
+bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_t size);
+/* The clumps' state from their owners to every rank (the energy guard). */
+bool sx__dd_clumps(sx_model *m);
 bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc));
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Energy tracking: term v of the sum k on the rank's tape; after the law

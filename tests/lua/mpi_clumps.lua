@@ -3,8 +3,8 @@
 -- dumbbells) among free balls settling in a box, run serially and under
 -- mpirun -np 1 ... 4, prints the same state hash at mid-run and at the end,
 -- and the same contact count, floor force, ratio and kinetic energy, to the
--- bit. The clumps' pebbles lie on several ranks: each rank steps every
--- clump from its pebbles' forces. Arguments: dim (3), steps (8000), with
+-- bit. The clumps' pebbles lie on several ranks: a clump's owner steps it
+-- from its pebbles' forces, the other ranks' sent to it. Arguments: dim (3), steps (8000), with
 -- the automatic timestep (rated from the clumps' pebbles), or a fixed one
 -- with a third argument "fixed".
 local dim = tonumber(arg and arg[1]) or 3

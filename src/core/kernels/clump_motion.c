@@ -70,6 +70,136 @@ static double KERNEL(place_pebbles)(sx_model *m, int64_t c, const double *R)
     return worst;
 }
 
+/* A term of the clump step's energy sums: onto the block's sum *work, or,
+ * decomposed, into slot k of the clump's terms (decompose.c sums them in
+ * the serial order). The serial step passes terms NULL: inlined, the
+ * branch goes. */
+static inline __attribute__((always_inline)) void energy_term(double *work, double *terms, int k, double v)
+{
+    if (terms) terms[k] = v;
+    else *work += v;
+}
+
+/* What every clump's step reads of the model, read once per run of
+ * clumps (the stores through the clumps' arrays could alias it). */
+typedef struct step_env {
+    sx_clumps *C;
+    sx_balls *B;
+    double dt, dtv;
+    const double *g;
+    bool track;
+} step_env;
+
+static step_env step_env_of(sx_model *m)
+{
+    /* the kick spans the time between the half-step velocities, as for balls */
+    return (step_env){m->clumps, &m->balls, m->dt, m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt, m->gravity,
+                      m->track_energy};
+}
+
+/* Steps clump c: its resultant, translation, rotation, and its pebbles
+ * placed. *worst takes the largest squared pebble displacement, work[0]
+ * and work[1] the damping and load terms (or terms, decomposed: the
+ * damping's d + r slots, then the loads' d + 1). False: a non-finite
+ * state. */
+static inline __attribute__((always_inline)) bool step_clump(sx_model *m, const step_env *env, int64_t c,
+                                                             double *worst, double *work, double *terms)
+{
+    const int d = D, r = RD, nd = D + RD;
+    sx_clumps *C = env->C;
+    sx_balls *B = env->B;
+    const double dt = env->dt, dtv = env->dtv, *g = env->g;
+    const bool track = env->track;
+    const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
+    const int32_t *peb = C->pebble + C->first[c];
+    double *x = C->x + c * d, *v = C->v + c * d, *w = C->w + c * r;
+    /* the resultant of the pebbles' forces, and its moment about the centroid:
+     * each pebble's own moment plus (x_pebble - x) x F (4-21 carried to the body) */
+    double F[3] = {0, 0, 0}, T[3] = {0, 0, 0}, Fa[3] = {0, 0, 0}, Ta[3] = {0, 0, 0};
+    for (int64_t k = 0; k < t->n; k++) {
+        const int64_t i = B->index_of[peb[k]];
+        double arm[3] = {0, 0, 0}, mo[3];
+        for (int j = 0; j < d; j++) arm[j] = B->x[i * d + j] - x[j];
+        moment_arm(d, arm, B->f + i * d, mo);
+        for (int j = 0; j < d; j++) F[j] += B->f[i * d + j];
+        for (int j = 0; j < r; j++) T[j] += B->t[i * r + j] + mo[j];
+        if (track && B->fapp) {
+            moment_arm(d, arm, B->fapp + i * d, mo);
+            for (int j = 0; j < d; j++) Fa[j] += B->fapp[i * d + j];
+            for (int j = 0; j < r; j++) Ta[j] += B->tapp[i * r + j] + mo[j];
+        }
+    }
+    memcpy(C->f + c * d, F, (size_t)d * sizeof(double));
+    memcpy(C->t + c * r, T, (size_t)r * sizeof(double));
+    const double mass = C->mass[c], a = C->alpha[c], *I = C->inertia + c * r;
+    const unsigned fix = C->fix[c];
+    /* translation: 4-46, 4-48 */
+    for (int k = 0; k < d; k++) {
+        if (!(fix & (SX_FIX_VX << k))) {
+            const double force = F[k] + g[k] * mass; /* 4-40: the weight acts at the centroid */
+            const double fd = sx__damped(force, v[k], a);
+            const double vold = v[k];
+            v[k] += fd / mass * dtv;
+            if (track) {
+                energy_term(&work[0], terms, k, (fd - force) * 0.5 * (vold + v[k]) * dt);
+                energy_term(&work[1], terms, nd + k, Fa[k] * 0.5 * (vold + v[k]) * dt);
+            }
+        }
+        x[k] += v[k] * dt;
+    }
+    /* rotation: 4-42 */
+    if (d == 3) {
+        double *q = C->q + c * 4, *L = C->L + c * 3, R[9];
+        qmatrix(q, R);
+        if ((fix & SX_FIX_SPIN) == SX_FIX_SPIN) {
+            imposed_rotation(q, w, dt);
+            qmatrix(q, R);
+            momentum_of(R, I, w, L);
+        } else {
+            /* the kick, with local damping per principal component */
+            double Tb[3], Lb[3], Md[3], dL[3];
+            mat_tvec(R, T, Tb);
+            mat_tvec(R, L, Lb);
+            for (int k = 0; k < 3; k++) Md[k] = sx__damped(Tb[k], Lb[k] / I[k], a);
+            mat_vec(R, Md, dL);
+            for (int k = 0; k < 3; k++) L[k] += dL[k] * dtv;
+            if (track) { /* work at the mean of the old and new spins, as for balls */
+                double Ln[3], wm[3];
+                mat_tvec(R, L, Ln);
+                for (int k = 0; k < 3; k++) {
+                    const double wold = Lb[k] / I[k], wnew = Ln[k] / I[k];
+                    energy_term(&work[0], terms, d + k, (Md[k] - Tb[k]) * 0.5 * (wold + wnew) * dt);
+                    wm[k] = 0.5 * (wold + wnew);
+                }
+                double ws[3];
+                mat_vec(R, wm, ws);
+                energy_term(&work[1], terms, nd + d, (Ta[0] * ws[0] + Ta[1] * ws[1] + Ta[2] * ws[2]) * dt);
+            }
+            free_rotor(q, R, L, I, dt); /* the drift */
+            qmatrix(q, R);
+            spin_of(R, I, L, w);
+        }
+        *worst = fmax(*worst, KERNEL(place_pebbles)(m, c, R));
+    } else {
+        if (!(fix & SX_FIX_WX)) {
+            const double md = sx__damped(T[0], w[0], a), wold = w[0];
+            w[0] += md / I[0] * dtv; /* 4-47 about z */
+            if (track) {
+                energy_term(&work[0], terms, d, (md - T[0]) * 0.5 * (wold + w[0]) * dt);
+                energy_term(&work[1], terms, nd + d, Ta[0] * 0.5 * (wold + w[0]) * dt);
+            }
+        }
+        C->q[c] += w[0] * dt;
+        double R[9];
+        body_rotation(m, c, R);
+        *worst = fmax(*worst, KERNEL(place_pebbles)(m, c, R));
+    }
+    bool ok = isfinite(C->q[c * (d == 3 ? 4 : 1)]);
+    for (int k = 0; k < d; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
+    for (int k = 0; k < r; k++) ok &= isfinite(w[k]);
+    return ok;
+}
+
 /* The step of clumps [c0, c1): partial sums of one block. Each clump
  * writes only itself and its own pebbles, so blocks run in parallel. */
 typedef struct clump_block {
@@ -79,112 +209,48 @@ typedef struct clump_block {
 
 static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
 {
-    const int d = D, r = RD;
-    sx_clumps *C = m->clumps;
-    sx_balls *B = &m->balls;
-    const double dt = m->dt;
-    /* the kick spans the time between the half-step velocities, as for balls */
-    const double dtv = m->dt_prev > 0 ? 0.5 * (m->dt_prev + m->dt) : m->dt;
-    const double *g = m->gravity;
-    const bool track = m->track_energy;
-    double worst = 0, damp_work = 0, load_work = 0;
+    const step_env env = step_env_of(m);
+    double worst = 0, work[2] = {0, 0};
     o->bad = -1;
-    for (int64_t c = c0; c < c1; c++) {
-        const sx_clump_tpl *t = &C->tpl[C->tpl_of[c]];
-        const int32_t *peb = C->pebble + C->first[c];
-        double *x = C->x + c * d, *v = C->v + c * d, *w = C->w + c * r;
-        /* the resultant of the pebbles' forces, and its moment about the centroid:
-         * each pebble's own moment plus (x_pebble - x) x F (4-21 carried to the body) */
-        double F[3] = {0, 0, 0}, T[3] = {0, 0, 0}, Fa[3] = {0, 0, 0}, Ta[3] = {0, 0, 0};
-        for (int64_t k = 0; k < t->n; k++) {
-            const int64_t i = B->index_of[peb[k]];
-            double arm[3] = {0, 0, 0}, mo[3];
-            for (int j = 0; j < d; j++) arm[j] = B->x[i * d + j] - x[j];
-            moment_arm(d, arm, B->f + i * d, mo);
-            for (int j = 0; j < d; j++) F[j] += B->f[i * d + j];
-            for (int j = 0; j < r; j++) T[j] += B->t[i * r + j] + mo[j];
-            if (track && B->fapp) {
-                moment_arm(d, arm, B->fapp + i * d, mo);
-                for (int j = 0; j < d; j++) Fa[j] += B->fapp[i * d + j];
-                for (int j = 0; j < r; j++) Ta[j] += B->tapp[i * r + j] + mo[j];
-            }
-        }
-        memcpy(C->f + c * d, F, (size_t)d * sizeof(double));
-        memcpy(C->t + c * r, T, (size_t)r * sizeof(double));
-        const double mass = C->mass[c], a = C->alpha[c], *I = C->inertia + c * r;
-        const unsigned fix = C->fix[c];
-        /* translation: 4-46, 4-48 */
-        for (int k = 0; k < d; k++) {
-            if (!(fix & (SX_FIX_VX << k))) {
-                const double force = F[k] + g[k] * mass; /* 4-40: the weight acts at the centroid */
-                const double fd = sx__damped(force, v[k], a);
-                const double vold = v[k];
-                v[k] += fd / mass * dtv;
-                if (track) {
-                    damp_work += (fd - force) * 0.5 * (vold + v[k]) * dt;
-                    load_work += Fa[k] * 0.5 * (vold + v[k]) * dt;
-                }
-            }
-            x[k] += v[k] * dt;
-        }
-        /* rotation: 4-42 */
-        if (d == 3) {
-            double *q = C->q + c * 4, *L = C->L + c * 3, R[9];
-            qmatrix(q, R);
-            if ((fix & SX_FIX_SPIN) == SX_FIX_SPIN) {
-                imposed_rotation(q, w, dt);
-                qmatrix(q, R);
-                momentum_of(R, I, w, L);
-            } else {
-                /* the kick, with local damping per principal component */
-                double Tb[3], Lb[3], Md[3], dL[3];
-                mat_tvec(R, T, Tb);
-                mat_tvec(R, L, Lb);
-                for (int k = 0; k < 3; k++) Md[k] = sx__damped(Tb[k], Lb[k] / I[k], a);
-                mat_vec(R, Md, dL);
-                for (int k = 0; k < 3; k++) L[k] += dL[k] * dtv;
-                if (track) { /* work at the mean of the old and new spins, as for balls */
-                    double Ln[3], wm[3];
-                    mat_tvec(R, L, Ln);
-                    for (int k = 0; k < 3; k++) {
-                        const double wold = Lb[k] / I[k], wnew = Ln[k] / I[k];
-                        damp_work += (Md[k] - Tb[k]) * 0.5 * (wold + wnew) * dt;
-                        wm[k] = 0.5 * (wold + wnew);
-                    }
-                    double ws[3];
-                    mat_vec(R, wm, ws);
-                    load_work += (Ta[0] * ws[0] + Ta[1] * ws[1] + Ta[2] * ws[2]) * dt;
-                }
-                free_rotor(q, R, L, I, dt); /* the drift */
-                qmatrix(q, R);
-                spin_of(R, I, L, w);
-            }
-            worst = fmax(worst, KERNEL(place_pebbles)(m, c, R));
-        } else {
-            if (!(fix & SX_FIX_WX)) {
-                const double md = sx__damped(T[0], w[0], a), wold = w[0];
-                w[0] += md / I[0] * dtv; /* 4-47 about z */
-                if (track) {
-                    damp_work += (md - T[0]) * 0.5 * (wold + w[0]) * dt;
-                    load_work += Ta[0] * 0.5 * (wold + w[0]) * dt;
-                }
-            }
-            C->q[c] += w[0] * dt;
-            double R[9];
-            body_rotation(m, c, R);
-            worst = fmax(worst, KERNEL(place_pebbles)(m, c, R));
-        }
-        bool ok = isfinite(C->q[c * (d == 3 ? 4 : 1)]);
-        for (int k = 0; k < d; k++) ok &= isfinite(x[k]) && isfinite(v[k]);
-        for (int k = 0; k < r; k++) ok &= isfinite(w[k]);
-        if (!ok && o->bad < 0) o->bad = c;
-    }
-    o->worst = worst, o->damp_work = damp_work, o->load_work = load_work;
+    for (int64_t c = c0; c < c1; c++)
+        if (!step_clump(m, &env, c, &worst, work, NULL) && o->bad < 0) o->bad = c;
+    o->worst = worst, o->damp_work = work[0], o->load_work = work[1];
 }
 
 /* In fixed blocks of clumps whose partial sums are added in block order:
  * the same bits for any thread count (as the balls' law of motion). */
 enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
+
+static sx_status KERNEL(clump_unstable)(sx_model *m, int64_t c)
+{
+    return sx__fail(m, SX_EUNSTABLE,
+                    "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
+                    "the timestep %g s is likely too large (critical estimate %g s)",
+                    (long long)m->step, (long long)m->clumps->id[c], m->dt, KERNEL(critical_dt)(m));
+}
+
+/* Decomposed: this rank steps its own clumps (decompose.c), from their
+ * pebbles' forces (those of other ranks' pebbles sent by their owners);
+ * with energy tracking each clump's terms go to the serial sums
+ * (sx__dd_clump_energy), in the serial step's blocks. */
+static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t size)
+{
+    sx_dd *d = m->dd;
+    const int W = 2 * D + RD + 1; /* the damping's D + RD terms, the loads' D + 1 */
+    const sx_span own = d->cl_own[d->x.rank];
+    double *terms = m->track_energy ? calloc((size_t)((own.hi - own.lo) * W + 1), sizeof *terms) : NULL;
+    if (m->track_energy && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    const step_env env = step_env_of(m);
+    double worst = *max_disp * *max_disp, work[2] = {0, 0};
+    int64_t bad = -1;
+    for (int64_t e = own.lo; e < own.hi; e++)
+        if (!step_clump(m, &env, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
+    *max_disp = sqrt(worst);
+    const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, terms, W, D + RD, size);
+    free(terms);
+    if (bad >= 0) return KERNEL(clump_unstable)(m, bad);
+    return ok ? SX_OK : sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the clumps' energies");
+}
 
 static sx_status KERNEL(clumps_step)(sx_model *m, double *max_disp)
 {
@@ -193,17 +259,13 @@ static sx_status KERNEL(clumps_step)(sx_model *m, double *max_disp)
     clump_block part[CLUMP_BLOCKS];
     int64_t size = (n + CLUMP_BLOCKS - 1) / CLUMP_BLOCKS;
     if (size < CLUMP_BLOCK) size = CLUMP_BLOCK;
+    if (m->dd && m->dd->active) return KERNEL(clumps_step_own)(m, max_disp, size);
     const int64_t nblk = (n + size - 1) / size;
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nblk > 1)
     for (int64_t k = 0; k < nblk; k++) step_block(m, k * size, (k + 1) * size < n ? (k + 1) * size : n, &part[k]);
     double worst = *max_disp * *max_disp;
     for (int64_t k = 0; k < nblk; k++) {
-        if (part[k].bad >= 0)
-            return sx__fail(m, SX_EUNSTABLE,
-                            "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
-                            "the timestep %g s is likely too large (critical estimate %g s)",
-                            (long long)m->step, (long long)C->id[part[k].bad], m->dt,
-                            KERNEL(critical_dt)(m));
+        if (part[k].bad >= 0) return KERNEL(clump_unstable)(m, part[k].bad);
         worst = fmax(worst, part[k].worst);
         if (m->track_energy) {
             m->acc.local_damping -= part[k].damp_work;

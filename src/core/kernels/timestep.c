@@ -157,7 +157,7 @@ static double KERNEL(critical_dt)(sx_model *m)
             if (dtr < best) best = dtr;
         }
     }
-    /* decomposed: every rank rates every clump, from its pebbles' sums made by their owners */
+    /* decomposed: a clump's owner rates it, from its pebbles' sums made by their owners */
     if (m->clumps && dd && !sx__dd_pebbles(m, kt, n)) best = NAN;
     else if (m->clumps) best = fmin(best, sx__clumps_critical_dt(m, kt, kr, ct, cr)); /* reads the sums above */
     sx__scratch_release(m);
