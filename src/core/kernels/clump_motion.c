@@ -226,7 +226,7 @@ static sx_status KERNEL(clump_unstable)(sx_model *m, int64_t c)
     return sx__fail(m, SX_EUNSTABLE,
                     "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
                     "the timestep %g s is likely too large (critical estimate %g s)",
-                    (long long)m->step, (long long)m->clumps->id[c], m->dt, KERNEL(critical_dt)(m));
+                    (long long)m->step, (long long)m->clumps->id[c], m->dt, KERNEL(estimate_dt)(m));
 }
 
 /* Decomposed: this rank steps its own clumps (decompose.c), from their

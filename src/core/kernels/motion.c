@@ -227,7 +227,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
             return sx__fail(m, SX_EUNSTABLE,
                             "unstable at step %lld: ball %lld has a non-finite position, velocity or spin; "
                             "the timestep %g s is likely too large (critical estimate %g s)",
-                            (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(critical_dt)(m));
+                            (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(estimate_dt)(m));
         if (o->worst > worst) worst = o->worst;
         if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (decompose.c, sx__dd_energy) */
             m->acc.local_damping -= o->damp_work;

@@ -119,7 +119,7 @@ static double fj_strain(const sx_model *m, int32_t s, double d)
     return e;
 }
 
-static double KERNEL(critical_dt)(sx_model *m);
+static double KERNEL(estimate_dt)(sx_model *m);
 
 /* 4-16 ... 4-20: the velocity v_{n-1/2} moved the entities from x_{n-1} to
  * x_n during the previous step, so displacement increments use its length. */
@@ -132,7 +132,7 @@ static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64
                     "the timestep %g s is too large for the contact stiffness (critical estimate %g s): "
                     "lower the timestep or use the automatic one",
                     (long long)m->step, what, (long long)ida, (long long)idb, un, r, m->dt,
-                    KERNEL(critical_dt)(m));
+                    KERNEL(estimate_dt)(m));
 }
 
 /* A chunk's error: an overlap deeper than a radius, or a bond broken with
@@ -144,7 +144,7 @@ static sx_status chunk_error(sx_model *m, const sx_chunk *o)
                         "unstable at step %lld: the bond of balls %lld and %lld broke with a force or moment that is "
                         "not finite; the timestep %g s is too large for its stiffness (critical estimate %g s): "
                         "lower the timestep or use the automatic one",
-                        (long long)m->step, (long long)o->err_a, (long long)o->err_b, m->dt, KERNEL(critical_dt)(m));
+                        (long long)m->step, (long long)o->err_a, (long long)o->err_b, m->dt, KERNEL(estimate_dt)(m));
     return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
 }
 

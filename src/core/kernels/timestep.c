@@ -72,7 +72,10 @@ static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
     kr[jo] += krot_j;
 }
 
-static double KERNEL(critical_dt)(sx_model *m)
+/* ranks: whether a decomposed rank may exchange with the others (the
+ * clumps' pebble sums go to their owners); not from an error found on one
+ * rank, whose partners are elsewhere in the step. */
+static double KERNEL(rate_dt)(sx_model *m, bool ranks)
 {
     sx_balls *B = &m->balls;
     const int64_t n = B->n;
@@ -158,8 +161,15 @@ static double KERNEL(critical_dt)(sx_model *m)
         }
     }
     /* decomposed: a clump's owner rates it, from its pebbles' sums made by their owners */
-    if (m->clumps && dd && !sx__dd_pebbles(m, kt, n)) best = NAN;
+    if (m->clumps && dd && ranks && !sx__dd_pebbles(m, kt, n)) best = NAN;
     else if (m->clumps) best = fmin(best, sx__clumps_critical_dt(m, kt, kr, ct, cr)); /* reads the sums above */
     sx__scratch_release(m);
     return best;
 }
+
+static double KERNEL(critical_dt)(sx_model *m) { return KERNEL(rate_dt)(m, true); }
+
+/* The critical estimate an instability message gives. Decomposed, it is
+ * the failing rank's own (its balls, and its clumps from the pebble sums it
+ * holds): the rank stops at once, with no exchange to wait for. */
+static double KERNEL(estimate_dt)(sx_model *m) { return KERNEL(rate_dt)(m, false); }
