@@ -8,13 +8,14 @@
 -- the automatic timestep (rated from the clumps' pebbles), or a fixed one
 -- with a third argument "fixed". With "unstable" instead, a timestep a
 -- hundred times the critical one: the cycle must stop on every rank with
--- the serial run's instability (mpi_unstable.sh), not hang.
+-- the serial run's instability (mpi_stops.sh), not hang.
 local dim = tonumber(arg and arg[1]) or 3
 local steps = tonumber(arg and arg[2]) or 8000
 local fixed = arg and arg[3] == "fixed"
 local unstable = arg and arg[3] == "unstable"
 local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81},
                       timestep = unstable and 3e-3 or fixed and 2e-5 or 0}
+io.stderr:write(string.format("ranks %d\n", m:ranks()))
 m:material("grain", {density = 2500, kn = 2e4, ks = 2e4, friction = 0.5, damping = 0.3, viscous_normal = 0.2})
 local r = 3e-3
 if dim == 3 then
@@ -50,4 +51,3 @@ m:cycle(steps - half)
 print(string.format("end %d contacts %d floor %.17g ratio %.17g kinetic %.17g", m:step(), m:contact_count(),
                     floor.force[dim], m:ratio(), m:energy().kinetic))
 print(string.format("hash %s", m:hash()))
-io.stderr:write(string.format("ranks %d\n", m:ranks()))

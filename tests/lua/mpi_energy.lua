@@ -1,5 +1,5 @@
 -- Energies under the MPI decomposition (issue 16; test lua_mpi_energy
--- through mpi_same.sh, and mpi_guard.sh): serially and under mpirun -np
+-- through mpi_same.sh, and mpi_stops.sh): serially and under mpirun -np
 -- 1 ... 4 each scene prints the same lines, to the bit.
 --   track D   energy tracking on a bonded specimen (D = 2: 480 disks, one
 --             chunk of pairs over every rank; 3: 576 spheres, two chunks)
@@ -11,7 +11,7 @@
 --             every 400 steps, and the state hash.
 --   guard D   an unforced bed (balls settled in a fixed box, no load) given
 --             a timestep far above the critical one: the energy guard stops
---             the cycle; its message (mpi_guard.sh compares it) must name
+--             the cycle; its message (mpi_stops.sh compares it) must name
 --             the same gain, scale, fastest ball and critical estimate
 --             under every rank count. Before it trips, the guard's checks
 --             every 64 steps must pass alike (a bed settling with a stable

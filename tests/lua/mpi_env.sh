@@ -1,4 +1,4 @@
-# Sourced by the MPI test scripts (mpi_same.sh, mpi_guard.sh, mpi_pour.sh)
+# Sourced by the MPI test scripts (mpi_same.sh, mpi_stops.sh, mpi_pour.sh)
 # once $seixo is set: exits 77 (skipped) without mpirun; sets root (Open
 # MPI refuses root without --allow-run-as-root), ranks and dir (a temporary
 # directory removed at exit). Under AddressSanitizer (scripts/test

@@ -1,0 +1,51 @@
+#!/bin/sh
+# A cycle that must stop, under the MPI decomposition (issue 16): the scene
+# is run serially and under mpirun --oversubscribe -np 1, 2, 3, 4; every run
+# must fail within a time limit (a rank waiting for partners that stopped
+# hangs), print what the serial run printed, and every rank that reports
+# must report what the serial run did: the part of its message matched by
+# PATTERN (grep -o), which must also contain MUST. Skipped (77) without
+# mpirun.
+#   mpi_stops.sh SEIXO SCRIPT 'ARGS' PATTERN MUST
+# The energy guard (mpi_energy.lua guard): its whole message, the same
+# step, gain, scale, fastest ball and critical estimate. An instability
+# found on one rank (mpi_clumps.lua ... unstable): its step and cause, up
+# to the critical estimate, which is the failing rank's own
+# (kernels/timestep.c, estimate_dt).
+set -u
+seixo=$1
+script=$2
+scene=$3
+pattern=$4
+must=$5
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+# the message, once per rank that printed it
+messages() { grep -o "$pattern" "$1" | sort -u; }
+# shellcheck disable=SC2086 # a scene is several arguments
+if "$seixo" "$script" $scene >"$dir/serial" 2>"$dir/err"; then
+  echo "the serial run did not fail"; cat "$dir/serial"; exit 1
+fi
+messages "$dir/err" >"$dir/message"
+if ! grep -q "$must" "$dir/message" || [ "$(wc -l <"$dir/message")" != 1 ]; then
+  echo "the serial run did not stop with '$must':"; cat "$dir/err"; exit 1
+fi
+echo "serial: $(cat "$dir/message")"
+fail=0
+for np in $ranks; do
+  # shellcheck disable=SC2086
+  timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" "$script" $scene >"$dir/out" 2>"$dir/err"
+  rc=$?
+  if [ $rc = 0 ]; then echo "-np $np did not fail"; fail=1; continue; fi
+  if [ $rc = 124 ]; then echo "-np $np hung (killed after 300 s)"; fail=1; continue; fi
+  if ! grep -q "^ranks $np$" "$dir/err"; then
+    echo "-np $np: the model was not decomposed over $np ranks:"; cat "$dir/err"; fail=1; continue
+  fi
+  messages "$dir/err" >"$dir/got"
+  if cmp -s "$dir/serial" "$dir/out" && cmp -s "$dir/message" "$dir/got"; then
+    echo "-np $np: the same output and message"
+  else
+    echo "-np $np differs:"; diff "$dir/serial" "$dir/out" | head -n 20; diff "$dir/message" "$dir/got"
+    head -n 20 "$dir/err"; fail=1
+  fi
+done
+exit $fail
