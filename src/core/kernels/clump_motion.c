@@ -221,14 +221,6 @@ static void step_block(sx_model *m, int64_t c0, int64_t c1, clump_block *o)
  * the same bits for any thread count (as the balls' law of motion). */
 enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
 
-static sx_status KERNEL(clump_unstable)(sx_model *m, int64_t c)
-{
-    return sx__fail(m, SX_EUNSTABLE,
-                    "unstable at step %lld: clump %lld has a non-finite position, velocity or spin; "
-                    "the timestep %g s is likely too large (critical estimate %g s)",
-                    (long long)m->step, (long long)m->clumps->id[c], m->dt, KERNEL(estimate_dt)(m));
-}
-
 /* Decomposed: this rank steps its own clumps (decompose.c), from their
  * pebbles' forces (those of other ranks' pebbles sent by their owners);
  * with energy tracking each clump's terms go to the serial sums
@@ -248,7 +240,7 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
     *max_disp = sqrt(worst);
     const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, terms, W, D + RD, size);
     free(terms);
-    if (bad >= 0) return KERNEL(clump_unstable)(m, bad);
+    if (bad >= 0) return KERNEL(nonfinite)(m, "clump", m->clumps->id[bad]);
     return ok ? SX_OK : sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the clumps' energies");
 }
 
@@ -265,7 +257,7 @@ static sx_status KERNEL(clumps_step)(sx_model *m, double *max_disp)
     for (int64_t k = 0; k < nblk; k++) step_block(m, k * size, (k + 1) * size < n ? (k + 1) * size : n, &part[k]);
     double worst = *max_disp * *max_disp;
     for (int64_t k = 0; k < nblk; k++) {
-        if (part[k].bad >= 0) return KERNEL(clump_unstable)(m, part[k].bad);
+        if (part[k].bad >= 0) return KERNEL(nonfinite)(m, "clump", C->id[part[k].bad]);
         worst = fmax(worst, part[k].worst);
         if (m->track_energy) {
             m->acc.local_damping -= part[k].damp_work;

@@ -197,6 +197,15 @@ SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 /* The law of motion in fixed blocks of balls whose partial sums are added
  * in block order (the same bits for any thread count). Returns the largest
  * displacement since the last build in *max_disp. */
+/* A ball's or clump's state became non-finite (what: "ball" or "clump"). */
+static sx_status KERNEL(nonfinite)(sx_model *m, const char *what, int64_t id)
+{
+    return sx__fail(m, SX_EUNSTABLE,
+                    "unstable at step %lld: %s %lld has a non-finite position, velocity or spin; "
+                    "the timestep %g s is likely too large (critical estimate %g s)",
+                    (long long)m->step, what, (long long)id, m->dt, KERNEL(estimate_dt)(m));
+}
+
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     const int64_t nb = m->nblock;
@@ -224,10 +233,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
         if (o->bad >= 0)
-            return sx__fail(m, SX_EUNSTABLE,
-                            "unstable at step %lld: ball %lld has a non-finite position, velocity or spin; "
-                            "the timestep %g s is likely too large (critical estimate %g s)",
-                            (long long)m->step, (long long)m->balls.id[o->bad], m->dt, KERNEL(estimate_dt)(m));
+            return KERNEL(nonfinite)(m, "ball", m->balls.id[o->bad]);
         if (o->worst > worst) worst = o->worst;
         if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (decompose.c, sx__dd_energy) */
             m->acc.local_damping -= o->damp_work;

@@ -31,6 +31,7 @@ static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
     const int64_t n = B->n;
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n;
     const int64_t i = p->a[c], j = p->b[c];
+    const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
     const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
     double dx[D];
     for (int k = 0; k < D; k++) dx[k] = B->x[j * D + k] - B->x[i * D + k];
@@ -50,7 +51,6 @@ static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
         if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
             const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
             const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
-            const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base];
             ct[i] += cn + cs, ct[jo] += cn + cs;
             cr[i] += cs * B->rad[i] * B->rad[i], cr[jo] += cs * B->rad[j] * B->rad[j];
         }
@@ -65,7 +65,6 @@ static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
     }
     if (bonds & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)) /* a flat joint's face: the section of 4-35 */
         sx_bond_parallel_stiffness(D, &m->bonds, slot, B->rad[i], B->rad[j], &ktr, &krot_i, &krot_j);
-    const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base]; /* a ghost's sums are its owner's */
     kt[i] += ktr;
     kt[jo] += ktr;
     kr[i] += krot_i;
