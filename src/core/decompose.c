@@ -758,11 +758,19 @@ bool sx__dd_gather(sx_model *m)
            (!m->cell || !m->cell->n || gather_ghosts(m)) && (!m->clumps || !m->clumps->n || sx__dd_clumps(m));
 }
 
+/* Only a servo and energy tracking read the walls' resultants inside a
+ * step (sx__walls_read_in_step): without them the step leaves its blocks'
+ * sums where they are and the cycle's end makes the last step's
+ * resultants, one exchange a cycle instead of one a step. */
 bool sx__dd_walls(sx_model *m)
 {
     sx_dd *d = m->dd;
-    if (!m->nwall) return true;
-    return share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1);
+    if (m->nwall &&
+        !share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1))
+        return false;
+    sx__walls_sum(m);
+    d->walls_stale = false;
+    return true;
 }
 
 /* The pebbles whose owner is not their clump's, from their owners to
@@ -956,6 +964,8 @@ sx_status sx__dd_begin(sx_model *m)
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
+    if (d->walls_stale && !sx__dd_walls(m))
+        return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
     if (!sx__dd_gather(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
     if (!replan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");

@@ -347,6 +347,7 @@ typedef struct sx_route {
 typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
+    bool walls_stale;       /* the walls' resultants lag their blocks' sums (sx__dd_walls) */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
     /* periodic space: this rank's pairs outside pairs[rank] whose b is a
      * ghost of one of its balls, in pair order (the first nxlow below
@@ -626,6 +627,11 @@ sx_status sx__pairs_expand_facets(sx_model *m);
  * cube of half-side h about body-frame point xb, each once, in cell order. */
 void sx__mesh_query(sx_mesh *mesh, const double xb[3], double h, void (*fn)(int32_t facet, void *ud), void *ud);
 void sx__walls_servo(sx_model *m); /* servo velocities from the step's wall loads */
+/* The walls' resultants, the blocks' partial sums (m->wall_acc) in block
+ * order; whether a step reads them (a servo, energy tracking's boundary
+ * work) or only a query after the cycle does. */
+void sx__walls_sum(sx_model *m);
+bool sx__walls_read_in_step(const sx_model *m);
 int64_t sx__ball_index(const sx_model *m, int64_t id); /* -1 if none */
 int64_t sx__wall_index(const sx_model *m, int64_t id);
 double *sx__scratch(sx_model *m, int64_t n); /* NULL on failure */
@@ -640,8 +646,8 @@ void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
  * start, the plan after a build, the ghosts' refresh, the whole state on
- * every rank (false: the exchange failed), the wall blocks' sums, and the
- * end of a cycle (the whole state, then replan: the serial chunk plan) */
+ * every rank (false: the exchange failed), the walls' resultants from
+ * every rank's blocks (sx__walls_sum), and the end of a cycle (the whole state, then replan: the serial chunk plan) */
 void sx__dd_free(sx_model *m);
 sx_status sx__dd_begin(sx_model *m);
 bool sx__dd_plan(sx_model *m);

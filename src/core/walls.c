@@ -384,6 +384,35 @@ void sx__walls_servo(sx_model *m)
     }
 }
 
+void sx__walls_sum(sx_model *m)
+{
+    const int64_t nw = m->nwall;
+    for (int64_t w = 0; w < nw; w++) {
+        sx_wall *wl = &m->walls[w];
+        memset(wl->force, 0, sizeof wl->force);
+        memset(wl->moment, 0, sizeof wl->moment);
+        wl->load = wl->kn_sum = 0;
+        wl->contacts = 0;
+    }
+    for (int64_t b = 0; b < m->nblock; b++)
+        for (int64_t w = 0; w < nw; w++) {
+            const sx_wall_acc *a = &m->wall_acc[b * nw + w];
+            sx_wall *wl = &m->walls[w];
+            for (int k = 0; k < 3; k++) wl->force[k] += a->force[k], wl->moment[k] += a->moment[k];
+            wl->load += a->load;
+            wl->kn_sum += a->kn_sum;
+            wl->contacts += a->contacts;
+        }
+}
+
+bool sx__walls_read_in_step(const sx_model *m)
+{
+    if (m->track_energy) return true;
+    for (int64_t w = 0; w < m->nwall; w++)
+        if (m->walls[w].servo_on) return true;
+    return false;
+}
+
 void sx__walls_free(sx_model *m)
 {
     for (int64_t i = 0; i < m->nwall; i++) sx__mesh_free(m, m->walls[i].mesh);

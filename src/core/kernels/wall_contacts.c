@@ -487,14 +487,10 @@ static sx_status KERNEL(walls)(sx_model *m)
         if (b < b_lo || b >= b_hi) m->blocks[b].st = SX_OK, m->blocks[b].slip = m->blocks[b].viscous = 0;
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (b_hi - b_lo > 1)
     for (int64_t b = b_lo; b < b_hi; b++) wall_block(m, &m->blocks[b], nw ? m->wall_acc + b * nw : NULL);
-    if (dd && !sx__dd_walls(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
-    for (int64_t w = 0; w < nw; w++) {
-        sx_wall *wl = &m->walls[w];
-        memset(wl->force, 0, sizeof wl->force);
-        memset(wl->moment, 0, sizeof wl->moment);
-        wl->load = wl->kn_sum = 0;
-        wl->contacts = 0;
-    }
+    /* decomposed, the blocks' sums come from the ranks sharing them when
+     * the step reads the resultants; else once, at the cycle's end */
+    if (dd && !sx__walls_read_in_step(m)) m->dd->walls_stale = true;
+    else if (dd && !sx__dd_walls(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
         if (o->st == SX_EINVAL)
@@ -507,15 +503,8 @@ static sx_status KERNEL(walls)(sx_model *m)
             m->acc.slip += o->slip;
             m->acc.viscous += o->viscous;
         }
-        for (int64_t w = 0; w < nw; w++) {
-            const sx_wall_acc *a = &m->wall_acc[b * nw + w];
-            sx_wall *wl = &m->walls[w];
-            for (int k = 0; k < 3; k++) wl->force[k] += a->force[k], wl->moment[k] += a->moment[k];
-            wl->load += a->load;
-            wl->kn_sum += a->kn_sum;
-            wl->contacts += a->contacts;
-        }
     }
+    if (!dd) sx__walls_sum(m);
     if (m->track_energy) /* boundary work of the moving walls over this step (and a mesh's turn) */
         for (int64_t w = 0; w < nw; w++) {
             const sx_wall *wl = &m->walls[w];
