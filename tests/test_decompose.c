@@ -142,7 +142,8 @@ static sx_model *bed(int dim, bool bonded)
  * touching pebbles, radii r and 0.7 r) on a lattice at random angles,
  * thrown about and spinning in a box under gravity: many lie across the
  * ranks' slabs (their pebbles on two ranks), and the cut moves as they
- * do, so clumps change owner; a load on some pebbles works on them. 2D: 720 clumps, two of the clump step's
+ * do, so clumps change owner; a load on some pebbles works on them,
+ * some clumps are held. 2D: 720 clumps, two of the clump step's
  * energy blocks. */
 static sx_model *clump_bed(int dim)
 {
@@ -170,6 +171,10 @@ static sx_model *clump_bed(int dim)
                 cd.spin[dim == 3 ? 1 : 0] = scene_rng_uniform(&seed, -50, 50);
                 ck_assert_int_eq(sx_clump_add(m, &cd, NULL), SX_OK);
             }
+    /* some clumps held along x or in their spin: a held motion has no
+     * energy term (each rank's terms must start from zero every step) */
+    for (int64_t id = 3; id <= sx_clump_count(m); id += 11)
+        ck_assert_int_eq(sx_clump_set_fixity(m, id, id % 2 ? SX_FIX_VX : dim == 3 ? SX_FIX_SPIN : SX_FIX_WZ), SX_OK);
     /* a load on some pebbles: the clumps' load work (energy tracking) */
     const double push[3] = {0.02, 0.01, 0};
     for (int64_t id = 1; id <= 2 * sx_clump_count(m); id += 7)

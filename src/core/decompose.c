@@ -58,6 +58,7 @@ void sx__dd_free(sx_model *m)
     free(d->cown);
     free(d->cl);
     free(d->cl_at);
+    free(d->cterm);
     free(d->fwd.item);
     free(d->back.item);
     free(d->fwd.need);
@@ -808,17 +809,30 @@ bool sx__dd_placed(sx_model *m)
  * absent from the serial sum a zero: adding +0 to a sum from +0 changes
  * no bit) go to rank 0, which folds them in the serial order; the block
  * sums go to every rank, which adds them in block order: two messages a
- * step per rank, only with energy tracking. */
-bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_t size)
+ * step per rank, only with energy tracking. The owners write their
+ * clumps' terms where the exchange sends them from (sx__dd_clump_terms),
+ * in a buffer kept from step to step. */
+double *sx__dd_clump_terms(sx_model *m, int w, int64_t size)
+{
+    sx_dd *d = m->dd;
+    const int64_t nblk = (m->clumps->n + size - 1) / size, len = d->ncl * w + 2 * nblk;
+    if (len > d->cap_cterm) {
+        double *q = realloc(d->cterm, (size_t)len * sizeof *q);
+        if (!q) return NULL;
+        d->cterm = q, d->cap_cterm = len;
+    }
+    const sx_span own = d->cl_own[d->x.rank];
+    memset(d->cterm + own.lo * w, 0, (size_t)((own.hi - own.lo) * w) * sizeof *d->cterm);
+    return d->cterm + own.lo * w;
+}
+
+bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks;
     const int64_t nc = m->clumps->n, nblk = (nc + size - 1) / size;
     if (!nc) return true; /* every clump removed: no block, on every rank */
-    double *t = malloc((size_t)(d->ncl * w + 2 * nblk) * sizeof *t), *sum = t + d->ncl * w;
-    if (!t) return false;
-    memcpy(t + d->cl_own[d->x.rank].lo * w, terms,
-           (size_t)(d->cl_own[d->x.rank].hi - d->cl_own[d->x.rank].lo) * (size_t)w * sizeof *t);
+    double *t = d->cterm, *sum = t + d->ncl * w;
     for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){0, r ? 0 : d->ncl}; /* rank 0 needs them all */
     bool ok = share(d, t, (size_t)w * sizeof *t, d->cl_own, d->scratch, 1);
     for (int64_t k = 0; ok && !d->x.rank && k < nblk; k++) {
@@ -836,7 +850,6 @@ bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_
         m->acc.local_damping -= sum[2 * k];
         m->acc.boundary_work += sum[2 * k + 1];
     }
-    free(t);
     return ok;
 }
 

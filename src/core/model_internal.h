@@ -379,6 +379,10 @@ typedef struct sx_dd {
     int64_t ncl, cap_cl;
     sx_span *cl_own;
     sx_route fwd, back;
+    /* energy tracking: every clump's terms at its entry, then the blocks'
+     * sums (sx__dd_clump_terms), kept from step to step */
+    double *cterm;
+    int64_t cap_cterm;
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
     /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
      * a pair reaching it, the pairs crossing it (first ball below it,
@@ -659,11 +663,13 @@ bool sx__dd_walls(sx_model *m);
  * each, from sums), from the pebbles' owners to their clumps' owners; the
  * placed pebbles (position, velocity, spin) from the clumps' owners to the
  * pebbles' owners; the clumps' energy terms (w a clump, the first nd its
- * damping's, at the clump's entry cl_at), summed in blocks of `size`
+ * damping's, at the clump's entry cl_at, written by the owner where
+ * sx__dd_clump_terms says), summed in blocks of `size`
  * clumps in the serial order and added to m->acc. */
 bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n);
 bool sx__dd_placed(sx_model *m);
-bool sx__dd_clump_energy(sx_model *m, const double *terms, int w, int nd, int64_t size);
+double *sx__dd_clump_terms(sx_model *m, int w, int64_t size); /* this rank's clumps' terms, zeroed; NULL: no memory */
+bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size);
 /* The clumps' state from their owners to every rank (the energy guard). */
 bool sx__dd_clumps(sx_model *m);
 bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc));

@@ -230,16 +230,15 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
     sx_dd *d = m->dd;
     const int W = 2 * D + RD + 1; /* the damping's D + RD terms, the loads' D + 1 */
     const sx_span own = d->cl_own[d->x.rank];
-    double *terms = m->track_energy ? calloc((size_t)((own.hi - own.lo) * W + 1), sizeof *terms) : NULL;
-    if (m->track_energy && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    double *terms = m->track_energy && m->clumps->n ? sx__dd_clump_terms(m, W, size) : NULL;
+    if (m->track_energy && m->clumps->n && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     const step_env env = step_env_of(m);
     double worst = *max_disp * *max_disp, work[2] = {0, 0};
     int64_t bad = -1;
     for (int64_t e = own.lo; e < own.hi; e++)
         if (!step_clump(m, &env, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
     *max_disp = sqrt(worst);
-    const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, terms, W, D + RD, size);
-    free(terms);
+    const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, W, D + RD, size);
     if (bad >= 0) return KERNEL(nonfinite)(m, "clump", m->clumps->id[bad]);
     return ok ? SX_OK : sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the clumps' energies");
 }
