@@ -123,12 +123,13 @@ typedef struct sx_exchange {
     bool (*agree)(void *ud, uint64_t v);
 } sx_exchange;
 
-/// Cycles of m run decomposed over x's ranks (NULL: not decomposed): each
-/// rank integrates a slab of the balls, balanced by count, with ghost
-/// copies of its neighbours' balls; every cycle ends with the whole state
-/// on every rank, bit-identical to a serial run's. SX_EINVAL (with the
-/// reason) for what is not decomposed yet: flat and smooth joints,
-/// meshes.
+/// Cycles of m run decomposed over x's ranks (NULL or one rank: not
+/// decomposed): each rank integrates a slab of the balls, cut again at
+/// every build to balance the ranks' work, with ghost copies of its
+/// neighbours' balls, and steps the clumps it owns; every cycle ends with
+/// the whole state on every rank, bit-identical to a serial run's for any
+/// number of ranks. SX_EINVAL when x lacks a function or its rank is out
+/// of range; SX_ELOCKED while m is stepping.
 SX_API sx_status sx_model_decompose(sx_model *m, const sx_exchange *x);
 /// The number of ranks m's cycles are decomposed over (1: not decomposed).
 SX_API int sx_model_ranks(const sx_model *m);
