@@ -1,6 +1,16 @@
 #include "scenes.h"
 
 #include <check.h>
+#include <stdlib.h>
+
+int scene_run_suite(Suite *s)
+{
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    const int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
 
 sx_model *scene_model(int dim, const double *gravity, double dt, double k, double mu, double rho)
 {
@@ -39,7 +49,6 @@ int64_t scene_ball(sx_model *m, const double *pos, const double *vel, double rad
 /* ---- random assemblies ---- */
 
 #include <math.h>
-#include <stdlib.h>
 
 uint64_t scene_rng_u64(uint64_t *s)
 {

@@ -3,6 +3,12 @@
 
 #include "seixo.h"
 
+struct Suite; /* Check's */
+
+/// Runs every test of the Check suite s; the program's exit status
+/// (EXIT_FAILURE when a test failed).
+int scene_run_suite(struct Suite *s);
+
 /// A model with one material "m" (linear, kn = ks = k, friction mu, density rho) and
 /// the given gravity (m/s^2, may be NULL); aborts the test on failure.
 sx_model *scene_model(int dim, const double *gravity, double dt, double k, double mu, double rho);

@@ -269,9 +269,5 @@ int main(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, ranks_give_the_serial_bits);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -230,9 +230,5 @@ int main(void)
     tcase_add_loop_test(tc, batched_pass_matches_full_pass, 2, 4);
     tcase_add_loop_test(tc, batched_motion_matches_full_motion, 2, 4);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

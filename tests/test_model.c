@@ -840,9 +840,5 @@ int main(void)
     tcase_add_loop_test(tq, interrupt_request_stops_long_loops, 2, 4);
     tcase_add_loop_test(tq, cycle_without_balls, 2, 4);
     suite_add_tcase(s, tq);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -148,9 +148,5 @@ int main(void)
     tcase_add_loop_test(tc, flat_jointed_bed_bit_identical, 2, 4);
     tcase_add_test(tc, thread_count_validated);
     suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    const int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return scene_run_suite(s);
 }

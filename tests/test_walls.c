@@ -613,9 +613,5 @@ int main(void)
     tcase_add_loop_test(tc, remove_wall_keeps_others, 2, 4);
     tcase_add_loop_test(tc, set_fields, 2, 4);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -157,9 +157,5 @@ int main(void)
     tcase_add_test(tc, bpm_plain_3d);
     tcase_add_test(tc, bpm_wall_3d);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

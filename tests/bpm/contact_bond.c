@@ -206,9 +206,5 @@ int main(void)
     tcase_add_test(tc, shear_3d);
     tcase_add_test(tc, shear_2d);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -305,9 +305,5 @@ int main(void)
     tcase_add_test(tc, energy_2d_flatjoint);
     tcase_add_test(tc, energy_3d_flatjoint);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -205,9 +205,5 @@ int main(void)
     tcase_add_loop_test(tc, sphere_sphere, 0, 4);
     tcase_add_loop_test(tc, sphere_wall, 0, 4);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -202,9 +202,5 @@ int main(void)
     TCase *tc = tcase_create("lattice");
     tcase_add_test(tc, hex_young);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -261,9 +261,5 @@ int main(void)
     tcase_add_loop_test(tc, bond_3d, TENSION, SHEAR_TWIST + 1);
     tcase_add_loop_test(tc, bond_2d, 0, 4);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -194,10 +194,7 @@ int main(void)
     tcase_add_test(tc, no_clumps);
     tcase_add_test(tc, series_clump_ids);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
+    const int status = scene_run_suite(s);
     io_rmdir();
-    return failed ? 1 : 0;
+    return status;
 }

@@ -458,9 +458,5 @@ int main(void)
     tcase_add_loop_test(t, canonical, 2, 4);
     tcase_add_loop_test(t, restart_keeps_it, 2, 4);
     suite_add_tcase(s, t);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

@@ -163,9 +163,5 @@ static inline double lab_mean_contact_force(const sx_model *m)
 
 static inline int lab_run(Suite *s)
 {
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return scene_run_suite(s);
 }

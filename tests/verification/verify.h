@@ -78,11 +78,7 @@ static inline void v_step(sx_model *m, int64_t n)
 static inline int v_run(Suite *s)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return scene_run_suite(s);
 }
 
 /* Adds the test function fn to a new test case of suite s named after it. */
