@@ -292,12 +292,58 @@ static int run_chunk(lua_State *L, const char *code)
     return report(L, status);
 }
 
+/* All of standard input (NULL when it cannot be read). */
+static char *read_all_input(void *ud, size_t *len, int *mark)
+{
+    (void)ud;
+    *mark = 0;
+    size_t cap = 4096, n = 0;
+    char *text = malloc(cap);
+    for (size_t got = 1; text && got > 0;) {
+        if (n + 1 == cap) {
+            char *more = realloc(text, cap *= 2);
+            if (!more) free(text);
+            text = more;
+            if (!text) break;
+        }
+        got = fread(text + n, 1, cap - n - 1, stdin);
+        n += got;
+    }
+    if (text && ferror(stdin)) {
+        free(text);
+        text = NULL;
+    }
+    if (text) text[n] = '\0';
+    *len = n;
+    return text;
+}
+
+/* The script read from standard input (`seixo -`): under mpirun rank 0
+ * reads it and every rank runs it. A first line starting with # is a
+ * comment (#!), kept as an empty line so the line numbers hold, as
+ * luaL_loadfile has it. */
+static int load_input(lua_State *L)
+{
+    size_t len;
+    int mark;
+    char *text = sx_lua_parallel_input(read_all_input, NULL, &len, &mark);
+    if (!text) {
+        lua_pushfstring(L, "cannot read the script from standard input: %s", strerror(errno));
+        return LUA_ERRFILE;
+    }
+    size_t skip = 0;
+    if (len > 0 && text[0] == '#')
+        while (skip < len && text[skip] != '\n') skip++;
+    const int status = luaL_loadbuffer(L, text + skip, len - skip, "=stdin");
+    free(text);
+    return status;
+}
+
 /* The script's arguments go to `...` as well as to the global `arg`; with
  * -i (keep), its top-level locals become globals for the session. */
 static int run_script(lua_State *L, char **argv, int script, int argc, bool keep)
 {
-    const char *fname = strcmp(argv[script], "-") == 0 ? NULL : argv[script];
-    int status = luaL_loadfile(L, fname);
+    int status = strcmp(argv[script], "-") == 0 ? load_input(L) : luaL_loadfile(L, argv[script]);
     if (status == LUA_OK) {
         const int n = argc - script - 1;
         luaL_checkstack(L, n, "too many arguments to the script");
@@ -609,28 +655,35 @@ static char *read_line(const char *prompt, bool *cancelled)
 }
 #endif
 
-/* Reads one line, without its newline, onto the stack; false at the end of
- * input. A Ctrl-C at the prompt gives an empty line and sets *cancelled. */
-static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
+/* What a line read at the prompt is (sx_lua_parallel_input's mark). */
+enum { LINE_TYPED, LINE_CANCELLED };
+
+typedef struct prompt_read {
+    const char *prompt;
+    bool tty;
+} prompt_read;
+
+/* One line from standard input, its newline dropped (NULL at the end of
+ * input); a Ctrl-C at the prompt gives an empty line marked cancelled. */
+static char *read_prompt_line(void *ud, size_t *len, int *mark)
 {
-    const char *prompt = first ? "> " : ">> ";
-    *cancelled = false;
+    const prompt_read *p = ud;
+    *mark = LINE_TYPED;
 #ifdef SX_HAVE_READLINE
-    if (tty) {
-        char *line = read_line(prompt, cancelled);
-        if (*cancelled) {
+    if (p->tty) {
+        bool cancelled = false;
+        char *line = read_line(p->prompt, &cancelled);
+        if (cancelled) {
+            *mark = LINE_CANCELLED;
             free(line);
-            lua_pushliteral(L, "");
-            return true;
+            line = calloc(1, 1);
         }
-        if (!line) return false;
-        lua_pushstring(L, line);
-        free(line);
-        return true;
+        *len = line ? strlen(line) : 0;
+        return line;
     }
 #endif
-    if (tty) {
-        fputs(prompt, stdout);
+    if (p->tty) {
+        fputs(p->prompt, stdout);
         fflush(stdout);
     }
     char *line = NULL;
@@ -638,10 +691,25 @@ static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
     ssize_t n = getline(&line, &cap, stdin);
     if (n < 0) {
         free(line);
-        return false;
+        return NULL;
     }
-    if (n > 0 && line[n - 1] == '\n') n--;
-    lua_pushlstring(L, line, (size_t)n);
+    if (n > 0 && line[n - 1] == '\n') line[--n] = '\0';
+    *len = (size_t)n;
+    return line;
+}
+
+/* Reads one line onto the stack (under mpirun, rank 0's, on every rank);
+ * false at the end of input. A Ctrl-C at the prompt gives an empty line
+ * and sets *cancelled. */
+static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
+{
+    prompt_read p = {first ? "> " : ">> ", tty};
+    size_t len;
+    int mark;
+    char *line = sx_lua_parallel_input(read_prompt_line, &p, &len, &mark);
+    *cancelled = mark == LINE_CANCELLED;
+    if (!line) return false;
+    lua_pushlstring(L, line, len);
     free(line);
     return true;
 }

@@ -242,6 +242,31 @@ int64_t sx_lua_parallel_root_value(int64_t v)
     return v;
 }
 
+char *sx_lua_parallel_input(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len, int *mark)
+{
+    *len = 0;
+#ifdef SX_HAVE_MPI
+    if (mpi_started && world_size > 1) {
+        char *text = world_rank == 0 ? read(ud, len, mark) : NULL;
+        int64_t head[3] = {text != NULL, (int64_t)*len, *mark}; /* text or the end, its length, the mark */
+        if (MPI_Bcast(head, 3, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+            sx_lua_parallel_fail("the ranks could not share rank 0's input");
+        *len = (size_t)head[1], *mark = (int)head[2];
+        if (!head[0]) return NULL;
+        if (world_rank != 0 && !(text = malloc(*len + 1))) sx_lua_parallel_fail("out of memory for rank 0's input");
+        for (size_t at = 0; at < *len;) { /* in pieces an int counts */
+            const size_t piece = *len - at < INT_MAX ? *len - at : INT_MAX;
+            if (MPI_Bcast(text + at, (int)piece, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+                sx_lua_parallel_fail("the ranks could not share rank 0's input");
+            at += piece;
+        }
+        if (world_rank != 0) text[*len] = '\0';
+        return text;
+    }
+#endif
+    return read(ud, len, mark);
+}
+
 bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count)

@@ -51,6 +51,16 @@ SX_API void sx_lua_set_profile(lua_State *L, int on);
 /// Call it first thing in main; seixo.rank() and seixo.ranks() tell the rest.
 SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
+/// Input every rank reads alike: mpirun gives standard input to rank 0
+/// alone, so under mpirun rank 0 calls read(ud, len, mark) and sends what
+/// it returns (len bytes, malloc'ed; NULL at the end of input) with *mark
+/// (an integer the caller gives meaning to) to the other ranks, which
+/// return a malloc'ed, NUL-terminated copy (or NULL) without reading.
+/// Serially, read's answer. The interactive mode's lines and a script read
+/// from standard input (`seixo -`) go through it.
+SX_API char *sx_lua_parallel_input(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len,
+                                   int *mark);
+
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
 /// when ok is 0 and other ranks exist (they would wait for this one forever).
 SX_API void sx_lua_parallel_stop(int ok);

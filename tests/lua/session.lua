@@ -15,6 +15,13 @@ local function tmpfile(text)
   return path
 end
 
+test("seixo -: the script read from standard input, its #! line a comment, its arguments passed", function()
+  local status, out = T.run("- 7 x", "#!/usr/bin/env seixo\nprint(select('#', ...), arg[1], arg[2], arg[0])\nerror('on line 3')\n")
+  check(status ~= 0, out)
+  check(out:find("2\t7\tx\t-\n", 1, true), out)
+  check(out:find("stdin:3: on line 3", 1, true), out)
+end)
+
 test("-i: the script's top-level locals are globals of the session", function()
   local script = tmpfile([[
 local m = seixo.model{dim = 2}

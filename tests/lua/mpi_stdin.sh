@@ -1,0 +1,49 @@
+#!/bin/sh
+# Standard input under mpirun, which gives it to rank 0 alone: a script
+# read from it (`seixo - ARGS`) and an interactive session fed to
+# `seixo -i` run alike on every rank (rank 0 reads, the others take its
+# input) and print what the serial run prints, serially and with 1 to 4
+# ranks, each run within a time limit (a rank waiting for input it never
+# gets would hang). Skipped (77) without mpirun.
+#   mpi_stdin.sh SEIXO SCRIPT 'ARGS'
+# SCRIPT prints "ranks N" on stderr once its model is made (mpi_pour.lua).
+set -u
+seixo=$1
+script=$2
+args=$3
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+# the session: a statement over three lines, an expression's value, a line
+# that does not compile, then the script with its arguments
+{
+  printf 'total = 0\nfor i = 1, 3 do\n  total = total + i\nend\nprint("total", total)\n6 * 7\n1 +* 2\n'
+  printf 'arg = {%s}\n' "$(echo "$args" | sed 's/ /, /g')"
+  printf 'dofile("%s")\nprint("after", total)\n' "$script"
+} >"$dir/session"
+fail=0
+for mode in script session; do
+  if [ $mode = script ]; then input=$script; set -- -; else input=$dir/session; set -- -i; fi
+  # shellcheck disable=SC2086 # the arguments are several words
+  if ! timeout 300 "$seixo" "$@" $([ $mode = script ] && echo "$args") <"$input" >"$dir/serial" 2>"$dir/err"; then
+    echo "serial $mode failed:"; cat "$dir/err"; exit 1
+  fi
+  echo "$mode, serial:"; cat "$dir/serial"
+  for np in $ranks; do
+    # shellcheck disable=SC2086
+    timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" "$@" $([ $mode = script ] && echo "$args") \
+      <"$input" >"$dir/out" 2>"$dir/err"
+    status=$?
+    if [ $status -ne 0 ]; then
+      echo "$mode, -np $np: exit status $status ($([ $status -eq 124 ] && echo 'a hang: stopped after 300 s'))"
+      cat "$dir/err"; fail=1; continue
+    fi
+    if ! grep -q "^ranks $np$" "$dir/err"; then
+      echo "$mode, -np $np: the model was not decomposed over $np ranks:"; cat "$dir/err"; fail=1; continue
+    fi
+    if cmp -s "$dir/serial" "$dir/out"; then
+      echo "$mode, -np $np: identical ($(wc -l <"$dir/out") lines)"
+    else
+      echo "$mode, -np $np differs:"; diff "$dir/serial" "$dir/out" | head -n 20; fail=1
+    fi
+  done
+done
+exit $fail
