@@ -9,17 +9,12 @@
 -- carries no wall effect (no wall-ball contacts, no looser packing along
 -- walls), so its modulus and peak are those of the material's interior.
 --   scripts/run examples/periodic_triaxial.lua [out_dir] [confining_Pa] [strain_rate]
--- Measured (defaults): walled 1303 balls, 2512 bonds, porosity 0.170,
--- peak 246.2 MPa at 0.0036, E 73.9 GPa, nu 0.290; periodic 1270 balls,
--- 2027 bonds, porosity 0.180, peak 129.1 MPa at 0.0026, E 51.4 GPa, nu
--- 0.360 (ratios 0.52 and 0.70). The two are not the same material yet:
--- the walled specimen is made by Potyondy & Cundall's genesis (seixo.lab:
--- radii scaled to sigma0, floaters moved and grown until each has three
--- neighbours within the bond gap: 3.9 bonds per ball), the periodic one by
--- expansion and the cell's servo alone (3.2 bonds per ball), so most of
--- the gap is the bonds', not the walls'. (When both were made by expansion
--- and servo, 1270 balls each: walled 2156 bonds, peak 150.3 MPa, E 59.0
--- GPa; ratios 0.86 and 0.87.)
+-- Measured (defaults, 1303 balls each): walled 2512 bonds, porosity 0.170,
+-- peak 246.2 MPa at 0.0036, E 73.9 GPa, nu 0.290; periodic 2579 bonds,
+-- porosity 0.164, peak 213.9 MPa at 0.0031, E 73.9 GPa, nu 0.317 (ratios
+-- 0.87 and 1.00): the same genesis (Potyondy & Cundall's, floaters grown)
+-- gives the same modulus, and the cell, with no platens to confine its
+-- ends, a lower peak.
 local lab = require "seixo.lab"
 local out = arg and arg[1] or "periodic-results"
 local confining = tonumber(arg and arg[2]) or 5e6

@@ -6,11 +6,14 @@
 --   local s = periodic.shear(spec, {normal = 1e6})
 --
 -- A specimen is a representative element: balls in a periodic cell, with
--- no wall anywhere, so no wall effect. Genesis: radius expansion in the
--- cell, frictionless; the cell's servo brings it to an isotropic stress
--- sigma0; the material's friction comes back, parallel bonds are installed
--- between touching balls (bonds = false: a granular specimen), and the
--- servo settles it again at sigma0. The tests drive the cell (m:cell_control):
+-- no wall anywhere, so no wall effect. Genesis: Potyondy & Cundall's, as
+-- seixo.lab's specimen, with the cell held still for the vessel: radius
+-- expansion, frictionless, then sigma0 (the mean direct stress) by scaling
+-- every radius, the material's friction back, and the floaters moved and
+-- grown until each has three neighbours within the bond gap (images across
+-- the faces are neighbours); parallel bonds are installed between the
+-- balls within the gap (bonds = false: a granular specimen), and the
+-- cell's servo settles it at sigma0 on every axis. The tests drive the cell (m:cell_control):
 -- a triaxial (or true-triaxial) test compresses the axial direction (z in 3D,
 -- y in 2D) at a strain rate with the lateral stresses servo-controlled; a
 -- simple shear tilts the cell at a shear rate with the normal stress (on y)
@@ -94,7 +97,7 @@ function periodic.specimen(opts)
   end
   local mat = lab.rock(opts.material)
   local sigma0 = positive(opts.sigma0 or 0.1e6, "sigma0", "specimen")
-  local porosity = opts.porosity or (dim == 3 and 0.42 or 0.18)
+  local porosity = opts.porosity or (dim == 3 and 0.35 or 0.16) -- seixo.lab's
   local seed = opts.seed or 1
   local bonds = opts.bonds ~= false
   local path = opts.path or fail("periodic.specimen: a path for the specimen file is required")
@@ -108,19 +111,22 @@ function periodic.specimen(opts)
   m:material("rock", frictionless)
   local lo = dim == 3 and {0, 0, 0} or {0, 0}
   m:periodic{min = lo, max = size}
+  -- P&C's genesis, as seixo.lab's specimen: the expansion to a porosity
+  -- below the one the packing jams at (it starts above sigma0 everywhere),
+  -- then, the cell held still, sigma0 by radius scaling and the floaters
+  -- grown (seixo.genesis)
   local n = m:generate{method = "expand", porosity = porosity, radius = radius, region = {box = {lo, size}},
-                      seed = seed}
+                      seed = seed, relax = false}
   say(opts, "periodic.specimen: %d balls by radius expansion to porosity %.3f in a periodic cell", n, porosity)
-  -- a frictionless packing does not come to rest at a small stress (see
-  -- seixo.lab): within 5 % is close enough before the friction comes back
-  servo_all(m, dim, sigma0)
-  local steps, err = settle(m, dim, sigma0, 0.05, 0.2, max_steps)
-  say(opts, "periodic.specimen: isotropic stress %.3g Pa within %.2f %% by the cell's servo (%d steps)", sigma0,
-      100 * err, steps)
-  m:material("rock", mat)
+  local gap = opts.gap or 1e-3 * radius[1]
+  local left, gen = require("seixo.genesis").periodic(m, mat, sigma0, gap, {max_steps = max_steps},
+                                                      function(fmt, ...) say(opts, "periodic.specimen: " .. fmt, ...) end)
   local nb = 0
-  if bonds then nb = m:bond{kind = "parallel", gap = opts.gap or 1e-3 * radius[1], seed = seed} end
-  steps, err = settle(m, dim, sigma0, 0.01, 1e-2, max_steps)
+  if bonds then nb = m:bond{kind = "parallel", gap = gap, seed = seed} end
+  -- the cell's servo then holds sigma0 on every axis (the radius scaling
+  -- installs their mean)
+  servo_all(m, dim, sigma0)
+  local steps, err = settle(m, dim, sigma0, 0.01, 1e-2, max_steps)
   say(opts, "periodic.specimen: %d parallel bonds; settled at %.3g Pa within %.2f %% (%d steps)", nb, sigma0,
       100 * err, steps)
   local cell = m:periodic()
@@ -128,7 +134,8 @@ function periodic.specimen(opts)
   for k = 1, dim do volume = volume * cell.size[k] end
   local spec = {path = path, dim = dim, size = cell.size, radius = radius, balls = m:ball_count(),
                 bonds = m:bond_count(), porosity = 1 - m:sum("volume") / volume, sigma0 = sigma0, material = mat,
-                seed = seed, genesis_steps = m:step(), genesis_time = seixo.clock() - t0, periodic = true}
+                seed = seed, genesis_steps = m:step(), genesis_time = seixo.clock() - t0, periodic = true,
+                floaters_found = gen.floaters_found, floaters_left = left}
   m:vars().lab_specimen = spec -- lab.open's key: a specimen of either kind
   m:save(path)
   say(opts, "periodic.specimen: %d balls, %d bonds, porosity %.3f, saved to %s (%.1f s)", spec.balls, spec.bonds,

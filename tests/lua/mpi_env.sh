@@ -19,3 +19,16 @@ export OMPI_MCA_mpi_yield_when_idle=1
 if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+# After a run with $2 ranks (its output in $dir/out, stderr in $dir/err):
+# fail=1, saying why, unless it said "ranks $2" (its model ran decomposed)
+# and printed what the serial run printed ($dir/serial). $1 names the run.
+same_as_serial() {
+  if ! grep -q "^ranks $2$" "$dir/err"; then
+    echo "$1: the model was not decomposed over $2 ranks:"; cat "$dir/err"; fail=1; return
+  fi
+  if cmp -s "$dir/serial" "$dir/out"; then
+    echo "$1: identical ($(wc -l <"$dir/out") lines)"
+  else
+    echo "$1 differs:"; diff "$dir/serial" "$dir/out" | head -n 40; fail=1
+  fi
+}

@@ -9,7 +9,7 @@ set -u
 seixo=$1
 script=$2
 shift 2
-. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir, same_as_serial
 fail=0
 for scene in "$@"; do
   # shellcheck disable=SC2086 # a scene is several arguments
@@ -23,14 +23,7 @@ for scene in "$@"; do
     if ! mpirun $root --oversubscribe -np "$np" "$seixo" "$script" $scene >"$dir/out" 2>"$dir/err"; then
       echo "-np $np failed:"; cat "$dir/err"; fail=1; continue
     fi
-    if ! grep -q "^ranks $np$" "$dir/err"; then
-      echo "-np $np: the model was not decomposed over $np ranks:"; cat "$dir/err"; fail=1; continue
-    fi
-    if cmp -s "$dir/serial" "$dir/out"; then
-      echo "-np $np: identical ($(wc -l <"$dir/out") lines)"
-    else
-      echo "-np $np differs:"; diff "$dir/serial" "$dir/out" | head -n 40; fail=1
-    fi
+    same_as_serial "-np $np" "$np"
   done
 done
 exit $fail

@@ -11,7 +11,7 @@ set -u
 seixo=$1
 script=$2
 args=$3
-. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir, same_as_serial
 # the session: a statement over three lines, an expression's value, a line
 # that does not compile, then the script with its arguments
 {
@@ -36,14 +36,7 @@ for mode in script session; do
       echo "$mode, -np $np: exit status $status ($([ $status -eq 124 ] && echo 'a hang: stopped after 300 s'))"
       cat "$dir/err"; fail=1; continue
     fi
-    if ! grep -q "^ranks $np$" "$dir/err"; then
-      echo "$mode, -np $np: the model was not decomposed over $np ranks:"; cat "$dir/err"; fail=1; continue
-    fi
-    if cmp -s "$dir/serial" "$dir/out"; then
-      echo "$mode, -np $np: identical ($(wc -l <"$dir/out") lines)"
-    else
-      echo "$mode, -np $np differs:"; diff "$dir/serial" "$dir/out" | head -n 20; fail=1
-    fi
+    same_as_serial "$mode, -np $np" "$np"
   done
 done
 exit $fail
