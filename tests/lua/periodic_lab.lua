@@ -44,6 +44,20 @@ T.test("a bonded periodic specimen", function()
   local spec = lab.periodic.specimen{dim = 2, size = 0.008, radius = {0.4e-3, 0.66e-3}, path = "periodic_bonded.h5",
                                      log = false}
   T.check(spec.bonds > spec.balls, "bonds: " .. spec.bonds)
+  -- Potyondy & Cundall's genesis: the floaters grown until every ball has
+  -- three neighbours within the bond gap, so three bonds at least (the
+  -- servo alone left balls with one or none)
+  T.check(spec.floaters_found > 0 and spec.floaters_left == 0,
+          "floaters found " .. spec.floaters_found .. ", left " .. spec.floaters_left)
+  local m = seixo.load("periodic_bonded.h5")
+  local bonds = {}
+  for c in m:contacts{kind = "ball-ball"} do
+    if c.bond then bonds[c.a.id], bonds[c.b.id] = (bonds[c.a.id] or 0) + 1, (bonds[c.b.id] or 0) + 1 end
+  end
+  local fewest = math.huge
+  for b in m:balls() do fewest = math.min(fewest, bonds[b.id] or 0) end
+  T.check(fewest >= 3, "the fewest bonds of a ball: " .. fewest)
+  m:close()
   os.remove("periodic_bonded.h5")
 end)
 
