@@ -1541,7 +1541,7 @@ local function gnuplot(script, outs)
     io.stderr:write("lab: gnuplot not found (apt-get install gnuplot-nox): no plots\n")
     return false
   end
-  local tag = math.random(1, 1 << 30)
+  local tag = seixo.rank() .. "." .. math.random(1, 1 << 30) -- every rank plots (see pool.write_file)
   for _, o in ipairs(outs) do script = script:gsub("@" .. o.key .. "@", o.path .. ".tmp" .. tag) end
   local gp = os.tmpname()
   local f = assert(io.open(gp, "w"))

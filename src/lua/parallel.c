@@ -221,8 +221,25 @@ bool sx_lua_parallel_decompose(sx_model *m)
 #endif
 }
 
+/* An error in the script, or one that every rank finds in a cycle, fails
+ * every rank alike: each would print the same message. Rank 0 reports at
+ * once and its MPI_Abort ends the others; a rank other than 0 first sleeps
+ * FAIL_WAIT_S waiting for that end, and reports only if it did not come: it
+ * failed alone (or rank 0 is slower by that much: the message twice). */
+enum { FAIL_WAIT_S = 2 };
+
+void sx_lua_parallel_failing(void)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_rank == 0) return;
+    const struct timespec wait = {FAIL_WAIT_S, 0};
+    nanosleep(&wait, NULL);
+#endif
+}
+
 void sx_lua_parallel_fail(const char *message)
 {
+    sx_lua_parallel_failing();
     fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
     fflush(stderr);
 #ifdef SX_HAVE_MPI
@@ -280,10 +297,46 @@ static int quiet_print(lua_State *L)
     return 0;
 }
 
+/* Every rank runs the script and must make the same calls, but Lua seeds
+ * math.random at random in each process: a script placing balls with it
+ * would build a different model on each rank (the first cycle stops them).
+ * The ranks take rank 0's seed, two integers drawn from its own randomly
+ * seeded generator, so such a script runs under mpirun as it does alone. */
+static void same_random_seed(lua_State *L)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return;
+    if (lua_getglobal(L, "math") != LUA_TTABLE) { /* no math library: nothing to seed */
+        lua_pop(L, 1);
+        return;
+    }
+    int64_t seed[2] = {0, 0};
+    if (world_rank == 0) {
+        for (int k = 0; k < 2; k++) {
+            lua_getfield(L, -1, "random");
+            lua_pushinteger(L, 0); /* math.random(0): an integer of random bits */
+            lua_call(L, 1, 1);
+            seed[k] = (int64_t)lua_tointeger(L, -1);
+            lua_pop(L, 1);
+        }
+    }
+    if (MPI_Bcast(seed, 2, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("the ranks could not agree on math.random's seed");
+    lua_getfield(L, -1, "randomseed");
+    lua_pushinteger(L, (lua_Integer)seed[0]);
+    lua_pushinteger(L, (lua_Integer)seed[1]);
+    lua_call(L, 2, 0);
+    lua_pop(L, 1);
+#else
+    (void)L;
+#endif
+}
+
 void sx_lua_parallel_open(lua_State *L)
 {
     /* one rank prints: the others would repeat every line */
     if (world_rank > 0) lua_register(L, "print", quiet_print);
+    same_random_seed(L);
 }
 
 const luaL_Reg sx_lua_parallel_functions[] = {
