@@ -15,6 +15,7 @@
 #include "bindings.h"
 #include "seixo_lua.h"
 
+#include <fcntl.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +45,18 @@ void sx_lua_parallel_start(int *argc, char ***argv)
     mpi_started = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    /* every rank runs the script: one writes to standard output, else each
+     * line would come once per rank, whether from print, io.write, a shell
+     * command or a plot on gnuplot's dumb terminal (errors, on standard
+     * error, are every rank's) */
+    if (world_rank > 0) {
+        const int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+            fflush(stdout);
+            dup2(null, STDOUT_FILENO);
+            close(null);
+        }
+    }
 #else
     (void)argc;
     (void)argv;
@@ -291,12 +304,6 @@ static int seixo_decompose(lua_State *L)
     return 1;
 }
 
-static int quiet_print(lua_State *L)
-{
-    (void)L;
-    return 0;
-}
-
 /* Every rank runs the script and must make the same calls, but Lua seeds
  * math.random at random in each process: a script placing balls with it
  * would build a different model on each rank (the first cycle stops them).
@@ -332,12 +339,7 @@ static void same_random_seed(lua_State *L)
 #endif
 }
 
-void sx_lua_parallel_open(lua_State *L)
-{
-    /* one rank prints: the others would repeat every line */
-    if (world_rank > 0) lua_register(L, "print", quiet_print);
-    same_random_seed(L);
-}
+void sx_lua_parallel_open(lua_State *L) { same_random_seed(L); }
 
 const luaL_Reg sx_lua_parallel_functions[] = {
     {"cores", seixo_cores}, {"executable", seixo_executable}, {"rank", seixo_rank},

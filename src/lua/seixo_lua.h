@@ -49,6 +49,7 @@ SX_API void sx_lua_set_profile(lua_State *L, int on);
 /// Starts MPI when the program was launched by mpirun (Open MPI's or a
 /// PMI launcher's environment) and seixo was built with MPI; else nothing.
 /// Call it first thing in main; seixo.rank() and seixo.ranks() tell the rest.
+/// On ranks other than 0 standard output then goes to /dev/null.
 SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
 /// To call before reporting the error that ends the run (then
