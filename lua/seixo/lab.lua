@@ -1541,9 +1541,12 @@ local function gnuplot(script, outs)
     io.stderr:write("lab: gnuplot not found (apt-get install gnuplot-nox): no plots\n")
     return false
   end
-  local tag = seixo.rank() .. "." .. math.random(1, 1 << 30) -- every rank plots (see pool.write_file)
+  local tag = math.random(1, 1 << 30)
   for _, o in ipairs(outs) do script = script:gsub("@" .. o.key .. "@", o.path .. ".tmp" .. tag) end
   local gp = os.tmpname()
+  -- under mpirun every rank gets here alike (the same draw, rank 0's os.tmpname):
+  -- rank 0 draws the figures
+  if seixo.rank() > 0 then return true end
   local f = assert(io.open(gp, "w"))
   f:write(script)
   f:close()

@@ -339,7 +339,75 @@ static void same_random_seed(lua_State *L)
 #endif
 }
 
-void sx_lua_parallel_open(lua_State *L) { same_random_seed(L); }
+#ifdef SX_HAVE_MPI
+/* os.tmpname under mpirun while models are decomposed: every rank runs the
+ * script, and a path it makes with os.tmpname (m:save there, seixo.load
+ * from there) must be the same path on every rank, as m:save writes from
+ * rank 0 alone. Rank 0 makes the name (and the file), every rank gets it;
+ * so every rank must call it alike, as it does everything that changes a
+ * model. With seixo.decompose(false) (lab.calibrate: ranks on their own)
+ * each rank makes its own. The upvalue is Lua's os.tmpname. */
+static int shared_tmpname(lua_State *L)
+{
+    if (!decompose_on) {
+        lua_pushvalue(L, lua_upvalueindex(1));
+        lua_call(L, 0, 1);
+        return 1;
+    }
+    /* rank 0's name, or its error (then length -1 and the message) */
+    char buf[4096];
+    int len = 0;
+    if (world_rank == 0) {
+        lua_pushvalue(L, lua_upvalueindex(1));
+        const int st = lua_pcall(L, 0, 1, 0);
+        size_t n = 0;
+        const char *text = lua_tolstring(L, -1, &n);
+        if (!text) {
+            text = "os.tmpname: no name";
+            n = strlen(text);
+        }
+        if (n >= sizeof buf) n = sizeof buf - 1;
+        memcpy(buf, text, n);
+        len = st == LUA_OK ? (int)n : -(int)n - 1;
+        lua_pop(L, 1);
+    }
+    if (MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
+    const int n = len < 0 ? -len - 1 : len;
+    if (MPI_Bcast(buf, n, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
+    lua_pushlstring(L, buf, (size_t)n);
+    if (len < 0) return lua_error(L);
+    return 1;
+}
+#endif
+
+/* os.tmpname shared by the ranks (shared_tmpname) */
+static void same_tmpname(lua_State *L)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return;
+    if (lua_getglobal(L, "os") != LUA_TTABLE) { /* no os library: nothing to share */
+        lua_pop(L, 1);
+        return;
+    }
+    if (lua_getfield(L, -1, "tmpname") == LUA_TFUNCTION) {
+        lua_pushcclosure(L, shared_tmpname, 1);
+        lua_setfield(L, -2, "tmpname");
+        lua_pop(L, 1);
+    } else {
+        lua_pop(L, 2);
+    }
+#else
+    (void)L;
+#endif
+}
+
+void sx_lua_parallel_open(lua_State *L)
+{
+    same_random_seed(L);
+    same_tmpname(L);
+}
 
 const luaL_Reg sx_lua_parallel_functions[] = {
     {"cores", seixo_cores}, {"executable", seixo_executable}, {"rank", seixo_rank},

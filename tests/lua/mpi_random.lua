@@ -20,15 +20,7 @@ end
 m:cycle(200)
 io.stderr:write(string.format("ranks %d\n", m:ranks()))
 print("balls", m:ball_count(), "step", m:step())
--- one file for all the ranks: rank 0's temporary name
-local path = seixo.rank() == 0 and os.tmpname() or nil
-if seixo.ranks() > 1 then
-  if seixo.rank() == 0 then
-    for r = 1, seixo.ranks() - 1 do seixo.send(r, path) end
-  else
-    path = seixo.receive()
-  end
-end
+local path = os.tmpname() -- one file for all the ranks: rank 0's name (mpi_tmpname.lua)
 for k = 1, 200 do lab.write_csv(path, {"k", "x"}, {{k, m:ball(1).pos[1]}}) end
 m:cycle(1) -- every rank has written its last
 local rows = require("seixo.util").read_csv(path)
