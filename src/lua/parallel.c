@@ -304,6 +304,7 @@ static int seixo_decompose(lua_State *L)
     return 1;
 }
 
+#ifdef SX_HAVE_MPI
 /* Every rank runs the script and must make the same calls, but Lua seeds
  * math.random at random in each process: a script placing balls with it
  * would build a different model on each rank (the first cycle stops them).
@@ -311,8 +312,6 @@ static int seixo_decompose(lua_State *L)
  * seeded generator, so such a script runs under mpirun as it does alone. */
 static void same_random_seed(lua_State *L)
 {
-#ifdef SX_HAVE_MPI
-    if (!mpi_started || world_size < 2) return;
     if (lua_getglobal(L, "math") != LUA_TTABLE) { /* no math library: nothing to seed */
         lua_pop(L, 1);
         return;
@@ -334,12 +333,8 @@ static void same_random_seed(lua_State *L)
     lua_pushinteger(L, (lua_Integer)seed[1]);
     lua_call(L, 2, 0);
     lua_pop(L, 1);
-#else
-    (void)L;
-#endif
 }
 
-#ifdef SX_HAVE_MPI
 /* os.tmpname under mpirun while models are decomposed: every rank runs the
  * script, and a path it makes with os.tmpname (m:save there, seixo.load
  * from there) must be the same path on every rank, as m:save writes from
@@ -380,33 +375,51 @@ static int shared_tmpname(lua_State *L)
     if (len < 0) return lua_error(L);
     return 1;
 }
-#endif
 
-/* os.tmpname shared by the ranks (shared_tmpname) */
-static void same_tmpname(lua_State *L)
+/* os.exit under mpirun: a rank that ends without MPI_Finalize is taken by
+ * mpirun for one that failed, and the job fails even when every rank ends
+ * with os.exit(0). Ending with success, every rank finalizes first, as at
+ * the end of the script (each rank ends alike, as it makes every call); a
+ * failure ends the job as before. The upvalue is Lua's os.exit. */
+static int mpi_exit(lua_State *L)
 {
-#ifdef SX_HAVE_MPI
-    if (!mpi_started || world_size < 2) return;
-    if (lua_getglobal(L, "os") != LUA_TTABLE) { /* no os library: nothing to share */
+    const bool ok = lua_isnoneornil(L, 1) ||
+                    (lua_isboolean(L, 1) ? lua_toboolean(L, 1) : luaL_checkinteger(L, 1) == EXIT_SUCCESS);
+    if (ok) sx_lua_parallel_stop(1);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, 0);
+    return 0;
+}
+
+/* Replaces os.<name> by fn with the original as its upvalue (nothing
+ * without the os library). */
+static void wrap_os(lua_State *L, const char *name, lua_CFunction fn)
+{
+    if (lua_getglobal(L, "os") != LUA_TTABLE) {
         lua_pop(L, 1);
         return;
     }
-    if (lua_getfield(L, -1, "tmpname") == LUA_TFUNCTION) {
-        lua_pushcclosure(L, shared_tmpname, 1);
-        lua_setfield(L, -2, "tmpname");
+    if (lua_getfield(L, -1, name) == LUA_TFUNCTION) {
+        lua_pushcclosure(L, fn, 1);
+        lua_setfield(L, -2, name);
         lua_pop(L, 1);
     } else {
         lua_pop(L, 2);
     }
-#else
-    (void)L;
-#endif
 }
+#endif
 
 void sx_lua_parallel_open(lua_State *L)
 {
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return;
     same_random_seed(L);
-    same_tmpname(L);
+    wrap_os(L, "tmpname", shared_tmpname);
+    wrap_os(L, "exit", mpi_exit);
+#else
+    (void)L;
+#endif
 }
 
 const luaL_Reg sx_lua_parallel_functions[] = {
