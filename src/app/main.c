@@ -106,7 +106,10 @@ static int report(lua_State *L, int status)
  * sx_lua_parallel_failing). */
 static int report_fatal(lua_State *L, int status)
 {
-    if (status != LUA_OK) sx_lua_parallel_failing();
+    if (status != LUA_OK && !sx_lua_parallel_failing()) {
+        lua_pop(L, 1);
+        return status;
+    }
     return report(L, status);
 }
 

@@ -29,6 +29,7 @@ static int world_rank = 0, world_size = 1;
 #include <mpi.h>
 
 static bool mpi_started;
+static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 
 enum { MESSAGE_TAG = 7 };
 #endif
@@ -45,6 +46,7 @@ void sx_lua_parallel_start(int *argc, char ***argv)
     mpi_started = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    MPI_Comm_dup(MPI_COMM_WORLD, &fail_comm);
     /* every rank runs the script: one writes to standard output, else each
      * line would come once per rank, whether from print, io.write, a shell
      * command or a plot on gnuplot's dumb terminal (errors, on standard
@@ -69,6 +71,7 @@ void sx_lua_parallel_stop(int ok)
     if (!mpi_started) return;
     /* a rank that failed would leave the others waiting for its messages */
     if (!ok && world_size > 1) MPI_Abort(MPI_COMM_WORLD, 1);
+    if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
     MPI_Finalize();
     mpi_started = false;
 #else
@@ -235,26 +238,44 @@ bool sx_lua_parallel_decompose(sx_model *m)
 }
 
 /* An error in the script, or one that every rank finds in a cycle, fails
- * every rank alike: each would print the same message. Rank 0 reports at
- * once and its MPI_Abort ends the others; a rank other than 0 first sleeps
- * FAIL_WAIT_S waiting for that end, and reports only if it did not come: it
- * failed alone (or rank 0 is slower by that much: the message twice). */
-enum { FAIL_WAIT_S = 2 };
+ * every rank alike: each would print the same message. A failing rank
+ * enters a barrier of the failing ranks and polls it for FAIL_WAIT_MS: when
+ * every rank has come (all failed), rank 0 alone reports; else this rank
+ * failed alone (or the others fail that much later: then each reports) and
+ * reports. Then each ends the job (MPI_Abort), as before; the ranks that
+ * keep quiet wait for rank 0's. (A timer alone, ranks > 0 waiting for rank
+ * 0's MPI_Abort to end them, failed under load: they outlived it.) */
+enum { FAIL_WAIT_MS = 5000, FAIL_POLL_MS = 10 };
 
-void sx_lua_parallel_failing(void)
+bool sx_lua_parallel_failing(void)
 {
 #ifdef SX_HAVE_MPI
-    if (!mpi_started || world_rank == 0) return;
-    const struct timespec wait = {FAIL_WAIT_S, 0};
+    if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
+    MPI_Request req;
+    if (MPI_Ibarrier(fail_comm, &req) != MPI_SUCCESS) return true;
+    int all = 0;
+    const struct timespec poll = {0, FAIL_POLL_MS * 1000000L};
+    for (int ms = 0; !all && ms < FAIL_WAIT_MS; ms += FAIL_POLL_MS) {
+        if (MPI_Test(&req, &all, MPI_STATUS_IGNORE) != MPI_SUCCESS) return true;
+        if (!all) nanosleep(&poll, NULL);
+    }
+    if (!all || world_rank == 0) return true;
+    /* rank 0 reports and its MPI_Abort ends this rank: an abort from here
+     * could end rank 0 before it printed */
+    const struct timespec wait = {FAIL_WAIT_MS / 1000, 0};
     nanosleep(&wait, NULL);
+    return false;
+#else
+    return true;
 #endif
 }
 
 void sx_lua_parallel_fail(const char *message)
 {
-    sx_lua_parallel_failing();
-    fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
-    fflush(stderr);
+    if (sx_lua_parallel_failing()) {
+        fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
+        fflush(stderr);
+    }
 #ifdef SX_HAVE_MPI
     if (mpi_started) MPI_Abort(MPI_COMM_WORLD, 1);
 #endif

@@ -53,10 +53,10 @@ SX_API void sx_lua_set_profile(lua_State *L, int on);
 SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
 /// To call before reporting the error that ends the run (then
-/// sx_lua_parallel_stop(0)): under mpirun a rank other than 0 waits a
-/// moment, so that an error every rank meets is printed once, by rank 0,
-/// whose MPI_Abort ends the others first. Else nothing.
-SX_API void sx_lua_parallel_failing(void);
+/// sx_lua_parallel_stop(0)): whether this process reports it. Under mpirun
+/// an error every rank meets (within a few seconds) is reported by rank 0
+/// alone; a rank failing alone reports after that wait. Else true at once.
+SX_API bool sx_lua_parallel_failing(void);
 
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
 /// when ok is 0 and other ranks exist (they would wait for this one forever).
