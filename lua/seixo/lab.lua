@@ -1286,6 +1286,10 @@ local function gnuplot(script, outs)
   local tag = math.random(1, 1 << 30)
   for _, o in ipairs(outs) do script = script:gsub("@" .. o.key .. "@", o.path .. ".tmp" .. tag) end
   local gp = os.tmpname()
+  -- under mpirun, ranks sharing the models get here alike (the same draw, rank
+  -- 0's os.tmpname): rank 0 draws the figures (with seixo.decompose(false)
+  -- each rank its own)
+  if seixo.rank() > 0 and seixo.decompose() then return true end
   local f = assert(io.open(gp, "w"))
   f:write(script)
   f:close()

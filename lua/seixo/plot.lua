@@ -12,6 +12,7 @@
 -- never changes the run: the same bits with or without a plot.
 
 local plot = {}
+local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
 
 local function fail(fmt, ...) error(string.format(fmt, ...), 3) end
 
@@ -95,7 +96,11 @@ function plot.live(m, names, opts)
   if type(every) ~= "number" or every ~= math.floor(every) or every < 1 or every == math.huge then
     fail("plot.live: every must be a whole number of steps >= 1")
   end
-  local pipe = io.popen("gnuplot 2>/dev/null", "w")
+  -- under mpirun every rank runs the script: rank 0 alone draws (the others
+  -- would open a window each, or print a dumb terminal's plot again, or
+  -- write the same file at once); the others keep the callback, since every
+  -- rank must cut its cycles at the same steps, and feed nothing
+  local pipe = seixo.rank() == 0 and io.popen("gnuplot 2>/dev/null", "w") or io.open("/dev/null", "w")
   if not pipe then fail("plot.live: gnuplot cannot be run (apt-get install gnuplot-qt, or gnuplot-nox with terminal = 'dumb')") end
   local head = {}
   if opts.terminal then head[#head + 1] = "set terminal " .. opts.terminal end

@@ -101,6 +101,18 @@ static int report(lua_State *L, int status)
     return status;
 }
 
+/* report() for an error that ends the run: under mpirun every rank meets
+ * an error in the script alike, and rank 0 alone prints it (see
+ * sx_lua_parallel_failing). */
+static int report_fatal(lua_State *L, int status)
+{
+    if (status != LUA_OK && !sx_lua_parallel_failing()) {
+        lua_pop(L, 1);
+        return status;
+    }
+    return report(L, status);
+}
+
 /* ------------------------------------------------------ protected calls */
 
 static int msghandler(lua_State *L)
@@ -289,7 +301,7 @@ static int run_chunk(lua_State *L, const char *code)
 {
     int status = luaL_loadbuffer(L, code, strlen(code), "=(command line)");
     if (status == LUA_OK) status = docall(L, 0, 0);
-    return report(L, status);
+    return report_fatal(L, status);
 }
 
 /* All of standard input (NULL when it cannot be read). */
@@ -360,7 +372,7 @@ static int run_script(lua_State *L, char **argv, int script, int argc, bool keep
             status = docall(L, n, 0);
         }
     }
-    return report(L, status);
+    return report_fatal(L, status);
 }
 
 /* arg[0] is the script, arg[1...] its arguments, and the program and its

@@ -72,7 +72,8 @@ bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count
 /// parallel.c: rank 0's v, on every rank (which all make the call and wait
 /// for it); v itself without MPI or with one rank.
 int64_t sx_lua_parallel_root_value(int64_t v);
-/// parallel.c: on ranks other than 0, print does nothing.
+/// parallel.c: under mpirun, rank 0's math.random seed and os.tmpname names on
+/// every rank, and os.exit finalizing MPI.
 void sx_lua_parallel_open(lua_State *L);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.

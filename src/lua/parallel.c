@@ -15,6 +15,7 @@
 #include "bindings.h"
 #include "seixo_lua.h"
 
+#include <fcntl.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,6 +29,7 @@ static int world_rank = 0, world_size = 1;
 #include <mpi.h>
 
 static bool mpi_started;
+static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 
 enum { MESSAGE_TAG = 7 };
 #endif
@@ -44,6 +46,19 @@ void sx_lua_parallel_start(int *argc, char ***argv)
     mpi_started = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    MPI_Comm_dup(MPI_COMM_WORLD, &fail_comm);
+    /* every rank runs the script: one writes to standard output, else each
+     * line would come once per rank, whether from print, io.write, a shell
+     * command or a plot on gnuplot's dumb terminal (errors, on standard
+     * error, are every rank's) */
+    if (world_rank > 0) {
+        const int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+            fflush(stdout);
+            dup2(null, STDOUT_FILENO);
+            close(null);
+        }
+    }
 #else
     (void)argc;
     (void)argv;
@@ -56,6 +71,7 @@ void sx_lua_parallel_stop(int ok)
     if (!mpi_started) return;
     /* a rank that failed would leave the others waiting for its messages */
     if (!ok && world_size > 1) MPI_Abort(MPI_COMM_WORLD, 1);
+    if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
     MPI_Finalize();
     mpi_started = false;
 #else
@@ -221,10 +237,45 @@ bool sx_lua_parallel_decompose(sx_model *m)
 #endif
 }
 
+/* An error in the script, or one that every rank finds in a cycle, fails
+ * every rank alike: each would print the same message. A failing rank
+ * enters a barrier of the failing ranks and polls it for FAIL_WAIT_MS: when
+ * every rank has come (all failed), rank 0 alone reports; else this rank
+ * failed alone (or the others fail that much later: then each reports) and
+ * reports. Then each ends the job (MPI_Abort), as before; the ranks that
+ * keep quiet wait for rank 0's. (A timer alone, ranks > 0 waiting for rank
+ * 0's MPI_Abort to end them, failed under load: they outlived it.) */
+enum { FAIL_WAIT_MS = 5000, FAIL_POLL_MS = 10 };
+
+bool sx_lua_parallel_failing(void)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
+    MPI_Request req;
+    if (MPI_Ibarrier(fail_comm, &req) != MPI_SUCCESS) return true;
+    int all = 0;
+    const struct timespec poll = {0, FAIL_POLL_MS * 1000000L};
+    for (int ms = 0; !all && ms < FAIL_WAIT_MS; ms += FAIL_POLL_MS) {
+        if (MPI_Test(&req, &all, MPI_STATUS_IGNORE) != MPI_SUCCESS) return true;
+        if (!all) nanosleep(&poll, NULL);
+    }
+    if (!all || world_rank == 0) return true;
+    /* rank 0 reports and its MPI_Abort ends this rank: an abort from here
+     * could end rank 0 before it printed */
+    const struct timespec wait = {FAIL_WAIT_MS / 1000, 0};
+    nanosleep(&wait, NULL);
+    return false;
+#else
+    return true;
+#endif
+}
+
 void sx_lua_parallel_fail(const char *message)
 {
-    fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
-    fflush(stderr);
+    if (sx_lua_parallel_failing()) {
+        fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
+        fflush(stderr);
+    }
 #ifdef SX_HAVE_MPI
     if (mpi_started) MPI_Abort(MPI_COMM_WORLD, 1);
 #endif
@@ -299,16 +350,122 @@ static int seixo_decompose(lua_State *L)
     return 1;
 }
 
-static int quiet_print(lua_State *L)
+#ifdef SX_HAVE_MPI
+/* Every rank runs the script and must make the same calls, but Lua seeds
+ * math.random at random in each process: a script placing balls with it
+ * would build a different model on each rank (the first cycle stops them).
+ * The ranks take rank 0's seed, two integers drawn from its own randomly
+ * seeded generator, so such a script runs under mpirun as it does alone. */
+static void same_random_seed(lua_State *L)
 {
-    (void)L;
+    if (lua_getglobal(L, "math") != LUA_TTABLE) { /* no math library: nothing to seed */
+        lua_pop(L, 1);
+        return;
+    }
+    int64_t seed[2] = {0, 0};
+    if (world_rank == 0) {
+        for (int k = 0; k < 2; k++) {
+            lua_getfield(L, -1, "random");
+            lua_pushinteger(L, 0); /* math.random(0): an integer of random bits */
+            lua_call(L, 1, 1);
+            seed[k] = (int64_t)lua_tointeger(L, -1);
+            lua_pop(L, 1);
+        }
+    }
+    if (MPI_Bcast(seed, 2, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("the ranks could not agree on math.random's seed");
+    lua_getfield(L, -1, "randomseed");
+    lua_pushinteger(L, (lua_Integer)seed[0]);
+    lua_pushinteger(L, (lua_Integer)seed[1]);
+    lua_call(L, 2, 0);
+    lua_pop(L, 1);
+}
+
+/* os.tmpname under mpirun while models are decomposed: every rank runs the
+ * script, and a path it makes with os.tmpname (m:save there, seixo.load
+ * from there) must be the same path on every rank, as m:save writes from
+ * rank 0 alone. Rank 0 makes the name (and the file), every rank gets it;
+ * so every rank must call it alike, as it does everything that changes a
+ * model. With seixo.decompose(false) (lab.calibrate: ranks on their own)
+ * each rank makes its own. The upvalue is Lua's os.tmpname. */
+static int shared_tmpname(lua_State *L)
+{
+    if (!decompose_on) {
+        lua_pushvalue(L, lua_upvalueindex(1));
+        lua_call(L, 0, 1);
+        return 1;
+    }
+    /* rank 0's name, or its error (then length -1 and the message) */
+    char buf[4096];
+    int len = 0;
+    if (world_rank == 0) {
+        lua_pushvalue(L, lua_upvalueindex(1));
+        const int st = lua_pcall(L, 0, 1, 0);
+        size_t n = 0;
+        const char *text = lua_tolstring(L, -1, &n);
+        if (!text) {
+            text = "os.tmpname: no name";
+            n = strlen(text);
+        }
+        if (n >= sizeof buf) n = sizeof buf - 1;
+        memcpy(buf, text, n);
+        len = st == LUA_OK ? (int)n : -(int)n - 1;
+        lua_pop(L, 1);
+    }
+    if (MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
+    const int n = len < 0 ? -len - 1 : len;
+    if (MPI_Bcast(buf, n, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
+    lua_pushlstring(L, buf, (size_t)n);
+    if (len < 0) return lua_error(L);
+    return 1;
+}
+
+/* os.exit under mpirun: a rank that ends without MPI_Finalize is taken by
+ * mpirun for one that failed, and the job fails even when every rank ends
+ * with os.exit(0). Ending with success, every rank finalizes first, as at
+ * the end of the script (each rank ends alike, as it makes every call); a
+ * failure ends the job as before. The upvalue is Lua's os.exit. */
+static int mpi_exit(lua_State *L)
+{
+    const bool ok = lua_isnoneornil(L, 1) ||
+                    (lua_isboolean(L, 1) ? lua_toboolean(L, 1) : luaL_checkinteger(L, 1) == EXIT_SUCCESS);
+    if (ok) sx_lua_parallel_stop(1);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, 0);
     return 0;
 }
 
+/* Replaces os.<name> by fn with the original as its upvalue (nothing
+ * without the os library). */
+static void wrap_os(lua_State *L, const char *name, lua_CFunction fn)
+{
+    if (lua_getglobal(L, "os") != LUA_TTABLE) {
+        lua_pop(L, 1);
+        return;
+    }
+    if (lua_getfield(L, -1, name) == LUA_TFUNCTION) {
+        lua_pushcclosure(L, fn, 1);
+        lua_setfield(L, -2, name);
+        lua_pop(L, 1);
+    } else {
+        lua_pop(L, 2);
+    }
+}
+#endif
+
 void sx_lua_parallel_open(lua_State *L)
 {
-    /* one rank prints: the others would repeat every line */
-    if (world_rank > 0) lua_register(L, "print", quiet_print);
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return;
+    same_random_seed(L);
+    wrap_os(L, "tmpname", shared_tmpname);
+    wrap_os(L, "exit", mpi_exit);
+#else
+    (void)L;
+#endif
 }
 
 const luaL_Reg sx_lua_parallel_functions[] = {

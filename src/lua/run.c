@@ -269,7 +269,8 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
     const sx_status st = sx_model_cycle(r->m, n);
     if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
         char msg[1024];
-        snprintf(msg, sizeof msg, "%s: %s", r->what, sx_lua_core_message(sx_model_error(r->m)));
+        luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
+        snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), r->what, sx_lua_core_message(sx_model_error(r->m)));
         sx_lua_parallel_fail(msg);
     }
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);

@@ -49,6 +49,7 @@ SX_API void sx_lua_set_profile(lua_State *L, int on);
 /// Starts MPI when the program was launched by mpirun (Open MPI's or a
 /// PMI launcher's environment) and seixo was built with MPI; else nothing.
 /// Call it first thing in main; seixo.rank() and seixo.ranks() tell the rest.
+/// On ranks other than 0 standard output then goes to /dev/null.
 SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
 /// Input every rank reads alike: mpirun gives standard input to rank 0
@@ -60,6 +61,12 @@ SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 /// from standard input (`seixo -`) go through it.
 SX_API char *sx_lua_parallel_input(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len,
                                    int *mark);
+
+/// To call before reporting the error that ends the run (then
+/// sx_lua_parallel_stop(0)): whether this process reports it. Under mpirun
+/// an error every rank meets (within a few seconds) is reported by rank 0
+/// alone; a rank failing alone reports after that wait. Else true at once.
+SX_API bool sx_lua_parallel_failing(void);
 
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
 /// when ok is 0 and other ranks exist (they would wait for this one forever).

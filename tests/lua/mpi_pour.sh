@@ -9,8 +9,9 @@
 # across the save);
 # and a servo-controlled lid moves alike with 2 and 3 ranks; an output
 # series written with 2 and 3 ranks is the serial one (mpi_output.lua); a
-# long cycle's progress lines come from rank 0 (mpi_progress.lua); ranks whose
-# models differ are stopped with the cause (mpi_diverge.lua).
+# long cycle's progress lines come from rank 0 (mpi_progress.lua), and so
+# does a live plot (mpi_plot.lua); ranks whose models differ are stopped
+# with the cause (mpi_diverge.lua).
 # Skipped without mpirun. The pours run through mpi_same.sh (which
 # checks 3 ranks only under AddressSanitizer).
 #   mpi_pour.sh SEIXO mpi_pour.lua
@@ -59,6 +60,19 @@ elif grep -q "m:cycle: the model differs between the 3 ranks" "$dir/err" && ! gr
   echo "diverging ranks, -np 3: stopped, naming the cause"
 else
   echo "diverging ranks, -np 3: failed without naming the cause:"; cat "$dir/out" "$dir/err"; fail=1
+fi
+# a live plot on gnuplot's dumb terminal (to standard output): drawn by rank 0 alone
+plotter=$(dirname "$script")/mpi_plot.lua
+if command -v gnuplot >/dev/null 2>&1; then
+  "$seixo" "$plotter" >"$dir/serial" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+  if mpirun $root --oversubscribe -np 3 "$seixo" "$plotter" >"$dir/out" 2>"$dir/err" &&
+     grep -q "^ranks 3$" "$dir/err" && cmp -s "$dir/serial" "$dir/out"; then
+    echo "live plot, -np 3: drawn once, identical ($(wc -l <"$dir/out") lines)"
+  else
+    echo "live plot, -np 3 differs or failed:"; diff "$dir/serial" "$dir/out" | head -n 20; cat "$dir/err"; fail=1
+  fi
+else
+  echo "gnuplot not found: the live plot under MPI not checked"
 fi
 restart=$(dirname "$script")/mpi_restart.lua
 for kind in pour bonded periodic; do
