@@ -908,7 +908,11 @@ static void repl(lua_State *L)
             lua_insert(L, 1);
             status = docall(L, lua_gettop(L) - 1, 0);
         }
-        report(L, status);
+        /* under mpirun every rank runs the line alike on the same model:
+         * rank 0 reports its error (a model that differed would stop the
+         * next cycle on every rank, with that cause) */
+        if (status != LUA_OK && sx_lua_parallel_rank() != 0) lua_pop(L, 1);
+        else report(L, status);
     }
     lua_settop(L, 0);
     if (tty) putchar('\n');

@@ -57,8 +57,6 @@ extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, exec
 bool sx_lua_parallel_decompose(sx_model *m);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);
-/// parallel.c: this process's MPI rank (0 without MPI).
-int sx_lua_parallel_rank(void);
 /// parallel.c: whether this process writes the files of a model, `shared`
 /// if it is decomposed over MPI ranks (sx_model_ranks > 1): then rank 0
 /// writes for all (every rank holds the whole model between cycles).

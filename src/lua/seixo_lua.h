@@ -52,6 +52,9 @@ SX_API void sx_lua_set_profile(lua_State *L, int on);
 /// On ranks other than 0 standard output then goes to /dev/null.
 SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
+/// This process's MPI rank (0 without mpirun).
+SX_API int sx_lua_parallel_rank(void);
+
 /// Input every rank reads alike: mpirun gives standard input to rank 0
 /// alone, so under mpirun rank 0 calls read(ud, len, mark) and sends what
 /// it returns (len bytes, malloc'ed; NULL at the end of input) with *mark

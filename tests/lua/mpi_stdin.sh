@@ -3,8 +3,9 @@
 # read from it (`seixo - ARGS`) and an interactive session fed to
 # `seixo -i` run alike on every rank (rank 0 reads, the others take its
 # input) and print what the serial run prints, serially and with 1 to 4
-# ranks, each run within a time limit (a rank waiting for input it never
-# gets would hang). Skipped (77) without mpirun.
+# ranks (the session's errors reported once), each run within a time
+# limit (a rank waiting for input it never gets would hang). Skipped (77)
+# without mpirun.
 #   mpi_stdin.sh SEIXO SCRIPT 'ARGS'
 # SCRIPT prints "ranks N" on stderr once its model is made (mpi_pour.lua).
 set -u
@@ -37,6 +38,10 @@ for mode in script session; do
       cat "$dir/err"; fail=1; continue
     fi
     same_as_serial "$mode, -np $np" "$np"
+    # the session's error, met by every rank, reported once (by rank 0)
+    if [ $mode = session ] && [ "$(grep -c "unexpected symbol" "$dir/err")" != 1 ]; then
+      echo "$mode, -np $np: the syntax error is not reported once:"; cat "$dir/err"; fail=1
+    fi
   done
 done
 exit $fail
