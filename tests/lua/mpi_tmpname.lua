@@ -6,12 +6,7 @@
 -- After seixo.decompose(false) (a rank on its own, as in lab.calibrate)
 -- each rank makes its own names and saves and loads its own model.
 local lab = require "seixo.lab"
-local m = seixo.model{dim = 2, gravity = {0, -9.81}}
-m:material("g", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.3})
-m:generate{count = 100, radius = {1e-3, 1.5e-3}, region = {box = {{0, 0}, {0.04, 0.03}}}, seed = 2}
-m:wall{kind = "box", min = {0, 0}, max = {0.04, 0.05}}
-m:cycle(100)
-io.stderr:write(string.format("ranks %d\n", m:ranks()))
+local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local base = os.tmpname()
 m:save(base .. ".h5")
 local loaded = seixo.load(base .. ".h5")
