@@ -48,6 +48,7 @@ typedef struct options {
     bool has_chunks;   // some -e
     long threads;      // --threads N (0: not given)
     bool profile;      // --profile
+    char bad[256];     // why the command line is wrong (parse: BAD)
 } options;
 
 enum { MAX_THREADS = 1024 };  // as many as sx_model_set_threads takes (model.c)
@@ -1040,7 +1041,7 @@ static enum parsed parse(int argc, char **argv, options *o)
         }
         if (strcmp(a, "-e") == 0) {
             if (++i == argc) {
-                message("'-e' needs an argument; seixo --help for usage");
+                snprintf(o->bad, sizeof o->bad, "'-e' needs an argument; seixo --help for usage");
                 return BAD;
             }
             o->has_chunks = true;
@@ -1052,8 +1053,8 @@ static enum parsed parse(int argc, char **argv, options *o)
             const char *v = a[9] == '=' ? a + 10 : (++i < argc ? argv[i] : NULL);
             const long t = thread_count(v);
             if (!t) {
-                fprintf(stderr, "%s: '--threads' needs a whole number from 1 to %d; seixo --help for usage\n", progname,
-                        MAX_THREADS);
+                snprintf(o->bad, sizeof o->bad, "'--threads' needs a whole number from 1 to %d; seixo --help for usage",
+                         MAX_THREADS);
                 return BAD;
             }
             o->threads = t;
@@ -1067,7 +1068,7 @@ static enum parsed parse(int argc, char **argv, options *o)
             return DONE;
         } else {
             /* one line, like every failure: the reason and where to look */
-            fprintf(stderr, "%s: unrecognized option '%s'; seixo --help for usage\n", progname, a);
+            snprintf(o->bad, sizeof o->bad, "unrecognized option '%s'; seixo --help for usage", a);
             return BAD;
         }
     }
@@ -1078,7 +1079,7 @@ static enum parsed parse(int argc, char **argv, options *o)
     if (!o->threads && env && *env) {
         o->threads = thread_count(env);
         if (!o->threads) {
-            fprintf(stderr, "%s: OMP_NUM_THREADS='%s' is not a whole number from 1 to %d\n", progname, env, MAX_THREADS);
+            snprintf(o->bad, sizeof o->bad, "OMP_NUM_THREADS='%s' is not a whole number from 1 to %d", env, MAX_THREADS);
             return BAD;
         }
     }
@@ -1133,7 +1134,10 @@ int main(int argc, char **argv)
     sx_lua_parallel_start(&argc, &argv);  // MPI_Init under mpirun, before anything reads argv
     switch (parse(argc, argv, &o)) {
     case DONE: sx_lua_parallel_stop(1); return EXIT_SUCCESS;
-    case BAD: sx_lua_parallel_stop(0); return EXIT_FAILURE;
+    case BAD: /* every rank parsed the same command line: under mpirun rank 0 says why */
+        if (sx_lua_parallel_failing()) message(o.bad);
+        sx_lua_parallel_stop(0);
+        return EXIT_FAILURE;
     case RUN: break;
     }
     lua_State *L = luaL_newstate();

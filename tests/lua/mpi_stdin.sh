@@ -4,8 +4,8 @@
 # `seixo -i` run alike on every rank (rank 0 reads, the others take its
 # input) and print what the serial run prints, serially and with 1 to 4
 # ranks (the session's errors reported once), each run within a time
-# limit (a rank waiting for input it never gets would hang). Skipped (77)
-# without mpirun.
+# limit (a rank waiting for input it never gets would hang); and a bad
+# option is refused with its message once. Skipped (77) without mpirun.
 #   mpi_stdin.sh SEIXO SCRIPT 'ARGS'
 # SCRIPT prints "ranks N" on stderr once its model is made (mpi_pour.lua).
 set -u
@@ -43,5 +43,15 @@ for mode in script session; do
       echo "$mode, -np $np: the syntax error is not reported once:"; cat "$dir/err"; fail=1
     fi
   done
+done
+# a bad option, which every rank parses alike: refused, said once (rank 0)
+for np in $ranks; do
+  timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" --frob >"$dir/out" 2>"$dir/err"
+  rc=$?
+  if [ $rc = 0 ] || [ $rc = 124 ] || [ "$(grep -c "unrecognized option '--frob'" "$dir/err")" != 1 ]; then
+    echo "--frob, -np $np: exit status $rc, the message not once:"; cat "$dir/err"; fail=1
+  else
+    echo "--frob, -np $np: refused, said once"
+  fi
 done
 exit $fail
