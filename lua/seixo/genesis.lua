@@ -70,13 +70,13 @@ end
 
 -- The balls of m in a cell grid of cells of size h: near(p) lists the
 -- entries {ball, pos, radius} in the 3^dim cells about p (every ball whose
--- centre is within h of p). In a periodic cell (cell: {min, size}) a ball
--- is entered where the cell wraps it, and again as each image within h of
--- the cell's faces (pos shifted by the cell's edges), so near(p) of a p in
--- the cell sees its neighbours across the faces; put(ball, x, r) moves a
--- ball's entries with it.
-local function ball_grid(m, h, cell)
-  local dim, cells, entries = m:dim(), {}, {}
+-- centre is within h of p), a ball entered where the vessel v holds it
+-- (v.place). In a periodic cell (v.cell: {min, size}) a ball is entered
+-- again as each image within h of the cell's faces (pos shifted by the
+-- cell's edges), so near(p) of a p in the cell sees its neighbours across
+-- the faces; put(ball, x, r) moves a ball's entries with it.
+local function ball_grid(m, h, v)
+  local dim, cells, entries, cell = m:dim(), {}, {}, v.cell
   local function key(p, off)
     local k = 0
     for j = 1, dim do k = k * 1048576 + (math.floor(p[j] / h) + (off and off[j] or 0)) % 1048576 end
@@ -92,35 +92,27 @@ local function ball_grid(m, h, cell)
     if not mine then mine = {}; entries[b.id] = mine end
     mine[#mine + 1] = e
   end
-  for b in m:balls() do
-    if not cell then
-      enter(b, b.pos)
-    else
-      local p = {}
-      for j = 1, dim do p[j] = cell.min[j] + (b.pos[j] - cell.min[j]) % cell.size[j] end
-      -- the shifts by -1, 0, +1 edges along each axis that bring p within h of the cell
-      for i = 0, 3 ^ dim - 1 do
-        local shift, q, inside = {}, i, true
-        for j = 1, dim do
-          local s = (q % 3 - 1) * cell.size[j]
-          q = q // 3
-          shift[j] = s
-          local x = p[j] + s
-          inside = inside and x >= cell.min[j] - h and x <= cell.min[j] + cell.size[j] + h
-        end
-        if inside then
-          local x = {}
-          for j = 1, dim do x[j] = p[j] + shift[j] end
-          enter(b, x, shift)
-        end
-      end
-    end
-  end
-  local offsets = {}
+  local offsets = {} -- -1, 0 or +1 along each axis
   for i = 0, 3 ^ dim - 1 do
     local off, q = {}, i
     for j = 1, dim do off[j] = q % 3 - 1; q = q // 3 end
     offsets[#offsets + 1] = off
+  end
+  for b in m:balls() do
+    local p = v.place(b.pos)
+    if not cell then
+      enter(b, p)
+    else -- the images, by -1, 0, +1 edges along each axis, that lie within h of the cell
+      for _, off in ipairs(offsets) do
+        local x, shift, inside = {}, {}, true
+        for j = 1, dim do
+          shift[j] = off[j] * cell.size[j]
+          x[j] = p[j] + shift[j]
+          inside = inside and x[j] >= cell.min[j] - h and x[j] <= cell.min[j] + cell.size[j] + h
+        end
+        if inside then enter(b, x, shift) end
+      end
+    end
   end
   local function near(p)
     local list = {}
@@ -145,7 +137,7 @@ end
 -- balls' vibrations, so the contacts that carry a force at a given step
 -- flicker; the bond gap does not.
 local function neighbour_counts(m, v, gap)
-  local near, counts = ball_grid(m, 2 * m:max("radius") + gap, v.cell), {}
+  local near, counts = ball_grid(m, 2 * m:max("radius") + gap, v), {}
   for b in m:balls() do
     local p, r, n = v.place(b.pos), b.radius, 0
     for _, e in ipairs(near(p)) do
@@ -250,7 +242,7 @@ local function eliminate_floaters(m, v, nf, gap, max_passes)
     found, left = found or #floaters, #floaters
     if left == 0 or pass > max_passes then break end
     passes = pass
-    local near, put = ball_grid(m, 4 * m:max("radius"), v.cell)
+    local near, put = ball_grid(m, 4 * m:max("radius"), v)
     for _, f in ipairs(floaters) do
       local p, r = v.place(f.pos), f.radius
       local cage = {}
