@@ -651,7 +651,8 @@ void sx__bonds_free(sx_model *m);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
  * start, the plan after a build, the ghosts' refresh, the whole state on
  * every rank (false: the exchange failed), the walls' resultants from
- * every rank's blocks (sx__walls_sum), and the end of a cycle (the whole state, then replan: the serial chunk plan) */
+ * every rank's blocks (sx__walls_sum), and the end of a cycle (the whole
+ * state, then replan: the serial chunk plan) */
 void sx__dd_free(sx_model *m);
 sx_status sx__dd_begin(sx_model *m);
 bool sx__dd_plan(sx_model *m);

@@ -230,8 +230,9 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
     sx_dd *d = m->dd;
     const int W = 2 * D + RD + 1; /* the damping's D + RD terms, the loads' D + 1 */
     const sx_span own = d->cl_own[d->x.rank];
-    double *terms = m->track_energy && m->clumps->n ? sx__dd_clump_terms(m, W, size) : NULL;
-    if (m->track_energy && m->clumps->n && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    const bool track = m->track_energy && m->clumps->n; /* (no clump left: no energy block) */
+    double *terms = track ? sx__dd_clump_terms(m, W, size) : NULL;
+    if (track && !terms) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     const step_env env = step_env_of(m);
     double worst = *max_disp * *max_disp, work[2] = {0, 0};
     int64_t bad = -1;

@@ -194,9 +194,6 @@ SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
     else motion_pass(m, o, false);
 }
 
-/* The law of motion in fixed blocks of balls whose partial sums are added
- * in block order (the same bits for any thread count). Returns the largest
- * displacement since the last build in *max_disp. */
 /* A ball's or clump's state became non-finite (what: "ball" or "clump"). */
 static sx_status KERNEL(nonfinite)(sx_model *m, const char *what, int64_t id)
 {
@@ -206,6 +203,9 @@ static sx_status KERNEL(nonfinite)(sx_model *m, const char *what, int64_t id)
                     (long long)m->step, what, (long long)id, m->dt, KERNEL(estimate_dt)(m));
 }
 
+/* The law of motion in fixed blocks of balls whose partial sums are added
+ * in block order (the same bits for any thread count). Returns the largest
+ * displacement since the last build in *max_disp. */
 static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
 {
     const int64_t nb = m->nblock;
