@@ -293,7 +293,7 @@ int64_t sx_lua_parallel_root_value(int64_t v)
     return v;
 }
 
-char *sx_lua_parallel_input(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len, int *mark)
+char *sx_lua_parallel_root_text(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len, int *mark)
 {
     *len = 0;
 #ifdef SX_HAVE_MPI
@@ -388,6 +388,22 @@ static void same_random_seed(lua_State *L)
  * so every rank must call it alike, as it does everything that changes a
  * model. With seixo.decompose(false) (lab.calibrate: ranks on their own)
  * each rank makes its own. The upvalue is Lua's os.tmpname. */
+static char *rank0_tmpname(void *ud, size_t *len, int *mark)
+{
+    lua_State *L = ud;
+    lua_pushvalue(L, lua_upvalueindex(1)); /* (shared_tmpname's upvalue: its frame is running) */
+    *mark = lua_pcall(L, 0, 1, 0);
+    const char *text = lua_tolstring(L, -1, len);
+    if (!text) {
+        text = "os.tmpname: no name";
+        *len = strlen(text);
+    }
+    char *copy = malloc(*len + 1);
+    if (copy) memcpy(copy, text, *len + 1);
+    lua_pop(L, 1);
+    return copy;
+}
+
 static int shared_tmpname(lua_State *L)
 {
     if (!decompose_on) {
@@ -395,31 +411,14 @@ static int shared_tmpname(lua_State *L)
         lua_call(L, 0, 1);
         return 1;
     }
-    /* rank 0's name, or its error (then length -1 and the message) */
-    char buf[4096];
-    int len = 0;
-    if (world_rank == 0) {
-        lua_pushvalue(L, lua_upvalueindex(1));
-        const int st = lua_pcall(L, 0, 1, 0);
-        size_t n = 0;
-        const char *text = lua_tolstring(L, -1, &n);
-        if (!text) {
-            text = "os.tmpname: no name";
-            n = strlen(text);
-        }
-        if (n >= sizeof buf) n = sizeof buf - 1;
-        memcpy(buf, text, n);
-        len = st == LUA_OK ? (int)n : -(int)n - 1;
-        lua_pop(L, 1);
-    }
-    if (MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
-        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
-    const int n = len < 0 ? -len - 1 : len;
-    if (MPI_Bcast(buf, n, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
-        sx_lua_parallel_fail("os.tmpname: the ranks could not share rank 0's name");
-    lua_pushlstring(L, buf, (size_t)n);
-    if (len < 0) return lua_error(L);
-    return 1;
+    /* rank 0's name, or its error (marked by its status) */
+    size_t len;
+    int status;
+    char *name = sx_lua_parallel_root_text(rank0_tmpname, L, &len, &status);
+    if (!name) return luaL_error(L, "os.tmpname: out of memory");
+    lua_pushlstring(L, name, len);
+    free(name);
+    return status == LUA_OK ? 1 : lua_error(L);
 }
 
 /* os.exit under mpirun: a rank that ends without MPI_Finalize is taken by

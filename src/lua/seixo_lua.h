@@ -55,14 +55,14 @@ SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 /// This process's MPI rank (0 without mpirun).
 SX_API int sx_lua_parallel_rank(void);
 
-/// Input every rank reads alike: mpirun gives standard input to rank 0
-/// alone, so under mpirun rank 0 calls read(ud, len, mark) and sends what
-/// it returns (len bytes, malloc'ed; NULL at the end of input) with *mark
-/// (an integer the caller gives meaning to) to the other ranks, which
-/// return a malloc'ed, NUL-terminated copy (or NULL) without reading.
-/// Serially, read's answer. The interactive mode's lines and a script read
-/// from standard input (`seixo -`) go through it.
-SX_API char *sx_lua_parallel_input(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len,
+/// Text rank 0 makes, on every rank: under mpirun rank 0 calls read(ud,
+/// len, mark) and sends what it returns (len bytes, malloc'ed and
+/// NUL-terminated; NULL: none) with *mark (an integer the caller gives
+/// meaning to) to the other ranks, which return a malloc'ed copy (or NULL)
+/// without calling read. Serially, read's answer. Standard input, which
+/// mpirun gives to rank 0 alone (the interactive mode's lines, a script
+/// read with `seixo -`), and os.tmpname's names go through it.
+SX_API char *sx_lua_parallel_root_text(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len,
                                    int *mark);
 
 /// To call before reporting the error that ends the run (then
