@@ -62,8 +62,9 @@ function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
 --- file.
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
-  -- under mpirun every rank writes the file, with the same random numbers
-  -- (rank 0's seed): the rank number keeps their temporary names apart
+  -- under mpirun with seixo.decompose(false) every rank writes the file,
+  -- with the same random numbers (rank 0's seed): the rank number keeps
+  -- their temporary names apart (with shared models rank 0 alone writes)
   local tmp = string.format("%s.tmp%d.%d", path, seixo.rank(), math.random(1, 1 << 30))
   local f, opened = io.open(tmp, "w")
   if not f then error("cannot write " .. path .. ": " .. tostring(opened), 2) end

@@ -73,6 +73,14 @@ int64_t sx_lua_parallel_root_value(int64_t v);
 /// parallel.c: under mpirun, rank 0's math.random seed and os.tmpname names on
 /// every rank, and os.exit finalizing MPI.
 void sx_lua_parallel_open(lua_State *L);
+/// parallel.c: whether models made now are decomposed over two MPI ranks or more (rank 0 writes their files).
+bool sx_lua_parallel_sharing(void);
+/// rank_files.c: under mpirun, on a rank above 0, the script's files become
+/// shadows while models are shared (rank 0 alone writes the real ones).
+void sx_lua_rank_files_open(lua_State *L);
+/// rank_files.c: pushes and returns the path to read for the script's file
+/// `path`: its shadow's on a rank above 0 that wrote it, else path itself.
+const char *sx_lua_rank_file(lua_State *L, const char *path);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.
 void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);

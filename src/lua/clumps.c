@@ -126,7 +126,8 @@ static int64_t read_pebbles(lua_State *L, int idx, int dim, double **pos, double
  * or commas), '#' starting a comment. Pushes the storage. */
 static int64_t read_sphere_file(lua_State *L, const char *path, int dim, double **pos, double **rad)
 {
-    FILE *f = fopen(path, "r");
+    FILE *f = fopen(sx_lua_rank_file(L, path), "r"); /* the script's own file, maybe */
+    lua_pop(L, 1);
     if (!f) luaL_error(L, "clump_template: cannot open '%s': %s", path, strerror(errno));
     luaL_Buffer b;
     luaL_buffinit(L, &b); /* the numbers, as doubles, grown in the buffer */

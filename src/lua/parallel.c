@@ -320,6 +320,15 @@ char *sx_lua_parallel_root_text(char *(*read)(void *ud, size_t *len, int *mark),
 
 bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 
+bool sx_lua_parallel_sharing(void)
+{
+#ifdef SX_HAVE_MPI
+    return mpi_started && decompose_on;
+#else
+    return false;
+#endif
+}
+
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count)
 {
 #ifdef SX_HAVE_MPI
@@ -462,6 +471,7 @@ void sx_lua_parallel_open(lua_State *L)
     same_random_seed(L);
     wrap_os(L, "tmpname", shared_tmpname);
     wrap_os(L, "exit", mpi_exit);
+    if (world_rank > 0) sx_lua_rank_files_open(L);
 #else
     (void)L;
 #endif

@@ -348,7 +348,9 @@ static void read_mesh(lua_State *L, sx_mesh_def *md)
         if (!path) luaL_argerror(L, 2, "field 'file' must be a file name");
         char err[512];
         double *soup;
-        if (sx_io_read_stl(path, &soup, &nt, err, sizeof err)) luaL_error(L, "m:wall: %s", err);
+        const bool failed = sx_io_read_stl(sx_lua_rank_file(L, path), &soup, &nt, err, sizeof err);
+        lua_pop(L, 1);
+        if (failed) luaL_error(L, "m:wall: %s", err);
         x = lua_newuserdatauv(L, (size_t)nt * 9 * sizeof *x, 0);
         memcpy(x, soup, (size_t)nt * 9 * sizeof *x);
         free(soup);

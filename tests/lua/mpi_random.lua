@@ -3,8 +3,8 @@
 -- random in each process, and every rank must build the same model, so the
 -- ranks share rank 0's seed. Balls placed at random positions, cycled
 -- (each decomposed cycle checks that the ranks' models agree), and a CSV
--- written by every rank through seixo.lab many times over (the temporary
--- names, random too, must stay apart between the ranks). Prints what does
+-- written through seixo.lab many times over (by rank 0; the other ranks
+-- write their shadows, src/lua/rank_files.c). Prints what does
 -- not depend on the draw: the same lines serially and on every rank count.
 local lab = require "seixo.lab"
 local m = seixo.model{dim = 2, gravity = {0, -9.81}}

@@ -1,0 +1,81 @@
+-- Files under mpirun (issue 16; test lua_mpi_files through mpi_same.sh):
+-- every rank runs the script, but while models are shared rank 0 alone
+-- writes the real files and the other ranks read back the shadows of what
+-- they wrote (src/lua/rank_files.c). A log appended after each cycle has
+-- its lines once, not once per rank (its header written while it is
+-- empty); a file rewritten, updated in place, written through io.output,
+-- renamed, removed, refused in a folder that is not there, and a clump
+-- template's spheres read back by C, give every rank rank 0's answers:
+-- each answer goes into the model (a ball's size), so that a rank which
+-- read something else stops the next cycle ("the model differs between
+-- the ranks"), and rank 0 prints them, which must be the serial run's.
+local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
+local base = os.tmpname() -- rank 0's name, on every rank
+local record = {}
+local function note(...)
+  local t = table.pack(...)
+  for i = 1, t.n do
+    local s, at = tostring(t[i]), 1
+    local a, b = s:find(base, 1, true) -- the path differs from the serial run's
+    if a then s = s:sub(1, a - 1) .. "BASE" .. s:sub(b + 1) end
+    t[i] = io.type(t[i]) and "a file" or s
+  end
+  record[#record + 1] = table.concat(t, " ", 1, t.n)
+end
+
+local log = base .. ".log"
+for _ = 1, 3 do
+  m:cycle(50)
+  local f = assert(io.open(log, "a"))
+  if f:seek("end") == 0 then f:write("step,balls\n") end
+  f:write(string.format("%d,%d\n", m:step(), m:ball_count()))
+  f:close()
+end
+for line in io.lines(log) do note("log", line) end
+
+local f = assert(io.open(base .. ".txt", "w"))
+f:write("first\n")
+f:close()
+f = assert(io.open(base .. ".txt", "w"))
+f:write("second\n")
+f:close()
+note("rewritten", io.open(base .. ".txt"):read("a"))
+f = assert(io.open(base .. ".txt", "r+"))
+f:write("S")
+f:seek("set", 0)
+note("updated", f:read("a"))
+f:close()
+
+io.output(base .. ".out")
+io.write("through io.output\n")
+io.close()
+io.output(io.stdout)
+io.input(base .. ".out")
+note("io.input", io.read("l"))
+io.close()
+io.input(io.stdin)
+
+note("rename", os.rename(base .. ".txt", base .. ".moved"))
+note("moved", io.open(base .. ".moved"):read("a"))
+note("old name", io.open(base .. ".txt"))
+note("remove", os.remove(base .. ".moved"))
+note("removed", io.open(base .. ".moved"))
+note("remove again", os.remove(base .. ".moved"))
+note("lines of a removed file", pcall(io.lines, base .. ".moved"))
+note("no folder", io.open(base .. ".none/file", "w"))
+
+f = assert(io.open(base .. ".spheres", "w"))
+f:write("0 0 1e-3\n1.5e-3 0 8e-4\n")
+f:close()
+local t = m:clump_template("pair", base .. ".spheres")
+note("template", #t.pebbles, string.format("%.6g %.6g", t.volume, t.centroid[1]))
+
+local sum = 0
+for _, line in ipairs(record) do
+  print(line)
+  for i = 1, #line do sum = (sum * 31 + line:byte(i)) % 1000003 end
+end
+m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e7)}
+m:cycle(100)
+print("end", m:step(), m:hash())
+for _, suffix in ipairs{"", ".log", ".out", ".spheres"} do os.remove(base .. suffix) end
