@@ -11,6 +11,7 @@
  * arrays of every binding file), materials, time, timestep, gravity,
  * energies and the summary that print(m) shows; cycling is in run.c. */
 #include "bindings.h"
+#include "seixo_lua.h"
 
 #include <inttypes.h>
 #include <math.h>
@@ -159,7 +160,10 @@ static void profile_at_end(lua_State *L, const sx_model *m)
     lua_pop(L, 1);
     if (!on || !m || sx_model_profile(m).steps == 0) return;
     sx_lua_push_profile_text(L, m);
-    fprintf(stderr, "seixo: profile of a %dD model of %lld balls at step %lld:\n%s", sx_model_dim(m),
+    /* decomposed, each rank times its own share: N tables, each named */
+    char rank[48] = "";
+    if (sx_model_ranks(m) > 1) snprintf(rank, sizeof rank, " (rank %d of %d)", sx_lua_parallel_rank(), sx_model_ranks(m));
+    fprintf(stderr, "seixo: profile%s of a %dD model of %lld balls at step %lld:\n%s", rank, sx_model_dim(m),
             (long long)sx_ball_count(m), (long long)sx_model_step_count(m), lua_tostring(L, -1));
     lua_pop(L, 1);
 }

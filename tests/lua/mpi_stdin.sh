@@ -5,7 +5,8 @@
 # input) and print what the serial run prints, serially and with 1 to 4
 # ranks (the session's errors reported once), each run within a time
 # limit (a rank waiting for input it never gets would hang); and a bad
-# option is refused with its message once. Skipped (77) without mpirun.
+# option is refused with its message once; --profile prints a table per
+# rank, named by its rank. Skipped (77) without mpirun.
 #   mpi_stdin.sh SEIXO SCRIPT 'ARGS'
 # SCRIPT prints "ranks N" on stderr once its model is made (mpi_pour.lua).
 set -u
@@ -53,5 +54,18 @@ for np in $ranks; do
   else
     echo "--frob, -np $np: refused, said once"
   fi
+done
+# --profile: a table per rank, each rank's own times, each named by its rank
+for np in $ranks; do
+  [ "$np" -lt 2 ] && continue
+  timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" --profile \
+    -e "local m = dofile('$(dirname "$0")/mpi_bed.lua')(50)" >"$dir/out" 2>"$dir/err"
+  r=0
+  while [ $r -lt "$np" ]; do
+    if [ "$(grep -c "^seixo: profile (rank $r of $np) of a 2D model of 100 balls at step 50:" "$dir/err")" != 1 ]; then
+      echo "--profile, -np $np: rank $r's table not named once:"; cat "$dir/err"; fail=1
+    fi
+    r=$((r + 1))
+  done
 done
 exit $fail
