@@ -6,14 +6,15 @@
  * shadow, a private unnamed copy of the file, and reads a file back from
  * its shadow: as it made the same calls as rank 0, its shadow holds rank
  * 0's bytes, without waiting for rank 0 to have written them (the ranks
- * are never in step outside a cycle) and on a disk rank 0 may not share.
+ * are not in step outside a cycle) and on a disk rank 0 may not share.
  *
  * Wrapped on ranks above 0: io.open, io.lines, io.input and io.output (a
  * path: through io.open), os.remove and os.rename (a shadow is removed or
  * renamed; the real file is rank 0's to change, and the answer is the one
- * rank 0 gets when the file is there). A write that rank 0 would be refused
- * (no folder, no permission) is refused alike: the real file is probed
- * first, without being changed. C functions that read a file the script may have
+ * rank 0 gets when the file is there). Devices (/dev/null), FIFOs and
+ * sockets are not shadowed. A write that rank 0 would be refused (no
+ * folder, no permission) is refused alike: the real file is probed first,
+ * without being changed. C functions that read a file the script may have
  * written (an STL mesh, a clump template's spheres) take its path through
  * sx_lua_rank_file. */
 #define _XOPEN_SOURCE 700 /* realpath */
@@ -211,7 +212,11 @@ static int rank_open(lua_State *L)
     const bool writes = mode[0] != 'r' || strchr(mode, '+');
     if (!push_real_name(L, path)) return writes ? luaL_fileresult(L, 0, path) : call_lua_own(L, nargs);
     int fd = shadow_of(L);
-    if (fd == NO_SHADOW && !writes) return call_lua_own(L, nargs); /* a file the script did not write */
+    struct stat st;
+    /* a file the script did not write; a device (/dev/null: plot.live's
+     * sink on these ranks), a FIFO or a socket, which are not copies */
+    if (fd == NO_SHADOW && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
+        return call_lua_own(L, nargs);
     if (fd == GONE && mode[0] == 'r') return fail_with(L, ENOENT, path);
     if (fd < 0) { /* a shadow stands for a file rank 0 made: only a new one is probed */
         if (!may_write(path, mode) || (fd = new_shadow(fd == NO_SHADOW ? path : NULL, mode)) < 0)
