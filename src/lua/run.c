@@ -125,7 +125,11 @@ static void progress_show(progress *p, const sx_model *m, int64_t total, double 
     const int64_t done = sx_model_step_count(m) - p->step0;
     const double rate = done / (t - p->start > 0 ? t - p->start : 1e-9);
     /* aim the next chunk at 0.1 s of cycling (over ranks, at a line's interval, and no less than PROGRESS_RANKS_S) */
-    const double want = rate * (p->ranks ? fmax(p->every, PROGRESS_RANKS_S) : 0.1);
+    double want = rate * (p->ranks ? fmax(p->every, PROGRESS_RANKS_S) : 0.1);
+    /* at most 8 times the last: the first chunks' rate, over a few steps,
+     * can be many times the run's, and one chunk would then take the rest
+     * of the run without a line (seen under MPI on an idle host) */
+    if (want > 8.0 * (double)p->chunk) want = 8.0 * (double)p->chunk;
     p->chunk = want < 1 ? 1 : want > 1e9 ? 1000000000 : (int64_t)want;
     if (!p->mode || t - p->start < p->delay || t - p->last < p->every) return;
     if (p->ranks && sx_lua_parallel_rank() > 0) return; /* one line per chunk, not one per rank */
