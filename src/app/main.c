@@ -339,7 +339,7 @@ static int load_input(lua_State *L)
 {
     size_t len;
     int mark;
-    char *text = sx_lua_parallel_root_text(read_all_input, NULL, &len, &mark);
+    char *text = sx_lua_parallel_root_text("standard input", read_all_input, NULL, &len, &mark);
     if (!text) {
         lua_pushfstring(L, "cannot read the script from standard input: %s", strerror(errno));
         return LUA_ERRFILE;
@@ -719,7 +719,7 @@ static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
     prompt_read p = {first ? "> " : ">> ", tty};
     size_t len;
     int mark;
-    char *line = sx_lua_parallel_root_text(read_prompt_line, &p, &len, &mark);
+    char *line = sx_lua_parallel_root_text("the prompt", read_prompt_line, &p, &len, &mark);
     *cancelled = mark == LINE_CANCELLED;
     if (!line) return false;
     lua_pushlstring(L, line, len);

@@ -67,6 +67,13 @@ bool sx_lua_parallel_writes(bool shared);
 /// ranks, which wait for it. True if the work failed. Not shared: only
 /// reads err. A collective call: never from __gc, whose time differs between ranks.
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count);
+/// parallel.c: the start of each collective call of the Lua layer (what
+/// names it: "m:save"): true if every rank is in a call of that name; else
+/// false, with a message naming two ranks' calls in err (then every rank
+/// of the check fails, and none waits for ever). True without MPI.
+bool sx_lua_parallel_same_call(const char *what, char *err, size_t size);
+/// parallel.c: sx_lua_parallel_same_call raising the message as a Lua error.
+void sx_lua_parallel_check_call(lua_State *L, const char *what);
 /// parallel.c: rank 0's v, on every rank (which all make the call and wait
 /// for it); v itself without MPI or with one rank.
 int64_t sx_lua_parallel_root_value(int64_t v);

@@ -330,6 +330,7 @@ static int model_save(lua_State *L)
      * file is there, or every rank raises rank 0's error: the I/O layer
      * writes a message to err with every failure) */
     const bool shared = sx_model_ranks(m) > 1;
+    if (shared) sx_lua_parallel_check_call(L, "m:save");
     if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     lua_pushvalue(L, 5);
@@ -431,6 +432,7 @@ static void write_now(lua_State *L, int idx, int model, const sx_model *m, bool 
     idx = lua_absindex(L, idx);
     model = lua_absindex(L, model);
     output *o = check_output(L, idx);
+    if (collective && o->shared) sx_lua_parallel_check_call(L, "an output's samples");
     lua_getiuservalue(L, idx, 3);
     const int passed = lua_gettop(L);
     int n;
@@ -473,6 +475,7 @@ static int output_callback(lua_State *L)
 static void close_series(lua_State *L, int idx, bool collective, char *err, size_t size)
 {
     output *o = check_output(L, idx);
+    if (collective && o->shared) sx_lua_parallel_check_call(L, "o:close");
     lua_pushboolean(L, collective);
     lua_pushcclosure(L, flush_histories, 1);
     lua_pushvalue(L, idx);
@@ -622,6 +625,7 @@ static int model_output(lua_State *L)
     so.provenance.script = script_path(L);
     so.provenance.seeds = seeds_of(L, 1, &so.provenance.nseeds);
     char err[1024] = "";
+    if (o->shared) sx_lua_parallel_check_call(L, "m:output");
     if (sx_lua_parallel_writes(o->shared)) {
         o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
         if (o->s) o->count = sx_series_count(o->s);

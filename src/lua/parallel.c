@@ -69,6 +69,10 @@ void sx_lua_parallel_stop(int ok)
 {
 #ifdef SX_HAVE_MPI
     if (!mpi_started) return;
+    /* a rank that ends while others are in a collective call would leave
+     * them waiting: it ends only with the others */
+    char err[512];
+    if (ok && !sx_lua_parallel_same_call("the script's end", err, sizeof err)) sx_lua_parallel_fail(err);
     /* a rank that failed would leave the others waiting for its messages */
     if (!ok && world_size > 1) MPI_Abort(MPI_COMM_WORLD, 1);
     if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
@@ -284,6 +288,48 @@ void sx_lua_parallel_fail(const char *message)
 
 int sx_lua_parallel_rank(void) { return world_rank; }
 
+/* Every rank must make the same calls, and a collective call that some
+ * ranks skip (a save under `if seixo.rank() == 0`) would leave the ranks
+ * that make it waiting for ever, or pair it with another collective of the
+ * others. So each collective call of the Lua layer starts with this one:
+ * the ranks' names for what they are doing, gathered (one MPI_Allgather,
+ * the same operation whatever call makes it); when they differ, every
+ * rank of the check fails with the message, which names two of them. */
+enum { CALL_NAME = 32 };
+
+bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return true;
+    char mine[CALL_NAME] = {0};
+    snprintf(mine, sizeof mine, "%s", what);
+    char *all = malloc((size_t)world_size * CALL_NAME);
+    if (!all) sx_lua_parallel_fail("out of memory to compare the ranks' calls");
+    if (MPI_Allgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD) != MPI_SUCCESS)
+        sx_lua_parallel_fail("the ranks could not compare their calls");
+    int other = 1;
+    while (other < world_size && memcmp(all, all + (size_t)other * CALL_NAME, CALL_NAME) == 0) other++;
+    if (other < world_size)
+        snprintf(err, size,
+                 "%s: the ranks made different calls: rank 0 is in %.*s, rank %d in %.*s (every rank runs the "
+                 "script and must make the same calls: one under `if seixo.rank() == 0`?)",
+                 what, CALL_NAME, all, other, CALL_NAME, all + (size_t)other * CALL_NAME);
+    free(all);
+    return other >= world_size;
+#else
+    (void)what;
+    (void)err;
+    (void)size;
+    return true;
+#endif
+}
+
+void sx_lua_parallel_check_call(lua_State *L, const char *what)
+{
+    char err[512];
+    if (!sx_lua_parallel_same_call(what, err, sizeof err)) luaL_error(L, "%s", err);
+}
+
 int64_t sx_lua_parallel_root_value(int64_t v)
 {
 #ifdef SX_HAVE_MPI
@@ -293,11 +339,14 @@ int64_t sx_lua_parallel_root_value(int64_t v)
     return v;
 }
 
-char *sx_lua_parallel_root_text(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len, int *mark)
+char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud, size_t *len, int *mark), void *ud,
+                                size_t *len, int *mark)
 {
     *len = 0;
 #ifdef SX_HAVE_MPI
     if (mpi_started && world_size > 1) {
+        char err[512];
+        if (!sx_lua_parallel_same_call(what, err, sizeof err)) sx_lua_parallel_fail(err);
         char *text = world_rank == 0 ? read(ud, len, mark) : NULL;
         int64_t head[3] = {text != NULL, (int64_t)*len, *mark}; /* text or the end, its length, the mark */
         if (MPI_Bcast(head, 3, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
@@ -423,7 +472,7 @@ static int shared_tmpname(lua_State *L)
     /* rank 0's name, or its error (marked by its status) */
     size_t len;
     int status;
-    char *name = sx_lua_parallel_root_text(rank0_tmpname, L, &len, &status);
+    char *name = sx_lua_parallel_root_text("os.tmpname", rank0_tmpname, L, &len, &status);
     if (!name) return luaL_error(L, "os.tmpname: out of memory");
     lua_pushlstring(L, name, len);
     free(name);

@@ -267,6 +267,8 @@ void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
     if ((r && atomic_load(&r->interrupted)) || sx_interrupt_pending()) interrupted(L, r);
 }
 
+/* Decomposed, a collective call: the caller has checked that every rank
+ * makes it (sx_lua_parallel_check_call). */
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
 {
     sx_lua_run_poll(L, r);
@@ -562,6 +564,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (k < n) n = k;
         }
         if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
+            sx_lua_parallel_check_call(L, what); /* first: every rank is here, none waits for ever */
             const int64_t chunk = sx_lua_parallel_root_value(p->mode ? p->chunk : INT64_MAX);
             if (chunk < n) n = chunk;
         } else if (p->mode && p->chunk < n) {

@@ -61,9 +61,11 @@ SX_API int sx_lua_parallel_rank(void);
 /// meaning to) to the other ranks, which return a malloc'ed copy (or NULL)
 /// without calling read. Serially, read's answer. Standard input, which
 /// mpirun gives to rank 0 alone (the interactive mode's lines, a script
-/// read with `seixo -`), and os.tmpname's names go through it.
-SX_API char *sx_lua_parallel_root_text(char *(*read)(void *ud, size_t *len, int *mark), void *ud, size_t *len,
-                                   int *mark);
+/// read with `seixo -`), and os.tmpname's names go through it. A
+/// collective call, named `what` (sx_lua_parallel_same_call): every rank
+/// stops with a message if another rank is in another call.
+SX_API char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud, size_t *len, int *mark), void *ud,
+                                       size_t *len, int *mark);
 
 /// To call before reporting the error that ends the run (then
 /// sx_lua_parallel_stop(0)): whether this process reports it. Under mpirun

@@ -1,0 +1,31 @@
+-- Collective calls made by some ranks only (issue 16; test lua_mpi_calls
+-- through mpi_calls.sh): every rank runs the script and must make the same
+-- calls; a save, an output, a cycle or os.tmpname under a branch on
+-- seixo.rank() would leave the ranks that make it waiting for ever (a
+-- save by rank 0 alone hung before the check). Each scene must stop every
+-- rank at once, with one message naming the ranks' calls; serially (one
+-- rank does everything) it runs to its end.
+--   save     m:save on rank 0 alone, the others cycling
+--   output   m:output on rank 0 alone
+--   tmpname  os.tmpname on rank 0 alone
+--   cycle    a cycle on the last rank alone, the others at the script's end
+local scene = arg and arg[1] or "save"
+local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
+local first = seixo.rank() == 0
+if scene == "save" then
+  if first then m:save("mpi_calls.h5") end
+  m:cycle(100)
+elseif scene == "output" then
+  if first then m:output{path = "mpi_calls_series.h5"} end
+  m:cycle(100)
+elseif scene == "tmpname" then
+  if first then os.tmpname() end
+  m:cycle(100)
+elseif scene == "cycle" then
+  if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end
+else
+  error("mpi_calls.lua: scene save, output, tmpname or cycle expected, got " .. tostring(scene))
+end
+print("ended " .. scene)
+os.remove("mpi_calls.h5")
+os.remove("mpi_calls_series.h5")

@@ -1,0 +1,30 @@
+#!/bin/sh
+# Collective calls made by some ranks only (mpi_calls.lua): each scene runs
+# serially to its end, and under mpirun --oversubscribe -np 2, 3, 4 must
+# fail within a time limit (never hang) with the message naming the
+# ranks' calls printed once. Skipped (77) without mpirun.
+#   mpi_calls.sh SEIXO SCRIPT SCENE CALL
+set -u
+seixo=$1
+script=$2
+scene=$3
+call=$4
+. "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+if ! "$seixo" "$script" "$scene" >"$dir/serial" 2>"$dir/err" || ! grep -q "^ended $scene$" "$dir/serial"; then
+  echo "the serial run of '$scene' did not end:"; cat "$dir/serial" "$dir/err"; exit 1
+fi
+fail=0
+for np in $ranks; do
+  [ "$np" -lt 2 ] && continue
+  timeout 120 mpirun $root --oversubscribe -np "$np" "$seixo" "$script" "$scene" >"$dir/out" 2>"$dir/err"
+  rc=$?
+  if [ $rc = 0 ]; then echo "$scene, -np $np did not fail"; cat "$dir/out"; fail=1; continue; fi
+  if [ $rc = 124 ]; then echo "$scene, -np $np hung (killed after 120 s)"; fail=1; continue; fi
+  said=$(grep -c "the ranks made different calls: rank 0 is in .*$call" "$dir/err")
+  if [ "$said" = 1 ]; then
+    echo "$scene, -np $np: stopped, said once: $(grep -o "the ranks made different calls: [^(]*" "$dir/err")"
+  else
+    echo "$scene, -np $np: the message not once ($said):"; cat "$dir/err"; fail=1
+  fi
+done
+exit $fail
