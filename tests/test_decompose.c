@@ -32,6 +32,7 @@ typedef struct rank_ctx {
     int rank, dim;
     bool bonded, clumped;
     int64_t crossing, moved; /* clumps: pebbles routed to another rank's clump; clumps whose owner changed */
+    int64_t first_own, last_own; /* the balls of the first and of the last rank, at cycle B's last plan */
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -196,7 +197,11 @@ static void *run_rank(void *arg)
     const sx_dd *d = m->dd;
     int32_t *owner = c->clumped && !c->st ? malloc((size_t)d->ncl * sizeof *owner) : NULL; /* at A's last plan */
     if (owner) memcpy(owner, d->cown, (size_t)d->ncl * sizeof *owner);
+    /* cycle B is cut as if the ranks above ran slower and slower (their
+     * paces, which every rank holds alike): uneven slabs, the same bits */
+    for (int r = 0; d && r < c->w->ranks; r++) d->pace[r] = 1 + 3 * r;
     if (!c->st) c->st = sx_model_cycle(m, STEPS_B);
+    if (d) c->first_own = d->own[0].hi - d->own[0].lo, c->last_own = d->own[c->w->ranks - 1].hi - d->own[c->w->ranks - 1].lo;
     if (owner) {
         c->crossing = d->fwd.n;
         for (int64_t k = 0; k < d->ncl; k++) c->moved += owner[k] != d->cown[k];
@@ -249,6 +254,8 @@ START_TEST(ranks_give_the_serial_bits)
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
             }
+            ck_assert_msg(c[0].first_own > 2 * c[0].last_own, "%dD, %d ranks: the paces must skew the cut (%lld, %lld balls)",
+                          dim, ranks, (long long)c[0].first_own, (long long)c[0].last_own);
             if (clumped) {
                 printf("%dD clumps, %d ranks: %lld pebbles routed to another rank's clump, %lld clumps changed owner\n",
                        dim, ranks, (long long)c[0].crossing, (long long)c[0].moved);

@@ -68,6 +68,7 @@ void sx__dd_free(sx_model *m)
     free(d->low_a);
     free(d->cross);
     free(d->work);
+    free(d->pace);
     free(d->xchunk.cracks);
     free(d->tape.e);
     free(d);
@@ -87,7 +88,9 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
      * gho_own, fwd.own, back.own; and the routes' needs (r per rank) */
     enum { SPANS = 13 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(2 * r * r, sizeof *routes) : NULL;
-    if (!routes) {
+    double *pace = routes ? calloc(3 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r) */
+    if (!pace) {
+        free(routes);
         free(s);
         free(d);
         return sx__fail(m, SX_ENOMEM, "decompose: out of memory");
@@ -99,6 +102,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->cl_own = s + 8 * r;
     d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
     d->fwd.need = routes, d->back.need = routes + r * r;
+    d->pace = pace, d->sample = pace + r;
     m->dd = d;
     return SX_OK;
 }
@@ -375,38 +379,63 @@ enum { WORK_PAIR = 4, WORK_WALL_PAIR = 5, WORK_BALL = 2 }; /* cut_by_work's weig
 /* The work of balls [low, e) (work[] is its prefix sum over balls). */
 static int64_t work_of(const sx_dd *d, int64_t low, int64_t e) { return d->work[e] - d->work[low]; }
 
+/* A rank's share of the work against an even one is kept within this
+ * factor of it, whatever the paces measured (a rank's clock stalled by a
+ * busy host for a moment must not starve it of work). */
+#define PACE_SPREAD 2.0
+
+/* Each rank's share of the work, against an even one (mean 1): in
+ * proportion to the inverse of its pace, so that the ranks' times even
+ * out; even until every rank's pace is measured. */
+static void shares_of(const sx_dd *d, double *w)
+{
+    const int R = d->x.ranks;
+    double sum = 0;
+    bool measured = true;
+    for (int r = 0; r < R; r++) {
+        measured = measured && d->pace[r] > 0;
+        sum += d->pace[r] > 0 ? 1 / d->pace[r] : 0;
+    }
+    for (int r = 0; r < R; r++) {
+        const double share = measured ? R / (d->pace[r] * sum) : 1;
+        w[r] = share < 1 / PACE_SPREAD ? 1 / PACE_SPREAD : share > PACE_SPREAD ? PACE_SPREAD : share;
+    }
+}
+
 /* The ranks filled in turn with balls while each one's work stays within
- * bound (a rank's work: its balls' and, from below, the pairs crossing its
- * first ball, which it evaluates too); the first ball of each rank in
- * first[] (R + 1 entries, the last n). True if they take every ball. */
-static bool fill(const sx_dd *d, int64_t n, int64_t bound, int64_t *first)
+ * its share (w) of bound (a rank's work: its balls' and, from below, the
+ * pairs crossing its first ball, which it evaluates too); the first ball
+ * of each rank in first[] (R + 1 entries, the last n). True if they take
+ * every ball. */
+static bool fill(const sx_dd *d, int64_t n, int64_t bound, const double *w, int64_t *first)
 {
     const int R = d->x.ranks;
     int64_t e = 0;
     for (int r = 0; r < R; r++) {
         const int64_t lo = first[r] = e, below = WORK_PAIR * d->cross[lo];
-        while (e < n && (r == R - 1 || below + work_of(d, lo, e + 1) <= bound)) e++;
+        while (e < n && (r == R - 1 || (double)(below + work_of(d, lo, e + 1)) <= (double)bound * w[r])) e++;
     }
     first[R] = n;
-    return WORK_PAIR * d->cross[first[R - 1]] + work_of(d, first[R - 1], n) <= bound;
+    return (double)(WORK_PAIR * d->cross[first[R - 1]] + work_of(d, first[R - 1], n)) <= (double)bound * w[R - 1];
 }
 
-/* The ranks' ranges of balls, cut to even their work rather than their
+/* The ranks' ranges of balls, cut to even their time rather than their
  * ball count: besides its balls' pairs a rank evaluates the pairs from
  * the layer below that reach its balls (counted as those crossing its
  * first ball, cross[]: with the few that span a rank thinner than a
  * pair's reach, which it skips), and the lowest rank has the floor's wall
- * pairs. The largest rank's work is bisected down to the smallest bound
- * whose ranks, filled in turn, take every ball. Any cut gives the same
- * bits (every sum keeps the serial order, whatever rank makes it): this
- * one evens the ranks' time. The weights are the SC-bed's costs per item
- * (WORK_*; callgrind, 1 thread: about 250 instructions a ball-ball pair,
- * 320 a ball-wall pair, 120 a ball's integration and clearing). False:
- * out of memory. */
+ * pairs. The work is weighed by the SC-bed's costs per item (WORK_*;
+ * callgrind, 1 thread: about 250 instructions a ball-ball pair, 320 a
+ * ball-wall pair, 120 a ball's integration and clearing), and shared out
+ * by the ranks' measured paces (shares_of). The largest rank's work
+ * against its share is bisected down to the smallest bound whose ranks,
+ * filled in turn, take every ball. Any cut gives the same bits (every sum
+ * keeps the serial order, whatever rank makes it): this one evens the
+ * ranks' time. False: out of memory. */
 static bool cut_by_work(sx_model *m)
 {
     sx_dd *d = m->dd;
-    const int R = d->x.ranks;
+    const int R = d->x.ranks, me = d->x.rank;
     const int64_t n = m->balls.n;
     const sx_pairs *p = &m->bb;
     if (d->cap_cut < n + 1) {
@@ -420,7 +449,12 @@ static bool cut_by_work(sx_model *m)
         d->cap_cut = n + 1;
     }
     int64_t *first = malloc((size_t)(R + 1) * sizeof *first);
-    if (!first) return false;
+    double *w = malloc((size_t)R * sizeof *w);
+    if (!first || !w) {
+        free(first);
+        free(w);
+        return false;
+    }
     for (int64_t i = 0; i <= n; i++) d->low_a[i] = (int32_t)i, d->cross[i] = 0, d->work[i] = 0;
     for (int64_t c = 0; c < p->n; c++) {
         if (p->b[c] < n && p->a[c] < d->low_a[p->b[c]]) d->low_a[p->b[c]] = p->a[c];
@@ -429,15 +463,21 @@ static bool cut_by_work(sx_model *m)
     }
     for (int64_t c = 0; c < m->bw.n; c++) d->work[m->bw.a[c] + 1] += WORK_WALL_PAIR;
     for (int64_t i = 0; i < n; i++) d->work[i + 1] += d->work[i] + WORK_BALL, d->cross[i + 1] += d->cross[i];
-    int64_t lo = d->work[n] / R, hi = d->work[n]; /* hi: one rank could take all */
+    shares_of(d, w);
+    double sum = 0, least = w[0];
+    for (int r = 0; r < R; r++) sum += w[r], least = w[r] < least ? w[r] : least;
+    /* lo: no cut does better; hi: the least share could take all */
+    int64_t lo = (int64_t)((double)d->work[n] / sum), hi = (int64_t)((double)d->work[n] / least) + 1;
     while (hi - lo > 1 + d->work[n] / 4096) {
         const int64_t mid = lo + (hi - lo) / 2;
-        if (fill(d, n, mid, first)) hi = mid;
+        if (fill(d, n, mid, w, first)) hi = mid;
         else lo = mid;
     }
-    fill(d, n, hi, first);
+    fill(d, n, hi, w, first);
     for (int r = 0; r < R; r++) d->own[r] = (sx_span){first[r], first[r + 1]};
+    d->planned = WORK_PAIR * d->cross[first[me]] + work_of(d, first[me], first[me + 1]);
     free(first);
+    free(w);
     return true;
 }
 
@@ -974,9 +1014,40 @@ sx_status sx__dd_begin(sx_model *m)
     return SX_OK;
 }
 
+/* A rank's computing time is trusted as a sample of its pace once every
+ * rank has computed this long since its last sample (a short cycle's
+ * clock is mostly noise). */
+#define PACE_MIN_S 0.05
+
+/* The ranks' paces, shared at a cycle's end (one exchange of two doubles
+ * a rank): each rank's computing seconds since its last sample and their
+ * ratio to its planned work; once every rank has computed PACE_MIN_S,
+ * every rank folds the samples into the paces alike (half the old pace,
+ * half the new), and the next plan's cut follows them. So the load is
+ * balanced again when it drifts from the cut's work model: a pair's cost
+ * varies with the scene and with where its balls lie in memory, and a
+ * rank whose core another process shares runs slower. The cut changes no
+ * bit. */
+static bool share_pace(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks, me = d->x.rank;
+    double *s = d->sample;
+    s[2 * me] = d->busy;
+    s[2 * me + 1] = d->busy_work > 0 ? d->busy / d->busy_work : 0;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
+    for (int r = 0; r < R; r++)
+        if (!(s[2 * r] >= PACE_MIN_S && s[2 * r + 1] > 0)) return true; /* measuring on */
+    for (int r = 0; r < R; r++) d->pace[r] = d->pace[r] > 0 ? 0.5 * (d->pace[r] + s[2 * r + 1]) : s[2 * r + 1];
+    d->busy = d->busy_work = 0;
+    return true;
+}
+
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
+    if (!share_pace(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their paces");
     if (d->walls_stale && !sx__dd_walls(m))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;

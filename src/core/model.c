@@ -736,6 +736,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange ghosts");
             break;
         }
+        const double t_own = dd ? now() : 0; /* decomposed: this rank's computing, for its pace */
         st = k->contacts(m);
         t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
         if (st) break;
@@ -744,6 +745,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
+        if (dd) dd->busy += now() - t_own, dd->busy_work += (double)dd->planned;
         if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
         if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */

@@ -389,6 +389,14 @@ typedef struct sx_dd {
      * second ball it or above), and the work of the balls before it */
     int32_t *low_a, *cross;
     int64_t *work, cap_cut;
+    /* the cut's balance by measured pace (decompose.c, share_pace): per
+     * rank its seconds of computing per unit of the cut's work, smoothed
+     * (0: not measured yet), and the ranks' last samples (2 per rank);
+     * this rank's computing seconds and planned work since its last
+     * sample, and its planned work per step (the cut's) */
+    double *pace, *sample;
+    double busy, busy_work;
+    int64_t planned;
 } sx_dd;
 
 struct sx_model {
