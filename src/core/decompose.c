@@ -785,11 +785,42 @@ bool sx__dd_clumps(sx_model *m)
     return move_rows(d, &f, d->cl, 0, d->ncl, d->cl_own, everything(d, d->ncl), 1);
 }
 
+/* A rank's computing time is trusted as a sample of its pace once every
+ * rank has computed this long since its last sample (a short cycle's
+ * clock is mostly noise). */
+#define PACE_MIN_S 0.05
+
+/* The ranks' paces, shared with every gather (a build, a cycle's end: one
+ * exchange of two doubles a rank more): each rank's computing seconds since its last sample and their
+ * ratio to its planned work; once every rank has computed PACE_MIN_S,
+ * every rank folds the samples into the paces alike (half the old pace,
+ * half the new), and the next plan's cut follows them. So the load is
+ * balanced again when it drifts from the cut's work model: a pair's cost
+ * varies with the scene and with where its balls lie in memory, and a
+ * rank whose core another process shares runs slower. The cut changes no
+ * bit. */
+static bool share_pace(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks, me = d->x.rank;
+    double *s = d->sample;
+    s[2 * me] = d->busy;
+    s[2 * me + 1] = d->busy_work > 0 ? d->busy / d->busy_work : 0;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
+    for (int r = 0; r < R; r++)
+        if (!(s[2 * r] >= PACE_MIN_S && s[2 * r + 1] > 0)) return true; /* measuring on */
+    for (int r = 0; r < R; r++) d->pace[r] = d->pace[r] > 0 ? 0.5 * (d->pace[r] + s[2 * r + 1]) : s[2 * r + 1];
+    d->busy = d->busy_work = 0;
+    return true;
+}
+
 bool sx__dd_gather(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
     const size_t v = (size_t)m->dim * sizeof(double), w = (size_t)m->rdim * sizeof(double);
+    if (!share_pace(m)) return false;
     const sx_span *all = everything(d, B->n);
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
            share(d, B->w, w, d->own, all, 1) && share(d, B->f, v, d->own, all, 1) &&
@@ -1014,40 +1045,9 @@ sx_status sx__dd_begin(sx_model *m)
     return SX_OK;
 }
 
-/* A rank's computing time is trusted as a sample of its pace once every
- * rank has computed this long since its last sample (a short cycle's
- * clock is mostly noise). */
-#define PACE_MIN_S 0.05
-
-/* The ranks' paces, shared at a cycle's end (one exchange of two doubles
- * a rank): each rank's computing seconds since its last sample and their
- * ratio to its planned work; once every rank has computed PACE_MIN_S,
- * every rank folds the samples into the paces alike (half the old pace,
- * half the new), and the next plan's cut follows them. So the load is
- * balanced again when it drifts from the cut's work model: a pair's cost
- * varies with the scene and with where its balls lie in memory, and a
- * rank whose core another process shares runs slower. The cut changes no
- * bit. */
-static bool share_pace(sx_model *m)
-{
-    sx_dd *d = m->dd;
-    const int R = d->x.ranks, me = d->x.rank;
-    double *s = d->sample;
-    s[2 * me] = d->busy;
-    s[2 * me + 1] = d->busy_work > 0 ? d->busy / d->busy_work : 0;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
-    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
-    for (int r = 0; r < R; r++)
-        if (!(s[2 * r] >= PACE_MIN_S && s[2 * r + 1] > 0)) return true; /* measuring on */
-    for (int r = 0; r < R; r++) d->pace[r] = d->pace[r] > 0 ? 0.5 * (d->pace[r] + s[2 * r + 1]) : s[2 * r + 1];
-    d->busy = d->busy_work = 0;
-    return true;
-}
-
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
-    if (!share_pace(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their paces");
     if (d->walls_stale && !sx__dd_walls(m))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
