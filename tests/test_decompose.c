@@ -33,6 +33,7 @@ typedef struct rank_ctx {
     bool bonded, clumped;
     int64_t crossing, moved; /* clumps: pebbles routed to another rank's clump; clumps whose owner changed */
     int64_t first_own, last_own; /* the balls of the first and of the last rank, at cycle B's last plan */
+    double pace[MAX_RANKS];      /* the ranks' paces after cycle C */
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -209,6 +210,16 @@ static void *run_rank(void *arg)
     }
     c->hash = sx_model_state_hash(m);
     c->energy = sx_model_energy(m);
+    /* cycle C: each rank as if it had computed 0.1 s per rank number (plus
+     * what it computes now) for a fixed work; the first gather shares the
+     * samples, which every rank must fold into the same paces */
+    if (!c->st && d) {
+        for (int r = 0; r < c->w->ranks; r++) d->pace[r] = 0;
+        m->dd->busy = 0.1 * (1 + c->rank);
+        m->dd->busy_work = 1e6;
+        c->st = sx_model_cycle(m, 20);
+        memcpy(c->pace, d->pace, (size_t)c->w->ranks * sizeof *d->pace);
+    }
     sx_model_destroy(m);
     return NULL;
 }
@@ -253,6 +264,13 @@ START_TEST(ranks_give_the_serial_bits)
                               ranks, r);
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
+            }
+            for (int r = 0; r < ranks; r++) {
+                ck_assert_msg(memcmp(c[r].pace, c[0].pace, (size_t)ranks * sizeof *c[0].pace) == 0,
+                              "%dD, %d ranks: rank %d's paces differ from rank 0's", dim, ranks, r);
+                ck_assert_msg(r == 0 || c[0].pace[r] > c[0].pace[r - 1],
+                              "%dD, %d ranks: the paces must follow the ranks' times (%g, %g)", dim, ranks,
+                              c[0].pace[r - 1 + (r == 0)], c[0].pace[r]);
             }
             ck_assert_msg(c[0].first_own > 2 * c[0].last_own, "%dD, %d ranks: the paces must skew the cut (%lld, %lld balls)",
                           dim, ranks, (long long)c[0].first_own, (long long)c[0].last_own);

@@ -384,7 +384,7 @@ static int64_t work_of(const sx_dd *d, int64_t low, int64_t e) { return d->work[
  * busy host for a moment must not starve it of work). */
 #define PACE_SPREAD 2.0
 
-/* Each rank's share of the work, against an even one (mean 1): in
+/* Each rank's share of the work, against an even one (1): in
  * proportion to the inverse of its pace, so that the ranks' times even
  * out; even until every rank's pace is measured. */
 static void shares_of(const sx_dd *d, double *w)
@@ -834,12 +834,16 @@ bool sx__dd_gather(sx_model *m)
  * step (sx__walls_read_in_step): without them the step leaves its blocks'
  * sums where they are and the cycle's end makes the last step's
  * resultants, one exchange a cycle instead of one a step. */
-bool sx__dd_walls(sx_model *m)
+bool sx__dd_walls(sx_model *m, bool in_step)
 {
     sx_dd *d = m->dd;
+    /* inside a step (a servo's, energy tracking's) the rank waits here for
+     * the others, within the time its pace counts as computing (share_pace) */
+    const double t0 = in_step ? sx__now() : 0;
     if (m->nwall &&
         !share(d, m->wall_acc, (size_t)m->nwall * sizeof *m->wall_acc, d->wblk, everything(d, m->nblock), 1))
         return false;
+    if (in_step) d->busy -= sx__now() - t0;
     sx__walls_sum(m);
     d->walls_stale = false;
     return true;
@@ -1048,7 +1052,7 @@ sx_status sx__dd_begin(sx_model *m)
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
-    if (d->walls_stale && !sx__dd_walls(m))
+    if (d->walls_stale && !sx__dd_walls(m, false))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
     if (!sx__dd_gather(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");

@@ -671,7 +671,7 @@ static void move_walls(sx_model *m, double *max_wall)
     }
 }
 
-static double now(void)
+double sx__now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -681,7 +681,7 @@ static double now(void)
 /* Closes a stage that began at t0; returns the time, the next stage's start. */
 static double stage_end(sx_model *m, sx_stage s, double t0)
 {
-    const double t = now();
+    const double t = sx__now();
     m->prof.seconds[s] += t - t0;
     m->prof.calls[s]++;
     return t;
@@ -689,7 +689,7 @@ static double stage_end(sx_model *m, sx_stage s, double t0)
 
 static sx_status cycle_steps(sx_model *m, int64_t n)
 {
-    double t = now();
+    double t = sx__now();
     const int64_t builds = m->builds;
     sx_status st = sx__prepare(m);
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
@@ -707,9 +707,9 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         return st;
     }
     m->guard_dirty = false;
-    double other = now() - t; /* the stages outside the four of the step, summed over the steps */
+    double other = sx__now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
-        t = now();
+        t = sx__now();
         if (sx__interrupted(m)) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
@@ -729,14 +729,14 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
             }
         }
         st = update_timestep(m);
-        double t1 = now();
+        double t1 = sx__now();
         other += t1 - t;
         if (st) break;
         if (dd && !sx__dd_halo(m)) {
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange ghosts");
             break;
         }
-        const double t_own = dd ? now() : 0; /* decomposed: this rank's computing, for its pace */
+        const double t_own = dd ? sx__now() : 0; /* decomposed: this rank's computing, for its pace */
         st = k->contacts(m);
         t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
         if (st) break;
@@ -745,7 +745,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         if (st) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
-        if (dd) dd->busy += now() - t_own, dd->busy_work += (double)dd->planned;
+        if (dd) dd->busy += sx__now() - t_own, dd->busy_work += (double)dd->planned;
         if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
         if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */
@@ -775,7 +775,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
         /* a ghost moves with its owner and with the cell vectors that shift it */
         if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
         if (m->step % GUARD_STEPS == 0) st = guard_check(m); /* decomposed: chained sums (kernels/queries.c) */
-        other += now() - t;
+        other += sx__now() - t;
         if (st) break;
     }
     m->prof.seconds[SX_STAGE_OTHER] += other;
@@ -793,9 +793,9 @@ sx_status sx_model_cycle(sx_model *m, int64_t n)
     if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
     m->err[0] = 0;
     m->interrupt = 0;
-    const double t0 = now();
+    const double t0 = sx__now();
     const sx_status st = cycle_steps(m, n);
-    m->prof.cycle_seconds += now() - t0;
+    m->prof.cycle_seconds += sx__now() - t0;
     m->prof.cycles++;
     return st;
 }

@@ -656,6 +656,9 @@ sx_status sx__bonds_reserve_pairs(sx_model *m); /* allocates pairs.bond when bon
 /* Re-expresses a bond's vectors for the reversed pair orientation (b -> a). */
 void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
+/* The monotonic clock, in seconds (model.c): the profile's stages, a
+ * decomposed rank's pace. */
+double sx__now(void);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
  * start, the plan after a build, the ghosts' refresh, the whole state on
  * every rank (false: the exchange failed), the walls' resultants from
@@ -666,7 +669,7 @@ sx_status sx__dd_begin(sx_model *m);
 bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
-bool sx__dd_walls(sx_model *m);
+bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n
  * each, from sums), from the pebbles' owners to their clumps' owners; the

@@ -198,6 +198,10 @@ sx_status sx_series_write_histories(sx_series *s, const sx_io_history *h, int nh
 /// Snapshots in the series.
 int64_t sx_series_count(const sx_series *s);
 const char *sx_series_path(const sx_series *s);
+/// The .xmf beside a series' .h5: path with its .h5 / .hdf5 / .hdf
+/// extension replaced by .xmf (or .xmf appended); malloc'd, NULL when out
+/// of memory.
+char *sx_io_xmf_path(const char *path);
 /// Closes the series (NULL is allowed); a failure to close is reported.
 sx_status sx_series_close(sx_series *s, char *err, size_t errlen);
 

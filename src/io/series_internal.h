@@ -39,9 +39,6 @@ bool sx_io_xmf_compose(xdoc *d);
 void sx_io_xdoc_free(xdoc *d);
 /// Adds the grids of snapshot k (described by s) of the .h5 named base.
 void sx_io_xmf_step(xdoc *d, const char *base, int64_t k, const snap *s);
-/// path with its .h5 / .hdf5 / .hdf extension replaced by .xmf (or .xmf
-/// appended); malloc'd, NULL when out of memory.
-char *sx_io_xmf_path(const char *path);
 /// The grids of the first `count` snapshots of file (read back from it).
 bool sx_io_xmf_body(sx_h5 *h, xdoc *d, const char *base, hid_t file, int dim, int64_t count);
 /// The whole document, written whole (temporary name, rename).

@@ -80,7 +80,8 @@ int64_t sx_lua_parallel_root_value(int64_t v);
 /// parallel.c: under mpirun, rank 0's math.random seed and os.tmpname names on
 /// every rank, and os.exit finalizing MPI.
 void sx_lua_parallel_open(lua_State *L);
-/// parallel.c: whether models made now are decomposed over two MPI ranks or more (rank 0 writes their files).
+/// parallel.c: whether the ranks share models: MPI runs, seixo.decompose is
+/// on and a model has been decomposed (rank 0 then writes the files).
 bool sx_lua_parallel_sharing(void);
 /// rank_files.c: under mpirun, on a rank above 0, the script's files become
 /// shadows while models are shared (rank 0 alone writes the real ones).
@@ -88,6 +89,9 @@ void sx_lua_rank_files_open(lua_State *L);
 /// rank_files.c: pushes and returns the path to read for the script's file
 /// `path`: its shadow's on a rank above 0 that wrote it, else path itself.
 const char *sx_lua_rank_file(lua_State *L, const char *path);
+/// rank_files.c: rank 0 has written `path` for every rank (m:save): a rank
+/// above 0 forgets its shadow of it, and reads the disk's file.
+void sx_lua_rank_file_written(lua_State *L, const char *path);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.
 void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);
@@ -328,6 +332,10 @@ const char *sx_lua_core_message(const char *msg);
 /// Unless st is SX_OK, raises the model's message as one of the Lua call
 /// `what` ("m:wall", "seixo.model"): "m:wall: the normal must not be zero".
 void sx_lua_check(lua_State *L, const sx_model *m, sx_status st, const char *what);
+/// Replaces the Lua library function lib.name by the C closure fn, whose
+/// first upvalue is the function it replaces and the next `extra` ones the
+/// values at the stack's top (popped); nothing when lib or name is missing.
+void sx_lua_wrap(lua_State *L, const char *lib, const char *name, lua_CFunction fn, int extra);
 /// The same for a field of an object of `kind` ("ball"), the field's name
 /// at stack index 2 (getters, setters): "ball field 'radius': ...".
 void sx_lua_checkfield(lua_State *L, const sx_model *m, sx_status st, const char *kind);

@@ -333,6 +333,7 @@ static int model_save(lua_State *L)
     if (shared) sx_lua_parallel_check_call(L, "m:save");
     if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
+    sx_lua_rank_file_written(L, path); /* rank 0 wrote it: no shadow stands for it */
     lua_pushvalue(L, 5);
     return 1;
 }
@@ -631,6 +632,11 @@ static int model_output(lua_State *L)
         if (o->s) o->count = sx_series_count(o->s);
     }
     if (sx_lua_parallel_outcome(o->shared, err, sizeof err, &o->count)) return luaL_error(L, "%s", err);
+    /* rank 0 made the series and its .xmf: no shadow stands for them */
+    sx_lua_rank_file_written(L, path);
+    char *xmf = sx_io_xmf_path(path);
+    if (xmf) sx_lua_rank_file_written(L, xmf);
+    free(xmf);
     o->open = true;
     lua_pushstring(L, o->s ? sx_series_path(o->s) : path);
     lua_setiuservalue(L, 3, 4);

@@ -171,6 +171,9 @@ static int seixo_receive(lua_State *L)
  * ranks (seixo.decompose; lab.calibrate turns it off: its ranks run
  * models of their own). */
 static bool decompose_on = true;
+/* a model of this run has been decomposed: from then on the ranks share
+ * models, and rank 0 writes the files (rank_files.c) */
+static bool models_shared;
 
 #ifdef SX_HAVE_MPI
 enum { SHARE_TAG = 8 };
@@ -234,7 +237,9 @@ bool sx_lua_parallel_decompose(sx_model *m)
 #ifdef SX_HAVE_MPI
     if (!mpi_started || !decompose_on) return false;
     const sx_exchange x = {world_rank, world_size, NULL, mpi_share, mpi_max, mpi_agree};
-    return sx_model_decompose(m, &x) == SX_OK;
+    if (sx_model_decompose(m, &x) != SX_OK) return false;
+    models_shared = true;
+    return true;
 #else
     (void)m;
     return false;
@@ -372,7 +377,7 @@ bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 bool sx_lua_parallel_sharing(void)
 {
 #ifdef SX_HAVE_MPI
-    return mpi_started && decompose_on;
+    return mpi_started && decompose_on && models_shared;
 #else
     return false;
 #endif
@@ -495,22 +500,6 @@ static int mpi_exit(lua_State *L)
     return 0;
 }
 
-/* Replaces os.<name> by fn with the original as its upvalue (nothing
- * without the os library). */
-static void wrap_os(lua_State *L, const char *name, lua_CFunction fn)
-{
-    if (lua_getglobal(L, "os") != LUA_TTABLE) {
-        lua_pop(L, 1);
-        return;
-    }
-    if (lua_getfield(L, -1, name) == LUA_TFUNCTION) {
-        lua_pushcclosure(L, fn, 1);
-        lua_setfield(L, -2, name);
-        lua_pop(L, 1);
-    } else {
-        lua_pop(L, 2);
-    }
-}
 #endif
 
 void sx_lua_parallel_open(lua_State *L)
@@ -518,8 +507,8 @@ void sx_lua_parallel_open(lua_State *L)
 #ifdef SX_HAVE_MPI
     if (!mpi_started || world_size < 2) return;
     same_random_seed(L);
-    wrap_os(L, "tmpname", shared_tmpname);
-    wrap_os(L, "exit", mpi_exit);
+    sx_lua_wrap(L, "os", "tmpname", shared_tmpname, 0);
+    sx_lua_wrap(L, "os", "exit", mpi_exit, 0);
     if (world_rank > 0) sx_lua_rank_files_open(L);
 #else
     (void)L;

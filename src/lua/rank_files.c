@@ -1,25 +1,33 @@
 /* Files under mpirun. Every rank runs the script, so every rank would write
  * each file the script writes: a log opened with "a" would get each line
  * once per rank, and ranks opening one file with "w" truncate each other's
- * lines at their own pace. While models are shared (seixo.decompose, on by
- * default) rank 0 alone writes the real files; a rank above 0 writes a
- * shadow, a private unnamed copy of the file, and reads a file back from
- * its shadow: as it made the same calls as rank 0, its shadow holds rank
- * 0's bytes, without waiting for rank 0 to have written them (the ranks
- * are not in step outside a cycle) and on a disk rank 0 may not share.
+ * lines at their own pace. Once the script has a model shared over the
+ * ranks (sx_lua_parallel_sharing), rank 0 alone writes the real files; a
+ * rank above 0 writes a shadow, a private copy of the file in a folder of
+ * its own, and reads a file back from its shadow: as it made the same
+ * calls as rank 0, its shadow holds rank 0's bytes, without waiting for
+ * rank 0 to have written them (the ranks are not in step outside a cycle)
+ * and on a disk rank 0 may not share.
  *
  * Wrapped on ranks above 0: io.open, io.lines, io.input and io.output (a
  * path: through io.open), os.remove and os.rename (a shadow is removed or
- * renamed; the real file is rank 0's to change, and the answer is the one
- * rank 0 gets when the file is there). Devices (/dev/null), FIFOs and
+ * renamed; the real file is rank 0's to change). A name the script removed
+ * or renamed away is remembered as gone, so a rank that runs ahead does
+ * not find rank 0's file still there. Devices (/dev/null), FIFOs and
  * sockets are not shadowed. A write that rank 0 would be refused (no
  * folder, no permission) is refused alike: the real file is probed first,
- * without being changed. C functions that read a file the script may have
- * written (an STL mesh, a clump template's spheres) take its path through
- * sx_lua_rank_file. */
-#define _XOPEN_SOURCE 700 /* realpath */
+ * without being changed. Of a file that was on the disk before the run
+ * and that the script did not write, the disk answers, as it is when the
+ * rank asks (rank 0 may have changed it already). C functions that read a
+ * file the script may have written (an STL mesh, a clump template's
+ * spheres) take its path through sx_lua_rank_file; after rank 0 has
+ * written a file for every rank (m:save, m:output), sx_lua_rank_file_written
+ * sends the others to the disk for it. */
+#define _XOPEN_SOURCE 700 /* realpath, mkdtemp */
 #include "bindings.h"
+#include "seixo_lua.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -29,9 +37,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const char shadows_key[] = "seixo.shadows"; /* registry: real path -> shadow's descriptor */
+static const char shadows_key[] = "seixo.shadows"; /* registry: real name -> shadow's path, or false: gone */
+static char shadow_dir[PATH_MAX];                  /* this rank's folder of shadows, made with the first */
+static unsigned shadow_count;                      /* the shadows made, which name them */
 
-/* Rank 0's files are real when this process is a rank above 0 of shared models. */
+/* Rank 0's files are the real ones when this process is a rank above 0 of shared models. */
 static bool shadowing(void) { return !sx_lua_parallel_writes(sx_lua_parallel_sharing()); }
 
 /* Lua's modes: r, w or a, then + maybe, then b's. */
@@ -43,26 +53,36 @@ static bool valid_mode(const char *mode)
     return strspn(mode, "b") == strlen(mode);
 }
 
-/* Pushes the file's absolute name (its folder resolved, so that two
- * spellings of one file find one shadow); false with errno if the folder
- * is not there. */
-static bool push_real_name(lua_State *L, const char *path)
+/* The folder of path into dir (PATH_MAX): "." for a bare name; the name
+ * after it in *base. False with errno if it does not fit. */
+static bool folder_of(const char *path, char *dir, const char **base)
 {
     const char *slash = strrchr(path, '/');
+    *base = slash ? slash + 1 : path;
+    const size_t n = !slash ? 1 : slash == path ? 1 : (size_t)(slash - path);
+    if (n >= PATH_MAX) {
+        errno = ENAMETOOLONG;
+        return false;
+    }
+    memcpy(dir, slash ? path : ".", n);
+    dir[n] = '\0';
+    return true;
+}
+
+/* Pushes the file's absolute name (its folder resolved, so that two
+ * spellings of one file find one shadow); false with errno (fopen's) if
+ * the folder is not there or the name is no file's. */
+static bool push_real_name(lua_State *L, const char *path)
+{
     char dir[PATH_MAX], real[PATH_MAX];
-    if (!slash) {
-        strcpy(dir, ".");
-    } else {
-        const size_t n = slash == path ? 1 : (size_t)(slash - path);
-        if (n >= sizeof dir) {
-            errno = ENAMETOOLONG;
-            return false;
-        }
-        memcpy(dir, path, n);
-        dir[n] = '\0';
+    const char *base;
+    if (!folder_of(path, dir, &base)) return false;
+    if (!*base) { /* "" or a folder's "x/" */
+        errno = *path ? EISDIR : ENOENT;
+        return false;
     }
     if (!realpath(dir, real)) return false;
-    lua_pushfstring(L, "%s/%s", real, slash ? slash + 1 : path);
+    lua_pushfstring(L, "%s/%s", real, base);
     return true;
 }
 
@@ -76,41 +96,50 @@ static void push_shadows(lua_State *L)
     }
 }
 
-/* What the table says of a file: its shadow's descriptor (>= 0), or: */
-enum {
-    NO_SHADOW = -1, /* the script has not written it: the disk's file */
-    GONE = -2,      /* the script removed it, or renamed it away */
-};
+/* What the table says of a file. */
+enum shadow { NO_SHADOW, SHADOWED, GONE };
 
-/* The shadow of the file named at the top of the stack. */
-static int shadow_of(lua_State *L)
+/* The shadow of the file named at the top of the stack; its path into
+ * path (PATH_MAX) when SHADOWED. */
+static enum shadow shadow_of(lua_State *L, char *path)
 {
     push_shadows(L);
     lua_pushvalue(L, -2);
     const int t = lua_gettable(L, -2);
-    const int fd = t == LUA_TNUMBER ? (int)lua_tointeger(L, -1) : t == LUA_TBOOLEAN ? GONE : NO_SHADOW;
+    const enum shadow s = t == LUA_TSTRING ? SHADOWED : t == LUA_TBOOLEAN ? GONE : NO_SHADOW;
+    if (s == SHADOWED) snprintf(path, PATH_MAX, "%s", lua_tostring(L, -1));
     lua_pop(L, 2);
-    return fd;
+    return s;
 }
 
-/* Records v as the shadow of the name at the top of the stack. */
-static void put_shadow(lua_State *L, int v)
+/* Records s (with the shadow's path when SHADOWED) for the name at the
+ * top of the stack; a shadow it replaces is deleted unless keep. */
+static void set_shadow(lua_State *L, enum shadow s, const char *path, bool keep)
 {
+    char old[PATH_MAX];
+    if (!keep && shadow_of(L, old) == SHADOWED && !(s == SHADOWED && strcmp(old, path) == 0)) unlink(old);
     push_shadows(L);
     lua_pushvalue(L, -2);
-    if (v >= 0) lua_pushinteger(L, v);
-    else if (v == GONE) lua_pushboolean(L, 0);
+    if (s == SHADOWED) lua_pushstring(L, path);
+    else if (s == GONE) lua_pushboolean(L, 0);
     else lua_pushnil(L);
     lua_settable(L, -3);
     lua_pop(L, 1);
 }
 
-/* put_shadow, closing the shadow it replaces. */
-static void set_shadow(lua_State *L, int v)
+/* The folder of shadows and what is in it, gone with the process's end. */
+static void remove_shadows(void)
 {
-    const int old = shadow_of(L);
-    if (old >= 0 && old != v) close(old);
-    put_shadow(L, v);
+    DIR *dir = shadow_dir[0] ? opendir(shadow_dir) : NULL;
+    if (!dir) return;
+    char path[PATH_MAX + 256];
+    for (struct dirent *e; (e = readdir(dir));) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+        snprintf(path, sizeof path, "%s/%s", shadow_dir, e->d_name);
+        unlink(path);
+    }
+    closedir(dir);
+    rmdir(shadow_dir);
 }
 
 /* Whether rank 0 may open path with mode, found without changing the file:
@@ -125,44 +154,50 @@ static bool may_write(const char *path, const char *mode)
         return true;
     }
     if (errno != ENOENT || mode[0] == 'r') return false;
-    const char *slash = strrchr(path, '/');
     char dir[PATH_MAX];
-    if (!slash) {
-        strcpy(dir, ".");
-    } else {
-        const size_t n = slash == path ? 1 : (size_t)(slash - path);
-        memcpy(dir, path, n); /* shorter than PATH_MAX: push_real_name resolved it */
-        dir[n] = '\0';
-    }
-    return access(dir, W_OK | X_OK) == 0;
+    const char *base;
+    return folder_of(path, dir, &base) && access(dir, W_OK | X_OK) == 0; /* fits: push_real_name resolved it */
 }
 
-/* A new shadow of path (NULL: of a file the script removed): its descriptor, or -1 with errno. Opened to update
- * ("r+"), it holds the real file's bytes; opened to append, it starts
- * empty: rank 0 may be appending already (the ranks are not in step), so
- * what the real file holds now is not what it held when rank 0 opened it.
- * A log appended by this run then reads back alike on every rank; one
- * that was there before the run holds, on the ranks above 0, this run's
- * lines. */
-static int new_shadow(const char *path, const char *mode)
+/* A new shadow, its path into shadow (PATH_MAX): holding the file at path
+ * (not NULL) as it is now, or empty. False with errno. Opened to update
+ * ("r+"), a shadow copies the file; opened to append, it starts empty:
+ * rank 0 may be appending already, so what the file holds now is not what
+ * it held when rank 0 opened it. A log appended by this run then reads
+ * back alike on every rank; one that was there before the run holds, on
+ * the ranks above 0, this run's lines. */
+static bool new_shadow(const char *path, char *shadow)
 {
-    const char *tmp = getenv("TMPDIR");
-    char name[PATH_MAX];
-    snprintf(name, sizeof name, "%s/seixo-shadow-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    const int fd = mkstemp(name);
-    if (fd < 0) return -1;
-    unlink(name); /* unnamed: gone with the process, however it ends */
-    FILE *real = path && mode[0] == 'r' ? fopen(path, "rb") : NULL;
+    if (!shadow_dir[0]) {
+        const char *tmp = getenv("TMPDIR");
+        snprintf(shadow_dir, sizeof shadow_dir, "%s/seixo-rank%d-XXXXXX", tmp && *tmp ? tmp : "/tmp",
+                 sx_lua_parallel_rank());
+        if (!mkdtemp(shadow_dir)) {
+            const int e = errno;
+            shadow_dir[0] = '\0';
+            errno = e;
+            return false;
+        }
+        atexit(remove_shadows);
+    }
+    snprintf(shadow, PATH_MAX, "%s/%u", shadow_dir, shadow_count++);
+    const int fd = open(shadow, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) return false;
+    FILE *real = path ? fopen(path, "rb") : NULL;
+    bool ok = !path || real;
+    int why = ok ? 0 : errno;
     char buf[65536];
     size_t got;
-    bool ok = true;
-    while (ok && real && (got = fread(buf, 1, sizeof buf, real)) > 0) ok = write(fd, buf, got) == (ssize_t)got;
+    while (ok && real && (got = fread(buf, 1, sizeof buf, real)) > 0)
+        if (write(fd, buf, got) != (ssize_t)got) ok = false, why = errno ? errno : EIO;
+    if (ok && real && ferror(real)) ok = false, why = EIO;
     if (real) fclose(real);
+    if (close(fd) != 0 && ok) ok = false, why = errno;
     if (!ok) {
-        close(fd);
-        return -1;
+        unlink(shadow);
+        errno = why;
     }
-    return fd;
+    return ok;
 }
 
 static int close_shadow_file(lua_State *L)
@@ -171,15 +206,13 @@ static int close_shadow_file(lua_State *L)
     return luaL_fileresult(L, fclose(p->f) == 0, NULL);
 }
 
-/* Opens the shadow fd afresh (its own position, mode's truncation) as a Lua file. */
-static int push_shadow_file(lua_State *L, int fd, const char *mode, const char *path)
+/* Opens a shadow (with mode's truncation and position) as a Lua file. */
+static int push_shadow_file(lua_State *L, const char *shadow, const char *mode, const char *path)
 {
-    char proc[64];
-    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
     luaL_Stream *p = lua_newuserdatauv(L, sizeof *p, 0);
     p->closef = NULL; /* not a file until it opens */
     luaL_setmetatable(L, LUA_FILEHANDLE);
-    if (!(p->f = fopen(proc, mode))) return luaL_fileresult(L, 0, path);
+    if (!(p->f = fopen(shadow, mode))) return luaL_fileresult(L, 0, path);
     p->closef = close_shadow_file;
     return 1;
 }
@@ -211,19 +244,20 @@ static int rank_open(lua_State *L)
     luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
     const bool writes = mode[0] != 'r' || strchr(mode, '+');
     if (!push_real_name(L, path)) return writes ? luaL_fileresult(L, 0, path) : call_lua_own(L, nargs);
-    int fd = shadow_of(L);
+    char shadow[PATH_MAX];
+    const enum shadow s = shadow_of(L, shadow);
     struct stat st;
     /* a file the script did not write; a device (/dev/null: plot.live's
      * sink on these ranks), a FIFO or a socket, which are not copies */
-    if (fd == NO_SHADOW && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
+    if (s == NO_SHADOW && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
         return call_lua_own(L, nargs);
-    if (fd == GONE && mode[0] == 'r') return fail_with(L, ENOENT, path);
-    if (fd < 0) { /* a shadow stands for a file rank 0 made: only a new one is probed */
-        if (!may_write(path, mode) || (fd = new_shadow(fd == NO_SHADOW ? path : NULL, mode)) < 0)
+    if (s == GONE && mode[0] == 'r') return fail_with(L, ENOENT, path);
+    if (s != SHADOWED) { /* a shadow stands for a file rank 0 made: only a new one is probed */
+        if (!may_write(path, mode) || !new_shadow(s == NO_SHADOW && mode[0] == 'r' ? path : NULL, shadow))
             return luaL_fileresult(L, 0, path);
-        set_shadow(L, fd);
+        set_shadow(L, SHADOWED, shadow, false);
     }
-    return push_shadow_file(L, fd, mode, path);
+    return push_shadow_file(L, shadow, mode, path);
 }
 
 /* io.lines' iterator over a shadow: the file's lines, closed at their end
@@ -247,12 +281,13 @@ static int rank_lines(lua_State *L)
     const int nargs = lua_gettop(L);
     if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return call_lua_own(L, nargs);
     if (!push_real_name(L, lua_tostring(L, 1))) return call_lua_own(L, nargs);
-    const int fd = shadow_of(L);
-    if (fd == NO_SHADOW) return call_lua_own(L, nargs);
-    if (fd == GONE) return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror(ENOENT));
+    char shadow[PATH_MAX];
+    const enum shadow s = shadow_of(L, shadow);
+    if (s == NO_SHADOW) return call_lua_own(L, nargs);
     lua_pop(L, 1);
-    if (push_shadow_file(L, fd, "r", lua_tostring(L, 1)) != 1)
-        return luaL_error(L, "%s", lua_tostring(L, -2)); /* io.lines raises what io.open returns */
+    /* io.lines' own error when the file cannot be opened */
+    if (s == GONE || push_shadow_file(L, shadow, "r", lua_tostring(L, 1)) != 1)
+        return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror(s == GONE ? ENOENT : errno));
     const int file = lua_gettop(L);
     lua_getfield(L, file, "lines"); /* f:lines(formats...) */
     lua_pushvalue(L, file);
@@ -294,11 +329,12 @@ static int rank_remove(lua_State *L)
     if (!shadowing()) return call_lua_own(L, lua_gettop(L));
     const char *path = luaL_checkstring(L, 1);
     if (!push_real_name(L, path)) return luaL_fileresult(L, 0, path);
-    const int fd = shadow_of(L);
+    char shadow[PATH_MAX];
+    const enum shadow s = shadow_of(L, shadow);
     struct stat st;
-    if (fd == GONE) return fail_with(L, ENOENT, path);
-    if (fd == NO_SHADOW && lstat(path, &st) != 0) return luaL_fileresult(L, 0, path);
-    set_shadow(L, GONE);
+    if (s == GONE) return fail_with(L, ENOENT, path);
+    if (s == NO_SHADOW && lstat(path, &st) != 0) return luaL_fileresult(L, 0, path);
+    set_shadow(L, GONE, NULL, false);
     lua_pushboolean(L, 1);
     return 1;
 }
@@ -309,15 +345,22 @@ static int rank_rename(lua_State *L)
     if (!shadowing()) return call_lua_own(L, lua_gettop(L));
     const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
     if (!push_real_name(L, from)) return luaL_fileresult(L, 0, NULL);
-    const int fd = shadow_of(L);
+    char shadow[PATH_MAX], dir[PATH_MAX];
+    const char *base;
+    const enum shadow s = shadow_of(L, shadow);
     struct stat st;
-    if (fd == GONE) return fail_with(L, ENOENT, NULL);
-    if (fd == NO_SHADOW && lstat(from, &st) != 0) return luaL_fileresult(L, 0, NULL);
+    if (s == GONE) return fail_with(L, ENOENT, NULL);
+    if (s == NO_SHADOW && lstat(from, &st) != 0) return luaL_fileresult(L, 0, NULL);
     if (!push_real_name(L, to)) return luaL_fileresult(L, 0, NULL);
+    /* rank 0 must be allowed to change both folders */
+    if (!folder_of(from, dir, &base) || access(dir, W_OK | X_OK) != 0 || !folder_of(to, dir, &base) ||
+        access(dir, W_OK | X_OK) != 0)
+        return luaL_fileresult(L, 0, NULL);
     if (!lua_rawequal(L, -1, -2)) { /* one file under two spellings: nothing moves */
-        set_shadow(L, fd); /* to's shadow is from's, or none: the disk's file rank 0 renames */
+        /* to's shadow is from's, or none: the disk's file rank 0 renames */
+        set_shadow(L, s == SHADOWED ? SHADOWED : NO_SHADOW, shadow, false);
         lua_pop(L, 1);
-        put_shadow(L, GONE); /* fd is to's now */
+        set_shadow(L, GONE, NULL, true); /* from's shadow is to's now */
     }
     lua_pushboolean(L, 1);
     return 1;
@@ -325,41 +368,29 @@ static int rank_rename(lua_State *L)
 
 const char *sx_lua_rank_file(lua_State *L, const char *path)
 {
-    int fd = NO_SHADOW;
+    enum shadow s = NO_SHADOW;
+    char shadow[PATH_MAX];
     if (shadowing() && push_real_name(L, path)) {
-        fd = shadow_of(L);
+        s = shadow_of(L, shadow);
         lua_pop(L, 1);
     }
-    if (fd == GONE) return lua_pushliteral(L, ""); /* no such file, as on rank 0 */
-    if (fd == NO_SHADOW) return lua_pushstring(L, path);
-    return lua_pushfstring(L, "/proc/self/fd/%d", fd);
+    if (s == GONE) return lua_pushliteral(L, ""); /* no such file, as on rank 0 */
+    return lua_pushstring(L, s == SHADOWED ? shadow : path);
 }
 
-/* Replaces lib.name by fn, with Lua's own function as its first upvalue
- * and `extra` more values from the stack's top. */
-static void wrap(lua_State *L, const char *lib, const char *name, lua_CFunction fn, int extra)
+void sx_lua_rank_file_written(lua_State *L, const char *path)
 {
-    if (lua_getglobal(L, lib) != LUA_TTABLE) { /* a script's state without that library */
-        lua_pop(L, 1 + extra);
-        return;
-    }
-    if (lua_getfield(L, -1, name) != LUA_TFUNCTION) {
-        lua_pop(L, 2 + extra);
-        return;
-    }
-    lua_insert(L, -2 - extra); /* own, extras..., table */
-    lua_insert(L, -2 - extra); /* table, own, extras... */
-    lua_pushcclosure(L, fn, 1 + extra);
-    lua_setfield(L, -2, name);
+    if (!shadowing() || !push_real_name(L, path)) return;
+    set_shadow(L, NO_SHADOW, NULL, false);
     lua_pop(L, 1);
 }
 
 void sx_lua_rank_files_open(lua_State *L)
 {
-    wrap(L, "io", "open", rank_open, 0);
-    wrap(L, "io", "lines", rank_lines, 0);
-    wrap(L, "os", "remove", rank_remove, 0);
-    wrap(L, "os", "rename", rank_rename, 0);
+    sx_lua_wrap(L, "io", "open", rank_open, 0);
+    sx_lua_wrap(L, "io", "lines", rank_lines, 0);
+    sx_lua_wrap(L, "os", "remove", rank_remove, 0);
+    sx_lua_wrap(L, "os", "rename", rank_rename, 0);
     for (int k = 0; k < 2; k++) {
         if (lua_getglobal(L, "io") != LUA_TTABLE) {
             lua_pop(L, 1);
@@ -367,6 +398,6 @@ void sx_lua_rank_files_open(lua_State *L)
         }
         lua_getfield(L, -1, "open"); /* the wrapped io.open */
         lua_remove(L, -2);
-        wrap(L, "io", k ? "output" : "input", k ? rank_output : rank_input, 1);
+        sx_lua_wrap(L, "io", k ? "output" : "input", k ? rank_output : rank_input, 1);
     }
 }

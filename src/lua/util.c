@@ -634,3 +634,20 @@ int sx_lua_nexthandle(lua_State *L, const sx_lua_kind *k)
     }
     return 1;  // the nil that ended the snapshot
 }
+
+void sx_lua_wrap(lua_State *L, const char *lib, const char *name, lua_CFunction fn, int extra)
+{
+    if (lua_getglobal(L, lib) != LUA_TTABLE) { /* a state without that library */
+        lua_pop(L, 1 + extra);
+        return;
+    }
+    if (lua_getfield(L, -1, name) != LUA_TFUNCTION) {
+        lua_pop(L, 2 + extra);
+        return;
+    }
+    lua_insert(L, -2 - extra); /* own, extras..., table */
+    lua_insert(L, -2 - extra); /* table, own, extras... */
+    lua_pushcclosure(L, fn, 1 + extra);
+    lua_setfield(L, -2, name);
+    lua_pop(L, 1);
+}

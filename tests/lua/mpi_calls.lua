@@ -12,11 +12,12 @@
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
+local base = os.tmpname() -- every rank: rank 0's name
 if scene == "save" then
-  if first then m:save("mpi_calls.h5") end
+  if first then m:save(base .. ".h5") end
   m:cycle(100)
 elseif scene == "output" then
-  if first then m:output{path = "mpi_calls_series.h5"} end
+  if first then m:output{path = base .. "_series.h5"} end
   m:cycle(100)
 elseif scene == "tmpname" then
   if first then os.tmpname() end
@@ -27,5 +28,4 @@ else
   error("mpi_calls.lua: scene save, output, tmpname or cycle expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
-os.remove("mpi_calls.h5")
-os.remove("mpi_calls_series.h5")
+for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end

@@ -1,16 +1,24 @@
 -- Files under mpirun (issue 16; test lua_mpi_files through mpi_same.sh):
--- every rank runs the script, but while models are shared rank 0 alone
+-- every rank runs the script, but once models are shared rank 0 alone
 -- writes the real files and the other ranks read back the shadows of what
--- they wrote (src/lua/rank_files.c). A log appended after each cycle has
+-- they wrote (src/lua/rank_files.c); before, each rank writes its own
+-- (a part each, all there after the first cycle). A log appended after each cycle has
 -- its lines once, not once per rank (its header written while it is
 -- empty); a file rewritten, updated in place, written through io.output,
--- renamed, removed, refused in a folder that is not there, and a clump
--- template's spheres read back by C, give every rank rank 0's answers:
+-- renamed, removed (rank 0 running late: the others must not find its
+-- files still there), refused in a folder that is not there or without a
+-- name, a clump template's spheres read back by C, and a file removed
+-- then written by m:save for every rank, give every rank rank 0's answers:
 -- each answer goes into the model (a ball's size), so that a rank which
 -- read something else stops the next cycle ("the model differs between
 -- the ranks"), and rank 0 prints them, which must be the serial run's.
-local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local base = os.tmpname() -- rank 0's name, on every rank
+-- before any model is shared each rank writes its own files, as a script
+-- splitting work by seixo.rank() does
+local part = io.open(string.format("%s.part%d", base, seixo.rank()), "w")
+part:write("part\n")
+part:close()
+local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local record = {}
 local function note(...)
   local t = table.pack(...)
@@ -22,6 +30,10 @@ local function note(...)
   end
   record[#record + 1] = table.concat(t, " ", 1, t.n)
 end
+
+local parts = true -- every rank's, after the cycle every rank has joined
+for r = 0, seixo.ranks() - 1 do parts = parts and io.open(string.format("%s.part%d", base, r)) ~= nil end
+note("every rank's part", parts)
 
 local log = base .. ".log"
 for _ = 1, 3 do
@@ -55,6 +67,9 @@ note("io.input", io.read("l"))
 io.close()
 io.input(io.stdin)
 
+-- rank 0 late, so the others remove and rename first: they must not find
+-- rank 0's files still there (os.execute is no collective call)
+if seixo.rank() == 0 then os.execute("sleep 0.5") end
 note("rename", os.rename(base .. ".txt", base .. ".moved"))
 note("moved", io.open(base .. ".moved"):read("a"))
 note("old name", io.open(base .. ".txt"))
@@ -63,6 +78,18 @@ note("removed", io.open(base .. ".moved"))
 note("remove again", os.remove(base .. ".moved"))
 note("lines of a removed file", pcall(io.lines, base .. ".moved"))
 note("no folder", io.open(base .. ".none/file", "w"))
+note("no name", io.open("", "w"))
+
+-- a file the script removed, then saved by m:save (rank 0 writes it for
+-- all): every rank reads the saved file
+f = assert(io.open(base .. ".h5", "w"))
+f:write("not a model")
+f:close()
+os.remove(base .. ".h5")
+m:save(base .. ".h5")
+f = io.open(base .. ".h5", "rb")
+note("saved after a remove", f ~= nil, f and f:read(4) == "\137HDF")
+if f then f:close() end
 
 f = assert(io.open(base .. ".spheres", "w"))
 f:write("0 0 1e-3\n1.5e-3 0 8e-4\n")
@@ -78,4 +105,5 @@ end
 m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e7)}
 m:cycle(100)
 print("end", m:step(), m:hash())
-for _, suffix in ipairs{"", ".log", ".out", ".spheres"} do os.remove(base .. suffix) end
+for _, suffix in ipairs{"", ".log", ".out", ".spheres", ".h5"} do os.remove(base .. suffix) end
+os.remove(string.format("%s.part%d", base, seixo.rank()))

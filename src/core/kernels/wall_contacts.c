@@ -490,7 +490,7 @@ static sx_status KERNEL(walls)(sx_model *m)
     /* decomposed, the blocks' sums come from the ranks sharing them when
      * the step reads the resultants; else once, at the cycle's end */
     if (dd && !sx__walls_read_in_step(m)) m->dd->walls_stale = true;
-    else if (dd && !sx__dd_walls(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
+    else if (dd && !sx__dd_walls(m, true)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
         if (o->st == SX_EINVAL)
