@@ -89,6 +89,9 @@ void sx_lua_rank_files_open(lua_State *L);
 /// rank_files.c: pushes and returns the path to read for the script's file
 /// `path`: its shadow's on a rank above 0 that wrote it, else path itself.
 const char *sx_lua_rank_file(lua_State *L, const char *path);
+/// rank_files.c: removes this rank's folder of shadows (at exit, and when
+/// the run fails, before mpirun's abort can kill the rank).
+void sx_lua_rank_files_remove(void);
 /// rank_files.c: rank 0 has written `path` for every rank (m:save): a rank
 /// above 0 forgets its shadow of it, and reads the disk's file.
 void sx_lua_rank_file_written(lua_State *L, const char *path);

@@ -258,6 +258,7 @@ enum { FAIL_WAIT_MS = 5000, FAIL_POLL_MS = 10 };
 
 bool sx_lua_parallel_failing(void)
 {
+    sx_lua_rank_files_remove(); /* the run ends: before rank 0's MPI_Abort can kill this rank */
 #ifdef SX_HAVE_MPI
     if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
     MPI_Request req;

@@ -127,8 +127,7 @@ static void set_shadow(lua_State *L, enum shadow s, const char *path, bool keep)
     lua_pop(L, 1);
 }
 
-/* The folder of shadows and what is in it, gone with the process's end. */
-static void remove_shadows(void)
+void sx_lua_rank_files_remove(void)
 {
     DIR *dir = shadow_dir[0] ? opendir(shadow_dir) : NULL;
     if (!dir) return;
@@ -178,7 +177,7 @@ static bool new_shadow(const char *path, char *shadow)
             errno = e;
             return false;
         }
-        atexit(remove_shadows);
+        atexit(sx_lua_rank_files_remove);
     }
     snprintf(shadow, PATH_MAX, "%s/%u", shadow_dir, shadow_count++);
     const int fd = open(shadow, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
