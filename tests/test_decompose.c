@@ -210,12 +210,13 @@ static void *run_rank(void *arg)
     }
     c->hash = sx_model_state_hash(m);
     c->energy = sx_model_energy(m);
-    /* cycle C: each rank as if it had computed 0.1 s per rank number (plus
-     * what it computes now) for a fixed work; the first gather shares the
-     * samples, which every rank must fold into the same paces */
+    /* cycle C: each rank as if it had computed 100 s per rank number (far
+     * above what it computes now, even under valgrind) for a fixed work;
+     * the first gather shares the samples, which every rank must fold into
+     * the same paces */
     if (!c->st && d) {
         for (int r = 0; r < c->w->ranks; r++) d->pace[r] = 0;
-        m->dd->busy = 0.1 * (1 + c->rank);
+        m->dd->busy = 100.0 * (1 + c->rank);
         m->dd->busy_work = 1e6;
         c->st = sx_model_cycle(m, 20);
         memcpy(c->pace, d->pace, (size_t)c->w->ranks * sizeof *d->pace);

@@ -80,8 +80,8 @@ int64_t sx_lua_parallel_root_value(int64_t v);
 /// parallel.c: under mpirun, rank 0's math.random seed and os.tmpname names on
 /// every rank, and os.exit finalizing MPI.
 void sx_lua_parallel_open(lua_State *L);
-/// parallel.c: whether the ranks share models: MPI runs, seixo.decompose is
-/// on and a model has been decomposed (rank 0 then writes the files).
+/// parallel.c: whether the ranks share models and files: MPI runs and
+/// seixo.decompose is on (rank 0 then writes the files).
 bool sx_lua_parallel_sharing(void);
 /// rank_files.c: under mpirun, on a rank above 0, the script's files become
 /// shadows while models are shared (rank 0 alone writes the real ones).
@@ -92,6 +92,9 @@ const char *sx_lua_rank_file(lua_State *L, const char *path);
 /// rank_files.c: removes this rank's folder of shadows (at exit, and when
 /// the run fails, before mpirun's abort can kill the rank).
 void sx_lua_rank_files_remove(void);
+/// rank_files.c: forgets every shadow (seixo.decompose switched: the files
+/// each rank writes change hands).
+void sx_lua_rank_files_forget(lua_State *L);
 /// rank_files.c: rank 0 has written `path` for every rank (m:save): a rank
 /// above 0 forgets its shadow of it, and reads the disk's file.
 void sx_lua_rank_file_written(lua_State *L, const char *path);

@@ -171,9 +171,6 @@ static int seixo_receive(lua_State *L)
  * ranks (seixo.decompose; lab.calibrate turns it off: its ranks run
  * models of their own). */
 static bool decompose_on = true;
-/* a model of this run has been decomposed: from then on the ranks share
- * models, and rank 0 writes the files (rank_files.c) */
-static bool models_shared;
 
 #ifdef SX_HAVE_MPI
 enum { SHARE_TAG = 8 };
@@ -237,9 +234,7 @@ bool sx_lua_parallel_decompose(sx_model *m)
 #ifdef SX_HAVE_MPI
     if (!mpi_started || !decompose_on) return false;
     const sx_exchange x = {world_rank, world_size, NULL, mpi_share, mpi_max, mpi_agree};
-    if (sx_model_decompose(m, &x) != SX_OK) return false;
-    models_shared = true;
-    return true;
+    return sx_model_decompose(m, &x) == SX_OK;
 #else
     (void)m;
     return false;
@@ -378,7 +373,7 @@ bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 bool sx_lua_parallel_sharing(void)
 {
 #ifdef SX_HAVE_MPI
-    return mpi_started && decompose_on && models_shared;
+    return mpi_started && decompose_on;
 #else
     return false;
 #endif
@@ -408,6 +403,8 @@ static int seixo_decompose(lua_State *L)
 {
     if (!lua_isnoneornil(L, 1)) {
         luaL_checktype(L, 1, LUA_TBOOLEAN);
+        /* the ranks' files change hands: shadows made before would be stale */
+        if (decompose_on != lua_toboolean(L, 1)) sx_lua_rank_files_forget(L);
         decompose_on = lua_toboolean(L, 1);
     }
     lua_pushboolean(L, decompose_on);
@@ -482,7 +479,9 @@ static int shared_tmpname(lua_State *L)
     if (!name) return luaL_error(L, "os.tmpname: out of memory");
     lua_pushlstring(L, name, len);
     free(name);
-    return status == LUA_OK ? 1 : lua_error(L);
+    if (status != LUA_OK) return lua_error(L);
+    sx_lua_rank_file_written(L, lua_tostring(L, -1)); /* rank 0 made the file */
+    return 1;
 }
 
 /* os.exit under mpirun: a rank that ends without MPI_Finalize is taken by

@@ -1,8 +1,8 @@
 /* Files under mpirun. Every rank runs the script, so every rank would write
  * each file the script writes: a log opened with "a" would get each line
  * once per rank, and ranks opening one file with "w" truncate each other's
- * lines at their own pace. Once the script has a model shared over the
- * ranks (sx_lua_parallel_sharing), rank 0 alone writes the real files; a
+ * lines at their own pace. While the ranks share models (seixo.decompose,
+ * on by default: sx_lua_parallel_sharing), rank 0 alone writes the real files; a
  * rank above 0 writes a shadow, a private copy of the file in a folder of
  * its own, and reads a file back from its shadow: as it made the same
  * calls as rank 0, its shadow holds rank 0's bytes, without waiting for
@@ -21,8 +21,10 @@
  * rank asks (rank 0 may have changed it already). C functions that read a
  * file the script may have written (an STL mesh, a clump template's
  * spheres) take its path through sx_lua_rank_file; after rank 0 has
- * written a file for every rank (m:save, m:output), sx_lua_rank_file_written
- * sends the others to the disk for it. */
+ * written a file for every rank (m:save, m:output, os.tmpname's),
+ * sx_lua_rank_file_written sends the others to the disk for it, and
+ * remembers it as there: a rank that runs late removes or renames it
+ * after rank 0 did, and must not find it missing. */
 #define _XOPEN_SOURCE 700 /* realpath, mkdtemp */
 #include "bindings.h"
 #include "seixo_lua.h"
@@ -96,8 +98,9 @@ static void push_shadows(lua_State *L)
     }
 }
 
-/* What the table says of a file. */
-enum shadow { NO_SHADOW, SHADOWED, GONE };
+/* What the table says of a file: nothing (the disk's), a shadow, gone, or
+ * on the disk, written there by rank 0 for every rank. */
+enum shadow { NO_SHADOW, SHADOWED, GONE, ON_DISK };
 
 /* The shadow of the file named at the top of the stack; its path into
  * path (PATH_MAX) when SHADOWED. */
@@ -106,7 +109,9 @@ static enum shadow shadow_of(lua_State *L, char *path)
     push_shadows(L);
     lua_pushvalue(L, -2);
     const int t = lua_gettable(L, -2);
-    const enum shadow s = t == LUA_TSTRING ? SHADOWED : t == LUA_TBOOLEAN ? GONE : NO_SHADOW;
+    const enum shadow s = t == LUA_TSTRING    ? SHADOWED
+                          : t == LUA_TBOOLEAN ? (lua_toboolean(L, -1) ? ON_DISK : GONE)
+                                              : NO_SHADOW;
     if (s == SHADOWED) snprintf(path, PATH_MAX, "%s", lua_tostring(L, -1));
     lua_pop(L, 2);
     return s;
@@ -121,7 +126,7 @@ static void set_shadow(lua_State *L, enum shadow s, const char *path, bool keep)
     push_shadows(L);
     lua_pushvalue(L, -2);
     if (s == SHADOWED) lua_pushstring(L, path);
-    else if (s == GONE) lua_pushboolean(L, 0);
+    else if (s == GONE || s == ON_DISK) lua_pushboolean(L, s == ON_DISK);
     else lua_pushnil(L);
     lua_settable(L, -3);
     lua_pop(L, 1);
@@ -177,7 +182,8 @@ static bool new_shadow(const char *path, char *shadow)
             errno = e;
             return false;
         }
-        atexit(sx_lua_rank_files_remove);
+        static bool at_exit;
+        if (!at_exit) at_exit = atexit(sx_lua_rank_files_remove) == 0;
     }
     snprintf(shadow, PATH_MAX, "%s/%u", shadow_dir, shadow_count++);
     const int fd = open(shadow, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
@@ -248,11 +254,11 @@ static int rank_open(lua_State *L)
     struct stat st;
     /* a file the script did not write; a device (/dev/null: plot.live's
      * sink on these ranks), a FIFO or a socket, which are not copies */
-    if (s == NO_SHADOW && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
+    if ((s == NO_SHADOW || s == ON_DISK) && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
         return call_lua_own(L, nargs);
     if (s == GONE && mode[0] == 'r') return fail_with(L, ENOENT, path);
     if (s != SHADOWED) { /* a shadow stands for a file rank 0 made: only a new one is probed */
-        if (!may_write(path, mode) || !new_shadow(s == NO_SHADOW && mode[0] == 'r' ? path : NULL, shadow))
+        if (!may_write(path, mode) || !new_shadow(s != GONE && mode[0] == 'r' ? path : NULL, shadow))
             return luaL_fileresult(L, 0, path);
         set_shadow(L, SHADOWED, shadow, false);
     }
@@ -282,11 +288,12 @@ static int rank_lines(lua_State *L)
     if (!push_real_name(L, lua_tostring(L, 1))) return call_lua_own(L, nargs);
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
-    if (s == NO_SHADOW) return call_lua_own(L, nargs);
+    if (s == NO_SHADOW || s == ON_DISK) return call_lua_own(L, nargs);
     lua_pop(L, 1);
     /* io.lines' own error when the file cannot be opened */
-    if (s == GONE || push_shadow_file(L, shadow, "r", lua_tostring(L, 1)) != 1)
-        return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror(s == GONE ? ENOENT : errno));
+    if (s == GONE) return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror(ENOENT));
+    if (push_shadow_file(L, shadow, "r", lua_tostring(L, 1)) != 1) /* nil, the message, errno */
+        return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror((int)lua_tointeger(L, -1)));
     const int file = lua_gettop(L);
     lua_getfield(L, file, "lines"); /* f:lines(formats...) */
     lua_pushvalue(L, file);
@@ -331,8 +338,11 @@ static int rank_remove(lua_State *L)
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
     struct stat st;
+    char dir[PATH_MAX];
+    const char *base;
     if (s == GONE) return fail_with(L, ENOENT, path);
     if (s == NO_SHADOW && lstat(path, &st) != 0) return luaL_fileresult(L, 0, path);
+    if (!folder_of(path, dir, &base) || access(dir, W_OK | X_OK) != 0) return luaL_fileresult(L, 0, path);
     set_shadow(L, GONE, NULL, false);
     lua_pushboolean(L, 1);
     return 1;
@@ -357,7 +367,7 @@ static int rank_rename(lua_State *L)
         return luaL_fileresult(L, 0, NULL);
     if (!lua_rawequal(L, -1, -2)) { /* one file under two spellings: nothing moves */
         /* to's shadow is from's, or none: the disk's file rank 0 renames */
-        set_shadow(L, s == SHADOWED ? SHADOWED : NO_SHADOW, shadow, false);
+        set_shadow(L, s, shadow, false);
         lua_pop(L, 1);
         set_shadow(L, GONE, NULL, true); /* from's shadow is to's now */
     }
@@ -380,8 +390,16 @@ const char *sx_lua_rank_file(lua_State *L, const char *path)
 void sx_lua_rank_file_written(lua_State *L, const char *path)
 {
     if (!shadowing() || !push_real_name(L, path)) return;
-    set_shadow(L, NO_SHADOW, NULL, false);
+    set_shadow(L, ON_DISK, NULL, false);
     lua_pop(L, 1);
+}
+
+void sx_lua_rank_files_forget(lua_State *L)
+{
+    sx_lua_rank_files_remove();
+    shadow_dir[0] = '\0';
+    lua_pushnil(L);
+    lua_setfield(L, LUA_REGISTRYINDEX, shadows_key);
 }
 
 void sx_lua_rank_files_open(lua_State *L)

@@ -1,24 +1,33 @@
 -- Files under mpirun (issue 16; test lua_mpi_files through mpi_same.sh):
--- every rank runs the script, but once models are shared rank 0 alone
--- writes the real files and the other ranks read back the shadows of what
--- they wrote (src/lua/rank_files.c); before, each rank writes its own
--- (a part each, all there after the first cycle). A log appended after each cycle has
--- its lines once, not once per rank (its header written while it is
--- empty); a file rewritten, updated in place, written through io.output,
+-- every rank runs the script, but while the ranks share models rank 0
+-- alone writes the real files and the other ranks read back the shadows
+-- of what they wrote (src/lua/rank_files.c); with seixo.decompose(false)
+-- each rank writes its own (a part each, all there after the first
+-- cycle). A log opened before the model has its lines once, not once per
+-- rank, as has one appended after each cycle (its header written while it
+-- is empty); a file rewritten, updated in place, written through io.output,
 -- renamed, removed (rank 0 running late: the others must not find its
 -- files still there), refused in a folder that is not there or without a
--- name, a clump template's spheres read back by C, and a file removed
--- then written by m:save for every rank, give every rank rank 0's answers:
+-- name, a clump template's spheres read back by C, a file removed then
+-- written by m:save for every rank, a file saved then renamed, and
+-- os.tmpname's file removed (rank 0 first), give every rank
+-- rank 0's answers:
 -- each answer goes into the model (a ball's size), so that a rank which
 -- read something else stops the next cycle ("the model differs between
 -- the ranks"), and rank 0 prints them, which must be the serial run's.
 local base = os.tmpname() -- rank 0's name, on every rank
--- before any model is shared each rank writes its own files, as a script
+-- a log opened before the model, written after it: its lines once
+local early = assert(io.open(base .. ".early", "a"))
+-- with seixo.decompose(false) each rank writes its own files, as a script
 -- splitting work by seixo.rank() does
+seixo.decompose(false)
 local part = io.open(string.format("%s.part%d", base, seixo.rank()), "w")
 part:write("part\n")
 part:close()
+seixo.decompose(true)
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
+early:write("after the first cycle\n")
+early:close()
 local record = {}
 local function note(...)
   local t = table.pack(...)
@@ -34,6 +43,7 @@ end
 local parts = true -- every rank's, after the cycle every rank has joined
 for r = 0, seixo.ranks() - 1 do parts = parts and io.open(string.format("%s.part%d", base, r)) ~= nil end
 note("every rank's part", parts)
+for line in io.lines(base .. ".early") do note("early", line) end
 
 local log = base .. ".log"
 for _ = 1, 3 do
@@ -90,6 +100,18 @@ m:save(base .. ".h5")
 f = io.open(base .. ".h5", "rb")
 note("saved after a remove", f ~= nil, f and f:read(4) == "\137HDF")
 if f then f:close() end
+-- saved (a collective call), then renamed and removed by rank 0 first:
+-- the others must not find it missing, and must find the name it took
+m:save(base .. ".tmp.h5")
+if seixo.rank() > 0 then os.execute("sleep 0.3") end
+note("saved, renamed", os.rename(base .. ".tmp.h5", base .. ".h5"))
+f = io.open(base .. ".h5", "rb")
+note("the new name", f ~= nil, f and f:read(4) == "\137HDF")
+if f then f:close() end
+note("the old name", io.open(base .. ".tmp.h5", "rb"))
+local t = os.tmpname()
+if seixo.rank() > 0 then os.execute("sleep 0.3") end
+note("os.tmpname's file removed", os.remove(t))
 
 f = assert(io.open(base .. ".spheres", "w"))
 f:write("0 0 1e-3\n1.5e-3 0 8e-4\n")
@@ -105,5 +127,6 @@ end
 m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e7)}
 m:cycle(100)
 print("end", m:step(), m:hash())
-for _, suffix in ipairs{"", ".log", ".out", ".spheres", ".h5"} do os.remove(base .. suffix) end
+for _, suffix in ipairs{"", ".log", ".out", ".spheres", ".h5", ".early"} do os.remove(base .. suffix) end
+seixo.decompose(false) -- each rank removes its own
 os.remove(string.format("%s.part%d", base, seixo.rank()))
