@@ -12,7 +12,8 @@
 # found on one rank (mpi_clumps.lua ... unstable): its step and cause, up
 # to the critical estimate, which is the failing rank's own
 # (kernels/timestep.c, estimate_dt). Errors in the script, in a callback
-# and on one rank alone (mpi_fail.lua): the message.
+# and on one rank alone (mpi_fail.lua): the message, and, when every rank
+# fails, no rank's folder of shadows left in TMPDIR.
 set -u
 seixo=$1
 script=$2
@@ -22,6 +23,10 @@ must=$5
 . "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
 # the message, as many times as it was printed
 messages() { grep -o "$pattern" "$1"; }
+# the runs' temporary files, where the ranks above 0 keep their shadows of
+# the files a script writes: none may be left by a run that failed
+export TMPDIR="$dir/tmp"
+mkdir -p "$TMPDIR"
 # shellcheck disable=SC2086 # a scene is several arguments
 if "$seixo" "$script" $scene >"$dir/serial" 2>"$dir/err"; then
   echo "the serial run did not fail"; cat "$dir/serial"; exit 1
@@ -34,10 +39,15 @@ echo "serial: $(cat "$dir/message")"
 fail=0
 for np in $ranks; do
   # shellcheck disable=SC2086
-  timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" "$script" $scene >"$dir/out" 2>"$dir/err"
+  timeout 300 mpirun $root --oversubscribe -x TMPDIR -np "$np" "$seixo" "$script" $scene >"$dir/out" 2>"$dir/err"
   rc=$?
   if [ $rc = 0 ]; then echo "-np $np did not fail"; fail=1; continue; fi
   if [ $rc = 124 ]; then echo "-np $np hung (killed after 300 s)"; fail=1; continue; fi
+  # ranks that fail remove their shadows before the abort (a rank that
+  # mpirun kills when another fails alone, scene 'last', cannot)
+  if [ "$scene" != last ] && ls "$TMPDIR" | grep -q "^seixo-rank"; then
+    echo "-np $np: a rank's shadow folder was left: $(ls "$TMPDIR")"; fail=1; rm -rf "$TMPDIR"/seixo-rank*
+  fi
   if ! grep -q "^ranks $np$" "$dir/err"; then
     echo "-np $np: the model was not decomposed over $np ranks:"; cat "$dir/err"; fail=1; continue
   fi
