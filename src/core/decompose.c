@@ -791,8 +791,9 @@ bool sx__dd_clumps(sx_model *m)
 #define PACE_MIN_S 0.05
 
 /* The ranks' paces, shared with every gather (a build, a cycle's end: one
- * exchange of two doubles a rank more): each rank's computing seconds since its last sample and their
- * ratio to its planned work; once every rank has computed PACE_MIN_S,
+ * exchange of two doubles a rank more): each rank's computing seconds
+ * since its last sample and their ratio to its planned work; once every
+ * rank has computed PACE_MIN_S,
  * every rank folds the samples into the paces alike (half the old pace,
  * half the new), and the next plan's cut follows them. So the load is
  * balanced again when it drifts from the cut's work model: a pair's cost

@@ -71,6 +71,15 @@ static bool folder_of(const char *path, char *dir, const char **base)
     return true;
 }
 
+/* Whether rank 0 may add or remove a name in path's folder (false with
+ * errno as the call would set it). */
+static bool folder_writable(const char *path)
+{
+    char dir[PATH_MAX];
+    const char *base;
+    return folder_of(path, dir, &base) && access(dir, W_OK | X_OK) == 0;
+}
+
 /* Pushes the file's absolute name (its folder resolved, so that two
  * spellings of one file find one shadow); false with errno (fopen's) if
  * the folder is not there or the name is no file's. */
@@ -158,9 +167,7 @@ static bool may_write(const char *path, const char *mode)
         return true;
     }
     if (errno != ENOENT || mode[0] == 'r') return false;
-    char dir[PATH_MAX];
-    const char *base;
-    return folder_of(path, dir, &base) && access(dir, W_OK | X_OK) == 0; /* fits: push_real_name resolved it */
+    return folder_writable(path);
 }
 
 /* A new shadow, its path into shadow (PATH_MAX): holding the file at path
@@ -338,11 +345,9 @@ static int rank_remove(lua_State *L)
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
     struct stat st;
-    char dir[PATH_MAX];
-    const char *base;
     if (s == GONE) return fail_with(L, ENOENT, path);
     if (s == NO_SHADOW && lstat(path, &st) != 0) return luaL_fileresult(L, 0, path);
-    if (!folder_of(path, dir, &base) || access(dir, W_OK | X_OK) != 0) return luaL_fileresult(L, 0, path);
+    if (!folder_writable(path)) return luaL_fileresult(L, 0, path);
     set_shadow(L, GONE, NULL, false);
     lua_pushboolean(L, 1);
     return 1;
@@ -354,17 +359,14 @@ static int rank_rename(lua_State *L)
     if (!shadowing()) return call_lua_own(L, lua_gettop(L));
     const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
     if (!push_real_name(L, from)) return luaL_fileresult(L, 0, NULL);
-    char shadow[PATH_MAX], dir[PATH_MAX];
-    const char *base;
+    char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
     struct stat st;
     if (s == GONE) return fail_with(L, ENOENT, NULL);
     if (s == NO_SHADOW && lstat(from, &st) != 0) return luaL_fileresult(L, 0, NULL);
     if (!push_real_name(L, to)) return luaL_fileresult(L, 0, NULL);
     /* rank 0 must be allowed to change both folders */
-    if (!folder_of(from, dir, &base) || access(dir, W_OK | X_OK) != 0 || !folder_of(to, dir, &base) ||
-        access(dir, W_OK | X_OK) != 0)
-        return luaL_fileresult(L, 0, NULL);
+    if (!folder_writable(from) || !folder_writable(to)) return luaL_fileresult(L, 0, NULL);
     if (!lua_rawequal(L, -1, -2)) { /* one file under two spellings: nothing moves */
         /* to's shadow is from's, or none: the disk's file rank 0 renames */
         set_shadow(L, s, shadow, false);
