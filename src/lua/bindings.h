@@ -92,11 +92,9 @@ const char *sx_lua_rank_file(lua_State *L, const char *path);
 /// rank_files.c: removes this rank's folder of shadows (at exit, and when
 /// the run fails, before mpirun's abort can kill the rank).
 void sx_lua_rank_files_remove(void);
-/// rank_files.c: forgets every shadow (seixo.decompose switched: the files
-/// each rank writes change hands).
-void sx_lua_rank_files_forget(lua_State *L);
 /// rank_files.c: rank 0 has written `path` for every rank (m:save): a rank
-/// above 0 forgets its shadow of it, and reads the disk's file.
+/// above 0 drops its shadow of it, reads the disk's file, and removes or
+/// renames it as rank 0 did even if rank 0 got there first.
 void sx_lua_rank_file_written(lua_State *L, const char *path);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.

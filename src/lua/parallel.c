@@ -403,8 +403,6 @@ static int seixo_decompose(lua_State *L)
 {
     if (!lua_isnoneornil(L, 1)) {
         luaL_checktype(L, 1, LUA_TBOOLEAN);
-        /* the ranks' files change hands: shadows made before would be stale */
-        if (decompose_on != lua_toboolean(L, 1)) sx_lua_rank_files_forget(L);
         decompose_on = lua_toboolean(L, 1);
     }
     lua_pushboolean(L, decompose_on);

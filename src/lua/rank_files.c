@@ -141,6 +141,16 @@ static void set_shadow(lua_State *L, enum shadow s, const char *path, bool keep)
     lua_pop(L, 1);
 }
 
+/* While the ranks do not share files (seixo.decompose(false)) this rank
+ * writes, removes and renames the real file itself: a shadow of that name
+ * made before would be stale once they share again. */
+static void drop_shadow(lua_State *L, const char *path)
+{
+    if (!push_real_name(L, path)) return;
+    set_shadow(L, NO_SHADOW, NULL, false);
+    lua_pop(L, 1);
+}
+
 void sx_lua_rank_files_remove(void)
 {
     DIR *dir = shadow_dir[0] ? opendir(shadow_dir) : NULL;
@@ -250,7 +260,11 @@ static int fail_with(lua_State *L, int err, const char *path)
 static int rank_open(lua_State *L)
 {
     const int nargs = lua_gettop(L);
-    if (!shadowing()) return call_lua_own(L, nargs);
+    if (!shadowing()) {
+        const char *mode = lua_type(L, 2) == LUA_TSTRING ? lua_tostring(L, 2) : "r";
+        if (lua_type(L, 1) == LUA_TSTRING && (mode[0] != 'r' || strchr(mode, '+'))) drop_shadow(L, lua_tostring(L, 1));
+        return call_lua_own(L, nargs);
+    }
     const char *path = luaL_checkstring(L, 1);
     const char *mode = luaL_optstring(L, 2, "r");
     luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
@@ -339,7 +353,10 @@ static int rank_output(lua_State *L) { return rank_default_file(L, "w"); }
 /* os.remove(path) */
 static int rank_remove(lua_State *L)
 {
-    if (!shadowing()) return call_lua_own(L, lua_gettop(L));
+    if (!shadowing()) {
+        if (lua_type(L, 1) == LUA_TSTRING) drop_shadow(L, lua_tostring(L, 1));
+        return call_lua_own(L, lua_gettop(L));
+    }
     const char *path = luaL_checkstring(L, 1);
     if (!push_real_name(L, path)) return luaL_fileresult(L, 0, path);
     char shadow[PATH_MAX];
@@ -356,7 +373,11 @@ static int rank_remove(lua_State *L)
 /* os.rename(from, to) */
 static int rank_rename(lua_State *L)
 {
-    if (!shadowing()) return call_lua_own(L, lua_gettop(L));
+    if (!shadowing()) {
+        for (int k = 1; k <= 2; k++)
+            if (lua_type(L, k) == LUA_TSTRING) drop_shadow(L, lua_tostring(L, k));
+        return call_lua_own(L, lua_gettop(L));
+    }
     const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
     if (!push_real_name(L, from)) return luaL_fileresult(L, 0, NULL);
     char shadow[PATH_MAX];
@@ -394,14 +415,6 @@ void sx_lua_rank_file_written(lua_State *L, const char *path)
     if (!shadowing() || !push_real_name(L, path)) return;
     set_shadow(L, ON_DISK, NULL, false);
     lua_pop(L, 1);
-}
-
-void sx_lua_rank_files_forget(lua_State *L)
-{
-    sx_lua_rank_files_remove();
-    shadow_dir[0] = '\0';
-    lua_pushnil(L);
-    lua_setfield(L, LUA_REGISTRYINDEX, shadows_key);
 }
 
 void sx_lua_rank_files_open(lua_State *L)
