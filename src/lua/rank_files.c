@@ -350,6 +350,15 @@ static int rank_default_file(lua_State *L, const char *mode)
 static int rank_input(lua_State *L) { return rank_default_file(L, "r"); }
 static int rank_output(lua_State *L) { return rank_default_file(L, "w"); }
 
+/* Whether a name the table says s of is there for rank 0 to remove or
+ * rename: false with errno as the call would set it. */
+static bool present(const char *path, enum shadow s)
+{
+    struct stat st;
+    if (s == GONE) errno = ENOENT;
+    return s == SHADOWED || s == ON_DISK || (s == NO_SHADOW && lstat(path, &st) == 0);
+}
+
 /* os.remove(path) */
 static int rank_remove(lua_State *L)
 {
@@ -360,11 +369,7 @@ static int rank_remove(lua_State *L)
     const char *path = luaL_checkstring(L, 1);
     if (!push_real_name(L, path)) return luaL_fileresult(L, 0, path);
     char shadow[PATH_MAX];
-    const enum shadow s = shadow_of(L, shadow);
-    struct stat st;
-    if (s == GONE) return fail_with(L, ENOENT, path);
-    if (s == NO_SHADOW && lstat(path, &st) != 0) return luaL_fileresult(L, 0, path);
-    if (!folder_writable(path)) return luaL_fileresult(L, 0, path);
+    if (!present(path, shadow_of(L, shadow)) || !folder_writable(path)) return luaL_fileresult(L, 0, path);
     set_shadow(L, GONE, NULL, false);
     lua_pushboolean(L, 1);
     return 1;
@@ -382,10 +387,7 @@ static int rank_rename(lua_State *L)
     if (!push_real_name(L, from)) return luaL_fileresult(L, 0, NULL);
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
-    struct stat st;
-    if (s == GONE) return fail_with(L, ENOENT, NULL);
-    if (s == NO_SHADOW && lstat(from, &st) != 0) return luaL_fileresult(L, 0, NULL);
-    if (!push_real_name(L, to)) return luaL_fileresult(L, 0, NULL);
+    if (!present(from, s) || !push_real_name(L, to)) return luaL_fileresult(L, 0, NULL);
     /* rank 0 must be allowed to change both folders */
     if (!folder_writable(from) || !folder_writable(to)) return luaL_fileresult(L, 0, NULL);
     if (!lua_rawequal(L, -1, -2)) { /* one file under two spellings: nothing moves */
