@@ -674,6 +674,36 @@ static bool gather_fjoints(sx_model *m)
     return ok;
 }
 
+/* A list made in parts, one a rank, joined in rank order on every rank (a
+ * decomposed build's pairs, a gather's cracks): the ranks' counts are
+ * shared, d->scratch becomes each rank's part of the whole, and *total its
+ * length; sx__dd_join then gives every rank every part. */
+bool sx__dd_parts(sx_model *m, int64_t count, sx_span *mine, int64_t *total)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    int64_t *counts = calloc((size_t)R, sizeof *counts);
+    if (!counts) return false;
+    counts[d->x.rank] = count;
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    const bool ok = share(d, counts, sizeof *counts, d->scratch, everything(d, R), 1);
+    int64_t sum = 0;
+    for (int r = 0; ok && r < R; r++) {
+        d->scratch[r] = (sx_span){sum, sum + counts[r]};
+        sum += counts[r];
+    }
+    free(counts);
+    *mine = d->scratch[d->x.rank];
+    *total = sum;
+    return ok;
+}
+
+bool sx__dd_join(sx_model *m, void *data, size_t size, int64_t total)
+{
+    sx_dd *d = m->dd;
+    return !total || share(d, data, size, d->scratch, everything(d, total), 1);
+}
+
 /* The cracks logged since the last gather, made one log in the serial
  * order. Every rank evaluates its own pairs and some of its neighbours'
  * (from a ghost to its balls): it keeps the cracks of its own pairs (a pair is
@@ -684,30 +714,23 @@ static bool gather_cracks(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_cracks *k = &m->cracks;
-    const int R = d->x.ranks, me = d->x.rank;
-    const sx_span own = d->own[me];
-    int64_t mine = d->crack0;
+    const int R = d->x.ranks;
+    const sx_span own = d->own[d->x.rank];
+    int64_t kept = d->crack0;
     for (int64_t e = d->crack0; e < k->n; e++) {
         const int64_t a = sx__ball_index(m, k->ev[e].a);
-        if (a >= own.lo && a < own.hi) k->ev[mine++] = k->ev[e];
+        if (a >= own.lo && a < own.hi) k->ev[kept++] = k->ev[e];
     }
-    int64_t *at = calloc((size_t)(2 * R), sizeof *at), *count = at + R; /* count[r]: rank r's; at[r]: its next */
-    if (!at) return false;
-    count[me] = mine - d->crack0;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
-    bool ok = share(d, count, sizeof *count, d->scratch, everything(d, R), 1);
-    int64_t total = 0;
-    for (int r = 0; ok && r < R; r++) {
-        d->scratch[r] = (sx_span){total, total + count[r]};
-        at[r] = total;
-        total += count[r];
-    }
+    int64_t *at = malloc((size_t)R * sizeof *at), total = 0; /* at[r]: rank r's next */
+    sx_span mine;
+    bool ok = at && sx__dd_parts(m, kept - d->crack0, &mine, &total);
     sx_crack *all = ok && total ? malloc((size_t)total * sizeof *all) : NULL;
     ok = ok && (!total || all);
     if (ok && total) {
-        if (count[me]) memcpy(all + at[me], k->ev + d->crack0, (size_t)count[me] * sizeof *all);
-        ok = share(d, all, sizeof *all, d->scratch, everything(d, total), 1);
+        if (mine.hi > mine.lo) memcpy(all + mine.lo, k->ev + d->crack0, (size_t)(mine.hi - mine.lo) * sizeof *all);
+        ok = sx__dd_join(m, all, sizeof *all, total);
     }
+    for (int r = 0; ok && r < R; r++) at[r] = d->scratch[r].lo;
     k->n = d->crack0;
     for (;;) {
         int pick = -1;

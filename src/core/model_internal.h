@@ -685,6 +685,12 @@ bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size);
 /* The clumps' state from their owners to every rank (the energy guard). */
 bool sx__dd_clumps(sx_model *m);
 bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc));
+/* A list made in parts, one a rank (a decomposed build's pairs): this
+ * rank's `count` entries go to *mine of the whole (*total long, the parts
+ * in rank order); once each rank has put its part there, sx__dd_join gives
+ * every rank the whole, an array of `size`-byte entries at a time. */
+bool sx__dd_parts(sx_model *m, int64_t count, sx_span *mine, int64_t *total);
+bool sx__dd_join(sx_model *m, void *data, size_t size, int64_t total);
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
 /* Energy tracking: term v of the sum k on the rank's tape; after the law
  * of motion, every chunk's and block's energy sums of the step, the serial

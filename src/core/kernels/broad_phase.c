@@ -38,10 +38,19 @@ typedef struct transfer {
     bool replaced;            /* the old ball-ball store was given up for the new one */
 } transfer;
 
+/* One part of a listing: the pairs of the balls `balls` (their first
+ * ball's), only counted in at (list false), or put into the list from
+ * entry at on. A build counts first, so each store is sized once. */
+typedef struct cursor {
+    sx_span balls;
+    int64_t at;
+    bool list, stopped;
+} cursor;
+
 /* periodic space (kernels/ghosts.c) */
 static void wrap_balls(sx_model *m, int32_t *wrap);
 static bool make_ghosts(sx_model *m);
-static void build_ghost_pairs(sx_model *m, transfer *tr, int64_t *count);
+static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *c);
 static bool bonded_ends(sx_model *m, int32_t a, int32_t b, int32_t *ra, int32_t *rb);
 
 /* First pair of each ball in a store grouped by a, into row (nb + 1). */
@@ -173,13 +182,13 @@ static int32_t old_ball_pair(const sx_model *m, const transfer *tr, int64_t a, i
     return 0;
 }
 
-static void transfer_push(transfer *tr, int32_t a, int32_t b, int32_t facet, int32_t src)
+static void put_pair(transfer *tr, int64_t at, int32_t a, int32_t b, int32_t facet, int32_t src)
 {
-    tr->a[tr->n] = a, tr->b[tr->n] = b;
-    if (tr->f) tr->f[tr->n] = facet;
-    if (tr->src) tr->src[tr->n] = src;
-    tr->n++;
+    tr->a[at] = a, tr->b[at] = b;
+    if (tr->f) tr->f[at] = facet;
+    if (tr->src) tr->src[at] = src;
 }
+
 
 /* Replaces *field (old_cap rows of per elements of size bytes) by the
  * listed pairs' rows, gathered from their old pairs (zero without);
@@ -263,7 +272,7 @@ static bool keep_bonded_pairs(sx_model *m, transfer *tr)
             const int32_t t = a;
             a = b, b = t;
         }
-        transfer_push(tr, a, b, 0, old_ball_pair(m, tr, a, b));
+        put_pair(tr, tr->n++, a, b, 0, old_ball_pair(m, tr, a, b));
     }
     return true;
 }
@@ -461,64 +470,74 @@ static int half_stencil(int64_t (*off)[3])
     return n;
 }
 
-/* A candidate pair (i, j), i < j: counted when count is given, else listed
- * with its old pair (a bond it carries is found again). */
-static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, int64_t *count)
+/* A candidate pair (i, j), i < j, counted or listed with its old pair. */
+static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, cursor *c)
 {
     const int32_t *cl = m->balls.clump; /* clumps: pebbles of one clump never pair (NULL without clumps) */
     if (cl && cl[i] && cl[i] == cl[j]) return;
-    if (count) {
-        (*count)++;
-        return;
-    }
-    const int32_t src = old_ball_pair(m, tr, i, j);
-    if (src && m->bb.bond) {
-        const int32_t bond = m->bb.bond[src > 0 ? src - 1 : -src - 1];
-        if (bond) tr->seen[bond - 1] = 1;
-    }
-    transfer_push(tr, i, j, 0, src);
+    if (c->list) put_pair(tr, c->at, i, j, 0, old_ball_pair(m, tr, i, j));
+    c->at++;
 }
 
-/* The grid's candidate pairs in cell order; with count, only counts them
- * (a build counts first, so the store is sized once, without growing). */
-static void build_ball_pairs(sx_model *m, transfer *tr, int64_t *count)
+/* The bonds whose pairs the grid listed again (keep_bonded_pairs lists the
+ * others). */
+static void mark_found_bonds(sx_model *m, transfer *tr)
 {
+    if (!tr->src || !m->bb.bond) return;
+    for (int64_t c = 0; c < tr->n; c++) {
+        const int32_t s = tr->src[c], bond = s ? m->bb.bond[s > 0 ? s - 1 : -s - 1] : 0;
+        if (bond) tr->seen[bond - 1] = 1;
+    }
+}
+
+/* The grid's candidate pairs of c's balls in cell order. The balls are
+ * sorted by cell, so a part is a run of cells, and its pairs a run of the
+ * whole list. */
+static void build_ball_pairs(sx_model *m, transfer *tr, cursor *c)
+{
+    const sx_span part = c->balls;
     const sx_grid *g = &m->grid;
     const sx_balls *b = &m->balls;
     int64_t off[13][3];
     const int nst = half_stencil(off);
-    for (int64_t cz = 0; cz < g->nc[2]; cz++)
-        for (int64_t cy = 0; cy < g->nc[1]; cy++)
-            for (int64_t cx = 0; cx < g->nc[0]; cx++) {
-                const int64_t cell = cx + g->nc[0] * (cy + g->nc[1] * cz);
-                for (int32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
-                    /* a wide skin can make this the longest loop of seixo */
-                    if (tr->poll && i % 64 == 0 && sx__interrupted(m)) {
-                        tr->stopped = true;
-                        return;
-                    }
-                    const double *xi = b->x + (int64_t)i * D;
-                    const double ri = b->rad[i] + m->skin;
-                    /* own cell: later balls only */
-                    for (int32_t j = i + 1; j < g->start[cell + 1]; j++) {
-                        double dx[D];
-                        for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
-                        const double reach = ri + b->rad[j];
-                        if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
-                    }
-                    for (int s = 0; s < nst; s++) {
-                        const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
-                        if (nx < 0 || nx >= g->nc[0] || ny < 0 || ny >= g->nc[1] || nz >= g->nc[2]) continue;
-                        const int64_t nc = nx + g->nc[0] * (ny + g->nc[1] * nz);
-                        for (int32_t j = g->start[nc]; j < g->start[nc + 1]; j++) {
-                            double dx[D];
-                            for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
-                            const double reach = ri + b->rad[j];
-                            if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, count);
-                        }
-                    }
+    int64_t cell = 0, top = g->ncells; /* the first cell ending after the part's first ball */
+    while (cell < top) {
+        const int64_t mid = cell + (top - cell) / 2;
+        if (g->start[mid + 1] <= part.lo) cell = mid + 1;
+        else top = mid;
+    }
+    for (; cell < g->ncells && g->start[cell] < part.hi; cell++) {
+        const int64_t cx = cell % g->nc[0], cy = cell / g->nc[0] % g->nc[1], cz = cell / (g->nc[0] * g->nc[1]);
+        const int32_t i0 = g->start[cell] > part.lo ? g->start[cell] : (int32_t)part.lo;
+        const int32_t i1 = g->start[cell + 1] < part.hi ? g->start[cell + 1] : (int32_t)part.hi;
+        for (int32_t i = i0; i < i1; i++) {
+            /* a wide skin can make this the longest loop of seixo */
+            if (tr->poll && i % 64 == 0 && sx__interrupted(m)) {
+                c->stopped = true;
+                return;
+            }
+            const double *xi = b->x + (int64_t)i * D;
+            const double ri = b->rad[i] + m->skin;
+            /* own cell: later balls only */
+            for (int32_t j = i + 1; j < g->start[cell + 1]; j++) {
+                double dx[D];
+                for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
+                const double reach = ri + b->rad[j];
+                if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, c);
+            }
+            for (int s = 0; s < nst; s++) {
+                const int64_t nx = cx + off[s][0], ny = cy + off[s][1], nz = cz + off[s][2];
+                if (nx < 0 || nx >= g->nc[0] || ny < 0 || ny >= g->nc[1] || nz >= g->nc[2]) continue;
+                const int64_t nc = nx + g->nc[0] * (ny + g->nc[1] * nz);
+                for (int32_t j = g->start[nc]; j < g->start[nc + 1]; j++) {
+                    double dx[D];
+                    for (int k = 0; k < D; k++) dx[k] = b->x[(int64_t)j * D + k] - xi[k];
+                    const double reach = ri + b->rad[j];
+                    if (dot(dx, dx) < reach * reach) candidate(m, tr, i, j, c);
                 }
             }
+        }
+    }
 }
 
 #if D == 3
@@ -541,8 +560,8 @@ static int by_index(const void *a, const void *b)
 
 /* Ball i's facets of mesh wall w closer than its radius plus the skin, in
  * facet order, found through the mesh's grid (the ball taken into the
- * mesh's frame); with count, only counts them. */
-static void list_mesh_pairs(sx_model *m, transfer *tr, int64_t i, int64_t w, int64_t *count)
+ * mesh's frame), counted or listed. */
+static void list_mesh_pairs(sx_model *m, transfer *tr, int64_t i, int64_t w, cursor *c)
 {
     const sx_wall *wl = &m->walls[w];
     sx_mesh *s = wl->mesh;
@@ -557,49 +576,100 @@ static void list_mesh_pairs(sx_model *m, transfer *tr, int64_t i, int64_t w, int
         facet_hit h;
         facet_closest(s, l.near[e], x, &h);
         if (!(h.dist < reach)) continue;
-        if (count) (*count)++;
-        else transfer_push(tr, (int32_t)i, (int32_t)w, l.near[e], old_pair(tr, &m->bw, tr->row_bw, i, w, true, l.near[e]));
+        if (c->list) put_pair(tr, c->at, (int32_t)i, (int32_t)w, l.near[e], old_pair(tr, &m->bw, tr->row_bw, i, w, true, l.near[e]));
+        c->at++;
     }
 }
 #endif
 
-/* Ball-wall candidates, ball-major so the contact loop walks balls in
- * order; with count, only counts them (as build_ball_pairs). */
-static void build_wall_pairs(sx_model *m, transfer *tr, int64_t *count)
+/* Ball-wall candidates of c's balls, ball-major so the contact loop walks
+ * balls in order. */
+static void build_wall_pairs(sx_model *m, transfer *tr, cursor *c)
 {
     const sx_balls *b = &m->balls;
-    for (int64_t i = 0; i < b->n; i++)
+    for (int64_t i = c->balls.lo; i < c->balls.hi; i++)
         for (int64_t w = 0; w < m->nwall; w++) {
 #if D == 3
             if (m->walls[w].mesh) {
-                list_mesh_pairs(m, tr, i, w, count);
+                list_mesh_pairs(m, tr, i, w, c);
                 continue;
             }
 #endif
             double n[D];
             const double dist = wall_distance(&m->walls[w], b->x + i * D, n);
             if (dist >= b->rad[i] + m->skin) continue;
-            if (count) (*count)++;
-            else transfer_push(tr, (int32_t)i, (int32_t)w, 0, old_pair(tr, &m->bw, tr->row_bw, i, w, true, 0));
+            if (c->list) put_pair(tr, c->at, (int32_t)i, (int32_t)w, 0, old_pair(tr, &m->bw, tr->row_bw, i, w, true, 0));
+            c->at++;
         }
 }
 
+/* The parts' pairs, each part on a thread of its own. */
+static void list_parts(sx_model *m, transfer *tr, bool walls, cursor *c, int parts)
+{
+#pragma omp parallel for num_threads(parts) schedule(static, 1) if (parts > 1)
+    for (int k = 0; k < parts; k++) {
+        if (walls) build_wall_pairs(m, tr, &c[k]);
+        else build_ball_pairs(m, tr, &c[k]);
+    }
+    for (int k = 0; k < parts; k++) tr->stopped |= c[k].stopped;
+}
+
+/* Every rank's part of the listed pairs on every rank. */
+static bool join_parts(sx_model *m, transfer *tr, int64_t total)
+{
+    return sx__dd_join(m, tr->a, sizeof *tr->a, total) && sx__dd_join(m, tr->b, sizeof *tr->b, total) &&
+           (!tr->f || sx__dd_join(m, tr->f, sizeof *tr->f, total)) &&
+           (!tr->src || sx__dd_join(m, tr->src, sizeof *tr->src, total));
+}
+
+/* Balls per thread below which a listing is not worth a thread. */
+#define LIST_THREAD_BALLS 1024
+#define LIST_PARTS_MAX 64
+
 /* The pairs of one store, counted, then listed (and the bonded pairs kept),
- * then carried over into the store. */
+ * then carried over into the store. The listing, the costly part of a
+ * build, is made in parts whose lists are joined in order, the serial
+ * list whatever the parts: the threads' (without meshes), and inside
+ * a decomposed cycle the ranks' (each the pairs of its own balls, the
+ * last plan's cut, balanced by work; periodic space's ghost pairs, listed
+ * after them, by every rank). */
 static bool build_store(sx_model *m, transfer *tr, bool walls)
 {
-    int64_t count = 0, most = 0;
+    int64_t most = 0;
     tr->facets = walls && m->mesh_pairs;
     for (int64_t w = 0; walls && w < m->nwall; w++)
         if (m->walls[w].mesh && m->walls[w].mesh->nt > most) most = m->walls[w].mesh->nt;
     if (most && !(tr->near = malloc((size_t)most * sizeof *tr->near))) return false;
-    if (walls) build_wall_pairs(m, tr, &count);
-    else build_ball_pairs(m, tr, &count);
-    if (!walls && m->cell) build_ghost_pairs(m, tr, &count);
-    if (tr->stopped || !transfer_list(m, tr, count, true)) return false;
-    if (walls) build_wall_pairs(m, tr, NULL);
-    else build_ball_pairs(m, tr, NULL);
-    if (!walls && m->cell) build_ghost_pairs(m, tr, NULL);
+    const bool split = m->dd && m->dd->active;
+    const sx_span part = split ? m->dd->own[m->dd->x.rank] : (sx_span){0, m->balls.n};
+    const int64_t len = part.hi - part.lo;
+    int64_t parts = most ? 1 : len / LIST_THREAD_BALLS; /* a mesh's listing uses tr->near: one part */
+    if (parts > m->threads) parts = m->threads;
+    if (parts > LIST_PARTS_MAX) parts = LIST_PARTS_MAX;
+    if (parts < 1) parts = 1;
+    cursor c[LIST_PARTS_MAX];
+    for (int64_t k = 0; k < parts; k++)
+        c[k] = (cursor){.balls = {part.lo + len * k / parts, part.lo + len * (k + 1) / parts}};
+    list_parts(m, tr, walls, c, (int)parts);
+    int64_t count = 0;
+    for (int64_t k = 0; k < parts; k++) count += c[k].at;
+    sx_span mine = {0, count};
+    int64_t total = count;
+    if (split && !sx__dd_parts(m, count, &mine, &total)) return false;
+    cursor ghosts = {.at = total};
+    if (!walls && m->cell) build_ghost_pairs(m, tr, &ghosts);
+    if (tr->stopped || !transfer_list(m, tr, ghosts.at, true)) return false;
+    for (int64_t k = 0, at = mine.lo; k < parts; k++) {
+        const int64_t n = c[k].at;
+        c[k].at = at, c[k].list = true;
+        at += n;
+    }
+    list_parts(m, tr, walls, c, (int)parts);
+    if (split && !join_parts(m, tr, total)) return false;
+    ghosts = (cursor){.at = total, .list = true};
+    if (!walls && m->cell) build_ghost_pairs(m, tr, &ghosts);
+    tr->n = ghosts.at;
+    if (!walls) mark_found_bonds(m, tr);
     if (tr->stopped || (!walls && !keep_bonded_pairs(m, tr))) return false;
     if (!walls) tr->replaced = true;
     return transfer_store(m, walls ? &m->bw : &m->bb, tr);
@@ -631,7 +701,7 @@ static sx_status KERNEL(build)(sx_model *m)
      * them and never grows while it is filled */
     transfer tr;
     bool ok = transfer_begin(m, &tr);
-    tr.poll = !m->cell;
+    tr.poll = !m->cell && !(m->dd && m->dd->active); /* the ranks' parts must all be listed */
     if (ok && m->cell) wrap_balls(m, tr.wrap); /* periodic space: balls into the cell, then their ghosts */
     ok = ok && grid_setup(m) && sort_balls(m, &tr) && (!m->cell || make_ghosts(m)) && build_store(m, &tr, false) &&
          build_store(m, &tr, true);
