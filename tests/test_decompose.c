@@ -34,6 +34,7 @@ typedef struct rank_ctx {
     int64_t crossing, moved; /* clumps: pebbles routed to another rank's clump; clumps whose owner changed */
     int64_t first_own, last_own; /* the balls of the first and of the last rank, at cycle B's last plan */
     double pace[MAX_RANKS];      /* the ranks' paces after cycle C */
+    int64_t builds;              /* cycle B's builds (all but a first one inside the cycle, the ranks listing in parts) */
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -112,6 +113,7 @@ static sx_model *tracked_model(int dim, int *mat)
 static sx_model *bed(int dim, bool bonded)
 {
     sx_model *m = tracked_model(dim, NULL);
+    m->skin_user = 2e-5; /* a thin skin: builds inside the cycles, where the ranks list the pairs in parts */
     const double r = 0.01, s = 2 * r - 1e-5;
     const int nx = dim == 3 ? 12 : 80, ny = dim == 3 ? 12 : 50, nz = dim == 3 ? 14 : 1;
     uint64_t seed = 11;
@@ -201,7 +203,9 @@ static void *run_rank(void *arg)
     /* cycle B is cut as if the ranks above ran slower and slower (their
      * paces, which every rank holds alike): uneven slabs, the same bits */
     for (int r = 0; d && r < c->w->ranks; r++) d->pace[r] = 1 + 3 * r;
+    c->builds = m->builds;
     if (!c->st) c->st = sx_model_cycle(m, STEPS_B);
+    c->builds = m->builds - c->builds;
     if (d) c->first_own = d->own[0].hi - d->own[0].lo, c->last_own = d->own[c->w->ranks - 1].hi - d->own[c->w->ranks - 1].lo;
     if (owner) {
         c->crossing = d->fwd.n;
@@ -273,6 +277,8 @@ START_TEST(ranks_give_the_serial_bits)
                               "%dD, %d ranks: the paces must follow the ranks' times (%g, %g)", dim, ranks,
                               c[0].pace[r - 1 + (r == 0)], c[0].pace[r]);
             }
+            ck_assert_msg(c[0].builds >= 2, "%dD, %d ranks: cycle B must build inside the cycle (%lld builds)", dim,
+                          ranks, (long long)c[0].builds);
             ck_assert_msg(c[0].first_own > 2 * c[0].last_own, "%dD, %d ranks: the paces must skew the cut (%lld, %lld balls)",
                           dim, ranks, (long long)c[0].first_own, (long long)c[0].last_own);
             if (clumped) {

@@ -721,27 +721,26 @@ static bool gather_cracks(sx_model *m)
         const int64_t a = sx__ball_index(m, k->ev[e].a);
         if (a >= own.lo && a < own.hi) k->ev[kept++] = k->ev[e];
     }
-    int64_t *at = malloc((size_t)R * sizeof *at), total = 0; /* at[r]: rank r's next */
     sx_span mine;
-    bool ok = at && sx__dd_parts(m, kept - d->crack0, &mine, &total);
+    int64_t total = 0;
+    bool ok = sx__dd_parts(m, kept - d->crack0, &mine, &total);
     sx_crack *all = ok && total ? malloc((size_t)total * sizeof *all) : NULL;
     ok = ok && (!total || all);
     if (ok && total) {
         if (mine.hi > mine.lo) memcpy(all + mine.lo, k->ev + d->crack0, (size_t)(mine.hi - mine.lo) * sizeof *all);
         ok = sx__dd_join(m, all, sizeof *all, total);
     }
-    for (int r = 0; ok && r < R; r++) at[r] = d->scratch[r].lo;
+    sx_span *next = d->scratch; /* each rank's part, its first entry not yet merged */
     k->n = d->crack0;
     for (;;) {
         int pick = -1;
         for (int r = 0; ok && r < R; r++) /* the earliest step; on a tie the lower rank */
-            if (at[r] < d->scratch[r].hi && (pick < 0 || all[at[r]].step < all[at[pick]].step)) pick = r;
+            if (next[r].lo < next[r].hi && (pick < 0 || all[next[r].lo].step < all[next[pick].lo].step)) pick = r;
         if (pick < 0) break;
-        ok = sx__crack_log(m, &all[at[pick]++]);
+        ok = sx__crack_log(m, &all[next[pick].lo++]);
     }
     d->crack0 = k->n;
     free(all);
-    free(at);
     return ok;
 }
 

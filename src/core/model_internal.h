@@ -688,7 +688,9 @@ bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx
 /* A list made in parts, one a rank (a decomposed build's pairs): this
  * rank's `count` entries go to *mine of the whole (*total long, the parts
  * in rank order); once each rank has put its part there, sx__dd_join gives
- * every rank the whole, an array of `size`-byte entries at a time. */
+ * every rank the whole, an array of `size`-byte entries at a time, from
+ * the parts sx__dd_parts left in the plan's scratch spans (no other
+ * exchange between the two). */
 bool sx__dd_parts(sx_model *m, int64_t count, sx_span *mine, int64_t *total);
 bool sx__dd_join(sx_model *m, void *data, size_t size, int64_t total);
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));

@@ -50,7 +50,7 @@ typedef struct cursor {
 /* periodic space (kernels/ghosts.c) */
 static void wrap_balls(sx_model *m, int32_t *wrap);
 static bool make_ghosts(sx_model *m);
-static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *c);
+static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *to);
 static bool bonded_ends(sx_model *m, int32_t a, int32_t b, int32_t *ra, int32_t *rb);
 
 /* First pair of each ball in a store grouped by a, into row (nb + 1). */
@@ -188,7 +188,6 @@ static void put_pair(transfer *tr, int64_t at, int32_t a, int32_t b, int32_t fac
     if (tr->f) tr->f[at] = facet;
     if (tr->src) tr->src[at] = src;
 }
-
 
 /* Replaces *field (old_cap rows of per elements of size bytes) by the
  * listed pairs' rows, gathered from their old pairs (zero without);
@@ -480,7 +479,8 @@ static inline void candidate(sx_model *m, transfer *tr, int32_t i, int32_t j, cu
 }
 
 /* The bonds whose pairs the grid listed again (keep_bonded_pairs lists the
- * others). */
+ * others): marked once the parts are joined, since a rank lists only its
+ * part, and threads marking as they list would write one array. */
 static void mark_found_bonds(sx_model *m, transfer *tr)
 {
     if (!tr->src || !m->bb.bond) return;
@@ -603,13 +603,16 @@ static void build_wall_pairs(sx_model *m, transfer *tr, cursor *c)
         }
 }
 
-/* The parts' pairs, each part on a thread of its own. */
+/* The parts' pairs, each part on a thread of its own, its cursor a copy
+ * of its own while it lists (cursors side by side share a cache line). */
 static void list_parts(sx_model *m, transfer *tr, bool walls, cursor *c, int parts)
 {
 #pragma omp parallel for num_threads(parts) schedule(static, 1) if (parts > 1)
     for (int k = 0; k < parts; k++) {
-        if (walls) build_wall_pairs(m, tr, &c[k]);
-        else build_ball_pairs(m, tr, &c[k]);
+        cursor mine = c[k];
+        if (walls) build_wall_pairs(m, tr, &mine);
+        else build_ball_pairs(m, tr, &mine);
+        c[k] = mine;
     }
     for (int k = 0; k < parts; k++) tr->stopped |= c[k].stopped;
 }
@@ -622,7 +625,9 @@ static bool join_parts(sx_model *m, transfer *tr, int64_t total)
            (!tr->src || sx__dd_join(m, tr->src, sizeof *tr->src, total));
 }
 
-/* Balls per thread below which a listing is not worth a thread. */
+/* Balls per thread below which a listing is not worth a thread; at most
+ * LIST_PARTS_MAX parts (their cursors on the stack: more threads than
+ * that gain nothing on a listing this short). */
 #define LIST_THREAD_BALLS 1024
 #define LIST_PARTS_MAX 64
 
@@ -643,7 +648,8 @@ static bool build_store(sx_model *m, transfer *tr, bool walls)
     const bool split = m->dd && m->dd->active;
     const sx_span part = split ? m->dd->own[m->dd->x.rank] : (sx_span){0, m->balls.n};
     const int64_t len = part.hi - part.lo;
-    int64_t parts = most ? 1 : len / LIST_THREAD_BALLS; /* a mesh's listing uses tr->near: one part */
+    /* a mesh's query writes tr->near and the mesh's own stamps: one part */
+    int64_t parts = most ? 1 : len / LIST_THREAD_BALLS;
     if (parts > m->threads) parts = m->threads;
     if (parts > LIST_PARTS_MAX) parts = LIST_PARTS_MAX;
     if (parts < 1) parts = 1;
@@ -669,8 +675,9 @@ static bool build_store(sx_model *m, transfer *tr, bool walls)
     ghosts = (cursor){.at = total, .list = true};
     if (!walls && m->cell) build_ghost_pairs(m, tr, &ghosts);
     tr->n = ghosts.at;
+    if (tr->stopped) return false;
     if (!walls) mark_found_bonds(m, tr);
-    if (tr->stopped || (!walls && !keep_bonded_pairs(m, tr))) return false;
+    if (!walls && !keep_bonded_pairs(m, tr)) return false;
     if (!walls) tr->replaced = true;
     return transfer_store(m, walls ? &m->bw : &m->bb, tr);
 }

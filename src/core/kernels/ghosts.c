@@ -140,7 +140,7 @@ static bool make_ghosts(sx_model *m)
  * nearest cell, whose neighbours then hold every ball within its reach).
  * The owner rule keeps one of the two images of a contact: the real end
  * has the smaller id. */
-static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *list)
+static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *to)
 {
     const sx_cell *c = m->cell;
     const sx_grid *g = &m->grid;
@@ -161,7 +161,7 @@ static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *list)
                         double dx[D];
                         for (int k = 0; k < D; k++) dx[k] = xq[k] - b->x[(int64_t)j * D + k];
                         const double reach = b->rad[q] + b->rad[j] + m->skin;
-                        if (dot(dx, dx) < reach * reach) candidate(m, tr, j, q, list);
+                        if (dot(dx, dx) < reach * reach) candidate(m, tr, j, q, to);
                     }
                 }
     }
