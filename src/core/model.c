@@ -687,7 +687,15 @@ static double stage_end(sx_model *m, sx_stage s, double t0)
     return t;
 }
 
-static sx_status cycle_steps(sx_model *m, int64_t n)
+bool sx_model_time_reached(const sx_model *m, double t_end)
+{
+    /* each sum of a timestep rounds by at most half an ulp of the time
+     * (an ulp <= eps |t|), one more for t_end itself */
+    const double rounding = ((double)m->step + 1) * DBL_EPSILON * fmax(fabs(m->time), fabs(t_end));
+    return m->time >= t_end - fmin(rounding, 0.5 * m->dt_prev);
+}
+
+static sx_status cycle_steps(sx_model *m, int64_t n, double t_end)
 {
     double t = sx__now();
     const int64_t builds = m->builds;
@@ -709,6 +717,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
     m->guard_dirty = false;
     double other = sx__now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
+        if (sx_model_time_reached(m, t_end)) break; /* the time is global: every rank stops here */
         t = sx__now();
         if (sx__interrupted(m)) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
@@ -787,14 +796,17 @@ static sx_status cycle_steps(sx_model *m, int64_t n)
     return st;
 }
 
-sx_status sx_model_cycle(sx_model *m, int64_t n)
+sx_status sx_model_cycle(sx_model *m, int64_t n) { return sx_model_cycle_until(m, n, INFINITY); }
+
+sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end)
 {
     if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
     if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
+    if (isnan(t_end)) return sx__fail(m, SX_EINVAL, "cycle: the time to stop at is not a number");
     m->err[0] = 0;
     m->interrupt = 0;
     const double t0 = sx__now();
-    const sx_status st = cycle_steps(m, n);
+    const sx_status st = cycle_steps(m, n, t_end);
     m->prof.cycle_seconds += sx__now() - t0;
     m->prof.cycles++;
     return st;

@@ -293,9 +293,10 @@ typedef struct sx_lua_run sx_lua_run;
 /// or by lua_settop below it). Refused while the model cycles (`what` names
 /// the caller in the message).
 sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
-/// Cycles the core n steps in the run, without user callbacks; an interrupt
-/// ("interrupted at step N") or a failure is a Lua error.
-void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n);
+/// Cycles the core n steps in the run, without user callbacks, stopping
+/// early at the first step that reaches model time t_end (INFINITY: none);
+/// an interrupt ("interrupted at step N") or a failure is a Lua error.
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end);
 /// Raises "interrupted at step N" when the run was interrupted, and
 /// "interrupted" when r is NULL and a Ctrl-C is pending: long C work (between
 /// cycles, or outside any run) calls it so that a Ctrl-C stops it too.

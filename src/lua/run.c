@@ -29,7 +29,6 @@
  * function (a __close is one), which is why it waits for Lua code (main.c).
  * Long C work outside the core's cycle (generation) opens a run too and
  * polls it, so a Ctrl-C stops it as promptly as a cycle. */
-#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -269,10 +268,10 @@ void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 
 /* Decomposed, a collective call: the caller has checked that every rank
  * makes it (sx_lua_parallel_check_call). */
-void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n)
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     sx_lua_run_poll(L, r);
-    const sx_status st = sx_model_cycle(r->m, n);
+    const sx_status st = sx_model_cycle_until(r->m, n, t_end);
     if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
         char msg[1024];
         luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
@@ -483,33 +482,15 @@ typedef struct limits {
 enum reason { BY_STEPS, BY_TIME, BY_RATIO };
 static const char *const reason_names[] = {"steps", "time", "ratio"};
 
-/* How far below t_end a step boundary still counts as reaching it: the
- * rounding that n additions of the timestep to the model time can have
- * accumulated (each at most half an ulp of the time, an ulp <= eps |t|; one
- * more for t_end itself). Without it, 1 s in steps of 1e-5 s took 100001
- * steps. Never more than half a step, so no run stops a step early. */
-static double time_slack(double t, double t_end, double dt, double n)
-{
-    const double rounding = (n + 1) * DBL_EPSILON * fmax(fabs(t), fabs(t_end));
-    return fmin(rounding, 0.5 * dt);
-}
-
-/* Steps to the first boundary at or after the model time t_end, `taken`
- * steps into the run. */
-static int64_t steps_to_time(sx_model *m, double t_end, int64_t taken)
+/* Steps enough to reach the model time t_end at the present timestep;
+ * the core stops at the first step that reaches it (sx_model_cycle_until),
+ * so a timestep that changes inside the chunk changes nothing. */
+static int64_t steps_to_time(sx_model *m, double t_end)
 {
     const double dt = sx_model_timestep(m);
     if (!(dt > 0)) return 1;  // let the core say what is wrong
-    const double t = sx_model_time(m), left = (t_end - t) / dt;
-    const double k = ceil((t_end - time_slack(t, t_end, dt, (double)taken + left + 1) - t) / dt);
+    const double k = ceil((t_end - sx_model_time(m)) / dt) + 1;
     return k < 1 ? 1 : k > 1e15 ? (int64_t)1e15 : (int64_t)k;
-}
-
-static bool time_reached(sx_model *m, double t_end, int64_t taken)
-{
-    if (isinf(t_end)) return false;
-    const double dt = sx_model_timestep(m), t = sx_model_time(m);
-    return t >= t_end - (dt > 0 ? time_slack(t, t_end, dt, (double)taken) : 0);
 }
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
@@ -538,7 +519,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             why = BY_STEPS;
             break;
         }
-        if (time_reached(m, lim->time, taken)) {
+        if (sx_model_time_reached(m, lim->time)) {
             why = BY_TIME;
             break;
         }
@@ -560,7 +541,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (k < n) n = k;
         }
         if (!isinf(lim->time)) {
-            const int64_t k = steps_to_time(m, lim->time, taken);
+            const int64_t k = steps_to_time(m, lim->time);
             if (k < n) n = k;
         }
         if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
@@ -572,7 +553,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
         }
         /* a placement check follows the first step; contact and region events are per step */
         if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
-        sx_lua_run_cycle(L, r, n);
+        sx_lua_run_cycle(L, r, n, lim->time);
         sx_lua_events_deliver(L, 1);
         double fraction = -1;
         int64_t total = 0;

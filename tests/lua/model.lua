@@ -64,6 +64,37 @@ test("solve{time} takes the whole number of steps the time is", function()
   eq(steps(0.0123 + 1e-9), 124)
 end)
 
+-- The automatic timestep grows as a burst cluster loses its contacts: a
+-- run with a time limit must still stop at the first step past it, and at
+-- the same step however it is cut into cycles (one step at a time under a
+-- callback, or in one long cycle without a progress display; cut at the
+-- start's timestep, it ran to 0.0825 s of 0.05 s, 110 steps instead of 69).
+test("solve{time} stops at the first step past the time, however the run is cut", function()
+  local progress = seixo.progress(false)
+  local function burst()
+    local m = seixo.model{dim = 2}
+    m:material("s", {kn = 1e5, ks = 1e5, density = 2500})
+    for j = 0, 6 do
+      for i = 0, 6 do m:ball{pos = {0.0095 * (i + 0.5 * (j % 2)), 0.0095 * 0.866 * j}, radius = 0.005} end
+    end
+    return m
+  end
+  local whole = burst()
+  eq(whole:solve{time = 0.05}, "time")
+  local stepped = burst()
+  local lo, hi = math.huge, 0
+  stepped:on("after", function()
+    local dt = stepped:timestep()
+    lo, hi = math.min(lo, dt), math.max(hi, dt)
+  end)
+  eq(stepped:solve{time = 0.05}, "time")
+  seixo.progress(progress)
+  check(hi > 1.5 * lo, "the automatic timestep must grow as the cluster bursts")
+  eq(whole:step(), stepped:step())
+  eq(whole:hash(), stepped:hash())
+  check(whole:time() >= 0.05 and whole:time() < 0.05 + hi, "by the first step past it: " .. whole:time())
+end)
+
 test("solve stops on the unbalanced-force ratio", function()
   for _, dim in ipairs({2, 3}) do
     local m = column(dim, 4)
