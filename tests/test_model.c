@@ -192,6 +192,28 @@ START_TEST(cycle_arguments)
 }
 END_TEST
 
+/* sx_model_cycle_until: no step once the time is reached (none when it is
+ * already), the first step past it, NaN refused. */
+START_TEST(cycle_until_time)
+{
+    const int dim = _i;
+    sx_model *m = scene_model(dim, NULL, 1e-4, 1e6, 0.5, 1000);
+    scene_ball(m, (const double[3]){0, 0, 0}, NULL, 0.1);
+    ck_assert_int_eq(sx_model_cycle_until(m, 1000, 0.0123, 0), SX_OK);
+    ck_assert_int_eq(sx_model_step_count(m), 123); /* 0.0123 within the rounding of 123 sums */
+    ck_assert_int_eq(sx_model_cycle_until(m, 1000, 0.0123, 0), SX_OK);
+    ck_assert_int_eq(sx_model_step_count(m), 123); /* reached: no step */
+    ck_assert_int_eq(sx_model_cycle_until(m, 5, 1.0, 123), SX_OK);
+    ck_assert_int_eq(sx_model_step_count(m), 128); /* n stops it first */
+    ck_assert_int_eq(sx_model_cycle_until(m, 1000, 0.01285, 123), SX_OK);
+    ck_assert_int_eq(sx_model_step_count(m), 129); /* past 0.01285 by the first step after it */
+    ck_assert_int_eq(sx_model_cycle_until(m, 1, NAN, 0), SX_EINVAL);
+    ck_assert_msg_has(m, "not a number");
+    ck_assert_int_eq(sx_model_step_count(m), 129);
+    sx_model_destroy(m);
+}
+END_TEST
+
 START_TEST(time_user_timestep)
 {
     const int dim = _i;
@@ -823,6 +845,7 @@ int main(void)
     tcase_add_test(tc, material_validation);
     tcase_add_loop_test(tc, cycle_arguments, 2, 4);
     tcase_add_loop_test(tc, time_user_timestep, 2, 4);
+    tcase_add_loop_test(tc, cycle_until_time, 2, 4);
     tcase_add_loop_test(tc, auto_timestep_free_ball, 2, 4);
     tcase_add_loop_test(tc, auto_timestep_contacts, 2, 4);
     tcase_add_loop_test(tc, bytes_grow_with_balls, 2, 4);

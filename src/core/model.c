@@ -687,15 +687,16 @@ static double stage_end(sx_model *m, sx_stage s, double t0)
     return t;
 }
 
-bool sx_model_time_reached(const sx_model *m, double t_end)
+bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since)
 {
-    /* each sum of a timestep rounds by at most half an ulp of the time
-     * (an ulp <= eps |t|), one more for t_end itself */
-    const double rounding = ((double)m->step + 1) * DBL_EPSILON * fmax(fabs(m->time), fabs(t_end));
+    /* each sum of a timestep in the run rounds by at most half an ulp of
+     * the time (an ulp <= eps |t|), one more for t_end itself */
+    const double sums = m->step > since ? (double)(m->step - since) : 0;
+    const double rounding = (sums + 1) * DBL_EPSILON * fmax(fabs(m->time), fabs(t_end));
     return m->time >= t_end - fmin(rounding, 0.5 * m->dt_prev);
 }
 
-static sx_status cycle_steps(sx_model *m, int64_t n, double t_end)
+static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
 {
     double t = sx__now();
     const int64_t builds = m->builds;
@@ -717,7 +718,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end)
     m->guard_dirty = false;
     double other = sx__now() - t; /* the stages outside the four of the step, summed over the steps */
     for (int64_t s = 0; s < n; s++) {
-        if (sx_model_time_reached(m, t_end)) break; /* the time is global: every rank stops here */
+        if (sx_model_time_reached(m, t_end, since)) break; /* the time is global: every rank stops here */
         t = sx__now();
         if (sx__interrupted(m)) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
@@ -729,6 +730,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end)
                 st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
                 break;
             }
+            if ((st = check_skin(m))) break; /* as at a cycle's start, however the run is cut */
             st = k->build(m);
             if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs: balls migrate */
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
@@ -796,9 +798,9 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end)
     return st;
 }
 
-sx_status sx_model_cycle(sx_model *m, int64_t n) { return sx_model_cycle_until(m, n, INFINITY); }
+sx_status sx_model_cycle(sx_model *m, int64_t n) { return sx_model_cycle_until(m, n, INFINITY, m->step); }
 
-sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end)
+sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end, int64_t since)
 {
     if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
     if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
@@ -806,7 +808,7 @@ sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end)
     m->err[0] = 0;
     m->interrupt = 0;
     const double t0 = sx__now();
-    const sx_status st = cycle_steps(m, n, t_end);
+    const sx_status st = cycle_steps(m, n, t_end, since);
     m->prof.cycle_seconds += sx__now() - t0;
     m->prof.cycles++;
     return st;

@@ -72,15 +72,18 @@ SX_API sx_status sx_model_set_gravity(sx_model *m, const double g[3]);
 /// Advances the model n steps. Stops early with SX_EUNSTABLE (stability
 /// guard) or SX_EINTERRUPT; the model stays consistent and inspectable.
 SX_API sx_status sx_model_cycle(sx_model *m, int64_t n);
-/// As sx_model_cycle, but also stops after the first step that reaches
-/// model time t_end (sx_model_time_reached): where a run with a time limit
-/// stops does not depend on how it is cut into cycles, even when the
-/// automatic timestep changes inside one.
-SX_API sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end);
-/// The model time has reached t_end: it is at least t_end less the
-/// rounding its sums of timesteps can have accumulated (at most half the
-/// last step; without it, 1 s in steps of 1e-5 s took 100,001 steps).
-SX_API bool sx_model_time_reached(const sx_model *m, double t_end);
+/// As sx_model_cycle, for a run begun at step count `since`, but takes no
+/// step once the model time has reached t_end (sx_model_time_reached;
+/// INFINITY: no limit; NaN is refused), so it stops after the first step
+/// that reaches it, and takes none when it is reached already: where a run
+/// with a time limit stops does not depend on how it is cut into cycles,
+/// even when the automatic timestep changes inside one.
+SX_API sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end, int64_t since);
+/// The model time has reached t_end, in a run begun at step count `since`:
+/// it is at least t_end less the rounding that the run's sums of timesteps
+/// can have accumulated (at most half the last step's timestep; none before
+/// the model's first step). Without it, 1 s in steps of 1e-5 s took 100,001.
+SX_API bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since);
 
 /// OpenMP threads used by the step (default 1). Results are bit-identical
 /// for any thread count: work is split in chunks that depend only on the model.

@@ -266,6 +266,8 @@ bool sx_lua_is_event(const char *name);
 int sx_lua_events_add(lua_State *L, lua_Integer id);
 /// Whether the model at `model` has handlers that need the run to go step by step.
 bool sx_lua_events_per_step(lua_State *L, int model);
+/// Whether the model at `model` has a bond_break handler (delivered at chunks' ends).
+bool sx_lua_events_on_bonds(lua_State *L, int model);
 /// Delivers the events of the steps since the last delivery to their handlers.
 void sx_lua_events_deliver(lua_State *L, int model);
 
@@ -294,7 +296,8 @@ typedef struct sx_lua_run sx_lua_run;
 /// the caller in the message).
 sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
 /// Cycles the core n steps in the run, without user callbacks, stopping
-/// early at the first step that reaches model time t_end (INFINITY: none);
+/// early at the first step that reaches model time t_end (INFINITY: none;
+/// the rounding allowed counts the run's steps, sx_model_time_reached);
 /// an interrupt ("interrupted at step N") or a failure is a Lua error.
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end);
 /// Raises "interrupted at step N" when the run was interrupted, and

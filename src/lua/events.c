@@ -12,9 +12,11 @@
  * its centre was inside after the last delivery and is not now. While a
  * contact or region event is registered the run is cycled one step at a
  * time (a step's events are delivered after that step); a bond_break alone
- * lets the run go in chunks and delivers after each chunk, every event
- * carrying the step it happened at. Cycling in chunks of any size gives
- * the same bits, so events change nothing in a run.
+ * lets the run go in chunks of 100 steps (ending at multiples of 100, not
+ * where the progress display would end them: a handler that changes the
+ * model acts at the same step on any machine) and delivers after each
+ * chunk, every event carrying the step it happened at. Cycling in chunks
+ * of any size gives the same bits, so events change nothing in a run.
  *
  * Order, deterministic: the bonds broken (crack log order), then the
  * contacts deleted, then those created (each by ball id, wall contacts
@@ -160,6 +162,14 @@ static bool has(lua_State *L, int handlers, int kind)
         lua_pop(L, 2);
     }
     return found;
+}
+
+bool sx_lua_events_on_bonds(lua_State *L, int model)
+{
+    sx_lua_state(L, model, "events");
+    const bool on = has(L, lua_gettop(L), EV_BOND);
+    lua_pop(L, 1);
+    return on;
 }
 
 bool sx_lua_events_per_step(lua_State *L, int model)

@@ -167,6 +167,7 @@ struct sx_lua_run {
     int slot;                // its place in runs[], -1 when not listed
     int saved_callback;      // ud->callback when the run started
     const char *what;        // the Lua call, in messages ("m:solve")
+    int64_t since;           // the model's step count when the run began
     bool open;               // not closed yet
     progress progress;       // the progress line, cleared when the run ends
 };
@@ -232,6 +233,7 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     r->ud = ud;
     r->slot = -1;
     r->what = what;
+    r->since = sx_model_step_count(m);
     atomic_init(&r->interrupted, 0);
     atomic_init(&r->in_lua, 0);
     lua_createtable(L, 0, 1);
@@ -271,7 +273,7 @@ void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     sx_lua_run_poll(L, r);
-    const sx_status st = sx_model_cycle_until(r->m, n, t_end);
+    const sx_status st = sx_model_cycle_until(r->m, n, t_end, r->since);
     if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
         char msg[1024];
         luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
@@ -482,6 +484,10 @@ typedef struct limits {
 enum reason { BY_STEPS, BY_TIME, BY_RATIO };
 static const char *const reason_names[] = {"steps", "time", "ratio"};
 
+/* Steps between deliveries of bond_break events when no event needs every
+ * step: a handler then acts at a multiple of it, whatever the machine. */
+#define BOND_EVENT_STEPS 100
+
 /* Steps enough to reach the model time t_end at the present timestep;
  * the core stops at the first step that reaches it (sx_model_cycle_until),
  * so a timestep that changes inside the chunk changes nothing. */
@@ -519,7 +525,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             why = BY_STEPS;
             break;
         }
-        if (sx_model_time_reached(m, lim->time)) {
+        if (sx_model_time_reached(m, lim->time, start)) {
             why = BY_TIME;
             break;
         }
@@ -544,11 +550,19 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = steps_to_time(m, lim->time);
             if (k < n) n = k;
         }
+        /* a bond_break handler runs at the chunk's end and may change the
+         * model: the chunks then end at fixed steps, not where the progress
+         * display's clock would end them */
+        const bool fixed = sx_lua_events_on_bonds(L, 1);
+        if (fixed) {
+            const int64_t k = BOND_EVENT_STEPS - s % BOND_EVENT_STEPS;
+            if (k < n) n = k;
+        }
         if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
             sx_lua_parallel_check_call(L, what); /* first: every rank is here, none waits for ever */
-            const int64_t chunk = sx_lua_parallel_root_value(p->mode ? p->chunk : INT64_MAX);
+            const int64_t chunk = fixed ? INT64_MAX : sx_lua_parallel_root_value(p->mode ? p->chunk : INT64_MAX);
             if (chunk < n) n = chunk;
-        } else if (p->mode && p->chunk < n) {
+        } else if (!fixed && p->mode && p->chunk < n) {
             n = p->chunk;
         }
         /* a placement check follows the first step; contact and region events are per step */

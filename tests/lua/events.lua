@@ -21,11 +21,16 @@ local function pair_key(a, b, wall) return (wall and "w" or "b") .. a.id .. "-" 
 test("bond_break: one event per crack, in the crack log's order, after its step", function()
   local m = rows()
   local seen = {}
+  local start = m:step()
   m:on("bond_break", function(mm, e)
     check(mm:step() >= e.step, "delivered after the step it happened in")
+    -- at a multiple of 100 steps (or the run's end), wherever the progress display's clock would cut the run
+    check(mm:step() % 100 == 0 or mm:step() == start + 1000, "delivered at step " .. mm:step())
     seen[#seen + 1] = e
   end)
+  local progress = seixo.progress("log", 1e-3)
   m:cycle(1000)
+  seixo.progress(progress, 10)
   local cracks = m:cracks()
   check(#cracks > 0)
   eq(#seen, #cracks)
