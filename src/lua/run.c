@@ -506,7 +506,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     run *r = sx_lua_run_open(L, 1, what);
     sx_model *m = r->m;
     const int top = lua_gettop(L);
-    const int64_t start = sx_model_step_count(m);
+    const int64_t start = r->since; /* the time limit's rounding, in the core too, counts from it */
     const double t0 = sx_model_time(m);
     progress *p = &r->progress;
     progress_start(L, p, m, what, r->ud->decomposed);
