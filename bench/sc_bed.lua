@@ -1,19 +1,24 @@
 -- The SC-bed of ../shared/BENCH.md as a script, for scripts/bench --mpi:
--- `mpirun -np N seixo bench/sc_bed.lua N_BALLS [STEPS [WARMUP]]` runs the
--- scene decomposed over the ranks (issue 16), as build/bench/sx-bench (the
--- same scene through the C API, bench/sc_bed.c) runs it on threads. The
--- last line, from rank 0: "SXBENCH n=... ranks=... steps=... seconds=...
--- hash=..."; seconds is the wall time of the timed block, which starts and
--- ends on every rank together (a cycle ends with every rank's state
--- gathered), and the hash lets the caller check that every rank count
--- computed the same bits.
+-- `mpirun -np N seixo bench/sc_bed.lua N_BALLS [STEPS [WARMUP [CHUNK]]]`
+-- runs the scene decomposed over the ranks (issue 16), as
+-- build/bench/sx-bench (the same scene through the C API, bench/sc_bed.c)
+-- runs it on threads; CHUNK cuts the timed steps into cycles of that many
+-- (a script cycling in short runs; default one cycle). The last line, from
+-- rank 0: "SXBENCH n=... ranks=... steps=... seconds=... hash=...";
+-- seconds is the wall time of the timed block, which starts and ends on
+-- every rank together (it ends with a query, m:contact_count(), which
+-- gathers the state the cycles left on each rank), and the hash lets the
+-- caller check that every rank count computed the same bits.
 local sizes = {[10000] = {20, 20, 25}, [50000] = {50, 40, 25}, [100000] = {50, 80, 25}, [400000] = {100, 160, 25}}
 local n = math.tointeger(tonumber(arg and arg[1]) or 10000)
 local steps = math.tointeger(tonumber(arg and arg[2]) or 2000)
 local warmup = math.tointeger(tonumber(arg and arg[3]) or 10)
+local chunk = math.tointeger(tonumber(arg and arg[4]) or steps)
 local size = n and sizes[n]
 if not size then error("sc_bed.lua: N must be 10000, 50000, 100000 or 400000 (BENCH.md's lattices), got " .. tostring(arg[1])) end
-if not steps or steps < 1 or not warmup or warmup < 0 then error("sc_bed.lua: STEPS >= 1 and WARMUP >= 0 expected") end
+if not steps or steps < 1 or not warmup or warmup < 0 or not chunk or chunk < 1 or steps % chunk ~= 0 then
+  error("sc_bed.lua: STEPS >= 1, WARMUP >= 0 and CHUNK >= 1 dividing STEPS expected")
+end
 local nx, ny, nz = size[1], size[2], size[3]
 
 -- BENCH.md's constants; seixo's springs are per ball, in series at a
@@ -45,7 +50,8 @@ for _, w in ipairs{{{0, 0, 0}, {0, 0, 1}}, {{0, 0, 0}, {1, 0, 0}}, {{lx, 0, 0}, 
 end
 m:cycle(warmup)
 local t0 = seixo.clock()
-m:cycle(steps)
+for _ = 1, steps // chunk do m:cycle(chunk) end
+local contacts = m:contact_count()
 local seconds = seixo.clock() - t0
 print(string.format("SXBENCH n=%d ranks=%d steps=%d seconds=%.6f contacts=%d kinetic=%.6e hash=%s", n, m:ranks(),
-                    steps, seconds, m:contact_count(), m:energy().kinetic, m:hash()))
+                    steps, seconds, contacts, m:energy().kinetic, m:hash()))

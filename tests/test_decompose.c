@@ -35,6 +35,8 @@ typedef struct rank_ctx {
     int64_t first_own, last_own; /* the balls of the first and of the last rank, at cycle B's last plan */
     double pace[MAX_RANKS];      /* the ranks' paces after cycle C */
     int64_t builds;              /* cycle B's builds (all but a first one inside the cycle, the ranks listing in parts) */
+    bool lazy;                   /* the cycles in short runs that leave the state scattered, gathered at the end */
+    int64_t resumed;             /* lazy: the runs that went on from a scattered state */
     uint64_t hash;
     sx_energy energy;
     sx_status st;
@@ -190,12 +192,35 @@ static sx_model *clump_bed(int dim)
 
 enum { STEPS_A = 150, STEPS_B = 250 };
 
+/* Lazily: cycles A and B in runs of 1 to 7 steps, each going on from the
+ * state the last left scattered (builds inside them and between them, the
+ * plan kept over the runs), the whole state gathered once at the end. */
+static void run_lazily(rank_ctx *c, sx_model *m)
+{
+    sx_model_gather_lazily(m, true);
+    for (int64_t done = 0, k = 0; done < STEPS_A + STEPS_B && !c->st; done += k) {
+        k = 1 + done % 7 < STEPS_A + STEPS_B - done ? 1 + done % 7 : STEPS_A + STEPS_B - done;
+        c->resumed += sx_model_scattered(m);
+        c->st = sx_model_cycle(m, k);
+        if (!c->st && !sx_model_scattered(m)) c->st = SX_EINVAL; /* a lazy cycle must not gather */
+    }
+    if (!c->st) c->st = sx_model_gather(m);
+    if (!c->st && sx_model_scattered(m)) c->st = SX_EINVAL;
+    c->hash = sx_model_state_hash(m);
+    c->energy = sx_model_energy(m);
+}
+
 static void *run_rank(void *arg)
 {
     rank_ctx *c = arg;
     sx_model *m = c->clumped ? clump_bed(c->dim) : bed(c->dim, c->bonded);
     const sx_exchange x = {c->rank, c->w->ranks, c, share, largest, agree};
     c->st = sx_model_decompose(m, &x);
+    if (c->lazy) {
+        if (!c->st) run_lazily(c, m);
+        sx_model_destroy(m);
+        return NULL;
+    }
     if (!c->st) c->st = sx_model_cycle(m, STEPS_A); /* two cycles: a cycle's end and start in between */
     const sx_dd *d = m->dd;
     int32_t *owner = c->clumped && !c->st ? malloc((size_t)d->ncl * sizeof *owner) : NULL; /* at A's last plan */
@@ -252,6 +277,28 @@ START_TEST(ranks_give_the_serial_bits)
         }
         sx_model_destroy(serial);
         int64_t crossing = 0, moved = 0; /* clumps: over the rank counts, at the cycles' last plans */
+        for (int ranks = 2; ranks <= 3; ranks++) { /* lazily: the cycles cut short, gathered once */
+            world w = {.ranks = ranks};
+            pthread_barrier_init(&w.bar, NULL, (unsigned)ranks);
+            rank_ctx c[MAX_RANKS];
+            pthread_t t[MAX_RANKS];
+            for (int r = 0; r < ranks; r++) {
+                c[r] = (rank_ctx){.w = &w, .rank = r, .dim = dim, .bonded = bonded, .clumped = clumped, .lazy = true};
+                ck_assert_int_eq(pthread_create(&t[r], NULL, run_rank, &c[r]), 0);
+            }
+            for (int r = 0; r < ranks; r++) pthread_join(t[r], NULL);
+            pthread_barrier_destroy(&w.bar);
+            for (int r = 0; r < ranks; r++) {
+                ck_assert_msg(c[r].st == SX_OK, "%dD lazily, %d ranks: rank %d failed (%d)", dim, ranks, r, c[r].st);
+                ck_assert_msg(c[r].hash == hash, "%dD lazily, %d ranks: rank %d's state differs from the serial run's",
+                              dim, ranks, r);
+                ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
+                              "%dD lazily, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
+            }
+            /* most runs go on from a scattered state; those after a build's step gather first */
+            ck_assert_msg(c[0].resumed > 20, "%dD lazily, %d ranks: %lld runs went on from a scattered state", dim,
+                          ranks, (long long)c[0].resumed);
+        }
         for (int ranks = 2; ranks <= MAX_RANKS; ranks++) {
             world w = {.ranks = ranks};
             pthread_barrier_init(&w.bar, NULL, (unsigned)ranks);

@@ -78,6 +78,8 @@ void sx__dd_free(sx_model *m)
 sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
 {
     if (m->locked) return sx__fail(m, SX_ELOCKED, "decompose: the model is stepping");
+    sx_status st = sx_model_gather(m); /* the ranks' own parts, before the plan that names them goes */
+    if (st) return st;
     sx__dd_free(m);
     if (!x || x->ranks <= 1) return SX_OK;
     if (!x->share || !x->max || !x->agree || x->rank < 0 || x->rank >= x->ranks)
@@ -1072,13 +1074,45 @@ sx_status sx__dd_begin(sx_model *m)
     return SX_OK;
 }
 
+/* A cycle that goes on from the state the last one left scattered: the
+ * plan, the ghosts' ranges and the crack log's shared part are that
+ * cycle's, as if it had not ended, and nothing but the walls, the
+ * materials and the scalars can have changed since (the caller gathers
+ * first for anything else), so the ranks compare those alone. */
+sx_status sx__dd_resume(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    if (!d->x.agree(d->x.ud, sx__replicated_digest(m)))
+        return sx__fail(m, SX_EINVAL,
+                        "cycle: the walls or settings differ between the %d ranks (every rank must make the same "
+                        "calls: a branch on seixo.rank()?)",
+                        d->x.ranks);
+    d->active = true;
+    return SX_OK;
+}
+
+sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *))
+{
+    sx_dd *d = m->dd;
+    if (!sx__dd_gather(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+    d->scattered = false;
+    if (!replan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
+    return SX_OK;
+}
+
 sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
     if (d->walls_stale && !sx__dd_walls(m, false))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
-    if (!sx__dd_gather(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
-    if (!replan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
-    return SX_OK;
+    d->scattered = true;
+    return d->lazy ? SX_OK : sx__dd_whole(m, replan);
 }
+
+void sx_model_gather_lazily(sx_model *m, bool lazily)
+{
+    if (m->dd) m->dd->lazy = lazily;
+}
+
+bool sx_model_scattered(const sx_model *m) { return m->dd && m->dd->scattered; }

@@ -584,7 +584,11 @@ static sx_status guard_start(sx_model *m)
     m->guard_on = unforced(m);
     if (!m->guard_on) return SX_OK;
     sx_energy e;
-    if (!kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    /* decomposed and gone on from a scattered state: the ghosts where the
+     * last step left their owners, as guard_check reads them */
+    const bool resumed = m->dd && m->dd->active && m->dd->scattered;
+    if ((resumed && (!sx__dd_halo(m) || (m->clumps && !sx__dd_clumps(m)))) || !kernels(m)->energy(m, &e))
+        return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     m->guard_e0 = mechanical(&e);
     /* the scale: the energy in play, with a floor of each ball's weight over its radius */
     double floor_e = 0, g = 0;
@@ -696,16 +700,40 @@ bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since)
     return m->time >= t_end - fmin(rounding, 0.5 * m->dt_prev);
 }
 
+/* What a decomposed cycle cannot go on to from the state the last one
+ * left scattered, each rank's own balls current: a build, which lists
+ * from every ball; and the check of bonded pairs' contact-model rows
+ * (sx__cmodel_prepare), which reads every pair. */
+static bool whole_needed(const sx_model *m)
+{
+    return m->build_needed || (m->ncmodel && m->bb.bond && m->bb.cmodel);
+}
+
+sx_status sx_model_gather(sx_model *m)
+{
+    if (!m->dd || !m->dd->scattered) return SX_OK;
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "gather: the model is stepping");
+    return sx__dd_whole(m, kernels(m)->plan);
+}
+
 static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
 {
     double t = sx__now();
     const int64_t builds = m->builds;
-    sx_status st = sx__prepare(m);
+    sx_status st = m->dd && m->dd->scattered && whole_needed(m) ? sx_model_gather(m) : SX_OK;
+    /* decomposed, the last cycle's plan goes on (nothing but the walls and
+     * settings changed since: a caller that changes more gathers first) */
+    const bool resume = m->dd && m->dd->scattered;
+    if (!st) st = sx__prepare(m);
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
     if (st) return st;
-    if ((st = update_timestep(m))) return st;
+    if (resume && (st = sx__dd_resume(m))) return st; /* the timestep is then rated rank by rank */
+    if ((st = update_timestep(m))) {
+        if (resume) m->dd->active = false;
+        return st;
+    }
     const sx_kernels *k = kernels(m);
-    if (m->dd && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
+    if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
     sx_dd *dd = m->dd;
     m->locked = true;
     /* the energy baseline is taken when the user has changed the system, not

@@ -348,6 +348,8 @@ typedef struct sx_dd {
     sx_exchange x;
     bool active;            /* inside a decomposed cycle: the plan below holds */
     bool walls_stale;       /* the walls' resultants lag their blocks' sums (sx__dd_walls) */
+    bool lazy;              /* a cycle leaves the state scattered (sx_model_gather_lazily) */
+    bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
     /* periodic space: this rank's pairs outside pairs[rank] whose b is a
      * ghost of one of its balls, in pair order (the first nxlow below
@@ -660,12 +662,16 @@ void sx__bonds_free(sx_model *m);
  * decomposed rank's pace. */
 double sx__now(void);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
- * start, the plan after a build, the ghosts' refresh, the whole state on
- * every rank (false: the exchange failed), the walls' resultants from
- * every rank's blocks (sx__walls_sum), and the end of a cycle (the whole
- * state, then replan: the serial chunk plan) */
+ * start (sx__dd_resume: of a cycle that goes on from a scattered state),
+ * the plan after a build, the ghosts' refresh, the whole state on every
+ * rank (false: the exchange failed), the walls' resultants from every
+ * rank's blocks (sx__walls_sum), and the end of a cycle (the whole state,
+ * then replan: the serial chunk plan; lazily, the state left scattered),
+ * and the whole state of a scattered model (sx__dd_whole, then replan) */
 void sx__dd_free(sx_model *m);
 sx_status sx__dd_begin(sx_model *m);
+sx_status sx__dd_resume(sx_model *m);
+sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *));
 bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);

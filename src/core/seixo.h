@@ -139,12 +139,29 @@ typedef struct sx_exchange {
 /// decomposed): each rank integrates a slab of the balls, cut again at
 /// every build to balance the ranks' work, with ghost copies of its
 /// neighbours' balls, and steps the clumps it owns; every cycle ends with
-/// the whole state on every rank, bit-identical to a serial run's for any
-/// number of ranks. SX_EINVAL when x lacks a function or its rank is out
+/// the whole state on every rank (or lazily, sx_model_gather_lazily),
+/// bit-identical to a serial run's for any number of ranks. A model the
+/// last cycle left scattered is gathered first. SX_EINVAL when x lacks a function or its rank is out
 /// of range; SX_ELOCKED while m is stepping.
 SX_API sx_status sx_model_decompose(sx_model *m, const sx_exchange *x);
 /// The number of ranks m's cycles are decomposed over (1: not decomposed).
 SX_API int sx_model_ranks(const sx_model *m);
+/// Decomposed: whether a cycle ends with the whole state on every rank
+/// (the default) or, lazily, with each rank's own balls, their pairs,
+/// bonds and clumps current and the rest as the last gather left it
+/// (scattered); the walls, their loads and resultants, the energies and
+/// the time are whole either way. A scattered model's next cycle goes on
+/// from where the last one stopped, without the exchange of the whole
+/// state; anything else that reads or changes the balls, pairs, bonds or
+/// clumps must first call sx_model_gather. Nothing when not decomposed.
+SX_API void sx_model_gather_lazily(sx_model *m, bool lazily);
+/// Whether the last cycle left m's state scattered (see above).
+SX_API bool sx_model_scattered(const sx_model *m);
+/// Makes the whole state current on every rank after a lazy cycle. A
+/// collective call: every rank calls it at the same point. SX_OK at once
+/// when not scattered; SX_ELOCKED while m is stepping; SX_EINVAL when the
+/// ranks could not exchange.
+SX_API sx_status sx_model_gather(sx_model *m);
 
 /// Bytes currently allocated by the model.
 SX_API size_t sx_model_bytes(const sx_model *m);

@@ -882,6 +882,15 @@ static void digest_bonds(digest *g, const sx_model *m)
     digest_array(g, e->fs, e->n * t, sizeof *e->fs);
 }
 
+uint64_t sx__replicated_digest(const sx_model *m)
+{
+    hasher s = {FNV_BASIS};
+    hash_scalars(&s, m);
+    hash_materials(&s, m);
+    hash_walls(&s, m);
+    return mix(s.h);
+}
+
 uint64_t sx__state_digest(const sx_model *m)
 {
     hasher s = {FNV_BASIS};

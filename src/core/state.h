@@ -61,6 +61,10 @@ bool sx__state_finite(const double *v, int64_t n);
 /// the same bytes (decompose.c): much faster than sx_model_state_hash, but
 /// not canonical (a re-sort changes it).
 uint64_t sx__state_digest(const sx_model *m);
+/// The digest of what every rank holds whole while the balls are
+/// scattered (the scalars, the materials and the walls): what a cycle
+/// that goes on from a scattered state compares (decompose.c).
+uint64_t sx__replicated_digest(const sx_model *m);
 /// The vector's squared length is finite: every component is, and none is
 /// so large (1e300) that a length, or a product of two, overflows (a
 /// restored vector's check: a finite spin of 1e300 broke a bond into NaN).

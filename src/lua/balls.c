@@ -7,7 +7,7 @@
 #include "bindings.h"
 
 static const char *const ball_shown[] = {"pos", "radius", "vel", "material", "group", NULL};
-const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras", ball_shown};
+const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "extras", ball_shown, false};
 #define ball_kind sx_lua_ball_kind
 
 /* The ball of the handle at index 1: live, in an open model. */
@@ -334,6 +334,7 @@ void sx_lua_apply_removals(lua_State *L, int model)
     lua_pushnil(L);
     lua_setfield(L, -3, "queue");
     const int q = lua_gettop(L);
+    if (lua_rawlen(L, q) > 0) sx_lua_gather(L, ud->m, "m");
     /* the balls go together, in one pass over the contacts */
     const lua_Unsigned len = lua_rawlen(L, q);
     int64_t *balls = lua_newuserdatauv(L, (size_t)(len > 0 ? len : 1) * sizeof *balls, 0);
@@ -431,7 +432,7 @@ static int model_balls(lua_State *L)
 
 static int model_ball_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_ball_count(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, (lua_Integer)sx_ball_count(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 

@@ -132,10 +132,22 @@ int sx_lua_model_new(lua_State *L);
 void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[]);
 /* Pushes the model's profile table as text (sx_profile_format). */
 void sx_lua_push_profile_text(lua_State *L, const sx_model *m);
-/// The model of the model userdata at idx, or NULL if it has been closed.
+/// The model of the model userdata at idx, or NULL if it has been closed;
+/// decomposed, as its last cycle left it (see sx_lua_checkmodel).
 sx_model *sx_lua_tomodel(lua_State *L, int idx);
-/// Like sx_lua_tomodel, but a closed model is a Lua error.
+/// Like sx_lua_tomodel, but a closed model is a Lua error, and a
+/// decomposed model that its last cycle left scattered (each rank its own
+/// balls: sx_model_gather_lazily) is gathered first (sx_lua_gather).
 sx_model *sx_lua_checkmodel(lua_State *L, int idx);
+/// Like sx_lua_checkmodel, without the gather: for the calls that read or
+/// change only what every rank holds whole after a cycle (the walls, the
+/// time and step, the counts of balls and walls) or that cycle the model.
+sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx);
+/// A scattered model's whole state on every rank: a collective call, so
+/// the ranks first check that they all make it (naming the running
+/// function as called on `self`, "m" or "b": m:save, b.pos); a failed
+/// exchange stops every rank.
+void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
 /// The userdata at idx (a Lua error if it is not a model, closed or not).
 sx_lua_model *sx_lua_modelud(lua_State *L, int idx);
 /// Pushes the table `field` of the state of the model userdata at idx,
@@ -298,7 +310,8 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
 /// Cycles the core n steps in the run, without user callbacks, stopping
 /// early at the first step that reaches model time t_end (INFINITY: none;
 /// the rounding allowed counts the run's steps, sx_model_time_reached);
-/// an interrupt ("interrupted at step N") or a failure is a Lua error.
+/// an interrupt ("interrupted at step N") or a failure is a Lua error;
+/// decomposed, the whole state is on every rank after it (sx_lua_gather).
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end);
 /// Raises "interrupted at step N" when the run was interrupted, and
 /// "interrupted" when r is NULL and a Ctrl-C is pending: long C work (between
@@ -412,6 +425,9 @@ typedef struct sx_lua_kind {
     bool (*exists)(const sx_model *, int64_t);  ///< whether an id is live
     const char *extras;                         ///< the model state's table of user extras, by id
     const char *const *shown;                   ///< the fields print(x) shows (NULL-terminated)
+    /// Every rank holds the kind's state whole after a decomposed cycle (the
+    /// walls): its handles do not gather a scattered model (sx_lua_checkmodel).
+    bool replicated;
 } sx_lua_kind;
 
 /// Pushes a handle for the object `id` of the model userdata at `model`.

@@ -17,7 +17,7 @@
 #include "bindings.h"
 
 static const char *const clump_shown[] = {"pos", "mass", "vel", "template", NULL};
-const sx_lua_kind sx_lua_clump_kind = {"seixo.clump", "clump", sx_clump_exists, NULL, clump_shown}; /* no user extras */
+const sx_lua_kind sx_lua_clump_kind = {"seixo.clump", "clump", sx_clump_exists, NULL, clump_shown, false}; /* no user extras */
 #define clump_kind sx_lua_clump_kind
 
 static sx_model *check_clump(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &clump_kind, id); }

@@ -37,11 +37,14 @@ void sx_lua_disp_fill(lua_State *L, int model)
     model = lua_absindex(L, model);
     lua_getiuservalue(L, model, 1);
     if (lua_getfield(L, -1, "disp_ref") == LUA_TTABLE) {
-        const sx_model *m = sx_lua_checkmodel(L, model);
+        sx_model *m = sx_lua_checkmodel_scattered(L, model); /* the ids are every rank's */
         const int refs = lua_gettop(L);
         for (int64_t i = 0; i < sx_ball_count(m); i++) {
             const int64_t id = sx_ball_id_at(m, i);
-            if (lua_rawgeti(L, refs, (lua_Integer)id) == LUA_TNIL) record(L, m, refs, id);
+            if (lua_rawgeti(L, refs, (lua_Integer)id) == LUA_TNIL) {
+                sx_lua_gather(L, m, "m"); /* a new ball's position: every rank finds it alike */
+                record(L, m, refs, id);
+            }
             lua_pop(L, 1);
         }
     }

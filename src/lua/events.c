@@ -340,13 +340,14 @@ static void deliver_leaves(lua_State *L, int model, int handlers, const sx_model
 void sx_lua_events_deliver(lua_State *L, int model)
 {
     model = lua_absindex(L, model);
-    const sx_model *m = sx_lua_checkmodel(L, model);
+    sx_model *m = sx_lua_checkmodel_scattered(L, model);
     sx_lua_state(L, model, "events");
     const int handlers = lua_gettop(L);
     if (lua_rawlen(L, handlers) == 0) {
         lua_pop(L, 1);
         return;
     }
+    sx_lua_gather(L, m, "m"); /* the crack log, the contacts, the balls' places */
     /* the handlers may change the list: deliver from a copy */
     lua_newtable(L);
     for (lua_Integer i = 1; lua_rawgeti(L, handlers, i) != LUA_TNIL; i++) lua_rawseti(L, -2, i);

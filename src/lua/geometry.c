@@ -135,6 +135,7 @@ static void sweep(lua_State *L, worst *w)
 
 void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
 {
+    sx_lua_gather(L, ud->m, "m"); /* the first step's contacts, every rank's */
     worst w = {ud->m, 0, 0, 0, 0, 0, false};
     if (failed)
         sweep(L, &w);

@@ -141,7 +141,7 @@ void sx_lua_history_record(lua_State *L, int model)
     const int t = lua_gettop(L);
     for (lua_Integer i = 1; lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
         const int e = lua_gettop(L);
-        sx_model *m = sx_lua_checkmodel(L, model);
+        sx_model *m = sx_lua_checkmodel_scattered(L, model);
         const int64_t s = sx_model_step_count(m);
         lua_getfield(L, e, "every");
         lua_getfield(L, e, "last");
@@ -168,12 +168,16 @@ void sx_lua_history_record(lua_State *L, int model)
             }
             value = lua_tonumber(L, -1);
             lua_pop(L, 1);
-            m = sx_lua_checkmodel(L, model);  // the function may have closed it
+            m = sx_lua_checkmodel_scattered(L, model);  // the function may have closed it
         } else {
             lua_getfield(L, e, "builtin");
             lua_getfield(L, e, "id");
             lua_getfield(L, e, "field");
             lua_getfield(L, e, "comp");
+            /* a wall's field, the time, the step and the ball count every rank holds after a lazy cycle */
+            const int b = (int)lua_tointeger(L, e + 1);
+            if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
+                sx_lua_gather(L, m, "m");
             if (src == SRC_BUILTIN)
                 value = sample_builtin(m, (int)lua_tointeger(L, e + 1));
             else
@@ -294,7 +298,7 @@ static void read_entity(lua_State *L, const sx_model *m, int src)
 static int model_history(lua_State *L)
 {
     static const char *const keys[] = {"every", NULL};
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* the records, and ids every rank holds */
     size_t len;
     const char *name = luaL_checklstring(L, 2, &len);
     if (lua_isnoneornil(L, 3)) return history_get(L, name);
@@ -371,7 +375,7 @@ static int model_history(lua_State *L)
 
 static int model_histories(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1);
     sx_lua_state(L, 1, "histories");
     lua_newtable(L);
     for (lua_Integer i = 1; lua_rawgeti(L, -2, i) == LUA_TTABLE; i++) {
@@ -385,7 +389,7 @@ static int model_histories(lua_State *L)
 
 static int model_history_remove(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1);
     const char *name = luaL_checkstring(L, 2);
     const lua_Integer at = find_history(L, name);
     if (!at) return luaL_argerror(L, 2, lua_pushfstring(L, "no history named '%s'", name));

@@ -22,10 +22,39 @@ sx_lua_model *sx_lua_modelud(lua_State *L, int idx) { return luaL_checkudata(L, 
 
 sx_model *sx_lua_tomodel(lua_State *L, int idx) { return sx_lua_modelud(L, idx)->m; }
 
-sx_model *sx_lua_checkmodel(lua_State *L, int idx)
+sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx)
 {
     sx_model *m = sx_lua_tomodel(L, idx);
     if (!m) luaL_error(L, "the model has been closed");
+    return m;
+}
+
+void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
+{
+    if (!sx_model_scattered(m)) return;
+    /* named as the script wrote the call: m:save, b.pos (a field, through __index) */
+    lua_Debug ar;
+    const bool named = lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.name;
+    char what[96];
+    if (named && strcmp(ar.namewhat, "metamethod") == 0 && lua_type(L, 2) == LUA_TSTRING)
+        snprintf(what, sizeof what, "%s.%s", self, lua_tostring(L, 2));
+    else if (named)
+        snprintf(what, sizeof what, "%s:%s", self, ar.name);
+    else
+        snprintf(what, sizeof what, "a query of %s", self);
+    sx_lua_parallel_check_call(L, what);
+    if (sx_model_gather(m) != SX_OK) {
+        char msg[1024];
+        luaL_where(L, 1);
+        snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), what, sx_lua_core_message(sx_model_error(m)));
+        sx_lua_parallel_fail(msg);
+    }
+}
+
+sx_model *sx_lua_checkmodel(lua_State *L, int idx)
+{
+    sx_model *m = sx_lua_checkmodel_scattered(L, idx);
+    sx_lua_gather(L, m, "m");
     return m;
 }
 
@@ -128,6 +157,8 @@ int sx_lua_model_new(lua_State *L)
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
     u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
+    /* a cycle leaves each rank its own balls; the calls that need more gather (sx_lua_checkmodel) */
+    sx_model_gather_lazily(u->m, true);
     const int self = lua_gettop(L);
     list_model(L, self);
     /* the executable's --threads N (seixo.threads); results do not depend on it */
@@ -242,6 +273,7 @@ static int model_summary(lua_State *L)
         lua_pushliteral(L, "seixo.model (closed)");
         return 1;
     }
+    sx_lua_gather(L, m, "m");
     lua_settop(L, 1);
     const int dim = sx_model_dim(m);
     const double dt = sx_model_timestep(m);
@@ -513,19 +545,19 @@ static int model_materials(lua_State *L)
 
 static int model_dim(lua_State *L)
 {
-    lua_pushinteger(L, sx_model_dim(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, sx_model_dim(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 
 static int model_time(lua_State *L)
 {
-    lua_pushnumber(L, sx_model_time(sx_lua_checkmodel(L, 1)));
+    lua_pushnumber(L, sx_model_time(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 
 static int model_step(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_model_step_count(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, (lua_Integer)sx_model_step_count(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 
@@ -629,7 +661,7 @@ static int model_hash(lua_State *L)
 /* m:ranks() -> the number of MPI ranks its cycles are decomposed over (1: serial) */
 static int model_ranks(lua_State *L)
 {
-    lua_pushinteger(L, sx_model_ranks(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, sx_model_ranks(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 

@@ -224,7 +224,7 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
 {
     model = lua_absindex(L, model);
     sx_lua_model *ud = sx_lua_modelud(L, model);
-    sx_model *m = sx_lua_checkmodel(L, model);
+    sx_model *m = sx_lua_checkmodel_scattered(L, model); /* a lazy cycle goes on from its ranks' own balls */
     if (ud->running)
         luaL_error(L, "%s: the model is already cycling (a callback cannot cycle its own model)", what);
     run *r = lua_newuserdatauv(L, sizeof *r, 0);
@@ -269,8 +269,10 @@ void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 }
 
 /* Decomposed, a collective call: the caller has checked that every rank
- * makes it (sx_lua_parallel_check_call). */
-void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
+ * makes it (sx_lua_parallel_check_call). The cycle leaves the state
+ * scattered: what follows gathers it when it needs more than the walls
+ * and the time (sx_lua_checkmodel). */
+static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle_until(r->m, n, t_end, r->since);
@@ -284,6 +286,12 @@ void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
     /* the first step since balls or walls were placed (run_model takes it alone) */
     if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
     sx_lua_check(L, r->m, st, r->what);
+}
+
+void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
+{
+    run_chunk(L, r, n, t_end);
+    sx_lua_gather(L, r->m, "m"); /* for the caller's own reads and changes of the balls */
 }
 
 /* ------------------------------------------------------------ callbacks */
@@ -407,7 +415,7 @@ static lua_Integer next_id(lua_State *L)
 static int model_on(lua_State *L)
 {
     static const char *const keys[] = {"every", NULL};
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1);
     if (lua_type(L, 2) == LUA_TSTRING && sx_lua_is_event(lua_tostring(L, 2))) return sx_lua_events_add(L, next_id(L));
     const int point = luaL_checkoption(L, 2, NULL, point_names);
     luaL_checktype(L, 3, LUA_TFUNCTION);
@@ -466,7 +474,7 @@ static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
 /* m:off(id): removes a callback or an event handler; true if there was one. */
 static int model_off(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1); /* also from an output's __gc: no collective call */
     const lua_Integer id = luaL_checkinteger(L, 2);
     lua_pushboolean(L, remove_entry(L, "callbacks", id) || remove_entry(L, "events", id));
     return 1;
@@ -491,8 +499,9 @@ static const char *const reason_names[] = {"steps", "time", "ratio"};
 /* Steps enough to reach the model time t_end at the present timestep;
  * the core stops at the first step that reaches it (sx_model_cycle_until),
  * so a timestep that changes inside the chunk changes nothing. */
-static int64_t steps_to_time(sx_model *m, double t_end)
+static int64_t steps_to_time(lua_State *L, sx_model *m, double t_end)
 {
+    sx_lua_gather(L, m, "m"); /* an automatic timestep is rated from every contact */
     const double dt = sx_model_timestep(m);
     if (!(dt > 0)) return 1;  // let the core say what is wrong
     const double k = ceil((t_end - sx_model_time(m)) / dt) + 1;
@@ -530,6 +539,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             break;
         }
         if (lim->ratio > 0 && !first && taken % lim->every == 0) {
+            sx_lua_gather(L, m, "m");
             *ratio = sx_model_unbalanced_ratio(m);
             if (*ratio <= lim->ratio) {
                 why = BY_RATIO;
@@ -547,7 +557,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (k < n) n = k;
         }
         if (!isinf(lim->time)) {
-            const int64_t k = steps_to_time(m, lim->time);
+            const int64_t k = steps_to_time(L, m, lim->time);
             if (k < n) n = k;
         }
         /* a bond_break handler runs at the chunk's end and may change the
@@ -567,7 +577,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
         }
         /* a placement check follows the first step; contact and region events are per step */
         if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
-        sx_lua_run_cycle(L, r, n, lim->time);
+        run_chunk(L, r, n, lim->time);
         sx_lua_events_deliver(L, 1);
         double fraction = -1;
         int64_t total = 0;
@@ -588,7 +598,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
 
 static int model_cycle(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1);
     const lua_Integer n = luaL_checkinteger(L, 2);
     luaL_argcheck(L, n >= 0, 2, "the number of steps must be >= 0");
     lua_settop(L, 1);
@@ -602,7 +612,7 @@ static int model_cycle(lua_State *L)
 static int model_solve(lua_State *L)
 {
     static const char *const keys[] = {"ratio", "steps", "time", "every", NULL};
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
     limits lim = {INT64_MAX, INFINITY, 0, 100};
     if (!lua_isnoneornil(L, 2)) {
         sx_lua_checkkeys(L, 2, keys);
@@ -622,6 +632,7 @@ static int model_solve(lua_State *L)
     double ratio;
     const enum reason why = run_model(L, &lim, &ratio, "m:solve");
     lua_pushstring(L, reason_names[why]);
+    if (isnan(ratio)) sx_lua_gather(L, m, "m");
     lua_pushnumber(L, isnan(ratio) ? sx_model_unbalanced_ratio(m) : ratio);
     lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));
     return 3;

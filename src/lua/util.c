@@ -418,6 +418,10 @@ sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_
 {
     sx_model *m = tohandle(L, idx, k, id);
     if (!m) luaL_error(L, "the model has been closed");
+    if (!k->replicated) {
+        const char self[2] = {k->name[0], 0}; /* b.pos, b:remove: as the manual writes a ball's calls */
+        sx_lua_gather(L, m, self);
+    }
     if (!k->exists(m, *id)) luaL_error(L, "%s %I has been removed", k->name, (lua_Integer)*id);
     return m;
 }

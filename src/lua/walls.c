@@ -46,7 +46,7 @@ static const struct shape {
 };
 
 static const char *const wall_shown[] = {"kind", "point", "normal", "vel", "force", NULL};
-const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras", wall_shown};
+const sx_lua_kind sx_lua_wall_kind = {"seixo.wall", "wall", sx_wall_exists, "wall_extras", wall_shown, true};
 #define wall_kind sx_lua_wall_kind
 
 /* The wall of the handle at index 1: live, in an open model. */
@@ -531,7 +531,7 @@ static int model_walls(lua_State *L)
 
 static int model_wall_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_wall_count(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, (lua_Integer)sx_wall_count(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 
