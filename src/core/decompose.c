@@ -1074,12 +1074,13 @@ sx_status sx__dd_begin(sx_model *m)
     return SX_OK;
 }
 
-/* A cycle that goes on from the state the last one left scattered: the
- * plan, the ghosts' ranges and the crack log's shared part are that
- * cycle's, as if it had not ended, and nothing but the walls, the
- * materials and the scalars can have changed since (the caller gathers
- * first for anything else), so the ranks compare those alone. */
-sx_status sx__dd_resume(sx_model *m)
+/* A cycle's start on a scattered state. It goes on with the plan, the
+ * ghosts' ranges and the crack log's shared part of the last cycle, as if
+ * that had not ended (or gathers first, when it must build), and nothing
+ * but the walls, the materials and the scalars can have changed since
+ * (the caller gathers first for anything else): the ranks compare those
+ * alone. */
+sx_status sx__dd_agree_replicated(sx_model *m)
 {
     sx_dd *d = m->dd;
     if (!d->x.agree(d->x.ud, sx__replicated_digest(m)))
@@ -1087,7 +1088,6 @@ sx_status sx__dd_resume(sx_model *m)
                         "cycle: the walls or settings differ between the %d ranks (every rank must make the same "
                         "calls: a branch on seixo.rank()?)",
                         d->x.ranks);
-    d->active = true;
     return SX_OK;
 }
 

@@ -720,14 +720,18 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
 {
     double t = sx__now();
     const int64_t builds = m->builds;
-    sx_status st = m->dd && m->dd->scattered && whole_needed(m) ? sx_model_gather(m) : SX_OK;
-    /* decomposed, the last cycle's plan goes on (nothing but the walls and
-     * settings changed since: a caller that changes more gathers first) */
+    sx_status st = SX_OK;
+    /* decomposed and scattered: the ranks agree on what they hold whole
+     * before any of them gathers (a wall moved on one rank alone would
+     * otherwise leave it gathering while the others resume) */
+    if (m->dd && m->dd->scattered && !(st = sx__dd_agree_replicated(m)) && whole_needed(m)) st = sx_model_gather(m);
+    /* the last cycle's plan goes on (nothing but the walls and settings
+     * changed since: a caller that changes more gathers first) */
     const bool resume = m->dd && m->dd->scattered;
     if (!st) st = sx__prepare(m);
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
     if (st) return st;
-    if (resume && (st = sx__dd_resume(m))) return st; /* the timestep is then rated rank by rank */
+    if (resume) m->dd->active = true, m->prof.resumed++; /* the timestep is then rated rank by rank */
     if ((st = update_timestep(m))) {
         if (resume) m->dd->active = false;
         return st;
@@ -819,10 +823,11 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     }
     m->prof.seconds[SX_STAGE_OTHER] += other;
     m->locked = false;
-    /* the whole state on every rank again (after an error the ranks are
-     * out of step: the caller stops them all) */
+    /* the whole state on every rank again, or lazily not (after an error
+     * the ranks are out of step, the state mixed: the caller stops them) */
     if (dd && !st) st = sx__dd_end(m, k->plan);
     if (dd) dd->active = false;
+    if (dd && st) dd->scattered = true;
     return st;
 }
 
@@ -892,6 +897,9 @@ int sx_profile_format(const sx_profile *p, int64_t balls, char *buf, size_t len)
     if (balls > 0 && p->cycle_seconds > 0 && p->steps > 0)
         OUT("%lld balls: %.3g particle-steps per second inside cycles\n", (long long)balls,
             (double)balls * (double)p->steps / p->cycle_seconds);
+    if (p->resumed > 0)
+        OUT("%lld of the cycles went on from the last one's scattered state, without a gather\n",
+            (long long)p->resumed);
 #undef OUT
     return need;
 }

@@ -662,7 +662,7 @@ void sx__bonds_free(sx_model *m);
  * decomposed rank's pace. */
 double sx__now(void);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
- * start (sx__dd_resume: of a cycle that goes on from a scattered state),
+ * start (sx__dd_agree_replicated: of one that starts scattered),
  * the plan after a build, the ghosts' refresh, the whole state on every
  * rank (false: the exchange failed), the walls' resultants from every
  * rank's blocks (sx__walls_sum), and the end of a cycle (the whole state,
@@ -670,7 +670,7 @@ double sx__now(void);
  * and the whole state of a scattered model (sx__dd_whole, then replan) */
 void sx__dd_free(sx_model *m);
 sx_status sx__dd_begin(sx_model *m);
-sx_status sx__dd_resume(sx_model *m);
+sx_status sx__dd_agree_replicated(sx_model *m);
 sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *));
 bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);

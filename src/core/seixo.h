@@ -149,8 +149,8 @@ SX_API int sx_model_ranks(const sx_model *m);
 /// Decomposed: whether a cycle ends with the whole state on every rank
 /// (the default) or, lazily, with each rank's own balls, their pairs,
 /// bonds and clumps current and the rest as the last gather left it
-/// (scattered); the walls, their loads and resultants, the energies and
-/// the time are whole either way. A scattered model's next cycle goes on
+/// (scattered); the walls, their loads and resultants, the tracked
+/// energies' sums and the time are whole either way. A scattered model's next cycle goes on
 /// from where the last one stopped, without the exchange of the whole
 /// state; anything else that reads or changes the balls, pairs, bonds or
 /// clumps must first call sx_model_gather. Nothing when not decomposed.
@@ -160,7 +160,8 @@ SX_API bool sx_model_scattered(const sx_model *m);
 /// Makes the whole state current on every rank after a lazy cycle. A
 /// collective call: every rank calls it at the same point. SX_OK at once
 /// when not scattered; SX_ELOCKED while m is stepping; SX_EINVAL when the
-/// ranks could not exchange.
+/// ranks could not exchange. A cycle that failed leaves the state
+/// scattered, and the ranks out of step: stop them rather than gather.
 SX_API sx_status sx_model_gather(sx_model *m);
 
 /// Bytes currently allocated by the model.
@@ -204,6 +205,7 @@ typedef struct sx_profile {
     double cycle_seconds;           ///< s of wall-clock time inside sx_model_cycle (all stages but callbacks)
     int64_t cycles;                 ///< sx_model_cycle calls
     int64_t steps;                  ///< steps taken
+    int64_t resumed;                ///< decomposed: cycles that went on from a scattered state (no gather)
 } sx_profile;
 
 /// The profile accumulated since the model was created or last reset.

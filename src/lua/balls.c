@@ -397,8 +397,11 @@ static int add_ball(lua_State *L, sx_model *m)
 /* m:ball{...} adds a ball; m:ball(id) returns the ball with that id, or nil. */
 static int model_ball(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
-    if (lua_type(L, 2) == LUA_TTABLE) return add_ball(L, m);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* a lookup reads the ids every rank holds */
+    if (lua_type(L, 2) == LUA_TTABLE) {
+        sx_lua_gather(L, m, "m");
+        return add_ball(L, m);
+    }
     if (lua_type(L, 2) != LUA_TNUMBER) return luaL_typeerror(L, 2, "table or integer");
     const int64_t id = (int64_t)luaL_checkinteger(L, 2);
     if (!sx_ball_exists(m, id)) return 0;

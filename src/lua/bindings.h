@@ -53,7 +53,8 @@ int sx_lua_ball_disp(lua_State *L, const sx_model *m, int64_t id);
 /* Functions of the seixo table beside the loader's own. */
 extern const luaL_Reg sx_lua_optimize_functions[];  ///< optimize.c: seixo.optimize
 extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, executable, rank, ranks, send, receive, decompose
-/// parallel.c: decomposes m over the MPI ranks when MPI runs and seixo.decompose is on; true if it did.
+/// parallel.c: decomposes m over the MPI ranks when MPI runs and seixo.decompose is on, its cycles
+/// leaving the state scattered (sx_model_gather_lazily); true if it did.
 bool sx_lua_parallel_decompose(sx_model *m);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);

@@ -157,8 +157,6 @@ int sx_lua_model_new(lua_State *L)
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
     u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
-    /* a cycle leaves each rank its own balls; the calls that need more gather (sx_lua_checkmodel) */
-    sx_model_gather_lazily(u->m, true);
     const int self = lua_gettop(L);
     list_model(L, self);
     /* the executable's --threads N (seixo.threads); results do not depend on it */
@@ -729,7 +727,7 @@ static int model_profile(lua_State *L)
         lua_writestring(text, len);
         lua_pop(L, 1);
     }
-    lua_createtable(L, 0, SX_STAGE_COUNT + 4);
+    lua_createtable(L, 0, SX_STAGE_COUNT + 5);
     double total = 0;
     for (int s = 0; s < SX_STAGE_COUNT; s++) {
         char key[32];
@@ -752,6 +750,8 @@ static int model_profile(lua_State *L)
     lua_setfield(L, -2, "steps");
     lua_pushinteger(L, (lua_Integer)p.cycles);
     lua_setfield(L, -2, "cycles");
+    lua_pushinteger(L, (lua_Integer)p.resumed);
+    lua_setfield(L, -2, "resumed");
     if (reset) sx_model_profile_reset(m);
     return 1;
 }

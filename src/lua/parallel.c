@@ -234,7 +234,10 @@ bool sx_lua_parallel_decompose(sx_model *m)
 #ifdef SX_HAVE_MPI
     if (!mpi_started || !decompose_on) return false;
     const sx_exchange x = {world_rank, world_size, NULL, mpi_share, mpi_max, mpi_agree};
-    return sx_model_decompose(m, &x) == SX_OK;
+    if (sx_model_decompose(m, &x) != SX_OK) return false;
+    /* a cycle leaves each rank its own balls; the calls that need more gather (sx_lua_checkmodel) */
+    sx_model_gather_lazily(m, true);
+    return true;
 #else
     (void)m;
     return false;

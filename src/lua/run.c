@@ -83,9 +83,9 @@ enum { PROGRESS_DELAY_MS = 1000, PROGRESS_EVERY_MS = 250, PROGRESS_LOG_EVERY_S =
 
 /* A model decomposed over MPI ranks cuts its cycles into chunks that every
  * rank takes alike (rank 0's, whose clock sets them), of a line's interval
- * and at least PROGRESS_RANKS_S: each chunk's cycle starts by checking that
- * the ranks' models agree (a digest of the whole state) and ends by gathering
- * the state, a cost of a few steps. */
+ * and at least PROGRESS_RANKS_S: each chunk costs the ranks a check that
+ * they make the same call and a broadcast of its length (the chunks go on
+ * from each other's scattered state, without a gather). */
 enum { PROGRESS_RANKS_S = 1 };
 
 typedef struct progress {
@@ -474,7 +474,7 @@ static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
 /* m:off(id): removes a callback or an event handler; true if there was one. */
 static int model_off(lua_State *L)
 {
-    sx_lua_checkmodel_scattered(L, 1); /* also from an output's __gc: no collective call */
+    sx_lua_checkmodel_scattered(L, 1); /* also from a plot's __gc: no collective call */
     const lua_Integer id = luaL_checkinteger(L, 2);
     lua_pushboolean(L, remove_entry(L, "callbacks", id) || remove_entry(L, "events", id));
     return 1;
@@ -495,18 +495,6 @@ static const char *const reason_names[] = {"steps", "time", "ratio"};
 /* Steps between deliveries of bond_break events when no event needs every
  * step: a handler then acts at a multiple of it, whatever the machine. */
 #define BOND_EVENT_STEPS 100
-
-/* Steps enough to reach the model time t_end at the present timestep;
- * the core stops at the first step that reaches it (sx_model_cycle_until),
- * so a timestep that changes inside the chunk changes nothing. */
-static int64_t steps_to_time(lua_State *L, sx_model *m, double t_end)
-{
-    sx_lua_gather(L, m, "m"); /* an automatic timestep is rated from every contact */
-    const double dt = sx_model_timestep(m);
-    if (!(dt > 0)) return 1;  // let the core say what is wrong
-    const double k = ceil((t_end - sx_model_time(m)) / dt) + 1;
-    return k < 1 ? 1 : k > 1e15 ? (int64_t)1e15 : (int64_t)k;
-}
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
  * and the last ratio measured (NaN when none was) in *ratio. */
@@ -556,10 +544,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = lim->every - taken % lim->every;
             if (k < n) n = k;
         }
-        if (!isinf(lim->time)) {
-            const int64_t k = steps_to_time(L, m, lim->time);
-            if (k < n) n = k;
-        }
+        /* a time limit cuts nothing here: the core stops at its first step past it */
         /* a bond_break handler runs at the chunk's end and may change the
          * model: the chunks then end at fixed steps, not where the progress
          * display's clock would end them */

@@ -612,7 +612,7 @@ void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_mode
                          int64_t (*id_at)(const sx_model *, int64_t), lua_CFunction next)
 {
     model = lua_absindex(L, model);
-    const sx_model *m = sx_lua_checkmodel(L, model);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, model); /* the ids every rank holds: a handle gathers */
     const int64_t n = count(m);
     lua_createtable(L, n < INT_MAX ? (int)n : INT_MAX, 0);
     for (int64_t i = 0; i < n; i++) {
@@ -625,7 +625,7 @@ void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_mode
 
 int sx_lua_nexthandle(lua_State *L, const sx_lua_kind *k)
 {
-    const sx_model *m = sx_lua_checkmodel(L, lua_upvalueindex(1));
+    const sx_model *m = sx_lua_checkmodel_scattered(L, lua_upvalueindex(1));
     lua_Integer i = lua_tointeger(L, lua_upvalueindex(3));
     while (lua_rawgeti(L, lua_upvalueindex(2), ++i) == LUA_TNUMBER) {
         const int64_t id = (int64_t)lua_tointeger(L, -1);

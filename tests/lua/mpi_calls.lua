@@ -9,6 +9,8 @@
 --   output   m:output on rank 0 alone
 --   tmpname  os.tmpname on rank 0 alone
 --   cycle    a cycle on the last rank alone, the others at the script's end
+--   query    a ball's position read on rank 0 alone after a cycle, which
+--            left each rank its own balls: the read gathers them
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -24,8 +26,13 @@ elseif scene == "tmpname" then
   m:cycle(100)
 elseif scene == "cycle" then
   if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end
+elseif scene == "query" then
+  m:cycle(10)
+  local b = m:ball(1)
+  if first then print(b.pos) end
+  m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname or cycle expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle or query expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end

@@ -11,7 +11,8 @@
 # series written with 2 and 3 ranks is the serial one (mpi_output.lua); a
 # long cycle's progress lines come from rank 0 (mpi_progress.lua), and so
 # does a live plot (mpi_plot.lua); ranks whose models differ are stopped
-# with the cause (mpi_diverge.lua).
+# with the cause, and so are ranks of which some moved a wall after a cycle
+# left the balls scattered (mpi_diverge.lua).
 # Skipped without mpirun. The pours run through mpi_same.sh (which
 # checks 3 ranks only under AddressSanitizer).
 #   mpi_pour.sh SEIXO mpi_pour.lua
@@ -60,6 +61,14 @@ elif grep -q "m:cycle: the model differs between the 3 ranks" "$dir/err" && ! gr
   echo "diverging ranks, -np 3: stopped, naming the cause"
 else
   echo "diverging ranks, -np 3: failed without naming the cause:"; cat "$dir/out" "$dir/err"; fail=1
+fi
+# a wall moved on the ranks above 0 alone, after a cycle that left the balls scattered
+if timeout 120 mpirun $root --oversubscribe -np 3 "$seixo" "$diverge" wall >"$dir/out" 2>"$dir/err"; then
+  echo "a wall moved on some ranks, -np 3: not stopped"; cat "$dir/out"; fail=1
+elif grep -q "m:cycle: the walls or settings differ between the 3 ranks" "$dir/err" && ! grep -q "not stopped" "$dir/out"; then
+  echo "a wall moved on some ranks, -np 3: stopped, naming the cause"
+else
+  echo "a wall moved on some ranks, -np 3: failed without naming the cause (or hung):"; cat "$dir/out" "$dir/err"; fail=1
 fi
 # a live plot on gnuplot's dumb terminal (to standard output): drawn by rank 0 alone
 plotter=$(dirname "$script")/mpi_plot.lua
