@@ -4,7 +4,10 @@
  *
  * The core makes no MPI call: the caller's sx_exchange moves bytes. Between
  * cycles every rank holds the whole model, the same on all ranks (checked
- * by a digest of its bytes when a cycle starts, sx__state_digest). Inside a cycle rank r owns the balls
+ * by a digest of its bytes when a cycle starts, sx__state_digest), or,
+ * lazily, its own balls current and the rest as the last gather left them
+ * (scattered: the next cycle goes on from there, sx__dd_agree_replicated).
+ * Inside a cycle rank r owns the balls
  * own[r], a contiguous range of dense indices: the broad phase sorts balls
  * by cell with the last axis slowest, so a range is a slab across that
  * axis, cut to balance the ranks' work (and cut again at every build, which
@@ -1060,14 +1063,22 @@ bool sx__dd_energy(sx_model *m)
     return ok;
 }
 
+/* The ranks hold the same digest of what they must hold alike; else every
+ * rank stops, naming what differs and the likely cause. */
+static sx_status agree(sx_model *m, uint64_t digest, const char *what, const char *cause)
+{
+    sx_dd *d = m->dd;
+    if (d->x.agree(d->x.ud, digest)) return SX_OK;
+    return sx__fail(m, SX_EINVAL, "cycle: %s between the %d ranks (every rank must make the same calls: %s?)", what,
+                    d->x.ranks, cause);
+}
+
 sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
-    if (!d->x.agree(d->x.ud, sx__state_digest(m)))
-        return sx__fail(m, SX_EINVAL,
-                        "cycle: the model differs between the %d ranks (every rank must make the same calls: "
-                        "random numbers without a fixed seed, or a branch on seixo.rank()?)",
-                        d->x.ranks);
+    sx_status st = agree(m, sx__state_digest(m), "the model differs",
+                         "random numbers without a fixed seed, or a branch on seixo.rank()");
+    if (st) return st;
     if (!sx__dd_plan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     d->crack0 = m->cracks.n;
     d->active = true;
@@ -1082,13 +1093,7 @@ sx_status sx__dd_begin(sx_model *m)
  * alone. */
 sx_status sx__dd_agree_replicated(sx_model *m)
 {
-    sx_dd *d = m->dd;
-    if (!d->x.agree(d->x.ud, sx__replicated_digest(m)))
-        return sx__fail(m, SX_EINVAL,
-                        "cycle: the walls or settings differ between the %d ranks (every rank must make the same "
-                        "calls: a branch on seixo.rank()?)",
-                        d->x.ranks);
-    return SX_OK;
+    return agree(m, sx__replicated_digest(m), "the walls or settings differ", "a branch on seixo.rank()");
 }
 
 sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *))
