@@ -32,16 +32,18 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx)
 void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
 {
     if (!sx_model_scattered(m)) return;
-    /* named as the script wrote the call: m:save, b.pos (a field, through __index) */
+    /* named as the script wrote the call (m:save, b.pos: a field, through
+     * __index) and marked, so that a rank gathering inside a call never
+     * meets another rank's other collective step of the same call */
     lua_Debug ar;
     const bool named = lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.name;
     char what[96];
     if (named && strcmp(ar.namewhat, "metamethod") == 0 && lua_type(L, 2) == LUA_TSTRING)
-        snprintf(what, sizeof what, "%s.%s", self, lua_tostring(L, 2));
+        snprintf(what, sizeof what, "%s.%s (gather)", self, lua_tostring(L, 2));
     else if (named)
-        snprintf(what, sizeof what, "%s:%s", self, ar.name);
+        snprintf(what, sizeof what, "%s:%s (gather)", self, ar.name);
     else
-        snprintf(what, sizeof what, "a query of %s", self);
+        snprintf(what, sizeof what, "a query of %s (gather)", self);
     sx_lua_parallel_check_call(L, what);
     if (sx_model_gather(m) != SX_OK) {
         char msg[1024];

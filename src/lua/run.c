@@ -553,15 +553,20 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             const int64_t k = BOND_EVENT_STEPS - s % BOND_EVENT_STEPS;
             if (k < n) n = k;
         }
+        /* a placement check follows the first step; contact and region events are per step */
+        if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
-            sx_lua_parallel_check_call(L, what); /* first: every rank is here, none waits for ever */
-            const int64_t chunk = fixed ? INT64_MAX : sx_lua_parallel_root_value(p->mode ? p->chunk : INT64_MAX);
+            /* first: every rank is here, none waits for ever, and every rank's
+             * callbacks, histories and handlers end the chunk at one step (one
+             * registered under a branch on seixo.rank() would not) */
+            char call[64];
+            snprintf(call, sizeof call, "%s to step %lld", what, (long long)(n < INT64_MAX - s ? s + n : INT64_MAX));
+            sx_lua_parallel_check_call(L, call);
+            const int64_t chunk = sx_lua_parallel_root_value(!fixed && p->mode ? p->chunk : INT64_MAX);
             if (chunk < n) n = chunk;
         } else if (!fixed && p->mode && p->chunk < n) {
             n = p->chunk;
         }
-        /* a placement check follows the first step; contact and region events are per step */
-        if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         run_chunk(L, r, n, lim->time);
         sx_lua_events_deliver(L, 1);
         double fraction = -1;

@@ -11,6 +11,8 @@
 --   cycle    a cycle on the last rank alone, the others at the script's end
 --   query    a ball's position read on rank 0 alone after a cycle, which
 --            left each rank its own balls: the read gathers them
+--   handler  a bond_break handler set on rank 0 alone: its cycles end at
+--            multiples of 100 steps, the others' do not (it hung)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -26,13 +28,16 @@ elseif scene == "tmpname" then
   m:cycle(100)
 elseif scene == "cycle" then
   if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end
+elseif scene == "handler" then
+  if first then m:on("bond_break", function() end) end
+  m:cycle(300)
 elseif scene == "query" then
   m:cycle(10)
   local b = m:ball(1)
   if first then print(b.pos) end
   m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle or query expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query or handler expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end
