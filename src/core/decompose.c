@@ -1077,7 +1077,8 @@ sx_status sx__dd_begin(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_status st = agree(m, sx__state_digest(m), "the model differs",
-                         "random numbers without a fixed seed, or a branch on seixo.rank()");
+                         "random numbers without a fixed seed, calls made in the order of pairs() over a "
+                         "table's names (an order each process draws), or a branch on seixo.rank()");
     if (st) return st;
     if (!sx__dd_plan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     d->crack0 = m->cracks.n;

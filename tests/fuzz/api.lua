@@ -253,8 +253,11 @@ local writable = {
   cl = {pos = "v", vel = "v", spin = "r", orientation = "q", scale = 1.1, material = "soft", damping = 0.2, fix = "spin"},
   w = {vel = "v", point = "v", normal = "v", friction = 0.2, extra = "x", material = "soft", rigid = true},
 }
-for kind, list in pairs(fields) do
-  for _, f in ipairs(list) do
+-- (in a fixed order: pairs' order over string keys differs from one process
+-- to the next, so a case's number would name another entry when replayed,
+-- or on another MPI rank)
+for _, kind in ipairs{"b", "cl", "w", "c"} do
+  for _, f in ipairs(fields[kind]) do
     E(kind .. "." .. f, function(c)
       local obj = kind == "b" and c.b or kind == "cl" and c.cl or kind == "w" and c.w or c.c
       local value = writable[kind] and writable[kind][f]
