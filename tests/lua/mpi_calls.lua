@@ -11,8 +11,10 @@
 --   cycle    a cycle on the last rank alone, the others at the script's end
 --   query    a ball's position read on rank 0 alone after a cycle, which
 --            left each rank its own balls: the read gathers them
---   handler  a bond_break handler set on rank 0 alone: its cycles end at
---            multiples of 100 steps, the others' do not (it hung)
+--   handler  a bond_break handler set on rank 0 alone, the model whole on
+--            every rank (registering it then makes no collective call):
+--            its cycles end at multiples of 100 steps, the others' do not
+--            (it hung)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -29,6 +31,7 @@ elseif scene == "tmpname" then
 elseif scene == "cycle" then
   if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end
 elseif scene == "handler" then
+  local _ = m:ball(1).pos -- every rank: the state whole again
   if first then m:on("bond_break", function() end) end
   m:cycle(300)
 elseif scene == "query" then
