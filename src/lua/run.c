@@ -557,11 +557,14 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
         if (r->ud->unchecked || sx_lua_events_per_step(L, 1)) n = 1;
         if (p->ranks) { /* the ranks' clocks differ, and they must cut their cycles alike */
             /* first: every rank is here, none waits for ever, and every rank's
-             * callbacks, histories and handlers end the chunk at one step (one
-             * registered under a branch on seixo.rank() would not) */
-            char call[64];
-            snprintf(call, sizeof call, "%s to step %lld", what, (long long)(n < INT64_MAX - s ? s + n : INT64_MAX));
-            sx_lua_parallel_check_call(L, call);
+             * callbacks, histories, handlers and limits end the chunk at one
+             * step (one registered under a branch on seixo.rank() would not) */
+            char call[64] = "";
+            if (n < INT64_MAX - s) snprintf(call, sizeof call, " to step %lld", (long long)(s + n));
+            if (!isinf(lim->time))
+                snprintf(call + strlen(call), sizeof call - strlen(call), " %s %.17g s", call[0] ? "or" : "to", lim->time);
+            sx_lua_parallel_check_call(L, lua_pushfstring(L, "%s%s", what, call));
+            lua_pop(L, 1);
             const int64_t chunk = sx_lua_parallel_root_value(!fixed && p->mode ? p->chunk : INT64_MAX);
             if (chunk < n) n = chunk;
         } else if (!fixed && p->mode && p->chunk < n) {

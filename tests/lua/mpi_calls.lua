@@ -15,6 +15,8 @@
 --            every rank (registering it then makes no collective call):
 --            its cycles end at multiples of 100 steps, the others' do not
 --            (it hung)
+--   time     a time limit that differs on rank 0: its cycles stop at
+--            another step (it hung)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -34,13 +36,15 @@ elseif scene == "handler" then
   local _ = m:ball(1).pos -- every rank: the state whole again
   if first then m:on("bond_break", function() end) end
   m:cycle(300)
+elseif scene == "time" then
+  m:solve{time = first and 0.001 or 0.002}
 elseif scene == "query" then
   m:cycle(10)
   local b = m:ball(1)
   if first then print(b.pos) end
   m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query or handler expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler or time expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end
