@@ -882,21 +882,25 @@ static void digest_bonds(digest *g, const sx_model *m)
     digest_array(g, e->fs, e->n * t, sizeof *e->fs);
 }
 
+/* What every rank holds whole, even while the balls are scattered. */
+static void hash_replicated(hasher *s, const sx_model *m)
+{
+    hash_scalars(s, m);
+    hash_materials(s, m);
+    hash_walls(s, m);
+}
+
 uint64_t sx__replicated_digest(const sx_model *m)
 {
     hasher s = {FNV_BASIS};
-    hash_scalars(&s, m);
-    hash_materials(&s, m);
-    hash_walls(&s, m);
+    hash_replicated(&s, m);
     return mix(s.h);
 }
 
 uint64_t sx__state_digest(const sx_model *m)
 {
     hasher s = {FNV_BASIS};
-    hash_scalars(&s, m);
-    hash_materials(&s, m);
-    hash_walls(&s, m);
+    hash_replicated(&s, m);
     hash_cracks(&s, m);
     hash_stores(&s, m);
     digest g = {{s.h, FNV_BASIS, ~FNV_BASIS, s.h ^ 0x9e3779b97f4a7c15ULL}};
