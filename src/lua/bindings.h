@@ -75,6 +75,12 @@ bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count
 bool sx_lua_parallel_same_call(const char *what, char *err, size_t size);
 /// parallel.c: sx_lua_parallel_same_call raising the message as a Lua error.
 void sx_lua_parallel_check_call(lua_State *L, const char *what);
+/// model.c: sx_lua_parallel_check_call for a call on model m, named
+/// with the model's creation number after the first ("m:save (model 2)").
+void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what);
+/// model.c: m's creation number in the session (seixo.models' order,
+/// closed models counted), 0 if it is not a Lua model.
+int sx_lua_model_number(lua_State *L, const sx_model *m);
 /// parallel.c: rank 0's v, on every rank (which all make the call and wait
 /// for it); v itself without MPI or with one rank.
 int64_t sx_lua_parallel_root_value(int64_t v);

@@ -1001,7 +1001,7 @@ static void relax_cycles(lua_State *L, sx_lua_run *run, const gen *g, const int6
     int64_t done = 0, since_check = 0;
     while (done < steps) {
         const int64_t k = steps - done < g->calm ? steps - done : g->calm;
-        if (ud->decomposed) sx_lua_parallel_check_call(L, "m:generate");
+        if (ud->decomposed) sx_lua_check_model_call(L, ud->m, "m:generate");
         sx_lua_run_cycle(L, run, k, INFINITY);
         done += k;
         since_check += k;

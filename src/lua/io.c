@@ -330,7 +330,7 @@ static int model_save(lua_State *L)
      * file is there, or every rank raises rank 0's error: the I/O layer
      * writes a message to err with every failure) */
     const bool shared = sx_model_ranks(m) > 1;
-    if (shared) sx_lua_parallel_check_call(L, "m:save");
+    if (shared) sx_lua_check_model_call(L, m, "m:save");
     if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     sx_lua_rank_file_written(L, path); /* rank 0 wrote it: no shadow stands for it */
@@ -433,7 +433,7 @@ static void write_now(lua_State *L, int idx, int model, const sx_model *m, bool 
     idx = lua_absindex(L, idx);
     model = lua_absindex(L, model);
     output *o = check_output(L, idx);
-    if (collective && o->shared) sx_lua_parallel_check_call(L, "an output's samples");
+    if (collective && o->shared) sx_lua_check_model_call(L, sx_lua_tomodel(L, model), "an output's samples");
     lua_getiuservalue(L, idx, 3);
     const int passed = lua_gettop(L);
     int n;
@@ -626,7 +626,7 @@ static int model_output(lua_State *L)
     so.provenance.script = script_path(L);
     so.provenance.seeds = seeds_of(L, 1, &so.provenance.nseeds);
     char err[1024] = "";
-    if (o->shared) sx_lua_parallel_check_call(L, "m:output");
+    if (o->shared) sx_lua_check_model_call(L, m, "m:output");
     if (sx_lua_parallel_writes(o->shared)) {
         o->s = sx_series_open(path, sx_model_dim(m), &so, err, sizeof err);
         if (o->s) o->count = sx_series_count(o->s);

@@ -44,7 +44,7 @@ void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
         snprintf(what, sizeof what, "%s:%s (gather)", self, ar.name);
     else
         snprintf(what, sizeof what, "a query of %s (gather)", self);
-    sx_lua_parallel_check_call(L, what);
+    sx_lua_check_model_call(L, m, what);
     if (sx_model_gather(m) != SX_OK) {
         char msg[1024];
         luaL_where(L, 1);
@@ -129,6 +129,35 @@ int sx_lua_models(lua_State *L)
             lua_pop(L, 1);
     }
     return 1;
+}
+
+int sx_lua_model_number(lua_State *L, const sx_model *m)
+{
+    push_model_list(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
+    const lua_Integer made = lua_tointeger(L, -1);
+    lua_pop(L, 1);
+    int number = 0;
+    for (lua_Integer i = 1; i <= made && !number; i++) {
+        if (lua_rawgeti(L, -1, i) == LUA_TUSERDATA && sx_lua_tomodel(L, -1) == m) number = (int)i;
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    return number;
+}
+
+void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what)
+{
+    /* ranks in one call on two models (`(seixo.rank() == 0 and m1 or
+     * m2):save(...)`) would pair one model's exchanges with the other's;
+     * the first model keeps the plain name, as most scripts have one */
+    const int number = sx_lua_model_number(L, m);
+    if (number <= 1) {
+        sx_lua_parallel_check_call(L, what);
+        return;
+    }
+    sx_lua_parallel_check_call(L, lua_pushfstring(L, "%s (model %d)", what, number));
+    lua_pop(L, 1);
 }
 
 int sx_lua_model_new(lua_State *L)

@@ -299,7 +299,7 @@ int sx_lua_parallel_rank(void) { return world_rank; }
  * the ranks' names for what they are doing, gathered (one MPI_Allgather,
  * the same operation whatever call makes it); when they differ, every
  * rank of the check fails with the message, which names two of them. */
-enum { CALL_NAME = 64 }; /* a chunk's name holds the step and the time it ends at */
+enum { CALL_NAME = 96 }; /* a chunk's name holds the step and the time it ends at, and the model */
 
 bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
 {

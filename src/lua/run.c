@@ -563,7 +563,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             if (n < INT64_MAX - s) snprintf(call, sizeof call, " to step %lld", (long long)(s + n));
             if (!isinf(lim->time))
                 snprintf(call + strlen(call), sizeof call - strlen(call), " %s %.17g s", call[0] ? "or" : "to", lim->time);
-            sx_lua_parallel_check_call(L, lua_pushfstring(L, "%s%s", what, call));
+            sx_lua_check_model_call(L, m, lua_pushfstring(L, "%s%s", what, call));
             lua_pop(L, 1);
             const int64_t chunk = sx_lua_parallel_root_value(!fixed && p->mode ? p->chunk : INT64_MAX);
             if (chunk < n) n = chunk;

@@ -17,6 +17,9 @@
 --            (it hung)
 --   time     a time limit that differs on rank 0: its cycles stop at
 --            another step (it hung)
+--   models   one call on two models, rank 0 saving one and the others
+--            another, after a cycle of each: the gathers of two models
+--            would have paired (the check named the call, not its model)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -38,13 +41,19 @@ elseif scene == "handler" then
   m:cycle(300)
 elseif scene == "time" then
   m:solve{time = first and 0.001 or 0.002}
+elseif scene == "models" then
+  local other = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
+  m:cycle(10)
+  other:cycle(10)
+  ;(first and m or other):save(base .. ".h5")
+  m:cycle(100)
 elseif scene == "query" then
   m:cycle(10)
   local b = m:ball(1)
   if first then print(b.pos) end
   m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler or time expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time or models expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end
