@@ -650,6 +650,10 @@ end
 -- A test's start: the specimen loaded from its file, its extents and
 -- centre, and the platens -- frictionless planes (lines) touching its ends
 -- along the loading axis.
+-- Set while a series runs over the MPI ranks (run_ranks): called with each
+-- test's model as it opens, so that rank 0 hands tests out during its own.
+local on_test_open
+
 local function open_test(spec, opts, fn)
   if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
   local dim, ax = spec.dim, axis_of(spec.dim)
@@ -673,6 +677,7 @@ local function open_test(spec, opts, fn)
   local kind = dim == 3 and "plane" or "line"
   local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
   local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
+  if on_test_open then on_test_open(m) end
   return m, lo, hi, centre, bottom, top
 end
 
@@ -1159,7 +1164,7 @@ end
 -- confinement down: the greater the confinement, the more steps), so that
 -- the last to start is the shortest and both cores end together. Each
 -- test's log is passed on as it ends.
-local function run_tests(spec, tests, jobs, opts)
+local function longest_first(tests)
   local order = {}
   for i = 1, #tests do order[i] = i end
   table.sort(order, function(a, b)
@@ -1168,6 +1173,11 @@ local function run_tests(spec, tests, jobs, opts)
     if ta.opts.confining ~= tb.opts.confining then return ta.opts.confining > tb.opts.confining end
     return a < b
   end)
+  return order
+end
+
+local function run_tests(spec, tests, jobs, opts)
+  local order = longest_first(tests)
   local calls, results = {}, {}
   for k, i in ipairs(order) do
     local o = copy(tests[i].opts)
@@ -1192,6 +1202,86 @@ local function run_tests(spec, tests, jobs, opts)
   return results
 end
 
+-- The tests of a series over the MPI ranks (under mpirun, the models
+-- shared): each test runs whole on one rank, on a model of that rank's own
+-- (seixo.decompose(false) while they run), as the processes of run_tests
+-- do: its results are the same bit for bit, and the tests take the ranks'
+-- cores without a message a step. Rank 0 hands each idle rank a test (the
+-- longest first), runs one itself while any is left (looking for idle
+-- ranks every POLL_STEPS steps of its own test: a callback, which changes
+-- no bit), and passes each test's log on as it ends; then every rank gets
+-- the results and the log
+-- lines in the order rank 0 said them (a log function of the script's then
+-- sees the same lines on every rank), or the first test's error, which
+-- every rank raises alike.
+local POLL_STEPS = 500
+local function run_ranks(spec, tests, opts)
+  local order, R = longest_first(tests), seixo.ranks()
+  local function run(k)
+    local t = tests[order[k]]
+    local o, lines = copy(t.opts), {}
+    if opts.log ~= false then o.log = function(line) lines[#lines + 1] = line end end
+    local ok, value = pcall(lab[t.call], spec, o)
+    return {k = k, ok = ok, value = ok and value or nil, error = not ok and tostring(value) or nil, lines = lines,
+            rank = seixo.rank()}
+  end
+  local shared = seixo.decompose()
+  seixo.decompose(false)
+  local done
+  if seixo.rank() == 0 then
+    local results, ran_on, said, err = {}, {}, {}, nil
+    local function record(msg)
+      for _, line in ipairs(msg.lines) do
+        said[#said + 1] = line
+        say(opts, "%s", line)
+      end
+      ran_on[order[msg.k]] = msg.rank
+      if msg.ok then results[order[msg.k]] = msg.value else err = err or msg.error end
+    end
+    local idle, out, next_test = {}, 0, 1
+    for r = 1, R - 1 do idle[#idle + 1] = r end
+    -- a rank's result, waiting for one or not: true if one came
+    local function collect(wait)
+      local text, from = seixo.receive(wait)
+      if not text then return false end
+      record(pool.deserialize(text))
+      idle[#idle + 1], out = from, out - 1
+      return true
+    end
+    local function hand_out()
+      while collect(false) do end -- the ranks that ended since the last look
+      while #idle > 0 and next_test <= #tests do
+        seixo.send(table.remove(idle, 1), pool.serialize({k = next_test}))
+        next_test, out = next_test + 1, out + 1
+      end
+    end
+    on_test_open = function(m) m:on("after", hand_out, {every = POLL_STEPS}) end
+    while next_test <= #tests or out > 0 do
+      hand_out()
+      if next_test <= #tests then
+        local k = next_test
+        next_test = k + 1 -- before the test: hand_out goes on from the next
+        record(run(k))
+      elseif out > 0 then
+        collect(true)
+      end
+    end
+    on_test_open = nil
+    done = {results = results, ran_on = ran_on, said = said, error = err}
+    local text = pool.serialize({done = done})
+    for r = 1, R - 1 do seixo.send(r, text) end
+  else
+    while not done do
+      local msg = pool.deserialize((seixo.receive(true)))
+      if msg.done then done = msg.done else seixo.send(0, pool.serialize(run(msg.k))) end
+    end
+    for _, line in ipairs(done.said) do say(opts, "%s", line) end
+  end
+  seixo.decompose(shared)
+  if done.error then error(done.error, 0) end
+  return done.results, done.ran_on
+end
+
 --- A triaxial series: the tests at each confining stress (0 is a UCS), then
 --- the Mohr-Coulomb fit of their peaks, and the plots. opts as for
 --- lab.triaxial, with confining = {sigma3, ...}; opts.out is a prefix.
@@ -1208,9 +1298,13 @@ function lab.series(spec, opts)
   if math.type(jobs) == nil or jobs ~= math.floor(jobs) or jobs < 1 or jobs == math.huge then
     fail("lab.series: jobs must be a whole number of processes >= 1 (got %s)", tostring(opts.jobs))
   end
-  -- under mpirun the ranks share each model, and under a stock lua5.4 there
-  -- is no seixo program to start: the tests run here, in turn
-  if seixo.ranks() > 1 or (jobs > 1 and not pool.can_serve()) then jobs = 1 end
+  -- under mpirun, with the ranks sharing the models, the tests go to the
+  -- ranks unless jobs = 1 asks for them in turn (each then decomposed);
+  -- ranks on their own (seixo.decompose(false)) and a stock lua5.4, which
+  -- has no seixo program to start, run the tests here, in turn
+  local over_ranks = seixo.ranks() > 1 and seixo.decompose() and opts.jobs ~= 1
+  if over_ranks then jobs = seixo.ranks() end
+  if not over_ranks and (seixo.ranks() > 1 or (jobs > 1 and not pool.can_serve())) then jobs = 1 end
   local tolerance = opts.quasi_static == true and 0.02 or opts.quasi_static
   if tolerance and (type(tolerance) ~= "number" or not (tolerance > 0 and tolerance < 1)) then
     fail("lab.series: quasi_static must be true, false or a tolerance in (0, 1) (got %s)", tostring(opts.quasi_static))
@@ -1243,8 +1337,10 @@ function lab.series(spec, opts)
     tests[#tests + 1] = {call = first.call, opts = o, slow = true}
   end
   jobs = math.min(jobs, #tests)
-  local results
-  if jobs > 1 then
+  local results, ran_on
+  if over_ranks then
+    results, ran_on = run_ranks(spec, tests, opts)
+  elseif jobs > 1 then
     results = run_tests(spec, tests, jobs, opts)
   else
     results = {}
@@ -1255,7 +1351,7 @@ function lab.series(spec, opts)
   local fit = lab.mohr_coulomb(points)
   say(opts, "lab.series: Mohr-Coulomb c %.4g MPa, phi %.2f deg (UCS of the fit %.4g MPa, R^2 %.4f, rms %.3g MPa)",
       fit.c / 1e6, fit.phi, fit.intercept / 1e6, fit.r2, fit.rms / 1e6)
-  local s = {tests = {table.unpack(results, 1, #list)}, fit = fit, jobs = jobs}
+  local s = {tests = {table.unpack(results, 1, #list)}, fit = fit, jobs = jobs, ran_on = ran_on}
   if tolerance then
     local slow, fast = results[#tests], results[1]
     local change = math.abs(slow.peak / fast.peak - 1)
