@@ -56,6 +56,10 @@ extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, exec
 /// parallel.c: decomposes m over the MPI ranks when MPI runs and seixo.decompose is on, its cycles
 /// leaving the state scattered (sx_model_gather_lazily); true if it did.
 bool sx_lua_parallel_decompose(sx_model *m);
+/// parallel.c: under mpirun, says once (rank 0, on stderr) when the ranks on
+/// this machine times `threads` are more than its cores and OpenMP's waits
+/// spin (OMP_WAIT_POLICY not passive).
+void sx_lua_parallel_check_threads(int threads);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);
 /// parallel.c: whether this process writes the files of a model, `shared`

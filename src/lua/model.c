@@ -198,6 +198,7 @@ int sx_lua_model_new(lua_State *L)
             return luaL_error(L, "seixo.model: seixo.threads must be a whole number from 1 to 1024 (got %s)",
                               luaL_tolstring(L, -1, NULL));
         sx_model_set_threads(u->m, (int)t);
+        sx_lua_parallel_check_threads((int)t);
     }
     lua_settop(L, self);
     return 1;

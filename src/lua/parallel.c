@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -80,6 +81,30 @@ void sx_lua_parallel_stop(int ok)
     mpi_started = false;
 #else
     (void)ok;
+#endif
+}
+
+void sx_lua_parallel_check_threads(int threads)
+{
+#ifdef SX_HAVE_MPI
+    /* OpenMP's threads wait for work by spinning: with more ranks times
+     * threads on a machine than cores, each rank's waiting threads take the
+     * cores its neighbours' work needs (2 ranks of 2 threads on 2 cores
+     * ran a test scene 10 to 20 times slower than with passive waiting).
+     * The runtime reads its policy once, before main: too late to set it
+     * here, so say it, once, from rank 0. */
+    static bool said;
+    const char *local = getenv("OMPI_COMM_WORLD_LOCAL_SIZE"), *policy = getenv("OMP_WAIT_POLICY");
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN), here = local ? atol(local) : world_size;
+    if (said || !mpi_started || threads < 2 || world_rank != 0 || cores < 1 || here * threads <= cores) return;
+    if (policy && strcasecmp(policy, "passive") == 0) return;
+    said = true;
+    fprintf(stderr,
+            "seixo: %ld ranks of %d threads on this machine's %ld cores: more threads than cores, whose OpenMP "
+            "waits spin (many times slower); run fewer, or set OMP_WAIT_POLICY=passive\n",
+            here, threads, cores);
+#else
+    (void)threads;
 #endif
 }
 
