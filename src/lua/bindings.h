@@ -138,6 +138,10 @@ typedef struct sx_lua_model {
 int sx_lua_models(lua_State *L);
 /// seixo.model{...}: the constructor.
 int sx_lua_model_new(lua_State *L);
+/// The executable's --threads N (seixo.threads), when set, on m (fn names
+/// the call in the error of a bad value; m NULL: only that check); results
+/// do not depend on it.
+void sx_lua_model_threads(lua_State *L, sx_model *m, const char *fn);
 /// Creates the model class with the methods of every array in `sets`
 /// (NULL-terminated); leaves nothing on the stack.
 void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[]);

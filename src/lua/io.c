@@ -354,6 +354,7 @@ static int seixo_load(lua_State *L)
         sx_lua_optintfield(L, 2, "dim", 2, 3, &dim);
     }
     lua_settop(L, 2);
+    sx_lua_model_threads(L, NULL, "seixo.load"); /* a bad seixo.threads, named here */
     /* the userdata first, so the loaded model always has an owner */
     lua_pushcfunction(L, sx_lua_model_new);
     lua_call(L, 0, 1);
@@ -371,6 +372,8 @@ static int seixo_load(lua_State *L)
     if (!m) return luaL_error(L, "%s", err);
     sx_model_destroy(u->m);
     u->m = m;
+    /* the file's thread count is the saving run's: --threads here wins, as for seixo.model */
+    sx_lua_model_threads(L, m, "seixo.load");
     u->decomposed = sx_lua_parallel_decompose(m); /* as seixo.model: over the ranks under mpirun */
     /* the trees into the model's state */
     for (int k = 0; k < info->ntrees; k++) {

@@ -190,18 +190,26 @@ int sx_lua_model_new(lua_State *L)
     u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
     const int self = lua_gettop(L);
     list_model(L, self);
-    /* the executable's --threads N (seixo.threads); results do not depend on it */
+    sx_lua_model_threads(L, u->m, "seixo.model");
+    lua_settop(L, self);
+    return 1;
+}
+
+void sx_lua_model_threads(lua_State *L, sx_model *m, const char *fn)
+{
+    const int top = lua_gettop(L);
     if (lua_getglobal(L, "seixo") == LUA_TTABLE && lua_getfield(L, -1, "threads") != LUA_TNIL) {
         int isint = 0;
         const lua_Integer t = lua_tointegerx(L, -1, &isint);
         if (!isint || t < 1 || t > 1024)
-            return luaL_error(L, "seixo.model: seixo.threads must be a whole number from 1 to 1024 (got %s)",
-                              luaL_tolstring(L, -1, NULL));
-        sx_model_set_threads(u->m, (int)t);
-        sx_lua_parallel_check_threads((int)t);
+            luaL_error(L, "%s: seixo.threads must be a whole number from 1 to 1024 (got %s)", fn,
+                       luaL_tolstring(L, -1, NULL));
+        if (m) {
+            sx_model_set_threads(m, (int)t);
+            sx_lua_parallel_check_threads((int)t);
+        }
     }
-    lua_settop(L, self);
-    return 1;
+    lua_settop(L, top);
 }
 
 /* With the executable's --profile, a model that cycled prints its profile
@@ -784,6 +792,8 @@ static int model_profile(lua_State *L)
     lua_setfield(L, -2, "cycles");
     lua_pushinteger(L, (lua_Integer)p.resumed);
     lua_setfield(L, -2, "resumed");
+    lua_pushinteger(L, sx_model_threads(m));
+    lua_setfield(L, -2, "threads");
     if (reset) sx_model_profile_reset(m);
     return 1;
 }

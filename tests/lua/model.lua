@@ -273,6 +273,19 @@ test("--threads is accepted and recorded", function()
   end
   seixo.threads = 2
   seixo.model{dim = 2}:close()
+  -- a loaded model runs on seixo.threads too, not the saving run's count
+  -- (every lab test loads its specimen: --threads did nothing there)
+  seixo.threads = 1
+  local one = seixo.model{dim = 2}
+  eq(one:profile{print = false}.threads, 1)
+  local path = os.tmpname()
+  one:save(path)
+  seixo.threads = 3
+  local loaded = seixo.load(path)
+  eq(loaded:profile{print = false}.threads, 3)
+  seixo.threads = "x"
+  raises(function() seixo.load(path) end, HERE, "seixo.load: seixo.threads must be a whole number")
+  os.remove(path)
   seixo.threads = nil
   seixo.model{dim = 2}:close()
   seixo.threads = 1
