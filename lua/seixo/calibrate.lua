@@ -59,6 +59,7 @@ local function fail(fmt, ...)
 end
 
 local copy -- lab.lua's deep copy, given at install
+local polling -- lab.lua's polling, given at install: fn(...) while handing out work
 
 -- ------------------------------------------------------- the parameters
 
@@ -259,7 +260,9 @@ local function run_processes(o, jobs, record)
 end
 
 -- Runs jobs over the MPI ranks: rank 0 hands each idle rank a job, runs
--- one itself while any is left, and collects the records as they come.
+-- one itself while any is left (handing out meanwhile to the ranks that
+-- end, every few hundred steps of the lab's models: lab's polling), and
+-- collects the records as they come.
 local function run_ranks(o, jobs, record)
   local idle, out, next_job = {}, 0, 1
   for r = 1, seixo.ranks() - 1 do idle[#idle + 1] = r end
@@ -271,15 +274,19 @@ local function run_ranks(o, jobs, record)
     idle[#idle + 1], out = from, out - 1
     return true
   end
-  while next_job <= #jobs or out > 0 do
+  local function hand_out()
     while collect(false) do end
     while #idle > 0 and next_job <= #jobs do
       seixo.send(table.remove(idle, 1), serialize({i = next_job, x = jobs[next_job].x, seed = jobs[next_job].seed}))
       next_job, out = next_job + 1, out + 1
     end
+  end
+  while next_job <= #jobs or out > 0 do
+    hand_out()
     if next_job <= #jobs then
-      record(next_job, run_job(o, jobs[next_job].x, jobs[next_job].seed))
-      next_job = next_job + 1
+      local i = next_job
+      next_job = i + 1 -- before the run: hand_out goes on from the next
+      record(i, polling(hand_out, run_job, o, jobs[i].x, jobs[i].seed))
     elseif out > 0 then
       collect(true)
     end
@@ -770,7 +777,15 @@ end
 --- figures of the lab look the same) and its deep copy.
 function M.install(lab, helpers)
   copy = helpers.copy
-  lab.calibrate = function(opts) return calibrate(lab, helpers, opts) end
+  polling = helpers.polling
+  -- the ranks' own models (seixo.decompose(false)) for the calibration's
+  -- runs only: the script's models after it are decomposed again, and its
+  -- files rank 0's again (each rank wrote the same files after it)
+  lab.calibrate = function(opts)
+    local shared = seixo.decompose()
+    local _ <close> = setmetatable({}, {__close = function() seixo.decompose(shared) end})
+    return calibrate(lab, helpers, opts)
+  end
 end
 
 return M

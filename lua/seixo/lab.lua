@@ -394,6 +394,7 @@ function lab.specimen(opts)
   local t0 = seixo.clock()
 
   local m = seixo.model{dim = dim}
+  if on_model_open then on_model_open(m) end
   -- genesis is frictionless (a dense packing); the rock's friction comes back before bonding
   m:material("rock", merge(mat, {friction = 0}))
   if grain then -- the pebbles' radii, scaled: the sizes the tests and the bond gap use
@@ -650,9 +651,20 @@ end
 -- A test's start: the specimen loaded from its file, its extents and
 -- centre, and the platens -- frictionless planes (lines) touching its ends
 -- along the loading axis.
--- Set while a series runs over the MPI ranks (run_ranks): called with each
--- test's model as it opens, so that rank 0 hands tests out during its own.
-local on_test_open
+-- Set while rank 0 runs work of its own and hands out the rest over the
+-- MPI ranks (polling): called with each model a test or a genesis opens.
+local on_model_open
+local POLL_STEPS = 500
+
+-- fn(...), with poll() called every POLL_STEPS steps of each model a lab
+-- test or genesis opens meanwhile (a callback: no bit changes), so that
+-- rank 0 hands out work to the ranks that end while it runs its own.
+local function polling(poll, fn, ...)
+  local was = on_model_open
+  local _ <close> = setmetatable({}, {__close = function() on_model_open = was end})
+  on_model_open = function(m) m:on("after", poll, {every = POLL_STEPS}) end
+  return fn(...)
+end
 
 local function open_test(spec, opts, fn)
   if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
@@ -677,7 +689,7 @@ local function open_test(spec, opts, fn)
   local kind = dim == 3 and "plane" or "line"
   local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
   local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
-  if on_test_open then on_test_open(m) end
+  if on_model_open then on_model_open(m) end
   return m, lo, hi, centre, bottom, top
 end
 
@@ -1208,13 +1220,12 @@ end
 -- do: its results are the same bit for bit, and the tests take the ranks'
 -- cores without a message a step. Rank 0 hands each idle rank a test (the
 -- longest first), runs one itself while any is left (looking for idle
--- ranks every POLL_STEPS steps of its own test: a callback, which changes
--- no bit), and passes each test's log on as it ends; then every rank gets
+-- ranks every POLL_STEPS steps of its own test: polling), and passes each
+-- test's log on as it ends; then every rank gets
 -- the results and the log
 -- lines in the order rank 0 said them (a log function of the script's then
 -- sees the same lines on every rank), or the first test's error, which
 -- every rank raises alike.
-local POLL_STEPS = 500
 local function run_ranks(spec, tests, opts)
   local order, R = longest_first(tests), seixo.ranks()
   local function run(k)
@@ -1226,6 +1237,7 @@ local function run_ranks(spec, tests, opts)
             rank = seixo.rank()}
   end
   local shared = seixo.decompose()
+  local _ <close> = setmetatable({}, {__close = function() seixo.decompose(shared) end})
   seixo.decompose(false)
   local done
   if seixo.rank() == 0 then
@@ -1255,18 +1267,16 @@ local function run_ranks(spec, tests, opts)
         next_test, out = next_test + 1, out + 1
       end
     end
-    on_test_open = function(m) m:on("after", hand_out, {every = POLL_STEPS}) end
     while next_test <= #tests or out > 0 do
       hand_out()
       if next_test <= #tests then
         local k = next_test
         next_test = k + 1 -- before the test: hand_out goes on from the next
-        record(run(k))
+        record(polling(hand_out, run, k))
       elseif out > 0 then
         collect(true)
       end
     end
-    on_test_open = nil
     done = {results = results, ran_on = ran_on, said = said, error = err}
     local text = pool.serialize({done = done})
     for r = 1, R - 1 do seixo.send(r, text) end
@@ -1277,7 +1287,6 @@ local function run_ranks(spec, tests, opts)
     end
     for _, line in ipairs(done.said) do say(opts, "%s", line) end
   end
-  seixo.decompose(shared)
   if done.error then error(done.error, 0) end
   return done.results, done.ran_on
 end
@@ -1494,7 +1503,7 @@ set yrange [0:%.6g]
 end
 
 -- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures
-require("seixo.calibrate").install(lab, {gnuplot = gnuplot, copy = copy})
+require("seixo.calibrate").install(lab, {gnuplot = gnuplot, copy = copy, polling = polling})
 
 -- periodic cells, without walls (lua/seixo/periodic.lua)
 lab.periodic = require "seixo.periodic"

@@ -38,5 +38,11 @@ for i, strength in ipairs({120e6, 90e6}) do
     results[i] = string.format("%.10g %.10g %.10g", r.parameters.modulus, r.parameters.stiffness_ratio, r.parameters.strength)
   end)
 end
+test("the models after a calibration are decomposed again", function()
+  eq(seixo.decompose(), true)
+  local m = seixo.model{dim = 2}
+  eq(m:ranks(), 2)
+  m:close()
+end)
 print(string.format("rank %d: %s | %s", rank, results[1] or "-", results[2] or "-"))
 T.done()
