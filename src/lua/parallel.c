@@ -31,6 +31,7 @@ static int world_rank = 0, world_size = 1;
 
 static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
+static bool fail_wait(void);
 
 enum { MESSAGE_TAG = 7 };
 #endif
@@ -74,8 +75,13 @@ void sx_lua_parallel_stop(int ok)
      * them waiting: it ends only with the others */
     char err[512];
     if (ok && !sx_lua_parallel_same_call("the script's end", err, sizeof err)) sx_lua_parallel_fail(err);
-    /* a rank that failed would leave the others waiting for its messages */
-    if (!ok && world_size > 1) MPI_Abort(MPI_COMM_WORLD, 1);
+    /* a rank that failed would leave the others waiting for its messages
+     * (rank 0, which reported at once, gives those failing alike their
+     * time to clean up first) */
+    if (!ok && world_size > 1) {
+        if (world_rank == 0) fail_wait();
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
     if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
     MPI_Finalize();
     mpi_started = false;
@@ -271,28 +277,44 @@ bool sx_lua_parallel_decompose(sx_model *m)
 
 /* An error in the script, or one that every rank finds in a cycle, fails
  * every rank alike: each would print the same message. A failing rank
- * enters a barrier of the failing ranks and polls it for FAIL_WAIT_MS: when
- * every rank has come (all failed), rank 0 alone reports; else this rank
- * failed alone (or the others fail that much later: then each reports) and
- * reports. Then each ends the job (MPI_Abort), as before; the ranks that
- * keep quiet wait for rank 0's. (A timer alone, ranks > 0 waiting for rank
- * 0's MPI_Abort to end them, failed under load: they outlived it.) */
+ * enters a barrier of the failing ranks. Rank 0 reports at once (whoever
+ * else fails says the same or keeps quiet), and waits on the barrier for
+ * FAIL_WAIT_MS before its MPI_Abort (fail_wait), so that the others
+ * failing alike remove their shadows first. A rank above 0 waits on it
+ * too: when every rank has come (all failed), rank 0 reports and it keeps
+ * quiet; else this rank failed alone (or the others fail that much later:
+ * then each reports) and reports. Then each ends the job (MPI_Abort); the
+ * ranks that keep quiet wait for rank 0's. (A timer alone, ranks > 0
+ * waiting for rank 0's MPI_Abort to end them, failed under load: they
+ * outlived it.) */
 enum { FAIL_WAIT_MS = 5000, FAIL_POLL_MS = 10 };
+
+#ifdef SX_HAVE_MPI
+static MPI_Request fail_req = MPI_REQUEST_NULL; /* this rank's entry in the failing ranks' barrier */
+static bool fail_entered;                          /* once: a second entry would be another barrier */
+
+/* Polls the failing ranks' barrier for up to FAIL_WAIT_MS: true once every
+ * rank has come (false at once when this rank is not in it, or when it
+ * completed already: MPI_Test then freed the request). */
+static bool fail_wait(void)
+{
+    int all = 0;
+    const struct timespec poll = {0, FAIL_POLL_MS * 1000000L};
+    for (int ms = 0; !all && fail_req != MPI_REQUEST_NULL && ms < FAIL_WAIT_MS; ms += FAIL_POLL_MS) {
+        if (MPI_Test(&fail_req, &all, MPI_STATUS_IGNORE) != MPI_SUCCESS) return false;
+        if (!all) nanosleep(&poll, NULL);
+    }
+    return all;
+}
+#endif
 
 bool sx_lua_parallel_failing(void)
 {
     sx_lua_rank_files_remove(); /* the run ends: before rank 0's MPI_Abort can kill this rank */
 #ifdef SX_HAVE_MPI
     if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
-    MPI_Request req;
-    if (MPI_Ibarrier(fail_comm, &req) != MPI_SUCCESS) return true;
-    int all = 0;
-    const struct timespec poll = {0, FAIL_POLL_MS * 1000000L};
-    for (int ms = 0; !all && ms < FAIL_WAIT_MS; ms += FAIL_POLL_MS) {
-        if (MPI_Test(&req, &all, MPI_STATUS_IGNORE) != MPI_SUCCESS) return true;
-        if (!all) nanosleep(&poll, NULL);
-    }
-    if (!all || world_rank == 0) return true;
+    if (!fail_entered && (fail_entered = true, MPI_Ibarrier(fail_comm, &fail_req) != MPI_SUCCESS)) return true;
+    if (world_rank == 0 || !fail_wait()) return true;
     /* rank 0 reports and its MPI_Abort ends this rank: an abort from here
      * could end rank 0 before it printed */
     const struct timespec wait = {FAIL_WAIT_MS / 1000, 0};
@@ -310,7 +332,10 @@ void sx_lua_parallel_fail(const char *message)
         fflush(stderr);
     }
 #ifdef SX_HAVE_MPI
-    if (mpi_started) MPI_Abort(MPI_COMM_WORLD, 1);
+    if (mpi_started) {
+        if (world_rank == 0) fail_wait();
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
 #endif
     exit(1);
 }

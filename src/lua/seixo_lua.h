@@ -70,7 +70,8 @@ SX_API char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud,
 /// To call before reporting the error that ends the run (then
 /// sx_lua_parallel_stop(0)): whether this process reports it. Under mpirun
 /// an error every rank meets (within a few seconds) is reported by rank 0
-/// alone; a rank failing alone reports after that wait. Else true at once.
+/// alone, at once; a rank above 0 failing alone reports after that wait.
+/// Else true at once.
 SX_API bool sx_lua_parallel_failing(void);
 
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort

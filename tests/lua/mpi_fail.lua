@@ -7,6 +7,8 @@
 --   callback   an error in a callback, inside a decomposed cycle
 --   last       an error on the last rank only, the others going on to
 --              cycle (they wait for it: the error must end them)
+--   first      the same on rank 0 only (which reports at once: it no
+--              longer waits 5 s to see whether the others fail alike)
 local scene = arg and arg[1] or "script"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 -- a file written: the ranks above 0 hold a shadow of it when they fail
@@ -25,7 +27,10 @@ elseif scene == "callback" then
 elseif scene == "last" then
   if seixo.rank() == seixo.ranks() - 1 then error("mpi_fail.lua: an error on the last rank alone") end
   m:cycle(100)
+elseif scene == "first" then
+  if seixo.rank() == 0 then error("mpi_fail.lua: an error on rank 0 alone") end
+  m:cycle(100)
 else
-  error("mpi_fail.lua: scene script, callback or last expected, got " .. tostring(scene))
+  error("mpi_fail.lua: scene script, callback, last or first expected, got " .. tostring(scene))
 end
 print("not stopped")

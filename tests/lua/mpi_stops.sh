@@ -44,8 +44,8 @@ for np in $ranks; do
   if [ $rc = 0 ]; then echo "-np $np did not fail"; fail=1; continue; fi
   if [ $rc = 124 ]; then echo "-np $np hung (killed after 300 s)"; fail=1; continue; fi
   # ranks that fail remove their shadows before the abort (a rank that
-  # mpirun kills when another fails alone, scene 'last', cannot)
-  if [ "$scene" != last ] && ls "$TMPDIR" | grep -q "^seixo-rank"; then
+  # mpirun kills when another fails alone, scenes 'last' and 'first', cannot)
+  if [ "$scene" != last ] && [ "$scene" != first ] && ls "$TMPDIR" | grep -q "^seixo-rank"; then
     echo "-np $np: a rank's shadow folder was left: $(ls "$TMPDIR")"; fail=1; rm -rf "$TMPDIR"/seixo-rank*
   fi
   if ! grep -q "^ranks $np$" "$dir/err"; then
