@@ -80,11 +80,15 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size);
 /// parallel.c: sx_lua_parallel_same_call raising the message as a Lua error.
 void sx_lua_parallel_check_call(lua_State *L, const char *what);
 /// model.c: sx_lua_parallel_check_call for a call on model m, named
-/// with the model's creation number after the first ("m:save (model 2)").
+/// with the model's number after the first ("model 2: m:save").
 void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what);
-/// model.c: m's creation number in the session (seixo.models' order,
-/// closed models counted), 0 if it is not a Lua model.
+/// model.c: m's number among the models every rank makes alike (the
+/// decomposed ones, by creation, closed ones counted), 0 if it has none.
 int sx_lua_model_number(lua_State *L, const sx_model *m);
+/// model.c: numbers m, a model just decomposed: the next number, or that
+/// of `was` (seixo.load's placeholder, not dereferenced), which it
+/// forgets; m NULL: only forgets `was`.
+void sx_lua_model_share(lua_State *L, const sx_model *was, const sx_model *m);
 /// parallel.c: rank 0's v, on every rank (which all make the call and wait
 /// for it); v itself without MPI or with one rank.
 int64_t sx_lua_parallel_root_value(int64_t v);
@@ -103,6 +107,16 @@ const char *sx_lua_rank_file(lua_State *L, const char *path);
 /// rank_files.c: removes this rank's folder of shadows (at exit, and when
 /// the run fails, before mpirun's abort can kill the rank).
 void sx_lua_rank_files_remove(void);
+/// rank_files.c: the names this rank wrote, removed or renamed itself
+/// while the ranks did not share files (seixo.decompose(false)), each with
+/// its NUL, sorted, in a malloc'ed block of *len bytes (NULL: no memory);
+/// forgets them.
+char *sx_lua_rank_files_alone(lua_State *L, size_t *len);
+/// rank_files.c: sx_lua_rank_file_written for each NUL-ended name of names.
+void sx_lua_rank_files_on_disk(lua_State *L, const char *names, size_t len);
+/// parallel.c: under mpirun with more than one rank, while the models are
+/// each rank's own (seixo.decompose(false)).
+bool sx_lua_parallel_alone(void);
 /// rank_files.c: rank 0 has written `path` for every rank (m:save): a rank
 /// above 0 drops its shadow of it, reads the disk's file, and removes or
 /// renames it as rank 0 did even if rank 0 got there first.

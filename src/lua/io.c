@@ -370,11 +370,13 @@ static int seixo_load(lua_State *L)
     char err[1024];
     sx_model *m = sx_snapshot_load(path, (int)dim, info, err, sizeof err);
     if (!m) return luaL_error(L, "%s", err);
+    const sx_model *placeholder = u->m;
     sx_model_destroy(u->m);
     u->m = m;
     /* the file's thread count is the saving run's: --threads here wins, as for seixo.model */
     sx_lua_model_threads(L, m, "seixo.load");
     u->decomposed = sx_lua_parallel_decompose(m); /* as seixo.model: over the ranks under mpirun */
+    sx_lua_model_share(L, placeholder, u->decomposed ? m : NULL); /* the placeholder's number, if shared */
     /* the trees into the model's state */
     for (int k = 0; k < info->ntrees; k++) {
         const char *name = info->trees[k].name;

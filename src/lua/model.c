@@ -131,18 +131,58 @@ int sx_lua_models(lua_State *L)
     return 1;
 }
 
-int sx_lua_model_number(lua_State *L, const sx_model *m)
+/* The models every rank makes alike (decomposed: shared) by creation
+ * number, for the same-call check: a table in the registry keyed by the
+ * model's address. Models a rank makes on its own (seixo.decompose(false):
+ * a lab.series test, a calibration run) are not counted, as the ranks make
+ * different numbers of them. */
+static const char shared_key[] = "seixo.shared_models";
+
+void sx_lua_model_share(lua_State *L, const sx_model *was, const sx_model *m)
 {
-    push_model_list(L);
-    lua_getfield(L, LUA_REGISTRYINDEX, "seixo.models_made");
-    const lua_Integer made = lua_tointeger(L, -1);
-    lua_pop(L, 1);
-    int number = 0;
-    for (lua_Integer i = 1; i <= made && !number; i++) {
-        if (lua_rawgeti(L, -1, i) == LUA_TUSERDATA && sx_lua_tomodel(L, -1) == m) number = (int)i;
+    if (!luaL_getsubtable(L, LUA_REGISTRYINDEX, shared_key)) {
+        lua_pushinteger(L, 0);
+        lua_setfield(L, -2, "made");
+    }
+    lua_Integer number = 0;
+    if (was && lua_rawgetp(L, -1, was) == LUA_TNUMBER) { /* seixo.load: the placeholder's number */
+        number = lua_tointeger(L, -1);
+        lua_pushnil(L);
+        lua_rawsetp(L, -3, was);
+    }
+    if (was) lua_pop(L, 1);
+    if (m && !number) {
+        lua_getfield(L, -1, "made");
+        number = lua_tointeger(L, -1) + 1;
         lua_pop(L, 1);
+        lua_pushinteger(L, number);
+        lua_setfield(L, -2, "made");
+    }
+    if (m) {
+        lua_pushinteger(L, number);
+        lua_rawsetp(L, -2, m);
     }
     lua_pop(L, 1);
+}
+
+/* Forgets a closed model's number (a later model may take its address). */
+static void unshare(lua_State *L, const sx_model *m)
+{
+    if (!m || lua_getfield(L, LUA_REGISTRYINDEX, shared_key) != LUA_TTABLE) {
+        lua_pop(L, 1);
+        return;
+    }
+    lua_pushnil(L);
+    lua_rawsetp(L, -2, m);
+    lua_pop(L, 1);
+}
+
+int sx_lua_model_number(lua_State *L, const sx_model *m)
+{
+    int number = 0;
+    if (lua_getfield(L, LUA_REGISTRYINDEX, shared_key) == LUA_TTABLE && lua_rawgetp(L, -1, m) == LUA_TNUMBER)
+        number = (int)lua_tointeger(L, -1);
+    lua_pop(L, lua_type(L, -1) == LUA_TTABLE ? 1 : 2);
     return number;
 }
 
@@ -150,13 +190,14 @@ void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what)
 {
     /* ranks in one call on two models (`(seixo.rank() == 0 and m1 or
      * m2):save(...)`) would pair one model's exchanges with the other's;
-     * the first model keeps the plain name, as most scripts have one */
+     * the first model keeps the plain name, as most scripts have one, and
+     * the others' number comes first, where no cut of a long name drops it */
     const int number = sx_lua_model_number(L, m);
     if (number <= 1) {
         sx_lua_parallel_check_call(L, what);
         return;
     }
-    sx_lua_parallel_check_call(L, lua_pushfstring(L, "%s (model %d)", what, number));
+    sx_lua_parallel_check_call(L, lua_pushfstring(L, "model %d: %s", number, what));
     lua_pop(L, 1);
 }
 
@@ -188,6 +229,7 @@ int sx_lua_model_new(lua_State *L)
     u->m = sx_model_create(&d, err, sizeof err);
     if (!u->m) return luaL_error(L, "seixo.model: %s", sx_lua_core_message(err));
     u->decomposed = sx_lua_parallel_decompose(u->m); /* under mpirun: over the ranks */
+    if (u->decomposed) sx_lua_model_share(L, NULL, u->m);
     const int self = lua_gettop(L);
     list_model(L, self);
     sx_lua_model_threads(L, u->m, "seixo.model");
@@ -242,6 +284,7 @@ static int model_close(lua_State *L)
     sx_lua_model *u = sx_lua_modelud(L, 1);
     if (u->running) return luaL_error(L, "the model is cycling; close it after the cycle returns");
     profile_at_end(L, u->m);
+    unshare(L, u->m);
     sx_model_destroy(u->m);
     u->m = NULL;
     return 0;
@@ -252,6 +295,7 @@ static int model_gc(lua_State *L)
 {
     sx_lua_model *u = sx_lua_modelud(L, 1);
     profile_at_end(L, u->m);
+    unshare(L, u->m);
     sx_model_destroy(u->m);
     u->m = NULL;
     return 0;
