@@ -54,7 +54,10 @@ local units = {E = {1e9, "GPa"}, UCS = {1e6, "MPa"}, BTS = {1e6, "MPa"}, c = {1e
 local here = debug.getinfo(1, "S").source
 local function fail(fmt, ...)
   local level = 2
-  while debug.getinfo(level, "S") and debug.getinfo(level, "S").source == here do level = level + 1 end
+  -- (and past a C function: the pcall of a search under mpirun)
+  while debug.getinfo(level, "S") and (debug.getinfo(level, "S").source == here or debug.getinfo(level, "S").what == "C") do
+    level = level + 1
+  end
   error(string.format("lab.calibrate: " .. fmt, ...), level)
 end
 
@@ -298,6 +301,7 @@ local function serve_rank(o)
   while true do
     local msg = deserialize((seixo.receive(true)))
     if msg.done then return msg.done end
+    if msg.failed then error(msg.failed, 0) end
     seixo.send(0, serialize({i = msg.i, rec = run_job(o, msg.x, msg.seed)}))
   end
 end
@@ -588,6 +592,8 @@ end
 
 -- -------------------------------------------------------------- search
 
+local search -- below: the search of a calibration, on rank 0
+
 local function calibrate(lab, helpers, opts)
   local o = check_options(lab, opts)
   o.gnuplot = helpers.gnuplot
@@ -595,7 +601,19 @@ local function calibrate(lab, helpers, opts)
   -- decomposed: the models made from here on are each rank's (seixo.decompose)
   if seixo.ranks() > 1 then seixo.decompose(false) end
   if seixo.rank() > 0 then return serve_rank(o) end
+  if seixo.ranks() == 1 then return search(lab, o) end
+  -- an error of the search reaches the other ranks, which raise it alike
+  -- (none waits for ever)
+  local ok, result = pcall(search, lab, o)
+  if not ok then
+    for r = 1, seixo.ranks() - 1 do seixo.send(r, serialize({failed = tostring(result)})) end
+    error(result, 0)
+  end
+  return result
+end
 
+-- Rank 0's part (the whole of it on one rank): the search.
+function search(lab, o)
   -- a worker process started for one run of this calibration
   local taken = pool.take(os.getenv("SEIXO_CALIBRATE_JOB"))
   local job = taken and taken.job

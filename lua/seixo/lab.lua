@@ -1219,13 +1219,15 @@ end
 -- (seixo.decompose(false) while they run), as the processes of run_tests
 -- do: its results are the same bit for bit, and the tests take the ranks'
 -- cores without a message a step. Rank 0 hands each idle rank a test (the
--- longest first), runs one itself while any is left (looking for idle
--- ranks every POLL_STEPS steps of its own test: polling), and passes each
--- test's log on as it ends; then every rank gets
--- the results and the log
--- lines in the order rank 0 said them (a log function of the script's then
--- sees the same lines on every rank), or the first test's error, which
--- every rank raises alike.
+-- longest first; none after a failure, as the tests in turn stop at the
+-- first), runs one itself while any is left (looking for idle ranks every
+-- POLL_STEPS steps of its own test: polling), and says each test's log
+-- lines as it ends. Then every rank gets the results, the lines rank 0
+-- said (which the others say in turn: a log function of the script's sees
+-- the same lines on every rank; one that raises stops the lines there, on
+-- every rank) and the error to raise: that of the first failing test in
+-- the series' order, else the log function's, else rank 0's own. Rank 0
+-- sends that outcome whatever happened, so no rank waits for ever.
 local function run_ranks(spec, tests, opts)
   local order, R = longest_first(tests), seixo.ranks()
   local function run(k)
@@ -1236,48 +1238,65 @@ local function run_ranks(spec, tests, opts)
     return {k = k, ok = ok, value = ok and value or nil, error = not ok and tostring(value) or nil, lines = lines,
             rank = seixo.rank()}
   end
+  local said, log_error = {}, nil
+  local function say_all(lines)
+    for _, line in ipairs(lines) do
+      if log_error then return end
+      said[#said + 1] = line
+      local ok, e = pcall(say, opts, "%s", line)
+      if not ok then log_error = tostring(e) end
+    end
+  end
   local shared = seixo.decompose()
   local _ <close> = setmetatable({}, {__close = function() seixo.decompose(shared) end})
   seixo.decompose(false)
   local done
   if seixo.rank() == 0 then
-    local results, ran_on, said, err = {}, {}, {}, nil
-    local function record(msg)
-      for _, line in ipairs(msg.lines) do
-        said[#said + 1] = line
-        say(opts, "%s", line)
-      end
-      ran_on[order[msg.k]] = msg.rank
-      if msg.ok then results[order[msg.k]] = msg.value else err = err or msg.error end
-    end
+    local results, ran_on, errors = {}, {}, {}
     local idle, out, next_test = {}, 0, 1
     for r = 1, R - 1 do idle[#idle + 1] = r end
+    local function record(msg)
+      local i = order[msg.k]
+      ran_on[i] = msg.rank
+      if msg.ok then results[i] = msg.value else errors[i] = msg.error end
+      say_all(msg.lines)
+    end
+    local function more() return next_test <= #tests and next(errors) == nil and not log_error end
     -- a rank's result, waiting for one or not: true if one came
     local function collect(wait)
       local text, from = seixo.receive(wait)
       if not text then return false end
-      record(pool.deserialize(text))
       idle[#idle + 1], out = from, out - 1
+      record(pool.deserialize(text))
       return true
     end
     local function hand_out()
       while collect(false) do end -- the ranks that ended since the last look
-      while #idle > 0 and next_test <= #tests do
+      while #idle > 0 and more() do
         seixo.send(table.remove(idle, 1), pool.serialize({k = next_test}))
         next_test, out = next_test + 1, out + 1
       end
     end
-    while next_test <= #tests or out > 0 do
-      hand_out()
-      if next_test <= #tests then
-        local k = next_test
-        next_test = k + 1 -- before the test: hand_out goes on from the next
-        record(polling(hand_out, run, k))
-      elseif out > 0 then
-        collect(true)
+    local ok, own_error = pcall(function()
+      while more() or out > 0 do
+        hand_out()
+        if more() then
+          local k = next_test
+          next_test = k + 1 -- before the test: hand_out goes on from the next
+          record(polling(hand_out, run, k))
+        elseif out > 0 then
+          collect(true)
+        end
       end
+    end)
+    while out > 0 do -- after an error of rank 0's own: the tests still out end, unrecorded
+      seixo.receive(true)
+      out = out - 1
     end
-    done = {results = results, ran_on = ran_on, said = said, error = err}
+    local first
+    for i = 1, #tests do if errors[i] then first = first or errors[i] end end
+    done = {results = results, ran_on = ran_on, said = said,
+            error = first or log_error or (not ok and tostring(own_error)) or nil}
     local text = pool.serialize({done = done})
     for r = 1, R - 1 do seixo.send(r, text) end
   else
@@ -1285,7 +1304,7 @@ local function run_ranks(spec, tests, opts)
       local msg = pool.deserialize((seixo.receive(true)))
       if msg.done then done = msg.done else seixo.send(0, pool.serialize(run(msg.k))) end
     end
-    for _, line in ipairs(done.said) do say(opts, "%s", line) end
+    say_all(done.said)
   end
   if done.error then error(done.error, 0) end
   return done.results, done.ran_on

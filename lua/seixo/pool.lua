@@ -62,10 +62,14 @@ function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
 --- file.
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
-  -- under mpirun with seixo.decompose(false) every rank writes the file,
-  -- with the same random numbers (rank 0's seed): the rank number keeps
-  -- their temporary names apart (with shared models rank 0 alone writes)
-  local tmp = string.format("%s.tmp%d.%d", path, seixo.rank(), math.random(1, 1 << 30))
+  -- processes writing one file at once (under mpirun with
+  -- seixo.decompose(false) every rank writes it; the workers of a pool)
+  -- each take a name of their own: the rank, and the address of a new
+  -- table, which differs between processes (each maps its heap at an
+  -- address of its own) and between live tables. Not math.random: a rank
+  -- that ran more tests of a series than another would draw more, and the
+  -- ranks must draw alike after it.
+  local tmp = string.format("%s.tmp%d.%s", path, seixo.rank(), (tostring({}):gsub("^table: ", "")))
   local f, opened = io.open(tmp, "w")
   if not f then error("cannot write " .. path .. ": " .. tostring(opened), 2) end
   local ok, err = f:write(text)

@@ -451,12 +451,62 @@ bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count
     return size > 0 && err[0] != '\0';
 }
 
+bool sx_lua_parallel_alone(void)
+{
+#ifdef SX_HAVE_MPI
+    return mpi_started && world_size > 1 && !decompose_on;
+#else
+    return false;
+#endif
+}
+
+/* The ranks share files again (seixo.decompose(true) after false): what
+ * each wrote, removed or renamed itself meanwhile is the disk's on every
+ * rank (a shadow of it from before is stale: a lab.series test's CSV that
+ * another rank wrote). A collective call: the names' lengths, then the
+ * names, to every rank. */
+static void share_alone_writes(lua_State *L)
+{
+#ifdef SX_HAVE_MPI
+    if (mpi_started && world_size > 1) sx_lua_parallel_check_call(L, "seixo.decompose(true)");
+#endif
+    size_t len;
+    char *mine = sx_lua_rank_files_alone(L, &len);
+    if (!mine) luaL_error(L, "seixo.decompose: out of memory");
+#ifdef SX_HAVE_MPI
+    if (mpi_started && world_size > 1) {
+        static const char fail[] = "seixo.decompose: the ranks could not share the names of the files they wrote";
+        int *count = malloc(2 * (size_t)world_size * sizeof *count);
+        if (!count) sx_lua_parallel_fail(fail);
+        const int n = len < INT_MAX ? (int)len : -1; /* every rank takes part, and all see a -1 */
+        if (MPI_Allgather(&n, 1, MPI_INT, count, 1, MPI_INT, MPI_COMM_WORLD) != MPI_SUCCESS) sx_lua_parallel_fail(fail);
+        size_t total = 0;
+        for (int r = 0; r < world_size; r++) {
+            if (count[r] < 0 || total + (size_t)count[r] >= INT_MAX) sx_lua_parallel_fail(fail);
+            count[world_size + r] = (int)total; /* the displacements */
+            total += (size_t)count[r];
+        }
+        char *all = malloc(total + 1);
+        if (!all || MPI_Allgatherv(mine, n, MPI_CHAR, all, count, count + world_size, MPI_CHAR, MPI_COMM_WORLD) !=
+                        MPI_SUCCESS)
+            sx_lua_parallel_fail(fail);
+        free(mine);
+        free(count);
+        mine = all, len = total;
+    }
+#endif
+    sx_lua_rank_files_on_disk(L, mine, len);
+    free(mine);
+}
+
 /* seixo.decompose([on]) -> whether models made from now on are decomposed */
 static int seixo_decompose(lua_State *L)
 {
     if (!lua_isnoneornil(L, 1)) {
         luaL_checktype(L, 1, LUA_TBOOLEAN);
+        const bool was = decompose_on;
         decompose_on = lua_toboolean(L, 1);
+        if (decompose_on && !was) share_alone_writes(L);
     }
     lua_pushboolean(L, decompose_on);
     return 1;
@@ -560,7 +610,9 @@ void sx_lua_parallel_open(lua_State *L)
     same_random_seed(L);
     sx_lua_wrap(L, "os", "tmpname", shared_tmpname, 0);
     sx_lua_wrap(L, "os", "exit", mpi_exit, 0);
-    if (world_rank > 0) sx_lua_rank_files_open(L);
+    /* rank 0's too: what it writes while the ranks do not share files is
+     * noted for the others (share_alone_writes) */
+    sx_lua_rank_files_open(L);
 #else
     (void)L;
 #endif

@@ -11,7 +11,9 @@
  *
  * Wrapped on ranks above 0: io.open, io.lines, io.input and io.output (a
  * path: through io.open), os.remove and os.rename (a shadow is removed or
- * renamed; the real file is rank 0's to change). A name the script removed
+ * renamed; the real file is rank 0's to change). (On rank 0 too, where
+ * they change nothing, for the names written while the ranks do not share
+ * files: drop_shadow.) A name the script removed
  * or renamed away is remembered as gone, so a rank that runs ahead does
  * not find rank 0's file still there. Devices (/dev/null), FIFOs and
  * sockets are not shadowed. A write that rank 0 would be refused (no
@@ -141,14 +143,70 @@ static void set_shadow(lua_State *L, enum shadow s, const char *path, bool keep)
     lua_pop(L, 1);
 }
 
+/* The names this rank wrote, removed or renamed itself while the ranks
+ * did not share files (a set in the registry): when they share again, the
+ * other ranks' shadows of them are stale (sx_lua_rank_files_alone). */
+static const char alone_key[] = "seixo.alone_writes";
+
 /* While the ranks do not share files (seixo.decompose(false)) this rank
  * writes, removes and renames the real file itself: a shadow of that name
- * made before would be stale once they share again. */
+ * made before would be stale once they share again, here and (the name is
+ * noted) on the other ranks. */
 static void drop_shadow(lua_State *L, const char *path)
 {
     if (!push_real_name(L, path)) return;
     set_shadow(L, NO_SHADOW, NULL, false);
+    if (sx_lua_parallel_alone()) {
+        luaL_getsubtable(L, LUA_REGISTRYINDEX, alone_key);
+        lua_pushvalue(L, -2);
+        lua_pushboolean(L, 1);
+        lua_settable(L, -3);
+        lua_pop(L, 1);
+    }
     lua_pop(L, 1);
+}
+
+char *sx_lua_rank_files_alone(lua_State *L, size_t *len)
+{
+    /* the names in sorted order: every rank then marks the union alike */
+    lua_newtable(L);
+    lua_Integer n = 0;
+    if (lua_getfield(L, LUA_REGISTRYINDEX, alone_key) == LUA_TTABLE)
+        for (lua_pushnil(L); lua_next(L, -2); lua_pop(L, 1)) {
+            lua_pushvalue(L, -2);
+            lua_rawseti(L, -5, ++n);
+        }
+    lua_pop(L, 1);
+    lua_pushnil(L);
+    lua_setfield(L, LUA_REGISTRYINDEX, alone_key);
+    lua_getglobal(L, "table");
+    lua_getfield(L, -1, "sort");
+    lua_pushvalue(L, -3);
+    lua_call(L, 1, 0);
+    lua_pop(L, 1);
+    size_t total = 0;
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, -1, i);
+        total += lua_rawlen(L, -1) + 1;
+        lua_pop(L, 1);
+    }
+    char *names = malloc(total + 1);
+    *len = 0;
+    for (lua_Integer i = 1; names && i <= n; i++) {
+        size_t k;
+        lua_rawgeti(L, -1, i);
+        const char *name = lua_tolstring(L, -1, &k);
+        memcpy(names + *len, name, k + 1);
+        *len += k + 1;
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    return names;
+}
+
+void sx_lua_rank_files_on_disk(lua_State *L, const char *names, size_t len)
+{
+    for (size_t at = 0; at < len; at += strlen(names + at) + 1) sx_lua_rank_file_written(L, names + at);
 }
 
 void sx_lua_rank_files_remove(void)

@@ -3,7 +3,7 @@
 -- return the same result. Two calibrations in a row: each is collective.
 --   mpirun --allow-run-as-root --oversubscribe -np 2 build/seixo tests/lua/calibrate_mpi.lua
 local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
-local test, check, eq, near = T.test, T.check, T.eq, T.near
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
 local lab = require("seixo.lab")
 
 local rank = seixo.rank()
@@ -38,6 +38,20 @@ for i, strength in ipairs({120e6, 90e6}) do
     results[i] = string.format("%.10g %.10g %.10g", r.parameters.modulus, r.parameters.stiffness_ratio, r.parameters.strength)
   end)
 end
+test("an error of the search on rank 0 is raised on every rank, none waiting for ever", function()
+  -- a log of another calibration's columns: rank 0 finds it as it starts
+  -- searching (the other ranks are waiting for jobs by then)
+  local log = "calibrate_mpi_other.csv"
+  local f = assert(io.open(log, "w")) -- rank 0's file (the others write a shadow)
+  f:write("candidate,seed,other\n1,1,2\n")
+  f:close()
+  raises(function()
+    lab.calibrate{targets = {E = 50e9}, parameters = {modulus = {10e9, 200e9}}, evaluate = synthetic, seeds = 1,
+                  maxeval = 4, log = log, plot = false, print = false}
+  end, "has the columns")
+  os.remove(log)
+end)
+
 test("the models after a calibration are decomposed again", function()
   eq(seixo.decompose(), true)
   local m = seixo.model{dim = 2}
