@@ -12,11 +12,13 @@
  * in its environment; only then, and for two ranks or more, does
  * sx_lua_parallel_start call MPI_Init, so a plain `seixo script.lua` never
  * starts MPI. */
+#define _GNU_SOURCE /* sched_getaffinity: the cores a rank may run on */
 #include "bindings.h"
 #include "seixo_lua.h"
 
 #include <fcntl.h>
 #include <limits.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,6 +27,7 @@
 #include <unistd.h>
 
 static int world_rank = 0, world_size = 1;
+static int node_size = 1; /* the ranks on this rank's machine */
 
 #ifdef SX_HAVE_MPI
 #include <mpi.h>
@@ -49,6 +52,11 @@ void sx_lua_parallel_start(int *argc, char ***argv)
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
     MPI_Comm_dup(MPI_COMM_WORLD, &fail_comm);
+    MPI_Comm node;
+    if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+        MPI_Comm_size(node, &node_size);
+        MPI_Comm_free(&node);
+    }
     /* every rank runs the script: one writes to standard output, else each
      * line would come once per rank, whether from print, io.write, a shell
      * command or a plot on gnuplot's dumb terminal (errors, on standard
@@ -93,22 +101,33 @@ void sx_lua_parallel_stop(int ok)
 void sx_lua_parallel_check_threads(int threads)
 {
 #ifdef SX_HAVE_MPI
-    /* OpenMP's threads wait for work by spinning: with more ranks times
-     * threads on a machine than cores, each rank's waiting threads take the
-     * cores its neighbours' work needs (2 ranks of 2 threads on 2 cores
-     * ran a test scene 10 to 20 times slower than with passive waiting).
-     * The runtime reads its policy once, before main: too late to set it
-     * here, so say it, once, from rank 0. */
+    /* OpenMP's threads wait for work by spinning: with more threads than
+     * the cores a rank may run on (mpirun binds each of 2 ranks to a core
+     * by default), or more ranks times threads on a machine than its
+     * cores, the waiting threads take the cores the working ones need (2
+     * ranks of 2 threads on 2 cores ran a test scene 10 to 20 times slower
+     * than with passive waiting). The runtime reads its policy once,
+     * before main: too late to set it here, so say it, once, from rank 0. */
     static bool said;
-    const char *local = getenv("OMPI_COMM_WORLD_LOCAL_SIZE"), *policy = getenv("OMP_WAIT_POLICY");
-    const long cores = sysconf(_SC_NPROCESSORS_ONLN), here = local ? atol(local) : world_size;
-    if (said || !mpi_started || threads < 2 || world_rank != 0 || cores < 1 || here * threads <= cores) return;
+    const char *policy = getenv("OMP_WAIT_POLICY");
+    if (said || !mpi_started || threads < 2 || world_rank != 0) return;
     if (policy && strcasecmp(policy, "passive") == 0) return;
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    cpu_set_t set;
+    const int mine = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : (int)cores;
+    if (threads <= mine && (long)node_size * threads <= cores) return;
     said = true;
-    fprintf(stderr,
-            "seixo: %ld ranks of %d threads on this machine's %ld cores: more threads than cores, whose OpenMP "
-            "waits spin (many times slower); run fewer, or set OMP_WAIT_POLICY=passive\n",
-            here, threads, cores);
+    if (threads > mine)
+        fprintf(stderr,
+                "seixo: %d threads on the %d core%s this rank may run on (mpirun binds ranks to cores: "
+                "--bind-to none, or --map-by ...:PE=%d): OpenMP's waits spin, many times slower; bind it to "
+                "more cores, run fewer threads, or set OMP_WAIT_POLICY=passive\n",
+                threads, mine, mine == 1 ? "" : "s", threads);
+    else
+        fprintf(stderr,
+                "seixo: %d ranks of %d threads on this machine's %ld cores: more threads than cores, whose "
+                "OpenMP waits spin (many times slower); run fewer, or set OMP_WAIT_POLICY=passive\n",
+                node_size, threads, cores);
 #else
     (void)threads;
 #endif

@@ -6,5 +6,15 @@
 --   mpi_threads.lua SCRIPT ARGS...
 local here = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
 seixo.threads = 2
+-- every model the scene makes or loads runs on them
+for _, make in ipairs{"model", "load"} do
+  local made = seixo[make]
+  seixo[make] = function(...)
+    local m = made(...)
+    local t = m:profile{print = false}.threads
+    if t ~= 2 then error(string.format("seixo.%s made a model of %d threads, not 2", make, t)) end
+    return m
+  end
+end
 arg = {[0] = here .. arg[1], table.unpack(arg, 2)}
 dofile(arg[0])
