@@ -265,16 +265,20 @@ end
 -- Runs jobs over the MPI ranks: rank 0 hands each idle rank a job, runs
 -- one itself while any is left (handing out meanwhile to the ranks that
 -- end, every few hundred steps of the lab's models: lab's polling), and
--- collects the records as they come.
+-- collects the records as they come. A record is counted in before it is
+-- recorded (record calls the script's print, which may raise inside rank
+-- 0's own run); after an error here, the jobs still out are awaited (a
+-- rank sending a large record waits until it is taken), unrecorded, so
+-- that the ranks are all waiting for rank 0 when the error goes on.
 local function run_ranks(o, jobs, record)
   local idle, out, next_job = {}, 0, 1
   for r = 1, seixo.ranks() - 1 do idle[#idle + 1] = r end
   local function collect(wait)
     local text, from = seixo.receive(wait)
     if not text then return false end
+    idle[#idle + 1], out = from, out - 1
     local msg = deserialize(text)
     record(msg.i, msg.rec)
-    idle[#idle + 1], out = from, out - 1
     return true
   end
   local function hand_out()
@@ -284,15 +288,33 @@ local function run_ranks(o, jobs, record)
       next_job, out = next_job + 1, out + 1
     end
   end
-  while next_job <= #jobs or out > 0 do
-    hand_out()
-    if next_job <= #jobs then
-      local i = next_job
-      next_job = i + 1 -- before the run: hand_out goes on from the next
-      record(i, polling(hand_out, run_job, o, jobs[i].x, jobs[i].seed))
-    elseif out > 0 then
-      collect(true)
+  -- inside rank 0's own run, an error of record's (the script's print)
+  -- would pass for the run's failure: it is kept, and raised after the run
+  local kept
+  local function hand_out_kept()
+    local ok, e = pcall(hand_out)
+    if not ok then kept = kept or e end
+  end
+  local ok, err = pcall(function()
+    while next_job <= #jobs or out > 0 do
+      hand_out()
+      if next_job <= #jobs then
+        local i = next_job
+        next_job = i + 1 -- before the run: hand_out goes on from the next
+        local rec = polling(hand_out_kept, run_job, o, jobs[i].x, jobs[i].seed)
+        if kept then error(kept, 0) end
+        record(i, rec)
+      elseif out > 0 then
+        collect(true)
+      end
     end
+  end)
+  if not ok then
+    while out > 0 do
+      seixo.receive(true)
+      out = out - 1
+    end
+    error(err, 0)
   end
 end
 

@@ -1407,7 +1407,7 @@ local function gnuplot(script, outs)
     io.stderr:write("lab: gnuplot not found (apt-get install gnuplot-nox): no plots\n")
     return false
   end
-  local tag = math.random(1, 1 << 30)
+  local tag = pool.tag() -- no draw of math.random: rank 0 alone may plot (a calibration's)
   for _, o in ipairs(outs) do script = script:gsub("@" .. o.key .. "@", o.path .. ".tmp" .. tag) end
   local gp = os.tmpname()
   -- under mpirun, ranks sharing the models get here alike (the same draw, rank

@@ -57,19 +57,21 @@ end
 --- A word for the shell.
 function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
 
+--- A part of a temporary file's name that processes writing one file at
+--- once (under mpirun with seixo.decompose(false) every rank writes it;
+--- the workers of a pool) do not share: the rank, and the address of a new
+--- table, which differs between processes (each maps its heap at an
+--- address of its own) and between live tables. Not math.random: a rank
+--- that ran more tests of a series than another, or drew a plot alone,
+--- would draw more, and the ranks must draw alike after it.
+function pool.tag() return string.format("%d.%s", seixo.rank(), (tostring({}):gsub("^table: ", ""))) end
+
 --- Writes text to path through a temporary name in the same folder,
 --- renamed when complete: an interrupted write never leaves a truncated
 --- file.
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
-  -- processes writing one file at once (under mpirun with
-  -- seixo.decompose(false) every rank writes it; the workers of a pool)
-  -- each take a name of their own: the rank, and the address of a new
-  -- table, which differs between processes (each maps its heap at an
-  -- address of its own) and between live tables. Not math.random: a rank
-  -- that ran more tests of a series than another would draw more, and the
-  -- ranks must draw alike after it.
-  local tmp = string.format("%s.tmp%d.%s", path, seixo.rank(), (tostring({}):gsub("^table: ", "")))
+  local tmp = path .. ".tmp" .. pool.tag()
   local f, opened = io.open(tmp, "w")
   if not f then error("cannot write " .. path .. ": " .. tostring(opened), 2) end
   local ok, err = f:write(text)

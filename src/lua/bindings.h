@@ -112,8 +112,13 @@ void sx_lua_rank_files_remove(void);
 /// its NUL, sorted, in a malloc'ed block of *len bytes (NULL: no memory);
 /// forgets them.
 char *sx_lua_rank_files_alone(lua_State *L, size_t *len);
-/// rank_files.c: sx_lua_rank_file_written for each NUL-ended name of names.
-void sx_lua_rank_files_on_disk(lua_State *L, const char *names, size_t len);
+/// rank_files.c: for each NUL-ended name of names (len bytes), whether it
+/// is on the disk now (1 or 0), in a malloc'ed array (NULL: no memory).
+char *sx_lua_rank_files_there(const char *names, size_t len);
+/// rank_files.c: a rank above 0 forgets its shadow of each name of names,
+/// which is the disk's (there[i]: sx_lua_rank_files_there on rank 0) or
+/// gone, as for rank 0.
+void sx_lua_rank_files_settle(lua_State *L, const char *names, size_t len, const char *there);
 /// parallel.c: under mpirun with more than one rank, while the models are
 /// each rank's own (seixo.decompose(false)).
 bool sx_lua_parallel_alone(void);

@@ -168,7 +168,8 @@ void sx_lua_model_share(lua_State *L, const sx_model *was, const sx_model *m)
 /* Forgets a closed model's number (a later model may take its address). */
 static void unshare(lua_State *L, const sx_model *m)
 {
-    if (!m || lua_getfield(L, LUA_REGISTRYINDEX, shared_key) != LUA_TTABLE) {
+    if (!m) return;
+    if (lua_getfield(L, LUA_REGISTRYINDEX, shared_key) != LUA_TTABLE) {
         lua_pop(L, 1);
         return;
     }
@@ -179,10 +180,11 @@ static void unshare(lua_State *L, const sx_model *m)
 
 int sx_lua_model_number(lua_State *L, const sx_model *m)
 {
+    const int top = lua_gettop(L);
     int number = 0;
     if (lua_getfield(L, LUA_REGISTRYINDEX, shared_key) == LUA_TTABLE && lua_rawgetp(L, -1, m) == LUA_TNUMBER)
         number = (int)lua_tointeger(L, -1);
-    lua_pop(L, lua_type(L, -1) == LUA_TTABLE ? 1 : 2);
+    lua_settop(L, top);
     return number;
 }
 

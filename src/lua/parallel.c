@@ -491,7 +491,7 @@ static void share_alone_writes(lua_State *L)
 #endif
     size_t len;
     char *mine = sx_lua_rank_files_alone(L, &len);
-    if (!mine) luaL_error(L, "seixo.decompose: out of memory");
+    if (!mine) sx_lua_parallel_fail("seixo.decompose: out of memory for the names of the files this rank wrote");
 #ifdef SX_HAVE_MPI
     if (mpi_started && world_size > 1) {
         static const char fail[] = "seixo.decompose: the ranks could not share the names of the files they wrote";
@@ -514,7 +514,19 @@ static void share_alone_writes(lua_State *L)
         mine = all, len = total;
     }
 #endif
-    sx_lua_rank_files_on_disk(L, mine, len);
+    /* what is on the disk now is rank 0's to say: a name written and then
+     * removed is gone on every rank, as it is there */
+    size_t n = 0;
+    for (size_t at = 0; at < len; at += strlen(mine + at) + 1) n++;
+    char *there = world_rank == 0 ? sx_lua_rank_files_there(mine, len) : malloc(n + 1);
+    if (!there) sx_lua_parallel_fail("seixo.decompose: out of memory for the names of the files the ranks wrote");
+#ifdef SX_HAVE_MPI
+    if (mpi_started && world_size > 1 && n > 0 &&
+        (n > INT_MAX || MPI_Bcast(there, (int)n, MPI_CHAR, 0, MPI_COMM_WORLD) != MPI_SUCCESS))
+        sx_lua_parallel_fail("seixo.decompose: the ranks could not share which of their files are there");
+#endif
+    sx_lua_rank_files_settle(L, mine, len, there);
+    free(there);
     free(mine);
 }
 

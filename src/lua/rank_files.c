@@ -166,47 +166,67 @@ static void drop_shadow(lua_State *L, const char *path)
     lua_pop(L, 1);
 }
 
+static int by_name(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
 char *sx_lua_rank_files_alone(lua_State *L, size_t *len)
 {
-    /* the names in sorted order: every rank then marks the union alike */
-    lua_newtable(L);
-    lua_Integer n = 0;
+    /* the names in sorted order: every rank then settles the union alike */
+    size_t n = 0, total = 0, cap = 0;
+    const char **name = NULL;
+    bool ok = true;
     if (lua_getfield(L, LUA_REGISTRYINDEX, alone_key) == LUA_TTABLE)
         for (lua_pushnil(L); lua_next(L, -2); lua_pop(L, 1)) {
-            lua_pushvalue(L, -2);
-            lua_rawseti(L, -5, ++n);
+            if (n == cap) {
+                const char **more = realloc(name, (cap = cap ? 2 * cap : 16) * sizeof *name);
+                if (!more) {
+                    ok = false;
+                    lua_pop(L, 2);
+                    break;
+                }
+                name = more;
+            }
+            name[n] = lua_tostring(L, -2); /* the set's key, alive while the set is */
+            total += strlen(name[n++]) + 1;
         }
-    lua_pop(L, 1);
-    lua_pushnil(L);
-    lua_setfield(L, LUA_REGISTRYINDEX, alone_key);
-    lua_getglobal(L, "table");
-    lua_getfield(L, -1, "sort");
-    lua_pushvalue(L, -3);
-    lua_call(L, 1, 0);
-    lua_pop(L, 1);
-    size_t total = 0;
-    for (lua_Integer i = 1; i <= n; i++) {
-        lua_rawgeti(L, -1, i);
-        total += lua_rawlen(L, -1) + 1;
-        lua_pop(L, 1);
+    char *names = ok ? malloc(total + 1) : NULL;
+    if (names) {
+        qsort(name, n, sizeof *name, by_name);
+        *len = 0;
+        for (size_t i = 0; i < n; i++) {
+            const size_t k = strlen(name[i]) + 1;
+            memcpy(names + *len, name[i], k);
+            *len += k;
+        }
     }
-    char *names = malloc(total + 1);
-    *len = 0;
-    for (lua_Integer i = 1; names && i <= n; i++) {
-        size_t k;
-        lua_rawgeti(L, -1, i);
-        const char *name = lua_tolstring(L, -1, &k);
-        memcpy(names + *len, name, k + 1);
-        *len += k + 1;
-        lua_pop(L, 1);
-    }
+    free(name);
     lua_pop(L, 1);
+    if (names) {
+        lua_pushnil(L);
+        lua_setfield(L, LUA_REGISTRYINDEX, alone_key);
+    }
     return names;
 }
 
-void sx_lua_rank_files_on_disk(lua_State *L, const char *names, size_t len)
+char *sx_lua_rank_files_there(const char *names, size_t len)
 {
-    for (size_t at = 0; at < len; at += strlen(names + at) + 1) sx_lua_rank_file_written(L, names + at);
+    size_t n = 0;
+    for (size_t at = 0; at < len; at += strlen(names + at) + 1) n++;
+    char *there = malloc(n + 1);
+    struct stat st;
+    n = 0;
+    for (size_t at = 0; there && at < len; at += strlen(names + at) + 1) there[n++] = lstat(names + at, &st) == 0;
+    return there;
+}
+
+void sx_lua_rank_files_settle(lua_State *L, const char *names, size_t len, const char *there)
+{
+    if (!shadowing()) return; /* rank 0 holds no shadow */
+    size_t i = 0;
+    for (size_t at = 0; at < len; at += strlen(names + at) + 1, i++) {
+        lua_pushstring(L, names + at); /* a real name already */
+        set_shadow(L, there[i] ? ON_DISK : GONE, NULL, false);
+        lua_pop(L, 1);
+    }
 }
 
 void sx_lua_rank_files_remove(void)
@@ -303,7 +323,17 @@ static int call_lua_own(lua_State *L, int nargs)
     lua_settop(L, nargs);
     lua_pushvalue(L, lua_upvalueindex(1));
     lua_insert(L, 1);
-    lua_call(L, nargs, LUA_MULTRET);
+    /* called from here, Lua's function finds this C function, not the
+     * script, where it names the place of its error: the script's place
+     * goes in front, as the script's own call would have it */
+    if (lua_pcall(L, nargs, LUA_MULTRET, 0) != LUA_OK) {
+        if (lua_type(L, -1) == LUA_TSTRING) {
+            luaL_where(L, 1);
+            lua_insert(L, -2);
+            lua_concat(L, 2);
+        }
+        return lua_error(L);
+    }
     return lua_gettop(L);
 }
 
@@ -318,9 +348,10 @@ static int fail_with(lua_State *L, int err, const char *path)
 static int rank_open(lua_State *L)
 {
     const int nargs = lua_gettop(L);
-    if (!shadowing()) {
-        const char *mode = lua_type(L, 2) == LUA_TSTRING ? lua_tostring(L, 2) : "r";
-        if (lua_type(L, 1) == LUA_TSTRING && (mode[0] != 'r' || strchr(mode, '+'))) drop_shadow(L, lua_tostring(L, 1));
+    if (!shadowing()) { /* the arguments checked here, where an error names io.open */
+        const char *path = luaL_checkstring(L, 1), *mode = luaL_optstring(L, 2, "r");
+        luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
+        if (mode[0] != 'r' || strchr(mode, '+')) drop_shadow(L, path);
         return call_lua_own(L, nargs);
     }
     const char *path = luaL_checkstring(L, 1);
@@ -363,6 +394,7 @@ static int shadow_lines_next(lua_State *L)
 static int rank_lines(lua_State *L)
 {
     const int nargs = lua_gettop(L);
+    if (!lua_isnoneornil(L, 1)) luaL_checkstring(L, 1); /* io.lines' own check, naming it */
     if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return call_lua_own(L, nargs);
     if (!push_real_name(L, lua_tostring(L, 1))) return call_lua_own(L, nargs);
     char shadow[PATH_MAX];
@@ -391,6 +423,7 @@ static int rank_lines(lua_State *L)
  * 1) takes the file. */
 static int rank_default_file(lua_State *L, const char *mode)
 {
+    if (!shadowing() && lua_type(L, 1) == LUA_TSTRING && mode[0] == 'w') drop_shadow(L, lua_tostring(L, 1));
     if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return call_lua_own(L, lua_gettop(L));
     const char *path = lua_tostring(L, 1);
     lua_settop(L, 1);
@@ -421,7 +454,7 @@ static bool present(const char *path, enum shadow s)
 static int rank_remove(lua_State *L)
 {
     if (!shadowing()) {
-        if (lua_type(L, 1) == LUA_TSTRING) drop_shadow(L, lua_tostring(L, 1));
+        drop_shadow(L, luaL_checkstring(L, 1));
         return call_lua_own(L, lua_gettop(L));
     }
     const char *path = luaL_checkstring(L, 1);
@@ -437,8 +470,9 @@ static int rank_remove(lua_State *L)
 static int rank_rename(lua_State *L)
 {
     if (!shadowing()) {
-        for (int k = 1; k <= 2; k++)
-            if (lua_type(L, k) == LUA_TSTRING) drop_shadow(L, lua_tostring(L, k));
+        const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
+        drop_shadow(L, from);
+        drop_shadow(L, to);
         return call_lua_own(L, lua_gettop(L));
     }
     const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
@@ -472,7 +506,11 @@ const char *sx_lua_rank_file(lua_State *L, const char *path)
 
 void sx_lua_rank_file_written(lua_State *L, const char *path)
 {
-    if (!shadowing() || !push_real_name(L, path)) return;
+    if (!shadowing()) { /* this rank wrote it itself: noted while the ranks do not share files */
+        drop_shadow(L, path);
+        return;
+    }
+    if (!push_real_name(L, path)) return;
     set_shadow(L, ON_DISK, NULL, false);
     lua_pop(L, 1);
 }

@@ -52,6 +52,67 @@ test("an error of the search on rank 0 is raised on every rank, none waiting for
   os.remove(log)
 end)
 
+-- rank 1's draw against rank 0's: the ranks must draw alike after a calibration
+local function same_draw()
+  local draw = tostring(math.random(1, 1 << 30))
+  if rank == 1 then seixo.send(0, draw) return end
+  eq(seixo.receive(true), draw, "rank 1's next random number against rank 0's")
+end
+
+test("after a calibration with its plot (rank 0's alone) the ranks draw alike", function()
+  lab.calibrate{targets = {E = 50e9}, parameters = {modulus = {10e9, 200e9}}, evaluate = synthetic, seeds = 2,
+                maxeval = 4, log = "calibrate_mpi_plot.csv", out = "calibrate_mpi_plot", print = false}
+  same_draw()
+  os.remove("calibrate_mpi_plot.csv")
+  os.remove("calibrate_mpi_plot_convergence.png")
+end)
+
+-- a 2D specimen for runs that take a while (rank 0's own run polls for results)
+local dir = os.tmpname()
+os.remove(dir)
+os.execute("mkdir -p '" .. dir .. "'")
+local spec = lab.specimen{dim = 2, shape = "rect", width = 0.01, height = 0.02, radius = {0.4e-3, 0.66e-3},
+                          seed = 3, path = dir .. "/spec.h5", log = false}
+
+test("a print that raises as rank 0 takes a record during its own run stops every rank, none waiting", function()
+  -- rank 1's run fails at once; rank 0 is inside its own test when the
+  -- record comes, and says "run failed" through the script's print
+  local raised = false
+  raises(function()
+    lab.calibrate{targets = {E = 50e9}, parameters = {modulus = {10e9, 200e9}}, seeds = 2, maxeval = 2,
+                  log = dir .. "/raise.csv", plot = false,
+                  evaluate = function(mat)
+                    if seixo.rank() == 1 then error("rank 1's run fails") end
+                    lab.ucs(spec, {log = false, plot = false, max_steps = 3000})
+                    return {E = mat.modulus}
+                  end,
+                  print = function(text)
+                    if seixo.rank() == 0 and not raised and text:find("run failed", 1, true) then
+                      raised = true
+                      error("the print refuses")
+                    end
+                  end}
+  end, "the print refuses")
+end)
+
+test("a search failing while a rank's large record is out stops every rank, and leaves no message behind", function()
+  raises(function()
+    lab.calibrate{targets = {E = 50e9}, parameters = {modulus = {10e9, 200e9}}, seeds = 2, maxeval = 2,
+                  log = dir .. "/large.csv", plot = false,
+                  evaluate = function()
+                    if seixo.rank() == 0 then error("rank 0's run fails") end
+                    local t = seixo.clock()
+                    while seixo.clock() - t < 0.5 do end
+                    error(string.rep("x", 200000)) -- a record far above MPI's eager sends
+                  end,
+                  print = function(text) if text:find("run failed", 1, true) then error("the print refuses") end end}
+  end, "the print refuses")
+  -- the ranks go on together: a series over them takes only its own results
+  local s = lab.series(spec, {confining = {0, 2e6}, log = false, max_steps = 2000})
+  eq(#s.tests, 2)
+end)
+os.execute("rm -rf '" .. dir .. "'")
+
 test("the models after a calibration are decomposed again", function()
   eq(seixo.decompose(), true)
   local m = seixo.model{dim = 2}

@@ -10,8 +10,9 @@
 -- files still there), refused in a folder that is not there or without a
 -- name, a clump template's spheres read back by C, a file removed then
 -- written by m:save for every rank, a file saved then renamed, and
--- os.tmpname's file removed (rank 0 first), give every rank
--- rank 0's answers:
+-- os.tmpname's file removed (rank 0 first), files rewritten or made and
+-- removed while the ranks worked alone, give every rank rank 0's answers
+-- (and errors of Lua's io functions name the script's line):
 -- each answer goes into the model (a ball's size), so that a rank which
 -- read something else stops the next cycle ("the model differs between
 -- the ranks"), and rank 0 prints them, which must be the serial run's.
@@ -123,6 +124,29 @@ f:close()
 local t = m:clump_template("pair", base .. ".spheres")
 note("template", #t.pebbles, string.format("%.6g %.6g", t.volume, t.centroid[1]))
 
+-- a file the last rank rewrites, and one it makes and removes, while the
+-- ranks work alone: once they share again every rank finds what is on the
+-- disk (the others' shadow of the first was stale; the second is gone)
+f = assert(io.open(base .. ".alone", "w"))
+f:write("before\n")
+f:close()
+seixo.decompose(false)
+if seixo.rank() == seixo.ranks() - 1 then
+  f = assert(io.open(base .. ".alone", "w"))
+  f:write("the last rank's\n")
+  f:close()
+  assert(io.open(base .. ".gone", "w")):close()
+  assert(os.remove(base .. ".gone"))
+end
+seixo.decompose(true)
+note("rewritten while alone", assert(io.open(base .. ".alone")):read("a"))
+note("made and removed while alone", io.open(base .. ".gone"))
+note("removed again", os.remove(base .. ".gone"))
+-- an error of Lua's own io function names the script's line, on rank 0
+-- too (its io functions are wrapped there)
+note("an io.lines error", select(2, pcall(function() for _ in io.lines(base .. ".none") do end end)))
+note("an io.open error", select(2, pcall(function() return io.open(base, "q") end)))
+
 local sum = 0
 for _, line in ipairs(record) do
   print(line)
@@ -131,6 +155,9 @@ end
 m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e7)}
 m:cycle(100)
 print("end", m:step(), m:hash())
-for _, suffix in ipairs{"", ".log", ".out", ".spheres", ".h5", ".early"} do os.remove(base .. suffix) end
+-- after a cycle: every rank has read them (rank 0 removing one while a
+-- rank still reads it from the disk is the race of files the other ranks
+-- do not shadow)
+for _, suffix in ipairs{"", ".log", ".out", ".spheres", ".h5", ".early", ".alone"} do os.remove(base .. suffix) end
 seixo.decompose(false) -- each rank removes its own
 os.remove(string.format("%s.part%d", base, seixo.rank()))

@@ -26,9 +26,13 @@ local spec = lab.specimen{dim = 2, shape = "rect", width = 0.01, height = 0.02, 
                           seed = 3, path = dir .. "/spec.h5", log = false}
 -- an older file where the UCS writes its CSV: the ranks above 0 hold a
 -- shadow of it, stale once a test has written the real one
-local old = assert(io.open(dir .. "/series_ucs.csv", "w"))
-old:write("old\n")
-old:close()
+-- (its CSV through io.open; its state and view from C: m:save, m:output)
+local outs = {"/series_ucs.csv", "/series_ucs.h5", "/series_ucs_view.xmf"}
+for _, name in ipairs(outs) do
+  local old = assert(io.open(dir .. name, "w"))
+  old:write("old\n")
+  old:close()
+end
 local lines = {}
 local s = lab.series(spec, {confining = {0, 2e6, 5e6}, quasi_static = true, out = dir .. "/series", plot = false,
                             jobs = R == 1 and 1 or nil, log = function(l) lines[#lines + 1] = l end})
@@ -56,9 +60,11 @@ for _, l in ipairs(lines) do
   print(l)
   see(l)
 end
-local csv = assert(io.open(dir .. "/series_ucs.csv")):read("l")
-print("the UCS's CSV begins: " .. csv)
-see(csv)
+for _, name in ipairs(outs) do
+  local head = assert(io.open(dir .. name, "rb")):read(5):gsub("[^%w<?]", ".")
+  print(name .. " begins: " .. head)
+  see(head)
+end
 -- the tests fail (every one: a negative strain limit), on whichever rank runs them
 local ok, err = pcall(lab.series, spec, {confining = {0, 2e6}, max_strain = -1, log = false})
 print("failed:", not ok, tostring(err):match("max_strain[^\n]*"))
