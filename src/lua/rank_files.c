@@ -190,7 +190,7 @@ char *sx_lua_rank_files_alone(lua_State *L, size_t *len)
         }
     char *names = ok ? malloc(total + 1) : NULL;
     if (names) {
-        qsort(name, n, sizeof *name, by_name);
+        if (n) qsort(name, n, sizeof *name, by_name); /* (no list at all when none was noted) */
         *len = 0;
         for (size_t i = 0; i < n; i++) {
             const size_t k = strlen(name[i]) + 1;
