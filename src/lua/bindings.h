@@ -56,9 +56,10 @@ extern const luaL_Reg sx_lua_parallel_functions[];  ///< parallel.c: cores, exec
 /// parallel.c: decomposes m over the MPI ranks when MPI runs and seixo.decompose is on, its cycles
 /// leaving the state scattered (sx_model_gather_lazily); true if it did.
 bool sx_lua_parallel_decompose(sx_model *m);
-/// parallel.c: under mpirun, says once (rank 0, on stderr) when the ranks on
-/// this machine times `threads` are more than its cores and OpenMP's waits
-/// spin (OMP_WAIT_POLICY not passive).
+/// parallel.c: under mpirun, says once (rank 0, on stderr) when `threads`
+/// are more than the cores rank 0 may run on, or the ranks on its machine
+/// times `threads` more than the machine's cores, and OpenMP's waits spin
+/// (OMP_WAIT_POLICY not passive).
 void sx_lua_parallel_check_threads(int threads);
 /// parallel.c: a decomposed cycle failed on this rank: the message, then every rank stops.
 _Noreturn void sx_lua_parallel_fail(const char *message);
@@ -112,9 +113,10 @@ void sx_lua_rank_files_remove(void);
 /// its NUL, sorted, in a malloc'ed block of *len bytes (NULL: no memory);
 /// forgets them.
 char *sx_lua_rank_files_alone(lua_State *L, size_t *len);
-/// rank_files.c: for each NUL-ended name of names (len bytes), whether it
-/// is on the disk now (1 or 0), in a malloc'ed array (NULL: no memory).
-char *sx_lua_rank_files_there(const char *names, size_t len);
+/// rank_files.c: for each of the n NUL-ended names of names (len bytes),
+/// whether it is on the disk now (1 or 0), in a malloc'ed array (NULL: no
+/// memory).
+char *sx_lua_rank_files_there(const char *names, size_t len, size_t n);
 /// rank_files.c: a rank above 0 forgets its shadow of each name of names,
 /// which is the disk's (there[i]: sx_lua_rank_files_there on rank 0) or
 /// gone, as for rank 0.

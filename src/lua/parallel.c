@@ -34,7 +34,7 @@ static int node_size = 1; /* the ranks on this rank's machine */
 
 static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
-static bool fail_wait(void);
+static _Noreturn void abort_job(void);
 
 enum { MESSAGE_TAG = 7 };
 #endif
@@ -83,13 +83,8 @@ void sx_lua_parallel_stop(int ok)
      * them waiting: it ends only with the others */
     char err[512];
     if (ok && !sx_lua_parallel_same_call("the script's end", err, sizeof err)) sx_lua_parallel_fail(err);
-    /* a rank that failed would leave the others waiting for its messages
-     * (rank 0, which reported at once, gives those failing alike their
-     * time to clean up first) */
-    if (!ok && world_size > 1) {
-        if (world_rank == 0) fail_wait();
-        MPI_Abort(MPI_COMM_WORLD, 1);
-    }
+    /* a rank that failed would leave the others waiting for its messages */
+    if (!ok && world_size > 1) abort_job();
     if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
     MPI_Finalize();
     mpi_started = false;
@@ -325,6 +320,15 @@ static bool fail_wait(void)
     }
     return all;
 }
+
+/* Ends the job after a failure: rank 0, which reported at once, first
+ * gives the ranks failing alike their time to clean up (fail_wait). */
+static _Noreturn void abort_job(void)
+{
+    if (world_rank == 0) fail_wait();
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    exit(1); /* MPI_Abort does not return */
+}
 #endif
 
 bool sx_lua_parallel_failing(void)
@@ -351,10 +355,7 @@ void sx_lua_parallel_fail(const char *message)
         fflush(stderr);
     }
 #ifdef SX_HAVE_MPI
-    if (mpi_started) {
-        if (world_rank == 0) fail_wait();
-        MPI_Abort(MPI_COMM_WORLD, 1);
-    }
+    if (mpi_started) abort_job();
 #endif
     exit(1);
 }
@@ -518,7 +519,7 @@ static void share_alone_writes(lua_State *L)
      * removed is gone on every rank, as it is there */
     size_t n = 0;
     for (size_t at = 0; at < len; at += strlen(mine + at) + 1) n++;
-    char *there = world_rank == 0 ? sx_lua_rank_files_there(mine, len) : malloc(n + 1);
+    char *there = world_rank == 0 ? sx_lua_rank_files_there(mine, len, n) : malloc(n + 1);
     if (!there) sx_lua_parallel_fail("seixo.decompose: out of memory for the names of the files the ranks wrote");
 #ifdef SX_HAVE_MPI
     if (mpi_started && world_size > 1 && n > 0 &&

@@ -207,14 +207,12 @@ char *sx_lua_rank_files_alone(lua_State *L, size_t *len)
     return names;
 }
 
-char *sx_lua_rank_files_there(const char *names, size_t len)
+char *sx_lua_rank_files_there(const char *names, size_t len, size_t n)
 {
-    size_t n = 0;
-    for (size_t at = 0; at < len; at += strlen(names + at) + 1) n++;
     char *there = malloc(n + 1);
     struct stat st;
-    n = 0;
-    for (size_t at = 0; there && at < len; at += strlen(names + at) + 1) there[n++] = lstat(names + at, &st) == 0;
+    size_t i = 0;
+    for (size_t at = 0; there && at < len; at += strlen(names + at) + 1) there[i++] = lstat(names + at, &st) == 0;
     return there;
 }
 
