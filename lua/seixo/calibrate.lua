@@ -124,7 +124,7 @@ end
 local function quantize(v) return tonumber(string.format("%.10g", v)) end
 
 -- messages and files between processes (seixo.pool)
-local serialize, deserialize, quote = pool.serialize, pool.deserialize, pool.quote
+local quote = pool.quote
 
 -- ------------------------------------------------------ the evaluation
 
@@ -262,70 +262,21 @@ local function run_processes(o, jobs, record)
            end}
 end
 
--- Runs jobs over the MPI ranks: rank 0 hands each idle rank a job, runs
--- one itself while any is left (handing out meanwhile to the ranks that
--- end, every few hundred steps of the lab's models: lab's polling), and
--- collects the records as they come. A record is counted in before it is
--- recorded (record calls the script's print, which may raise inside rank
--- 0's own run); after an error here, the jobs still out are awaited (a
--- rank sending a large record waits until it is taken), unrecorded, so
--- that the ranks are all waiting for rank 0 when the error goes on.
+-- Runs jobs over the MPI ranks (pool.hand_out: rank 0 runs jobs too,
+-- handing out meanwhile to the ranks that end, every few hundred steps of
+-- the lab's models: lab's polling); record(i, rec) as the records come.
 local function run_ranks(o, jobs, record)
-  local idle, out, next_job = {}, 0, 1
-  for r = 1, seixo.ranks() - 1 do idle[#idle + 1] = r end
-  local function collect(wait)
-    local text, from = seixo.receive(wait)
-    if not text then return false end
-    idle[#idle + 1], out = from, out - 1
-    local msg = deserialize(text)
-    record(msg.i, msg.rec)
-    return true
-  end
-  local function hand_out()
-    while collect(false) do end
-    while #idle > 0 and next_job <= #jobs do
-      seixo.send(table.remove(idle, 1), serialize({i = next_job, x = jobs[next_job].x, seed = jobs[next_job].seed}))
-      next_job, out = next_job + 1, out + 1
-    end
-  end
-  -- inside rank 0's own run, an error of record's (the script's print)
-  -- would pass for the run's failure: it is kept, and raised after the run
-  local kept
-  local function hand_out_kept()
-    local ok, e = pcall(hand_out)
-    if not ok then kept = kept or e end
-  end
-  local ok, err = pcall(function()
-    while next_job <= #jobs or out > 0 do
-      hand_out()
-      if next_job <= #jobs then
-        local i = next_job
-        next_job = i + 1 -- before the run: hand_out goes on from the next
-        local rec = polling(hand_out_kept, run_job, o, jobs[i].x, jobs[i].seed)
-        if kept then error(kept, 0) end
-        record(i, rec)
-      elseif out > 0 then
-        collect(true)
-      end
-    end
-  end)
-  if not ok then
-    while out > 0 do
-      seixo.receive(true)
-      out = out - 1
-    end
-    error(err, 0)
-  end
+  local ok, err = pool.hand_out{
+    more = function(i) return i <= #jobs end,
+    message = function(i) return {i = i, x = jobs[i].x, seed = jobs[i].seed} end,
+    own = function(i, poll) return {i = i, rec = polling(poll, run_job, o, jobs[i].x, jobs[i].seed)} end,
+    record = function(msg) record(msg.i, msg.rec) end}
+  if not ok then error(err, 0) end
 end
 
 -- A rank other than 0: runs the jobs rank 0 sends until it sends the result.
 local function serve_rank(o)
-  while true do
-    local msg = deserialize((seixo.receive(true)))
-    if msg.done then return msg.done end
-    if msg.failed then error(msg.failed, 0) end
-    seixo.send(0, serialize({i = msg.i, rec = run_job(o, msg.x, msg.seed)}))
-  end
+  return pool.serve_rank(function(msg) return {i = msg.i, rec = run_job(o, msg.x, msg.seed)} end)
 end
 
 -- ------------------------------------------------------------------ log
@@ -628,7 +579,7 @@ local function calibrate(lab, helpers, opts)
   -- (none waits for ever)
   local ok, result = pcall(search, lab, o)
   if not ok then
-    for r = 1, seixo.ranks() - 1 do seixo.send(r, serialize({failed = tostring(result)})) end
+    pool.tell_ranks({failed = tostring(result)})
     error(result, 0)
   end
   return result
@@ -809,7 +760,7 @@ function search(lab, o)
     o.print(string.format("calibrate: %s after %d evaluations (%.1f s); best:\n%s", status, #history,
                           result.wall_time, result.table))
   end
-  for r = 1, seixo.ranks() - 1 do seixo.send(r, serialize({done = result})) end
+  pool.tell_ranks({done = result})
   return result
 end
 

@@ -1221,7 +1221,7 @@ end
 -- cores without a message a step. Rank 0 hands each idle rank a test (the
 -- longest first; none after a failure, as the tests in turn stop at the
 -- first), runs one itself while any is left (looking for idle ranks every
--- POLL_STEPS steps of its own test: polling), and says each test's log
+-- POLL_STEPS steps of its own test: polling, pool.hand_out), and says each test's log
 -- lines as it ends. Then every rank gets the results, the lines rank 0
 -- said (which the others say in turn: a log function of the script's sees
 -- the same lines on every rank; one that raises stops the lines there, on
@@ -1229,7 +1229,7 @@ end
 -- the series' order, else the log function's, else rank 0's own. Rank 0
 -- sends that outcome whatever happened, so no rank waits for ever.
 local function run_ranks(spec, tests, opts)
-  local order, R = longest_first(tests), seixo.ranks()
+  local order = longest_first(tests)
   local function run(k)
     local t = tests[order[k]]
     local o, lines = copy(t.opts), {}
@@ -1253,57 +1253,23 @@ local function run_ranks(spec, tests, opts)
   local done
   if seixo.rank() == 0 then
     local results, ran_on, errors = {}, {}, {}
-    local idle, out, next_test = {}, 0, 1
-    for r = 1, R - 1 do idle[#idle + 1] = r end
-    local function record(msg)
-      local i = order[msg.k]
-      ran_on[i] = msg.rank
-      if msg.ok then results[i] = msg.value else errors[i] = msg.error end
-      say_all(msg.lines)
-    end
-    local function more() return next_test <= #tests and next(errors) == nil and not log_error end
-    -- a rank's result, waiting for one or not: true if one came
-    local function collect(wait)
-      local text, from = seixo.receive(wait)
-      if not text then return false end
-      idle[#idle + 1], out = from, out - 1
-      record(pool.deserialize(text))
-      return true
-    end
-    local function hand_out()
-      while collect(false) do end -- the ranks that ended since the last look
-      while #idle > 0 and more() do
-        seixo.send(table.remove(idle, 1), pool.serialize({k = next_test}))
-        next_test, out = next_test + 1, out + 1
-      end
-    end
-    local ok, own_error = pcall(function()
-      while more() or out > 0 do
-        hand_out()
-        if more() then
-          local k = next_test
-          next_test = k + 1 -- before the test: hand_out goes on from the next
-          record(polling(hand_out, run, k))
-        elseif out > 0 then
-          collect(true)
-        end
-      end
-    end)
-    while out > 0 do -- after an error of rank 0's own: the tests still out end, unrecorded
-      seixo.receive(true)
-      out = out - 1
-    end
+    local ok, own_error = pool.hand_out{
+      more = function(k) return k <= #tests and next(errors) == nil and not log_error end,
+      message = function(k) return {k = k} end,
+      own = function(k, poll) return polling(poll, run, k) end,
+      record = function(msg)
+        local i = order[msg.k]
+        ran_on[i] = msg.rank
+        if msg.ok then results[i] = msg.value else errors[i] = msg.error end
+        say_all(msg.lines)
+      end}
     local first
     for i = 1, #tests do if errors[i] then first = first or errors[i] end end
     done = {results = results, ran_on = ran_on, said = said,
             error = first or log_error or (not ok and tostring(own_error)) or nil}
-    local text = pool.serialize({done = done})
-    for r = 1, R - 1 do seixo.send(r, text) end
+    pool.tell_ranks({done = done})
   else
-    while not done do
-      local msg = pool.deserialize((seixo.receive(true)))
-      if msg.done then done = msg.done else seixo.send(0, pool.serialize(run(msg.k))) end
-    end
+    done = pool.serve_rank(function(msg) return run(msg.k) end)
     say_all(done.said)
   end
   if done.error then error(done.error, 0) end

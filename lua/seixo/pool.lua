@@ -136,6 +136,86 @@ function pool.run(o)
   if not ok then error(err, 0) end
 end
 
+--- Under mpirun, rank 0's part of a batch of jobs run each whole on one
+--- rank (lab.series's tests, lab.calibrate's runs; the other ranks serve
+--- them: pool.serve_rank). Rank 0 hands each idle rank the next job, runs
+--- one itself while any is left, and meanwhile, at each poll() its own
+--- run calls (lab's polling: every few hundred steps), collects what the
+--- ranks that ended answered and hands them the next. o:
+---   more(i)      whether job i, the next, may start (the jobs left, no failure)
+---   message(i)   job i's message to a rank (a table)
+---   own(i, poll) runs job i here; returns its answer, as a rank sends it
+---   record(answer) takes one job's answer, rank 0's or a rank's
+--- An error of record's met at a poll (the script's print, a log that
+--- raises) is kept and raised after rank 0's run: inside it, it would pass
+--- for the run's failure. After any error the jobs still out are awaited,
+--- unrecorded (a rank sending an answer above MPI's eager size waits until
+--- it is taken), so that every rank waits for rank 0 again. Returns true,
+--- or false and the error.
+function pool.hand_out(o)
+  local idle, out, next_job = {}, 0, 1
+  for r = 1, seixo.ranks() - 1 do idle[#idle + 1] = r end
+  -- a rank's answer, waiting for one or not: true if one came (counted in
+  -- before it is recorded, which may raise)
+  local function collect(wait)
+    local text, from = seixo.receive(wait)
+    if not text then return false end
+    idle[#idle + 1], out = from, out - 1
+    o.record(pool.deserialize(text))
+    return true
+  end
+  local function hand_out()
+    while out > 0 and collect(false) do end
+    while #idle > 0 and o.more(next_job) do
+      seixo.send(table.remove(idle, 1), pool.serialize(o.message(next_job)))
+      next_job, out = next_job + 1, out + 1
+    end
+  end
+  local kept
+  local function poll()
+    local ok, e = pcall(hand_out)
+    if not ok then kept = kept or e end
+  end
+  local ok, err = pcall(function()
+    while o.more(next_job) or out > 0 do
+      hand_out()
+      if o.more(next_job) then
+        local i = next_job
+        next_job = i + 1 -- before the run: a poll goes on from the next
+        local answer = o.own(i, poll)
+        if kept then error(kept, 0) end
+        o.record(answer)
+      elseif out > 0 then
+        collect(true)
+      end
+    end
+  end)
+  while out > 0 do
+    seixo.receive(true)
+    out = out - 1
+  end
+  return ok, err
+end
+
+--- Rank 0's last word to every other rank after pool.hand_out: a table
+--- whose done the ranks return, or whose failed they raise.
+function pool.tell_ranks(msg)
+  local text = pool.serialize(msg)
+  for r = 1, seixo.ranks() - 1 do seixo.send(r, text) end
+end
+
+--- A rank other than 0 under pool.hand_out: answers each job rank 0 sends
+--- with run(message) until rank 0 tells it the end (pool.tell_ranks):
+--- returns done, or raises failed.
+function pool.serve_rank(run)
+  while true do
+    local msg = pool.deserialize((seixo.receive(true)))
+    if msg.failed then error(msg.failed, 0) end
+    if msg.done ~= nil then return msg.done end
+    seixo.send(0, pool.serialize(run(msg)))
+  end
+end
+
 --- In a worker: the job in the file (nil if none), to pass to pool.answer.
 function pool.take(path)
   local e = path and pool.deserialize(pool.read_all(path) or "")
