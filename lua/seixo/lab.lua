@@ -1221,13 +1221,14 @@ end
 -- cores without a message a step. Rank 0 hands each idle rank a test (the
 -- longest first; none after a failure, as the tests in turn stop at the
 -- first), runs one itself while any is left (looking for idle ranks every
--- POLL_STEPS steps of its own test: polling, pool.hand_out), and says each test's log
--- lines as it ends. Then every rank gets the results, the lines rank 0
--- said (which the others say in turn: a log function of the script's sees
--- the same lines on every rank; one that raises stops the lines there, on
--- every rank) and the error to raise: that of the first failing test in
--- the series' order, else the log function's, else rank 0's own. Rank 0
--- sends that outcome whatever happened, so no rank waits for ever.
+-- POLL_STEPS steps of its own test: polling; pool.hand_out), and says
+-- each test's log lines as it ends. Then every rank gets the results,
+-- the lines rank 0 said (which the others say in turn: a log function of
+-- the script's sees the same lines on every rank; one that raises stops
+-- the lines there, on every rank) and the error to raise: that of the
+-- first failing test in the series' order, else the log function's, else
+-- rank 0's own. Rank 0 sends that outcome whatever happened, so no rank
+-- waits for ever.
 local function run_ranks(spec, tests, opts)
   local order = longest_first(tests)
   local function run(k)
