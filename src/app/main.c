@@ -107,7 +107,7 @@ static int report(lua_State *L, int status)
  * sx_lua_parallel_failing). */
 static int report_fatal(lua_State *L, int status)
 {
-    if (status != LUA_OK && !sx_lua_parallel_failing()) {
+    if (status != LUA_OK && !sx_lua_parallel_failing(lua_tostring(L, -1))) {
         lua_pop(L, 1);
         return status;
     }
@@ -1135,7 +1135,7 @@ int main(int argc, char **argv)
     switch (parse(argc, argv, &o)) {
     case DONE: sx_lua_parallel_stop(1); return EXIT_SUCCESS;
     case BAD: /* every rank parsed the same command line: under mpirun rank 0 says why */
-        if (sx_lua_parallel_failing()) message(o.bad);
+        if (sx_lua_parallel_failing(o.bad)) message(o.bad);
         sx_lua_parallel_stop(0);
         return EXIT_FAILURE;
     case RUN: break;

@@ -36,7 +36,8 @@ static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 static _Noreturn void abort_job(void);
 
-enum { MESSAGE_TAG = 7 };
+enum { MESSAGE_TAG = 7, FAIL_TAG = 8 };
+static void fail_heard(void);
 #endif
 
 void sx_lua_parallel_start(int *argc, char ***argv)
@@ -193,6 +194,7 @@ static int seixo_receive(lua_State *L)
         MPI_Iprobe(MPI_ANY_SOURCE, MESSAGE_TAG, MPI_COMM_WORLD, &ready, &st);
         if (ready) break;
         if (!wait) return 0;
+        fail_heard(); /* the rank waited for may have failed alone */
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
@@ -294,13 +296,17 @@ bool sx_lua_parallel_decompose(sx_model *m)
  * enters a barrier of the failing ranks. Rank 0 reports at once (whoever
  * else fails says the same or keeps quiet), and waits on the barrier for
  * FAIL_WAIT_MS before its MPI_Abort (fail_wait), so that the others
- * failing alike remove their shadows first. A rank above 0 waits on it
- * too: when every rank has come (all failed), rank 0 reports and it keeps
- * quiet; else this rank failed alone (or the others fail that much later:
- * then each reports) and reports. Then each ends the job (MPI_Abort); the
- * ranks that keep quiet wait for rank 0's. (A timer alone, ranks > 0
- * waiting for rank 0's MPI_Abort to end them, failed under load: they
- * outlived it.) */
+ * failing alike remove their shadows first. A rank above 0 first tells
+ * rank 0 its message (fail_tell): rank 0, if it is waiting for the others
+ * in a same-call check or in seixo.receive, where a rank failing alone
+ * leaves it, reports that message at once and ends the job (fail_heard).
+ * Else the failing rank waits on the barrier too: when every rank has
+ * come (all failed), rank 0 reports and it keeps quiet; else this rank
+ * failed alone while rank 0 was elsewhere (in a cycle's exchanges), or
+ * the others fail that much later (then each reports), and it reports.
+ * Then each ends the job (MPI_Abort); the ranks that keep quiet wait for
+ * rank 0's. (A timer alone, ranks > 0 waiting for rank 0's MPI_Abort to
+ * end them, failed under load: they outlived it.) */
 enum { FAIL_WAIT_MS = 5000, FAIL_POLL_MS = 10 };
 
 #ifdef SX_HAVE_MPI
@@ -329,13 +335,46 @@ static _Noreturn void abort_job(void)
     MPI_Abort(MPI_COMM_WORLD, 1);
     exit(1); /* MPI_Abort does not return */
 }
+
+/* A rank above 0 that fails tells rank 0 its message, once; the text
+ * stays until the job ends (the send completes when rank 0 takes it). */
+static void fail_tell(const char *message)
+{
+    static char *told;
+    static MPI_Request req = MPI_REQUEST_NULL;
+    if (world_rank == 0 || told || !message) return;
+    if ((told = strdup(message))) MPI_Isend(told, (int)strlen(told) + 1, MPI_CHAR, 0, FAIL_TAG, fail_comm, &req);
+}
+
+/* Rank 0, waiting for the others: a rank that told its failure is
+ * reported, and the job ends (that rank removed its shadows before it
+ * told; the others are in this wait's collective or on their way). */
+static void fail_heard(void)
+{
+    if (!mpi_started || world_rank != 0 || fail_comm == MPI_COMM_NULL) return;
+    int ready = 0, len = 0;
+    MPI_Status st;
+    if (MPI_Iprobe(MPI_ANY_SOURCE, FAIL_TAG, fail_comm, &ready, &st) != MPI_SUCCESS || !ready) return;
+    MPI_Get_count(&st, MPI_CHAR, &len);
+    char *text = malloc((size_t)len + 1);
+    if (text) {
+        MPI_Recv(text, len, MPI_CHAR, st.MPI_SOURCE, FAIL_TAG, fail_comm, MPI_STATUS_IGNORE);
+        text[len] = '\0';
+    }
+    fprintf(stderr, "seixo: rank %d of %d: %s\n", st.MPI_SOURCE, world_size,
+            text ? text : "failed (its message did not fit in memory)");
+    fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    exit(1);
+}
 #endif
 
-bool sx_lua_parallel_failing(void)
+bool sx_lua_parallel_failing(const char *message)
 {
     sx_lua_rank_files_remove(); /* the run ends: before rank 0's MPI_Abort can kill this rank */
 #ifdef SX_HAVE_MPI
     if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
+    fail_tell(message);
     if (!fail_entered && (fail_entered = true, MPI_Ibarrier(fail_comm, &fail_req) != MPI_SUCCESS)) return true;
     if (world_rank == 0 || !fail_wait()) return true;
     /* rank 0 reports and its MPI_Abort ends this rank: an abort from here
@@ -344,13 +383,14 @@ bool sx_lua_parallel_failing(void)
     nanosleep(&wait, NULL);
     return false;
 #else
+    (void)message;
     return true;
 #endif
 }
 
 void sx_lua_parallel_fail(const char *message)
 {
-    if (sx_lua_parallel_failing()) {
+    if (sx_lua_parallel_failing(message)) {
         fprintf(stderr, "seixo: rank %d of %d: %s\n", world_rank, world_size, message);
         fflush(stderr);
     }
@@ -366,9 +406,11 @@ int sx_lua_parallel_rank(void) { return world_rank; }
  * ranks skip (a save under `if seixo.rank() == 0`) would leave the ranks
  * that make it waiting for ever, or pair it with another collective of the
  * others. So each collective call of the Lua layer starts with this one:
- * the ranks' names for what they are doing, gathered (one MPI_Allgather,
- * the same operation whatever call makes it); when they differ, every
- * rank of the check fails with the message, which names two of them. */
+ * the ranks' names for what they are doing, gathered (one MPI_Iallgather,
+ * the same operation whatever call makes it, awaited by testing so that
+ * rank 0 hears a rank that failed alone: fail_heard); when they differ,
+ * every rank of the check fails with the message, which names two of
+ * them. */
 enum { CALL_NAME = 96 }; /* a chunk's name holds the step and the time it ends at, and the model */
 
 bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
@@ -379,8 +421,19 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
     snprintf(mine, sizeof mine, "%s", what);
     char *all = malloc((size_t)world_size * CALL_NAME);
     if (!all) sx_lua_parallel_fail("out of memory to compare the ranks' calls");
-    if (MPI_Allgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD) != MPI_SUCCESS)
+    /* not blocking: rank 0 hears meanwhile whether the rank it waits for failed alone */
+    MPI_Request req;
+    int done = 0;
+    if (MPI_Iallgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD, &req) != MPI_SUCCESS)
         sx_lua_parallel_fail("the ranks could not compare their calls");
+    while (!done) {
+        if (MPI_Test(&req, &done, MPI_STATUS_IGNORE) != MPI_SUCCESS)
+            sx_lua_parallel_fail("the ranks could not compare their calls");
+        if (!done) {
+            fail_heard();
+            sched_yield();
+        }
+    }
     int other = 1;
     while (other < world_size && memcmp(all, all + (size_t)other * CALL_NAME, CALL_NAME) == 0) other++;
     if (other < world_size)

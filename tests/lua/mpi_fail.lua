@@ -6,7 +6,8 @@
 --   script     an error in the script, after a decomposed cycle
 --   callback   an error in a callback, inside a decomposed cycle
 --   last       an error on the last rank only, the others going on to
---              cycle (they wait for it: the error must end them)
+--              cycle (they wait for it: the error must end them; rank 0,
+--              waiting in m:cycle's same-call check, reports it at once)
 --   first      the same on rank 0 only (which reports at once: it no
 --              longer waits 5 s to see whether the others fail alike)
 local scene = arg and arg[1] or "script"
