@@ -37,7 +37,8 @@ static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua
 static _Noreturn void abort_job(void);
 
 enum { MESSAGE_TAG = 7, FAIL_TAG = 8 };
-static void fail_heard(void);
+static void fail_heard(int n, MPI_Request *req);
+static bool await(int n, MPI_Request *req);
 #endif
 
 void sx_lua_parallel_start(int *argc, char ***argv)
@@ -194,7 +195,7 @@ static int seixo_receive(lua_State *L)
         MPI_Iprobe(MPI_ANY_SOURCE, MESSAGE_TAG, MPI_COMM_WORLD, &ready, &st);
         if (ready) break;
         if (!wait) return 0;
-        fail_heard(); /* the rank waited for may have failed alone */
+        fail_heard(0, NULL); /* the rank waited for may have failed alone */
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
@@ -256,7 +257,7 @@ static bool mpi_share(void *ud, void *data, size_t size, const sx_span *own, con
                           &req[nreq++]);
         }
     }
-    ok = MPI_Waitall(nreq, req, MPI_STATUSES_IGNORE) == MPI_SUCCESS && ok;
+    ok = await(nreq, req) && ok;
     free(req);
     return ok;
 }
@@ -264,15 +265,19 @@ static bool mpi_share(void *ud, void *data, size_t size, const sx_span *own, con
 static bool mpi_max(void *ud, double *v)
 {
     (void)ud;
-    return MPI_Allreduce(MPI_IN_PLACE, v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD) == MPI_SUCCESS;
+    MPI_Request req;
+    return MPI_Iallreduce(MPI_IN_PLACE, v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD, &req) == MPI_SUCCESS &&
+           await(1, &req);
 }
 
 static bool mpi_agree(void *ud, uint64_t v)
 {
     (void)ud;
     uint64_t lo = v, hi = v;
-    return MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD) == MPI_SUCCESS &&
-           MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD) == MPI_SUCCESS && lo == hi;
+    MPI_Request req[2];
+    return MPI_Iallreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD, &req[0]) == MPI_SUCCESS &&
+           MPI_Iallreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD, &req[1]) == MPI_SUCCESS &&
+           await(2, req) && lo == hi;
 }
 #endif
 
@@ -297,13 +302,13 @@ bool sx_lua_parallel_decompose(sx_model *m)
  * else fails says the same or keeps quiet), and waits on the barrier for
  * FAIL_WAIT_MS before its MPI_Abort (fail_wait), so that the others
  * failing alike remove their shadows first. A rank above 0 first tells
- * rank 0 its message (fail_tell): rank 0, if it is waiting for the others
- * in a same-call check or in seixo.receive, where a rank failing alone
- * leaves it, reports that message at once and ends the job (fail_heard).
- * Else the failing rank waits on the barrier too: when every rank has
- * come (all failed), rank 0 reports and it keeps quiet; else this rank
- * failed alone while rank 0 was elsewhere (in a cycle's exchanges), or
- * the others fail that much later (then each reports), and it reports.
+ * rank 0 its message (fail_tell): rank 0, waiting for the others (a
+ * same-call check, a cycle's exchanges, seixo.receive: await), where a
+ * rank failing alone leaves it, reports that message and ends the job
+ * (fail_heard). Else the failing rank waits on the barrier too: when
+ * every rank has come (all failed), rank 0 reports and it keeps quiet;
+ * else this rank failed alone while rank 0 was elsewhere, or the others
+ * fail that much later (then each reports), and it reports.
  * Then each ends the job (MPI_Abort); the ranks that keep quiet wait for
  * rank 0's. (A timer alone, ranks > 0 waiting for rank 0's MPI_Abort to
  * end them, failed under load: they outlived it.) */
@@ -346,26 +351,60 @@ static void fail_tell(const char *message)
     if ((told = strdup(message))) MPI_Isend(told, (int)strlen(told) + 1, MPI_CHAR, 0, FAIL_TAG, fail_comm, &req);
 }
 
-/* Rank 0, waiting for the others: a rank that told its failure is
- * reported, and the job ends (that rank removed its shadows before it
- * told; the others are in this wait's collective or on their way). */
-static void fail_heard(void)
+/* Rank 0 in a wait that has not ended, for the requests req[n] (n 0: a
+ * wait for a message, seixo.receive): takes a failure a rank told
+ * (fail_tell), then reports it and ends the job (that rank removed its
+ * shadows before it told) unless the wait ends within FAIL_GRACE_MS. A
+ * rank that failed after this wait's partners had all come (failing
+ * alike, a moment after; rank 0 goes on to meet the same error and report
+ * it, the ranks failing alike wait for each other) lets it end: the
+ * failure is kept for the next wait that does not end. */
+enum { FAIL_GRACE_MS = 500 };
+static char *heard; /* the failure told, once taken */
+static int heard_from;
+
+static double clock_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
+}
+
+static void fail_heard(int n, MPI_Request *req)
 {
     if (!mpi_started || world_rank != 0 || fail_comm == MPI_COMM_NULL) return;
-    int ready = 0, len = 0;
-    MPI_Status st;
-    if (MPI_Iprobe(MPI_ANY_SOURCE, FAIL_TAG, fail_comm, &ready, &st) != MPI_SUCCESS || !ready) return;
-    MPI_Get_count(&st, MPI_CHAR, &len);
-    char *text = malloc((size_t)len + 1);
-    if (text) {
-        MPI_Recv(text, len, MPI_CHAR, st.MPI_SOURCE, FAIL_TAG, fail_comm, MPI_STATUS_IGNORE);
-        text[len] = '\0';
+    if (!heard) {
+        int ready = 0, len = 0;
+        MPI_Status st;
+        if (MPI_Iprobe(MPI_ANY_SOURCE, FAIL_TAG, fail_comm, &ready, &st) != MPI_SUCCESS || !ready) return;
+        MPI_Get_count(&st, MPI_CHAR, &len);
+        static char lost[] = "failed (its message did not fit in memory)";
+        char *text = malloc((size_t)len + 1);
+        MPI_Recv(text ? text : lost, text ? len : 0, MPI_CHAR, st.MPI_SOURCE, FAIL_TAG, fail_comm, MPI_STATUS_IGNORE);
+        if (text) text[len] = '\0';
+        heard = text ? text : lost, heard_from = st.MPI_SOURCE;
     }
-    fprintf(stderr, "seixo: rank %d of %d: %s\n", st.MPI_SOURCE, world_size,
-            text ? text : "failed (its message did not fit in memory)");
+    for (const double t0 = clock_ms(); n > 0 && clock_ms() - t0 < FAIL_GRACE_MS;) {
+        int done = 0;
+        if (MPI_Testall(n, req, &done, MPI_STATUSES_IGNORE) != MPI_SUCCESS) break;
+        if (done) return; /* the caller's next test finds the requests done */
+    }
+    fprintf(stderr, "seixo: rank %d of %d: %s\n", heard_from, world_size, heard);
     fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, 1);
     exit(1);
+}
+
+/* Waits for the requests req[n], as MPI_Waitall; rank 0 listens meanwhile
+ * for a rank that failed alone (fail_heard: every 64 tests, a probe). */
+static bool await(int n, MPI_Request *req)
+{
+    for (unsigned spin = 1;; spin++) {
+        int done = 0;
+        if (MPI_Testall(n, req, &done, MPI_STATUSES_IGNORE) != MPI_SUCCESS) return false;
+        if (done) return true;
+        if (spin % 64 == 0) fail_heard(n, req);
+    }
 }
 #endif
 
@@ -423,17 +462,9 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
     if (!all) sx_lua_parallel_fail("out of memory to compare the ranks' calls");
     /* not blocking: rank 0 hears meanwhile whether the rank it waits for failed alone */
     MPI_Request req;
-    int done = 0;
-    if (MPI_Iallgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD, &req) != MPI_SUCCESS)
+    if (MPI_Iallgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD, &req) != MPI_SUCCESS ||
+        !await(1, &req))
         sx_lua_parallel_fail("the ranks could not compare their calls");
-    while (!done) {
-        if (MPI_Test(&req, &done, MPI_STATUS_IGNORE) != MPI_SUCCESS)
-            sx_lua_parallel_fail("the ranks could not compare their calls");
-        if (!done) {
-            fail_heard();
-            sched_yield();
-        }
-    }
     int other = 1;
     while (other < world_size && memcmp(all, all + (size_t)other * CALL_NAME, CALL_NAME) == 0) other++;
     if (other < world_size)

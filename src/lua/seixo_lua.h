@@ -70,9 +70,10 @@ SX_API char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud,
 /// To call before reporting the error that ends the run, message (then
 /// sx_lua_parallel_stop(0)): whether this process reports it. Under mpirun
 /// an error every rank meets (within a few seconds) is reported by rank 0
-/// alone, at once; a rank above 0 failing alone is reported by rank 0 at
-/// once when rank 0 waits for it in a same-call check or seixo.receive,
-/// else by itself after that wait. Else true at once.
+/// alone, at once; a rank above 0 failing alone is reported by rank 0
+/// within half a second when rank 0 waits for it (a collective call, a
+/// cycle's exchanges, seixo.receive), else by itself after that wait.
+/// Else true at once.
 SX_API bool sx_lua_parallel_failing(const char *message);
 
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
