@@ -31,6 +31,7 @@
 #include "bindings.h"
 #include "seixo_io.h"
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -101,6 +102,76 @@ static const char *child_path(lua_State *L, const char *path, int key)
     return lua_pushfstring(L, "%s[%s]", path, luaL_typename(L, key));
 }
 
+/* A key of a table to save, for the order of keys_in_order. */
+typedef struct saved_key {
+    int kind; /* booleans, then numbers, then strings, then the rest (skipped with a message) */
+    bool integer;
+    lua_Integer i;
+    lua_Number d;
+    const char *str;
+    size_t len;
+    lua_Integer slot; /* the key's place in the list keys_in_order pushes */
+} saved_key;
+
+static int key_kind(int type) { return type == LUA_TBOOLEAN ? 0 : type == LUA_TNUMBER ? 1 : type == LUA_TSTRING ? 2 : 3; }
+
+static int compare_keys(const void *pa, const void *pb)
+{
+    const saved_key *a = pa, *b = pb;
+    if (a->kind != b->kind) return a->kind < b->kind ? -1 : 1;
+    if (a->kind == 1) {
+        if (a->integer && b->integer) return (a->i > b->i) - (a->i < b->i);
+        const lua_Number x = a->integer ? (lua_Number)a->i : a->d, y = b->integer ? (lua_Number)b->i : b->d;
+        if (x != y) return x < y ? -1 : 1;
+        if (a->integer != b->integer) return a->integer ? -1 : 1; /* 2^53 + 1 and 2^53.0: the integer first */
+    } else if (a->kind == 0 || a->kind == 2) {
+        const size_t n = a->len < b->len ? a->len : b->len;
+        const int c = a->kind == 2 ? memcmp(a->str, b->str, n) : 0;
+        if (c) return c;
+        if (a->kind == 0 && a->i != b->i) return a->i < b->i ? -1 : 1;
+        if (a->len != b->len) return a->len < b->len ? -1 : 1;
+    }
+    return (a->slot > b->slot) - (a->slot < b->slot); /* the rest (skipped): as Lua lists them */
+}
+
+/* Pushes the keys of the table at idx as a list, in a fixed order
+ * (booleans, numbers, strings, each by value, strings bytewise), not in
+ * the order of Lua's hash, which is seeded per run: the same tables save
+ * to the same file on every run (and the first of two places holding one
+ * table is the same). Returns their count. */
+static lua_Integer keys_in_order(lua_State *L, int idx)
+{
+    lua_newtable(L);
+    const int list = lua_gettop(L);
+    lua_Integer n = 0;
+    for (lua_pushnil(L); lua_next(L, idx); lua_pop(L, 1)) {
+        lua_pushvalue(L, -2);
+        lua_rawseti(L, list, ++n);
+    }
+    saved_key *k = n ? malloc((size_t)n * sizeof *k) : NULL;
+    if (n && !k) luaL_error(L, "out of memory to save a table of %I keys", n);
+    for (lua_Integer j = 0; j < n; j++) {
+        const int type = lua_rawgeti(L, list, j + 1);
+        saved_key *e = &k[j];
+        memset(e, 0, sizeof *e);
+        e->kind = key_kind(type), e->slot = j + 1;
+        if (type == LUA_TNUMBER && (e->integer = lua_isinteger(L, -1))) e->i = lua_tointeger(L, -1);
+        else if (type == LUA_TNUMBER) e->d = lua_tonumber(L, -1);
+        else if (type == LUA_TBOOLEAN) e->i = lua_toboolean(L, -1);
+        else if (type == LUA_TSTRING) e->str = lua_tolstring(L, -1, &e->len); /* held by the list */
+        lua_pop(L, 1);
+    }
+    if (n) qsort(k, (size_t)n, sizeof *k, compare_keys);
+    lua_createtable(L, n < INT_MAX ? (int)n : 0, 0);
+    for (lua_Integer j = 0; j < n; j++) {
+        lua_rawgeti(L, list, k[j].slot);
+        lua_rawseti(L, -2, j + 1);
+    }
+    free(k);
+    lua_replace(L, list);
+    return n;
+}
+
 /* Writes the entries of the table at idx as children of node `parent`. */
 static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char *path)
 {
@@ -109,8 +180,12 @@ static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char 
     lua_pushvalue(L, idx);
     lua_pushboolean(L, 1);
     lua_rawset(L, s->seen);
-    lua_pushnil(L);
-    while (!s->oom && lua_next(L, idx)) {
+    const lua_Integer nkeys = keys_in_order(L, idx);
+    const int keys = lua_gettop(L);
+    for (lua_Integer j = 1; j <= nkeys && !s->oom; j++) {
+        lua_rawgeti(L, keys, j);
+        lua_pushvalue(L, -1);
+        lua_rawget(L, idx);
         const int key = lua_gettop(L) - 1, val = key + 1;
         const char *p = child_path(L, path, key);
         sx_io_node n;
@@ -151,8 +226,9 @@ static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char 
             default: skip(L, s, p, luaL_typename(L, val)); break;
             }
         }
-        lua_settop(L, key);
+        lua_settop(L, keys);
     }
+    lua_pop(L, 1);
 }
 
 /* Builds the Lua table of a tree and leaves it on the stack. */
