@@ -67,6 +67,10 @@ _Noreturn void sx_lua_parallel_fail(const char *message);
 /// if it is decomposed over MPI ranks (sx_model_ranks > 1): then rank 0
 /// writes for all (every rank holds the whole model between cycles).
 bool sx_lua_parallel_writes(bool shared);
+/// parallel.c: whether this process prints a warning about model m (or
+/// one m has every rank alike): rank 0 alone for a model decomposed over
+/// the MPI ranks, every process for its own.
+bool sx_lua_parallel_says(const sx_model *m);
 /// parallel.c: the outcome of a file's work, which rank 0 alone does for a
 /// `shared` model, made every rank's: err (empty: it succeeded; every rank
 /// passes the same size) and *count (if not NULL) go from rank 0 to all

@@ -165,9 +165,11 @@ void sx_lua_check_range(lua_State *L, int model, const char *what, double v, dou
         lua_pushboolean(L, 1);
         lua_setfield(L, -3, what);
         luaL_where(L, 1);
-        fprintf(stderr, "seixo: warning: %s%s %g is outside the range of rocks and grains, %g ... %g %s (seixo's unit is %s)\n",
-                lua_tostring(L, -1), what, v, lo, hi, unit, unit);
-        fflush(stderr);
+        if (sx_lua_parallel_says(sx_lua_tomodel(L, model))) {
+            fprintf(stderr, "seixo: warning: %s%s %g is outside the range of rocks and grains, %g ... %g %s (seixo's unit is %s)\n",
+                    lua_tostring(L, -1), what, v, lo, hi, unit, unit);
+            fflush(stderr);
+        }
         lua_pop(L, 1);
     }
     lua_pop(L, 2);

@@ -527,6 +527,8 @@ char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud, size_t
 
 bool sx_lua_parallel_writes(bool shared) { return !shared || world_rank == 0; }
 
+bool sx_lua_parallel_says(const sx_model *m) { return sx_lua_parallel_writes(m && sx_model_ranks(m) > 1); }
+
 bool sx_lua_parallel_sharing(void)
 {
 #ifdef SX_HAVE_MPI

@@ -412,10 +412,11 @@ static int add_mesh(lua_State *L, sx_model *m, sx_wall_def *d)
     int64_t id;
     sx_mesh_report rep;
     sx_lua_check(L, m, sx_wall_add_mesh(m, d, &md, &id, &rep), "m:wall");
-    if (rep.dropped)
+    const bool says = sx_lua_parallel_says(m);
+    if (says && rep.dropped)
         fprintf(stderr, "seixo: warning: mesh wall %lld: %lld degenerate triangle(s) dropped (the first: triangle %lld)\n",
                 (long long)id, (long long)rep.dropped, (long long)rep.first_dropped + 1);
-    if (rep.flipped)
+    if (says && rep.flipped)
         fprintf(stderr,
                 "seixo: warning: mesh wall %lld: %lld triangle(s) turned round to wind as their neighbours (the first: "
                 "triangle %lld)\n",
