@@ -333,6 +333,12 @@ void sx_lua_check_ball_walls(lua_State *L, int model, const sx_model *m, const d
 /// beyond the limit is an error (of the Lua call `what`) naming the two
 /// entities. Clears ud->unchecked.
 void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
+/// geometry.c: the check of sx_lua_check_placement on the state as this
+/// process holds it, without a gather (a decomposed cycle that failed on
+/// this rank alone: its copy of the other ranks' balls is as placed): true
+/// with the message (without the script's place) pushed, or false. Clears
+/// ud->unchecked.
+bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
 /// Warns on stderr (once per model and `what`) when v != 0 lies outside
 /// [lo, hi] in magnitude, naming the unit expected.
 void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit);

@@ -1069,6 +1069,9 @@ static int model_generate(lua_State *L)
     m = sx_lua_checkmodel(L, 1);
     const int64_t *ids = add_balls(L, m, &g, x, rad, n);
     sx_lua_record_seed(L, 1, (int64_t)g.seed); /* the balls exist: the files' provenance lists it */
+    /* placed over the balls there already (distribute does not see them):
+     * named after the next step, the relaxation's first (geometry.c) */
+    if (n > 0) ud->unchecked = true;
     if (g.method == M_EXPAND && shrink < 1 && n > 0) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);

@@ -133,26 +133,38 @@ static void sweep(lua_State *L, worst *w)
     lua_pop(L, 2);
 }
 
-void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
+bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
 {
-    sx_lua_gather(L, ud->m, "m"); /* the first step's contacts, every rank's */
     worst w = {ud->m, 0, 0, 0, 0, 0, false};
     if (failed)
         sweep(L, &w);
     else
         sx_contact_each(ud->m, scan_contact, &w);
     ud->unchecked = false;
-    if (w.ratio <= ud->overlap_limit * (1 + 1e-9)) return;  // "more than": a placement at the limit, rounded, passes
+    if (w.ratio <= ud->overlap_limit * (1 + 1e-9)) return false;  // "more than": a placement at the limit, rounded, passes
     const int pct = (int)lround(100 * w.ratio), lim = (int)lround(100 * ud->overlap_limit);
     if (w.wall)
-        luaL_error(L, "%s: ball %I overlaps wall %I by %f m, %d%% of its radius %f m%s, as it was placed (more than "
-                      "the %d%% of seixo.model{overlap_limit}): move it clear of the wall; the timestep is not the cause",
-                   what, (lua_Integer)w.a, (lua_Integer)w.b, w.overlap, pct, w.radius,
-                   w.ratio > 1 ? " (its centre is behind the wall)" : "", lim);
-    luaL_error(L, "%s: balls %I and %I overlap by %f m, %d%% of the smaller radius %f m, as they were placed (more "
-                  "than the %d%% of seixo.model{overlap_limit}): move them apart or make them smaller; the timestep "
-                  "is not the cause",
-               what, (lua_Integer)w.a, (lua_Integer)w.b, w.overlap, pct, w.radius, lim);
+        lua_pushfstring(L, "%s: ball %I overlaps wall %I by %f m, %d%% of its radius %f m%s, as it was placed (more "
+                           "than the %d%% of seixo.model{overlap_limit}): move it clear of the wall; the timestep is "
+                           "not the cause",
+                        what, (lua_Integer)w.a, (lua_Integer)w.b, w.overlap, pct, w.radius,
+                        w.ratio > 1 ? " (its centre is behind the wall)" : "", lim);
+    else
+        lua_pushfstring(L, "%s: balls %I and %I overlap by %f m, %d%% of the smaller radius %f m, as they were placed "
+                           "(more than the %d%% of seixo.model{overlap_limit}): move them apart or make them smaller; "
+                           "the timestep is not the cause",
+                        what, (lua_Integer)w.a, (lua_Integer)w.b, w.overlap, pct, w.radius, lim);
+    return true;
+}
+
+void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
+{
+    sx_lua_gather(L, ud->m, "m"); /* the first step's contacts, every rank's */
+    if (!sx_lua_placement_overlap(L, ud, what, failed)) return;
+    luaL_where(L, 1);
+    lua_insert(L, -2);
+    lua_concat(L, 2);
+    lua_error(L);
 }
 
 /* --------------------------------------------------------------- units */

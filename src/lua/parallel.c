@@ -36,8 +36,9 @@ static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 static _Noreturn void abort_job(void);
 
-enum { MESSAGE_TAG = 7, FAIL_TAG = 8 };
+enum { MESSAGE_TAG = 7, FAIL_TAG = 8, END_TAG = 9 };
 static void fail_heard(int n, MPI_Request *req);
+static void fail_ended(void);
 static bool await(int n, MPI_Request *req);
 #endif
 
@@ -196,6 +197,7 @@ static int seixo_receive(lua_State *L)
         if (ready) break;
         if (!wait) return 0;
         fail_heard(0, NULL); /* the rank waited for may have failed alone */
+        fail_ended();
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
@@ -332,13 +334,49 @@ static bool fail_wait(void)
     return all;
 }
 
-/* Ends the job after a failure: rank 0, which reported at once, first
- * gives the ranks failing alike their time to clean up (fail_wait). */
+/* This rank's entry in the failing ranks' barrier, once. */
+static void fail_enter(void)
+{
+    if (!fail_entered && (fail_entered = true, MPI_Ibarrier(fail_comm, &fail_req) != MPI_SUCCESS))
+        fail_req = MPI_REQUEST_NULL;
+}
+
+/* Ends the job after a failure. Rank 0, which reported at once, first
+ * tells every other rank the job ends (END_TAG): those waiting for the
+ * others (await, seixo.receive: fail_ended) remove their shadows and come
+ * to the barrier, as the ranks failing alike do, and rank 0 waits for
+ * them there (fail_wait: up to FAIL_WAIT_MS for a rank that is busy). */
 static _Noreturn void abort_job(void)
 {
-    if (world_rank == 0) fail_wait();
+    if (world_rank == 0 && fail_comm != MPI_COMM_NULL) {
+        static char none;
+        for (int r = 1; r < world_size; r++) {
+            MPI_Request req; /* never awaited: the job ends */
+            if (MPI_Isend(&none, 0, MPI_CHAR, r, END_TAG, fail_comm, &req) == MPI_SUCCESS) MPI_Request_free(&req);
+        }
+        fail_enter();
+        fail_wait();
+    }
     MPI_Abort(MPI_COMM_WORLD, 1);
     exit(1); /* MPI_Abort does not return */
+}
+
+/* A rank above 0 waiting for the others, whom rank 0 told that the job
+ * ends (abort_job): its shadows removed, it comes to the failing ranks'
+ * barrier and waits for rank 0's MPI_Abort. */
+static void fail_ended(void)
+{
+    int ready = 0;
+    if (!mpi_started || world_rank == 0 || fail_comm == MPI_COMM_NULL ||
+        MPI_Iprobe(0, END_TAG, fail_comm, &ready, MPI_STATUS_IGNORE) != MPI_SUCCESS || !ready)
+        return;
+    sx_lua_rank_files_remove();
+    fail_enter();
+    fail_wait();
+    const struct timespec wait = {FAIL_WAIT_MS / 1000, 0};
+    nanosleep(&wait, NULL);
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    exit(1);
 }
 
 /* A rank above 0 that fails tells rank 0 its message, once; the text
@@ -391,19 +429,22 @@ static void fail_heard(int n, MPI_Request *req)
     }
     fprintf(stderr, "seixo: rank %d of %d: %s\n", heard_from, world_size, heard);
     fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, 1);
-    exit(1);
+    abort_job();
 }
 
-/* Waits for the requests req[n], as MPI_Waitall; rank 0 listens meanwhile
- * for a rank that failed alone (fail_heard: every 64 tests, a probe). */
+/* Waits for the requests req[n], as MPI_Waitall, listening meanwhile
+ * (every 64 tests, a probe): rank 0 for a rank that failed alone
+ * (fail_heard), the others for rank 0's end of the job (fail_ended). */
 static bool await(int n, MPI_Request *req)
 {
     for (unsigned spin = 1;; spin++) {
         int done = 0;
         if (MPI_Testall(n, req, &done, MPI_STATUSES_IGNORE) != MPI_SUCCESS) return false;
         if (done) return true;
-        if (spin % 64 == 0) fail_heard(n, req);
+        if (spin % 64 == 0) {
+            fail_heard(n, req);
+            fail_ended();
+        }
     }
 }
 #endif
@@ -414,7 +455,7 @@ bool sx_lua_parallel_failing(const char *message)
 #ifdef SX_HAVE_MPI
     if (!mpi_started || fail_comm == MPI_COMM_NULL) return true;
     fail_tell(message);
-    if (!fail_entered && (fail_entered = true, MPI_Ibarrier(fail_comm, &fail_req) != MPI_SUCCESS)) return true;
+    fail_enter();
     if (world_rank == 0 || !fail_wait()) return true;
     /* rank 0 reports and its MPI_Abort ends this rank: an abort from here
      * could end rank 0 before it printed */

@@ -279,7 +279,12 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
     if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
         char msg[1024];
         luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
-        snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), r->what, sx_lua_core_message(sx_model_error(r->m)));
+        /* the first step since a placement failed: the placement is named,
+         * as serially, from this rank's copy of the balls as placed */
+        if (st == SX_EUNSTABLE && r->ud->unchecked && sx_lua_placement_overlap(L, r->ud, r->what, true))
+            snprintf(msg, sizeof msg, "%s%s", lua_tostring(L, -2), lua_tostring(L, -1));
+        else
+            snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), r->what, sx_lua_core_message(sx_model_error(r->m)));
         sx_lua_parallel_fail(msg);
     }
     if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);

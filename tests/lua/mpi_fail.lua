@@ -10,6 +10,9 @@
 --              waiting in m:cycle's same-call check, reports it at once)
 --   first      the same on rank 0 only (which reports at once: it no
 --              longer waits 5 s to see whether the others fail alike)
+--   placed     a ball placed over another: the first step fails on the
+--              rank that owns them, which names the placement, as
+--              serially, not the timestep
 local scene = arg and arg[1] or "script"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 -- a file written: the ranks above 0 hold a shadow of it when they fail
@@ -31,7 +34,10 @@ elseif scene == "last" then
 elseif scene == "first" then
   if seixo.rank() == 0 then error("mpi_fail.lua: an error on rank 0 alone") end
   m:cycle(100)
+elseif scene == "placed" then
+  m:ball{pos = m:ball(5).pos, radius = 1e-3}
+  m:cycle(10)
 else
-  error("mpi_fail.lua: scene script, callback, last or first expected, got " .. tostring(scene))
+  error("mpi_fail.lua: scene script, callback, last, first or placed expected, got " .. tostring(scene))
 end
 print("not stopped")

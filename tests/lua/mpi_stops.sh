@@ -12,9 +12,8 @@
 # found on one rank (mpi_clumps.lua ... unstable): its step and cause, up
 # to the critical estimate, which is the failing rank's own
 # (kernels/timestep.c, estimate_dt). Errors in the script, in a callback
-# and on one rank alone (mpi_fail.lua): the message, and, when every rank
-# fails, no rank's folder of shadows left in TMPDIR. Every message comes
-# from rank 0.
+# and on one rank alone (mpi_fail.lua): the message, and no rank's folder
+# of shadows left in TMPDIR. Every message comes from rank 0.
 set -u
 seixo=$1
 script=$2
@@ -48,9 +47,9 @@ for np in $ranks; do
   sed -E 's/^\[[0-9]+,[0-9]+\]<stderr>://' "$dir/tagged_err" >"$dir/err"
   if [ $rc = 0 ]; then echo "-np $np did not fail"; fail=1; continue; fi
   if [ $rc = 124 ]; then echo "-np $np hung (killed after 300 s)"; fail=1; continue; fi
-  # ranks that fail remove their shadows before the abort (a rank that
-  # mpirun kills when another fails alone, scenes 'last' and 'first', cannot)
-  if [ "$scene" != last ] && [ "$scene" != first ] && ls "$TMPDIR" | grep -q "^seixo-rank"; then
+  # ranks that fail remove their shadows before the abort, and so do those
+  # waiting for a rank that failed alone (rank 0 tells them the job ends)
+  if ls "$TMPDIR" | grep -q "^seixo-rank"; then
     echo "-np $np: a rank's shadow folder was left: $(ls "$TMPDIR")"; fail=1; rm -rf "$TMPDIR"/seixo-rank*
   fi
   if ! grep -q "^ranks $np$" "$dir/err"; then

@@ -240,6 +240,18 @@ test("balls placed overlapping are named at the first step, not blamed on the ti
   m:ball{pos = {0, 0.5e-3}, radius = 1e-3}
   m:wall{kind = "box", min = {-0.01, 1e-3}, max = {0.01, 0.02}}
   raises(function() m:cycle(10) end, "ball 1 overlaps wall 3 by 0.0015 m, 150% of its radius 0.001 m (its centre is behind the wall)")
+  -- balls generated (distribute) over balls that have cycled: the
+  -- relaxation's first step names them
+  m = seixo.model{dim = 2}
+  m:material("a", {kn = 1e6, ks = 1e6, damping = 0.5})
+  m:wall{kind = "box", min = {0, 0}, max = {0.05, 0.05}}
+  m:generate{count = 100, radius = {0.8e-3, 1e-3}, region = {box = {{0, 0}, {0.05, 0.05}}}, seed = 2}
+  m:cycle(10)
+  err = raises(function()
+    m:generate{method = "distribute", porosity = 0.5, radius = {0.5e-3, 0.6e-3}, region = {box = {{0, 0}, {0.05, 0.05}}},
+               seed = 4}
+  end, "m:generate: balls 28 and 1023 overlap by", "as they were placed")
+  check(not err:find("lower the timestep", 1, true), err)
 end)
 
 test("values outside a material's physical range warn once, with the unit expected", function()
