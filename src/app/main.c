@@ -910,8 +910,9 @@ static void repl(lua_State *L)
             status = docall(L, lua_gettop(L) - 1, 0);
         }
         /* under mpirun every rank runs the line alike on the same model:
-         * rank 0 reports its error (a model that differed would stop the
-         * next cycle on every rank, with that cause) */
+         * rank 0 reports its error; a line that failed on some ranks only
+         * leaves the ranks different, and ends the job with its message */
+        sx_lua_parallel_line_end(status != LUA_OK, status != LUA_OK ? lua_tostring(L, -1) : NULL);
         if (status != LUA_OK && sx_lua_parallel_rank() != 0) lua_pop(L, 1);
         else report(L, status);
     }

@@ -468,6 +468,36 @@ bool sx_lua_parallel_failing(const char *message)
 #endif
 }
 
+void sx_lua_parallel_line_end(bool failed, const char *message)
+{
+#ifdef SX_HAVE_MPI
+    if (!mpi_started || world_size < 2) return;
+    int some = failed, every = failed;
+    MPI_Request req[2];
+    if (MPI_Iallreduce(MPI_IN_PLACE, &some, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req[0]) != MPI_SUCCESS ||
+        MPI_Iallreduce(MPI_IN_PLACE, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &req[1]) != MPI_SUCCESS ||
+        !await(2, req))
+        sx_lua_parallel_fail("the ranks could not compare the outcome of the line");
+    if (some == every) return;
+    if (failed) {
+        char text[1024];
+        snprintf(text, sizeof text, "%s (on some ranks only: they differ from the others now, and the session ends)",
+                 message ? message : "(error object is not a string)");
+        sx_lua_parallel_fail(text);
+    }
+    /* the others wait for the failing ranks' message (rank 0) or for the end (fail_ended) */
+    const struct timespec ms = {0, 1000000};
+    for (;;) {
+        fail_heard(0, NULL);
+        fail_ended();
+        nanosleep(&ms, NULL);
+    }
+#else
+    (void)failed;
+    (void)message;
+#endif
+}
+
 void sx_lua_parallel_fail(const char *message)
 {
     if (sx_lua_parallel_failing(message)) {

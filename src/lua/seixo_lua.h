@@ -76,6 +76,13 @@ SX_API char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud,
 /// Else true at once.
 SX_API bool sx_lua_parallel_failing(const char *message);
 
+/// After a line of the interactive session, which every rank runs alike:
+/// when it `failed` on some ranks only (message: the error, or NULL), the
+/// ranks differ from then on, and the job ends with a failing rank's
+/// message, reported by rank 0. Serially, and when every rank agrees,
+/// returns at once (the caller reports its error). A collective call.
+SX_API void sx_lua_parallel_line_end(bool failed, const char *message);
+
 /// Ends MPI if sx_lua_parallel_start started it: MPI_Finalize, or MPI_Abort
 /// when ok is 0 and other ranks exist (they would wait for this one forever).
 SX_API void sx_lua_parallel_stop(int ok);

@@ -4,7 +4,8 @@
 # `seixo -i` run alike on every rank (rank 0 reads, the others take its
 # input) and print what the serial run prints, serially and with 1 to 4
 # ranks (the session's errors reported once), each run within a time
-# limit (a rank waiting for input it never gets would hang); and a bad
+# limit (a rank waiting for input it never gets would hang), and a line
+# failing on one rank alone ends the session with its message; and a bad
 # option is refused with its message once; --profile prints a table per
 # rank, named by its rank. Skipped (77) without mpirun.
 #   mpi_stdin.sh SEIXO SCRIPT 'ARGS'
@@ -44,6 +45,21 @@ for mode in script session; do
       echo "$mode, -np $np: the syntax error is not reported once:"; cat "$dir/err"; fail=1
     fi
   done
+done
+# a session line that fails on the last rank only: the ranks differ after
+# it, so the job ends with that rank's message, reported once (by rank 0),
+# and the next line runs nowhere
+for np in $ranks; do
+  [ "$np" -lt 2 ] && continue
+  printf 'if seixo.rank() == seixo.ranks() - 1 then error("on the last rank") end\nprint("went on")\n' |
+    timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" -i >"$dir/out" 2>"$dir/err"
+  rc=$?
+  if [ $rc = 0 ] || [ $rc = 124 ] || grep -q "went on" "$dir/out" ||
+     [ "$(grep -c "^seixo: rank $((np - 1)) of $np: stdin:1: on the last rank (on some ranks only" "$dir/err")" != 1 ]; then
+    echo "a line failing on one rank, -np $np: exit status $rc, the message not once:"; cat "$dir/out" "$dir/err"; fail=1
+  else
+    echo "a line failing on one rank, -np $np: the session ended with its message"
+  fi
 done
 # a bad option, which every rank parses alike: refused, said once (rank 0)
 for np in $ranks; do
