@@ -36,10 +36,21 @@ static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 static _Noreturn void abort_job(void);
 
-enum { MESSAGE_TAG = 7, FAIL_TAG = 8, END_TAG = 9 };
+enum { MESSAGE_TAG = 7, FAIL_TAG = 8, END_TAG = 9, WAIT_TAG = 10 };
+enum { CALL_NAME = 96 }; /* a chunk's name holds the step and the time it ends at, and the model */
 static void fail_heard(int n, MPI_Request *req);
 static void fail_ended(void);
-static bool await(int n, MPI_Request *req);
+static bool await(int n, MPI_Request *req, const char *call);
+static void say_wait(const char *call);
+static const char *nobody_sends(void);
+enum { WAIT_SAID_MS = 1000, STUCK_MS = 3000 }; /* say_wait, nobody_sends */
+
+static double clock_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
+}
 #endif
 
 void sx_lua_parallel_start(int *argc, char ***argv)
@@ -192,15 +203,24 @@ static int seixo_receive(lua_State *L)
 #ifdef SX_HAVE_MPI
     MPI_Status st;
     int ready = 0;
+    bool said = false;
+    const double t0 = clock_ms();
+    double stuck = -1; /* since when no rank can send, as the others say */
     for (;;) {
         MPI_Iprobe(MPI_ANY_SOURCE, MESSAGE_TAG, MPI_COMM_WORLD, &ready, &st);
         if (ready) break;
         if (!wait) return 0;
         fail_heard(0, NULL); /* the rank waited for may have failed alone */
         fail_ended();
+        if (!said && clock_ms() - t0 > WAIT_SAID_MS) said = (say_wait("seixo.receive"), true);
+        const char *why = nobody_sends();
+        if (!why) stuck = -1;
+        else if (stuck < 0) stuck = clock_ms();
+        else if (clock_ms() - stuck > STUCK_MS) return luaL_error(L, "seixo.receive: no message can come: %s", why);
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
+    if (said) say_wait(NULL);
     int len = 0;
     MPI_Get_count(&st, MPI_CHAR, &len);
     luaL_Buffer b;
@@ -259,7 +279,7 @@ static bool mpi_share(void *ud, void *data, size_t size, const sx_span *own, con
                           &req[nreq++]);
         }
     }
-    ok = await(nreq, req) && ok;
+    ok = await(nreq, req, NULL) && ok;
     free(req);
     return ok;
 }
@@ -269,7 +289,7 @@ static bool mpi_max(void *ud, double *v)
     (void)ud;
     MPI_Request req;
     return MPI_Iallreduce(MPI_IN_PLACE, v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD, &req) == MPI_SUCCESS &&
-           await(1, &req);
+           await(1, &req, NULL);
 }
 
 static bool mpi_agree(void *ud, uint64_t v)
@@ -279,7 +299,7 @@ static bool mpi_agree(void *ud, uint64_t v)
     MPI_Request req[2];
     return MPI_Iallreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD, &req[0]) == MPI_SUCCESS &&
            MPI_Iallreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD, &req[1]) == MPI_SUCCESS &&
-           await(2, req) && lo == hi;
+           await(2, req, NULL) && lo == hi;
 }
 #endif
 
@@ -401,12 +421,6 @@ enum { FAIL_GRACE_MS = 500 };
 static char *heard; /* the failure told, once taken */
 static int heard_from;
 
-static double clock_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
-}
 
 static void fail_heard(int n, MPI_Request *req)
 {
@@ -432,20 +446,85 @@ static void fail_heard(int n, MPI_Request *req)
     abort_job();
 }
 
+/* A rank that waits long (WAIT_SAID_MS) in a call every rank makes
+ * (await of a same-call check: it cannot end before every rank has come)
+ * or in seixo.receive says so to the others (WAIT_TAG: the call's name),
+ * and says when it goes on. A rank waiting in seixo.receive keeps what
+ * they say (note_waits): when every other rank waits so, no message can
+ * come, and once that has lasted STUCK_MS (a message sent just before its
+ * sender began to wait is taken meanwhile) the receive fails, naming
+ * their calls, instead of waiting for ever. */
+static char *waits_in; /* per rank: the call it says it waits in ("" when it goes on) */
+
+/* Sends to every other rank the call this rank waits in, or NULL when it
+ * goes on. A message of CALL_NAME bytes, sent eagerly by MPI_Send (never
+ * waiting for its receiver): a rank that never looks leaves it unread. */
+static void say_wait(const char *call)
+{
+    char msg[CALL_NAME] = {0};
+    if (call) snprintf(msg, sizeof msg, "%s", call);
+    for (int r = 0; r < world_size; r++)
+        if (r != world_rank) MPI_Send(msg, CALL_NAME, MPI_CHAR, r, WAIT_TAG, fail_comm);
+}
+
+/* Takes what the other ranks said of their waits, in the order they said it. */
+static void note_waits(void)
+{
+    if (!waits_in && !(waits_in = calloc((size_t)world_size, CALL_NAME))) return;
+    for (;;) {
+        int ready = 0;
+        MPI_Status st;
+        if (MPI_Iprobe(MPI_ANY_SOURCE, WAIT_TAG, fail_comm, &ready, &st) != MPI_SUCCESS || !ready) return;
+        char *to = waits_in + (size_t)st.MPI_SOURCE * CALL_NAME;
+        MPI_Recv(to, CALL_NAME, MPI_CHAR, st.MPI_SOURCE, WAIT_TAG, fail_comm, MPI_STATUS_IGNORE);
+        to[CALL_NAME - 1] = '\0';
+    }
+}
+
+/* NULL while some other rank may send; else why none can (a static text). */
+static const char *nobody_sends(void)
+{
+    note_waits();
+    if (!waits_in) return NULL;
+    static char why[512];
+    int at = 0, named = 0;
+    for (int r = 0; r < world_size; r++) {
+        if (r == world_rank) continue;
+        const char *call = waits_in + (size_t)r * CALL_NAME;
+        if (!call[0]) return NULL;
+        if (named++ < 2)
+            at += snprintf(why + at, sizeof why - (size_t)at, "%srank %d waits in %s", at ? ", " : "", r, call);
+    }
+    if (named > 2) at += snprintf(why + at, sizeof why - (size_t)at, ", and %d more", named - 2);
+    snprintf(why + at, sizeof why - (size_t)at, " (every rank must make the same calls: a receive that no send on "
+                                               "another rank answers?)");
+    return why;
+}
+
 /* Waits for the requests req[n], as MPI_Waitall, listening meanwhile
  * (every 64 tests, a probe): rank 0 for a rank that failed alone
- * (fail_heard), the others for rank 0's end of the job (fail_ended). */
-static bool await(int n, MPI_Request *req)
+ * (fail_heard), the others for rank 0's end of the job (fail_ended); a
+ * wait in a call every rank makes (call, else NULL) long enough is said
+ * to the others (say_wait). */
+static bool await(int n, MPI_Request *req, const char *call)
 {
+    bool said = false;
+    double t0 = -1;
     for (unsigned spin = 1;; spin++) {
         int done = 0;
         if (MPI_Testall(n, req, &done, MPI_STATUSES_IGNORE) != MPI_SUCCESS) return false;
-        if (done) return true;
+        if (done) break;
         if (spin % 64 == 0) {
             fail_heard(n, req);
             fail_ended();
+            if (call && !said) {
+                if (t0 < 0) t0 = clock_ms();
+                else if (clock_ms() - t0 > WAIT_SAID_MS) said = (say_wait(call), true);
+            }
         }
     }
+    if (said) say_wait(NULL);
+    return true;
 }
 #endif
 
@@ -476,7 +555,7 @@ void sx_lua_parallel_line_end(bool failed, const char *message)
     MPI_Request req[2];
     if (MPI_Iallreduce(MPI_IN_PLACE, &some, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req[0]) != MPI_SUCCESS ||
         MPI_Iallreduce(MPI_IN_PLACE, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &req[1]) != MPI_SUCCESS ||
-        !await(2, req))
+        !await(2, req, "the interactive session's line"))
         sx_lua_parallel_fail("the ranks could not compare the outcome of the line");
     if (some == every) return;
     if (failed) {
@@ -521,8 +600,6 @@ int sx_lua_parallel_rank(void) { return world_rank; }
  * rank 0 hears a rank that failed alone: fail_heard); when they differ,
  * every rank of the check fails with the message, which names two of
  * them. */
-enum { CALL_NAME = 96 }; /* a chunk's name holds the step and the time it ends at, and the model */
-
 bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
 {
 #ifdef SX_HAVE_MPI
@@ -534,7 +611,7 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
     /* not blocking: rank 0 hears meanwhile whether the rank it waits for failed alone */
     MPI_Request req;
     if (MPI_Iallgather(mine, CALL_NAME, MPI_CHAR, all, CALL_NAME, MPI_CHAR, MPI_COMM_WORLD, &req) != MPI_SUCCESS ||
-        !await(1, &req))
+        !await(1, &req, what))
         sx_lua_parallel_fail("the ranks could not compare their calls");
     int other = 1;
     while (other < world_size && memcmp(all, all + (size_t)other * CALL_NAME, CALL_NAME) == 0) other++;

@@ -20,6 +20,9 @@
 --   models   one call on two models, rank 0 saving one and the others
 --            another, after a cycle of each: the gathers of two models
 --            would have paired (the check named the call, not its model)
+--   receive  seixo.receive on rank 0 alone, the others cycling: no
+--            message can come (it hung); serially no receive
+--   receives seixo.receive on every rank, none sending (it hung)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -52,8 +55,14 @@ elseif scene == "query" then
   local b = m:ball(1)
   if first then print(b.pos) end
   m:cycle(100)
+elseif scene == "receive" then
+  if first and seixo.ranks() > 1 then seixo.receive() end
+  m:cycle(100)
+elseif scene == "receives" then
+  if seixo.ranks() > 1 then seixo.receive() end
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time or models expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive or receives expected, "
+        .. "got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end

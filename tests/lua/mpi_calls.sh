@@ -3,12 +3,15 @@
 # serially to its end, and under mpirun --oversubscribe -np 2, 3, 4 must
 # fail within a time limit (never hang) with the message naming the
 # ranks' calls printed once. Skipped (77) without mpirun.
-#   mpi_calls.sh SEIXO SCRIPT SCENE CALL
+#   mpi_calls.sh SEIXO SCRIPT SCENE CALL [MESSAGE]
+# MESSAGE, the message's beginning before CALL (a pattern), is by default
+# that of two calls that differ.
 set -u
 seixo=$1
 script=$2
 scene=$3
 call=$4
+message=${5:-"the ranks made different calls: rank 0 is in "}
 . "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
 if ! "$seixo" "$script" "$scene" >"$dir/serial" 2>"$dir/err" || ! grep -q "^ended $scene$" "$dir/serial"; then
   echo "the serial run of '$scene' did not end:"; cat "$dir/serial" "$dir/err"; exit 1
@@ -20,9 +23,9 @@ for np in $ranks; do
   rc=$?
   if [ $rc = 0 ]; then echo "$scene, -np $np did not fail"; cat "$dir/out"; fail=1; continue; fi
   if [ $rc = 124 ]; then echo "$scene, -np $np hung (killed after 120 s)"; fail=1; continue; fi
-  said=$(grep -c "the ranks made different calls: rank 0 is in .*$call" "$dir/err")
+  said=$(grep -c "$message.*$call" "$dir/err")
   if [ "$said" = 1 ]; then
-    echo "$scene, -np $np: stopped, said once: $(grep -o "the ranks made different calls: [^(]*" "$dir/err")"
+    echo "$scene, -np $np: stopped, said once: $(grep -o "$message[^(]*" "$dir/err")"
   else
     echo "$scene, -np $np: the message not once ($said):"; cat "$dir/err"; fail=1
   fi
