@@ -27,11 +27,11 @@
 #include <unistd.h>
 
 static int world_rank = 0, world_size = 1;
-static int node_size = 1; /* the ranks on this rank's machine */
 
 #ifdef SX_HAVE_MPI
 #include <mpi.h>
 
+static int node_size = 1; /* the ranks on this rank's machine */
 static bool mpi_started;
 static MPI_Comm fail_comm = MPI_COMM_NULL; /* the failing ranks' barrier (sx_lua_parallel_failing) alone */
 static _Noreturn void abort_job(void);
@@ -209,9 +209,9 @@ static int seixo_receive(lua_State *L)
     for (;;) {
         MPI_Iprobe(MPI_ANY_SOURCE, MESSAGE_TAG, MPI_COMM_WORLD, &ready, &st);
         if (ready) break;
-        if (!wait) return 0;
-        fail_heard(0, NULL); /* the rank waited for may have failed alone */
+        fail_heard(0, NULL); /* the rank waited for (or polled for, as pool.hand_out does) may have failed */
         fail_ended();
+        if (!wait) return 0;
         if (!said && clock_ms() - t0 > WAIT_SAID_MS) said = (say_wait("seixo.receive"), true);
         const char *why = nobody_sends();
         if (!why) stuck = -1;
@@ -669,6 +669,8 @@ char *sx_lua_parallel_root_text(const char *what, char *(*read)(void *ud, size_t
         if (world_rank != 0) text[*len] = '\0';
         return text;
     }
+#else
+    (void)what;
 #endif
     return read(ud, len, mark);
 }
