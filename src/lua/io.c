@@ -618,7 +618,7 @@ static int output_write(lua_State *L)
 static int output_count(lua_State *L)
 {
     output *o = check_output(L, 1);
-    lua_pushinteger(L, o->open ? (lua_Integer)o->count : 0);
+    lua_pushinteger(L, (lua_Integer)o->count); /* closed too: what it wrote */
     return 1;
 }
 

@@ -31,5 +31,6 @@ o:write()
 assert(o:count() == 6 and tostring(o):find("6 snapshots", 1, true)) -- and 1500, 2000, now
 print("count", o:count(), tostring(o):match("%(.*%)"))
 o:close()
+assert(o:count() == 6) -- closed: what it wrote
 print("closed", o:count(), pcall(o.write, o))
 print("hash", m:hash())
