@@ -589,6 +589,69 @@ static void place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const
 
 /* ------------------------------------------------------- distribute */
 
+/* The worst overlap of one of the model's balls (x, r) with the new balls
+ * of a grid: its ratio to the smaller radius, and which new ball. */
+typedef struct clash {
+    const double *x;
+    double r, ratio, overlap, radius;
+    int64_t i;
+} clash;
+
+static bool worst_clash(const grid *gr, int64_t i, void *ud)
+{
+    clash *c = ud;
+    double d2 = 0;
+    for (int k = 0; k < gr->dim; k++) d2 += (gr->x[3 * i + k] - c->x[k]) * (gr->x[3 * i + k] - c->x[k]);
+    const double over = gr->r[i] + c->r - sqrt(d2), small = fmin(gr->r[i], c->r);
+    if (over > 0 && small > 0 && over / small > c->ratio) c->ratio = over / small, c->overlap = over, c->radius = small, c->i = i;
+    return false;
+}
+
+/* distribute pushes apart only the balls it makes: one of them over a ball
+ * of the model (a region not clear of them) beyond seixo.model{overlap_limit}
+ * is an error naming both, before any is added (a cycle would otherwise
+ * fail on it, blaming the timestep). */
+static void check_clear(lua_State *L, const sx_model *m, double limit, const gen *g, const double *x,
+                        const double *rad, int64_t n)
+{
+    const int64_t nb = sx_ball_count(m);
+    if (n == 0 || nb == 0) return;
+    const int top = lua_gettop(L), dim = g->dim;
+    double rnew = 0, rold = 0;
+    for (int64_t i = 0; i < n; i++) rnew = fmax(rnew, rad[i]);
+    for (int64_t j = 0; j < nb; j++) {
+        double rb;
+        sx_ball_get(m, sx_ball_id_at(m, j), SX_BALL_RADIUS, &rb);
+        rold = fmax(rold, rb);
+    }
+    grid *gr = lua_newuserdatauv(L, sizeof *gr, 0);
+    grid_init(L, gr, dim, g->region.lo, g->region.hi, rnew + rold, n);
+    for (int64_t i = 0; i < n; i++) grid_add(gr, x + 3 * i, rad[i]);
+    clash worst = {NULL, 0, 0, 0, 0, 0};
+    int64_t worst_id = 0;
+    for (int64_t j = 0; j < nb; j++) {
+        const int64_t id = sx_ball_id_at(m, j);
+        double p[3] = {0, 0, 0}, rb;
+        sx_ball_get_vec(m, id, SX_BALL_POS, p);
+        sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
+        bool near = true; /* the grid's cells clamp what lies beyond them: only balls within reach */
+        for (int k = 0; k < dim; k++) near &= p[k] > g->region.lo[k] - rb - rnew && p[k] < g->region.hi[k] + rb + rnew;
+        if (!near) continue;
+        clash c = worst;
+        c.x = p, c.r = rb;
+        grid_near(gr, p, worst_clash, &c);
+        if (c.ratio > worst.ratio) worst = c, worst_id = id;
+    }
+    lua_settop(L, top);
+    if (worst.ratio <= limit * (1 + 1e-9)) return;
+    const double *q = x + 3 * worst.i;
+    luaL_error(L, "m:generate: a ball it places (at %f, %f%s) would overlap ball %I by %f m, %d%% of the smaller radius "
+                  "%f m (more than the %d%% of seixo.model{overlap_limit}): distribute moves only the balls it makes; "
+                  "generate into a region clear of the model's balls, or remove them first",
+               q[0], q[1], dim == 3 ? lua_pushfstring(L, ", %f", q[2]) : "", (lua_Integer)worst_id, worst.overlap,
+               (int)lround(100 * worst.ratio), worst.radius, (int)lround(100 * limit));
+}
+
 /* Moves x back inside where a ball of radius rad fits; false if it cannot (then x is unchanged). */
 static bool project(const sx_lua_region *g, double rad, double *x)
 {
@@ -1065,13 +1128,11 @@ static int model_generate(lua_State *L)
         if (worst > 0.9)
             return luaL_error(L, "m:generate: cannot reach porosity %f in this region: overlaps stay at %f of a radius; "
                               "raise the porosity", g.porosity, worst);
+        check_clear(L, sx_lua_checkmodel(L, 1), ud->overlap_limit, &g, x, rad, n);
     }
     m = sx_lua_checkmodel(L, 1);
     const int64_t *ids = add_balls(L, m, &g, x, rad, n);
     sx_lua_record_seed(L, 1, (int64_t)g.seed); /* the balls exist: the files' provenance lists it */
-    /* placed over the balls there already (distribute does not see them):
-     * named after the next step, the relaxation's first (geometry.c) */
-    if (n > 0) ud->unchecked = true;
     if (g.method == M_EXPAND && shrink < 1 && n > 0) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);

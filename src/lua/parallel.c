@@ -43,6 +43,7 @@ static void fail_ended(void);
 static bool await(int n, MPI_Request *req, const char *call);
 static void say_wait(const char *call);
 static const char *nobody_sends(void);
+static void note_waits(void);
 enum { WAIT_SAID_MS = 1000, STUCK_MS = 3000 }; /* say_wait, nobody_sends */
 
 static double clock_ms(void)
@@ -99,6 +100,7 @@ void sx_lua_parallel_stop(int ok)
     if (ok && !sx_lua_parallel_same_call("the script's end", err, sizeof err)) sx_lua_parallel_fail(err);
     /* a rank that failed would leave the others waiting for its messages */
     if (!ok && world_size > 1) abort_job();
+    note_waits(); /* the others' words on their waits, which this rank did not need */
     if (fail_comm != MPI_COMM_NULL) MPI_Comm_free(&fail_comm);
     MPI_Finalize();
     mpi_started = false;
@@ -216,7 +218,10 @@ static int seixo_receive(lua_State *L)
         const char *why = nobody_sends();
         if (!why) stuck = -1;
         else if (stuck < 0) stuck = clock_ms();
-        else if (clock_ms() - stuck > STUCK_MS) return luaL_error(L, "seixo.receive: no message can come: %s", why);
+        else if (clock_ms() - stuck > STUCK_MS) {
+            if (said) say_wait(NULL); /* a script that catches the error goes on */
+            return luaL_error(L, "seixo.receive: no message can come: %s", why);
+        }
         const struct timespec ms = {0, 1000000};
         nanosleep(&ms, NULL);
     }
@@ -341,14 +346,20 @@ static MPI_Request fail_req = MPI_REQUEST_NULL; /* this rank's entry in the fail
 static bool fail_entered;                          /* once: a second entry would be another barrier */
 
 /* Polls the failing ranks' barrier for up to FAIL_WAIT_MS: true once every
- * rank has come (false at once when this rank is not in it, or when it
- * completed already: MPI_Test then freed the request). */
+ * rank has come, or (a rank above 0) once rank 0 has said the job ends
+ * (END_TAG: it reported, see abort_job); false at once when this rank is
+ * not in the barrier, or when it completed already (MPI_Test then freed
+ * the request). */
 static bool fail_wait(void)
 {
     int all = 0;
     const struct timespec poll = {0, FAIL_POLL_MS * 1000000L};
     for (int ms = 0; !all && fail_req != MPI_REQUEST_NULL && ms < FAIL_WAIT_MS; ms += FAIL_POLL_MS) {
         if (MPI_Test(&fail_req, &all, MPI_STATUS_IGNORE) != MPI_SUCCESS) return false;
+        int ended = 0;
+        if (!all && world_rank > 0 && MPI_Iprobe(0, END_TAG, fail_comm, &ended, MPI_STATUS_IGNORE) == MPI_SUCCESS &&
+            ended)
+            return true;
         if (!all) nanosleep(&poll, NULL);
     }
     return all;
@@ -431,9 +442,11 @@ static void fail_heard(int n, MPI_Request *req)
         if (MPI_Iprobe(MPI_ANY_SOURCE, FAIL_TAG, fail_comm, &ready, &st) != MPI_SUCCESS || !ready) return;
         MPI_Get_count(&st, MPI_CHAR, &len);
         static char lost[] = "failed (its message did not fit in memory)";
-        char *text = malloc((size_t)len + 1);
-        MPI_Recv(text ? text : lost, text ? len : 0, MPI_CHAR, st.MPI_SOURCE, FAIL_TAG, fail_comm, MPI_STATUS_IGNORE);
-        if (text) text[len] = '\0';
+        char *text = malloc((size_t)len + 1); /* none: the message stays unread, the job ends */
+        if (text) {
+            MPI_Recv(text, len, MPI_CHAR, st.MPI_SOURCE, FAIL_TAG, fail_comm, MPI_STATUS_IGNORE);
+            text[len] = '\0';
+        }
         heard = text ? text : lost, heard_from = st.MPI_SOURCE;
     }
     for (const double t0 = clock_ms(); n > 0 && clock_ms() - t0 < FAIL_GRACE_MS;) {
@@ -551,26 +564,28 @@ void sx_lua_parallel_line_end(bool failed, const char *message)
 {
 #ifdef SX_HAVE_MPI
     if (!mpi_started || world_size < 2) return;
-    int some = failed, every = failed;
-    MPI_Request req[2];
-    if (MPI_Iallreduce(MPI_IN_PLACE, &some, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req[0]) != MPI_SUCCESS ||
-        MPI_Iallreduce(MPI_IN_PLACE, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &req[1]) != MPI_SUCCESS ||
-        !await(2, req, "the interactive session's line"))
-        sx_lua_parallel_fail("the ranks could not compare the outcome of the line");
-    if (some == every) return;
+    /* a same-call check (the same MPI operation as every collective call's:
+     * a rank still in another call of the line meets this one there) */
+    char err[512];
+    if (sx_lua_parallel_same_call(failed ? "the end of a line that failed" : "the end of a line", err, sizeof err)) return;
+    /* the ranks differ: a rank whose line failed ends the job with its
+     * error; the others wait a moment for its message (rank 0) or the end
+     * (fail_ended), then fail with the calls that differed (a rank still
+     * inside its line, in a check this one left, hears nothing else) */
     if (failed) {
         char text[1024];
         snprintf(text, sizeof text, "%s (on some ranks only: they differ from the others now, and the session ends)",
                  message ? message : "(error object is not a string)");
         sx_lua_parallel_fail(text);
     }
-    /* the others wait for the failing ranks' message (rank 0) or for the end (fail_ended) */
+    const double t0 = clock_ms();
     const struct timespec ms = {0, 1000000};
-    for (;;) {
+    while (clock_ms() - t0 < 2 * FAIL_GRACE_MS) {
         fail_heard(0, NULL);
         fail_ended();
         nanosleep(&ms, NULL);
     }
+    sx_lua_parallel_fail(err);
 #else
     (void)failed;
     (void)message;

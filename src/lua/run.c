@@ -295,6 +295,12 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
+    /* the first step since balls or walls were placed alone, as run_model
+     * takes it: its check sweeps the balls as placed */
+    if (r->ud->unchecked && n > 1) {
+        run_chunk(L, r, 1, t_end);
+        n--;
+    }
     run_chunk(L, r, n, t_end);
     sx_lua_gather(L, r->m, "m"); /* for the caller's own reads and changes of the balls */
 }

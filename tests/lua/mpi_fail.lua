@@ -10,6 +10,10 @@
 --              waiting in m:cycle's same-call check, reports it at once)
 --   first      the same on rank 0 only (which reports at once: it no
 --              longer waits 5 s to see whether the others fail alike)
+--   busy       an error on rank 1 alone (serially rank 0) while the
+--              last of 3 or more ranks computes for 7 s: rank 0 reports it,
+--              once (the failing rank, whose own wait ended first, said it
+--              again)
 --   placed     a ball placed over another: the first step fails on the
 --              rank that owns them, which names the placement, as
 --              serially, not the timestep
@@ -34,10 +38,18 @@ elseif scene == "last" then
 elseif scene == "first" then
   if seixo.rank() == 0 then error("mpi_fail.lua: an error on rank 0 alone") end
   m:cycle(100)
+elseif scene == "busy" then
+  local R = seixo.ranks()
+  if seixo.rank() == math.min(1, R - 1) then error("mpi_fail.lua: an error on rank 1 alone") end
+  if R >= 3 and seixo.rank() == R - 1 then
+    local t0 = seixo.clock()
+    while seixo.clock() - t0 < 7 do end
+  end
+  m:cycle(100)
 elseif scene == "placed" then
   m:ball{pos = m:ball(5).pos, radius = 1e-3}
   m:cycle(10)
 else
-  error("mpi_fail.lua: scene script, callback, last, first or placed expected, got " .. tostring(scene))
+  error("mpi_fail.lua: scene script, callback, last, first, busy or placed expected, got " .. tostring(scene))
 end
 print("not stopped")

@@ -46,20 +46,33 @@ for mode in script session; do
     fi
   done
 done
-# a session line that fails on the last rank only: the ranks differ after
-# it, so the job ends with that rank's message, reported once (by rank 0),
-# and the next line runs nowhere
+# a session line that fails on the last rank only, then ends (1), or goes
+# on to a collective call the others make (2); a line making a collective
+# call on rank 0 only (3): the ranks differ after it, so the job ends with
+# one message, said once (by rank 0), and the next line runs nowhere
+bed="m = dofile('$(dirname "$0")/mpi_bed.lua')(10)"
 for np in $ranks; do
   [ "$np" -lt 2 ] && continue
-  printf 'if seixo.rank() == seixo.ranks() - 1 then error("on the last rank") end\nprint("went on")\n' |
-    timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" -i >"$dir/out" 2>"$dir/err"
-  rc=$?
-  if [ $rc = 0 ] || [ $rc = 124 ] || grep -q "went on" "$dir/out" ||
-     [ "$(grep -c "^seixo: rank $((np - 1)) of $np: stdin:1: on the last rank (on some ranks only" "$dir/err")" != 1 ]; then
-    echo "a line failing on one rank, -np $np: exit status $rc, the message not once:"; cat "$dir/out" "$dir/err"; fail=1
-  else
-    echo "a line failing on one rank, -np $np: the session ended with its message"
-  fi
+  for case in 1 2 3; do
+    case $case in
+      1) line='if seixo.rank() == seixo.ranks() - 1 then error("on the last rank") end'
+         said="^seixo: rank $((np - 1)) of $np: stdin:1: on the last rank (on some ranks only" ;;
+      2) line='if seixo.rank() == seixo.ranks() - 1 then error("on the last rank") end m:cycle(2)'
+         said="^seixo: rank $((np - 1)) of $np: stdin:1: on the last rank (on some ranks only" ;;
+      3) line='if seixo.rank() == 0 then m:cycle(3) end'
+         said="the ranks made different calls: rank 0 is in .*m:cycle" ;;
+    esac
+    printf '%s\n%s\nprint("went on")\n' "$bed" "$line" |
+      timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" -i >"$dir/out" 2>"$dir/err"
+    rc=$?
+    if [ $rc = 0 ] || [ $rc = 124 ] || grep -q "went on" "$dir/out" || [ "$(grep -c "$said" "$dir/err")" != 1 ] ||
+       grep -q "MPI_ERR" "$dir/err"; then
+      echo "line $case failing on some ranks, -np $np: exit status $rc, the message not once:"
+      cat "$dir/out" "$dir/err"; fail=1
+    else
+      echo "line $case failing on some ranks, -np $np: the session ended with its message"
+    fi
+  done
 done
 # a bad option, which every rank parses alike: refused, said once (rank 0)
 for np in $ranks; do
