@@ -123,7 +123,7 @@ static int compare_keys(const void *pa, const void *pb)
         if (a->integer && b->integer) return (a->i > b->i) - (a->i < b->i);
         const lua_Number x = a->integer ? (lua_Number)a->i : a->d, y = b->integer ? (lua_Number)b->i : b->d;
         if (x != y) return x < y ? -1 : 1;
-        if (a->integer != b->integer) return a->integer ? -1 : 1; /* 2^53 + 1 and 2^53.0: the integer first */
+        if (a->integer != b->integer) return a->integer ? -1 : 1; /* 2^63 - 1 and 2^63.0, equal as doubles: the integer first */
     } else if (a->kind == 0 || a->kind == 2) {
         const size_t n = a->len < b->len ? a->len : b->len;
         const int c = a->kind == 2 ? memcmp(a->str, b->str, n) : 0;
@@ -148,8 +148,7 @@ static lua_Integer keys_in_order(lua_State *L, int idx)
         lua_pushvalue(L, -2);
         lua_rawseti(L, list, ++n);
     }
-    saved_key *k = n ? malloc((size_t)n * sizeof *k) : NULL;
-    if (n && !k) luaL_error(L, "out of memory to save a table of %I keys", n);
+    saved_key *k = lua_newuserdatauv(L, (size_t)(n ? n : 1) * sizeof *k, 0); /* collected, also after an error */
     for (lua_Integer j = 0; j < n; j++) {
         const int type = lua_rawgeti(L, list, j + 1);
         saved_key *e = &k[j];
@@ -167,8 +166,8 @@ static lua_Integer keys_in_order(lua_State *L, int idx)
         lua_rawgeti(L, list, k[j].slot);
         lua_rawseti(L, -2, j + 1);
     }
-    free(k);
     lua_replace(L, list);
+    lua_settop(L, list);
     return n;
 }
 
