@@ -156,6 +156,7 @@ typedef struct sx_lua_model {
     int callback;          ///< depth of user callbacks being run (removals are queued while > 0)
     double overlap_limit;  ///< seixo.model{overlap_limit}: the largest overlap placed, a fraction of the radius
     bool unchecked;        ///< a ball or wall was added since the last placement check (geometry.c)
+    int64_t fresh_lo, fresh_hi; ///< the ids of the balls m:generate made since that check, their overlaps among themselves its relaxation's, not checked (0, 0: none; ids are from 1)
     bool decomposed;       ///< its cycles run decomposed over the MPI ranks (parallel.c)
 } sx_lua_model;
 

@@ -1133,6 +1133,16 @@ static int model_generate(lua_State *L)
     m = sx_lua_checkmodel(L, 1);
     const int64_t *ids = add_balls(L, m, &g, x, rad, n);
     sx_lua_record_seed(L, 1, (int64_t)g.seed); /* the balls exist: the files' provenance lists it */
+    /* placed over the model's balls or walls (lattice and expand do not see
+     * the balls; distribute checked them: check_clear): named after the next
+     * step, the relaxation's first (geometry.c); the overlaps among the new
+     * balls are the relaxation's to remove, not checked */
+    if (n > 0) {
+        ud->unchecked = true;
+        ud->fresh_lo = ids[0], ud->fresh_hi = ids[n - 1];
+        for (int64_t i = 0; i < n; i++) ud->fresh_lo = ids[i] < ud->fresh_lo ? ids[i] : ud->fresh_lo;
+        for (int64_t i = 0; i < n; i++) ud->fresh_hi = ids[i] > ud->fresh_hi ? ids[i] : ud->fresh_hi;
+    }
     if (g.method == M_EXPAND && shrink < 1 && n > 0) {
         const int top = lua_gettop(L);
         push_gravity_guard(L, ud);

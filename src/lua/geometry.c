@@ -58,7 +58,8 @@ void sx_lua_check_ball_walls(lua_State *L, int model, const sx_model *m, const d
 
 typedef struct worst {
     const sx_model *m;
-    double ratio;   // overlap over the smaller radius
+    int64_t fresh_lo, fresh_hi; // two balls of m:generate's: not checked (sx_lua_model)
+    double ratio;               // overlap over the smaller radius
     double overlap, radius;
     int64_t a, b;
     bool wall;
@@ -66,7 +67,9 @@ typedef struct worst {
 
 static void consider(worst *w, double overlap, double r, int64_t a, int64_t b, bool wall)
 {
-    if (r > 0 && overlap / r > w->ratio) *w = (worst){w->m, overlap / r, overlap, r, a, b, wall};
+    if (!wall && a >= w->fresh_lo && a <= w->fresh_hi && b >= w->fresh_lo && b <= w->fresh_hi) return;
+    if (r > 0 && overlap / r > w->ratio)
+        w->ratio = overlap / r, w->overlap = overlap, w->radius = r, w->a = a, w->b = b, w->wall = wall;
 }
 
 static bool scan_contact(const sx_contact_info *c, void *ud)
@@ -135,12 +138,13 @@ static void sweep(lua_State *L, worst *w)
 
 bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
 {
-    worst w = {ud->m, 0, 0, 0, 0, 0, false};
+    worst w = {ud->m, ud->fresh_lo, ud->fresh_hi, 0, 0, 0, 0, 0, false};
     if (failed)
         sweep(L, &w);
     else
         sx_contact_each(ud->m, scan_contact, &w);
     ud->unchecked = false;
+    ud->fresh_lo = ud->fresh_hi = 0;
     if (w.ratio <= ud->overlap_limit * (1 + 1e-9)) return false;  // "more than": a placement at the limit, rounded, passes
     const int pct = (int)lround(100 * w.ratio), lim = (int)lround(100 * ud->overlap_limit);
     if (w.wall)

@@ -578,9 +578,9 @@ void sx_lua_parallel_line_end(bool failed, const char *message)
                  message ? message : "(error object is not a string)");
         sx_lua_parallel_fail(text);
     }
-    const double t0 = clock_ms();
+    const double t0 = clock_ms(), wait = strstr(err, "that failed") ? FAIL_WAIT_MS : 2 * FAIL_GRACE_MS;
     const struct timespec ms = {0, 1000000};
-    while (clock_ms() - t0 < 2 * FAIL_GRACE_MS) {
+    while (clock_ms() - t0 < wait) { /* a failing rank named: its message is on its way */
         fail_heard(0, NULL);
         fail_ended();
         nanosleep(&ms, NULL);

@@ -255,10 +255,21 @@ test("balls placed overlapping are named at the first step, not blamed on the ti
          "250% of the smaller radius", "distribute moves only the balls it makes")
   check(not err:find("lower the timestep", 1, true), err)
   eq(m:ball_count(), 100, "none added")
-  local tight = seixo.model{dim = 2, overlap_limit = 0.02}
-  tight:material("a", {kn = 1e6, ks = 1e6})
-  eq(tight:generate{method = "distribute", porosity = 0.2, radius = {0.5e-3, 0.6e-3},
-                    region = {box = {{0, 0}, {0.01, 0.01}}}, seed = 4} > 0, true)
+  for _, wall in ipairs{false, true} do -- a wall first: the relaxation's first step is checked
+    local tight = seixo.model{dim = 2, overlap_limit = 0.02}
+    tight:material("a", {kn = 1e6, ks = 1e6})
+    if wall then tight:wall{kind = "box", min = {0, 0}, max = {0.01, 0.01}} end
+    eq(tight:generate{method = "distribute", porosity = 0.2, radius = {0.5e-3, 0.6e-3},
+                      region = {box = {{0, 0}, {0.01, 0.01}}}, seed = 4} > 0, true)
+  end
+  -- a lattice over a ball that has cycled: the next step names the placement
+  m = seixo.model{dim = 2}
+  m:material("a", {kn = 1e6, ks = 1e6, damping = 0.5})
+  m:ball{pos = {0.0051, 0.0052}, radius = 1e-3}
+  m:cycle(1)
+  m:generate{method = "lattice", radius = 0.5e-3, region = {box = {{0, 0}, {0.01, 0.01}}}}
+  err = raises(function() m:cycle(10) end, "m:cycle: balls 1 and", "as they were placed")
+  check(not err:find("lower the timestep", 1, true), err)
 end)
 
 test("values outside a material's physical range warn once, with the unit expected", function()
