@@ -373,18 +373,28 @@ static void fail_enter(void)
 }
 
 /* Ends the job after a failure. Rank 0, which reported at once, first
- * tells every other rank the job ends (END_TAG): those waiting for the
+ * tells every other rank the job ends (END_TAG, tell_end: once, and as
+ * soon as it takes a failure told, fail_heard): those waiting for the
  * others (await, seixo.receive: fail_ended) remove their shadows and come
- * to the barrier, as the ranks failing alike do, and rank 0 waits for
- * them there (fail_wait: up to FAIL_WAIT_MS for a rank that is busy). */
+ * to the barrier, as the ranks failing alike do, a failing rank's own
+ * wait ends quiet (fail_wait), and rank 0 waits for them there (up to
+ * FAIL_WAIT_MS for a rank that is busy). */
+static void tell_end(void)
+{
+    static bool told;
+    static char none;
+    if (told || world_rank != 0 || fail_comm == MPI_COMM_NULL) return;
+    told = true;
+    for (int r = 1; r < world_size; r++) {
+        MPI_Request req; /* never awaited: the job ends */
+        if (MPI_Isend(&none, 0, MPI_CHAR, r, END_TAG, fail_comm, &req) == MPI_SUCCESS) MPI_Request_free(&req);
+    }
+}
+
 static _Noreturn void abort_job(void)
 {
     if (world_rank == 0 && fail_comm != MPI_COMM_NULL) {
-        static char none;
-        for (int r = 1; r < world_size; r++) {
-            MPI_Request req; /* never awaited: the job ends */
-            if (MPI_Isend(&none, 0, MPI_CHAR, r, END_TAG, fail_comm, &req) == MPI_SUCCESS) MPI_Request_free(&req);
-        }
+        tell_end();
         fail_enter();
         fail_wait();
     }
@@ -448,6 +458,9 @@ static void fail_heard(int n, MPI_Request *req)
             text[len] = '\0';
         }
         heard = text ? text : lost, heard_from = st.MPI_SOURCE;
+        /* the job ends whatever follows (rank 0 reports this or its own
+         * error): said now, the failing ranks' own waits end quiet */
+        tell_end();
     }
     for (const double t0 = clock_ms(); n > 0 && clock_ms() - t0 < FAIL_GRACE_MS;) {
         int done = 0;
