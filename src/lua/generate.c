@@ -392,6 +392,15 @@ static void grid_add(grid *gr, const double *x, double r)
     gr->head[c] = i;
 }
 
+/* Whether a ball at p of radius r reaches within `reach` of the region's
+ * box: the model's balls that new ones may meet. */
+static bool near_region(const sx_lua_region *reg, int dim, const double *p, double r, double reach)
+{
+    bool in = true;
+    for (int k = 0; k < dim; k++) in &= p[k] > reg->lo[k] - r - reach && p[k] < reg->hi[k] + r + reach;
+    return in;
+}
+
 /* A grid (a Lua userdata on the stack) over the region holding the model's
  * balls near it, within `reach` of its box, so new balls are also checked
  * against them; cells fit a new ball of radius rnew against the largest
@@ -410,9 +419,7 @@ static grid *grid_of_model(lua_State *L, const sx_model *m, const sx_lua_region 
             double p[3], rb;
             sx_ball_get_vec(m, id, SX_BALL_POS, p);
             sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
-            bool in = true;
-            for (int k = 0; k < dim; k++) in &= p[k] > reg->lo[k] - rb - reach && p[k] < reg->hi[k] + rb + reach;
-            if (!in) continue;
+            if (!near_region(reg, dim, p, rb, reach)) continue;
             if (gr) {
                 grid_add(gr, p, rb);
             } else {
@@ -634,9 +641,7 @@ static void check_clear(lua_State *L, const sx_model *m, double limit, const gen
         double p[3] = {0, 0, 0}, rb;
         sx_ball_get_vec(m, id, SX_BALL_POS, p);
         sx_ball_get(m, id, SX_BALL_RADIUS, &rb);
-        bool near = true; /* the grid's cells clamp what lies beyond them: only balls within reach */
-        for (int k = 0; k < dim; k++) near &= p[k] > g->region.lo[k] - rb - rnew && p[k] < g->region.hi[k] + rb + rnew;
-        if (!near) continue;
+        if (!near_region(&g->region, dim, p, rb, rnew)) continue; /* the grid's cells clamp what lies beyond */
         clash c = worst;
         c.x = p, c.r = rb;
         grid_near(gr, p, worst_clash, &c);
@@ -1139,9 +1144,11 @@ static int model_generate(lua_State *L)
      * balls are the relaxation's to remove, not checked */
     if (n > 0) {
         ud->unchecked = true;
-        ud->fresh_lo = ids[0], ud->fresh_hi = ids[n - 1];
-        for (int64_t i = 0; i < n; i++) ud->fresh_lo = ids[i] < ud->fresh_lo ? ids[i] : ud->fresh_lo;
-        for (int64_t i = 0; i < n; i++) ud->fresh_hi = ids[i] > ud->fresh_hi ? ids[i] : ud->fresh_hi;
+        ud->fresh_lo = ud->fresh_hi = ids[0];
+        for (int64_t i = 1; i < n; i++) {
+            if (ids[i] < ud->fresh_lo) ud->fresh_lo = ids[i];
+            if (ids[i] > ud->fresh_hi) ud->fresh_hi = ids[i];
+        }
     }
     if (g.method == M_EXPAND && shrink < 1 && n > 0) {
         const int top = lua_gettop(L);

@@ -442,7 +442,6 @@ enum { FAIL_GRACE_MS = 500 };
 static char *heard; /* the failure told, once taken */
 static int heard_from;
 
-
 static void fail_heard(int n, MPI_Request *req)
 {
     if (!mpi_started || world_rank != 0 || fail_comm == MPI_COMM_NULL) return;
