@@ -191,9 +191,8 @@ local function lab_evaluate(lab, o, material, seed)
       end
     end
     if t.BTS then
-      local disk = copy(recipe)
-      for k, v in pairs(o.brazilian or {}) do disk[k] = v end
-      disk.shape = o.specimen.dim == 3 and "disc" or "disk"
+      local disk = copy(o.disk)
+      disk.material, disk.seed, disk.log = material, seed, false
       disk.path = base .. "_disk.h5"
       files[#files + 1] = disk.path
       local b = lab.brazilian(lab.specimen(disk), {log = false})
@@ -445,6 +444,17 @@ local option_keys = {"targets", "weights", "parameters", "material", "specimen",
                      "seeds", "workers", "maxeval", "xtol", "tolerance", "algorithm", "guesses", "penalty", "log",
                      "out", "plot", "print", "evaluate"}
 
+-- What a rock's or a grain's macro-property can be: a target outside is a
+-- slip of the unit (E = 50 for 50 GPa), found before hours of runs.
+local target_range = {
+  E = {1e5, 1e12, "Pa", " (seixo's unit is the pascal: 50 GPa is 50e9)"},
+  UCS = {1e3, 1e10, "Pa", " (seixo's unit is the pascal: 150 MPa is 150e6)"},
+  BTS = {1e3, 1e10, "Pa", " (seixo's unit is the pascal: 10 MPa is 10e6)"},
+  c = {1e3, 1e10, "Pa", " (seixo's unit is the pascal: 30 MPa is 30e6)"},
+  nu = {-0.999, 0.499, "", " (a Poisson's ratio lies between -1 and 0.5)"},
+  phi = {0.1, 89.9, "degrees", ""},
+}
+
 local function check_options(lab, opts)
   if type(opts) ~= "table" then fail("a table of options expected, got %s", type(opts)) end
   local allowed = {}
@@ -464,6 +474,9 @@ local function check_options(lab, opts)
         end
       elseif type(v) ~= "number" or v ~= v or v == 0 or math.abs(v) == math.huge then
         fail("targets.%s must be a finite non-zero number (got %s)", k, tostring(v))
+      elseif target_range[k] and not (v >= target_range[k][1] and v <= target_range[k][2]) then
+        local r = target_range[k]
+        fail("targets.%s = %g is outside %g ... %g %s%s", k, v, r[1], r[2], r[3], r[4])
       end
       o.targets[k] = v
       o.target_names[#o.target_names + 1] = k
@@ -509,7 +522,25 @@ local function check_options(lab, opts)
   if not opts.evaluate and type(opts.specimen) ~= "table" then
     fail("specimen = {dim =, width =, height =, ...} (lab.specimen's options) expected")
   end
-  o.specimen, o.test, o.brazilian = opts.specimen, opts.test, opts.brazilian
+  o.specimen, o.test = opts.specimen, opts.test
+  if opts.brazilian ~= nil and type(opts.brazilian) ~= "table" then
+    fail("brazilian must be a table of the disk's options (got %s)", type(opts.brazilian))
+  end
+  if o.targets.BTS and not opts.evaluate then
+    -- the Brazilian disk: the recipe's balls and material, as wide as the
+    -- specimen (its diameter or width) and, in 3D, half as thick (ISRM's
+    -- t/D = 0.5), unless brazilian says otherwise
+    local disk, dim = copy(opts.specimen), opts.specimen.dim or 3
+    disk.width, disk.height, disk.depth, disk.thickness = nil, nil, nil, nil
+    for k, v in pairs(opts.brazilian or {}) do disk[k] = v end
+    disk.shape = dim == 3 and "disc" or "disk"
+    disk.diameter = disk.diameter or opts.specimen.diameter or opts.specimen.width
+    if dim == 3 and not disk.thickness and type(disk.diameter) == "number" then disk.thickness = 0.5 * disk.diameter end
+    if type(disk.diameter) ~= "number" or not (disk.diameter > 0) then
+      fail("the Brazilian disk needs a diameter: brazilian = {diameter = ...} (m)")
+    end
+    o.disk = disk
+  end
   o.evaluate = opts.evaluate or function(material, seed) return lab_evaluate(lab, o, material, seed) end
   local seeds = opts.seeds or 3
   if type(seeds) == "number" then
@@ -555,6 +586,10 @@ local function check_options(lab, opts)
   end
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")
+  for _, path in ipairs({o.log, o.out .. "_convergence.csv"}) do -- before hours of runs, not after
+    local ok, why = pool.writable(path)
+    if not ok then fail("cannot write %s: %s", path, why) end
+  end
   o.plot = opts.plot
   if opts.print ~= nil and opts.print ~= false and type(opts.print) ~= "function" then
     fail("print must be a function or false (got %s)", type(opts.print))

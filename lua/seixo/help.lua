@@ -263,6 +263,8 @@ local entries = {
   ["lab.triaxial"] = {"lab.triaxial(spec, {confining =, strain_rate =, target_ratio = 2e-3, max_rate =, density_scale = 1, out =, ...}) -> result",
     "A triaxial test at confining = sigma3 [Pa] held by servo-controlled walls (0: unconfined); returns peak [Pa], E [Pa], nu, cracks, curves. The platens speed up from strain_rate to max_rate [1/s] (default 8 x strain_rate) while the unbalanced-force ratio stays under target_ratio/2 and no bond breaks, and slow down when it exceeds target_ratio or bonds break (target_ratio = false: a constant rate); density_scale >= 1 multiplies the balls' density (timestep x sqrt)."},
   ["lab.ucs"] = {"lab.ucs(spec[, opts]) -> result", "The unconfined compression test (lab.triaxial without confinement)."},
+  ["lab.lateral_strain"] = {"lab.lateral_strain(m[, axis]) -> strain",
+    "strain() returns the lateral strain since the call (compression positive): the affine fit of the balls' motion across axis (default the last), without a ball squeezed out of the assembly."},
   ["lab.brazilian"] = {"lab.brazilian(spec[, opts]) -> result", "The Brazilian test of a disk: two platens close; sigma_t = 2 F / (pi D t) [Pa] at the peak (tensile_strength) and at the split (split: the halves parted)."},
   ["lab.mohr_coulomb"] = {"lab.mohr_coulomb({{sigma3, sigma1}, ...}) -> {c =, phi =, N =, intercept =, r2 =, rms =, points =}",
     "The Mohr-Coulomb fit of failure states [Pa]; phi in degrees."},

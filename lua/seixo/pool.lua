@@ -69,16 +69,36 @@ function pool.tag() return string.format("%d.%s", seixo.rank(), (tostring({}):gs
 --- Writes text to path through a temporary name in the same folder,
 --- renamed when complete: an interrupted write never leaves a truncated
 --- file.
+-- An io or os call's message about the temporary name tmp, as the cause
+-- for path's: "No such file or directory", not the temporary name.
+local function cause(message, tmp)
+  message = tostring(message)
+  if message:sub(1, #tmp + 2) == tmp .. ": " then return message:sub(#tmp + 3) end
+  return message
+end
+
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
   local tmp = path .. ".tmp" .. pool.tag()
   local f, opened = io.open(tmp, "w")
-  if not f then error("cannot write " .. path .. ": " .. tostring(opened), 2) end
+  if not f then error("cannot write " .. path .. ": " .. cause(opened, tmp), 2) end
   local ok, err = f:write(text)
   f:close()
-  if not ok then os.remove(tmp); error("cannot write " .. path .. ": " .. tostring(err), 2) end
+  if not ok then os.remove(tmp); error("cannot write " .. path .. ": " .. cause(err, tmp), 2) end
   local done, why = os.rename(tmp, path)
-  if not done then os.remove(tmp); error("cannot write " .. path .. ": " .. tostring(why), 2) end
+  if not done then os.remove(tmp); error("cannot write " .. path .. ": " .. cause(why, tmp), 2) end
+end
+
+--- Whether a file can be made at path: true, or nil and the cause (a
+--- probe through a temporary name beside it, removed at once). A genesis
+--- or a test checks its output folders before its work, not when done.
+function pool.writable(path)
+  local tmp = path .. ".tmp" .. pool.tag()
+  local f, opened = io.open(tmp, "w")
+  if not f then return nil, cause(opened, tmp) end
+  f:close()
+  os.remove(tmp)
+  return true
 end
 
 --- Runs o.jobs (serializable tables) in processes, o.workers at a time:

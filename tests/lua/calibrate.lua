@@ -231,7 +231,7 @@ end)
 test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for their targets", function()
   local r = lab.calibrate{targets = {BTS = 20e6, c = 30e6, phi = 30}, parameters = {strength = {50e6, 400e6}},
                           specimen = {dim = 2, width = 0.012, height = 0.024, radius = {0.6e-3, 1e-3}},
-                          brazilian = {diameter = 0.012}, confining = {0, 5e6}, seeds = {1}, workers = 1, maxeval = 1,
+                          confining = {0, 5e6}, seeds = {1}, workers = 1, maxeval = 1, -- (the disk: the width)
                           log = fresh("calibrate_2d_strengths.csv"), out = "calibrate_2d_strengths", plot = false,
                           print = false}
   eq(r.evaluations, 1)
@@ -266,6 +266,20 @@ test("bad options are clear errors at the caller", function()
                                     seeds = {1, 0.5}} end, "seeds[2] must be a whole number, not 0.5")
   T.raises(function() lab.calibrate{targets = {G = 1}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
            "unknown target 'G'")
+  -- a unit slipped (50 meant as GPa), a ratio that no material has: before hours of runs
+  T.raises(function() lab.calibrate{targets = {E = 50}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic} end,
+           "lab.calibrate: targets.E = 50 is outside 100000 ... 1e+12 Pa (seixo's unit is the pascal")
+  T.raises(function() lab.calibrate{targets = {E = 1e9, nu = 0.7}, parameters = {modulus = {1e9, 2e9}},
+                                    evaluate = synthetic} end, "targets.nu = 0.7 is outside")
+  -- an output folder that is not there, found before the runs
+  T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = synthetic,
+                                    out = "no/such/folder/cal"} end,
+           "lab.calibrate: cannot write no/such/folder/cal.csv: No such file or directory")
+  -- the Brazilian disk of a cylinder's recipe: its diameter, half as thick
+  -- (a rect's recipe: its width); a recipe with neither names what to give
+  T.raises(function() lab.calibrate{targets = {BTS = 1e7}, parameters = {strength = {1e7, 2e7}},
+                                    specimen = {dim = 3, shape = "prism", depth = 0.01, height = 0.02}} end,
+           "the Brazilian disk needs a diameter: brazilian = {diameter = ...}")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {nothing = {1, 2}}, evaluate = synthetic} end,
            "parameter 'nothing'")
   T.raises(function() lab.calibrate{targets = {c = 1e6}, parameters = {cohesion = {1e6, 2e6}}, specimen = {}} end,
