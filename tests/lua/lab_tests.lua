@@ -225,6 +225,18 @@ test("the Brazilian test splits a disk", function()
   near(r.split, r.tensile_strength, 1e-12)
 end)
 
+test("3D: a disc too coarse for a Brazilian test is reported, not read as a split", function()
+  -- 8 balls across: the one ball a platen presses is pushed in; the force
+  -- falls by half at the first two cracks, its peak without any
+  local disc = lab.specimen{dim = 3, shape = "disc", diameter = 0.016, thickness = 0.008, radius = {0.8e-3, 1.33e-3},
+                            seed = 1, path = dir .. "/disc.h5", log = false}
+  local r = lab.brazilian(disc, {log = false})
+  eq(r.cracks.tension + r.cracks.shear, 0)
+  check(r.split == nil, "no split")
+  check(#r.warnings > 0 and r.warnings[1]:find("no bond had broken at the peak force", 1, true),
+        table.concat(r.warnings, "; "))
+end)
+
 test("3D: a tiny cylinder through UCS and triaxial tests in a servo-controlled cylindrical wall", function()
   local cyl = lab.specimen{dim = 3, shape = "cylinder", diameter = 0.01, height = 0.02, radius = {0.8e-3, 1.33e-3},
                            seed = 2, path = dir .. "/cyl.h5", log = false}
