@@ -12,7 +12,7 @@ local out = arg and arg[1] or "lab-results-calibrate"
 local maxeval = tonumber(arg and arg[2]) or 16
 local seeds = tonumber(arg and arg[3]) or 2
 local width = tonumber(arg and arg[4]) or 0.03
-if seixo.rank() == 0 then os.execute("mkdir -p '" .. out .. "'") end
+os.execute("mkdir -p '" .. out .. "'") -- on every rank, as each checks a file's folder before writing it
 
 local t0 = seixo.clock()
 local r = lab.calibrate{

@@ -197,7 +197,7 @@ local function lab_evaluate(lab, o, material, seed)
       files[#files + 1] = disk.path
       local b = peaked(lab.brazilian(lab.specimen(disk), {log = false}), "the Brazilian test")
       -- a disk that gave way at the platens measured no tensile strength
-      if #b.warnings > 0 then error("the Brazilian test: " .. b.warnings[1], 0) end
+      if b.gave_way then error("the Brazilian test: " .. b.warnings[1], 0) end
       values.BTS = b.tensile_strength
     end
     return values
@@ -531,15 +531,20 @@ local function check_options(lab, opts)
   if o.targets.BTS and not opts.evaluate then
     -- the Brazilian disk: the recipe's balls and material, as wide as the
     -- specimen (its diameter or width) and, in 3D, half as thick (ISRM's
-    -- t/D = 0.5), unless brazilian says otherwise
+    -- t/D = 0.5) but at least the 5 largest radii lab.specimen needs,
+    -- unless brazilian says otherwise
     local disk, dim = copy(opts.specimen), opts.specimen.dim or 3
     disk.width, disk.height, disk.depth, disk.thickness = nil, nil, nil, nil
     for k, v in pairs(opts.brazilian or {}) do disk[k] = v end
     disk.shape = dim == 3 and "disc" or "disk"
     disk.diameter = disk.diameter or opts.specimen.diameter or opts.specimen.width
-    if dim == 3 and not disk.thickness and type(disk.diameter) == "number" then disk.thickness = 0.5 * disk.diameter end
     if type(disk.diameter) ~= "number" or not (disk.diameter > 0) then
       fail("the Brazilian disk needs a diameter: brazilian = {diameter = ...} (m)")
+    end
+    if dim == 3 and not disk.thickness then
+      -- (of clumps: their radii come from the template; 1.33e-3: lab.specimen's default rmax)
+      local rmax = disk.clump and 0 or type(disk.radius) == "table" and disk.radius[2] or 1.33e-3
+      disk.thickness = math.max(0.5 * disk.diameter, type(rmax) == "number" and 5 * rmax or 0)
     end
     o.disk = disk
   end
@@ -588,10 +593,6 @@ local function check_options(lab, opts)
   end
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")
-  for _, path in ipairs({o.log, o.out .. "_convergence.csv"}) do -- before hours of runs, not after
-    local ok, why = pool.writable(path)
-    if not ok then fail("cannot write %s: %s", path, why) end
-  end
   o.plot = opts.plot
   if opts.print ~= nil and opts.print ~= false and type(opts.print) ~= "function" then
     fail("print must be a function or false (got %s)", type(opts.print))
@@ -633,6 +634,13 @@ function search(lab, o)
   end
   -- (a worker for a later calibration of the script replays this one from its log)
   local replay = job ~= nil
+  -- the files written, checked before hours of runs, not after them (on
+  -- rank 0 alone, which writes them: another rank may come here before
+  -- rank 0 made their folder)
+  for _, path in ipairs(replay and {} or {o.log, o.out .. "_convergence.csv"}) do
+    local ok, why = pool.writable(path)
+    if not ok then fail("cannot write %s: %s", path, why) end
+  end
   local mode = seixo.ranks() > 1 and "ranks" or (o.workers > 1 and script_command() and "processes" or "serial")
   if mode == "serial" then o.workers = 1 end
 

@@ -17,6 +17,8 @@ local entries = {
   ["seixo.vec"] = {"seixo.vec(x, y[, z]) | seixo.vec{x, y[, z]} -> vector",
     "A vector with arithmetic (v + w, v - w, -v, v * s, s * v, v / s, v == w), fields x, y, z and methods dot, cross, norm, unit, copy; accepted wherever {x, y, z} is, and what b.pos, b.vel, w.force, ... return. A field's vector (b.pos) is a read-only copy: b.pos[1] = 5 is an error; set the whole field (local p = b.pos:copy(); p[1] = 5; b.pos = p)."},
   ["seixo.models"] = {"seixo.models() -> {model, ...}", "The open models, in the order they were made (a model no longer referenced may be collected)."},
+  ["seixo.check_material"] = {"seixo.check_material({...}) -> true",
+    "Checks a material table as m:material would (its keys, the core's ranges), without a model; raises m:material's error."},
   ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",
     "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},
   ["seixo.clock"] = {"seixo.clock() -> seconds", "Wall-clock seconds from a monotonic clock: the difference of two readings times a run."},

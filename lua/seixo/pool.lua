@@ -66,9 +66,6 @@ function pool.quote(s) return "'" .. tostring(s):gsub("'", "'\\''") .. "'" end
 --- would draw more, and the ranks must draw alike after it.
 function pool.tag() return string.format("%d.%s", seixo.rank(), (tostring({}):gsub("^table: ", ""))) end
 
---- Writes text to path through a temporary name in the same folder,
---- renamed when complete: an interrupted write never leaves a truncated
---- file.
 -- An io or os call's message about the temporary name tmp, as the cause
 -- for path's: "No such file or directory", not the temporary name.
 local function cause(message, tmp)
@@ -77,6 +74,9 @@ local function cause(message, tmp)
   return message
 end
 
+--- Writes text to path through a temporary name in the same folder,
+--- renamed when complete: an interrupted write never leaves a truncated
+--- file.
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
   local tmp = path .. ".tmp" .. pool.tag()
@@ -93,6 +93,13 @@ end
 --- probe through a temporary name beside it, removed at once). A genesis
 --- or a test checks its output folders before its work, not when done.
 function pool.writable(path)
+  if path == "" or path:sub(-1) == "/" then return nil, "not a file's name" end
+  local there = io.open(path, "r") -- (a folder opens, and reads as one)
+  if there then
+    local _, _, code = there:read(0)
+    there:close()
+    if code == 21 then return nil, "Is a directory" end
+  end
   local tmp = path .. ".tmp" .. pool.tag()
   local f, opened = io.open(tmp, "w")
   if not f then return nil, cause(opened, tmp) end

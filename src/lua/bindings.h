@@ -164,6 +164,8 @@ typedef struct sx_lua_model {
 int sx_lua_models(lua_State *L);
 /// seixo.model{...}: the constructor.
 int sx_lua_model_new(lua_State *L);
+/// model.c: seixo.check_material({...}), m:material's checks without a model
+int sx_lua_check_material(lua_State *L);
 /// The executable's --threads N (seixo.threads), when set, on m (fn names
 /// the call in the error of a bad value; m NULL: only that check); results
 /// do not depend on it.

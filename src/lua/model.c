@@ -443,28 +443,69 @@ static void warn_unusual(lua_State *L, const sx_material_def *d)
     sx_lua_check_range(L, 1, "shear_modulus", d->shear_modulus, 1e5, 1e12, "Pa");
 }
 
-static int model_material(lua_State *L)
+/* The material table at arg (if any) into d and bpm, its keys checked. */
+static void check_material(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm)
 {
     const char *keys[48] = {"kn",      "ks",             "friction",      "density", "damping",
                             "viscous_normal", "viscous_shear", "model", "modulus", "stiffness_ratio",
                             "bond"};
     keys[sx_lua_law_keys(keys, 11, 47)] = NULL; /* and the laws' parameters */
+    *d = sx_material_default_def();
+    *has_bpm = false;
+    memset(bpm, 0, sizeof *bpm);
+    if (lua_isnoneornil(L, arg)) return;
+    sx_lua_checkkeys(L, arg, keys);
+    read_material(L, arg, d, has_bpm, bpm);
+}
+
+static int model_material(lua_State *L)
+{
     sx_model *m = sx_lua_checkmodel(L, 1);
     const char *name = luaL_checkstring(L, 2);
-    sx_material_def d = sx_material_default_def();
-    bool has_bpm = false;
+    sx_material_def d;
+    bool has_bpm;
     sx_bpm_def bpm;
-    memset(&bpm, 0, sizeof bpm);
-    if (!lua_isnoneornil(L, 3)) {
-        sx_lua_checkkeys(L, 3, keys);
-        read_material(L, 3, &d, &has_bpm, &bpm);
-    }
+    check_material(L, 3, &d, &has_bpm, &bpm);
     int index = -1;
     sx_lua_check(L, m, sx_material_set(m, name, &d, &index), "m:material");
     if (has_bpm) sx_lua_check(L, m, sx_material_set_bpm(m, index, &bpm), "m:material");
     warn_unusual(L, &d);
     lua_settop(L, 2);
     return 1;  // the name: materials are referred to by name everywhere
+}
+
+/* seixo.check_material({...}) -> true, or m:material's error: the table
+ * checked as m:material checks it (its keys, then the core's ranges), on a
+ * core model of its own that no script sees: no model is made, counted or
+ * shared between ranks, and no warning printed (lab.rock checks its
+ * overrides so). */
+int sx_lua_check_material(lua_State *L)
+{
+    luaL_checktype(L, 1, LUA_TTABLE);
+    sx_material_def d;
+    bool has_bpm;
+    sx_bpm_def bpm;
+    check_material(L, 1, &d, &has_bpm, &bpm);
+    char err[256];
+    sx_model_def md = sx_model_default_def();
+    sx_model *m = sx_model_create(&md, err, sizeof err);
+    if (!m) return luaL_error(L, "seixo.check_material: %s", sx_lua_core_message(err));
+    int index = -1;
+    sx_status st = sx_material_set(m, "material", &d, &index);
+    if (st == SX_OK && has_bpm) st = sx_material_set_bpm(m, index, &bpm);
+    if (st != SX_OK) {
+        static const char named[] = "material 'material': "; /* the core's prefix: no name here */
+        const char *why = sx_lua_core_message(sx_model_error(m));
+        if (!strncmp(why, named, sizeof named - 1)) why += sizeof named - 1;
+        luaL_where(L, 1);
+        lua_pushfstring(L, "seixo.check_material: %s", why);
+        lua_concat(L, 2);
+        sx_model_destroy(m);
+        return lua_error(L);
+    }
+    sx_model_destroy(m);
+    lua_pushboolean(L, 1);
+    return 1;
 }
 
 /* The two names of field `key` of the table at arg ({"x", "y"}, or one

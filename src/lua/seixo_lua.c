@@ -60,6 +60,7 @@ int luaopen_seixo(lua_State *L)
     static const luaL_Reg functions[] = {
         {"model", sx_lua_model_new},
         {"models", sx_lua_models},
+        {"check_material", sx_lua_check_material},
         {"progress", seixo_progress},
         {"clock", seixo_clock},
         {NULL, NULL},

@@ -113,6 +113,23 @@ test("a search failing while a rank's large record is out stops every rank, and 
 end)
 os.execute("rm -rf '" .. dir .. "'")
 
+test("a folder rank 0 alone made, while the other rank is already in lab.calibrate", function()
+  -- (the output folders are checked before the runs, by rank 0, which
+  -- writes them: checked on every rank, rank 1 found the folder missing)
+  local out = os.tmpname()
+  os.remove(out)
+  if rank == 0 then
+    local t = seixo.clock()
+    while seixo.clock() - t < 0.3 do end
+    os.execute("mkdir -p '" .. out .. "'")
+  end
+  local r = lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, seeds = {1}, maxeval = 2,
+                          evaluate = function(mat) return {E = mat.modulus * 0.6} end, plot = false, print = false,
+                          out = out .. "/calibration"}
+  eq(r.evaluations, 2)
+  if rank == 0 then os.execute("rm -rf '" .. out .. "'") end
+end)
+
 test("the models after a calibration are decomposed again", function()
   eq(seixo.decompose(), true)
   local m = seixo.model{dim = 2}

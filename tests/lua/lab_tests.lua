@@ -152,6 +152,10 @@ test("bad options name the problem", function()
   raises(function() lab.triaxial(spec, {confining = 1e6, lateral = "plane"}) end,
          "lateral must be \"cylinder\" or \"planes\" (got plane)")
   raises(function() lab.triaxial(spec, {confining = 1e6, lateral = "cylinder"}) end, "needs a 3D cylinder")
+  raises(function() lab.ucs(spec, {out = {}}) end, "lab.ucs: out must be a path prefix (a string; got table)")
+  os.execute("mkdir -p '" .. dir .. "/folder.csv'")
+  raises(function() lab.ucs(spec, {out = dir .. "/folder"}) end, "folder.csv (out): Is a directory")
+  raises(function() lab.lateral_strain(seixo.model{dim = 2}, 3) end, "lab.lateral_strain: axis must be 1 to 2 (got 3)")
   raises(function() lab.specimen{dim = 2, width = 0.004, height = 0.008, radius = {1e-3, 1.5e-3}, path = "x.h5"} end,
          "lab.specimen: the balls are too large for the specimen: its size along x is 0.004 m")
 end)
@@ -193,6 +197,7 @@ end)
 test("a true triaxial test: E is the secant of the loading, from the deviator sigma2 - sigma3 it starts at", function()
   local prism = lab.specimen{dim = 3, shape = "prism", width = 0.01, height = 0.02, radius = {0.8e-3, 1.33e-3},
                              seed = 2, path = dir .. "/prism.h5", log = false}
+  raises(function() lab.triaxial(prism, {intermediate = 10e6}) end, "an intermediate stress needs confining > 0")
   local conventional = lab.triaxial(prism, {confining = 5e6, log = false})
   local true_ = lab.triaxial(prism, {confining = 5e6, intermediate = 15e6, log = false})
   eq(true_.stopped, "post_peak")
@@ -227,13 +232,13 @@ end)
 
 test("3D: a disc too coarse for a Brazilian test is reported, not read as a split", function()
   -- 8 balls across: the one ball a platen presses is pushed in; the force
-  -- falls by half at the first two cracks, its peak without any
+  -- falls by half at the first two cracks while the halves close (3.0 MPa,
+  -- where a finer disc of the same rock splits at about 20)
   local disc = lab.specimen{dim = 3, shape = "disc", diameter = 0.016, thickness = 0.008, radius = {0.8e-3, 1.33e-3},
                             seed = 1, path = dir .. "/disc.h5", log = false}
   local r = lab.brazilian(disc, {log = false})
-  eq(r.cracks.tension + r.cracks.shear, 0)
   check(r.split == nil, "no split")
-  check(#r.warnings > 0 and r.warnings[1]:find("no bond had broken at the peak force", 1, true),
+  check(#r.warnings > 0 and r.warnings[1]:find("the halves were not seen to part", 1, true),
         table.concat(r.warnings, "; "))
 end)
 
