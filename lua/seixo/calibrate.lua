@@ -669,7 +669,8 @@ function search(lab, o)
       cache[key_of(j.x, j.seed)] = rec
       local row = {j.candidate, j.seed, rec.status, rec.time}
       for _, v in ipairs(j.x) do row[#row + 1] = v end
-      for _, k in ipairs(macros) do row[#row + 1] = rec.values and rec.values[k] or nil end
+      local at = #row -- (by index: a target not measured leaves its column empty, not the next one's)
+      for m, k in ipairs(macros) do row[at + m] = rec.values and rec.values[k] or nil end
       rows[i] = row
       for k = #log_rows, base + 1, -1 do log_rows[k] = nil end
       for k = 1, #jobs do if rows[k] then log_rows[#log_rows + 1] = rows[k] end end
