@@ -280,7 +280,9 @@ START_TEST(random_flips)
     const long n = file_size(from);
     uint64_t s = 2024;
     int failed = 0, loaded = 0;
-    for (int k = 0; k < 250; k++) {
+    const char *count = getenv("SX_TEST_FLIPS"); /* fewer under the sanitizers (tests/io/meson.build) */
+    const int flips = count && atoi(count) > 0 ? atoi(count) : 250;
+    for (int k = 0; k < flips; k++) {
         copy_file(from, p);
         flip(p, (long)(scene_rng_u64(&s) % (uint64_t)n));
         char err[1024] = "";
@@ -297,7 +299,7 @@ START_TEST(random_flips)
     }
     printf("  random flips: %d refused, %d loaded (bytes HDF5 does not read)\n", failed, loaded);
     fflush(stdout);
-    ck_assert(failed > 190); /* most bytes of a small snapshot are read (checksummed) */
+    ck_assert(25 * failed > 19 * flips); /* most bytes of a small snapshot are read (checksummed): > 190 of 250 */
 }
 END_TEST
 

@@ -3,8 +3,9 @@
 # MPI refuses root without --allow-run-as-root), ranks and dir (a temporary
 # directory removed at exit). Under AddressSanitizer (scripts/test
 # --sanitize) ranks is 3 only (a middle rank with a neighbour on each side
-# and two end ranks: the memory checks of every code path): the plain
-# suite checks every rank count, and CI's time stays short.
+# and two end ranks: the memory checks of every code path) and sanitized
+# is 1 (mpi_same.sh then runs every other scene): the plain suite checks
+# every rank count and scene, and CI's time stays short.
 if ! command -v mpirun >/dev/null 2>&1; then
   echo "mpirun not found: skipped"
   exit 77
@@ -19,7 +20,8 @@ export OMPI_MCA_mpi_yield_when_idle=1
 # The same for OpenMP's threads (mpi_threads.lua: 2 a rank): spinning, 4
 # ranks of 2 on 2 cores ran a scene 100 times slower than passive.
 export OMP_WAIT_POLICY=passive
-if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; fi
+sanitized=
+if command -v ldd >/dev/null 2>&1 && ldd "$seixo" 2>/dev/null | grep -q libasan; then ranks="3"; sanitized=1; fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 # After a run with $2 ranks (its output in $dir/out, stderr in $dir/err):
