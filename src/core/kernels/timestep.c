@@ -13,10 +13,40 @@
  * stiffness. A ball is never rated below its own stiffness (as if touching
  * one entity like itself), so the first impact is already resolved and the
  * timestep does not jump as contacts form. */
-/* A ball's own rating under pair law l: its stiffnesses against an entity of its own. */
-static void self_rating(const sx_pair_law *l, double r, double *kn, double *ks)
+/* The overlap a ball of radius r, mass and speed is rated at under pair
+ * law l: HERTZ_REFERENCE_OVERLAP of its radius or, if larger, the deepest
+ * overlap of a head-on impact with its twin (reduced mass m/2, closing
+ * speed 2v: m v^2 = the law's strain energy, strain x Fn(u) u). A law
+ * whose stiffness grows with the overlap (Hertz) would otherwise rate a
+ * fast ball as if it touched lightly: the timestep is rated again only
+ * every few steps, and an impact lasting 4 of them went wrong (a Hertz
+ * ball hitting a plane at 10 m/s came back at 11.55). For a law of constant
+ * stiffness the overlap changes nothing. */
+static double rating_overlap(const sx_pair_law *l, double r, double mass, double speed)
 {
-    stiffness(l, r, r, r, HERTZ_REFERENCE_OVERLAP * r, kn, ks);
+    const double u0 = HERTZ_REFERENCE_OVERLAP * r, energy = mass * speed * speed;
+    if (!(energy > 0) || !isfinite(energy)) return u0; /* at rest, or fixed (no mass to stop) */
+    double kn, ks;
+    const double f0 = stiffness(l, r, r, r, u0, &kn, &ks), k0 = f0 / u0;
+    stiffness(l, r, r, r, 2 * u0, &kn, &ks);
+    if (!(kn > k0 * (1 + 1e-12))) return u0; /* a constant stiffness */
+    const double strain = sx__law(l->law)->strain;
+    /* u = sqrt(energy / (strain kn(u))) with kn(u) = Fn(u) / u, by fixed
+     * points: for Hertz they close in from both sides, a quarter of the gap
+     * a step; the larger of the last two is the safe side */
+    double u = u0, last = u0;
+    for (int k = 0; k < 8; k++) {
+        last = u;
+        u = sqrt(energy / (strain * stiffness(l, r, r, r, u, &kn, &ks) / u));
+    }
+    return fmax(u0, fmax(u, last));
+}
+
+/* A ball's own rating under pair law l: its stiffnesses against an entity
+ * of its own, at the overlap of rating_overlap. */
+static void self_rating(const sx_pair_law *l, double r, double mass, double speed, double *kn, double *ks)
+{
+    stiffness(l, r, r, r, rating_overlap(l, r, mass, speed), kn, ks);
     const sx_law *own = sx__law(l->law);
     *kn *= own->tangent;
     if (own->series) *kn *= 2, *ks *= 2; /* undo the series combination with itself */
@@ -126,12 +156,12 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : n;
     for (int64_t i = i0; i < i1; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
-        const double r = B->rad[i];
+        const double r = B->rad[i], mass = 1.0 / B->inv_mass[i], speed = sqrt(dot(B->v + i * D, B->v + i * D));
         double kn, ks;
-        self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], r, &kn, &ks);
+        self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], r, mass, speed, &kn, &ks);
         for (int row = 0; row < m->ncmodel; row++) { /* and not below a contact-model row's (cmodel.c) */
             double knr, ksr;
-            self_rating(&m->cmodel[row].law, r, &knr, &ksr);
+            self_rating(&m->cmodel[row].law, r, mass, speed, &knr, &ksr);
             if (knr + ksr > kn + ks) kn = knr, ks = ksr;
         }
         for (int64_t q = 0; q < m->njoint; q++) { /* a smooth joint's contact may form at any step */
