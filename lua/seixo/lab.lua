@@ -627,9 +627,10 @@ local function axis_of(dim) return dim end
 function lab.lateral_strain(m, ax)
   local dim = m:dim()
   ax = ax or dim
-  if math.type(ax) ~= "integer" or ax < 1 or ax > dim then
+  if type(ax) ~= "number" or ax ~= math.floor(ax) or ax < 1 or ax > dim then
     error(string.format("lab.lateral_strain: axis must be 1 to %d (got %s)", dim, tostring(ax)), 2)
   end
+  ax = math.tointeger(ax)
   local x0, ids = {}, {}
   for b in m:balls() do
     x0[b.id] = b.pos

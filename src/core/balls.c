@@ -632,6 +632,7 @@ sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const doub
     if (!finite_vec(val, n)) return sx__fail(m, SX_EINVAL, "ball_set_vec: components must be finite, below 1e100");
     for (int k = 0; k < n; k++) dst[i * n + k] = val[k];
     if (which == SX_BALL_POS) m->build_needed = true; /* a jump may skip the skin test */
+    if (which == SX_BALL_VEL && sx__speed_rated(m)) m->dt_stale = true;
     return SX_OK;
 }
 

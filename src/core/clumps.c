@@ -274,6 +274,7 @@ sx_status sx_clump_set_vec(sx_model *m, int64_t id, sx_clump_vec which, const do
         if (d == 3) momentum_of(R, C->inertia + c * 3, C->w + c * 3, C->L + c * 3);
     }
     place_pebbles(m, c, R);
+    if (which != SX_CLUMP_POS && sx__speed_rated(m)) m->dt_stale = true; /* (the pebbles' speeds) */
     return SX_OK;
 }
 

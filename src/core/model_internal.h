@@ -568,6 +568,11 @@ sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
 /* A Ctrl-C for the core's long loops to stop at (sx_interrupt_request, or
  * the model's sx_model_interrupt while it cycles) (model.c). */
 bool sx__interrupted(const sx_model *m);
+/* Whether the automatic timestep rates a ball by its speed: some material's
+ * own law or a contact-model row stiffens with the overlap (Hertz: its
+ * tangent stiffness is not its secant; kernels/timestep.c). A velocity set
+ * by hand then rates the timestep again at the next step. */
+bool sx__speed_rated(const sx_model *m);
 
 /* Dimension kernels (kernels.c, one instance per dimension). */
 typedef struct sx_kernels {
