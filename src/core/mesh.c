@@ -208,42 +208,92 @@ bool sx__mesh_derive(sx_model *m, sx_mesh *s)
 
 /* ---------------------------------------------------------- the triangles */
 
+/* Corners closer than this fraction of the mesh's largest extent, in every
+ * coordinate, are one vertex: a mesh built by trigonometry closes within
+ * rounding (sin 2 pi is -2.4e-16, not 0), and a seam left open would give
+ * a ball two contacts on it, one for each side's edge. */
+#define WELD_TOLERANCE 1e-9
+
+/* An input vertex by the cell of side tol it lies in. */
 typedef struct keyed {
-    double x[3];
+    int64_t cell[3];
     int64_t i;
 } keyed;
 
-static int by_coords(const void *pa, const void *pb)
+static int by_cell(const void *pa, const void *pb)
 {
     const keyed *a = pa, *b = pb;
     for (int k = 0; k < 3; k++)
-        if (a->x[k] != b->x[k]) return a->x[k] < b->x[k] ? -1 : 1;
+        if (a->cell[k] != b->cell[k]) return a->cell[k] < b->cell[k] ? -1 : 1;
     return a->i < b->i ? -1 : a->i > b->i;
 }
 
-/* Equal coordinates (-0 and 0 alike, as the sort has them). */
-static bool by_coords_equal(const double *a, const double *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+/* The first entry of k (n, sorted by by_cell) in cell c, or n. */
+static int64_t first_in_cell(const keyed *k, int64_t n, const int64_t *c)
+{
+    int64_t lo = 0, hi = n;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        const keyed probe = {{c[0], c[1], c[2]}, -1};
+        if (by_cell(&k[mid], &probe) < 0) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* The smallest input index of v's group (path halving). */
+static int64_t group_of(int64_t *up, int64_t v)
+{
+    while (up[v] != v) v = up[v] = up[up[v]];
+    return v;
+}
 
 /* map[v]: the welded index of input vertex v, welded vertices numbered in
- * order of first appearance; returns their count, -1 out of memory. */
+ * order of first appearance: corners within WELD_TOLERANCE of the extent
+ * of each other (a chain of them too) are one; returns their count, -1 out
+ * of memory. Each cell's own and the next 13 of its 26 neighbours are
+ * searched, so each close pair is met once. */
 static int64_t weld(const double *x, int64_t nv, int64_t *map)
 {
     keyed *k = malloc((size_t)nv * sizeof *k);
-    int64_t *first = malloc((size_t)nv * sizeof *first);
-    if (!k || !first) {
+    int64_t *up = malloc((size_t)nv * sizeof *up);
+    if (!k || !up) {
         free(k);
-        free(first);
+        free(up);
         return -1;
     }
-    for (int64_t v = 0; v < nv; v++) memcpy(k[v].x, x + 3 * v, sizeof k[v].x), k[v].i = v;
-    qsort(k, (size_t)nv, sizeof *k, by_coords);
-    /* each input vertex points to the first input vertex of its coordinates */
-    for (int64_t j = 0; j < nv; j++)
-        first[k[j].i] = j > 0 && by_coords_equal(k[j].x, k[j - 1].x) ? first[k[j - 1].i] : k[j].i;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, extent = 0;
+    for (int64_t v = 0; v < nv; v++)
+        for (int q = 0; q < 3; q++) lo[q] = fmin(lo[q], x[3 * v + q]);
+    for (int64_t v = 0; v < nv; v++)
+        for (int q = 0; q < 3; q++) extent = fmax(extent, x[3 * v + q] - lo[q]);
+    const double tol = WELD_TOLERANCE * extent;
+    for (int64_t v = 0; v < nv; v++) {
+        for (int q = 0; q < 3; q++) k[v].cell[q] = tol > 0 ? (int64_t)floor((x[3 * v + q] - lo[q]) / tol) : 0;
+        k[v].i = v, up[v] = v;
+    }
+    qsort(k, (size_t)nv, sizeof *k, by_cell);
+    for (int64_t j = 0; j < nv; j++) {
+        const double *p = x + 3 * k[j].i;
+        for (int d = 13; d < 27; d++) { /* offsets (0,0,0) and after, in the sort's order */
+            const int64_t c[3] = {k[j].cell[0] + d / 9 - 1, k[j].cell[1] + d / 3 % 3 - 1, k[j].cell[2] + d % 3 - 1};
+            for (int64_t e = d == 13 ? j + 1 : first_in_cell(k, nv, c); e < nv; e++) {
+                if (k[e].cell[0] != c[0] || k[e].cell[1] != c[1] || k[e].cell[2] != c[2]) break;
+                const double *r = x + 3 * k[e].i;
+                if (!(fabs(p[0] - r[0]) <= tol && fabs(p[1] - r[1]) <= tol && fabs(p[2] - r[2]) <= tol)) continue;
+                const int64_t a = group_of(up, k[j].i), b = group_of(up, k[e].i);
+                if (a < b) up[b] = a;
+                else up[a] = b;
+            }
+        }
+    }
     int64_t n = 0;
-    for (int64_t v = 0; v < nv; v++) map[v] = first[v] == v ? n++ : map[first[v]];
+    for (int64_t v = 0; v < nv; v++) {
+        const int64_t g = group_of(up, v);
+        map[v] = g == v ? n++ : map[g];
+    }
     free(k);
-    free(first);
+    free(up);
     return n;
 }
 
@@ -384,7 +434,8 @@ static sx_status shape(sx_model *m, const sx_mesh_def *def, sx_mesh *s, sx_mesh_
     s->body = sx_alloc_resize(&m->alloc, NULL, 0, 3 * (size_t)s->nv, sizeof(double));
     s->tri = sx_alloc_resize(&m->alloc, NULL, 0, 3 * (size_t)def->nt, sizeof(int32_t));
     if (!s->body || !s->tri) goto out;
-    for (int64_t v = 0; v < def->nv; v++) memcpy(s->body + 3 * map[v], def->vertices + 3 * v, 3 * sizeof(double));
+    /* a welded vertex is where its first corner is */
+    for (int64_t v = def->nv - 1; v >= 0; v--) memcpy(s->body + 3 * map[v], def->vertices + 3 * v, 3 * sizeof(double));
     st = SX_EINVAL;
     for (int64_t t = 0; t < def->nt; t++) {
         const int32_t *in = def->triangles + 3 * t;

@@ -64,6 +64,96 @@ T.test("with rolling resistance too (the rolling moment passes to the next facet
   rolling_across("rolling")
 end)
 
+-- The force of a fixed ball of radius 0.01 m with its centre at (x, y, 0.01
+-- - depth) on a rigid wall of the triangles given (or, with none, on the
+-- plane z = 0), and how many contacts it has.
+local function pressed(tris, x, y, depth)
+  local m = model(nil, {0, 0, 0})
+  if tris then m:wall{kind = "mesh", triangles = tris, rigid = true}
+  else m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, rigid = true} end
+  local b = m:ball{pos = {x, y, 0.01 - depth}, radius = 0.01, material = "rock"}
+  b.fix = "all"
+  m:cycle(1)
+  return b.force, m:contact_count()
+end
+
+-- Whether every listed point of a flat mesh at z = 0 presses the ball as the plane does.
+local function as_on_the_plane(tris, points, depth)
+  local plane = pressed(nil, 0, 0, depth)
+  for _, p in ipairs(points) do
+    local f, n = pressed(tris, p[1], p[2], depth)
+    local what = string.format("the ball over (%g, %g): force (%.6g, %.6g, %.6g) N in %d contacts, the plane's %.6g N",
+                               p[1], p[2], f[1], f[2], f[3], n, plane[3])
+    T.check(n == 1, what)
+    T.check(math.abs(f[3] / plane[3] - 1) < 1e-12 and math.abs(f[1]) + math.abs(f[2]) < 1e-12 * plane[3], what)
+  end
+end
+
+T.test("a ball pressed near a vertex six facets share feels one contact, the plane's force", function()
+  -- four cells of 20 mm about the origin, each cut by its diagonal: six of
+  -- the eight facets meet at the origin, two of them only there (they share
+  -- no edge with the facet under the ball, and each was counted: 1.9 times
+  -- the plane's force 0.5 mm from the vertex)
+  local L, tris = 0.02, {}
+  for i = -1, 0 do
+    for j = -1, 0 do
+      local x0, y0, x1, y1 = i * L, j * L, (i + 1) * L, (j + 1) * L
+      tris[#tris + 1] = {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}}
+      tris[#tris + 1] = {{x0, y0, 0}, {x1, y1, 0}, {x0, y1, 0}}
+    end
+  end
+  local points = {{0, 0}, {0.0005, 0}, {0.0005, 0.0001}, {-0.0003, 0.0007}, {0.0004, 0.0004}, {-0.001, -0.0002}}
+  as_on_the_plane(tris, points, 1e-4)
+  as_on_the_plane(tris, points, 1e-3) -- pressed in 10 % of its radius, the overlap reaching 4.4 mm round
+end)
+
+T.test("a fan of facets closed by trigonometry is welded at its seam: one contact there", function()
+  -- sin(2 pi) is -2.4e-16, not 0: the last facet's edge missed the first's
+  -- by that, and a ball on the seam had a contact on each side's edge
+  local n, R, tris = 8, 0.06, {}
+  for k = 0, n - 1 do
+    local a0, a1 = 2 * math.pi * k / n, 2 * math.pi * (k + 1) / n
+    tris[#tris + 1] = {{0, 0, 0}, {R * math.cos(a0), R * math.sin(a0), 0}, {R * math.cos(a1), R * math.sin(a1), 0}}
+  end
+  T.eq(model():wall{kind = "mesh", triangles = tris}.vertex_count, n + 1)
+  as_on_the_plane(tris, {{0.01, 0}, {0.01, 0.001}, {0.02, -0.0005}, {0.0002, 0}}, 1e-4)
+end)
+
+T.test("on a shallow pyramid the apex is one contact, and near it the face under the ball is the only one", function()
+  -- six facets rising 5 degrees to an apex 2.6 mm above a hexagon 30 mm round
+  local L, h, r, depth = 0.03, 0.03 * math.tan(math.rad(5)), 0.01, 1e-4
+  local tris = {}
+  for k = 0, 5 do
+    local a0, a1 = math.pi / 3 * k, math.pi / 3 * (k + 1)
+    tris[#tris + 1] = {{0, 0, h}, {L * math.cos(a0), L * math.sin(a0), 0}, {L * math.cos(a1), L * math.sin(a1), 0}}
+  end
+  -- straight above the apex: one vertex contact, its overlap the depth
+  local f, n = pressed(tris, 0, 0, depth - h)
+  T.eq(n, 1)
+  T.near(f[3], 1e6 * depth, 1e-9)
+  -- over the first facet, down its line of steepest slope (30 degrees round)
+  -- from the apex, pressed along its normal: that face alone, as the plane
+  -- through it (the other facets' nearest points, on their edges and the
+  -- apex, were kept too: 3.3 times the force 1.8 mm from the apex)
+  local tilt = math.atan(math.tan(math.rad(5)) / math.cos(math.rad(30)))
+  local c, s = math.cos(math.rad(30)), math.sin(math.rad(30))
+  local nrm = {math.sin(tilt) * c, math.sin(tilt) * s, math.cos(tilt)}
+  for _, from_apex in ipairs{0.0003, 0.001, 0.0018} do
+    local q = {from_apex * math.cos(tilt) * c, from_apex * math.cos(tilt) * s, h - from_apex * math.sin(tilt)}
+    local m = model(nil, {0, 0, 0})
+    m:wall{kind = "mesh", triangles = tris, rigid = true}
+    local b = m:ball{pos = {q[1] + (r - depth) * nrm[1], q[2] + (r - depth) * nrm[2], q[3] + (r - depth) * nrm[3]},
+                     radius = r, material = "rock"}
+    b.fix = "all"
+    m:cycle(1)
+    local F = b.force
+    local what = string.format("%g m from the apex: force (%.6g, %.6g, %.6g) N in %d contacts", from_apex, F[1], F[2],
+                               F[3], m:contact_count())
+    T.check(m:contact_count() == 1, what)
+    for k = 1, 3 do T.check(math.abs(F[k] - 1e6 * depth * nrm[k]) < 1e-9, what) end
+  end
+end)
+
 -- The box [0, L]^3: each side two triangles, in the order of the box's
 -- planes (-x, +x, -y, +y, -z, +z), wound outward (the mesh is two-sided).
 local function box_triangles(L)

@@ -189,30 +189,45 @@ static inline __attribute__((always_inline)) bool wall_contact(sx_model *m, sx_b
 
 #if D == 3
 
-/* Whether touching feature k is already felt through a kept one: a face
- * of the same plane at the same point (two facets met at their shared
- * edge), the same edge or vertex reached from another facet, or an edge or
- * vertex of a kept face or edge (the face is the surface there). */
+/* Whether facet t has vertex v among its corners. */
+static bool facet_has(const sx_mesh *s, int32_t t, int32_t v)
+{
+    const int32_t *tv = s->tri + 3 * (int64_t)t;
+    return tv[0] == v || tv[1] == v || tv[2] == v;
+}
+
+/* Whether touching feature k is not a contact of its own. A face is one
+ * unless a kept face of the same plane meets the ball at the same point
+ * (two facets met at their shared edge). An edge or a vertex is a contact
+ * only where the mesh is nearest there: where every facet that has it
+ * finds its own closest point there too (the point is then a local
+ * minimum of the distance over the whole surface, as on a ridge or an
+ * apex); a facet that has it but is nearer elsewhere (a face, or another
+ * of its edges) carries the load there. Testing only the kept features'
+ * own facets missed facets that share a vertex and no edge with them: a
+ * ball pressed into a flat fan of facets near their common vertex felt one
+ * contact per facet (up to four times the plane's force). The same edge or
+ * vertex reached from several facets is kept once. The facets that have a
+ * touching feature are all candidates (nearer than it, so than the
+ * radius). Distances within 1e-9 of the radius count as equal, so a
+ * centre over a boundary between two facets' regions, which rounding may
+ * give to either, keeps one contact. */
 static bool shadowed(const sx_mesh *s, const int32_t *facet, const facet_hit *h, const uint8_t *keep, int64_t n,
                      int64_t k, double r)
 {
     const facet_hit *a = &h[k];
+    const double tie = 1e-9 * r;
     for (int64_t j = 0; j < n; j++) {
-        if (!keep[j]) continue;
+        if (j == k) continue;
         const facet_hit *b = &h[j];
-        if (b->kind == FACET_FACE && a->kind == FACET_FACE) {
+        if (a->kind == FACET_FACE) {
+            if (!keep[j] || b->kind != FACET_FACE) continue;
             double dq[3];
             for (int e = 0; e < 3; e++) dq[e] = a->q[e] - b->q[e];
             if (dot(dq, dq) <= 1e-18 * r * r && dot(a->n, b->n) >= 1 - 1e-12) return true;
-        } else if (b->kind == FACET_FACE) {
-            const int32_t *tv = s->tri + 3 * (int64_t)facet[j];
-            const bool has0 = tv[0] == a->v0 || tv[1] == a->v0 || tv[2] == a->v0;
-            const bool has1 = tv[0] == a->v1 || tv[1] == a->v1 || tv[2] == a->v1;
-            if (has0 && has1) return true;
-        } else if (b->kind == FACET_EDGE && a->kind == FACET_EDGE) {
-            if (a->v0 == b->v0 && a->v1 == b->v1) return true;
-        } else if (a->kind == FACET_VERTEX) { /* b an edge or a vertex */
-            if (a->v0 == b->v0 || a->v0 == b->v1) return true;
+        } else if (facet_has(s, facet[j], a->v0) && facet_has(s, facet[j], a->v1)) {
+            if (b->dist < a->dist - tie) return true; /* nearer elsewhere: not a minimum */
+            if (keep[j] && b->dist <= a->dist + tie) return true; /* felt already */
         }
     }
     return false;
