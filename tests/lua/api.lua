@@ -443,7 +443,7 @@ test("wall extras", function()
   eq(v:get_extra("tag", "none"), "none")
   eq(m:walls()().extra.tag, "floor", "another handle of the same wall")
   -- kept by m:save, back after seixo.load
-  local path = os.tmpname() .. ".h5"
+  local path = T.tmpname(".h5")
   m:save(path)
   local c = seixo.load(path)
   os.remove(path)

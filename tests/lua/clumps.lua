@@ -221,7 +221,7 @@ test("save and load continue bit-for-bit", function()
   m:generate{template = "tri", count = 40, region = {box = {{0, 0, 0}, {0.05, 0.05, 0.1}}}, seed = 1}
   m:cycle(40000) -- the pile has formed by then
   check(m:contact_count() > 0)
-  local path = os.tmpname() .. ".h5"
+  local path = T.tmpname(".h5")
   m:save(path)
   local l = seixo.load(path)
   os.remove(path)

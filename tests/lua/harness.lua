@@ -54,7 +54,17 @@ function T.raises(fn, ...)
   return err
 end
 
+-- A new temporary path ending in suffix: os.tmpname's file (the name's
+-- claim, removed by T.done) and the suffix.
+local claimed = {}
+function T.tmpname(suffix)
+  local base = os.tmpname()
+  claimed[#claimed + 1] = base
+  return base .. suffix
+end
+
 function T.done()
+  for _, base in ipairs(claimed) do os.remove(base) end
   print(string.format("%d passed, %d failed", T.passed, T.failed))
   if T.failed > 0 then os.exit(1) end
 end

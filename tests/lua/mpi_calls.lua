@@ -26,7 +26,7 @@
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
-local base = os.tmpname() -- every rank: rank 0's name
+local base = "calls_" .. scene -- in the folder mpi_calls.sh runs in (a run that fails leaves its files)
 if scene == "save" then
   if first then m:save(base .. ".h5") end
   m:cycle(100)
@@ -34,7 +34,7 @@ elseif scene == "output" then
   if first then m:output{path = base .. "_series.h5"} end
   m:cycle(100)
 elseif scene == "tmpname" then
-  if first then os.tmpname() end
+  if first then os.remove(os.tmpname()) end
   m:cycle(100)
 elseif scene == "cycle" then
   if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end

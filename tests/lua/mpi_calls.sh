@@ -7,12 +7,13 @@
 # MESSAGE, the message's beginning before CALL (a pattern), is by default
 # that of two calls that differ.
 set -u
-seixo=$1
-script=$2
+seixo=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") # absolute: the runs are in $dir
+script=$(cd "$(dirname "$2")" && pwd)/$(basename "$2")
 scene=$3
 call=$4
 message=${5:-"the ranks made different calls: rank 0 is in "}
 . "$(dirname "$0")/mpi_env.sh" # mpirun or skip; root, ranks, dir
+cd "$dir" || exit 1 # the scenes' files go with it
 if ! "$seixo" "$script" "$scene" >"$dir/serial" 2>"$dir/err" || ! grep -q "^ended $scene$" "$dir/serial"; then
   echo "the serial run of '$scene' did not end:"; cat "$dir/serial" "$dir/err"; exit 1
 fi

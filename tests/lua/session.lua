@@ -374,7 +374,7 @@ test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API",
   eq(tostring(b2.pos), "{6.0, 1.0, 2.5}")
   -- kept in m:vars(), it is saved as its components
   m:vars().where = b.pos
-  local file = os.tmpname() .. ".h5"
+  local file = T.tmpname(".h5")
   eq(#m:save(file), 0, "nothing skipped")
   local loaded = seixo.load(file)
   eq(loaded:vars().where[1], 5.0)
@@ -454,7 +454,7 @@ test("group slots 2 to 8: saved by m:save, restored by seixo.load, in m:hash(), 
   m:ball(7):set_group(nil, 2)
   eq(m:hash(), h)
   m:ball(7):set_group("even", 2)
-  local path = os.tmpname() .. ".h5"
+  local path = T.tmpname(".h5")
   m:save(path)
   local r = seixo.load(path)
   eq(r:hash(), h7, "same hash after the load")
@@ -503,7 +503,7 @@ v[1.5], v[3], v[true], v[false] = "f", "i", 1, 0
 v.t = {x = 1, y = 2, [2] = 3, z = {w = "deep"}}
 m:save(arg[1])
 ]])
-  local a, b = os.tmpname() .. ".h5", os.tmpname() .. ".h5"
+  local a, b = T.tmpname(".h5"), T.tmpname(".h5")
   for _, f in ipairs{a, b} do eq(T.run(T.quote(script) .. " " .. T.quote(f)), 0) end
   check(os.execute("h5diff -q " .. T.quote(a) .. " " .. T.quote(b) .. " /lua"), "two runs' /lua groups differ")
   local m = seixo.load(a)
