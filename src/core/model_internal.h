@@ -259,6 +259,7 @@ typedef struct sx_pair_law {
     double beta_n, beta_s;  /* critical-damping ratios (mean of the two) */
     double mu_r;            /* rolling friction (laws/rolling.h; 0: no rolling resistance) */
     bool total_shear;       /* Mindlin's total tangential form (laws/total_shear.h) */
+    bool unloading;         /* Mindlin-Deresiewicz unloading (laws/mindlin_unloading.h) */
     double dash_n;          /* 4 beta_n^2 kn: the normal dashpot is sqrt(dash_n m*) (linear, not per radius) */
     uint8_t law;            /* its number in the registry (laws/registry.h) */
     bool plain;             /* the batched passes' case: linear, not per radius (laws/linear.h) */

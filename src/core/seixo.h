@@ -251,6 +251,8 @@ typedef struct sx_material_def {
     double hertz_mixing;    ///< Hertz, two different materials (or a ball and a wall's material):
                             ///< 0: the means of G and nu (4-27); 1: the literature's
                             ///< 1/E* = sum (1 - nu_i^2)/E_i, 1/G* = sum (2 - nu_i)/G_i (both ask)
+    double mindlin_unloading; ///< 1: as the overlap shrinks the shear force shrinks with ks (Mindlin &
+                              ///< Deresiewicz, Thornton; both materials of a contact); 0: not
 } sx_material_def;
 
 /// The units of the contact-law registry (src/core/laws/registry.h), numbered in its order:

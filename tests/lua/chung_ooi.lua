@@ -98,6 +98,52 @@ T.test("no slip: both forms give their ODE's rebound, the same one (1.0135), to 
                         100 * (got / inc - 1)))
     T.near(got, inc, 0.005)
   end
+  -- with Mindlin & Deresiewicz's unloading (the force shrinking with the
+  -- contact radius as the overlap falls) the incremental form is their ODE's
+  local r = I.run{vn = 3.9, vt = 0.2, mindlin_unloading = 1, friction = 1e3}
+  local got = r.vt_after / r.vt_before
+  print(string.format("no slip, Mindlin-Deresiewicz unloading: vt after / before %.6f (ODE %.6f, %+.3f %%)", got, md,
+                      100 * (got / md - 1)))
+  T.near(got, md, 0.005)
+  -- and between two balls (the ball-ball pass), the lower one fixed: the
+  -- same dimensionless problem (ks and kn both halved over R* = R/2), the same rebound
+  local s = I.sphere
+  local dt = 2e-10
+  local m = seixo.model{dim = 3, timestep = dt}
+  m:material("ball", {model = "hertz", density = s.density, shear_modulus = s.E / (2 * (1 + s.nu)), poisson = s.nu,
+                      friction = 1e3, mindlin_unloading = 1})
+  m:ball{pos = {0, 0, 0}, radius = s.radius, material = "ball"}.fix = "all"
+  local b = m:ball{pos = {0, 0, 2 * s.radius + 1e-9}, radius = s.radius, vel = {0.2, 0, -3.9}, material = "ball"}
+  local touched = false
+  for _ = 1, 100000 do
+    m:cycle(1)
+    if m:contact_count() > 0 then touched = true elseif touched then break end
+  end
+  T.check(touched and m:contact_count() == 0, "the balls did not part")
+  got = (b.vel[1] - s.radius * b.spin[2]) / 0.2
+  print(string.format("no slip, two balls, Mindlin-Deresiewicz unloading: %.6f (ODE %.6f, %+.3f %%)", got, md,
+                      100 * (got / md - 1)))
+  T.near(got, md, 0.005)
+end)
+
+T.test("Mindlin-Deresiewicz unloading: at small angles no tangential energy is made, and gross sliding is unchanged", function()
+  for _, deg in ipairs{1, 3, 5} do
+    local a = math.rad(deg)
+    local o = {vn = 3.9 * math.cos(a), vt = 3.9 * math.sin(a), mindlin_unloading = 1}
+    local r = I.run(o)
+    print(string.format("%d deg, Mindlin-Deresiewicz unloading: vx after / before %.4f, psi2 / psi1 %.4f", deg,
+                        r.vx / o.vt, r.vt_after / r.vt_before))
+    T.check(r.vx / o.vt < 1, deg .. " deg: the centre left faster along the plane than it came")
+    T.check(r.vt_after / r.vt_before < 0.9, deg .. " deg: the contact point kept " .. r.vt_after / r.vt_before)
+  end
+  -- sliding throughout, the force sits on the Coulomb cap: the same rebound
+  local a = math.rad(60)
+  local o = {vn = 3.9 * math.cos(a), vt = 3.9 * math.sin(a)}
+  local plain = I.run(o)
+  o.mindlin_unloading = 1
+  local md = I.run(o)
+  T.near(md.vx, plain.vx, 1e-9)
+  T.near(md.wy, plain.wy, 1e-9)
 end)
 
 T.done()

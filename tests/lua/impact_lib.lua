@@ -25,7 +25,8 @@ end
 
 -- Runs one impact in seixo: normal approach speed vn, tangential velocity
 -- vt (along x), spin wy (about y, rad/s), a rigid plane z = 0, Hertz,
--- elastic, no gravity; o.total_shear (0, 1), o.friction, o.steps_per_contact.
+-- elastic, no gravity; o.total_shear (0, 1), o.mindlin_unloading (0, 1),
+-- o.friction, o.steps_per_contact.
 -- Returns the rebound: vx, vz, wy, and the contact point's tangential
 -- velocity before (vt - R wy) and after.
 function M.run(o)
@@ -36,7 +37,8 @@ function M.run(o)
   local dt = tc / (o.steps_per_contact or 2000)
   local m = seixo.model{dim = 3, timestep = dt}
   m:material("ball", {model = "hertz", density = s.density, shear_modulus = shear_modulus(s), poisson = s.nu,
-                      friction = o.friction or s.friction, total_shear = o.total_shear or 0})
+                      friction = o.friction or s.friction, total_shear = o.total_shear or 0,
+                      mindlin_unloading = o.mindlin_unloading or 0})
   m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}, rigid = true, friction = 1e9}
   local r = s.radius
   local b = m:ball{pos = {0, 0, r + 0.5 * o.vn * dt}, radius = r, vel = {o.vt, 0, -o.vn}, material = "ball"}

@@ -568,6 +568,12 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         if (active) {
             fn = stiffness(law, ri, rj, 2 * ri * rj / rsum, un, &kn, &ks);
             carry_apply(&rot, fs);
+            if (law->unloading && touching[c] && un > 0) { /* laws/mindlin_unloading.h: from the last evaluation's overlap */
+                double kn0, ks0;
+                stiffness(law, ri, rj, 2 * ri * rj / rsum, rsum - sqrt(dot(rel, rel)), &kn0, &ks0);
+                const double e = sx_law_mindlin_unloading_scale(D, fs, ks, ks0);
+                if (track) chunk_energy(m, o, E_SLIP, e);
+            }
             double f0[D]; /* the shear force before this step's increment, for the slip energy */
             for (int k = 0; k < D; k++) f0[k] = fs[k];
             const double ksdt = ks * dt;

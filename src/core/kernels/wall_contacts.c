@@ -88,6 +88,12 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     carry rot;
     carry_make(&rot, p->geo + c * D, n, wspin, B->w + i * RD, dt);
     carry_apply(&rot, fs);
+    if (law->unloading && p->touching[c] && p->un[c] > 0) { /* laws/mindlin_unloading.h: from the last step's overlap */
+        double kn0, ks0;
+        stiffness(law, r, 0, r, p->un[c], &kn0, &ks0);
+        const double e = sx_law_mindlin_unloading_scale(D, fs, ks, ks0);
+        if (track) o->slip += e;
+    }
     double f0[D];
     for (int k = 0; k < D; k++) f0[k] = fs[k];
     const double ksdt = ks * dt;

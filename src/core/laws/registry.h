@@ -8,12 +8,13 @@
 #include "hertz.h"
 #include "hertz_mixing.h"
 #include "linear.h"
+#include "mindlin_unloading.h"
 #include "restitution.h"
 #include "rolling.h"
 #include "total_shear.h"
 
 #define SX_LAWS(X) X(linear) X(hertz)
-#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear) X(hertz_mixing)
+#define SX_PARTS(X) X(restitution) X(rolling) X(total_shear) X(hertz_mixing) X(mindlin_unloading)
 
 #define SX_LAW_ID(name) SX_LAW_ID_##name
 #define SX_LAW_ENUM_(name) SX_LAW_ID(name),
