@@ -13,7 +13,10 @@
 -- (Before the meshes' vertex contacts were mended, each ball near a vertex
 -- of the caps' fans or the shell felt it once per facet: 24.4 and 23.8.)
 -- The angle is measured two ways, each averaged over the second half of
--- the run: the bed's centre of mass lies on the perpendicular to a flat
+-- the run (at faster turns give it more revolutions: 0.6 leaves a run at
+-- 3 or 6 rad/s in its start-up: a new user measured 27.4 and 25.5 deg there,
+-- 25.8 and 27.1 in 1.5 and 2 revolutions, before the mesh mends): the bed's centre of
+-- mass lies on the perpendicular to a flat
 -- free surface through the axis, so its direction from the axis gives the
 -- slope (atan of its horizontal over its vertical offset); and a straight
 -- line fitted to the top balls of the central part of the surface.

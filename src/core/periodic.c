@@ -220,7 +220,7 @@ static const char *control_problem(const sx_model *m, const sx_cell_control *ctl
     }
     for (int k = 0; k < m->dim && *on; k++)
         if (!m->cell || !m->cell->axis[k])
-            return snprintf(why, len, "the space must be periodic on every axis (set_periodic first)"), why;
+            return snprintf(why, len, "the space must be periodic on every axis (make it periodic first)"), why;
     if (!(ctl->alpha > 0 && ctl->alpha <= 1)) return snprintf(why, len, "alpha must be in (0, 1] (got %g)", ctl->alpha), why;
     if (!(ctl->max_rate > 0) || !isfinite(ctl->max_rate))
         return snprintf(why, len, "max_rate must be > 0 1/s (got %g)", ctl->max_rate), why;
@@ -232,7 +232,7 @@ sx_status sx_cell_set_control(sx_model *m, const sx_cell_control *ctl)
     char why[160];
     bool on;
     if (control_problem(m, ctl, &on, why, sizeof why)) return sx__fail(m, SX_EINVAL, "cell_control: %s", why);
-    if (!m->cell) return sx__fail(m, SX_EINVAL, "cell_control: the space is not periodic (set_periodic first)");
+    if (!m->cell) return sx__fail(m, SX_EINVAL, "cell_control: the space is not periodic (make it periodic first)");
     m->cell->ctl = *ctl;
     m->cell->controlled = on;
     /* the rates hold from the next step on, so the images move with the

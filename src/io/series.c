@@ -60,6 +60,7 @@ struct sx_series {
     unsigned fields;
     int compression;
     int64_t count;    /* complete snapshots */
+    int64_t last;     /* the last snapshot's step (-1: none) */
     xdoc x;           /* the XDMF: a grid per block and complete snapshot */
     held *held;       /* histories met so far */
     int nheld, capheld;
@@ -149,7 +150,7 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
     sx_h5 h;
     sx_h5_begin(&h, path ? path : "", err, errlen);
     sx_series *s = calloc(1, sizeof *s);
-    if (s) s->file = -1;
+    if (s) s->file = -1, s->last = -1;
     const unsigned fields = o && o->fields ? o->fields : SX_OUT_DEFAULT;
     if (!s) {
         sx_h5_fail(&h, "out of memory");
@@ -172,6 +173,13 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
             int d = 0, version = 0;
             s->file = sx_io_open(&h, path, true, "series", dim, &d, &version);
             if (s->file >= 0) sx_h5_get_i64(&h, s->file, "/", "count", &s->count, 1, true);
+            if (s->file >= 0 && s->count > 0) {
+                char last[48];
+                snprintf(last, sizeof last, "/snapshots/%06lld", (long long)s->count - 1);
+                hid_t g = sx_h5_open_group(&h, s->file, last, true);
+                if (g >= 0) sx_h5_get_i64(&h, g, last, "step", &s->last, 1, true);
+                sx_h5_close(g);
+            }
             /* what is appended now follows this format: an older reader must refuse the file */
             if (s->file >= 0 && version < SX_IO_FORMAT_VERSION &&
                 sx_h5_attr_int(&h, s->file, "format_version", SX_IO_FORMAT_VERSION) && !sync_file(s->file))
@@ -372,6 +380,12 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         sx_h5_fail(&h, "out of memory");
     } else if (m && m->dim != s->dim) {
         sx_h5_fail(&h, "the series holds %dD models, this one is %dD", s->dim, m->dim);
+    } else if (m && m->step < s->last) {
+        /* a model loaded from a save older than the series' end, appending:
+         * its snapshots would follow later ones, their times going back */
+        sx_h5_fail(&h, "the series' last snapshot is at step %lld, later than this model's step %lld (a model "
+                       "loaded from an earlier save?): its snapshots would go back in time; write a new series",
+                   (long long)s->last, (long long)m->step);
     } else if (s->file < 0) {
         sx_h5_fail(&h, "the series is closed");
     } else {
@@ -407,6 +421,7 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         }
         if (!h.failed) {
             s->count += m ? 1 : 0;
+            if (m) s->last = m->step;
             hist_commit(s, p, nh);
             if (have_tmp && sx_h5_rename(&h, tmp, s->xmf)) have_tmp = false;
             /* 6. the counts durable too */

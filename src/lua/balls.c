@@ -388,6 +388,7 @@ static int add_ball(lua_State *L, sx_model *m)
     int64_t id;
     if (d.radius > 0) sx_lua_check_ball_walls(L, 1, m, d.pos, d.radius);
     sx_lua_check(L, m, sx_ball_add(m, &d, &id), "m:ball");
+    sx_lua_check_range(L, 1, "radius", d.radius, 1e-6, 1, "m"); /* radius = 2 meant in mm, say */
     sx_lua_modelud(L, 1)->unchecked = true;
     if (g) sx_lua_check(L, m, sx_ball_set_group(m, id, g), "m:ball");
     sx_lua_pushhandle(L, 1, &ball_kind, id);

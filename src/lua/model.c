@@ -235,6 +235,8 @@ int sx_lua_model_new(lua_State *L)
     const int self = lua_gettop(L);
     list_model(L, self);
     sx_lua_model_threads(L, u->m, "seixo.model");
+    const double g = sqrt(d.gravity[0] * d.gravity[0] + d.gravity[1] * d.gravity[1] + d.gravity[2] * d.gravity[2]);
+    sx_lua_check_range(L, self, "gravity", g, 0.1, 2000, "m/s^2"); /* a centrifuge's 200 g passes; mm/s^2 do not */
     lua_settop(L, self);
     return 1;
 }
@@ -736,6 +738,7 @@ static int model_set_gravity(lua_State *L)
     const char *err = sx_lua_tovec(L, 2, sx_model_dim(m), g);
     if (err) return luaL_argerror(L, 2, err);
     sx_lua_check(L, m, sx_model_set_gravity(m, g), "m:set_gravity");
+    sx_lua_check_range(L, 1, "gravity", sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), 0.1, 2000, "m/s^2");
     return 0;
 }
 

@@ -27,7 +27,7 @@ static const char *const rect_keys[] = {"kind", "corner", "point", "edge1", "edg
                                         "material", "rigid", NULL};
 static const char *const segment_keys[] = {"kind", "p1", "p2", "kn", "ks", "friction", "vel", "material", "rigid", NULL};
 static const char *const mesh_keys[] = {"kind", "file",   "triangles", "vertices", "point", "vel", "spin",
-                                        "kn",   "ks",     "friction",  "repair",   "material", "rigid", NULL};
+                                        "kn",   "ks",     "friction",  "repair",   "material", "rigid", "scale", NULL};
 static const char *const box_keys[] = {"kind", "min", "max", "kn", "ks", "friction", "material", "rigid", NULL};
 
 /* What a wall kind needs: its dimension, its counterpart in the other
@@ -395,6 +395,20 @@ static void read_mesh(lua_State *L, sx_mesh_def *md)
             ix[3 * t + j] = (int32_t)(k - 1);
             lua_pop(L, 2);
         }
+    /* a CAD file in mm, say: scale = 0.001 */
+    double scale = 1, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (sx_lua_optnumfield(L, 2, "scale", &scale) && !(scale > 0 && isfinite(scale)))
+        luaL_argerror(L, 2, "field 'scale' must be a positive number: the factor to m of the coordinates (0.001 for mm)");
+    for (int64_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++) {
+            x[3 * v + k] *= scale;
+            if (!isfinite(x[3 * v + k]) && file)
+                luaL_error(L, "m:wall: '%s': facet %d, corner %d is not a finite number", sx_lua_optstrfield(L, 2, "file"),
+                           (int)(v / 3) + 1, (int)(v % 3) + 1);
+            lo[k] = fmin(lo[k], x[3 * v + k]), hi[k] = fmax(hi[k], x[3 * v + k]);
+        }
+    const double extent = nv > 0 ? fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2])) : 0;
+    sx_lua_check_range(L, 1, "mesh size", extent, 1e-4, 50, "m"); /* a file in mm: scale = 0.001 */
     md->vertices = x, md->nv = nv;
     md->triangles = ix, md->nt = nt;
     lua_getfield(L, 2, "repair");

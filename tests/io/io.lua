@@ -129,6 +129,16 @@ T.test("an output series: every N steps, fields, append, xdmf", function()
   n = 0
   for _ in io.open(path("series.xmf")):read("a"):gmatch("/balls/vertices</DataItem>") do n = n + 1 end
   T.eq(n, 6)
+  -- a model from a save older than the series' end (step 170; the series
+  -- ends at 250): an error, the series as it was (its snapshots had gone
+  -- on at steps 170, 200, ... after that of 250, their times going back)
+  local old = seixo.load(path("mid.h5"))
+  T.raises(function() old:output{path = path("series.h5"), every = 50, append = true} end,
+           "last snapshot is at step 250, later than this model's step 170")
+  n = 0
+  for _ in io.open(path("series.xmf")):read("a"):gmatch("/balls/vertices</DataItem>") do n = n + 1 end
+  T.eq(n, 6)
+  T.eq(c:output{path = path("series.h5"), every = 50, append = true}:count(), 7) -- the model at its end goes on
   T.raises(function() m:output{path = path("o.h5"), fields = {"colour"}} end, "unknown field 'colour'", "velocity")
   T.raises(function() m:output{every = 5} end, "path")
   T.raises(function() m:output{path = path("o.h5"), every = 0} end, "every")

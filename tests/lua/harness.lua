@@ -55,11 +55,13 @@ function T.raises(fn, ...)
 end
 
 -- A new temporary path ending in suffix: os.tmpname's file (the name's
--- claim, removed by T.done) and the suffix.
+-- claim) and the suffix; T.done removes both (a test that failed before
+-- its own removal leaves nothing).
 local claimed = {}
 function T.tmpname(suffix)
   local base = os.tmpname()
   claimed[#claimed + 1] = base
+  claimed[#claimed + 1] = base .. suffix
   return base .. suffix
 end
 

@@ -154,6 +154,30 @@ T.test("on a shallow pyramid the apex is one contact, and near it the face under
   end
 end)
 
+T.test("a shallow bowl of facets is one smooth surface: one contact, the nearest face's", function()
+  -- six facets sinking 0.5 degrees to a low vertex (each face's own tilt,
+  -- down its line of steepest slope, is atan(tan 0.5 / cos 30)): a ball
+  -- pressed in over the vertex had a contact on each face, six times the force
+  local L, r, depth = 0.03, 0.01, 1e-4
+  local h = -L * math.tan(math.rad(0.5))
+  local tris = {}
+  for k = 0, 5 do
+    local a0, a1 = math.pi / 3 * k, math.pi / 3 * (k + 1)
+    tris[#tris + 1] = {{0, 0, h}, {L * math.cos(a0), L * math.sin(a0), 0}, {L * math.cos(a1), L * math.sin(a1), 0}}
+  end
+  local f, n = pressed(tris, 0, 0, depth - h)
+  T.eq(n, 1)
+  local tilt = math.atan(math.tan(math.rad(0.5)) / math.cos(math.rad(30)))
+  local overlap = r - (r - depth) * math.cos(tilt)
+  T.near(math.sqrt(f[1] ^ 2 + f[2] ^ 2 + f[3] ^ 2), 1e6 * overlap, 1e-9)
+  -- a crease sharper than 20 degrees is a corner: a ball in a 90-degree
+  -- trough of two facets has a contact on each side
+  local trough = {{{-1, -1, 1}, {0, -1, 0}, {0, 1, 0}}, {{-1, -1, 1}, {0, 1, 0}, {-1, 1, 1}},
+                  {{0, -1, 0}, {1, -1, 1}, {1, 1, 1}}, {{0, -1, 0}, {1, 1, 1}, {0, 1, 0}}}
+  local _, corner = pressed(trough, 0, 0, 0.01 - 0.0099 * math.sqrt(2))
+  T.eq(corner, 2)
+end)
+
 -- The box [0, L]^3: each side two triangles, in the order of the box's
 -- planes (-x, +x, -y, +y, -z, +z), wound outward (the mesh is two-sided).
 local function box_triangles(L)
@@ -205,6 +229,24 @@ T.test("STL files, ASCII and binary, give the mesh their triangles give", functi
   T.check(not ok and err:find("cannot open", 1, true), err)
   ok, err = pcall(function() return model():wall{kind = "mesh", file = dir .. "/broken.stl"} end)
   T.check(not ok and err:find("line 5", 1, true) and err:find("facet 1", 1, true), err)
+end)
+
+T.test("a mesh's coordinates scaled (a file in mm), and a corner that is not a number named with its file", function()
+  local dir = os.getenv("SEIXO_TEST_DATA")
+  local a = model():wall{kind = "mesh", file = dir .. "/square.stl"}
+  local b = model():wall{kind = "mesh", file = dir .. "/square.stl", scale = 0.001}
+  for v = 1, 4 do
+    for k = 1, 3 do T.near(b.vertices[v][k], 0.001 * a.vertices[v][k], 1e-15) end
+  end
+  local ok, err = pcall(function() return model():wall{kind = "mesh", file = dir .. "/square.stl", scale = 0} end)
+  T.check(not ok and err:find("scale", 1, true), err)
+  local path = T.tmpname(".stl")
+  local f = assert(io.open(path, "w"))
+  f:write("solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex nan 1 0\n endloop\nendfacet\nendsolid x\n")
+  f:close()
+  ok, err = pcall(function() return model():wall{kind = "mesh", file = path} end)
+  os.remove(path)
+  T.check(not ok and err:find(path, 1, true) and err:find("facet 1, corner 3", 1, true), err)
 end)
 
 T.test("degenerate triangles are an error naming them, or dropped when repair is asked", function()

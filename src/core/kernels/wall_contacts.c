@@ -202,9 +202,28 @@ static bool facet_has(const sx_mesh *s, int32_t t, int32_t v)
     return tv[0] == v || tv[1] == v || tv[2] == v;
 }
 
+/* Faces of one mesh whose normals differ by less than this angle (its
+ * cosine; 20 degrees), sharing a corner, are one smooth surface: a curve
+ * tessellated (a drum of 18 strips or more, a shallow bowl) gives one
+ * contact there, the nearest face's, as on the surface it stands for; each
+ * was counted before, six times the force in a bowl of six facets sinking
+ * 0.5 degrees. Sharper creases are corners, with a contact per face. */
+#define MESH_SMOOTH_COS 0.93969262078590838
+
+/* Whether facets s and t have a corner in common. */
+static bool facets_meet(const sx_mesh *s, int32_t a, int32_t b)
+{
+    const int32_t *ta = s->tri + 3 * (int64_t)a, *tb = s->tri + 3 * (int64_t)b;
+    for (int e = 0; e < 3; e++)
+        if (ta[e] == tb[0] || ta[e] == tb[1] || ta[e] == tb[2]) return true;
+    return false;
+}
+
 /* Whether touching feature k is not a contact of its own. A face is one
- * unless a kept face of the same plane meets the ball at the same point
- * (two facets met at their shared edge). An edge or a vertex is a contact
+ * unless a kept face meets the ball at the same point in the same plane
+ * (two facets met at their shared edge), or is nearer on a facet sharing a
+ * corner with it within MESH_SMOOTH_COS (faces are taken nearest first).
+ * An edge or a vertex is a contact
  * only where the mesh is nearest there: where every facet that has it
  * finds its own closest point there too (the point is then a local
  * minimum of the distance over the whole surface, as on a ridge or an
@@ -231,6 +250,7 @@ static bool shadowed(const sx_mesh *s, const int32_t *facet, const facet_hit *h,
             double dq[3];
             for (int e = 0; e < 3; e++) dq[e] = a->q[e] - b->q[e];
             if (dot(dq, dq) <= 1e-18 * r * r && dot(a->n, b->n) >= 1 - 1e-12) return true;
+            if (dot(a->n, b->n) >= MESH_SMOOTH_COS && facets_meet(s, facet[j], facet[k])) return true;
         } else if (facet_has(s, facet[j], a->v0) && facet_has(s, facet[j], a->v1)) {
             if (b->dist < a->dist - tie) return true; /* nearer elsewhere: not a minimum */
             if (keep[j] && b->dist <= a->dist + tie) return true; /* felt already */
@@ -277,7 +297,19 @@ static bool mesh_rows(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, in
         facet_closest(wl->mesh, p->facet[c0 + k], x, &h[k]);
         keep[k] = given[k] = 0;
     }
-    for (int kind = FACET_FACE; kind <= FACET_VERTEX; kind++)
+    /* the faces nearest first (a smooth surface's contact is its nearest
+     * face's: continuous as a ball crosses a shallow crease), by insertion,
+     * ties in row order; then the edges and vertices */
+    int16_t order[MESH_ROWS_MAX];
+    int64_t nf = 0;
+    for (int64_t k = 0; k < n; k++) {
+        if (h[k].kind != FACET_FACE || !(h[k].dist < r)) continue;
+        int64_t at = nf++;
+        for (; at > 0 && h[order[at - 1]].dist > h[k].dist; at--) order[at] = order[at - 1];
+        order[at] = (int16_t)k;
+    }
+    for (int64_t e = 0; e < nf; e++) keep[order[e]] = !shadowed(wl->mesh, p->facet + c0, h, keep, n, order[e], r);
+    for (int kind = FACET_EDGE; kind <= FACET_VERTEX; kind++)
         for (int64_t k = 0; k < n; k++)
             if (h[k].kind == kind && h[k].dist < r)
                 keep[k] = !shadowed(wl->mesh, p->facet + c0, h, keep, n, k, r);

@@ -22,7 +22,9 @@
 static inline void sx_law_mindlin_unloading_mix(sx_pair_law *l, const sx_material *a, const sx_material *b, int self)
 {
     (void)self;
-    l->unloading = a->def.mindlin_unloading == 1 && (!b || b->def.mindlin_unloading == 1);
+    /* a constant-stiffness law (tangent 1: linear) has nothing to scale,
+     * and keeps the batched passes */
+    l->unloading = a->def.mindlin_unloading == 1 && (!b || b->def.mindlin_unloading == 1) && sx__law(l->law)->tangent != 1;
     if (l->unloading) l->plain = false; /* the batched passes do not scale */
 }
 
@@ -38,16 +40,17 @@ static inline const char *sx_law_mindlin_unloading_check(const sx_material_def *
 
 /* Scales the shear force fs (dim components, carried into the current
  * contact plane) from the stiffness before, ks0, to the current ks when
- * it fell; returns the strain energy taken from the spring (the strain
- * fs^2 / (2 ks) at the current ks, before less after), which the
- * micro-slip of the shrinking contact's rim dissipates. */
+ * it fell; returns the strain energy the spring gave up: fs^2 / (2 ks0)
+ * as the last step left it, less (ratio fs)^2 / (2 ks) now, which is
+ * (1 - ratio) of it (the tangential displacement fs / ks0 is kept); the
+ * micro-slip of the shrinking contact's rim dissipates it. */
 static inline double sx_law_mindlin_unloading_scale(int dim, double *fs, double ks, double ks0)
 {
     if (!(ks < ks0) || !(ks > 0)) return 0;
     const double ratio = ks / ks0;
     double f2 = 0;
     for (int k = 0; k < dim; k++) f2 += fs[k] * fs[k], fs[k] *= ratio;
-    return 0.5 * f2 * (1 - ratio * ratio) / ks;
+    return 0.5 * f2 * (1 - ratio) / ks0;
 }
 
 static inline const sx_law *sx_law_mindlin_unloading(void)
