@@ -14,6 +14,9 @@
 --            drifting along it), with rolling resistance: the turning
 --            sides drag the balls across the slabs; the box's force and
 --            moment and the state hash as above.
+--   drum hertz  the same with Hertz-Mindlin grains and Mindlin &
+--            Deresiewicz's unloading (laws/mindlin_unloading.h: the
+--            previous overlap from each pair's history, on every rank).
 local scene = arg and arg[1] or "plough"
 local dir = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
 
@@ -99,8 +102,13 @@ if scene == "plough" then
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "drum" then
   local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
-  m:material("grain", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.4, rolling_friction = 0.05, damping = 0.3,
-                       viscous_normal = 0.3})
+  if arg[2] == "hertz" then
+    m:material("grain", {model = "hertz", density = 2650, shear_modulus = 5e7, poisson = 0.25, friction = 0.4,
+                         rolling_friction = 0.05, damping = 0.3, viscous_normal = 0.3, mindlin_unloading = 1})
+  else
+    m:material("grain", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.4, rolling_friction = 0.05, damping = 0.3,
+                         viscous_normal = 0.3})
+  end
   local S = 0.12
   local t = {}
   local o, x, y, z = {0, 0, 0}, {S, 0, 0}, {0, S, 0}, {0, 0, S}
