@@ -565,5 +565,6 @@ sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3])
     for (int k = 0; k < 3; k++)
         if (!isfinite(spin[k])) return sx__fail(m, SX_EINVAL, "wall_set_spin: the spin must be finite");
     memcpy(w->def.spin, spin, sizeof w->def.spin);
+    if (sx__speed_rated(m)) m->dt_stale = true; /* as wall_set_vel */
     return SX_OK;
 }

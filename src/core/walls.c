@@ -220,6 +220,7 @@ sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel)
         return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: wall %lld is not a cylinder", (long long)id);
     if (!isfinite(radial_vel)) return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: the velocity must be finite");
     w->def.radial_vel = radial_vel;
+    if (sx__speed_rated(m)) m->dt_stale = true; /* as wall_set_vel */
     return SX_OK;
 }
 
@@ -230,6 +231,7 @@ sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
     if (!w) return SX_ENOTFOUND;
     if (!finite3(vel, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_vel: velocity must be finite");
     for (int k = 0; k < m->dim; k++) w->def.vel[k] = vel[k];
+    if (sx__speed_rated(m)) m->dt_stale = true; /* a faster wall may strike harder (kernels/timestep.c) */
     return SX_OK;
 }
 

@@ -247,6 +247,25 @@ T.test("a fast Hertz impact at the automatic timestep is resolved: undamped, it 
     T.near(b.vel[3], case[2], 0.01)
     m:close()
   end
+  -- struck: a resting ball hit by a plane moving at 5 m/s leaves at 10 m/s
+  -- (it was rated at rest: 4 steps, 0.955 of that), the plane moving from
+  -- the start or set moving after a step
+  for _, set in ipairs{false, true} do
+    local m = seixo.model{dim = 3, gravity = {0, 0, 0}}
+    m:material("s", {model = "hertz", density = 2650, shear_modulus = 1e8, poisson = 0.25})
+    local w = m:wall{kind = "plane", point = {0, 0, -0.0001}, normal = {0, 0, 1}, rigid = true}
+    local b = m:ball{pos = {0, 0, 0.01}, radius = 0.01}
+    if set then m:cycle(1) end
+    w.vel = {0, 0, 5}
+    local steps, touched = 0, false
+    for _ = 1, 100000 do
+      m:cycle(1)
+      if m:contact_count() > 0 then steps, touched = steps + 1, true elseif touched then break end
+    end
+    T.check(steps >= 5, string.format("struck at 5 m/s%s: %d steps in contact", set and " (set)" or "", steps))
+    T.near(b.vel[3], 10, 0.01)
+    m:close()
+  end
 end)
 
 T.done()
