@@ -177,6 +177,8 @@ typedef struct sx_series_opts {
     unsigned fields;           ///< SX_OUT_* bits (0: SX_OUT_DEFAULT)
     int compression;           ///< deflate level 0 .. 9
     bool append;               ///< continue an existing series (same dimension) instead of replacing it
+    bool check_step;           ///< appending: refuse a series holding a step after `step`
+    int64_t step;              ///< the appending model's step (with check_step)
     sx_io_provenance provenance;
 } sx_series_opts;
 

@@ -143,7 +143,10 @@ static void read_radius(lua_State *L, gen *g, const char *key)
     lua_pop(L, 1);
     if (!(g->rmin > 0 && g->rmax >= g->rmin && isfinite(g->rmax)))
         sx_lua_fielderror(L, 2, key, "sizes must be finite, > 0, and min <= max");
-    if (g->tpl < 0) sx_lua_check_range(L, 1, "radius", g->rmax, 1e-6, 1, "m");
+    if (g->tpl < 0) { /* balls, not clumps' scales */
+        sx_lua_check_range(L, 1, "radius", g->rmax, 1e-6, 1, "m");
+        sx_lua_check_range(L, 1, "radius", g->rmin, 1e-6, 1, "m");
+    }
 }
 
 static void read_relax(lua_State *L, gen *g)

@@ -182,7 +182,7 @@ void sx_lua_check_range(lua_State *L, int model, const char *what, double v, dou
         lua_setfield(L, -3, what);
         luaL_where(L, 1);
         if (sx_lua_parallel_says(sx_lua_tomodel(L, model))) {
-            fprintf(stderr, "seixo: warning: %s%s %g is outside the range of rocks and grains, %g ... %g %s (seixo's unit is %s)\n",
+            fprintf(stderr, "seixo: warning: %s%s %g is outside the usual range for DEM, %g ... %g %s (seixo's unit is %s)\n",
                     lua_tostring(L, -1), what, v, lo, hi, unit, unit);
             fflush(stderr);
         }

@@ -703,6 +703,7 @@ static int model_output(lua_State *L)
     so.fields = fields;
     so.compression = (int)level;
     so.append = append;
+    so.check_step = true, so.step = sx_model_step_count(m);
     so.provenance.script = script_path(L);
     so.provenance.seeds = seeds_of(L, 1, &so.provenance.nseeds);
     char err[1024] = "";

@@ -92,6 +92,7 @@ local function append(p, dim)
   m:material("rock")
   m:ball{pos = V(dim, 0, 0, 0), radius = 0.01}
   m:history("ke", "kinetic")
+  m:cycle(150) -- past the series' end (its histories reach step 105), or appending is refused
   local o = m:output{path = p, every = 10, append = true}
   m:cycle(25)
   o:close()

@@ -133,12 +133,27 @@ T.test("an output series: every N steps, fields, append, xdmf", function()
   -- ends at 250): an error, the series as it was (its snapshots had gone
   -- on at steps 170, 200, ... after that of 250, their times going back)
   local old = seixo.load(path("mid.h5"))
+  local bytes = io.open(path("series.h5"), "rb"):read("a")
   T.raises(function() old:output{path = path("series.h5"), every = 50, append = true} end,
-           "last snapshot is at step 250, later than this model's step 170")
+           "holds snapshots up to step 250, later than this model's step 170")
+  T.check(io.open(path("series.h5"), "rb"):read("a") == bytes, "the refused append changed the file")
   n = 0
   for _ in io.open(path("series.xmf")):read("a"):gmatch("/balls/vertices</DataItem>") do n = n + 1 end
   T.eq(n, 6)
   T.eq(c:output{path = path("series.h5"), every = 50, append = true}:count(), 7) -- the model at its end goes on
+  -- a history's samples past the last snapshot count too (written at close)
+  local t = seixo.model{dim = 3, timestep = 1e-5}
+  t:material("rock")
+  t:ball{pos = {0, 0, 0}, radius = 0.01}
+  t:history("ke", "kinetic")
+  local ot = t:output{path = file("tails.h5"), every = 50}
+  made[#made + 1] = path("tails.xmf")
+  t:cycle(110)
+  t:save(file("tails_110.h5"))
+  t:cycle(10)
+  ot:close()
+  T.raises(function() seixo.load(path("tails_110.h5")):output{path = path("tails.h5"), every = 50, append = true} end,
+           "holds histories up to step 120, later than this model's step 110")
   T.raises(function() m:output{path = path("o.h5"), fields = {"colour"}} end, "unknown field 'colour'", "velocity")
   T.raises(function() m:output{every = 5} end, "path")
   T.raises(function() m:output{path = path("o.h5"), every = 0} end, "every")

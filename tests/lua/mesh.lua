@@ -178,6 +178,32 @@ T.test("a shallow bowl of facets is one smooth surface: one contact, the nearest
   T.eq(corner, 2)
 end)
 
+-- A valley along y: two strips of facets rising at `deg` degrees each side of x = 0.
+local function valley(deg)
+  local L, s = 0.05, math.tan(math.rad(deg))
+  return {{{-L, -L, L * s}, {0, -L, 0}, {0, L, 0}}, {{-L, -L, L * s}, {0, L, 0}, {-L, L, L * s}},
+          {{0, -L, 0}, {L, -L, L * s}, {L, L, L * s}}, {{0, -L, 0}, {L, L, L * s}, {0, L, 0}}}
+end
+
+T.test("across a shallow concave crease the force turns smoothly, and a 20-degree crease is merged whatever the rounding", function()
+  -- a 10-degree valley (5 each side): one contact along the faces' normals
+  -- weighted by their overlaps; the nearest face's normal alone flipped the
+  -- sideways force from +12 to -12 N (of 137 N) between x = -1e-9 and 1e-9 m
+  local tris, depth = valley(5), 1e-4
+  local up = pressed(tris, 0, 0, depth)
+  for _, x in ipairs{-1e-9, 1e-9, -1e-6, 1e-6} do
+    local f, n = pressed(tris, x, 0, depth)
+    T.eq(n, 1)
+    T.check(math.abs(f[1]) < 1e-3 * up[3], string.format("x = %g: sideways %g N of %g", x, f[1], f[3]))
+  end
+  -- 20 degrees between the faces (a drum of 18 strips): one contact at every offset
+  tris = valley(10)
+  for k = -5, 5 do
+    local _, n = pressed(tris, k * 1e-4, 0.004 * k, depth)
+    T.eq(n, 1)
+  end
+end)
+
 -- The box [0, L]^3: each side two triangles, in the order of the box's
 -- planes (-x, +x, -y, +y, -z, +z), wound outward (the mesh is two-sided).
 local function box_triangles(L)

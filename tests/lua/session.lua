@@ -283,11 +283,11 @@ w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
 w:servo{target = 10, area = 1}
 print("done")]]))
   eq(status, 0, out)
-  check(out:find("seixo: warning: (command line):2: density 2.5 is outside the range of rocks and grains, 100 ... 30000 kg/m^3 (seixo's unit is kg/m^3)", 1, true), out)
+  check(out:find("seixo: warning: (command line):2: density 2.5 is outside the usual range for DEM, 100 ... 30000 kg/m^3 (seixo's unit is kg/m^3)", 1, true), out)
   local _, count = out:gsub("density", "")
   eq(count, 1, "once per model")
-  check(out:find("(command line):4: modulus 40 is outside the range of rocks and grains, 100000 ... 1e+12 Pa", 1, true), out)
-  check(out:find("(command line):7: servo target stress 10 is outside the range of rocks and grains, 1000 ... 1e+10 Pa (seixo's unit is Pa)", 1, true), out)
+  check(out:find("(command line):4: modulus 40 is outside the usual range for DEM, 100000 ... 1e+12 Pa", 1, true), out)
+  check(out:find("(command line):7: servo target stress 10 is outside the usual range for DEM, 1000 ... 1e+10 Pa (seixo's unit is Pa)", 1, true), out)
   check(out:find("done\n$"), out)
 end)
 
@@ -313,7 +313,7 @@ print("done")]]))
   -- no warning before "valid": the invalid values only failed (material c's density 2.5 included)
   local before = out:sub(1, out:find("valid", 1, true))
   check(not before:find("warning", 1, true), out)
-  check(out:find("valid\nseixo: warning: (command line):10: density 2.5 is outside the range", 1, true), out)
+  check(out:find("valid\nseixo: warning: (command line):10: density 2.5 is outside the usual range", 1, true), out)
   check(out:find("done\n$"), out)
 end)
 

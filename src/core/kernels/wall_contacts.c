@@ -202,13 +202,16 @@ static bool facet_has(const sx_mesh *s, int32_t t, int32_t v)
     return tv[0] == v || tv[1] == v || tv[2] == v;
 }
 
-/* Faces of one mesh whose normals differ by less than this angle (its
- * cosine; 20 degrees), sharing a corner, are one smooth surface: a curve
- * tessellated (a drum of 18 strips or more, a shallow bowl) gives one
- * contact there, the nearest face's, as on the surface it stands for; each
- * was counted before, six times the force in a bowl of six facets sinking
- * 0.5 degrees. Sharper creases are corners, with a contact per face. */
-#define MESH_SMOOTH_COS 0.93969262078590838
+/* Faces of one mesh whose normals differ by at most 20 degrees (and a
+ * hair: this is the cosine of 20.5, so that a drum of 18 strips, 20
+ * degrees to the crease, is not split by rounding), sharing a corner, are
+ * one smooth surface: a curve tessellated (a drum of 18 strips or more, a
+ * shallow bowl) gives one contact there, at the nearest face's overlap,
+ * along the faces' normals weighted by their overlaps (mesh_rows), as on
+ * the surface it stands for; each was counted before, six times the force
+ * in a bowl of six facets sinking 0.5 degrees. Sharper creases are
+ * corners, with a contact per face. */
+#define MESH_SMOOTH_COS 0.93667199738904622
 
 /* Whether facets s and t have a corner in common. */
 static bool facets_meet(const sx_mesh *s, int32_t a, int32_t b)
@@ -313,6 +316,29 @@ static bool mesh_rows(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, in
         for (int64_t k = 0; k < n; k++)
             if (h[k].kind == kind && h[k].dist < r)
                 keep[k] = !shadowed(wl->mesh, p->facet + c0, h, keep, n, k, r);
+    /* a face that stands for faces merged with it (MESH_SMOOTH_COS) pushes
+     * along their normals weighted by their overlaps, so the force turns
+     * smoothly as a ball crosses a shallow crease (the nearest face's normal
+     * alone flipped there: a ball never settled in a 10-degree valley);
+     * alone, or with coplanar faces only, it keeps its own, to the bit */
+    for (int64_t e = 0; e < nf; e++) {
+        const int64_t k = order[e];
+        if (!keep[k]) continue;
+        double sum[3], w = r - h[k].dist;
+        bool turned = false;
+        for (int q = 0; q < 3; q++) sum[q] = w * h[k].n[q];
+        for (int64_t f = 0; f < nf; f++) {
+            const int64_t j = order[f];
+            const double c = dot(h[j].n, h[k].n);
+            if (keep[j] || c < MESH_SMOOTH_COS || !facets_meet(wl->mesh, p->facet[c0 + j], p->facet[c0 + k])) continue;
+            w = r - h[j].dist;
+            for (int q = 0; q < 3; q++) sum[q] += w * h[j].n[q];
+            turned = turned || c < 1 - 1e-12;
+        }
+        if (!turned) continue;
+        const double len = sqrt(dot(sum, sum));
+        for (int q = 0; q < 3; q++) h[k].n[q] = sum[q] / len;
+    }
     for (int64_t k = 0; k < n; k++) {
         if (!keep[k] || p->touching[c0 + k]) continue;
         int64_t best = -1;
