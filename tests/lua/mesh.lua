@@ -119,14 +119,21 @@ T.test("a fan of facets closed by trigonometry is welded at its seam: one contac
   as_on_the_plane(tris, {{0.01, 0}, {0.01, 0.001}, {0.02, -0.0005}, {0.0002, 0}}, 1e-4)
 end)
 
-T.test("on a shallow pyramid the apex is one contact, and near it the face under the ball is the only one", function()
-  -- six facets rising 5 degrees to an apex 2.6 mm above a hexagon 30 mm round
-  local L, h, r, depth = 0.03, 0.03 * math.tan(math.rad(5)), 0.01, 1e-4
+-- Six facets from a hexagon of radius L at z = 0 to its centre at height h
+-- (a pyramid rising, or a bowl sinking when h < 0).
+local function hexagon_fan(L, h)
   local tris = {}
   for k = 0, 5 do
     local a0, a1 = math.pi / 3 * k, math.pi / 3 * (k + 1)
     tris[#tris + 1] = {{0, 0, h}, {L * math.cos(a0), L * math.sin(a0), 0}, {L * math.cos(a1), L * math.sin(a1), 0}}
   end
+  return tris
+end
+
+T.test("on a shallow pyramid the apex is one contact, and near it the face under the ball is the only one", function()
+  -- six facets rising 5 degrees to an apex 2.6 mm above a hexagon 30 mm round
+  local L, h, r, depth = 0.03, 0.03 * math.tan(math.rad(5)), 0.01, 1e-4
+  local tris = hexagon_fan(L, h)
   -- straight above the apex: one vertex contact, its overlap the depth
   local f, n = pressed(tris, 0, 0, depth - h)
   T.eq(n, 1)
@@ -160,11 +167,7 @@ T.test("a shallow bowl of facets is one smooth surface: one contact, the nearest
   -- pressed in over the vertex had a contact on each face, six times the force
   local L, r, depth = 0.03, 0.01, 1e-4
   local h = -L * math.tan(math.rad(0.5))
-  local tris = {}
-  for k = 0, 5 do
-    local a0, a1 = math.pi / 3 * k, math.pi / 3 * (k + 1)
-    tris[#tris + 1] = {{0, 0, h}, {L * math.cos(a0), L * math.sin(a0), 0}, {L * math.cos(a1), L * math.sin(a1), 0}}
-  end
+  local tris = hexagon_fan(L, h)
   local f, n = pressed(tris, 0, 0, depth - h)
   T.eq(n, 1)
   local tilt = math.atan(math.tan(math.rad(0.5)) / math.cos(math.rad(30)))
