@@ -556,6 +556,21 @@ sx_status sx_wall_mesh_get(const sx_model *m, int64_t id, double *vertices, int3
     return SX_OK;
 }
 
+double sx__mesh_spin_speed(const sx_mesh *s, const double *point, const double *spin)
+{
+    if (!(dot3(spin, spin) > 0)) return 0;
+    double best = 0;
+    for (int64_t v = 0; v < s->nv; v++) {
+        double r[3], c[3];
+        for (int k = 0; k < 3; k++) r[k] = s->x[3 * v + k] - point[k];
+        c[0] = spin[1] * r[2] - spin[2] * r[1];
+        c[1] = spin[2] * r[0] - spin[0] * r[2];
+        c[2] = spin[0] * r[1] - spin[1] * r[0];
+        best = fmax(best, dot3(c, c));
+    }
+    return sqrt(best);
+}
+
 sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3])
 {
     m->guard_dirty = true; /* new energy baseline for the stability guard */
@@ -565,6 +580,6 @@ sx_status sx_wall_set_spin(sx_model *m, int64_t id, const double spin[3])
     for (int k = 0; k < 3; k++)
         if (!isfinite(spin[k])) return sx__fail(m, SX_EINVAL, "wall_set_spin: the spin must be finite");
     memcpy(w->def.spin, spin, sizeof w->def.spin);
-    if (sx__speed_rated(m)) m->dt_stale = true; /* as wall_set_vel */
+    sx__wall_speed_changed(m, w);
     return SX_OK;
 }

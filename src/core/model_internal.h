@@ -413,6 +413,7 @@ struct sx_model {
     double time;
     int64_t step;
     bool dt_stale;           /* recompute the automatic timestep before the next step */
+    double dt_wall_speed;    /* the fastest wall speed the timestep was rated at (kernels/timestep.c) */
     bool build_needed;       /* broad phase must be rebuilt before the next step */
     bool locked;             /* stepping */
     volatile sig_atomic_t interrupt;
@@ -574,6 +575,12 @@ bool sx__interrupted(const sx_model *m);
  * tangent stiffness is not its secant; kernels/timestep.c). A velocity set
  * by hand then rates the timestep again at the next step. */
 bool sx__speed_rated(const sx_model *m);
+/* The fastest speed at which wall w's surface may close on a ball
+ * (walls.c), and what a change of it does to the timestep's rating. */
+double sx__wall_speed(const sx_model *m, const sx_wall *w);
+void sx__wall_speed_changed(sx_model *m, const sx_wall *w);
+/* The fastest speed of a vertex of mesh s turning at spin about point (mesh.c). */
+double sx__mesh_spin_speed(const sx_mesh *s, const double *point, const double *spin);
 
 /* Dimension kernels (kernels.c, one instance per dimension). */
 typedef struct sx_kernels {

@@ -220,7 +220,7 @@ sx_status sx_wall_set_radial_vel(sx_model *m, int64_t id, double radial_vel)
         return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: wall %lld is not a cylinder", (long long)id);
     if (!isfinite(radial_vel)) return sx__fail(m, SX_EINVAL, "wall_set_radial_vel: the velocity must be finite");
     w->def.radial_vel = radial_vel;
-    if (sx__speed_rated(m)) m->dt_stale = true; /* as wall_set_vel */
+    sx__wall_speed_changed(m, w);
     return SX_OK;
 }
 
@@ -231,7 +231,7 @@ sx_status sx_wall_set_vel(sx_model *m, int64_t id, const double vel[3])
     if (!w) return SX_ENOTFOUND;
     if (!finite3(vel, m->dim)) return sx__fail(m, SX_EINVAL, "wall_set_vel: velocity must be finite");
     for (int k = 0; k < m->dim; k++) w->def.vel[k] = vel[k];
-    if (sx__speed_rated(m)) m->dt_stale = true; /* a faster wall may strike harder (kernels/timestep.c) */
+    sx__wall_speed_changed(m, w);
     return SX_OK;
 }
 
@@ -360,6 +360,37 @@ sx_status sx_wall_load(const sx_model *m, int64_t id, double *normal_force, int6
     return SX_OK;
 }
 
+/* A plane or a line closes on a ball at its velocity along its normal only
+ * (sliding in itself it closes on nothing); another wall at its whole
+ * velocity, a cylinder at its radial one too, a mesh also at its spin's
+ * fastest vertex. kernels/timestep.c rates balls under a stiffening law
+ * (Hertz) as if struck at the fastest wall's. */
+double sx__wall_speed(const sx_model *m, const sx_wall *w)
+{
+    double v = 0;
+    if (w->def.kind == SX_WALL_PLANE || w->def.kind == SX_WALL_LINE) {
+        for (int k = 0; k < m->dim; k++) v += w->def.vel[k] * w->def.normal[k];
+        v = fabs(v);
+    } else {
+        for (int k = 0; k < m->dim; k++) v += w->def.vel[k] * w->def.vel[k];
+        v = sqrt(v);
+    }
+    v += fabs(w->def.radial_vel);
+    if (w->mesh) v += sx__mesh_spin_speed(w->mesh, w->def.point, w->def.spin);
+    return v;
+}
+
+/* A wall's speed set, by hand or by its servo: the timestep is rated again
+ * at the next step if it now moves more than a quarter faster than the
+ * rating took (a Hertz impact's stiffness grows with its speed; the step
+ * with it as v^-1/5: a quarter is under 5 %), not at every set of the same
+ * or a slower speed (a Lua servo setting it every step re-rated every step,
+ * doubling the step's cost). */
+void sx__wall_speed_changed(sx_model *m, const sx_wall *w)
+{
+    if (sx__wall_speed(m, w) > 1.25 * m->dt_wall_speed && sx__speed_rated(m)) m->dt_stale = true;
+}
+
 /* PFC's servo (DESIGN 1): the normal velocity G (sigma - target), positive
  * away from the balls, from the loads of the step just computed. */
 void sx__walls_servo(sx_model *m)
@@ -383,6 +414,7 @@ void sx__walls_servo(sx_model *m)
         } else {
             for (int k = 0; k < m->dim; k++) w->def.vel[k] = -speed * w->def.normal[k];
         }
+        sx__wall_speed_changed(m, w); /* a servo striking fast is rated too */
     }
 }
 

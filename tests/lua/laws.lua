@@ -266,6 +266,22 @@ T.test("a fast Hertz impact at the automatic timestep is resolved: undamped, it 
     T.near(b.vel[3], 10, 0.01)
     m:close()
   end
+  -- a servo's own speed, set inside the step, is rated too (it was rated
+  -- at rest: 4 steps, 9.55 m/s; now 5 steps and 9.89: the servo sets its
+  -- speed from the step's load, a step behind the plane set by hand)
+  local m = seixo.model{dim = 3, gravity = {0, 0, 0}}
+  m:material("s", {model = "hertz", density = 2650, shear_modulus = 1e8, poisson = 0.25})
+  local w = m:wall{kind = "plane", point = {0, 0, -0.0001}, normal = {0, 0, 1}, rigid = true}
+  local b = m:ball{pos = {0, 0, 0.01}, radius = 0.01}
+  w:servo{target = 1e9, max_speed = 5}
+  local steps, touched = 0, false
+  for _ = 1, 100000 do
+    m:cycle(1)
+    if m:contact_count() > 0 then steps, touched = steps + 1, true elseif touched then break end
+  end
+  T.check(steps >= 5, string.format("struck by a servo at 5 m/s: %d steps in contact", steps))
+  T.near(b.vel[3], 10, 0.02)
+  m:close()
 end)
 
 T.done()

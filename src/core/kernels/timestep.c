@@ -157,14 +157,8 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
      * flying at a resting plane is); a resting Hertz ball hit by a plane at
      * 5 m/s was rated at rest and left at 0.955 of 10 m/s */
     double vwall = 0;
-    for (int64_t w = 0; w < m->nwall; w++) {
-        const sx_wall *wl = &m->walls[w];
-        double s = sqrt(dot(wl->def.vel, wl->def.vel)) + fabs(wl->def.radial_vel);
-#if D == 3
-        if (wl->mesh) s += sqrt(dot(wl->def.spin, wl->def.spin)) * wl->mesh->reach;
-#endif
-        vwall = fmax(vwall, s);
-    }
+    for (int64_t w = 0; w < m->nwall; w++) vwall = fmax(vwall, sx__wall_speed(m, &m->walls[w]));
+    m->dt_wall_speed = vwall; /* a wall set faster than a quarter more rates it again (walls.c) */
     const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : n;
     for (int64_t i = i0; i < i1; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
