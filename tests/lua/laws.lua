@@ -282,6 +282,21 @@ T.test("a fast Hertz impact at the automatic timestep is resolved: undamped, it 
   T.check(steps >= 5, string.format("struck by a servo at 5 m/s: %d steps in contact", steps))
   T.near(b.vel[3], 10, 0.02)
   m:close()
+  -- a wall far from every ball (no candidate pair) leaves the timestep as
+  -- it is: each ball is rated at the walls it may meet before the next
+  -- build (every Hertz ball of a mill was rated at its liner's speed)
+  local dts = {}
+  for _, far in ipairs{false, true} do
+    local q = seixo.model{dim = 3, gravity = {0, 0, 0}}
+    q:material("s", {model = "hertz", density = 2650, shear_modulus = 1e8, poisson = 0.25})
+    q:wall{kind = "plane", point = {0, 0, -0.0001}, normal = {0, 0, 1}, rigid = true}
+    q:ball{pos = {0, 0, 0.01}, radius = 0.01}
+    if far then q:wall{kind = "plane", point = {0, 0, 5}, normal = {0, 0, -1}, rigid = true}.vel = {0, 0, -20} end
+    q:cycle(1)
+    dts[#dts + 1] = q:timestep()
+    q:close()
+  end
+  T.eq(dts[2], dts[1])
 end)
 
 T.done()

@@ -108,10 +108,16 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     sx_balls *B = &m->balls;
     const int64_t n = B->n;
     if (n == 0) return INFINITY;
-    double *kt = sx__scratch(m, 4 * n);
+    double *kt = sx__scratch(m, 5 * n + m->nwall);
     if (!kt) return INFINITY;
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
-    memset(kt, 0, (size_t)(4 * n) * sizeof(double));
+    /* the fastest wall each ball has a candidate pair with, and each wall's
+     * speed (sx__wall_speed: how fast its surface may close on a ball) */
+    double *struck = kt + 4 * n, *wall_speed = kt + 5 * n;
+    memset(kt, 0, (size_t)(5 * n) * sizeof(double));
+    double vwall = 0;
+    for (int64_t w = 0; w < m->nwall; w++) vwall = fmax(vwall, wall_speed[w] = sx__wall_speed(m, &m->walls[w]));
+    m->dt_wall_speed = vwall; /* a wall set faster than a quarter more rates it again (walls.c) */
     /* decomposed: this rank's balls, summed over their pairs in the serial
      * order (decompose.c): those of pairs[rank] that reach them (inpair,
      * then its own), and in periodic space the pairs through the boundary
@@ -132,6 +138,7 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     const int64_t w0 = dd ? dd->bw_own[dd->x.rank].lo : 0, w1 = dd ? dd->bw_own[dd->x.rank].hi : p->n;
     for (int64_t c = w0; c < w1; c++) {
         const int64_t i = p->a[c];
+        struck[i] = fmax(struck[i], wall_speed[p->b[c]]);
         double nrm[D];
         /* a mesh's contacts as the last step kept them (a shadowed facet adds no stiffness) */
         const bool mesh = m->walls[p->b[c]].mesh != NULL;
@@ -152,18 +159,17 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
         kr[i] += ks * B->rad[i] * B->rad[i] * (law.mu_r > 0 ? 2 : 1); /* with the rolling spring ks R^2 */
     }
     double best = INFINITY;
-    /* the fastest wall surface: a ball may be struck at its own speed plus
-     * this, and is rated as if it moved at that closing speed (as a ball
-     * flying at a resting plane is); a resting Hertz ball hit by a plane at
-     * 5 m/s was rated at rest and left at 0.955 of 10 m/s */
-    double vwall = 0;
-    for (int64_t w = 0; w < m->nwall; w++) vwall = fmax(vwall, sx__wall_speed(m, &m->walls[w]));
-    m->dt_wall_speed = vwall; /* a wall set faster than a quarter more rates it again (walls.c) */
     const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : n;
     for (int64_t i = i0; i < i1; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
         const double r = B->rad[i], mass = 1.0 / B->inv_mass[i], own = sqrt(dot(B->v + i * D, B->v + i * D));
-        const double speed = own + vwall;
+        /* a ball may be struck by a wall it has a candidate pair with at its
+         * own speed plus the wall's, and is rated as if it moved at that
+         * closing speed (as a ball flying at a resting plane is); a resting
+         * Hertz ball hit by a plane at 5 m/s was rated at rest and left at
+         * 0.955 of 10 m/s. A wall coming from farther is listed at a build,
+         * which rates the timestep again. */
+        const double speed = own + struck[i];
         double kn, ks;
         self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], r, mass, speed, &kn, &ks);
         for (int row = 0; row < m->ncmodel; row++) { /* and not below a contact-model row's (cmodel.c) */
