@@ -563,9 +563,7 @@ double sx__mesh_spin_speed(const sx_mesh *s, const double *point, const double *
     for (int64_t v = 0; v < s->nv; v++) {
         double r[3], c[3];
         for (int k = 0; k < 3; k++) r[k] = s->x[3 * v + k] - point[k];
-        c[0] = spin[1] * r[2] - spin[2] * r[1];
-        c[1] = spin[2] * r[0] - spin[0] * r[2];
-        c[2] = spin[0] * r[1] - spin[1] * r[0];
+        cross3(spin, r, c);
         best = fmax(best, dot3(c, c));
     }
     return sqrt(best);

@@ -146,17 +146,17 @@ int sx_interrupt_pending(void) { return atomic_load(&interrupt_requested); }
 
 void sx_interrupt_clear(void) { atomic_store(&interrupt_requested, 0); }
 
-/* a model's own flag only while it cycles: it stays set after the cycle it stopped */
 bool sx__speed_rated(const sx_model *m)
 {
     if (m->dt_user > 0) return false;
     for (int k = 0; k < m->law_n; k++)
-        if (sx__law(m->law[k * m->law_n + k].law)->tangent != 1) return true;
+        if (sx__law_stiffens(m->law[k * m->law_n + k].law)) return true;
     for (int row = 0; row < m->ncmodel; row++)
-        if (sx__law(m->cmodel[row].law.law)->tangent != 1) return true;
+        if (sx__law_stiffens(m->cmodel[row].law.law)) return true;
     return false;
 }
 
+/* a model's own flag only while it cycles: it stays set after the cycle it stopped */
 bool sx__interrupted(const sx_model *m) { return (m->locked && m->interrupt) || atomic_load(&interrupt_requested); }
 
 sx_status sx_model_set_threads(sx_model *m, int threads)

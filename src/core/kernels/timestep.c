@@ -26,9 +26,8 @@ static double rating_overlap(const sx_pair_law *l, double r, double mass, double
 {
     const double u0 = HERTZ_REFERENCE_OVERLAP * r, energy = mass * speed * speed;
     if (!(energy > 0) || !isfinite(energy)) return u0; /* at rest, or fixed (no mass to stop) */
-    const sx_law *law = sx__law(l->law);
-    if (law->tangent == 1) return u0; /* a constant stiffness (sx__speed_rated's test too) */
-    const double strain = law->strain;
+    if (!sx__law_stiffens(l->law)) return u0; /* a constant stiffness: the overlap changes nothing */
+    const double strain = sx__law(l->law)->strain;
     double kn, ks;
     /* u = sqrt(energy / (strain kn(u))) with kn(u) = Fn(u) / u, by fixed
      * points: for Hertz they close in from both sides, a quarter of the gap

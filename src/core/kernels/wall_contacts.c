@@ -213,13 +213,13 @@ static bool facet_has(const sx_mesh *s, int32_t t, int32_t v)
  * corners, with a contact per face. */
 #define MESH_SMOOTH_COS 0.93667199738904622
 
-/* Whether facets s and t have a corner in common. */
-static bool facets_meet(const sx_mesh *s, int32_t a, int32_t b)
+/* Whether the faces of facets a and b, their normals na and nb toward the
+ * ball, are one smooth surface (MESH_SMOOTH_COS, a corner in common). */
+static bool smooth_faces(const sx_mesh *s, int32_t a, int32_t b, const double *na, const double *nb)
 {
-    const int32_t *ta = s->tri + 3 * (int64_t)a, *tb = s->tri + 3 * (int64_t)b;
-    for (int e = 0; e < 3; e++)
-        if (ta[e] == tb[0] || ta[e] == tb[1] || ta[e] == tb[2]) return true;
-    return false;
+    if (dot(na, nb) < MESH_SMOOTH_COS) return false;
+    const int32_t *ta = s->tri + 3 * (int64_t)a;
+    return facet_has(s, b, ta[0]) || facet_has(s, b, ta[1]) || facet_has(s, b, ta[2]);
 }
 
 /* Whether touching feature k is not a contact of its own. A face is one
@@ -253,7 +253,7 @@ static bool shadowed(const sx_mesh *s, const int32_t *facet, const facet_hit *h,
             double dq[3];
             for (int e = 0; e < 3; e++) dq[e] = a->q[e] - b->q[e];
             if (dot(dq, dq) <= 1e-18 * r * r && dot(a->n, b->n) >= 1 - 1e-12) return true;
-            if (dot(a->n, b->n) >= MESH_SMOOTH_COS && facets_meet(s, facet[j], facet[k])) return true;
+            if (smooth_faces(s, facet[j], facet[k], b->n, a->n)) return true;
         } else if (facet_has(s, facet[j], a->v0) && facet_has(s, facet[j], a->v1)) {
             if (b->dist < a->dist - tie) return true; /* nearer elsewhere: not a minimum */
             if (keep[j] && b->dist <= a->dist + tie) return true; /* felt already */
@@ -329,11 +329,10 @@ static bool mesh_rows(sx_model *m, sx_block *o, sx_wall_acc *acc, int64_t c0, in
         for (int q = 0; q < 3; q++) sum[q] = w * h[k].n[q];
         for (int64_t f = 0; f < nf; f++) {
             const int64_t j = order[f];
-            const double c = dot(h[j].n, h[k].n);
-            if (keep[j] || c < MESH_SMOOTH_COS || !facets_meet(wl->mesh, p->facet[c0 + j], p->facet[c0 + k])) continue;
+            if (keep[j] || !smooth_faces(wl->mesh, p->facet[c0 + j], p->facet[c0 + k], h[j].n, h[k].n)) continue;
             w = r - h[j].dist;
             for (int q = 0; q < 3; q++) sum[q] += w * h[j].n[q];
-            turned = turned || c < 1 - 1e-12;
+            turned = turned || dot(h[j].n, h[k].n) < 1 - 1e-12;
         }
         if (!turned) continue;
         const double len = sqrt(dot(sum, sum));

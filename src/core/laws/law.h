@@ -59,6 +59,10 @@ typedef struct sx_law {
 
 /* The law or part numbered id, or NULL (laws.c). */
 const sx_law *sx__law(int id);
+/* Whether law id's stiffness grows with the overlap (Hertz: its tangent
+ * stiffness is not its secant): the timestep's rating by speed and
+ * Mindlin & Deresiewicz's unloading apply to it, not to a constant one. */
+static inline bool sx__law_stiffens(int id) { return sx__law(id)->tangent != 1; }
 /* Mixes every part into l (after its law's mix). */
 void sx__law_parts_mix(sx_pair_law *l, const sx_material *a, const sx_material *b);
 /* A material's parameter of a law. */

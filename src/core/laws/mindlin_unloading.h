@@ -24,7 +24,7 @@ static inline void sx_law_mindlin_unloading_mix(sx_pair_law *l, const sx_materia
     (void)self;
     /* a constant-stiffness law (tangent 1: linear) has nothing to scale,
      * and keeps the batched passes */
-    l->unloading = a->def.mindlin_unloading == 1 && (!b || b->def.mindlin_unloading == 1) && sx__law(l->law)->tangent != 1;
+    l->unloading = a->def.mindlin_unloading == 1 && (!b || b->def.mindlin_unloading == 1) && sx__law_stiffens(l->law);
     if (l->unloading) l->plain = false; /* the batched passes do not scale */
 }
 
