@@ -481,6 +481,41 @@ out_failed:
     return st;
 }
 
+/* A mesh restored from a file written before meshes were welded (a
+ * trigonometric seam left open) is welded as sx_wall_add_mesh would have:
+ * its body frame is the frame it was welded in. A mesh already welded is
+ * left to the bit; one whose welding would make a triangle degenerate is
+ * kept as saved (dropping a facet would renumber the contacts' facets).
+ * False: out of memory. */
+bool sx__mesh_weld_restored(sx_model *m, sx_mesh *s)
+{
+    int64_t *map = malloc((size_t)s->nv * sizeof *map);
+    if (!map) return false;
+    const int64_t n = weld(s->body, s->nv, map);
+    bool ok = n >= 0;
+    if (n > 0 && n < s->nv) {
+        double *x = sx_alloc_resize(&m->alloc, NULL, 0, 3 * (size_t)n, sizeof *x);
+        ok = x != NULL;
+        bool kept = ok;
+        if (ok)
+            for (int64_t v = s->nv - 1; v >= 0; v--) memcpy(x + 3 * map[v], s->body + 3 * v, 3 * sizeof(double));
+        for (int64_t t = 0; t < s->nt && kept; t++) {
+            const int32_t *c = s->tri + 3 * t;
+            kept = !degenerate(x + 3 * map[c[0]], x + 3 * map[c[1]], x + 3 * map[c[2]]);
+        }
+        if (kept) {
+            sx_alloc_free(&m->alloc, s->body, 3 * (size_t)s->nv, sizeof(double));
+            s->body = x;
+            for (int64_t k = 0; k < 3 * s->nt; k++) s->tri[k] = (int32_t)map[s->tri[k]];
+            s->nv = n;
+        } else {
+            sx_alloc_free(&m->alloc, x, 3 * (size_t)n, sizeof(double));
+        }
+    }
+    free(map);
+    return ok;
+}
+
 sx_status sx_wall_add_mesh(sx_model *m, const sx_wall_def *def, const sx_mesh_def *mesh, int64_t *id,
                            sx_mesh_report *report)
 {

@@ -648,6 +648,9 @@ double sx__mesh_turn(sx_wall *w, double dt);
 /* A mesh from its frame's vertices and triangles as stored (a restore):
  * derived arrays and the grid; false when out of memory. */
 bool sx__mesh_derive(sx_model *m, sx_mesh *mesh);
+/* A restored mesh welded as sx_wall_add_mesh welds (files from before the
+ * welding); false: out of memory. */
+bool sx__mesh_weld_restored(sx_model *m, sx_mesh *mesh);
 /* Sets m->mesh_pairs, with m->bw.facet (zeros) at the store's size; SX_ENOMEM. */
 sx_status sx__pairs_expand_facets(sx_model *m);
 /* Calls fn on each facet of mesh whose box in the mesh's frame meets the

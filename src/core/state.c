@@ -279,7 +279,7 @@ static sx_status check_mesh(sx_model *m, sx_wall *w)
         if (s->tri[t] < 0 || s->tri[t] >= s->nv)
             return sx__fail(m, SX_EINVAL, "state: mesh wall %lld: triangle %lld names vertex %d of %lld", (long long)w->id,
                             (long long)(t / 3), s->tri[t], (long long)s->nv);
-    if (!sx__mesh_derive(m, s)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
+    if (!sx__mesh_weld_restored(m, s) || !sx__mesh_derive(m, s)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
     sx__mesh_pose(w);
     return SX_OK;
 }

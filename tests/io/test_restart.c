@@ -312,6 +312,69 @@ START_TEST(histories_saved)
 }
 END_TEST
 
+/* A mesh saved before meshes were welded (here: a square of two triangles
+ * whose diagonal's ends are stored twice, as an open trigonometric seam
+ * was) is welded on loading: one vertex per corner, and a ball on the
+ * diagonal touches it once, with the force of a plane. */
+START_TEST(unwelded_mesh)
+{
+    const double gravity[3] = {0, 0, 0};
+    sx_model *m = scene_model(3, gravity, 1e-6, 1e6, 0.3, 2500);
+    /* the second triangle's copies of corners 0 and 2 start 1e-5 m away,
+     * more than welding takes, and are moved onto them in the file */
+    const double h = 0.1, off = 1e-5;
+    const double x[6 * 3] = {-h, -h, 0, h, -h, 0, h, h, 0, -h, h, 0, -h + off, -h, 0, h, h + off, 0};
+    const int32_t tri[6] = {0, 1, 2, 4, 5, 3};
+    sx_wall_def wd = sx_wall_default_def(3);
+    wd.kind = SX_WALL_MESH;
+    wd.kn = wd.ks = 1e6;
+    const sx_mesh_def md = {x, 6, tri, 2, false};
+    int64_t wall;
+    ck_assert_int_eq(sx_wall_add_mesh(m, &wd, &md, &wall, NULL), SX_OK);
+    int64_t nv, nt;
+    ck_assert_int_eq(sx_wall_mesh_size(m, wall, &nv, &nt), SX_OK);
+    ck_assert_int_eq(nv, 6);
+    const double r = 0.01, dent = 1e-4, at[3] = {0, 0, r - dent};
+    scene_ball(m, at, NULL, r);
+    char p[512];
+    io_save(m, io_path(p, sizeof p, "unwelded.h5"));
+    sx_model_destroy(m);
+
+    hid_t f = H5Fopen(p, H5F_ACC_RDWR, H5P_DEFAULT);
+    ck_assert(f >= 0);
+    hid_t d = H5Dopen2(f, "/walls/mesh_1/body_vertices", H5P_DEFAULT);
+    ck_assert(d >= 0);
+    double body[6 * 3];
+    ck_assert(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, body) >= 0);
+    memcpy(body + 3 * 4, body + 3 * 0, 3 * sizeof(double));
+    memcpy(body + 3 * 5, body + 3 * 2, 3 * sizeof(double));
+    ck_assert(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, body) >= 0);
+    H5Dclose(d);
+    H5Fclose(f);
+
+    m = io_load(p, 3);
+    ck_assert_int_eq(sx_wall_mesh_size(m, wall, &nv, &nt), SX_OK);
+    ck_assert_int_eq(nv, 4);
+    ck_assert_int_eq(nt, 2);
+    double v[4 * 3];
+    int32_t t[6];
+    ck_assert_int_eq(sx_wall_mesh_get(m, wall, v, t), SX_OK);
+    ck_assert(t[0] == t[3] && t[2] == t[4] && t[5] == 3);
+    io_cycle(m, 1);
+    double fn, kn;
+    int64_t contacts;
+    ck_assert_int_eq(sx_wall_load(m, wall, &fn, &contacts, &kn), SX_OK);
+    ck_assert_int_eq(contacts, 1);
+    ck_assert_double_eq_tol(fn, 0.5e6 * dent, 1e-6 * 0.5e6 * dent); /* kn in series with the wall's */
+    /* welding a welded mesh changes nothing: saved again, it loads to the bit */
+    io_save(m, io_path(p, sizeof p, "welded.h5"));
+    sx_model *c = io_load(p, 3);
+    ck_assert_uint_eq(sx_model_state_hash(c), sx_model_state_hash(m));
+    sx_model_destroy(c);
+    sx_model_destroy(m);
+}
+END_TEST
+
 /* Threads are a setting of the model: kept, and results do not depend on them. */
 START_TEST(threads_kept)
 {
@@ -340,6 +403,7 @@ int main(void)
     tcase_add_loop_test(tc, resave, 2, 4);
     tcase_add_loop_test(tc, contents, 2, 4);
     tcase_add_test(tc, threads_kept);
+    tcase_add_test(tc, unwelded_mesh);
     tcase_add_test(tc, histories_saved);
     suite_add_tcase(s, tc);
     return io_run_suite(s);
