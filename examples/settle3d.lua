@@ -5,7 +5,7 @@
 -- 0.3) and fall; local damping, a normal dashpot and rolling resistance
 -- (mu_r = 0.1) settle them until PFC's mean unbalanced-force ratio falls to
 -- `ratio` (default 1e-3) or max_steps pass (default 250,000). Measured:
--- 300 balls stop on the ratio after 116,500 steps, 1,000 after 189,100.
+-- 300 balls stop on the ratio after 125,700 steps, 1,000 after 231,300.
 -- Without rolling resistance (rolling_friction 0) a ball rolling on the
 -- bed's surface feels no force to damp: 300 balls are still at ratio 0.024
 -- after 200,000 steps. Times are wall-clock (seixo.clock).

@@ -9,8 +9,9 @@
  * (scattered: the next cycle goes on from there, sx__dd_agree_replicated).
  * Inside a cycle rank r owns the balls
  * own[r], a contiguous range of dense indices: the broad phase sorts balls
- * by cell with the last axis slowest, so a range is a slab across that
- * axis, cut to balance the ranks' work (and cut again at every build, which
+ * by cell with the grid's last axis slowest (the model's last, or one with
+ * at least twice its cells), so a range is a slab across that axis, cut to
+ * balance the ranks' work (and cut again at every build, which
  * is where balls migrate). Each step it
  *   - refreshes its ghosts, the balls need[4r] below and need[4r + 1]
  *     above its own (and the far ends of a periodic cell), from their

@@ -191,6 +191,10 @@ static inline size_t sx__pair_size(const sx_pair_field *f)
 }
 
 typedef struct sx_grid {
+    /* lo, nc and a cell's coordinates are along the grid's axes: grid axis
+     * k is the model's axis axis[k], the last one the slowest of the cell
+     * order (broad_phase.c, grid_axes) */
+    int axis[3];
     double lo[3], cell;
     int64_t nc[3], ncells, cap_cells;
     int32_t *start;        /* cells' start in sorted order (ncells + 1) */

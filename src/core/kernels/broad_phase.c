@@ -337,6 +337,23 @@ static double finite_wall_distance(const sx_wall *w, const double *x, double *n)
     return dist;
 }
 
+/* The cell order's axes (sx_grid): the last axis is the slowest unless
+ * another has at least twice its cells, which then is (the one with most
+ * cells; the others keep their order). A decomposed run's slabs are cut
+ * across the slowest axis, so a flat bed is cut across its length, not
+ * its depth (the ghosts: one layer of cells each side of a slab). */
+static void grid_axes(const int64_t *nc, int *axis)
+{
+    int slow = D - 1;
+    for (int k = 0; k < D - 1; k++)
+        if (nc[k] >= 2 * nc[D - 1] && nc[k] > nc[slow]) slow = k;
+    int n = 0;
+    for (int k = 0; k < D; k++)
+        if (k != slow) axis[n++] = k;
+    axis[n++] = slow;
+    for (; n < 3; n++) axis[n] = n;
+}
+
 /* Grid over the balls' bounding box; cells at least a diameter plus the
  * skin wide, widened if a sparse scene would need more cells than ~2 per ball. */
 static bool grid_setup(sx_model *m)
@@ -368,9 +385,12 @@ static bool grid_setup(sx_model *m)
     }
     g->cell = cell;
     g->ncells = 1;
+    int64_t nc[D];
+    for (int k = 0; k < D; k++) nc[k] = (int64_t)floor(extent[k] / cell) + 1;
+    grid_axes(nc, g->axis);
     for (int k = 0; k < 3; k++) {
-        g->lo[k] = k < D ? lo[k] : 0;
-        g->nc[k] = k < D ? (int64_t)floor(extent[k] / cell) + 1 : 1;
+        g->lo[k] = k < D ? lo[g->axis[k]] : 0;
+        g->nc[k] = k < D ? nc[g->axis[k]] : 1;
         g->ncells *= g->nc[k];
     }
     if (g->ncells + 1 > g->cap_cells) {
@@ -385,7 +405,7 @@ static bool grid_setup(sx_model *m)
 static inline void cell_coords(const sx_grid *g, const double *x, int64_t *c)
 {
     for (int k = 0; k < D; k++) {
-        const double q = (x[k] - g->lo[k]) / g->cell; /* NaN when both are infinite: cell 0 */
+        const double q = (x[g->axis[k]] - g->lo[k]) / g->cell; /* NaN when both are infinite: cell 0 */
         c[k] = q >= (double)g->nc[k] ? g->nc[k] - 1 : q >= 0 ? (int64_t)q : 0;
     }
 }
