@@ -21,7 +21,9 @@
 --
 -- Stresses are compression positive; strains are compression positive
 -- (a lateral expansion is a negative lateral strain); volumetric strain is
--- the axial strain plus (dim - 1) lateral strains. In 2D (disks of unit
+-- 1 - V/V0 = 1 - (1 - ea)(1 - el)^(dim - 1), the specimen's change of volume
+-- (at small strains the axial strain plus (dim - 1) lateral strains, which
+-- drifts at large ones: a sand's 25 %). In 2D (disks of unit
 -- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
 
 local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
@@ -1056,7 +1058,7 @@ local function compression(spec, opts, fn)
       ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
       if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
     end
-    local row = {m:step(), m:time() - t_start, ea, el, ea + (dim - 1) * el, sa, sl, q,
+    local row = {m:step(), m:time() - t_start, ea, el, 1 - (1 - ea) * (1 - el) ^ (dim - 1), sa, sl, q,
                  m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial,
                  rate * factor}
     rows[#rows + 1] = row
@@ -1653,29 +1655,7 @@ require("seixo.calibrate").install(lab, {gnuplot = gnuplot, copy = copy, polling
 -- periodic cells, without walls (lua/seixo/periodic.lua)
 lab.periodic = require "seixo.periodic"
 
--- Errors point at the caller's line, not into this file: what fails inside
--- an exported function is raised again from its caller's position (the
--- helpers above raise at a fixed level, which is the caller's only for
--- some call paths). One wrapper here keeps every function honest; an
--- error raised in another of seixo's modules that lab calls counts as lab's.
-local own = {lab = true, pool = true, calibrate = true, periodic = true, plot = true, util = true}
-local function at_caller(f)
-  return function(...)
-    local r = table.pack(pcall(f, ...))
-    if r[1] then return table.unpack(r, 2, r.n) end
-    local e = r[2]
-    if type(e) ~= "string" then error(e, 0) end
-    local caller = debug.getinfo(2, "Sl")
-    local here = caller and caller.currentline > 0 and (caller.short_src .. ":" .. caller.currentline .. ": ")
-    if here and e:sub(1, #here) == here then error(e, 0) end -- already the caller's
-    local module, inner = e:match("^[^\n]-seixo/([%w_]+)%.lua:%d+: (.*)$")
-    if inner and own[module] then error(inner, 2) end
-    if e:match("^[^\n:]+:%d+: ") then error(e, 0) end -- another file's (a user's callback)
-    error(e, 2) -- no position (a helper's level fell on a tail call)
-  end
-end
-for name, f in pairs(lab) do
-  if type(f) == "function" then lab[name] = at_caller(f) end
-end
+-- Errors point at the caller's line, not into this file (seixo.caller)
+require("seixo.caller").wrap(lab)
 
 return lab

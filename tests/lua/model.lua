@@ -112,6 +112,31 @@ test("solve stops on the unbalanced-force ratio", function()
   end
 end)
 
+test("with no contact force the ratio is settled only when nothing moves", function()
+  -- balls afloat (no gravity) and a wall closing on them: solve{ratio} had
+  -- stopped at once, at a ratio of 0, before the wall touched them
+  local m = seixo.model{dim = 3, gravity = {0, 0, 0}}
+  m:material("g", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.7})
+  for i = 0, 3 do m:ball{pos = {0.02 * i, 0, 0.01}, radius = 0.005} end
+  eq(m:ratio(), 0, "a still cloud is settled")
+  local why = m:solve{ratio = 1e-3}
+  eq(why, "ratio")
+  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  m:wall{kind = "plane", point = {0, 0, 0.03}, normal = {0, 0, -1}, vel = {0, 0, -0.05}}
+  eq(m:ratio(), math.huge, "a wall moves: not settled")
+  local steps
+  why, _, steps = m:solve{ratio = 1e-2, every = 10, steps = 200000}
+  eq(why, "ratio")
+  -- the lid squeezes the balls onto the floor: 4 balls, 2 contacts each
+  eq(m:contact_count(), 8, "stopped once the lid pressed the balls onto the floor")
+  check(steps > 1000, "it cycled until the lid touched: " .. steps)
+  -- a moving ball, no contact
+  local m2 = seixo.model{dim = 2, gravity = {0, 0}}
+  m2:material("g", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5})
+  m2:ball{pos = {0, 0}, radius = 0.005, vel = {1, 0}}
+  eq(m2:ratio(), math.huge)
+end)
+
 test("solve with no limit uses ratio 1e-5; the first of several limits wins", function()
   local m = column(3, 2)
   local why, ratio = m:solve()

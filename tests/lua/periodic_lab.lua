@@ -32,8 +32,48 @@ T.test("periodic triaxial: the lateral stress held within 1 % while the cell is 
   T.near(r.rows[#r.rows].ea, 0.001, 0.1)
 end)
 
+T.test("periodic triaxial: ev is the cell's change of volume", function()
+  local r = lab.periodic.triaxial(granular, {confining = 1e6, strain_rate = 20, max_strain = 0.08, post_peak = 0.01,
+                                             log = false})
+  local m = seixo.load(granular.path)
+  local c0 = m:periodic().size
+  m:close()
+  local last = r.rows[#r.rows]
+  -- 1 - V/V0 from the strains of the cell's edges (the lateral ones alike in 2D)
+  local v = (1 - last.ea) * (1 - last.el)
+  T.near(last.ev, 1 - v, 1e-9)
+  -- the small-strain sum drifts from it by ea el at 8 %
+  T.check(math.abs(last.ev - (last.ea + last.el)) > 0.5 * math.abs(last.ea * last.el), "not the small-strain sum")
+  T.check(c0[1] > 0, "the cell")
+end)
+
+T.test("the periodic tests' options are checked (a sand user's findings)", function()
+  local function refused(fn, opts, text)
+    local ok, err = pcall(function()
+      local r = fn(granular, opts) -- (not a tail call: the caller's line is this one)
+      return r
+    end)
+    T.check(not ok and err:find(text, 1, true), tostring(err))
+    -- the error points at this script's line, not into the library
+    T.check(err:find("periodic_lab.lua", 1, true), "at the caller: " .. tostring(err))
+  end
+  -- every = 0 cycled nothing, forever
+  refused(lab.periodic.triaxial, {every = 0}, "every must be a whole number of steps >= 1 (got 0)")
+  refused(lab.periodic.shear, {every = 0}, "every must be a whole number of steps >= 1 (got 0)")
+  refused(lab.periodic.triaxial, {post_peak = 5}, "post_peak must be in (0, 1) (got 5)")
+  refused(lab.periodic.triaxial, {confinig = 1e6}, "unknown option 'confinig'")
+  -- bonds = 0 gave a bonded specimen
+  local ok, err = pcall(lab.periodic.specimen, {dim = 2, bonds = 0, path = "never.h5", log = false})
+  T.check(not ok and err:find("bonds must be true or false", 1, true), tostring(err))
+end)
+
 T.test("periodic simple shear at constant normal stress", function()
   local r = lab.periodic.shear(granular, {normal = 1e6, shear_rate = 2, max_strain = 0.004, log = false})
+  local m = seixo.load(granular.path)
+  local step0 = m:step()
+  m:close()
+  -- steps are the shearing's: the rows' last step less the first's start
+  T.eq(r.steps, r.rows[#r.rows].step - step0 - r.confine_steps)
   local last = r.rows[#r.rows]
   T.check(last.gamma >= 0.004, "sheared to the strain")
   T.near(last.sn, 1e6, 0.05)
