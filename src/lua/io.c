@@ -42,6 +42,16 @@
 /* The state fields saved with the model: plain data kept by other files. */
 static const char *const saved_state[] = {"groups", "group_names", "extras", "wall_extras", NULL};
 
+/* Those saved only when the model has them, so that a model without them
+ * writes what it did before: the group slots 2 and up, and the balls'
+ * displacement references (disp.c: a model that never asked for b.disp
+ * must not start recording them once loaded). NULL past the last. */
+static const char *optional_state(int k)
+{
+    if (k + 2 <= SX_LUA_SLOTS) return sx_lua_slot_table(k + 2);
+    return k + 2 == SX_LUA_SLOTS + 1 ? "disp_ref" : NULL;
+}
+
 typedef struct ser {
     sx_io_tree *tree;
     int seen;     /* stack index: tables already written */
@@ -370,10 +380,9 @@ static int model_save(lua_State *L)
         if (me >= 0) ser_table(L, &s, -1, me, saved_state[k]);
         lua_pop(L, 1);
     }
-    /* group slots 2 and up: only those in use, so a model without them writes what it did before */
     lua_getiuservalue(L, 1, 1);
-    for (int k = 2; k <= SX_LUA_SLOTS && !s.oom; k++) {
-        const char *name = sx_lua_slot_table(k);
+    const char *name;
+    for (int k = 0; (name = optional_state(k)) && !s.oom; k++) {
         if (lua_getfield(L, -1, name) == LUA_TTABLE) {
             sx_io_node n = {.parent = -1, .key_kind = SX_IO_STRING, .key_string = (char *)name,
                             .key_length = strlen(name), .kind = SX_IO_TABLE};
@@ -465,8 +474,9 @@ static int seixo_load(lua_State *L)
             for (int q = 0; saved_state[q]; q++)
                 if (lua_getfield(L, -2, saved_state[q]) == LUA_TTABLE) lua_setfield(L, -2, saved_state[q]);
                 else lua_pop(L, 1);
-            for (int q = 2; q <= SX_LUA_SLOTS; q++)
-                if (lua_getfield(L, -2, sx_lua_slot_table(q)) == LUA_TTABLE) lua_setfield(L, -2, sx_lua_slot_table(q));
+            const char *field;
+            for (int q = 0; (field = optional_state(q)); q++)
+                if (lua_getfield(L, -2, field) == LUA_TTABLE) lua_setfield(L, -2, field);
                 else lua_pop(L, 1);
         }
         lua_pop(L, 2);

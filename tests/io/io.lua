@@ -84,6 +84,32 @@ T.test("variables, groups and extras come back", function()
   T.eq(c:count{group = "bottom"}, m:count{group = "bottom"})
 end)
 
+T.test("the balls' displacement references come back (an MPI user's finding)", function()
+  for _, dim in ipairs{2, 3} do
+    local a, b = scene(dim), scene(dim)
+    a:reset_disp{group = "top"}
+    b:reset_disp{group = "top"}
+    a:cycle(300)
+    b:cycle(150)
+    b:save(file("disp" .. dim .. ".h5"))
+    local c = seixo.load(path("disp" .. dim .. ".h5"))
+    c:cycle(150)
+    -- (the balls outside the reset took theirs when the next cycle began)
+    for ball in a:balls() do
+      local d = ball.disp
+      T.check(d:norm() > 0, "it moved")
+      T.eq(c:ball(ball.id).disp, d, dim .. "D ball " .. ball.id)
+    end
+  end
+  -- a model that never reset them: no reference after a load
+  local m = scene(3)
+  m:save(file("nodisp.h5"))
+  local c = seixo.load(path("nodisp.h5"))
+  c:cycle(10)
+  local ok, err = pcall(function() return c:ball(1).disp end)
+  T.check(not ok and err:find("no reference position yet", 1, true), tostring(err))
+end)
+
 T.test("bad files give one-line errors naming the file", function()
   local m = scene(2)
   m:save(file("two.h5"))
