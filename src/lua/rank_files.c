@@ -10,8 +10,9 @@
  * and on a disk rank 0 may not share.
  *
  * Wrapped on ranks above 0: io.open, io.lines, io.input and io.output (a
- * path: through io.open), os.remove and os.rename (a shadow is removed or
- * renamed; the real file is rank 0's to change). (On rank 0 too, where
+ * path: through io.open), dofile and loadfile (read from the shadow),
+ * os.remove and os.rename (a shadow is removed or renamed; the real file
+ * is rank 0's to change). (On rank 0 too, where
  * they change nothing, for the names written while the ranks do not share
  * files: drop_shadow.) A name the script removed
  * or renamed away is remembered as gone, so a rank that runs ahead does
@@ -416,6 +417,23 @@ static int rank_lines(lua_State *L)
     return 4;
 }
 
+/* dofile(path) and loadfile(path, ...): a file the script wrote is read
+ * from the shadow, as io.open reads it (a rank above 0 ran ahead of rank
+ * 0's write: a params.lua it had just written was not there yet). Lua's
+ * own function (the upvalue) with the path replaced; a chunk read from a
+ * shadow names the shadow in its messages. */
+static int rank_load(lua_State *L)
+{
+    if (shadowing() && lua_type(L, 1) == LUA_TSTRING) {
+        sx_lua_rank_file(L, lua_tostring(L, 1));
+        lua_replace(L, 1);
+    }
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+    return lua_gettop(L);
+}
+
 /* io.input([file]) and io.output([file]): a path opens through io.open
  * (upvalue 2, the wrapped one) with mode, and Lua's own function (upvalue
  * 1) takes the file. */
@@ -519,6 +537,8 @@ void sx_lua_rank_files_open(lua_State *L)
     sx_lua_wrap(L, "io", "lines", rank_lines, 0);
     sx_lua_wrap(L, "os", "remove", rank_remove, 0);
     sx_lua_wrap(L, "os", "rename", rank_rename, 0);
+    sx_lua_wrap(L, "_G", "dofile", rank_load, 0);
+    sx_lua_wrap(L, "_G", "loadfile", rank_load, 0);
     for (int k = 0; k < 2; k++) {
         if (lua_getglobal(L, "io") != LUA_TTABLE) {
             lua_pop(L, 1);

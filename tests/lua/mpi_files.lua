@@ -147,6 +147,16 @@ note("removed again", os.remove(base .. ".gone"))
 note("an io.lines error", select(2, pcall(function() for _ in io.lines(base .. ".none") do end end)))
 note("an io.open error", select(2, pcall(function() return io.open(base, "q") end)))
 
+-- a Lua file the script writes, rank 0 late, then run by dofile and
+-- loadfile (an MPI user's finding: the others read the disk before rank 0
+-- had written it, and found nothing)
+if seixo.rank() == 0 then os.execute("sleep 0.3") end
+f = assert(io.open(base .. ".params.lua", "w"))
+f:write("return {k = 7, name = 'params'}\n")
+f:close()
+note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name)
+os.remove(base .. ".params.lua")
+
 local sum = 0
 for _, line in ipairs(record) do
   print(line)
