@@ -106,6 +106,13 @@ bool sx_lua_parallel_sharing(void);
 /// rank_files.c: under mpirun, on a rank above 0, the script's files become
 /// shadows while models are shared (rank 0 alone writes the real ones).
 void sx_lua_rank_files_open(lua_State *L);
+/// rank_files.c: the C closure's upvalue 1 (the function it wraps, Lua's
+/// own) called with the first nargs arguments, its values returned; an
+/// error is raised again with the script's place in front, as the script's
+/// own call would have it.
+int sx_lua_call_own(lua_State *L, int nargs);
+/// rank_stdin.c: standard input read by rank 0 for every rank while the ranks share models.
+void sx_lua_rank_stdin_open(lua_State *L);
 /// rank_files.c: pushes and returns the path to read for the script's file
 /// `path`: its shadow's on a rank above 0 that wrote it, else path itself.
 const char *sx_lua_rank_file(lua_State *L, const char *path);

@@ -172,6 +172,15 @@ static int seixo_ranks(lua_State *L)
     return 1;
 }
 
+/* seixo.barrier(): every rank waits until all are there (a no-op serially).
+ * A shell command rank 0 ran alone (`if seixo.rank() == 0 then
+ * os.execute(...) end`) has then written its files for the others to read. */
+static int seixo_barrier(lua_State *L)
+{
+    sx_lua_parallel_check_call(L, "seixo.barrier");
+    return 0;
+}
+
 static void check_ranks(lua_State *L, const char *fn)
 {
     if (world_size < 2) luaL_error(L, "seixo.%s: one rank only (start the script with mpirun -np N)", fn);
@@ -908,6 +917,7 @@ void sx_lua_parallel_open(lua_State *L)
     /* rank 0's too: what it writes while the ranks do not share files is
      * noted for the others (share_alone_writes) */
     sx_lua_rank_files_open(L);
+    sx_lua_rank_stdin_open(L);
 #else
     (void)L;
 #endif
@@ -916,6 +926,6 @@ void sx_lua_parallel_open(lua_State *L)
 const luaL_Reg sx_lua_parallel_functions[] = {
     {"cores", seixo_cores}, {"executable", seixo_executable}, {"rank", seixo_rank},
     {"ranks", seixo_ranks}, {"send", seixo_send},             {"receive", seixo_receive},
-    {"decompose", seixo_decompose},
+    {"decompose", seixo_decompose}, {"barrier", seixo_barrier},
     {NULL, NULL},
 };

@@ -316,8 +316,7 @@ static int push_shadow_file(lua_State *L, const char *shadow, const char *mode, 
     return 1;
 }
 
-/* The upvalue, Lua's own function, with this call's arguments. */
-static int call_lua_own(lua_State *L, int nargs)
+int sx_lua_call_own(lua_State *L, int nargs)
 {
     lua_settop(L, nargs);
     lua_pushvalue(L, lua_upvalueindex(1));
@@ -351,20 +350,20 @@ static int rank_open(lua_State *L)
         const char *path = luaL_checkstring(L, 1), *mode = luaL_optstring(L, 2, "r");
         luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
         if (mode[0] != 'r' || strchr(mode, '+')) drop_shadow(L, path);
-        return call_lua_own(L, nargs);
+        return sx_lua_call_own(L, nargs);
     }
     const char *path = luaL_checkstring(L, 1);
     const char *mode = luaL_optstring(L, 2, "r");
     luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
     const bool writes = mode[0] != 'r' || strchr(mode, '+');
-    if (!push_real_name(L, path)) return writes ? luaL_fileresult(L, 0, path) : call_lua_own(L, nargs);
+    if (!push_real_name(L, path)) return writes ? luaL_fileresult(L, 0, path) : sx_lua_call_own(L, nargs);
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
     struct stat st;
     /* a file the script did not write; a device (/dev/null: plot.live's
      * sink on these ranks), a FIFO or a socket, which are not copies */
     if ((s == NO_SHADOW || s == ON_DISK) && (!writes || (stat(path, &st) == 0 && !S_ISREG(st.st_mode))))
-        return call_lua_own(L, nargs);
+        return sx_lua_call_own(L, nargs);
     if (s == GONE && mode[0] == 'r') return fail_with(L, ENOENT, path);
     if (s != SHADOWED) { /* a shadow stands for a file rank 0 made: only a new one is probed */
         if (!may_write(path, mode) || !new_shadow(s != GONE && mode[0] == 'r' ? path : NULL, shadow))
@@ -394,11 +393,11 @@ static int rank_lines(lua_State *L)
 {
     const int nargs = lua_gettop(L);
     if (!lua_isnoneornil(L, 1)) luaL_checkstring(L, 1); /* io.lines' own check, naming it */
-    if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return call_lua_own(L, nargs);
-    if (!push_real_name(L, lua_tostring(L, 1))) return call_lua_own(L, nargs);
+    if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return sx_lua_call_own(L, nargs);
+    if (!push_real_name(L, lua_tostring(L, 1))) return sx_lua_call_own(L, nargs);
     char shadow[PATH_MAX];
     const enum shadow s = shadow_of(L, shadow);
-    if (s == NO_SHADOW || s == ON_DISK) return call_lua_own(L, nargs);
+    if (s == NO_SHADOW || s == ON_DISK) return sx_lua_call_own(L, nargs);
     lua_pop(L, 1);
     /* io.lines' own error when the file cannot be opened */
     if (s == GONE) return luaL_error(L, "cannot open file '%s' (%s)", lua_tostring(L, 1), strerror(ENOENT));
@@ -440,7 +439,7 @@ static int rank_load(lua_State *L)
 static int rank_default_file(lua_State *L, const char *mode)
 {
     if (!shadowing() && lua_type(L, 1) == LUA_TSTRING && mode[0] == 'w') drop_shadow(L, lua_tostring(L, 1));
-    if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return call_lua_own(L, lua_gettop(L));
+    if (!shadowing() || lua_type(L, 1) != LUA_TSTRING) return sx_lua_call_own(L, lua_gettop(L));
     const char *path = lua_tostring(L, 1);
     lua_settop(L, 1);
     lua_pushvalue(L, lua_upvalueindex(2));
@@ -451,7 +450,7 @@ static int rank_default_file(lua_State *L, const char *mode)
         return luaL_error(L, "cannot open file '%s' (%s)", path, strerror((int)lua_tointeger(L, -1)));
     lua_pop(L, 2);
     lua_replace(L, 1);
-    return call_lua_own(L, 1);
+    return sx_lua_call_own(L, 1);
 }
 
 static int rank_input(lua_State *L) { return rank_default_file(L, "r"); }
@@ -471,7 +470,7 @@ static int rank_remove(lua_State *L)
 {
     if (!shadowing()) {
         drop_shadow(L, luaL_checkstring(L, 1));
-        return call_lua_own(L, lua_gettop(L));
+        return sx_lua_call_own(L, lua_gettop(L));
     }
     const char *path = luaL_checkstring(L, 1);
     if (!push_real_name(L, path)) return luaL_fileresult(L, 0, path);
@@ -489,7 +488,7 @@ static int rank_rename(lua_State *L)
         const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
         drop_shadow(L, from);
         drop_shadow(L, to);
-        return call_lua_own(L, lua_gettop(L));
+        return sx_lua_call_own(L, lua_gettop(L));
     }
     const char *from = luaL_checkstring(L, 1), *to = luaL_checkstring(L, 2);
     if (!push_real_name(L, from)) return luaL_fileresult(L, 0, NULL);

@@ -157,6 +157,14 @@ f:close()
 note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name)
 os.remove(base .. ".params.lua")
 
+-- a shell command rank 0 runs alone, late, then seixo.barrier(): its file
+-- is there for every rank (an MPI user's finding: no call could wait for it)
+if seixo.rank() == 0 then os.execute("sleep 0.3; echo from-the-shell > " .. base .. ".shell") end
+seixo.barrier()
+note("after the barrier", io.open(base .. ".shell"):read("l"))
+seixo.barrier() -- (every rank has read it before rank 0 removes it)
+if seixo.rank() == 0 then os.remove(base .. ".shell") end
+
 local sum = 0
 for _, line in ipairs(record) do
   print(line)

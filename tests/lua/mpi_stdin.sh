@@ -74,6 +74,36 @@ for np in $ranks; do
     fi
   done
 done
+# a script file that reads standard input (an MPI user's finding: io.read
+# gave nil on the ranks above 0): io.read's formats, io.lines(),
+# io.stdin:read and io.stdin:lines, each value put into the model, so a
+# rank that read something else stops the next cycle; it prints what the
+# serial run prints
+cat >"$dir/reads.lua" <<EOF
+local m = dofile('$(dirname "$0")/mpi_bed.lua')(40)
+local word, n, x = io.read("l", "n", "n")
+local count = 0
+for line in io.lines() do
+  count = count + 1
+  if line == "--" then break end
+end
+local tail = io.stdin:read("l")
+local more = {}
+for a, b in io.stdin:lines("n", "n") do more[#more + 1] = a + b end
+local sum = n + x + count + #tail + #more + more[1]
+m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e4)}
+m:cycle(10)
+print(word, n, x, count, tail, #more, more[1], more[2], io.read("l"), m:hash())
+EOF
+printf 'hello\n42 2.5\na\nb\n--\nthe tail\n1 2\n3 4\n' >"$dir/input"
+timeout 300 "$seixo" "$dir/reads.lua" <"$dir/input" >"$dir/serial" 2>"$dir/err" || { echo "reads, serial:"; cat "$dir/err"; exit 1; }
+echo "reads, serial:"; cat "$dir/serial"
+for np in $ranks; do
+  timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" "$dir/reads.lua" <"$dir/input" >"$dir/out" 2>"$dir/err"
+  rc=$?
+  if [ $rc != 0 ]; then echo "reads, -np $np: exit status $rc"; cat "$dir/err"; fail=1; continue; fi
+  same_as_serial "reads, -np $np" "$np"
+done
 # a bad option, which every rank parses alike: refused, said once (rank 0)
 for np in $ranks; do
   timeout 300 mpirun $root --oversubscribe -np "$np" "$seixo" --frob >"$dir/out" 2>"$dir/err"
