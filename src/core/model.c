@@ -243,7 +243,8 @@ sx_status sx_material_get(const sx_model *m, int index, sx_material_def *out)
 const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len)
 {
 #define CHECK(cond, what, val) \
-    if (!(cond) || !isfinite(val)) return snprintf(why, len, "%s (got %g)", what, (double)(val)), why
+    if (!(cond) || !isfinite(val)) \
+        return snprintf(why, len, isfinite(val) ? "%s (got %g)" : "%s, a finite number (got %g)", what, (double)(val)), why
     CHECK(d->density > 0, "density must be > 0 kg/m^3", d->density);
     CHECK(d->kn > 0, "kn must be > 0 N/m", d->kn);
     CHECK(d->ks >= 0, "ks must be >= 0 N/m", d->ks);

@@ -125,13 +125,15 @@ static double KERNEL(estimate_dt)(sx_model *m);
  * x_n during the previous step, so displacement increments use its length. */
 static inline double motion_dt(const sx_model *m) { return m->dt_prev > 0 ? m->dt_prev : m->dt; }
 
-static sx_status overlap_error(sx_model *m, const char *what, int64_t ida, int64_t idb, double un, double r)
+/* what_a, what_b: "ball", "ball" or "ball", "wall" */
+static sx_status overlap_error(sx_model *m, const char *what_a, const char *what_b, int64_t ida, int64_t idb,
+                               double un, double r)
 {
     return sx__fail(m, SX_EUNSTABLE,
-                    "unstable at step %lld: %s %lld and %lld overlap by %g m, more than the radius %g m; "
+                    "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m; "
                     "the timestep %g s is too large for the contact stiffness (critical estimate %g s): "
                     "lower the timestep or use the automatic one",
-                    (long long)m->step, what, (long long)ida, (long long)idb, un, r, m->dt,
+                    (long long)m->step, what_a, (long long)ida, what_b, (long long)idb, un, r, m->dt,
                     KERNEL(estimate_dt)(m));
 }
 
@@ -145,7 +147,7 @@ static sx_status chunk_error(sx_model *m, const sx_chunk *o)
                         "not finite; the timestep %g s is too large for its stiffness (critical estimate %g s): "
                         "lower the timestep or use the automatic one",
                         (long long)m->step, (long long)o->err_a, (long long)o->err_b, m->dt, KERNEL(estimate_dt)(m));
-    return overlap_error(m, "balls", o->err_a, o->err_b, o->err_un, o->err_r);
+    return overlap_error(m, "ball", "ball", o->err_a, o->err_b, o->err_un, o->err_r);
 }
 
 static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode mode, sx_bond_kind kind, int element,

@@ -576,7 +576,7 @@ static sx_status KERNEL(walls)(sx_model *m)
                             "ball %lld is near %.0f facets of mesh wall %lld, more than %d: the mesh is too fine for "
                             "a ball of radius %g m (coarsen it)",
                             (long long)o->err_ball, o->err_un, (long long)o->err_wall, MESH_ROWS_MAX, o->err_r);
-        if (o->st) return overlap_error(m, "ball and wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
+        if (o->st) return overlap_error(m, "ball", "wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
         if (!dd) { /* decomposed: the energy sums are the ranks' to chain (decompose.c, sx__dd_energy) */
             m->acc.slip += o->slip;
             m->acc.viscous += o->viscous;
