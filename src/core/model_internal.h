@@ -449,6 +449,14 @@ struct sx_model {
     int64_t cap_wlaw;
     double *scratch;        /* scratch of one operation (sorting, timestep sums), released after it */
     int64_t scratch_cap;
+    /* per ball slot (periodic ghosts included), the inverse mass a contact's
+     * dashpot sees: 0 for a ball whose velocity is fixed on every axis,
+     * which moves as it is told whatever the forces (a wall's infinite
+     * mass), else its own; filled for each pass that needs it, only while
+     * some ball is so fixed (pair_contacts.c, dashpot_inverse_mass) */
+    double *dash_im;
+    int64_t cap_dash_im;
+    const double *dash_im_now; /* the contact pass's: dash_im or balls.inv_mass */
     sx_grid grid;
     int64_t builds;         /* number of broad-phase builds so far */
 

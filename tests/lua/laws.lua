@@ -43,6 +43,9 @@ local function impact(dim, model, e, against)
   local b
   if against == "wall" then
     m:wall{kind = dim == 3 and "plane" or "line", point = vec(0), normal = vec(1), kn = 1e9, ks = 1e9}
+  elseif against == "fixed ball" then -- its velocity fixed (at rest): a wall's infinite mass to the dashpot
+    b = m:ball{pos = vec(-r - 1e-4), radius = r}
+    b.fix = "vel"
   else
     b = m:ball{pos = vec(-r - 1e-4), radius = r, vel = vec(v)}
   end
@@ -54,12 +57,12 @@ local function impact(dim, model, e, against)
   end
   T.check(touched, "no impact")
   local va = a.vel[1]
-  if against == "wall" then return va / v end
+  if against ~= "ball" then return va / v end
   return (va - b.vel[1]) / (2 * v)
 end
 
 for _, model in ipairs{"hertz", "linear"} do
-  for _, against in ipairs{"wall", "ball"} do
+  for _, against in ipairs{"wall", "ball", "fixed ball"} do
     for _, dim in ipairs{3, 2} do
       T.test(string.format("restitution %s %s %dD: e from 0.1 to 1 within 0.01 (Chung & Ooi test 3)", model, against,
                            dim), function()

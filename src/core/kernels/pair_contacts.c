@@ -443,6 +443,34 @@ static void chunk_start(sx_model *m, sx_chunk *o)
     o->err_break = false;
 }
 
+/* The inverse masses a contact's dashpot takes its reduced mass from
+ * (m->dash_im): a ball whose velocity is fixed on every axis moves as it
+ * is told whatever the forces, so its mass is a wall's, infinite, and a
+ * free ball striking it rebounds at the restitution asked for (with its
+ * own mass in the reduced mass, at 0.616 for 0.5 against a fixed twin; as
+ * LAMMPS takes a frozen atom's). B->inv_mass itself while no ball is so
+ * fixed; NULL when out of memory. A periodic ghost is as its owner. */
+static const double *dashpot_inverse_mass(sx_model *m)
+{
+    const sx_balls *B = &m->balls;
+    const unsigned all = D == 3 ? SX_FIX_VEL : SX_FIX_VX | SX_FIX_VY;
+    uint8_t any = 0; /* (no early exit: the loop vectorizes, a step's cost stays out of sight) */
+    const uint8_t vel = (uint8_t)all;
+    for (int64_t i = 0; i < B->n; i++) any |= (uint8_t)((B->fix[i] & vel) == vel);
+    if (!any) return B->inv_mass;
+    const int64_t slots = m->cell ? m->cell->base + m->cell->n : B->n;
+    if (slots > m->cap_dash_im) {
+        double *q = sx_alloc_resize(&m->alloc, m->dash_im, (size_t)m->cap_dash_im, (size_t)slots, sizeof *q);
+        if (!q) return NULL;
+        m->dash_im = q, m->cap_dash_im = slots;
+    }
+    for (int64_t k = 0; k < slots; k++) {
+        const int64_t o = k < B->n ? k : m->cell->owner[k - m->cell->base];
+        m->dash_im[k] = o >= 0 && (B->fix[o] & all) == all ? 0 : B->inv_mass[k];
+    }
+    return m->dash_im;
+}
+
 /* Ball-ball contacts of one chunk, every model: 4-1 ... 4-21 with the
  * contact models of 4.3.3 - 4.3.5. The total force F acts on b and -F on
  * a; energies, cracks and errors go to the chunk. */
@@ -451,7 +479,7 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
     const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
-    const double *restrict im = B->inv_mass;
+    const double *restrict im = m->dash_im_now; /* the dashpots' (dashpot_inverse_mass) */
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
     const int32_t *restrict bond = p->bond;
@@ -634,13 +662,14 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             if ((law->beta_n > 0 || law->beta_s > 0) && un > 0) {
                 /* viscous dashpots at the critical-damping ratios on the reduced mass
                  * m* = 1 / (1/ma + 1/mb): c = 2 beta sqrt(m* k), a per-law factor when k is */
-                const double sum_im = im[i] + im[j];
-                const double cn = !law->plain ? 2 * law->beta_n * sqrt(kn / sum_im)
-                                                                : sqrt(law->dash_n / sum_im);
+                const double sum_im = im[i] + im[j]; /* 0: both balls fixed, no dashpot between them */
+                const double cn = !(sum_im > 0) ? 0
+                                  : !law->plain ? 2 * law->beta_n * sqrt(kn / sum_im)
+                                                : sqrt(law->dash_n / sum_im);
                 const double fdn = -cn * vn;
                 fd += fdn;
                 double work = fdn * vn;
-                if (!slip && law->beta_s > 0) {
+                if (!slip && law->beta_s > 0 && sum_im > 0) {
                     const double cs = 2 * law->beta_s * sqrt(ks / sum_im);
                     for (int k = 0; k < D; k++) dsh[k] = -cs * vs[k];
                     work += dot(dsh, vs);
@@ -859,6 +888,7 @@ static sx_status KERNEL(contacts)(sx_model *m)
      * pair order (a ghost is only ever a pair's b; one chunk) */
     sx_dd *dd = m->dd && m->dd->active && m->dd->nxpair ? m->dd : NULL;
     if (m->cell) KERNEL(ghosts_refresh)(m, false); /* the ghosts where their owners are now */
+    if (!(m->dash_im_now = dashpot_inverse_mass(m))) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     sx_status st;
     if (dd && (st = far_pairs(m, 0, dd->nxlow))) return st;
 #pragma omp parallel num_threads(m->threads) if (nchunk > 2)

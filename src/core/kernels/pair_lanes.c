@@ -20,7 +20,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
     sx_balls *B = &m->balls;
     sx_pairs *p = &m->bb;
     const double *restrict x = B->x, *restrict v = B->v, *restrict w = B->w, *restrict rad = B->rad;
-    const double *restrict im = B->inv_mass;
+    const double *restrict im = m->dash_im_now; /* the dashpots' (dashpot_inverse_mass) */
     const uint16_t *restrict mat = B->mat;
     const int32_t *restrict pa = p->a, *restrict pb = p->b;
     double *restrict fs_all = p->fs, *restrict geo_all = p->geo, *restrict fn_all = p->fn;
@@ -142,7 +142,7 @@ SX_VECTOR_CLONES static void ball_chunk_batched(sx_model *m, sx_chunk *o)
         if (!VANY(other)) {
             cn = VZERO + memo_cn;
         } else {
-            cn = VSQRT(dash / sim);
+            cn = VSQRT(VSEL(sim > VZERO, dash / sim, VZERO)); /* 0: both balls fixed, no dashpot */
             memo_sim = sim[0], memo_dash = dash[0], memo_cn = cn[0];
         }
         const vd fd = VSEL(active & (bn > VZERO), fn + -cn * vn, fn);

@@ -51,8 +51,9 @@ static void self_rating(const sx_pair_law *l, double r, double mass, double spee
 }
 
 /* Adds ball-ball pair c's stiffness and dashpot to its balls' sums kt,
- * kr, ct, cr (n each, from kt); a ghost's go to its owner. */
-static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
+ * kr, ct, cr (n each, from kt); a ghost's go to its owner. im: the
+ * dashpots' inverse masses (dashpot_inverse_mass). */
+static inline void rate_pair(const sx_model *m, int64_t c, const double *im, double *kt)
 {
     const sx_balls *B = &m->balls;
     const sx_pairs *p = &m->bb;
@@ -77,7 +78,7 @@ static inline void rate_pair(const sx_model *m, int64_t c, double *kt)
         double kn, ks;
         stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks);
         if (un > 0 && (law->beta_n > 0 || law->beta_s > 0)) { /* the dashpots of ball_contacts */
-            const double mstar = 1.0 / (B->inv_mass[i] + B->inv_mass[j]);
+            const double sum_im = im[i] + im[j], mstar = sum_im > 0 ? 1.0 / sum_im : 0; /* 0: both fixed */
             const double cn = 2 * law->beta_n * sqrt(mstar * kn), cs = 2 * law->beta_s * sqrt(mstar * ks);
             ct[i] += cn + cs, ct[jo] += cn + cs;
             cr[i] += cs * B->rad[i] * B->rad[i], cr[jo] += cs * B->rad[j] * B->rad[j];
@@ -124,14 +125,16 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
      * pairs[rank], the rest after it); a ghost's sums are its owner's */
     const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
+    const double *im = dashpot_inverse_mass(m);
+    if (!im) im = m->balls.inv_mass; /* (out of memory: each ball's own mass, as before) */
     if (!dd) {
-        for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, kt);
+        for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, im, kt);
     } else {
         const sx_span mine = dd->bb_own[dd->x.rank];
-        for (int64_t e = 0; e < dd->nxlow; e++) rate_pair(m, dd->xpair[e], kt);
-        for (int64_t e = 0; e < dd->ninpair; e++) rate_pair(m, dd->inpair[e], kt);
-        for (int64_t c = mine.lo; c < mine.hi; c++) rate_pair(m, c, kt);
-        for (int64_t e = dd->nxlow; e < dd->nxpair; e++) rate_pair(m, dd->xpair[e], kt);
+        for (int64_t e = 0; e < dd->nxlow; e++) rate_pair(m, dd->xpair[e], im, kt);
+        for (int64_t e = 0; e < dd->ninpair; e++) rate_pair(m, dd->inpair[e], im, kt);
+        for (int64_t c = mine.lo; c < mine.hi; c++) rate_pair(m, c, im, kt);
+        for (int64_t e = dd->nxlow; e < dd->nxpair; e++) rate_pair(m, dd->xpair[e], im, kt);
     }
     p = &m->bw;
     const int64_t w0 = dd ? dd->bw_own[dd->x.rank].lo : 0, w1 = dd ? dd->bw_own[dd->x.rank].hi : p->n;
