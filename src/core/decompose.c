@@ -1008,8 +1008,8 @@ void sx__tape_add(sx_tape *t, int64_t k, double v)
  * ranks' parts do not touch) and of the wall blocks it shares (wblk: run
  * whole, their sums are the serial ones), then its tape's terms, in their
  * order, onto the sums the lower ranks began. The sums: three per chunk
- * (slip, viscous, released), two per wall block (slip, viscous), two per
- * motion block (damping, loads). */
+ * (slip, viscous, released), two per wall block (slip, viscous), three per
+ * motion block (damping, loads, the dashpots' share). */
 static void energy_part(const sx_model *m, int r, double *acc)
 {
     const sx_dd *d = m->dd;
@@ -1025,7 +1025,8 @@ static void energy_part(const sx_model *m, int r, double *acc)
     const sx_span own = d->own[r];
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
-        if (o->b0 >= own.lo && o->b0 < own.hi) motion[2 * b] = o->damp_work, motion[2 * b + 1] = o->load_work;
+        if (o->b0 >= own.lo && o->b0 < own.hi)
+            motion[3 * b] = o->damp_work, motion[3 * b + 1] = o->load_work, motion[3 * b + 2] = o->visc_work;
     }
     for (int64_t e = 0; e < d->tape.n; e++) acc[d->tape.e[e].k] += d->tape.e[e].v;
 }
@@ -1043,7 +1044,7 @@ static void energy_part(const sx_model *m, int r, double *acc)
 bool sx__dd_energy(sx_model *m)
 {
     sx_dd *d = m->dd;
-    const int64_t K = m->nchunk, nb = m->nblock, len = 3 * K + 4 * nb;
+    const int64_t K = m->nchunk, nb = m->nblock, len = 3 * K + 5 * nb;
     double *s = calloc((size_t)len, sizeof *s);
     const bool ok = s && !d->tape.lost && sx__dd_chain(m, s, (int)len, energy_part);
     d->tape.n = 0;
@@ -1057,8 +1058,9 @@ bool sx__dd_energy(sx_model *m)
         m->acc.viscous += s[3 * K + 2 * b + 1];
     }
     for (int64_t b = 0; ok && b < nb; b++) {
-        m->acc.local_damping -= s[3 * K + 2 * nb + 2 * b];
-        m->acc.boundary_work += s[3 * K + 2 * nb + 2 * b + 1];
+        m->acc.local_damping -= s[3 * K + 2 * nb + 3 * b];
+        m->acc.boundary_work += s[3 * K + 2 * nb + 3 * b + 1];
+        m->acc.viscous += s[3 * K + 2 * nb + 3 * b + 2];
     }
     free(s);
     return ok;

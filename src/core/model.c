@@ -103,6 +103,8 @@ void sx_model_destroy(sx_model *m)
     sx_alloc_free(&m->alloc, m->law, (size_t)(m->law_n * m->law_n), sizeof *m->law);
     sx_alloc_free(&m->alloc, m->scratch, (size_t)m->scratch_cap, sizeof(double));
     sx_alloc_free(&m->alloc, m->dash_im, (size_t)m->cap_dash_im, sizeof(double));
+    sx_alloc_free(&m->alloc, m->visc_f, (size_t)(m->cap_visc * m->dim), sizeof(double));
+    sx_alloc_free(&m->alloc, m->visc_t, (size_t)(m->cap_visc * m->rdim), sizeof(double));
     sx_alloc_free(&m->alloc, m->mats, (size_t)m->cap_mat, sizeof *m->mats);
     sx_alloc_free(&m->alloc, m->cmodel, (size_t)m->cap_cmodel, sizeof *m->cmodel);
     free(m);

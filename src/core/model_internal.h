@@ -245,10 +245,11 @@ typedef struct sx_wall_acc {
 typedef struct sx_block {
     int64_t b0, b1;        /* balls [b0, b1) */
     int64_t w0, w1;        /* their ball-wall pairs [w0, w1) */
-    double worst, damp_work, load_work, slip, viscous;
+    double worst, damp_work, load_work, visc_work, slip, viscous;
     /* decomposed with energy tracking: this rank's part of a block begun on
      * a lower rank puts its law of motion's energy terms on its tape at
-     * tape_k (damping) and tape_k + 1 (loads) (decompose.c); -1: in the sums */
+     * tape_k (damping), tape_k + 1 (loads) and tape_k + 2 (the dashpots'
+     * share, visc_work) (decompose.c); -1: in the sums */
     int64_t tape_k;
     int64_t bad;           /* first ball with a non-finite state, or -1 */
     sx_status st;          /* a wall contact's overlap error */
@@ -457,6 +458,11 @@ struct sx_model {
     double *dash_im;
     int64_t cap_dash_im;
     const double *dash_im_now; /* the contact pass's: dash_im or balls.inv_mass */
+    /* with energy tracking, per ball slot (periodic ghosts included): the
+     * step's dashpot forces (dim) and their moments (rdim) on the ball, for
+     * the law of motion's share of the viscous work (motion.c); cap in slots */
+    double *visc_f, *visc_t;
+    int64_t cap_visc;
     sx_grid grid;
     int64_t builds;         /* number of broad-phase builds so far */
 

@@ -217,6 +217,10 @@ static void fold_ghosts(sx_model *m)
         if (o < 0) continue;
         for (int k = 0; k < D; k++) B->f[o * D + k] += B->f[q * D + k];
         for (int k = 0; k < RD; k++) B->t[o * RD + k] += B->t[q * RD + k];
+        if (m->track_energy) { /* the dashpots' share too (motion.c) */
+            for (int k = 0; k < D; k++) m->visc_f[o * D + k] += m->visc_f[q * D + k];
+            for (int k = 0; k < RD; k++) m->visc_t[o * RD + k] += m->visc_t[q * RD + k];
+        }
     }
 }
 

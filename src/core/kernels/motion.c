@@ -20,8 +20,9 @@ static void blame_non_finite(const sx_model *m, sx_block *o, double check)
     }
 }
 
-/* An energy term of the block's sum (k: 0 damping, 1 loads), or, decomposed
- * in a block begun on a lower rank, of the rank's tape (decompose.c). */
+/* An energy term of the block's sum (k: 0 damping, 1 loads, 2 the
+ * dashpots' share), or, decomposed in a block begun on a lower rank, of
+ * the rank's tape (decompose.c). */
 static inline void motion_energy(sx_model *m, const sx_block *o, int k, double *sum, double x)
 {
     if (o->tape_k >= 0) sx__tape_add(&m->dd->tape, o->tape_k + k, x);
@@ -31,7 +32,10 @@ static inline void motion_energy(sx_model *m, const sx_block *o, int k, double *
 /* 4-46 ... 4-48: central differences, velocities at half steps, for the
  * balls of one block; partial sums go to the block. With energy tracking,
  * the damping's and applied loads' work use the mean of the old and new
- * velocities. A free, undamped component takes v += (F/m + g) dt, the
+ * velocities, and so does the dashpots': the contact passes booked it at
+ * the old velocity, this adds -dt/2 Fd . (v_new - v_old) per ball (the
+ * dashpots' forces and moments on it, m->visc_f and visc_t; a pebble's
+ * stays at the old velocity). A free, undamped component takes v += (F/m + g) dt, the
  * same lines in both instances: `plain` (a constant at each call site)
  * compiles a block without fixities, damping or tracking alone. */
 static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_block *o, const bool plain)
@@ -51,7 +55,8 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
     const double *restrict ima = B->inv_mass, *restrict iia = B->inv_inertia;
     const uint8_t *restrict fixa = B->fix;
     const int32_t *cl = B->clump;
-    double worst = 0, damp_work = 0, load_work = 0;
+    double worst = 0, damp_work = 0, load_work = 0, visc_work = 0;
+    const double *restrict vf = track ? m->visc_f : NULL, *restrict vt = track ? m->visc_t : NULL;
     /* the displacements' squares (a non-finite velocity makes its position
      * so) and 0 x every spin: not finite once some value is not (or once
      * the squares overflow; the search below tells) */
@@ -62,7 +67,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
         const double a = plain ? 0 : sx__ball_damping(m, i), im = ima[i], ii = iia[i];
         double *v = va + i * D, *x = xa + i * D;
         const double *f = fa + i * D;
-        double disp2 = 0;
+        double disp2 = 0, visc = 0;
         for (int k = 0; k < D; k++) {
             if (!(fix & (SX_FIX_VX << k))) {
                 const double vold = v[k];
@@ -76,6 +81,7 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 }
                 if (track && B->fapp)
                     motion_energy(m, o, 1, &load_work, B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt);
+                if (track) visc += vf[i * D + k] * (v[k] - vold);
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - xb[i * D + k];
@@ -96,14 +102,17 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 }
                 if (track && B->tapp)
                     motion_energy(m, o, 1, &load_work, B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt);
+                if (track) visc += vt[i * RD + k] * (w[k] - wold);
             }
             check += 0 * w[k];
         }
+        if (visc != 0) motion_energy(m, o, 2, &visc_work, -0.5 * visc * dt);
         worst = disp2 > worst ? disp2 : worst;
     }
     o->worst = worst;
     o->damp_work = damp_work;
     o->load_work = load_work;
+    o->visc_work = visc_work;
     blame_non_finite(m, o, check);
 }
 
@@ -178,7 +187,7 @@ static inline __attribute__((always_inline)) void motion_lanes(sx_model *m, sx_b
         most = disp2 > most ? disp2 : most;
     }
     o->worst = most;
-    o->damp_work = o->load_work = 0;
+    o->damp_work = o->load_work = o->visc_work = 0;
     blame_non_finite(m, o, sum);
 }
 
@@ -213,17 +222,19 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
     if (dd) { /* decomposed: this rank's own balls of each block */
         const sx_span own = m->dd->own[m->dd->x.rank];
         /* energy tracking: the terms of a block begun on a lower rank go to
-         * the tape, after the chunks' sums (3 a chunk) and the wall blocks' (2 a block) */
+         * the tape, after the chunks' sums (3 a chunk) and the wall blocks' (2 a block),
+         * 3 a block */
         const int64_t tape0 = 3 * m->nchunk + 2 * nb;
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
         for (int64_t b = 0; b < nb; b++) {
             sx_block *o = &m->blocks[b], part = *o;
             part.b0 = o->b0 > own.lo ? o->b0 : own.lo;
             part.b1 = o->b1 < own.hi ? o->b1 : own.hi;
-            part.worst = 0, part.bad = -1, part.damp_work = part.load_work = 0;
-            part.tape_k = o->b0 < own.lo ? tape0 + 2 * b : -1;
+            part.worst = 0, part.bad = -1, part.damp_work = part.load_work = part.visc_work = 0;
+            part.tape_k = o->b0 < own.lo ? tape0 + 3 * b : -1;
             if (part.b1 > part.b0) integrate_block(m, &part);
             o->worst = part.worst, o->bad = part.bad, o->damp_work = part.damp_work, o->load_work = part.load_work;
+            o->visc_work = part.visc_work;
         }
     } else {
 #pragma omp parallel for schedule(static) num_threads(m->threads) if (nb > 1)
@@ -238,6 +249,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (decompose.c, sx__dd_energy) */
             m->acc.local_damping -= o->damp_work;
             m->acc.boundary_work += o->load_work;
+            m->acc.viscous += o->visc_work;
         }
     }
     *max_disp = sqrt(worst);

@@ -125,8 +125,8 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
      * pairs[rank], the rest after it); a ghost's sums are its owner's */
     const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
-    const double *im = dashpot_inverse_mass(m);
-    if (!im) im = m->balls.inv_mass; /* (out of memory: each ball's own mass, as before) */
+    const double *im;
+    if (!dashpot_inverse_mass(m, &im)) im = m->balls.inv_mass; /* (out of memory: each ball's own mass, as before) */
     if (!dd) {
         for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, im, kt);
     } else {

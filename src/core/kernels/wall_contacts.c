@@ -125,7 +125,7 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     if (p->cmodel) p->cmodel[c] = row;
     p->touching[c] = 1;
 
-    double fd = fn, dsh[D], F[D];
+    double fd = fn, fdn = 0, dsh[D] = {0}, F[D];
     bool shear_dashpot = false;
     if (law->beta_n > 0 || law->beta_s > 0) {
         /* the ball's full mass: c = 2 beta sqrt(m k); balls of one size and material share it */
@@ -138,7 +138,7 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
             cn = sqrt(law->dash_n / B->inv_mass[i]);
             memo->dash = law->dash_n, memo->im = B->inv_mass[i], memo->cn = cn;
         }
-        const double fdn = -cn * vn;
+        fdn = -cn * vn;
         fd += fdn;
         double work = fdn * vn;
         if (!slip && law->beta_s > 0) {
@@ -160,6 +160,13 @@ static inline __attribute__((always_inline)) bool wall_force(sx_model *m, sx_blo
     /* 4-21: the ball's arm is -lb n */
     double nf[RD], mw[RD], arm[D];
     moment_of(n, F, nf);
+    if (track && (fdn != 0 || shear_dashpot)) { /* the dashpots' force on the ball: the law of motion's share of its work */
+        double Fd[D], nd[RD];
+        for (int k = 0; k < D; k++) Fd[k] = fdn * n[k] + dsh[k];
+        moment_of(n, Fd, nd);
+        for (int k = 0; k < D; k++) m->visc_f[i * D + k] += Fd[k];
+        for (int k = 0; k < RD; k++) m->visc_t[i * RD + k] -= lb * nd[k];
+    }
     for (int k = 0; k < D; k++) {
         f[i * D + k] += F[k];
         wa->force[k] -= F[k];
