@@ -29,6 +29,8 @@ local entries = {
   ["seixo.executable"] = {"seixo.executable() -> path", "The path of the running seixo program, to start worker processes."},
   ["seixo.rank"] = {"seixo.rank() -> r", "This process's MPI rank: 0 unless started by mpirun (and seixo built with MPI)."},
   ["seixo.ranks"] = {"seixo.ranks() -> n", "The number of MPI ranks: 1 unless started by mpirun -np N."},
+  ["seixo.barrier"] = {"seixo.barrier()", "Every MPI rank waits until all are there (nothing serially): after " ..
+                       "a shell command rank 0 ran alone, its files are there for every rank."},
   ["seixo.decompose"] = {"seixo.decompose([on]) -> on", "Whether models made from now on run their cycles decomposed over the MPI ranks (default true; lab.calibrate and lab.series turn it off while they run). Turning it on again is collective: the ranks settle the files each wrote meanwhile."},
   ["seixo.send"] = {"seixo.send(rank, text)", "Sends a string to another MPI rank (under mpirun only)."},
   ["seixo.receive"] = {"seixo.receive([wait = true]) -> text, rank", "The next string sent by any MPI rank and its sender; with wait = false, nil when none has come."},

@@ -416,21 +416,100 @@ static int rank_lines(lua_State *L)
     return 4;
 }
 
-/* dofile(path) and loadfile(path, ...): a file the script wrote is read
- * from the shadow, as io.open reads it (a rank above 0 ran ahead of rank
- * 0's write: a params.lua it had just written was not there yet). Lua's
- * own function (the upvalue) with the path replaced; a chunk read from a
- * shadow names the shadow in its messages. */
-static int rank_load(lua_State *L)
+/* A file's chunk read from its shadow, under the file's own name (a
+ * script that takes anything from its path finds the same on every rank),
+ * with mode and a first line starting with # skipped, as luaL_loadfilex;
+ * a name the script removed, an error as on rank 0. Pushes the chunk, or
+ * the message; returns the status. */
+static int load_shadow(lua_State *L, const char *path, const char *shadow, enum shadow s, const char *mode)
 {
-    if (shadowing() && lua_type(L, 1) == LUA_TSTRING) {
-        sx_lua_rank_file(L, lua_tostring(L, 1));
-        lua_replace(L, 1);
+    /* Lua's own messages (luaL_loadfilex's) */
+    FILE *f = s == GONE ? NULL : fopen(shadow, "rb");
+    if (!f) {
+        lua_pushfstring(L, "cannot open %s: %s", path, strerror(s == GONE ? ENOENT : errno));
+        return LUA_ERRFILE;
     }
-    lua_pushvalue(L, lua_upvalueindex(1));
-    lua_insert(L, 1);
-    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
-    return lua_gettop(L);
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    char piece[4096];
+    size_t n;
+    while ((n = fread(piece, 1, sizeof piece, f)) > 0) luaL_addlstring(&b, piece, n);
+    const bool failed = ferror(f);
+    fclose(f);
+    luaL_pushresult(&b);
+    if (failed) {
+        lua_pop(L, 1);
+        lua_pushfstring(L, "cannot read %s: %s", path, strerror(EIO));
+        return LUA_ERRFILE;
+    }
+    size_t len;
+    const char *text = lua_tolstring(L, -1, &len), *start = text;
+    if (len > 0 && text[0] == '#') { /* a first line such as #!/usr/bin/env seixo */
+        const char *nl = memchr(text, '\n', len);
+        start = nl ? nl : text + len;
+    }
+    lua_pushfstring(L, "@%s", path);
+    const int status = luaL_loadbufferx(L, start, len - (size_t)(start - text), lua_tostring(L, -1), mode);
+    lua_replace(L, -3); /* the chunk (or message) where the text was */
+    lua_pop(L, 1);
+    return status;
+}
+
+/* The shadow of a file the script wrote into shadow: SHADOWED or GONE,
+ * else NO_SHADOW (the disk's file, as Lua's own functions read it). */
+static enum shadow own_file(lua_State *L, const char *path, char *shadow)
+{
+    if (!shadowing() || !push_real_name(L, path)) return NO_SHADOW;
+    const enum shadow s = shadow_of(L, shadow);
+    lua_pop(L, 1);
+    return s == SHADOWED || s == GONE ? s : NO_SHADOW;
+}
+
+/* loadfile(path[, mode[, env]]): a file the script wrote is read from its
+ * shadow, as io.open reads it (a rank above 0 ran ahead of rank 0's
+ * write: a params.lua it had just written was not there yet). */
+static int rank_loadfile(lua_State *L)
+{
+    const int nargs = lua_gettop(L);
+    char shadow[PATH_MAX];
+    const enum shadow s = lua_type(L, 1) == LUA_TSTRING ? own_file(L, lua_tostring(L, 1), shadow) : NO_SHADOW;
+    if (s == NO_SHADOW) return sx_lua_call_own(L, nargs);
+    const char *mode = luaL_optstring(L, 2, "bt");
+    const bool env = !lua_isnone(L, 3);
+    if (load_shadow(L, lua_tostring(L, 1), shadow, s, mode) != LUA_OK) {
+        luaL_pushfail(L);
+        lua_insert(L, -2);
+        return 2; /* nil, the message, as loadfile */
+    }
+    if (env) { /* the chunk's first upvalue, its _ENV */
+        lua_pushvalue(L, 3);
+        if (!lua_setupvalue(L, -2, 1)) lua_pop(L, 1);
+    }
+    return 1;
+}
+
+static int dofile_results(lua_State *L, int status, lua_KContext ctx)
+{
+    (void)status;
+    return lua_gettop(L) - (int)ctx; /* what the chunk returned, above the path (ctx 1) or nothing (0) */
+}
+
+/* dofile([path]): as loadfile, then the chunk runs (a continuation, so a
+ * coroutine may yield inside it, as Lua's dofile allows) */
+static int rank_dofile(lua_State *L)
+{
+    char shadow[PATH_MAX];
+    const enum shadow s = lua_type(L, 1) == LUA_TSTRING ? own_file(L, lua_tostring(L, 1), shadow) : NO_SHADOW;
+    if (s == NO_SHADOW) { /* Lua's own, called as the script would: its chunk's errors as they are */
+        lua_pushvalue(L, lua_upvalueindex(1));
+        lua_insert(L, 1);
+        lua_callk(L, lua_gettop(L) - 1, LUA_MULTRET, 0, dofile_results);
+        return dofile_results(L, 0, 0);
+    }
+    lua_settop(L, 1);
+    if (load_shadow(L, lua_tostring(L, 1), shadow, s, NULL) != LUA_OK) return lua_error(L);
+    lua_callk(L, 0, LUA_MULTRET, 1, dofile_results);
+    return dofile_results(L, 0, 1);
 }
 
 /* io.input([file]) and io.output([file]): a path opens through io.open
@@ -536,8 +615,8 @@ void sx_lua_rank_files_open(lua_State *L)
     sx_lua_wrap(L, "io", "lines", rank_lines, 0);
     sx_lua_wrap(L, "os", "remove", rank_remove, 0);
     sx_lua_wrap(L, "os", "rename", rank_rename, 0);
-    sx_lua_wrap(L, "_G", "dofile", rank_load, 0);
-    sx_lua_wrap(L, "_G", "loadfile", rank_load, 0);
+    sx_lua_wrap(L, "_G", "dofile", rank_dofile, 0);
+    sx_lua_wrap(L, "_G", "loadfile", rank_loadfile, 0);
     for (int k = 0; k < 2; k++) {
         if (lua_getglobal(L, "io") != LUA_TTABLE) {
             lua_pop(L, 1);

@@ -8,8 +8,9 @@
  * ranks skip stops the run with the ranks' calls named, never a hang.
  *
  * Wrapped: io.read and io.lines() (no path) while the default input is
- * standard input, and the read and lines methods of io.stdin. Files the
- * script opens are rank_files.c's. */
+ * standard input. Not io.stdin:read: the file handles' methods are every
+ * file's, and a method called from a wrapper names neither itself nor the
+ * script in its errors. Files the script opens are rank_files.c's. */
 #include "bindings.h"
 #include "seixo_lua.h"
 
@@ -108,11 +109,15 @@ static char *rank0_read(void *ud, size_t *len, int *mark)
     packed p = {0};
     for (int k = c->base + 1; k <= lua_gettop(L); k++) pack_value(L, k, &p);
     lua_settop(L, c->base);
-    if (p.oom || !p.bytes) {
+    if (p.oom) { /* every rank raises it, rank 0's way */
         free(p.bytes);
-        p.bytes = malloc(1);
-        p.n = 0;
+        p = (packed){0};
+        lua_pushliteral(L, "out of memory for the values read");
+        pack_value(L, lua_gettop(L), &p);
+        lua_pop(L, 1);
+        *mark = LUA_ERRMEM;
     }
+    if (!p.bytes) p.bytes = malloc(1); /* no value: an empty text, not the end */
     *len = p.n;
     return p.bytes;
 }
@@ -132,7 +137,14 @@ static int shared_call(lua_State *L, int fn, int first, int last, const char *wh
     if (!bytes) return luaL_error(L, "%s: out of memory", what);
     const int n = unpack_values(L, bytes, len);
     free(bytes);
-    if (status != LUA_OK) return lua_error(L); /* rank 0's message */
+    if (status != LUA_OK) { /* rank 0's message, with the script's place as the script's own call has it */
+        if (lua_type(L, -1) == LUA_TSTRING) {
+            luaL_where(L, 1);
+            lua_insert(L, -2);
+            lua_concat(L, 2);
+        }
+        return lua_error(L);
+    }
     return n;
 }
 
@@ -150,21 +162,29 @@ static bool input_is_stdin(lua_State *L)
     return yes;
 }
 
+/* Lua's formats of read from argument first on: a count, or n, l, L or a
+ * (a * before it allowed), checked here so that the error names the
+ * script's call (Lua's read, called from C, could not). */
+static void check_formats(lua_State *L, int first, int last)
+{
+    for (int k = first; k <= last; k++) {
+        if (lua_type(L, k) == LUA_TNUMBER) {
+            luaL_checkinteger(L, k);
+            continue;
+        }
+        const char *f = luaL_checkstring(L, k);
+        if (*f == '*') f++;
+        luaL_argcheck(L, *f && strchr("nlLa", *f), k, "invalid format");
+    }
+}
+
 /* io.read(formats...): upvalue 1 Lua's own, 2 io.stdin */
 static int stdin_read(lua_State *L)
 {
     const int nargs = lua_gettop(L);
+    check_formats(L, 1, nargs);
     if (sx_lua_parallel_sharing() && input_is_stdin(L))
         return shared_call(L, lua_upvalueindex(1), 1, nargs, "io.read (standard input)");
-    return sx_lua_call_own(L, nargs);
-}
-
-/* f:read(formats...) of a file handle: upvalue 1 the method, 2 io.stdin */
-static int stdin_method_read(lua_State *L)
-{
-    const int nargs = lua_gettop(L);
-    if (sx_lua_parallel_sharing() && is_stdin(L, 1))
-        return shared_call(L, lua_upvalueindex(1), 1, nargs, "io.stdin:read");
     return sx_lua_call_own(L, nargs);
 }
 
@@ -185,9 +205,7 @@ static int push_stdin_lines(lua_State *L, int first, int last)
 {
     lua_getglobal(L, "io");
     lua_getfield(L, -1, "stdin");
-    lua_getfield(L, -1, "read"); /* the (wrapped) method: its upvalue is Lua's */
-    lua_getupvalue(L, -1, 1);
-    lua_replace(L, -2);
+    lua_getfield(L, -1, "read"); /* the file handles' method */
     lua_insert(L, -2); /* io, read, stdin */
     lua_createtable(L, last - first + 1, 0);
     for (int k = first; k <= last; k++) {
@@ -202,15 +220,10 @@ static int push_stdin_lines(lua_State *L, int first, int last)
 static int stdin_lines(lua_State *L)
 {
     const int nargs = lua_gettop(L);
-    if (sx_lua_parallel_sharing() && lua_isnoneornil(L, 1) && input_is_stdin(L)) return push_stdin_lines(L, 2, nargs);
-    return sx_lua_call_own(L, nargs);
-}
-
-/* f:lines(formats...): upvalue 1 the method, 2 io.stdin */
-static int stdin_method_lines(lua_State *L)
-{
-    const int nargs = lua_gettop(L);
-    if (sx_lua_parallel_sharing() && is_stdin(L, 1)) return push_stdin_lines(L, 2, nargs);
+    if (sx_lua_parallel_sharing() && lua_isnoneornil(L, 1) && input_is_stdin(L)) {
+        check_formats(L, 2, nargs);
+        return push_stdin_lines(L, 2, nargs);
+    }
     return sx_lua_call_own(L, nargs);
 }
 
@@ -232,12 +245,6 @@ void sx_lua_rank_stdin_open(lua_State *L)
     const int io = lua_gettop(L);
     lua_getfield(L, io, "stdin");
     const int in = lua_gettop(L);
-    if (luaL_getmetafield(L, in, "__index") == LUA_TTABLE) { /* the file handles' methods */
-        const int methods = lua_gettop(L);
-        wrap_with_stdin(L, methods, "read", stdin_method_read, in);
-        wrap_with_stdin(L, methods, "lines", stdin_method_lines, in);
-        lua_pop(L, 1);
-    }
     wrap_with_stdin(L, io, "read", stdin_read, in);
     wrap_with_stdin(L, io, "lines", stdin_lines, in);
     lua_pop(L, 2);

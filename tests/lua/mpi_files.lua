@@ -152,9 +152,11 @@ note("an io.open error", select(2, pcall(function() return io.open(base, "q") en
 -- had written it, and found nothing)
 if seixo.rank() == 0 then os.execute("sleep 0.3") end
 f = assert(io.open(base .. ".params.lua", "w"))
-f:write("return {k = 7, name = 'params'}\n")
+f:write("#!/usr/bin/env seixo\nreturn {k = 7, name = 'params', src = debug.getinfo(1, 'S').short_src}\n")
 f:close()
-note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name)
+-- (the chunk is named by the file's own path on every rank, not by a shadow's)
+note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name,
+     dofile(base .. ".params.lua").src)
 os.remove(base .. ".params.lua")
 
 -- a shell command rank 0 runs alone, late, then seixo.barrier(): its file

@@ -13,6 +13,12 @@
 --             of fixed balls, in a cell periodic along that axis only: it
 --             goes round the cell (through every rank's slab and the
 --             boundary) keeping its bonds and contacts
+--   flat D    a flat bed, long along x and periodic along x (and y), its
+--             cells ordered with x the slowest (the grid's longest axis),
+--             so the slabs cut it across x and the first and last rank meet
+--             through that boundary; balls thrown along x over a rough
+--             floor of fixed balls (a dashpot between a free and a fixed
+--             ball: infinite mass), dashpots, energy tracking (every term)
 -- Arguments: scene (cell), dim (3).
 local scene = arg and arg[1] or "cell"
 local dim = tonumber(arg and arg[2]) or 3
@@ -84,6 +90,34 @@ elseif scene == "drift" then
     if m:bond_count() ~= 3 or own ~= 3 then error("mpi_periodic.lua drift: the triplet lost a bond or a contact") end
   end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
+elseif scene == "flat" then
+  local m = seixo.model{dim = dim, gravity = dim == 3 and {0, 0, -9.81} or {0, -9.81}}
+  m:material("g", {density = 2500, kn = 1e5, ks = 1e5, friction = 0.5, viscous_normal = 0.3, viscous_shear = 0.1})
+  local L, W = 0.4, 0.06
+  local function at(x, y, z) return dim == 3 and {x, y, z} or {x, z} end
+  m:periodic{min = at(0, 0, -0.5), max = at(L, W, 0.5), axes = dim == 3 and "xy" or "x"}
+  m:wall{kind = dim == 3 and "plane" or "line", point = at(0, 0, 0), normal = at(0, 0, 1)}
+  -- the rough floor: fixed balls in a row along x
+  local floor = {}
+  for k = 0, 79 do
+    local f = m:ball{pos = at((k + 0.5) * L / 80, W / 2, 0.002), radius = 0.002}
+    f.fix = "all"
+    floor[f.id] = true
+  end
+  m:generate{count = dim == 3 and 1500 or 150, radius = {0.002, 0.003},
+             region = {box = {at(0, 0, 0.006), at(L, W, 0.03)}}, seed = 3}
+  for b in m:balls() do
+    if not floor[b.id] then b.vel = at(1 + 0.5 * math.sin(b.id), 0.2, 0) end
+  end
+  m:track_energy(true)
+  for step = 1, 3 do
+    m:cycle(dim == 3 and 2500 or 3000)
+    report(m, "flat " .. step)
+    local e = m:energy()
+    print(string.format("energy kinetic %a strain %a slip %a viscous %a damping %a boundary %a", e.kinetic, e.strain,
+                        e.slip, e.viscous, e.local_damping, e.boundary_work))
+  end
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
 else
-  error("mpi_periodic.lua: scene cell or drift expected")
+  error("mpi_periodic.lua: scene cell, drift or flat expected")
 end

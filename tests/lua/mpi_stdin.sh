@@ -75,8 +75,8 @@ for np in $ranks; do
   done
 done
 # a script file that reads standard input (an MPI user's finding: io.read
-# gave nil on the ranks above 0): io.read's formats, io.lines(),
-# io.stdin:read and io.stdin:lines, each value put into the model, so a
+# gave nil on the ranks above 0): io.read's formats and io.lines() with
+# and without formats, each value put into the model, so a
 # rank that read something else stops the next cycle; it prints what the
 # serial run prints
 cat >"$dir/reads.lua" <<EOF
@@ -87,9 +87,9 @@ for line in io.lines() do
   count = count + 1
   if line == "--" then break end
 end
-local tail = io.stdin:read("l")
+local tail = io.read("l")
 local more = {}
-for a, b in io.stdin:lines("n", "n") do more[#more + 1] = a + b end
+for a, b in io.lines(nil, "n", "n") do more[#more + 1] = a + b end
 local sum = n + x + count + #tail + #more + more[1]
 m:ball{pos = {0.02, 0.045}, radius = 1e-3 * (1 + sum / 1e4)}
 m:cycle(10)

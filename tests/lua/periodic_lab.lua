@@ -35,16 +35,12 @@ end)
 T.test("periodic triaxial: ev is the cell's change of volume", function()
   local r = lab.periodic.triaxial(granular, {confining = 1e6, strain_rate = 20, max_strain = 0.08, post_peak = 0.01,
                                              log = false})
-  local m = seixo.load(granular.path)
-  local c0 = m:periodic().size
-  m:close()
   local last = r.rows[#r.rows]
   -- 1 - V/V0 from the strains of the cell's edges (the lateral ones alike in 2D)
   local v = (1 - last.ea) * (1 - last.el)
   T.near(last.ev, 1 - v, 1e-9)
   -- the small-strain sum drifts from it by ea el at 8 %
   T.check(math.abs(last.ev - (last.ea + last.el)) > 0.5 * math.abs(last.ea * last.el), "not the small-strain sum")
-  T.check(c0[1] > 0, "the cell")
 end)
 
 T.test("the periodic tests' options are checked (a sand user's findings)", function()

@@ -126,7 +126,7 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
     const sx_pairs *p = &m->bb;
     const double *im;
-    if (!dashpot_inverse_mass(m, &im)) im = m->balls.inv_mass; /* (out of memory: each ball's own mass, as before) */
+    if (!dashpot_inverse_mass(m, &im)) return INFINITY; /* out of memory, as the scratch's above */
     if (!dd) {
         for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, im, kt);
     } else {
