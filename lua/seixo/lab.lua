@@ -397,7 +397,7 @@ end
 function lab.specimen(opts)
   check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
                                 "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "gapped", "seed", "path",
-                                "log", "max_steps", "clump", "model"})
+                                "log", "max_steps", "clump", "model", "bonds"})
   local dim = opts.dim or 3
   if dim ~= 2 and dim ~= 3 then fail("lab.specimen: dim must be 2 or 3 (got %s)", tostring(dim)) end
   local shape = opts.shape or (dim == 3 and "cylinder" or "rect")
@@ -408,6 +408,18 @@ function lab.specimen(opts)
     fail("lab.specimen: shape '%s' is not a %dD shape (valid: %s)", tostring(shape), dim, table.concat(names, ", "))
   end
   local size, cyl_axis, trim = shape_of(merge(opts, {shape = shape}), dim)
+  -- bonds = false: a granular specimen (a sand's), left at sigma0 as the
+  -- vessel held it, for the compression tests' walls to confine again
+  if opts.bonds ~= nil and type(opts.bonds) ~= "boolean" then
+    fail("lab.specimen: bonds must be true or false (false: a granular specimen; got %s)", tostring(opts.bonds))
+  end
+  local granular = opts.bonds == false
+  if granular and trim then
+    fail("lab.specimen: a granular specimen cannot be a %s: without bonds nothing holds a Brazilian disc together", shape)
+  end
+  if granular and (opts.model ~= nil or opts.gapped ~= nil) then
+    fail("lab.specimen: a granular specimen has no bond model (model, gapped)")
+  end
   -- a specimen of clumps: {pebbles = {...} (m:clump_template's form), scale = s | {smin, smax}}
   local grain = opts.clump
   local radius = opts.radius or {0.8e-3, 1.33e-3}
@@ -522,13 +534,21 @@ function lab.specimen(opts)
   local kind = opts.model or "parallel" -- "flatjoint": seixo.joints (its parameters in the material's bond table)
   if kind ~= "parallel" and kind ~= "flatjoint" then fail("lab.specimen: model must be 'parallel' or 'flatjoint'") end
   if opts.gapped ~= nil and kind ~= "flatjoint" then fail("lab.specimen: gapped is an option of flat joints") end
-  local bonds = m:bond{kind = kind, gap = gap, seed = seed, gapped = opts.gapped}
-  say(opts, "lab.specimen: %d %s bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
-      .. "ball %.3f", bonds, kind, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
+  if granular then
+    kind = "granular"
+    say(opts, "lab.specimen: granular (no bonds), %d floaters; wall stress %.4g Pa, loaded contacts per %s %.3f",
+        floaters, gen.sigma, grain and "clump" or "ball", gen.coordination)
+  else
+    local bonds = m:bond{kind = kind, gap = gap, seed = seed, gapped = opts.gapped}
+    say(opts, "lab.specimen: %d %s bonds (%.2f per %s), %d floaters; wall stress %.4g Pa, loaded contacts per "
+        .. "ball %.3f", bonds, kind, 2 * bonds / n, grain and "clump" or "ball", floaters, gen.sigma, gen.coordination)
+  end
 
-  -- out of the vessel: the specimen relaxes and its locked-in stresses fall
+  -- out of the vessel: a bonded specimen relaxes and its locked-in stresses
+  -- fall; a granular one is saved as the vessel held it (it would fall
+  -- apart), and a test's walls confine it before its first step
   for _, w in ipairs(v.walls) do w:remove() end
-  m:solve{ratio = 1e-4, steps = 20000}
+  if not granular then m:solve{ratio = 1e-4, steps = 20000} end
   if trim then -- balls (clumps: by their centroid) outside the disk go
     local c, r = trim.center, trim.radius
     if grain then -- the square the clumps jammed in, about its nominal centre
@@ -584,7 +604,8 @@ function lab.specimen(opts)
     path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
     genesis = gen, rmax = rmax,
-    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, model = kind, genesis_steps = m:step(), clumps = m:clump_count(),
+    sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, model = kind, granular = granular,
+    genesis_steps = m:step(), clumps = m:clump_count(),
     clump = copy(grain),
     genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
     depth = opts.depth, thickness = opts.thickness,
@@ -893,6 +914,9 @@ local function compression(spec, opts, fn)
   if sigma2 ~= sigma3 and sigma3 == 0 then
     fail("lab.%s: an intermediate stress needs confining > 0 (without it the test has no lateral walls)", fn)
   end
+  if spec.granular and sigma3 == 0 then
+    fail("lab.%s: a granular specimen needs confining > 0: without bonds nothing holds it together", fn)
+  end
   if opts.lateral ~= nil and opts.lateral ~= "planes" and opts.lateral ~= "cylinder" then
     fail("lab.%s: lateral must be \"cylinder\" or \"planes\" (got %s)", fn, tostring(opts.lateral))
   end
@@ -1121,7 +1145,7 @@ local function compression(spec, opts, fn)
     r.warnings[#r.warnings + 1] = string.format("mean unbalanced-force ratio %.2g during loading: the specimen is "
                                                 .. "not near equilibrium; lower strain_rate", r.mean_ratio)
   end
-  if why ~= "post_peak" then
+  if why ~= "post_peak" and not spec.granular then -- (a sand is loaded to max_strain: its critical state)
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
   end
   for _, w in ipairs(r.warnings) do say(opts, "lab.%s: warning: %s", fn, w) end

@@ -330,6 +330,9 @@ sx_status sx_wall_set_servo(sx_model *m, int64_t id, const sx_servo_def *def)
     if (w->mesh) return sx__fail(m, SX_EINVAL, "wall_set_servo: wall %lld is a mesh, which has no one normal to servo along", (long long)id);
     if (!isfinite(def->target))
         return sx__fail(m, SX_EINVAL, "wall_set_servo: the target stress must be finite (got %g)", def->target);
+    if (def->target < 0) /* a sand user's finding: a negative target was taken, and the wall ran off */
+        return sx__fail(m, SX_EINVAL, "wall_set_servo: the target stress must be >= 0 Pa: a wall only pushes (got %g)",
+                        def->target);
     if (!(def->area > 0) || !isfinite(def->area))
         return sx__fail(m, SX_EINVAL, "wall_set_servo: the area must be > 0 (got %g)", def->area);
     if (!(def->alpha > 0 && def->alpha <= 1))

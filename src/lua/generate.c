@@ -34,6 +34,7 @@
  * through a uniform cell grid of the region, so placement is O(N). Every
  * working array is a Lua userdata: an error anywhere frees them. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -317,6 +318,17 @@ static double *draw_radii(lua_State *L, gen *g, rng *r)
             luaL_argerror(L, 2, "the radii cannot be scaled to this porosity and count (their volume overflows or "
                                 "vanishes)");
         for (int64_t i = 0; i < g->count; i++) rad[i] *= k;
+        /* the grain size moved: said, since a user asked for those radii (a
+         * sand user's finding: 0.5 ... 0.8 mm became 1.13 ... 1.80 mm, silently) */
+        if (fabs(k - 1) > 0.01 && sx_lua_parallel_says(sx_lua_tomodel(L, 1))) {
+            luaL_where(L, 1);
+            fprintf(stderr,
+                    "seixo: warning: %sm:generate: the radii were scaled by %.4g to reach porosity %g with %lld balls: "
+                    "%g ... %g m instead of %g ... %g m (give count or porosity alone to keep the radii)\n",
+                    lua_tostring(L, -1), k, g->porosity, (long long)g->count, g->rmin * k, g->rmax * k, g->rmin, g->rmax);
+            fflush(stderr);
+            lua_pop(L, 1);
+        }
         g->rmin *= k;
         g->rmax *= k;
     }

@@ -291,6 +291,20 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("m:generate says when count and porosity together scaled the radii asked for", function()
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 2}
+m:material("g", {density = 2500, kn = 1e6, ks = 1e6})
+m:generate{count = 100, porosity = 0.3, radius = {0.5e-3, 0.8e-3}, region = {box = {{0, 0}, {0.05, 0.05}}}, method = "distribute"}
+m:generate{count = 10, radius = {0.5e-3, 0.8e-3}, region = {box = {{0, 0.06}, {0.05, 0.1}}}}
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("seixo: warning: (command line):3: m:generate: the radii were scaled by 3.519 to reach porosity 0.3 " ..
+                 "with 100 balls: 0.0017597 ... 0.00281553 m instead of 0.0005 ... 0.0008 m", 1, true), out)
+  local _, count = out:gsub("warning", "")
+  eq(count, 1, "the count alone keeps the radii: no warning")
+end)
+
 test("an invalid value is an error with no range warning before it; a valid, unusual one warns", function()
   local status, out = T.run("-e " .. T.quote([[
 m = seixo.model{dim = 3}
