@@ -524,6 +524,10 @@ local function check_options(lab, opts)
   if not opts.evaluate and type(opts.specimen) ~= "table" then
     fail("specimen = {dim =, width =, height =, ...} (lab.specimen's options) expected")
   end
+  if not opts.evaluate and opts.specimen.bonds == false then -- its tests never pass a peak to the post_peak stop
+    fail("a granular specimen (specimen.bonds = false) is not calibrated here: its compression tests load to "
+         .. "max_strain, and E, nu, UCS and c, phi are read past a bonded specimen's peak; give evaluate = fn")
+  end
   o.specimen, o.test = opts.specimen, opts.test
   if opts.brazilian ~= nil and type(opts.brazilian) ~= "table" then
     fail("brazilian must be a table of the disk's options (got %s)", type(opts.brazilian))

@@ -598,8 +598,8 @@ function lab.specimen(opts)
   for k = 1, dim do mean = mean + inside.stress[k][k] / dim end
   gen.locked_in, gen.locked_in_stress, gen.core_porosity = mean, inside.stress, inside.porosity
   gen.core_coordination = inside.coordination
-  say(opts, "lab.specimen: locked-in mean stress %.4g Pa in the core (%d balls), its porosity %.4f, coordination %.3f",
-      mean, inside.balls, inside.porosity, inside.coordination)
+  say(opts, "lab.specimen: %s mean stress %.4g Pa in the core (%d balls), its porosity %.4f, coordination %.3f",
+      granular and "the vessel's (kept)" or "locked-in", mean, inside.balls, inside.porosity, inside.coordination)
   local spec = {
     path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
@@ -1145,7 +1145,7 @@ local function compression(spec, opts, fn)
     r.warnings[#r.warnings + 1] = string.format("mean unbalanced-force ratio %.2g during loading: the specimen is "
                                                 .. "not near equilibrium; lower strain_rate", r.mean_ratio)
   end
-  if why ~= "post_peak" and not spec.granular then -- (a sand is loaded to max_strain: its critical state)
+  if why == "max_steps" or (why ~= "post_peak" and not spec.granular) then -- (a sand is loaded to max_strain)
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
   end
   for _, w in ipairs(r.warnings) do say(opts, "lab.%s: warning: %s", fn, w) end
@@ -1496,6 +1496,9 @@ function lab.series(spec, opts)
   for i, s3 in ipairs(list) do
     if type(s3) ~= "number" or not (s3 >= 0 and s3 < math.huge) then
       fail("lab.series: confining[%d] must be a stress >= 0 Pa (got %s)", i, tostring(s3))
+    end
+    if spec.granular and s3 == 0 then -- (refused before any test starts)
+      fail("lab.series: confining[%d] is 0: a granular specimen needs confining > 0 (nothing holds it together)", i)
     end
     local o = copy(opts)
     o.confining = s3

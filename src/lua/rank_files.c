@@ -443,13 +443,14 @@ static int load_shadow(lua_State *L, const char *path, const char *shadow, enum 
         return LUA_ERRFILE;
     }
     size_t len;
-    const char *text = lua_tolstring(L, -1, &len), *start = text;
-    if (len > 0 && text[0] == '#') { /* a first line such as #!/usr/bin/env seixo */
-        const char *nl = memchr(text, '\n', len);
-        start = nl ? nl : text + len;
+    const char *text = lua_tolstring(L, -1, &len), *start = text, *end = text + len;
+    if (end - start >= 3 && memcmp(start, "\xEF\xBB\xBF", 3) == 0) start += 3; /* a UTF-8 mark, as Lua skips it */
+    if (start < end && *start == '#') { /* a first line such as #!/usr/bin/env seixo (its newline kept: the lines count alike) */
+        const char *nl = memchr(start, '\n', (size_t)(end - start));
+        start = nl ? nl : end;
     }
     lua_pushfstring(L, "@%s", path);
-    const int status = luaL_loadbufferx(L, start, len - (size_t)(start - text), lua_tostring(L, -1), mode);
+    const int status = luaL_loadbufferx(L, start, (size_t)(end - start), lua_tostring(L, -1), mode);
     lua_replace(L, -3); /* the chunk (or message) where the text was */
     lua_pop(L, 1);
     return status;

@@ -275,6 +275,10 @@ test("bad options are clear errors at the caller", function()
                                     print = math.mininteger} end, "lab.calibrate: print must be a function or false (got number)")
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {2e9, 1e9}}, evaluate = synthetic} end,
            "parameters.modulus must be {lower, upper}")
+  -- a granular specimen: refused up front, not run to fail every evaluation (a review's finding)
+  T.raises(function() lab.calibrate{targets = {E = 1e8}, parameters = {modulus = {1e8, 1e9}},
+                                    specimen = {dim = 2, width = 0.01, height = 0.02, bonds = false}} end,
+           "a granular specimen (specimen.bonds = false) is not calibrated here")
   -- the long fuzz run (issue 18): a list for parameters and a function for out failed inside calibrate.lua
   T.raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {1, 2, 3, 4}, evaluate = synthetic} end,
            "lab.calibrate: parameters must be keyed by name, {modulus = {lower, upper}, ...} (got a number key: 1)")

@@ -130,17 +130,29 @@ test("a granular specimen (bonds = false) through a biaxial test: a sand's frict
                             seed = 3, bonds = false, material = {friction = 0.5}, path = dir .. "/sand.h5", log = false}
   eq(sand.bonds, 0)
   check(sand.granular, "marked granular")
-  local r = lab.triaxial(sand, {confining = 1e5, max_strain = 0.04, strain_rate = 0.5, log = false})
+  local r = lab.triaxial(sand, {confining = 1e5, max_strain = 0.02, strain_rate = 0.5, max_steps = 1000000,
+                                log = false})
+  eq(r.stopped, "max_strain")
   -- 2D disks with friction 0.5, dense: a peak friction angle of some 20 to
-  -- 35 deg (27.7 measured; 45.8 at 2/s, too fast: the unbalanced-force
-  -- ratio's warning said so)
+  -- 35 deg (28.8 measured at 1.5 % strain; 45.8 at 2/s, too fast: the
+  -- unbalanced-force ratio's warning said so), then softening
   local phi = math.deg(math.asin((r.peak - 1e5) / (r.peak + 1e5)))
   check(phi > 20 and phi < 35, "peak friction angle " .. phi)
+  check(r.peak_strain < 0.019, "a peak before the end: at " .. r.peak_strain)
   eq(r.cracks_total.tension + r.cracks_total.shear, 0)
   for _, w in ipairs(r.warnings) do check(not w:find("before the stress fell past the peak", 1, true), w) end
   -- a dense packing dilates: its volume grows by the end (ev, compression positive, below 0)
   check(r.rows[#r.rows][5] < 0, "dilation: ev " .. r.rows[#r.rows][5])
   raises(function() lab.ucs(sand, {log = false}) end, "a granular specimen needs confining > 0")
+  raises(function() lab.series(sand, {confining = {1e5, 0}, log = false}) end,
+         "confining[2] is 0: a granular specimen needs confining > 0")
+  -- a test cut short by max_steps says so (max_strain is a sand's end, max_steps is not)
+  local short = lab.triaxial(sand, {confining = 1e5, max_strain = 0.02, strain_rate = 0.5, max_steps = 3000,
+                                    log = false})
+  eq(short.stopped, "max_steps")
+  local said = false
+  for _, w in ipairs(short.warnings) do said = said or w:find("stopped on max_steps", 1, true) ~= nil end
+  check(said, "the early stop is a warning")
   raises(function() lab.specimen{dim = 2, shape = "disk", diameter = 0.01, bonds = false, path = "x.h5"} end,
          "a granular specimen cannot be a disk")
   raises(function() lab.specimen{dim = 2, width = 0.01, height = 0.02, bonds = 0, path = "x.h5"} end,

@@ -152,7 +152,8 @@ note("an io.open error", select(2, pcall(function() return io.open(base, "q") en
 -- had written it, and found nothing)
 if seixo.rank() == 0 then os.execute("sleep 0.3") end
 f = assert(io.open(base .. ".params.lua", "w"))
-f:write("#!/usr/bin/env seixo\nreturn {k = 7, name = 'params', src = debug.getinfo(1, 'S').short_src}\n")
+-- (a UTF-8 mark and a # line first, both of which Lua skips)
+f:write("\xEF\xBB\xBF#!/usr/bin/env seixo\nreturn {k = 7, name = 'params', src = debug.getinfo(1, 'S').short_src}\n")
 f:close()
 -- (the chunk is named by the file's own path on every rank, not by a shadow's)
 note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name,
