@@ -128,6 +128,25 @@ T.test("a dashpot's energy balances a bounce to second order in the timestep", f
   end
 end)
 
+T.test("the stability guard stays on beside a ball fixed at rest (an obstacle does no work)", function()
+  -- a contact-bonded pair, one ball fixed at rest, at 1.5 times the
+  -- critical timestep (omega dt = 3): the guard had been off for any
+  -- fixity, and the free ball left at 2.8e11 m/s without a word
+  for _, beta in ipairs{0, 0.7} do
+    local m = seixo.model{dim = 3}
+    m:material("A", {density = 2650, kn = 2e6, ks = 2e6, viscous_normal = beta,
+                     bond = {normal_strength = 1e12, shear_strength = 1e12}})
+    local a = m:ball{pos = {0, 0, 0}, radius = 1e-3}
+    a.fix = "all"
+    local b = m:ball{pos = {2e-3, 0, 0}, radius = 1e-3}
+    m:bond{kind = "contact", gap = 1e-9}
+    m:set_timestep(3 / math.sqrt(1e6 / b.mass))
+    b.vel = {1e-3, 0, 0}
+    local ok, err = pcall(m.cycle, m, 3000)
+    T.check(not ok and tostring(err):find("unstable at step", 1, true), "beta " .. beta .. ": " .. tostring(err))
+  end
+end)
+
 -- Rolling resistance (laws/rolling.h). A ball rolling on a floor with
 -- rolling friction mu_r meets a moment that grows on the rolling spring
 -- kr = ks R^2 (rotation theta1 = Ml / kr) and then stays at its limit
