@@ -443,6 +443,9 @@ static void chunk_start(sx_model *m, sx_chunk *o)
     o->err_break = false;
 }
 
+/* Ball slots: the balls, then the periodic ghosts past them. */
+static inline int64_t ball_slots(const sx_model *m) { return m->cell ? m->cell->base + m->cell->n : m->balls.n; }
+
 /* The inverse masses a contact's dashpot takes its reduced mass from
  * (m->dash_im): a ball whose velocity is fixed on every axis moves as it
  * is told whatever the forces, so its mass is a wall's, infinite, and a
@@ -460,7 +463,7 @@ static bool dashpot_inverse_mass(sx_model *m, const double **im)
     for (int64_t i = 0; i < B->n; i++) any |= (uint8_t)((B->fix[i] & vel) == vel);
     *im = B->inv_mass;
     if (!any) return true;
-    const int64_t slots = m->cell ? m->cell->base + m->cell->n : B->n;
+    const int64_t slots = ball_slots(m);
     if (slots > m->cap_dash_im) {
         double *q = sx_alloc_resize(&m->alloc, m->dash_im, (size_t)m->cap_dash_im, (size_t)slots, sizeof *q);
         if (!q) return false;
@@ -484,7 +487,7 @@ static bool dashpot_inverse_mass(sx_model *m, const double **im)
  * False: out of memory. */
 static bool visc_clear(sx_model *m)
 {
-    const int64_t slots = m->cell ? m->cell->base + m->cell->n : m->balls.n;
+    const int64_t slots = ball_slots(m);
     if (slots == 0) return true;
     if (slots > m->cap_visc) {
         double *f = sx_alloc_resize(&m->alloc, m->visc_f, (size_t)(m->cap_visc * D), (size_t)(slots * D), sizeof *f);
