@@ -13,6 +13,29 @@ local genesis = {}
 -- installs sigma0 by scaling every radius by one factor, the vessel held
 -- still, and step 3 grows the floaters until each has the contacts it needs.
 
+-- A specimen's sizes: opts.radius = {rmin, rmax} (default dflt, drawn
+-- uniformly) or opts.psd, a grading curve as m:generate takes it (which
+-- checks it in full). Returns the range {rmin, rmax} and m:generate's
+-- fields for the sizes.
+function genesis.sizes(opts, fn, dflt)
+  local psd = opts.psd
+  if psd == nil then
+    local radius = opts.radius or dflt
+    if type(radius) ~= "table" or #radius ~= 2 or not (radius[1] > 0) or not (radius[2] >= radius[1]) then
+      error(string.format("%s: radius must be {rmin, rmax} with 0 < rmin <= rmax", fn), 2)
+    end
+    return radius, {radius = radius}
+  end
+  if opts.radius ~= nil then error(string.format("%s: give radius or psd, not both", fn), 2) end
+  local first, last = type(psd) == "table" and psd[1], type(psd) == "table" and psd[#psd]
+  if type(psd) ~= "table" or #psd < 2 or type(first) ~= "table" or type(last) ~= "table" or not (type(first[1]) == "number" and first[1] > 0)
+     or not (type(last[1]) == "number" and last[1] >= first[1]) then
+    error(string.format("%s: psd must be a grading curve {{r1, 0}, ..., {rn, 1}} (radius in m, fraction of the volume "
+                        .. "passing)", fn), 2)
+  end
+  return {first[1], last[1]}, {psd = psd}
+end
+
 -- The mean overlap of the ball-ball contacts that carry a force, and their number.
 function genesis.loaded_contacts(m)
   local overlap, k = 0, 0

@@ -52,7 +52,7 @@ local entries = {
   ["model:walls"] = {"m:walls() -> iterator", "for w in m:walls() do ... end"},
   ["model:wall_count"] = {"m:wall_count() -> n", "Number of walls."},
   ["model:generate"] = {"m:generate{region =, radius =, count = | porosity =, method =, seed =, ...} -> n, porosity",
-    "Generates balls in a region: method 'random' (non-overlapping), 'distribute' (overlapping to a porosity, then relaxed), 'expand' (radius expansion to a porosity), 'lattice' (packing = square|hex|cubic|fcc). radius = r or {rmin, rmax} [m]; distribution 'uniform' | 'normal' (mean, std); material, group, tries, relax = {steps, ratio, calm}. With template = name: clumps at random orientations, scale = s or {smin, smax} in place of radius (method 'random')."},
+    "Generates balls in a region: method 'random' (non-overlapping), 'distribute' (overlapping to a porosity, then relaxed), 'expand' (radius expansion to a porosity), 'lattice' (packing = square|hex|cubic|fcc). radius = r or {rmin, rmax} [m]; distribution 'uniform' | 'normal' | 'lognormal' (mean, std), or psd = {{r, fraction of the volume passing}, ...} (a grading curve); material, group, tries, relax = {steps, ratio, calm}. With template = name: clumps at random orientations, scale = s or {smin, smax} in place of radius (method 'random')."},
   ["model:close"] = {"m:close()", "Frees the model now; any later use is an error."},
   ["model:summary"] = {"m:summary() -> text", "The summary print(m) shows."},
 

@@ -395,7 +395,7 @@ end
 --- Returns a specimen table for the tests: {path, dim, shape, size, balls,
 --- bonds, porosity, floaters, sigma0, material, ...}.
 function lab.specimen(opts)
-  check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius",
+  check_keys(opts, "specimen", {"dim", "shape", "diameter", "height", "width", "depth", "thickness", "radius", "psd",
                                 "porosity", "material", "sigma0", "sigma0_tol", "floater_contacts", "gap", "gapped", "seed", "path",
                                 "log", "max_steps", "clump", "model", "bonds"})
   local dim = opts.dim or 3
@@ -422,16 +422,13 @@ function lab.specimen(opts)
   end
   -- a specimen of clumps: {pebbles = {...} (m:clump_template's form), scale = s | {smin, smax}}
   local grain = opts.clump
-  local radius = opts.radius or {0.8e-3, 1.33e-3}
   if grain ~= nil then
     if type(grain) ~= "table" or type(grain.pebbles) ~= "table" or #grain.pebbles < 1 then
       fail("lab.specimen: clump must be {pebbles = {...}, scale = s | {smin, smax}}")
     end
-    if opts.radius then fail("lab.specimen: a clump specimen takes scale, not radius") end
+    if opts.radius or opts.psd then fail("lab.specimen: a clump specimen takes scale, not %s", opts.radius and "radius" or "psd") end
   end
-  if type(radius) ~= "table" or #radius ~= 2 or not (radius[1] > 0) or not (radius[2] >= radius[1]) then
-    fail("lab.specimen: radius must be {rmin, rmax} with 0 < rmin <= rmax")
-  end
+  local radius, sizes = genesis.sizes(opts, "lab.specimen", {0.8e-3, 1.33e-3})
   local mat = lab.rock(opts.material)
   local sigma0 = opts.sigma0 or 0.1e6
   positive(sigma0, "sigma0", "specimen")
@@ -495,8 +492,8 @@ function lab.specimen(opts)
     say(opts, "lab.specimen: unloaded to about %.3g Pa, frictionless (%d steps)", sigma0, steps)
     m:material("rock", mat)
   else
-    n = m:generate{method = "expand", porosity = porosity, radius = radius, region = v.region, seed = seed,
-                   relax = false}
+    n = m:generate{method = "expand", porosity = porosity, radius = sizes.radius, psd = sizes.psd, region = v.region,
+                   seed = seed, relax = false}
     say(opts, "lab.specimen: %d balls by radius expansion to porosity %.3f (%d steps), mean wall stress %.3g Pa", n,
         porosity, m:step(), v.stress())
   end
@@ -601,7 +598,7 @@ function lab.specimen(opts)
   say(opts, "lab.specimen: %s mean stress %.4g Pa in the core (%d balls), its porosity %.4f, coordination %.3f",
       granular and "the vessel's (kept)" or "locked-in", mean, inside.balls, inside.porosity, inside.coordination)
   local spec = {
-    path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius),
+    path = path, dim = dim, shape = shape, size = size, lo = elo, hi = ehi, radius = copy(radius), psd = copy(opts.psd),
     balls = m:ball_count(), bonds = m:bond_count(), porosity = 1 - solid / volume, floaters = floaters,
     genesis = gen, rmax = rmax,
     sigma0 = sigma0, material = mat, wall_kn = kn, seed = seed, model = kind, granular = granular,

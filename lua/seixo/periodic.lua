@@ -92,7 +92,7 @@ end
 
 --- A periodic specimen saved at opts.path; returns its table (periodic.open reads it back).
 function periodic.specimen(opts)
-  check_keys(opts, "specimen", {"dim", "size", "radius", "porosity", "material", "sigma0", "bonds", "gap", "seed",
+  check_keys(opts, "specimen", {"dim", "size", "radius", "psd", "porosity", "material", "sigma0", "bonds", "gap", "seed",
                                 "path", "log", "max_steps"})
   local lab = require "seixo.lab"
   local dim = opts.dim or 3
@@ -101,10 +101,7 @@ function periodic.specimen(opts)
   if type(size) == "number" then size = dim == 3 and {size, size, size} or {size, size} end
   if type(size) ~= "table" or #size ~= dim then fail("periodic.specimen: size must be a length or %d lengths", dim) end
   for k = 1, dim do positive(size[k], "size", "specimen") end
-  local radius = opts.radius or {0.4e-3, 0.66e-3}
-  if type(radius) ~= "table" or #radius ~= 2 or not (radius[1] > 0) or not (radius[2] >= radius[1]) then
-    fail("periodic.specimen: radius must be {rmin, rmax} with 0 < rmin <= rmax")
-  end
+  local radius, sizes = require("seixo.genesis").sizes(opts, "periodic.specimen", {0.4e-3, 0.66e-3})
   local mat = lab.rock(opts.material)
   local sigma0 = positive(opts.sigma0 or 0.1e6, "sigma0", "specimen")
   local porosity = opts.porosity or (dim == 3 and 0.35 or 0.16) -- seixo.lab's
@@ -128,8 +125,8 @@ function periodic.specimen(opts)
   -- below the one the packing jams at (it starts above sigma0 everywhere),
   -- then, the cell held still, sigma0 by radius scaling and the floaters
   -- grown (seixo.genesis)
-  local n = m:generate{method = "expand", porosity = porosity, radius = radius, region = {box = {lo, size}},
-                      seed = seed, relax = false}
+  local n = m:generate{method = "expand", porosity = porosity, radius = sizes.radius, psd = sizes.psd,
+                      region = {box = {lo, size}}, seed = seed, relax = false}
   say(opts, "periodic.specimen: %d balls by radius expansion to porosity %.3f in a periodic cell", n, porosity)
   local gap = opts.gap or 1e-3 * radius[1]
   local left, gen = require("seixo.genesis").periodic(m, mat, sigma0, gap, {max_steps = max_steps},
@@ -145,7 +142,7 @@ function periodic.specimen(opts)
   local cell = m:periodic()
   local volume = 1
   for k = 1, dim do volume = volume * cell.size[k] end
-  local spec = {path = path, dim = dim, size = cell.size, radius = radius, balls = m:ball_count(),
+  local spec = {path = path, dim = dim, size = cell.size, radius = radius, psd = opts.psd, balls = m:ball_count(),
                 bonds = m:bond_count(), porosity = 1 - m:sum("volume") / volume, sigma0 = sigma0, material = mat,
                 seed = seed, genesis_steps = m:step(), genesis_time = seixo.clock() - t0, periodic = true,
                 floaters_found = gen.floaters_found, floaters_left = left}

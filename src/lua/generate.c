@@ -20,7 +20,10 @@
  *   lattice     regular packings of touching balls: square or hex (2D),
  *               cubic or fcc (3D); every site whose ball lies in the region.
  * Radii: `radius = r` or `{rmin, rmax}` with distribution "uniform"
- * (default) or "normal" (mean, std; truncated to [rmin, rmax]). When both
+ * (default), "normal" or "lognormal" (mean, std of the radius; truncated to
+ * [rmin, rmax]), or `psd`, a grading curve: the fraction of the solid
+ * volume in balls up to each radius, linear in the radius between its
+ * points (a sieve curve's mass passing). When both
  * count and porosity are given (distribute, expand), the drawn radii are
  * scaled by one factor to reach the porosity exactly.
  * Clumps: `template = name` generates clumps of that template instead
@@ -94,8 +97,9 @@ enum { M_RANDOM, M_DISTRIBUTE, M_EXPAND, M_LATTICE };
 static const char *const method_names[] = {"random", "distribute", "expand", "lattice", NULL};
 enum { P_SQUARE, P_HEX, P_CUBIC, P_FCC };
 static const char *const packing_names[] = {"square", "hex", "cubic", "fcc", NULL};
-enum { D_UNIFORM, D_NORMAL };
-static const char *const dist_names[] = {"uniform", "normal", NULL};
+enum { D_UNIFORM, D_NORMAL, D_LOGNORMAL, D_PSD };
+static const char *const dist_names[] = {"uniform", "normal", "lognormal", NULL};
+enum { MAX_PSD = 100 };
 
 typedef struct gen {
     int dim, method, packing, dist, material;
@@ -105,6 +109,10 @@ typedef struct gen {
     int64_t count, tries;
     bool has_count, has_porosity;
     double porosity, rmin, rmax, mean, std;
+    double log_mean, log_std; /* lognormal: of ln r */
+    int psd_points;
+    double psd_r[MAX_PSD];    /* the grading curve's radii, increasing */
+    double psd_count[MAX_PSD]; /* the fraction of the balls' count up to each (by count, not volume) */
     sx_lua_region region;
     uint64_t seed;
     bool relax;
@@ -150,6 +158,55 @@ static void read_radius(lua_State *L, gen *g, const char *key)
     }
 }
 
+/* The grading curve {{r1, 0}, ..., {rn, 1}}: F(r), the fraction of the
+ * solid volume in bodies of size up to r, linear in r between points. A
+ * ball's volume goes as r^dim, so within a bin the count's density goes as
+ * r^-dim; psd_count holds the count's cumulative fraction at each point. */
+static void read_psd(lua_State *L, gen *g, const char *size)
+{
+    const int t = lua_gettop(L);
+    const int n = (int)lua_rawlen(L, t);
+    if (n < 2 || n > MAX_PSD)
+        sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "2 to %d points {r, F} expected, got %d", (int)MAX_PSD, n));
+    double F[MAX_PSD];
+    for (int i = 0; i < n; i++) {
+        lua_rawgeti(L, t, i + 1);
+        const bool pair = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == 2;
+        if (pair) {
+            lua_rawgeti(L, -1, 1);
+            lua_rawgeti(L, -2, 2);
+        }
+        if (!pair || lua_type(L, -1) != LUA_TNUMBER || lua_type(L, -2) != LUA_TNUMBER)
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: {%s, fraction passing} (two numbers) expected", i + 1, size));
+        g->psd_r[i] = lua_tonumber(L, -2);
+        F[i] = lua_tonumber(L, -1);
+        lua_pop(L, 3);
+        if (!(g->psd_r[i] > 0 && isfinite(g->psd_r[i])) || (i > 0 && !(g->psd_r[i] > g->psd_r[i - 1])))
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the %ss must be finite, > 0 and increasing", i + 1, size));
+        if (!(F[i] >= 0 && F[i] <= 1))
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: a fraction passing in [0, 1] expected, got %f%s", i + 1,
+                                                          F[i], F[i] > 1 && F[i] <= 100 ? " (a percentage? divide by 100)" : ""));
+        if (i > 0 && F[i] < F[i - 1])
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the fractions passing must not decrease", i + 1));
+    }
+    if (F[0] != 0 || F[n - 1] != 1)
+        sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "the curve must start at fraction 0 (its smallest %s) and end at 1 "
+                                                          "(its largest), got %f and %f", size, F[0], F[n - 1]));
+    const int k = g->dim;
+    double sum = 0;
+    g->psd_count[0] = 0;
+    for (int i = 1; i < n; i++) {
+        const double a = g->psd_r[i - 1], b = g->psd_r[i];
+        sum += (F[i] - F[i - 1]) / (b - a) * (pow(a, 1 - k) - pow(b, 1 - k)) / (k - 1);
+        g->psd_count[i] = sum;
+    }
+    for (int i = 1; i < n; i++) g->psd_count[i] /= sum;
+    g->psd_count[n - 1] = 1;
+    g->psd_points = n;
+    g->rmin = g->psd_r[0];
+    g->rmax = g->psd_r[n - 1];
+}
+
 static void read_relax(lua_State *L, gen *g)
 {
     static const char *const keys[] = {"steps", "ratio", "calm", NULL};
@@ -192,7 +249,7 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
 {
     static const char *const keys[] = {"count", "porosity", "radius", "distribution", "mean",   "std",   "region",
                                        "seed",  "material", "group",  "method",       "packing", "tries", "relax",
-                                       "template", "scale", NULL};
+                                       "template", "scale", "psd", NULL};
     sx_lua_checkkeys(L, 2, keys);
     memset(g, 0, sizeof *g);
     g->dim = sx_model_dim(m);
@@ -229,16 +286,44 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
         if ((g->packing <= P_HEX) != (g->dim == 2))
             sx_lua_fielderror(L, 2, "packing", g->dim == 2 ? "'square' or 'hex' in 2D" : "'cubic' or 'fcc' in 3D");
     }
-    read_radius(L, g, clumps ? "scale" : "radius");
-    g->dist = pick(L, "distribution", dist_names, D_UNIFORM);
+    const char *size = clumps ? "scale" : "radius";
+    lua_pushliteral(L, "psd");
+    const int psd_type = lua_rawget(L, 2);
+    if (psd_type == LUA_TNIL) {
+        lua_pop(L, 1);
+        read_radius(L, g, size);
+        g->dist = pick(L, "distribution", dist_names, D_UNIFORM);
+    } else {
+        if (psd_type != LUA_TTABLE)
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "a table of points {r, F} expected, got %s", lua_typename(L, psd_type)));
+        static const char *const by_psd[] = {"radius", "scale", "distribution", NULL};
+        for (int k = 0; by_psd[k]; k++) {
+            lua_pushstring(L, by_psd[k]);
+            const bool given = lua_rawget(L, 2) != LUA_TNIL;
+            lua_pop(L, 1);
+            if (given) sx_lua_fielderror(L, 2, by_psd[k], "the psd gives the sizes and their distribution: leave this out");
+        }
+        read_psd(L, g, size);
+        lua_pop(L, 1);
+        g->dist = D_PSD;
+        if (!clumps) {
+            sx_lua_check_range(L, 1, "radius", g->rmax, 1e-6, 1, "m");
+            sx_lua_check_range(L, 1, "radius", g->rmin, 1e-6, 1, "m");
+        }
+    }
     g->mean = 0.5 * (g->rmin + g->rmax);
     g->std = (g->rmax - g->rmin) / 6;
     const bool has_mean = sx_lua_optnumfield(L, 2, "mean", &g->mean), has_std = sx_lua_optnumfield(L, 2, "std", &g->std);
-    if ((has_mean || has_std) && g->dist != D_NORMAL)
-        sx_lua_fielderror(L, 2, has_mean ? "mean" : "std", "only for distribution = 'normal'");
-    if (g->dist == D_NORMAL) {
+    const bool parametric = g->dist == D_NORMAL || g->dist == D_LOGNORMAL;
+    if ((has_mean || has_std) && !parametric)
+        sx_lua_fielderror(L, 2, has_mean ? "mean" : "std", "only for distribution = 'normal' or 'lognormal'");
+    if (parametric) {
         if (!(g->mean >= g->rmin && g->mean <= g->rmax)) sx_lua_fielderror(L, 2, "mean", "must lie in [rmin, rmax]");
         if (!(g->std >= 0 && isfinite(g->std))) sx_lua_fielderror(L, 2, "std", "must be finite and >= 0");
+    }
+    if (g->dist == D_LOGNORMAL) { /* ln r's parameters for r's mean and std */
+        g->log_std = sqrt(log1p((g->std / g->mean) * (g->std / g->mean)));
+        g->log_mean = log(g->mean) - 0.5 * g->log_std * g->log_std;
     }
     g->has_count = sx_lua_optintfield(L, 2, "count", 0, MAX_GENERATE, &g->count);
     g->has_porosity = sx_lua_optnumfield(L, 2, "porosity", &g->porosity);
@@ -255,7 +340,7 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
         break;
     case M_LATTICE:
         if (g->has_porosity) sx_lua_fielderror(L, 2, "porosity", "a lattice's porosity follows from its packing");
-        if (g->rmin != g->rmax) sx_lua_fielderror(L, 2, "radius", "a lattice takes one radius");
+        if (g->rmin != g->rmax) sx_lua_fielderror(L, 2, g->dist == D_PSD ? "psd" : "radius", "a lattice takes one radius");
         break;
     }
     int64_t seed = 1;
@@ -276,15 +361,29 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
 
 /* --------------------------------------------------------------- radii */
 
+/* A size from the grading curve: a bin by the count's fractions, then the
+ * inverse of the count's distribution in it, whose density goes as r^-dim. */
+static double draw_psd(const gen *g, rng *r)
+{
+    const double u = rng_uniform(r);
+    int i = 1;
+    while (i < g->psd_points - 1 && !(u < g->psd_count[i])) i++;
+    const double a = g->psd_r[i - 1], b = g->psd_r[i], e = 1 - g->dim;
+    const double pa = pow(a, e), pb = pow(b, e);
+    const double x = pow(pa - rng_uniform(r) * (pa - pb), 1 / e);
+    return fmin(fmax(x, a), b);
+}
+
 static double draw_radius(lua_State *L, const gen *g, rng *r)
 {
     if (g->rmin == g->rmax) return g->rmin;
     if (g->dist == D_UNIFORM) return g->rmin + (g->rmax - g->rmin) * rng_uniform(r);
+    if (g->dist == D_PSD) return draw_psd(g, r);
     for (int k = 0; k < 100000; k++) {
-        const double x = g->mean + g->std * rng_normal(r);
+        const double x = g->dist == D_NORMAL ? g->mean + g->std * rng_normal(r) : exp(g->log_mean + g->log_std * rng_normal(r));
         if (x >= g->rmin && x <= g->rmax) return x;
     }
-    luaL_argerror(L, 2, "the normal distribution (mean, std) almost never falls in [rmin, rmax]");
+    luaL_argerror(L, 2, lua_pushfstring(L, "the %s distribution (mean, std) almost never falls in [rmin, rmax]", dist_names[g->dist]));
     return 0;
 }
 

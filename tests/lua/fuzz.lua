@@ -27,13 +27,13 @@ end
 local keys = {"dim", "gravity", "timestep", "timestep_safety", "skin", "kn", "ks", "friction", "density", "damping",
               "viscous_normal", "viscous_shear", "model", "shear_modulus", "poisson", "modulus", "stiffness_ratio",
               "bond", "pos", "radius", "vel", "spin", "material", "group", "kind", "point", "normal", "corner",
-              "edge1", "edge2", "p1", "p2", "min", "max", "count", "porosity", "distribution", "mean", "std",
+              "edge1", "edge2", "p1", "p2", "min", "max", "count", "porosity", "distribution", "psd", "mean", "std",
               "region", "seed", "method", "packing", "tries", "relax", "steps", "ratio", "calm", "time", "every",
               "where", "box", "sphere", "cylinder", "disk", "polygon", "center", "fix", "applied_force",
               "applied_moment", "ball", "wall", "field", "component", "gap", "materials", "fricton", "template",
               "scale", "orientation", "axis", "angle", "lines", 1, 2, 3}
 local words = {"", "x", "rock", "auto", "cycle", "after", "before", "box", "plane", "line", "rect", "segment",
-               "pos", "vel", "radius", "kinetic", "time", "ratio", "uniform", "normal", "random", "distribute",
+               "pos", "vel", "radius", "kinetic", "time", "ratio", "uniform", "normal", "lognormal", "random", "distribute",
                "expand", "lattice", "hex", "fcc", "square", "cubic", "vx", "all", "spin", "ball-ball", "top",
                "linear", "hertz", "parallel", "contact", "tension", "pair", string.rep("z", 300), "a,b", "\0"}
 local numbers = {0, 1, -1, 2, 3, 7, 0.5, -0.5, 100, 2 ^ 31, 2 ^ 53, 1e300, -1e300, 1e-320, math.huge, -math.huge,

@@ -157,6 +157,89 @@ test("truncated normal radii", function()
   near(u:mean("radius"), 2e-3, 4 * (2e-3 / math.sqrt(12)) / math.sqrt(3000) / 2e-3)
 end)
 
+-- The volume fraction of the balls up to radius x, and its standard error
+-- by the delta method (a ratio of two sample means), so that the bound is
+-- the sampling's own and not a tolerance picked to pass.
+local function passing(m, dim, x)
+  local n, sv, sa = 0, 0, 0
+  for b in m:balls() do
+    local v = b.radius ^ dim
+    n, sv = n + 1, sv + v
+    if b.radius <= x then sa = sa + v end
+  end
+  local frac = sa / sv
+  local var = 0
+  for b in m:balls() do
+    local v = b.radius ^ dim
+    var = var + (v * ((b.radius <= x and 1 or 0) - frac)) ^ 2
+  end
+  return frac, math.sqrt(var / n) / (sv / n) / math.sqrt(n)
+end
+
+test("a grading curve (psd): the balls' volume passing each point", function()
+  local curve = {{0.5e-3, 0}, {0.8e-3, 0.1}, {1.2e-3, 0.5}, {1.3e-3, 0.5}, {2e-3, 0.9}, {3e-3, 1}}
+  for _, dim in ipairs{2, 3} do
+    local m = T.model(dim)
+    local region = dim == 3 and {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}} or {box = {{0, 0}, {0.6, 0.6}}}
+    m:generate{count = 20000, psd = curve, region = region, seed = 3}
+    local lo, hi, gap = math.huge, 0, 0
+    for b in m:balls() do
+      lo, hi = math.min(lo, b.radius), math.max(hi, b.radius)
+      if b.radius > 1.2e-3 and b.radius < 1.3e-3 then gap = gap + 1 end
+    end
+    check(lo >= 0.5e-3 and hi <= 3e-3, "within the curve's radii")
+    eq(gap, 0)  -- a flat stretch of the curve holds no balls
+    for i = 2, #curve - 1 do
+      local frac, se = passing(m, dim, curve[i][1])
+      check(math.abs(frac - curve[i][2]) < 4 * se, string.format("%dD passing %g: %g (se %g), curve %g", dim, curve[i][1], frac,
+                                                                 se, curve[i][2]))
+    end
+    -- by porosity: balls are drawn until their volume reaches the target
+    local p = T.model(dim)
+    local _, porosity = p:generate{porosity = 0.9, psd = curve, region = region, seed = 4}
+    check(porosity <= 0.9 and porosity > 0.89, "porosity " .. porosity)
+  end
+  -- one bin: the count's density goes as r^-dim (3D: the mean radius of
+  -- r^-3 on [a, b] is 2ab/(a + b))
+  local m = T.model(3)
+  m:generate{count = 5000, psd = {{1e-3, 0}, {3e-3, 1}}, region = {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}}, seed = 5}
+  local s, s2 = 0, 0
+  for b in m:balls() do s, s2 = s + b.radius, s2 + b.radius ^ 2 end
+  local mean = s / 5000
+  local sd = math.sqrt(s2 / 5000 - mean * mean)
+  check(math.abs(mean - 2 * 1e-3 * 3e-3 / 4e-3) < 4 * sd / math.sqrt(5000), "mean radius " .. mean)
+end)
+
+test("lognormal radii: the truncated distribution's mean and sd", function()
+  local mu_r, sd_r, a, b = 1e-3, 0.4e-3, 0.5e-3, 3e-3
+  local m = T.model(3)
+  m:generate{count = 20000, radius = {a, b}, distribution = "lognormal", mean = mu_r, std = sd_r,
+             region = {box = {{0, 0, 0}, {0.2, 0.2, 0.2}}}, seed = 9}
+  -- the moments of ln r for r's mean and sd, and the truncated moments by quadrature
+  local s2 = math.log(1 + (sd_r / mu_r) ^ 2)
+  local mu = math.log(mu_r) - s2 / 2
+  local z, m1, m2 = 0, 0, 0
+  local steps = 20000
+  for i = 0, steps - 1 do
+    local r = a + (b - a) * (i + 0.5) / steps
+    local f = math.exp(-(math.log(r) - mu) ^ 2 / (2 * s2)) / r
+    z, m1, m2 = z + f, m1 + f * r, m2 + f * r * r
+  end
+  local want_mean, want_sd = m1 / z, math.sqrt(m2 / z - (m1 / z) ^ 2)
+  local n, s, q, lo, hi = 0, 0, 0, math.huge, 0
+  for ball in m:balls() do
+    local r = ball.radius
+    n, s, q, lo, hi = n + 1, s + r, q + r * r, math.min(lo, r), math.max(hi, r)
+  end
+  local mean = s / n
+  local sd = math.sqrt(q / n - mean * mean)
+  check(lo >= a and hi <= b, "truncated to the range")
+  check(math.abs(mean - want_mean) < 4 * want_sd / math.sqrt(n), string.format("mean %g, expected %g", mean, want_mean))
+  check(math.abs(sd - want_sd) < 0.05 * want_sd, string.format("sd %g, expected %g", sd, want_sd))
+  -- a skewed law: the median is below the mean, at exp(mu) untruncated
+  check(want_mean > math.exp(mu), "lognormal's mean above its median")
+end)
+
 test("existing balls are avoided", function()
   local m = T.model(2)
   local region = {box = {{0, 0}, {0.06, 0.06}}}
@@ -306,9 +389,27 @@ test("argument errors name the function, the field and the position", function()
   raises(function() m3:generate{packing = "hex", radius = 0.1, region = box3} end, HERE, "'cubic' or 'fcc' in 3D")
   raises(function() m2:generate{packing = "fcc", radius = 0.1, region = {box = {{0, 0}, {1, 1}}}} end, HERE, "in 2D")
   raises(function() m3:generate{packing = "fcc", radius = {0.1, 0.2}, region = box3} end, HERE, "one radius")
-  raises(function() m3:generate{count = 1, radius = 0.1, region = box3, mean = 0.1} end, HERE, "field 'mean'", "normal")
+  raises(function() m3:generate{count = 1, radius = 0.1, region = box3, mean = 0.1} end, HERE, "field 'mean'", "'normal' or 'lognormal'")
   raises(function() m3:generate{count = 1, radius = {0.1, 0.2}, region = box3, distribution = "normal", mean = 0.5} end,
          HERE, "field 'mean'")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 100}}, region = box3} end, HERE, "field 'psd'",
+         "point 2", "a percentage? divide by 100")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0.2}, {0.2, 1}}, region = box3} end, HERE, "field 'psd'", "start at fraction 0")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 0.9}}, region = box3} end, HERE, "end at 1")
+  raises(function() m3:generate{count = 1, psd = {{0.2, 0}, {0.1, 1}}, region = box3} end, HERE, "point 2", "increasing")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 0.6}, {0.3, 0.5}, {0.4, 1}}, region = box3} end, HERE,
+         "point 3", "must not decrease")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2}}, region = box3} end, HERE, "point 2", "two numbers")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}}, region = box3} end, HERE, "2 to 100 points")
+  raises(function() m3:generate{count = 1, psd = 0.1, region = box3} end, HERE, "field 'psd'", "got number")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 1}}, radius = 0.1, region = box3} end, HERE, "field 'radius'",
+         "leave this out")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 1}}, distribution = "normal", region = box3} end, HERE,
+         "field 'distribution'")
+  raises(function() m3:generate{count = 1, psd = {{0.1, 0}, {0.2, 1}}, mean = 0.15, region = box3} end, HERE, "field 'mean'")
+  raises(function() m3:generate{packing = "fcc", psd = {{0.1, 0}, {0.2, 1}}, region = box3} end, HERE, "field 'psd'", "one radius")
+  raises(function() m3:generate{count = 1, radius = {0.1, 0.2}, distribution = "lognormal", mean = 0.05, region = box3} end,
+         HERE, "field 'mean'", "[rmin, rmax]")
   raises(function() m3:generate{count = 1, radius = 0.1, region = box3, material = "glass"} end, HERE, "no material named 'glass'")
   raises(function() m3:generate{count = 1, radius = 0.1, region = {disk = {center = {0, 0}, radius = 1}}} end, HERE,
          "field 'region'", "a disk is a 2D region")

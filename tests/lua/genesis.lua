@@ -87,5 +87,48 @@ test("a sigma0 that the steps allowed cannot install is a warning in the log", f
   check(logged, table.concat(lines, "\n"))
 end)
 
+-- The volume fraction of the balls of a file below radius x, with its
+-- standard error (delta method: the sampling's own scatter).
+local function volume_below(path, x)
+  local m = seixo.load(path)
+  local dim, rs = m:dim(), {}
+  for b in m:balls() do rs[#rs + 1] = b.radius end
+  m:close()
+  local sv, sa = 0, 0
+  for _, r in ipairs(rs) do
+    sv = sv + r ^ dim
+    if r < x then sa = sa + r ^ dim end
+  end
+  local frac, var = sa / sv, 0
+  for _, r in ipairs(rs) do var = var + (r ^ dim * ((r < x and 1 or 0) - frac)) ^ 2 end
+  return frac, math.sqrt(var / #rs) / (sv / #rs) / math.sqrt(#rs), rs
+end
+
+test("a grading curve (psd) through the genesis, walled and periodic", function()
+  -- gap-graded: 60 % of the volume in 0.2-0.25 mm, the rest in 0.4-0.45 mm
+  -- (a uniform draw over 0.2-0.45 mm would put 30 % below 0.32 mm)
+  local psd = {{0.2e-3, 0}, {0.25e-3, 0.6}, {0.4e-3, 0.6}, {0.45e-3, 1}}
+  local spec = lab.specimen{dim = 2, width = 0.008, height = 0.016, psd = psd, bonds = false, seed = 2,
+                            path = dir .. "/psd.h5", log = false}
+  eq(spec.psd[3][1], 0.4e-3)
+  eq(spec.radius[1], 0.2e-3)
+  eq(spec.radius[2], 0.45e-3)
+  local frac, se, rs = volume_below(spec.path, 0.32e-3)
+  -- sigma0's radius scaling moves every radius by one factor (a few %), and
+  -- floaters grow: the split at 0.32 mm stays in the gap
+  check(math.abs(frac - 0.6) < 4 * se, string.format("volume below 0.32 mm: %g (se %g)", frac, se))
+  local in_gap = 0
+  for _, r in ipairs(rs) do if r > 0.27e-3 and r < 0.37e-3 then in_gap = in_gap + 1 end end
+  check(in_gap <= spec.genesis.floaters_found, string.format("%d balls in the gap", in_gap))
+  local cell = lab.periodic.specimen{dim = 2, size = 0.008, psd = psd, bonds = false, seed = 2, path = dir .. "/psdcell.h5",
+                                     log = false}
+  frac, se = volume_below(cell.path, 0.32e-3)
+  check(math.abs(frac - 0.6) < 4 * se, string.format("periodic: volume below 0.32 mm: %g (se %g)", frac, se))
+  eq(lab.periodic.open(cell.path).psd[2][2], 0.6)
+  T.raises(function() lab.specimen{dim = 2, width = 0.008, height = 0.016, psd = psd, radius = {1e-3, 2e-3}, path = dir .. "/x.h5"} end,
+           "radius or psd")
+  T.raises(function() lab.periodic.specimen{dim = 2, psd = {}, path = dir .. "/x.h5"} end, "psd must be a grading curve")
+end)
+
 os.execute("rm -rf '" .. dir .. "'")
 T.done()
