@@ -7,7 +7,7 @@
 --   caller.wrap(module_table)   -- every function of the table
 local caller = {}
 
-local own = {lab = true, pool = true, calibrate = true, periodic = true, plot = true, util = true, genesis = true, caller = true,
+local own = {lab = true, check = true, pool = true, calibrate = true, periodic = true, plot = true, util = true, genesis = true, caller = true,
              joints = true}
 
 function caller.at_caller(f)

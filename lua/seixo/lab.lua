@@ -36,36 +36,8 @@ local plot_test, plot_brazilian, plot_series -- the figures, at the end
 
 -- ------------------------------------------------------------------ helpers
 
-local function fail(fmt, ...) error(string.format(fmt, ...), 3) end
-
-local function check_keys(t, fn, allowed)
-  if type(t) ~= "table" then error(string.format("lab.%s: a table of options expected, got %s", fn, type(t)), 3) end
-  local set = {}
-  for _, k in ipairs(allowed) do set[k] = true end
-  for k in pairs(t) do
-    if not set[k] then
-      table.sort(allowed)
-      error(string.format("lab.%s: unknown option '%s' (valid: %s)", fn, tostring(k), table.concat(allowed, ", ")), 3)
-    end
-  end
-end
-
--- Fails unless a file can be made at path (an output's, checked before
--- the work that makes it).
-local function check_writable(path, what, fn)
-  if type(path) ~= "string" then
-    error(string.format("lab.%s: %s must be a path (a string; got %s)", fn, what, type(path)), 3)
-  end
-  local ok, why = pool.writable(path)
-  if not ok then error(string.format("lab.%s: cannot write %s (%s): %s", fn, path, what, why), 3) end
-end
-
-local function positive(v, what, fn)
-  if type(v) ~= "number" or not (v > 0) or v == math.huge then
-    error(string.format("lab.%s: %s must be a positive number (got %s)", fn, what, tostring(v)), 3)
-  end
-  return v
-end
+local c = require("seixo.check").module("lab")
+local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
 
 -- a specimen of lab.specimen or lab.open: its file and dimension at least
 local function check_spec(spec, fn)
@@ -73,14 +45,6 @@ local function check_spec(spec, fn)
     error(string.format("lab.%s: a specimen (from lab.specimen or lab.open) expected, got %s", fn,
                         type(spec) == "table" and "a table without its path or dim" or type(spec)), 3)
   end
-end
-
--- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
-local function steps(v, what, fn)
-  if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
-    error(string.format("lab.%s: %s must be a whole number of steps >= 1 (got %s)", fn, what, tostring(v)), 3)
-  end
-  return math.tointeger(v)
 end
 
 local function copy(t)
@@ -96,12 +60,6 @@ local function merge(base, over)
     if type(v) == "table" and type(r[k]) == "table" then r[k] = merge(r[k], v) else r[k] = copy(v) end
   end
   return r
-end
-
-local function say(opts, fmt, ...)
-  local log = opts.log
-  if log == false then return end
-  (log or print)(string.format(fmt, ...))
 end
 
 -- The balls' bounding box including their radii, and the mean radius.

@@ -28,38 +28,8 @@
 
 local periodic = {}
 
-local function fail(fmt, ...) error(string.format(fmt, ...), 3) end
-
-local function check_keys(t, fn, allowed)
-  if type(t) ~= "table" then fail("periodic.%s: a table of options expected, got %s", fn, type(t)) end
-  local set = {}
-  for _, k in ipairs(allowed) do set[k] = true end
-  for k in pairs(t) do
-    if not set[k] then
-      table.sort(allowed)
-      fail("periodic.%s: unknown option '%s' (valid: %s)", fn, tostring(k), table.concat(allowed, ", "))
-    end
-  end
-end
-
-local function positive(v, what, fn)
-  if type(v) ~= "number" or not (v > 0) or v == math.huge then
-    fail("periodic.%s: %s must be a positive number (got %s)", fn, what, tostring(v))
-  end
-  return v
-end
-
--- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
-local function steps(v, what, fn)
-  if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
-    fail("periodic.%s: %s must be a whole number of steps >= 1 (got %s)", fn, what, tostring(v))
-  end
-  return math.tointeger(v)
-end
-
-local function say(opts, fmt, ...)
-  if opts.log ~= false then print(string.format(fmt, ...)) end
-end
+local c = require("seixo.check").module("periodic")
+local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
 
 local names = {"xx", "yy", "zz"}
 
@@ -111,6 +81,7 @@ function periodic.specimen(opts)
   end
   local bonds = opts.bonds ~= false
   local path = opts.path or fail("periodic.specimen: a path for the specimen file is required")
+  check_writable(path, "path", "specimen") -- before the genesis, not at its end
   local max_steps = opts.max_steps or 50000
   local t0 = seixo.clock()
 
@@ -245,7 +216,7 @@ end
 --- shear), the normal stress and the volumetric strain.
 function periodic.shear(spec, opts)
   opts = opts or {}
-  check_keys(opts, "shear", {"normal", "shear_rate", "max_strain", "every", "log"})
+  check_keys(opts, "shear", {"normal", "shear_rate", "max_strain", "every", "log", "max_steps"})
   local m = open_test(spec, "shear")
   local dim = spec.dim
   local normal = positive(opts.normal or spec.sigma0, "normal", "shear")
@@ -255,8 +226,9 @@ function periodic.shear(spec, opts)
   local every = steps(opts.every or 100, "every", "shear")
   local t0 = seixo.clock()
   servo_all(m, dim, normal)
-  local confine_steps = settle(m, dim, normal, 0.01, 1e-2, 100000)
-  local start = m:step()
+  local max_steps = opts.max_steps and steps(opts.max_steps, "max_steps", "shear")
+  local confine_steps = settle(m, dim, normal, 0.01, 1e-2, max_steps or 100000)
+  local start, why = m:step(), "max_strain"
   servo_all(m, 0, nil, {yy = {stress = normal}, xy = {rate = rate}})
   local L0 = m:periodic().size
   local rows, peak = {}, -math.huge
@@ -267,8 +239,9 @@ function periodic.shear(spec, opts)
                  ev = (L0[2] - cell.size[2]) / L0[2], ratio = m:ratio()}
     rows[#rows + 1] = row
     peak = math.max(peak, row.tau / row.sn)
+    if row.gamma < max_strain and m:step() - start >= (max_steps or 1000000) then why = "max_steps"; break end
   until row.gamma >= max_strain
-  local r = {kind = "periodic shear", dim = dim, normal = normal, rows = rows, steps = m:step() - start,
+  local r = {kind = "periodic shear", dim = dim, normal = normal, rows = rows, steps = m:step() - start, stopped = why,
              confine_steps = confine_steps,
              peak_ratio = peak, friction_angle = math.deg(math.atan(peak)), wall_time = seixo.clock() - t0}
   say(opts, "periodic.shear: normal %.4g MPa: peak tau/sigma %.3f (%.1f deg), dilation %.4g (%.1f s)", normal / 1e6,

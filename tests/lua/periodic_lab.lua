@@ -61,6 +61,19 @@ T.test("the periodic tests' options are checked (a sand user's findings)", funct
   -- bonds = 0 gave a bonded specimen
   local ok, err = pcall(lab.periodic.specimen, {dim = 2, bonds = 0, path = "never.h5", log = false})
   T.check(not ok and err:find("bonds must be true or false", 1, true), tostring(err))
+  refused(lab.periodic.shear, {max_steps = 0}, "max_steps must be a whole number of steps >= 1 (got 0)")
+  -- a path that cannot be written failed at the save, after the genesis
+  local t0 = seixo.clock()
+  ok, err = pcall(lab.periodic.specimen, {dim = 2, path = "/nonexistent-dir/cell.h5", log = false})
+  T.check(not ok and err:find("cannot write /nonexistent-dir/cell.h5", 1, true), tostring(err))
+  T.check(seixo.clock() - t0 < 1, "refused before the genesis")
+end)
+
+T.test("periodic shear stops at max_steps and says so", function()
+  local r = lab.periodic.shear(granular, {normal = 1e6, shear_rate = 2, max_strain = 0.5, max_steps = 2000, log = false})
+  T.eq(r.stopped, "max_steps")
+  T.eq(r.steps, 2000)
+  T.check(r.rows[#r.rows].gamma < 0.5, "stopped short of max_strain")
 end)
 
 T.test("periodic simple shear at constant normal stress", function()

@@ -1,0 +1,63 @@
+-- seixo.check: the option checks and the log of the lab modules
+-- (seixo.lab, seixo.periodic). Every message starts with the function's
+-- name as the user calls it ("lab.triaxial: ..."), and is raised at the
+-- level of that function's caller (seixo.caller then puts it at the
+-- user's line):
+--   local c = require("seixo.check").module("periodic")
+--   c.keys(opts, "shear", {"normal", ...}); c.positive(v, "normal", "shear")
+local check = {}
+
+function check.module(name)
+  local c = {}
+
+  -- an error at the caller of the function that calls fail
+  function c.fail(fmt, ...) error(string.format(fmt, ...), 3) end
+
+  function c.keys(t, fn, allowed)
+    if type(t) ~= "table" then error(string.format("%s.%s: a table of options expected, got %s", name, fn, type(t)), 3) end
+    local set = {}
+    for _, k in ipairs(allowed) do set[k] = true end
+    for k in pairs(t) do
+      if not set[k] then
+        table.sort(allowed)
+        error(string.format("%s.%s: unknown option '%s' (valid: %s)", name, fn, tostring(k), table.concat(allowed, ", ")), 3)
+      end
+    end
+  end
+
+  function c.positive(v, what, fn)
+    if type(v) ~= "number" or not (v > 0) or v == math.huge then
+      error(string.format("%s.%s: %s must be a positive number (got %s)", name, fn, what, tostring(v)), 3)
+    end
+    return v
+  end
+
+  -- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
+  function c.steps(v, what, fn)
+    if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
+      error(string.format("%s.%s: %s must be a whole number of steps >= 1 (got %s)", name, fn, what, tostring(v)), 3)
+    end
+    return math.tointeger(v)
+  end
+
+  -- Fails unless a file can be made at path (an output's, checked before
+  -- the work that would end by writing it).
+  function c.writable(path, what, fn)
+    if type(path) ~= "string" then
+      error(string.format("%s.%s: %s must be a path (a string; got %s)", name, fn, what, type(path)), 3)
+    end
+    local ok, why = require("seixo.pool").writable(path)
+    if not ok then error(string.format("%s.%s: cannot write %s (%s): %s", name, fn, path, what, why), 3) end
+  end
+
+  -- a progress line: opts.log false (silent), a function, or print
+  function c.say(opts, fmt, ...)
+    local log = opts.log
+    if log == false then return end
+    (log or print)(string.format(fmt, ...))
+  end
+
+  return c
+end
+
+return check
