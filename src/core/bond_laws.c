@@ -12,13 +12,13 @@ static const sx_bond_law *(*const registry[])(void) = {SX_BONDS(SX_BOND_GET_)};
 #undef SX_BOND_GET_
 enum { NKINDS = sizeof registry / sizeof *registry, MAX_KEYS = 64 };
 
-const sx_bond_law *sx__bond_law(int k) { return k >= 0 && k < NKINDS ? registry[k]() : NULL; }
+static const sx_bond_law *bond_law(int k) { return k >= 0 && k < NKINDS ? registry[k]() : NULL; }
 
 int sx_bond_kind_count(void) { return NKINDS; }
 
 const char *sx_bond_kind_name(int k, sx_bond_kind *kind)
 {
-    const sx_bond_law *l = sx__bond_law(k);
+    const sx_bond_law *l = bond_law(k);
     if (l && kind) *kind = l->kind;
     return l ? l->name : NULL;
 }

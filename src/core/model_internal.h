@@ -653,7 +653,6 @@ size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p);
 /* Sorts the store by a, stably (a no-op when it is); false when out of memory. */
 bool sx__pairs_sort(sx_model *m, sx_pairs *p);
 void sx__walls_free(sx_model *m);
-void sx__wall_prepare(sx_model *m, sx_wall *w);
 /* sx_wall_add, with the mesh (owned from then on) of a mesh wall. */
 sx_status sx__wall_add(sx_model *m, const sx_wall_def *def, sx_mesh *mesh, int64_t *id);
 /* Meshes (mesh.c). */

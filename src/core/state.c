@@ -12,29 +12,6 @@
 #include <stddef.h>
 #include <string.h>
 
-void sx__state_sizes(const sx_model *m, sx_state_sizes *out)
-{
-    memset(out, 0, sizeof *out);
-    out->balls = m->balls.n;
-    out->next_ball_id = m->balls.next_id < 1 ? 1 : m->balls.next_id;
-    out->applied = m->balls.fapp != NULL;
-    out->bb = m->bb.n;
-    out->bw = m->bw.n;
-    out->bw_facets = m->mesh_pairs;
-    out->bb_bonds = m->bb.bond != NULL;
-    out->rolling = m->bb.mr != NULL;
-    out->total_shear = m->bb.us != NULL;
-    out->bonds = m->bonds.n;
-    out->fj_elements = m->fjel.n;
-    out->joints = m->njoint;
-    out->cracks = m->cracks.n;
-    out->walls = m->nwall;
-    out->materials = m->nmat;
-    out->cmodels = m->ncmodel;
-    out->bb_cmodel = m->bb.cmodel != NULL;
-    out->bw_cmodel = m->bw.cmodel != NULL;
-}
-
 /* An array of n elements of `size` bytes, zeroed; false when out of memory. */
 static bool alloc_array(sx_model *m, void **p, int64_t n, size_t size)
 {

@@ -52,8 +52,6 @@ typedef struct sx_state_sizes {
     bool bw_cmodel;       ///< the ball-wall store carries each contact's row (a wall row exists)
 } sx_state_sizes;
 
-/// The sizes of m's stores now.
-void sx__state_sizes(const sx_model *m, sx_state_sizes *out);
 
 /// Every one of the n values is finite (a restored array's check).
 bool sx__state_finite(const double *v, int64_t n);

@@ -51,7 +51,7 @@ int64_t sx__wall_index(const sx_model *m, int64_t id)
 }
 
 /* Derived geometry: unit normal, rectangle frame, segment length. */
-void sx__wall_prepare(sx_model *m, sx_wall *w)
+static void wall_prepare(sx_model *m, sx_wall *w)
 {
     const int d = m->dim;
     sx_wall_def *def = &w->def;
@@ -156,7 +156,7 @@ sx_status sx__wall_add(sx_model *m, const sx_wall_def *def, sx_mesh *mesh, int64
     w->id = ++m->next_wall_id;
     w->mesh = mesh;
     if (def->kind != SX_WALL_MESH) memset(w->def.spin, 0, sizeof w->def.spin); /* only a mesh turns */
-    sx__wall_prepare(m, w);
+    wall_prepare(m, w);
     m->build_needed = true;
     m->dt_stale = true;
     if (id) *id = w->id;

@@ -164,7 +164,7 @@ hid_t sx_h5_fcpl(void)
     return fcpl;
 }
 
-bool sx_h5_sync_path(const char *path)
+static bool sync_path(const char *path)
 {
     const int fd = open(path, O_RDONLY);
     if (fd < 0) return false;
@@ -176,7 +176,7 @@ bool sx_h5_sync_path(const char *path)
 bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path)
 {
     if (h->failed) return false;
-    if (!sx_h5_sync_path(tmp)) {
+    if (!sync_path(tmp)) {
         sx_h5_fail(h, "cannot flush the temporary file '%s' to disk: %s", tmp, strerror(errno));
         return false;
     }
@@ -316,7 +316,6 @@ bool sx_h5_attr_i64(sx_h5 *h, hid_t obj, const char *name, const int64_t *v, siz
     return attr_num(h, obj, name, H5T_NATIVE_INT64, H5T_STD_I64LE, v, n, scalar);
 }
 
-bool sx_h5_has_attr(hid_t obj, const char *name) { return H5Aexists(obj, name) > 0; }
 
 size_t sx_h5_attr_len(hid_t obj, const char *name)
 {

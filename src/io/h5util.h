@@ -63,8 +63,6 @@ bool sx_h5_rename(sx_h5 *h, const char *tmp, const char *path);
 /// disk; its name goes to tmp (len bytes). False (failed) on any error, with
 /// nothing left behind.
 bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len);
-/// fsync of a file by name (after HDF5 has closed it).
-bool sx_h5_sync_path(const char *path);
 
 /* ---------------------------------------------------------- attributes */
 
@@ -81,8 +79,6 @@ static inline bool sx_h5_attr_int(sx_h5 *h, hid_t obj, const char *name, int64_t
     return sx_h5_attr_i64(h, obj, name, &v, 1, true);
 }
 
-/// Whether obj has the attribute (false, without failing, if not).
-bool sx_h5_has_attr(hid_t obj, const char *name);
 /// Reads n numbers (a scalar when n == 1) converted to double / int64.
 /// A missing attribute fails when `required`, else leaves v untouched and
 /// returns true. `where` names the object in messages ("/model").

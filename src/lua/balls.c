@@ -301,7 +301,7 @@ void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n,
     }
 }
 
-void sx_lua_remove_ball(lua_State *L, int model, int64_t id, const char *what)
+static void remove_ball(lua_State *L, int model, int64_t id, const char *what)
 {
     sx_lua_remove_balls(L, model, &id, 1, what);
 }
@@ -357,7 +357,7 @@ static int ball_remove(lua_State *L)
     int64_t id;
     check_ball(L, &id);
     lua_getiuservalue(L, 1, 1);
-    sx_lua_remove_ball(L, -1, id, "b:remove");
+    remove_ball(L, -1, id, "b:remove");
     return 0;
 }
 

@@ -87,9 +87,6 @@ void sx_lua_parallel_check_call(lua_State *L, const char *what);
 /// model.c: sx_lua_parallel_check_call for a call on model m, named
 /// with the model's number after the first ("model 2: m:save").
 void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what);
-/// model.c: m's number among the models every rank makes alike (the
-/// decomposed ones, by creation, closed ones counted), 0 if it has none.
-int sx_lua_model_number(lua_State *L, const sx_model *m);
 /// model.c: numbers m, a model just decomposed: the next number, or that
 /// of `was` (seixo.load's placeholder, not dereferenced), which it
 /// forgets; m NULL: only forgets `was`.
@@ -180,8 +177,6 @@ void sx_lua_model_threads(lua_State *L, sx_model *m, const char *fn);
 /// Creates the model class with the methods of every array in `sets`
 /// (NULL-terminated); leaves nothing on the stack.
 void sx_lua_model_register(lua_State *L, const luaL_Reg *const sets[]);
-/* Pushes the model's profile table as text (sx_profile_format). */
-void sx_lua_push_profile_text(lua_State *L, const sx_model *m);
 /// The model of the model userdata at idx, or NULL if it has been closed;
 /// decomposed, as its last cycle left it (see sx_lua_checkmodel).
 sx_model *sx_lua_tomodel(lua_State *L, int idx);
@@ -223,10 +218,6 @@ int sx_lua_law_keys(const char **keys, int n, int cap);
 
 extern const struct sx_lua_kind sx_lua_ball_kind, sx_lua_wall_kind;
 
-/// Removes a ball (wall) of the model userdata at `model` and forgets its
-/// extras, or queues the removal while a callback runs; `what` names the
-/// Lua call in an error.
-void sx_lua_remove_ball(lua_State *L, int model, int64_t id, const char *what);
 /// Removes the n balls listed (each live, one listed twice goes once) in
 /// one pass over the contacts, or queues them while a callback runs.
 void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n, const char *what);
@@ -242,11 +233,6 @@ void sx_lua_pushfixmask(lua_State *L, unsigned mask);
 /* ----------------------------------------------------------- clumps.c */
 
 extern const struct sx_lua_kind sx_lua_clump_kind;
-/// An orientation at idx (3D: {w, x, y, z} or {axis =, angle =}; 2D: an
-/// angle) as a quaternion; NULL, or a message pushed.
-const char *sx_lua_toorientation(lua_State *L, int idx, int dim, double q[4]);
-/// Pushes an orientation (3D: {w, x, y, z}; 2D: the angle about z).
-void sx_lua_pushorientation(lua_State *L, int dim, const double q[4]);
 /// The clump template named by field `key` of the table at arg (required).
 int sx_lua_template_arg(lua_State *L, const sx_model *m, int arg, const char *key);
 /// Puts every pebble of clump id in group number `group`.
@@ -314,8 +300,6 @@ extern const char *const sx_lua_filter_keys[];
 /// Reads the filter keys (group, region, where) of the table at arg (none
 /// when arg is nil or absent). May push values: keep them until done.
 void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f);
-/// Whether ball `id` passes the filter (calls the predicate, if any).
-bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t id);
 /// Collects the ids of the balls that pass into a Lua-owned array pushed on
 /// the stack; returns it, its length in *n.
 int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);

@@ -24,7 +24,7 @@ static sx_model *check_clump(lua_State *L, int64_t *id) { return sx_lua_checkhan
 
 /* --------------------------------------------------------- orientations */
 
-void sx_lua_pushorientation(lua_State *L, int dim, const double q[4])
+static void push_orientation(lua_State *L, int dim, const double q[4])
 {
     if (dim == 2) {
         lua_pushnumber(L, 2 * atan2(q[3], q[0]));
@@ -38,7 +38,7 @@ void sx_lua_pushorientation(lua_State *L, int dim, const double q[4])
 }
 
 /* An orientation at idx as a quaternion; NULL, or a message pushed. */
-const char *sx_lua_toorientation(lua_State *L, int idx, int dim, double q[4])
+static const char *to_orientation(lua_State *L, int idx, int dim, double q[4])
 {
     idx = lua_absindex(L, idx);
     if (dim == 2) {
@@ -135,6 +135,11 @@ static int64_t read_sphere_file(lua_State *L, const char *path, int dim, double 
     int64_t n = 0, lineno = 0;
     while (fgets(line, sizeof line, f)) {
         lineno++;
+        if (!strchr(line, '\n') && !feof(f)) { /* a line fgets would split, its numbers read as two lines' */
+            fclose(f);
+            return luaL_error(L, "clump_template: %s:%I: a line longer than %d characters", path, (lua_Integer)lineno,
+                              (int)sizeof line - 2);
+        }
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;
         for (char *c = line; *c; c++)
@@ -372,7 +377,7 @@ static int get_orientation(lua_State *L)
     const sx_model *m = check_clump(L, &id);
     double q[4];
     sx_lua_checkfield(L, m, sx_clump_orientation(m, id, q), "clump");
-    sx_lua_pushorientation(L, sx_model_dim(m), q);
+    push_orientation(L, sx_model_dim(m), q);
     return 1;
 }
 
@@ -381,7 +386,7 @@ static int set_orientation(lua_State *L)
     int64_t id;
     sx_model *m = check_clump(L, &id);
     double q[4];
-    const char *bad = sx_lua_toorientation(L, 3, sx_model_dim(m), q);
+    const char *bad = to_orientation(L, 3, sx_model_dim(m), q);
     if (bad) return luaL_error(L, "field 'orientation': %s", bad);
     sx_lua_checkfield(L, m, sx_clump_set_orientation(m, id, q), "clump");
     return 0;
@@ -503,7 +508,7 @@ static int add_clump(lua_State *L, sx_model *m)
     sx_lua_checkvecfield(L, 2, "pos", dim, d.pos);
     lua_pushliteral(L, "orientation");
     if (lua_rawget(L, 2) != LUA_TNIL) {
-        const char *bad = sx_lua_toorientation(L, -1, dim, d.orientation);
+        const char *bad = to_orientation(L, -1, dim, d.orientation);
         if (bad) sx_lua_fielderror(L, 2, "orientation", bad);
     }
     lua_pop(L, 1);

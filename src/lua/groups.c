@@ -217,7 +217,7 @@ void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f)
     }
 }
 
-bool sx_lua_filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t id)
+static bool filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t id)
 {
     if (f->group) {
         bool in = false;
@@ -250,7 +250,7 @@ int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter 
         /* a predicate may remove balls or close the model */
         if (f->where) m = sx_lua_checkmodel(L, f->model);
         if (!sx_ball_exists(m, ids[i])) continue;
-        if (sx_lua_filter_match(L, m, f, ids[i])) ids[k++] = ids[i];
+        if (filter_match(L, m, f, ids[i])) ids[k++] = ids[i];
     }
     *n = k;
     return ids;

@@ -178,7 +178,7 @@ static void unshare(lua_State *L, const sx_model *m)
     lua_pop(L, 1);
 }
 
-int sx_lua_model_number(lua_State *L, const sx_model *m)
+static int model_number(lua_State *L, const sx_model *m)
 {
     const int top = lua_gettop(L);
     int number = 0;
@@ -194,7 +194,7 @@ void sx_lua_check_model_call(lua_State *L, const sx_model *m, const char *what)
      * m2):save(...)`) would pair one model's exchanges with the other's;
      * the first model keeps the plain name, as most scripts have one, and
      * the others' number comes first, where no cut of a long name drops it */
-    const int number = sx_lua_model_number(L, m);
+    const int number = model_number(L, m);
     if (number <= 1) {
         sx_lua_parallel_check_call(L, what);
         return;
@@ -268,13 +268,15 @@ void sx_lua_set_profile(lua_State *L, int on)
     lua_setfield(L, LUA_REGISTRYINDEX, profile_key);
 }
 
+static void push_profile_text(lua_State *L, const sx_model *m);
+
 static void profile_at_end(lua_State *L, const sx_model *m)
 {
     lua_getfield(L, LUA_REGISTRYINDEX, profile_key);
     const bool on = lua_toboolean(L, -1);
     lua_pop(L, 1);
     if (!on || !m || sx_model_profile(m).steps == 0) return;
-    sx_lua_push_profile_text(L, m);
+    push_profile_text(L, m);
     /* decomposed, each rank times its own share: N tables, each named */
     char rank[48] = "";
     if (sx_model_ranks(m) > 1) snprintf(rank, sizeof rank, " (rank %d of %d)", sx_lua_parallel_rank(), sx_model_ranks(m));
@@ -827,7 +829,7 @@ static int model_memory(lua_State *L)
 }
 
 /* The profile as text, for m:profile() and the executable's --profile. */
-void sx_lua_push_profile_text(lua_State *L, const sx_model *m)
+static void push_profile_text(lua_State *L, const sx_model *m)
 {
     const sx_profile p = sx_model_profile(m);
     const int need = sx_profile_format(&p, sx_ball_count(m), NULL, 0);
@@ -851,7 +853,7 @@ static int model_profile(lua_State *L)
     }
     const sx_profile p = sx_model_profile(m);
     if (print) {
-        sx_lua_push_profile_text(L, m);
+        push_profile_text(L, m);
         size_t len;
         const char *text = lua_tolstring(L, -1, &len);
         lua_writestring(text, len);

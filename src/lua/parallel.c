@@ -882,8 +882,12 @@ static int shared_tmpname(lua_State *L)
     int status;
     char *name = sx_lua_parallel_root_text("os.tmpname", rank0_tmpname, L, &len, &status);
     if (!name) return luaL_error(L, "os.tmpname: out of memory");
-    lua_pushlstring(L, name, len);
+    /* copied out before anything that may raise: the name is malloc'd */
+    char copy[4096];
+    const size_t n = len < sizeof copy ? len : sizeof copy - 1;
+    memcpy(copy, name, n);
     free(name);
+    lua_pushlstring(L, copy, n);
     if (status != LUA_OK) return lua_error(L);
     sx_lua_rank_file_written(L, lua_tostring(L, -1)); /* rank 0 made the file */
     return 1;

@@ -333,6 +333,17 @@ static void read_corner(lua_State *L, double *corner)
  * vertices with 0-based indices, from `file` (STL), `triangles` (a list of
  * three corners each) or `vertices` with `triangles` (a list of three
  * 1-based vertex numbers each). Arrays on the Lua stack as userdata. */
+
+/* A triangle soup of n triangles (malloc'd, 9 numbers each) copied into a
+ * userdata: lua_pcall'd, as the allocation may raise. */
+static int soup_to_userdata(lua_State *L)
+{
+    const double *soup = lua_touserdata(L, 1);
+    const size_t bytes = (size_t)lua_tointeger(L, 2) * 9 * sizeof *soup;
+    memcpy(lua_newuserdatauv(L, bytes, 0), soup, bytes);
+    return 1;
+}
+
 static void read_mesh(lua_State *L, sx_mesh_def *md)
 {
     const bool file = lua_getfield(L, 2, "file") != LUA_TNIL;
@@ -351,9 +362,15 @@ static void read_mesh(lua_State *L, sx_mesh_def *md)
         const bool failed = sx_io_read_stl(sx_lua_rank_file(L, path), &soup, &nt, err, sizeof err);
         lua_pop(L, 1);
         if (failed) luaL_error(L, "m:wall: %s", err);
-        x = lua_newuserdatauv(L, (size_t)nt * 9 * sizeof *x, 0);
-        memcpy(x, soup, (size_t)nt * 9 * sizeof *x);
+        /* the copy into Lua's memory may raise (out of memory): protected,
+         * so that the soup is freed on either path */
+        lua_pushcfunction(L, soup_to_userdata);
+        lua_pushlightuserdata(L, soup);
+        lua_pushinteger(L, nt);
+        const int status = lua_pcall(L, 2, 1, 0);
         free(soup);
+        if (status != LUA_OK) lua_error(L);
+        x = lua_touserdata(L, -1);
         nv = 3 * nt;
     } else {
         nt = (int64_t)luaL_len(L, -2);

@@ -58,8 +58,6 @@ static inline double sx_bond_dot(int dim, const double *a, const double *b)
     return s;
 }
 
-/* Bond law number k of the registry (laws/bonds.h), or NULL (bond_laws.c). */
-const sx_bond_law *sx__bond_law(int k);
 /* The first micro-parameter of d (a material's, or with call an installing
  * call's sx_bond_def) out of its range, described into why, or NULL. */
 const char *sx__bond_params_invalid(const void *d, bool call, char *why, size_t len);
