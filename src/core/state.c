@@ -536,24 +536,33 @@ static void hash_scalars(hasher *s, const sx_model *m)
     put_int(s, m->next_wall_id);
 }
 
+/* Every registry parameter of a material (the models' and the parts'),
+ * each by its unit's and its own name, so that a law added to the registry
+ * shifts no other's. */
+static void hash_law_params(hasher *s, const sx_material_def *d)
+{
+    for (int u = 0; u < sx_law_count(); u++) {
+        const char *unit = sx_law_name(u);
+        for (int k = 0; k < sx_law_param_count(u); k++) {
+            const char *name = sx_law_param_name(u, k, NULL);
+            put(s, unit, strlen(unit) + 1);
+            put(s, name, strlen(name) + 1);
+            put_double(s, *sx_law_param_value((sx_material_def *)d, u, k));
+        }
+    }
+}
+
 static void hash_material(hasher *s, const sx_material *t)
 {
     put(s, t->name, strnlen(t->name, sizeof t->name));
     put_int(s, t->def.model);
-    const double def[] = {t->def.density,  t->def.kn,        t->def.ks,       t->def.modulus,
-                          t->def.stiffness_ratio, t->def.shear_modulus, t->def.poisson, t->def.friction,
-                          t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
+    /* the fixed parameters; the models' own (Hertz's shear_modulus and
+     * poisson) come from the registry with the parts' */
+    const double def[] = {t->def.density, t->def.kn,       t->def.ks,       t->def.modulus,       t->def.stiffness_ratio,
+                          t->def.friction, t->def.damping, t->def.viscous_normal, t->def.viscous_shear};
     put_doubles(s, def, sizeof def / sizeof *def, 1);
     put_doubles(s, (const double *)&t->bpm, sizeof t->bpm / sizeof(double), 1);
-    /* the parameters of the registry's parts that are on (0 is off: a model that uses none hashes as before) */
-    for (int u = 0; u < sx_law_count(); u++)
-        for (int k = 0; !sx_law_is_model(u) && k < sx_law_param_count(u); k++) {
-            const double x = *sx_law_param_value((sx_material_def *)&t->def, u, k);
-            if (x == 0) continue;
-            put_int(s, u);
-            put_int(s, k);
-            put_double(s, x);
-        }
+    hash_law_params(s, &t->def);
 }
 
 static void hash_materials(hasher *s, const sx_model *m)
@@ -562,15 +571,12 @@ static void hash_materials(hasher *s, const sx_model *m)
     for (int i = 0; i < m->nmat; i++) hash_material(s, &m->mats[i]);
     if (!m->ncmodel) return; /* a model without the table hashes as before it existed */
     put_int(s, m->ncmodel);
-    for (int r = 0; r < m->ncmodel; r++) { /* each row: its match and its law with every registry parameter */
+    for (int r = 0; r < m->ncmodel; r++) { /* each row: its match and its law */
         const sx_cmodel_row *t = &m->cmodel[r];
         put_int(s, t->def.match);
         put_int(s, t->def.a);
         put_int(s, t->def.b);
         hash_material(s, &t->mat);
-        for (int law = 0; law < sx_law_count(); law++)
-            for (int k = 0; k < sx_law_param_count(law); k++)
-                put_double(s, *sx_law_param_value((sx_material_def *)&t->mat.def, law, k));
     }
 }
 
