@@ -119,6 +119,7 @@ local entries = {
   ["model:vars"] = {"m:vars() -> table", "The user's variables: plain data kept with the model and saved by m:save."},
   ["model:output"] = {"m:output{path =, every =, fields =, compression =, append =} -> output",
     "Writes the model now and every `every` steps to an HDF5 series with an .xmf for ParaView; the histories grow in it as the run goes."},
+  ["seixo.replaceable"] = {"seixo.replaceable(path) -> true | false, why", "Whether a file written to path may replace what is there: files are written under a temporary name and renamed over the old one, so a symbolic link, a device such as /dev/null, a pipe or a folder at path is refused (m:save, outputs, histories and the lab library's files)."},
   ["seixo.load"] = {"seixo.load(path[, {dim = 2 | 3}]) -> model", "Reads a snapshot written by m:save (histories recording on); callbacks, outputs and history functions are registered again by the script."},
   ["seixo.xdmf"] = {"seixo.xdmf(path)", "Rebuilds the .xmf file of an output series."},
   ["output:write"] = {"o:write()", "Writes the model to the series now."},

@@ -79,6 +79,8 @@ end
 --- file.
 function pool.write_file(path, text)
   if type(path) ~= "string" then error("cannot write a file: its path must be a string, not a " .. type(path), 2) end
+  local ok_kind, what = seixo.replaceable(path)
+  if not ok_kind then error("cannot write " .. path .. ": it " .. what, 2) end
   local tmp = path .. ".tmp" .. pool.tag()
   local f, opened = io.open(tmp, "w")
   if not f then error("cannot write " .. path .. ": " .. cause(opened, tmp), 2) end
@@ -94,6 +96,8 @@ end
 --- or a test checks its output folders before its work, not when done.
 function pool.writable(path)
   if path == "" or path:sub(-1) == "/" then return nil, "not a file's name" end
+  local replaceable, what = seixo.replaceable(path)
+  if not replaceable then return nil, "it " .. what end
   local there = io.open(path, "r") -- (a folder opens, and reads as one)
   if there then
     local _, _, code = there:read(0)

@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -120,6 +121,18 @@ void sx_h5_close(hid_t id)
 
 /* --------------------------------------------------------------- files */
 
+const char *sx_io_unreplaceable(const char *path)
+{
+    struct stat st;
+    if (!path || lstat(path, &st) != 0 || S_ISREG(st.st_mode)) return NULL; /* (a missing folder: the write says) */
+    if (S_ISLNK(st.st_mode))
+        return "is a symbolic link: writing renames a new file over it, which would replace the link and leave its "
+               "target as it was; give the target's path";
+    if (S_ISDIR(st.st_mode)) return "is a folder";
+    return "is not a regular file (a device, a pipe or a socket): writing renames a new file over it, which would "
+           "replace it";
+}
+
 bool sx_h5_temp_name(const char *path, char *out, size_t len)
 {
     static unsigned counter;
@@ -192,6 +205,7 @@ bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path)
 bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len)
 {
     if (h->failed) return false;
+    if (sx_io_unreplaceable(path)) return sx_h5_fail(h, "'%s' %s", path, sx_io_unreplaceable(path));
     if (!sx_h5_temp_name(path, tmp, len)) return sx_h5_fail(h, "the path of '%s' is too long", path);
     /* O_EXCL: a name left by another writer is never written into */
     const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);

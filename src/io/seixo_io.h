@@ -210,5 +210,12 @@ sx_status sx_series_close(sx_series *s, char *err, size_t errlen);
 /// Rewrites the XDMF of the series at h5path from its complete snapshots.
 sx_status sx_series_write_xdmf(const char *h5path, char *err, size_t errlen);
 
+/// Why seixo will not replace what is at path, or NULL (nothing there, or
+/// a regular file): every file is written under a temporary name and
+/// renamed over the old one, which would put a regular file in place of a
+/// symbolic link (its target left as it was), a device such as /dev/null,
+/// a pipe or a folder.
+const char *sx_io_unreplaceable(const char *path);
+
 /// Number of complete snapshots of the series at path (-1 on error).
 int64_t sx_series_read_count(const char *path, char *err, size_t errlen);

@@ -124,6 +124,7 @@ static void fields_text(unsigned f, char *out, size_t len)
 static bool create_file(sx_h5 *h, const char *path, int dim, const sx_series_opts *o, unsigned fields)
 {
     char tmp[4096];
+    if (sx_io_unreplaceable(path)) return sx_h5_fail(h, "%s", sx_io_unreplaceable(path));
     if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path is too long");
     hid_t fapl = sx_h5_fapl(false);
     hid_t fcpl = sx_h5_fcpl();

@@ -359,6 +359,8 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
     char tmp[4096];
     if (!path || !*path) {
         sx_h5_fail(&h, "an empty path");
+    } else if (sx_io_unreplaceable(path)) {
+        sx_h5_fail(&h, "%s", sx_io_unreplaceable(path));
     } else if (!sx_h5_temp_name(path, tmp, sizeof tmp)) {
         sx_h5_fail(&h, "the path is too long");
     } else {

@@ -747,6 +747,18 @@ static int model_output(lua_State *L)
     return 1;
 }
 
+/* seixo.replaceable(path) -> true | false, why: whether a file written to
+ * path (through a temporary name renamed over it) may replace what is
+ * there; the lab library's files check it as m:save does. */
+static int seixo_replaceable(lua_State *L)
+{
+    const char *why = sx_io_unreplaceable(luaL_checkstring(L, 1));
+    lua_pushboolean(L, why == NULL);
+    if (!why) return 1;
+    lua_pushstring(L, why);
+    return 2;
+}
+
 static int seixo_xdmf(lua_State *L)
 {
     const char *path = luaL_checkstring(L, 1);
@@ -781,6 +793,7 @@ void sx_lua_io_register(lua_State *L)
     static const luaL_Reg functions[] = {
         {"load", seixo_load},
         {"xdmf", seixo_xdmf},
+        {"replaceable", seixo_replaceable},
         {NULL, NULL},
     };
     /* the module table is on the top of the stack */

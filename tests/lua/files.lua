@@ -1,0 +1,65 @@
+-- What a write does to what the user has at its path (a robustness
+-- tester's findings): every file is written under a temporary name and
+-- renamed over the old one, so a path that is not a regular file is
+-- refused, not replaced; the device, the pipe, the link and its target
+-- are left as they were.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, raises = T.test, T.check, T.eq, T.raises
+
+local dir = os.tmpname()
+os.remove(dir)
+os.execute("mkdir -p '" .. dir .. "'")
+
+local function kind(path) -- "file", "link", "fifo", "char" or "missing", by the shell's test
+  for _, k in ipairs{{"-L", "link"}, {"-p", "fifo"}, {"-c", "char"}, {"-d", "folder"}, {"-f", "file"}} do
+    if os.execute("test " .. k[1] .. " '" .. path .. "'") then return k[2] end
+  end
+  return "missing"
+end
+
+local function small_model()
+  local m = seixo.model{dim = 2}
+  m:material("s", {kn = 1e6})
+  m:ball{pos = {0, 0}, radius = 0.01}
+  m:history("kinetic", "kinetic")
+  m:cycle(3)
+  return m
+end
+
+test("a path that is not a regular file is refused, and left as it was", function()
+  local m = small_model()
+  local target, link, fifo = dir .. "/target.h5", dir .. "/link.h5", dir .. "/fifo"
+  m:save(target)
+  local before = io.open(target, "rb"):read("a")
+  os.execute("ln -s '" .. target .. "' '" .. link .. "' && mkfifo '" .. fifo .. "'")
+  -- as root, m:save("/dev/null") had replaced the system's /dev/null by a file
+  raises(function() m:save("/dev/null") end, "'/dev/null'", "not a regular file")
+  eq(kind("/dev/null"), "char")
+  raises(function() m:save(link) end, "is a symbolic link", "give the target's path")
+  eq(kind(link), "link")
+  eq(io.open(target, "rb"):read("a"), before)
+  raises(function() m:save(fifo) end, "not a regular file")
+  eq(kind(fifo), "fifo")
+  raises(function() m:save(dir) end, "is a folder")
+  raises(function() m:history_csv(link) end, "is a symbolic link")
+  raises(function() m:output{path = fifo} end, "not a regular file")
+  eq(kind(fifo), "fifo")
+  -- the lab library's files: checked before the work, as m:save checks
+  local ok, why = seixo.replaceable("/dev/null")
+  check(ok == false and why:find("not a regular file", 1, true), tostring(why))
+  eq(seixo.replaceable(dir .. "/new.csv"), true)
+  local pool = require "seixo.pool"
+  raises(function() pool.write_file(link, "x") end, "cannot write " .. link, "symbolic link")
+  eq(io.open(target, "rb"):read("a"), before)
+  local lab = require "seixo.lab"
+  raises(function() lab.specimen{dim = 2, width = 0.01, height = 0.02, path = "/dev/null", log = false} end,
+         "lab.specimen: cannot write /dev/null", "not a regular file")
+  -- a regular file is replaced as before
+  m:save(dir .. "/plain.h5")
+  m:save(dir .. "/plain.h5")
+  eq(kind(dir .. "/plain.h5"), "file")
+  m:close()
+end)
+
+os.execute("rm -rf '" .. dir .. "'")
+T.done()
