@@ -32,6 +32,10 @@ bool sx_io_read_strings(sx_h5 *h, hid_t loc, const char *where, const char *name
 
 /// Checks a history's name and definition (fails naming the history).
 bool sx_io_history_valid(sx_h5 *h, const sx_io_history *x);
+/* Whether path names the file of an output series open in this process
+ * (series.c): a second writer there would replace or interleave it while
+ * the first kept writing into the file the name no longer reaches. */
+bool sx_io_series_open_at(const char *path);
 /// Creates the group of history x under parent: its definition and
 /// `order` as attributes, empty datasets step, time, value without a
 /// maximum size in chunks of `chunk` rows, and count 0.

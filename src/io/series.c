@@ -43,6 +43,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* A history the file holds: its complete rows and their last step. */
@@ -63,7 +64,44 @@ struct sx_series {
     xdoc x;           /* the XDMF: a grid per block and complete snapshot */
     held *held;       /* histories met so far */
     int nheld, capheld;
+    dev_t dev;        /* the .h5's file, however its path is spelt */
+    ino_t ino;
+    sx_series *next;  /* the process's open series */
 };
+
+/* The series open in this process, so that no other writer takes one's
+ * file (a robustness tester's finding: a second m:output, or an m:save, to
+ * an open series' path replaced its file while the first went on writing
+ * into the unnamed old one, counting snapshots that were lost). */
+static sx_series *open_series;
+
+bool sx_io_series_open_at(const char *path)
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0) return false;
+    for (const sx_series *s = open_series; s; s = s->next)
+        if (s->dev == st.st_dev && s->ino == st.st_ino) return true;
+    return false;
+}
+
+static void remember_open(sx_series *s)
+{
+    struct stat st;
+    if (stat(s->path, &st) != 0) return;
+    s->dev = st.st_dev;
+    s->ino = st.st_ino;
+    s->next = open_series;
+    open_series = s;
+}
+
+static void forget_open(sx_series *s)
+{
+    for (sx_series **p = &open_series; *p; p = &(*p)->next)
+        if (*p == s) {
+            *p = s->next;
+            return;
+        }
+}
 
 static const struct {
     unsigned bit;
@@ -207,6 +245,8 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
         sx_h5_fail(&h, "an empty path");
     } else if (dim != 2 && dim != 3) {
         sx_h5_fail(&h, "dim must be 2 or 3");
+    } else if (sx_io_series_open_at(path)) {
+        sx_h5_fail(&h, "an output series open in this session writes this file: close it first (o:close())");
     } else if (!(s->path = dup_str(path)) || !(s->xmf = sx_io_xmf_path(path))) {
         sx_h5_fail(&h, "out of memory");
     } else {
@@ -251,6 +291,7 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
         sx_series_close(s, NULL, 0);
         return NULL;
     }
+    remember_open(s);
     return s;
 }
 
@@ -496,6 +537,7 @@ sx_status sx_series_write_histories(sx_series *s, const sx_io_history *h, int nh
 sx_status sx_series_close(sx_series *s, char *err, size_t errlen)
 {
     if (!s) return SX_OK;
+    forget_open(s);
     sx_h5 h;
     sx_h5_begin(&h, s->path ? s->path : "", err, errlen);
     if (s->file >= 0 && H5Fclose(s->file) < 0) sx_h5_fail_h5(&h, "cannot close the series");

@@ -361,6 +361,8 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
         sx_h5_fail(&h, "an empty path");
     } else if (sx_io_unreplaceable(path)) {
         sx_h5_fail(&h, "%s", sx_io_unreplaceable(path));
+    } else if (sx_io_series_open_at(path)) {
+        sx_h5_fail(&h, "an output series open in this session writes this file: close it first, or save elsewhere");
     } else if (!sx_h5_temp_name(path, tmp, sizeof tmp)) {
         sx_h5_fail(&h, "the path is too long");
     } else {

@@ -61,5 +61,32 @@ test("a path that is not a regular file is refused, and left as it was", functio
   m:close()
 end)
 
+test("an open output series' file is not taken by another writer", function()
+  local m, other = small_model(), small_model()
+  local path = dir .. "/series.h5"
+  local o = m:output{path = path}
+  o:write()
+  m:cycle(2)
+  o:write()
+  -- a second output on the path (this model's or another's), or a save to
+  -- it, replaced the file while the first went on counting snapshots lost
+  raises(function() other:output{path = path} end, "an output series open in this session writes this file")
+  raises(function() m:output{path = path, append = true} end, "close it first")
+  raises(function() other:save(path) end, "an output series open in this session writes this file")
+  raises(function() m:history_csv(path) end, "an output series open")
+  os.execute("ln -s series.h5 '" .. dir .. "/alias.h5'")
+  raises(function() other:save(dir .. "/alias.h5") end, "symbolic link")
+  o:write()
+  eq(o:count(), 4) -- m:output's own first snapshot and three writes: none lost
+  o:close()
+  -- closed, the file is the user's to replace or to append to
+  local again = m:output{path = path, append = true}
+  eq(again:count(), 5)
+  again:close()
+  other:save(path)
+  m:close()
+  other:close()
+end)
+
 os.execute("rm -rf '" .. dir .. "'")
 T.done()
