@@ -298,8 +298,9 @@ typedef struct sx_cmodel_row {
  * and made afresh at every build. A contact through the boundary is one
  * pair (real ball, ghost), kept once by the owner rule: the real end has
  * the smaller id. The ghost's force is added to its owner after the pass,
- * in ghost order, so every ball's force is summed in a fixed order. The
- * same slots are meant for balls owned by other MPI ranks (issue 16). */
+ * in ghost order, so every ball's force is summed in a fixed order. (The
+ * MPI decomposition does not use them: each rank holds the whole model and
+ * works on its slab's range of the dense order, decompose.c.) */
 typedef struct sx_cell {
     bool axis[3];
     double lo[3];
@@ -777,8 +778,9 @@ double sx__cell_thickness(const sx_cell *c, int dim, int k);
 /* SX_EINVAL when the cell is too thin for the balls' contact reach. */
 sx_status sx__cell_check(sx_model *m);
 /* After the step's motion: sets the cell's rates (a servo from the
- * stress) and moves the cell. */
-bool sx__cell_step(sx_model *m);
+ * stress) and moves the cell; an error, the cell left as it was, when the
+ * move would flatten it or turn it inside out. */
+sx_status sx__cell_step(sx_model *m);
 uint64_t sx__cell_hash(const sx_model *m, uint64_t h);
 size_t sx__cell_bytes(const sx_model *m);
 /* Room for n ghosts in the table and in the ball slots past base; SX_ENOMEM. */

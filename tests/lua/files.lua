@@ -88,5 +88,41 @@ test("an open output series' file is not taken by another writer", function()
   other:close()
 end)
 
+test("a run stops before a state that could not be saved and loaded", function()
+  -- a cylinder shrinking through a zero radius: saved, then refused as damaged
+  local m = seixo.model{dim = 3}
+  m:material("s", {kn = 1e6})
+  local w = m:wall{kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 1}, radius = 0.01, height = 0.1}
+  m:ball{pos = {0, 0, 0.05}, radius = 0.002}
+  w:set_radial_vel(-100)
+  raises(function() m:cycle(1000) end, "cylinder 1: its radius", "a radius must stay > 0")
+  check(w:radius() > 0, "radius " .. w:radius())
+  local at = m:step()
+  m:save(dir .. "/cylinder.h5")
+  local back = seixo.load(dir .. "/cylinder.h5")
+  eq(back:step(), at)
+  eq(back:hash(), m:hash())
+  back:close()
+  w:set_radial_vel(0)
+  m:cycle(2) -- and it goes on once stopped
+  -- gravity whose step velocity overflows its square (the run's state then loaded as damaged)
+  raises(function() m:set_gravity{0, 0, 1e308} end, "below 1e100")
+  raises(function() seixo.model{dim = 3, gravity = {0, 0, 1e200}} end, "below 1e100")
+  m:close()
+  -- a cell driven inside out (no ball to meet the contact-reach check)
+  local p = seixo.model{dim = 2}
+  p:material("s", {kn = 1e6})
+  p:periodic{min = {0, 0}, max = {1, 1}}
+  p:set_timestep(1e-3)
+  p:cell_control{xx = {rate = -1e6}}
+  raises(function() p:cycle(10) end, "would make it", "thick across axis x", "lower the rate")
+  check(p:periodic().size[1] > 0, "width " .. p:periodic().size[1])
+  p:save(dir .. "/cell.h5")
+  local q = seixo.load(dir .. "/cell.h5")
+  eq(q:periodic().size[1], p:periodic().size[1])
+  q:close()
+  p:close()
+end)
+
 os.execute("rm -rf '" .. dir .. "'")
 T.done()
