@@ -189,6 +189,14 @@ test("timestep and gravity", function()
   raises(function() m:set_timestep("fast") end, HERE, "'auto'")
   m:set_gravity({0, 0, -1})
   T.vec_eq(m:gravity(), {0, 0, -1})
+  -- an automatic timestep below the user's floor (1e-15 s) is an error: a
+  -- stiffness of 1e300 N/m gave 0 s, and cycles counted steps at a standstill
+  local stiff = seixo.model{dim = 2}
+  stiff:material("s", {kn = 1e300, ks = 1e300})
+  stiff:ball{pos = {0, 0}, radius = 0.01}
+  raises(function() stiff:cycle(5) end, HERE, "automatic timestep is 0 s, below 1e-15 s")
+  eq(stiff:step(), 0)
+  raises(function() stiff:timestep() end, HERE, "below 1e-15 s")
 end)
 
 test("materials()", function()
