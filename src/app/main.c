@@ -347,7 +347,7 @@ static int load_input(lua_State *L)
     size_t skip = 0;
     if (len > 0 && text[0] == '#')
         while (skip < len && text[skip] != '\n') skip++;
-    const int status = luaL_loadbuffer(L, text + skip, len - skip, "=stdin");
+    const int status = luaL_loadbufferx(L, text + skip, len - skip, "=stdin", "t");
     free(text);
     return status;
 }
@@ -356,7 +356,7 @@ static int load_input(lua_State *L)
  * -i (keep), its top-level locals become globals for the session. */
 static int run_script(lua_State *L, char **argv, int script, int argc, bool keep)
 {
-    int status = strcmp(argv[script], "-") == 0 ? load_input(L) : luaL_loadfile(L, argv[script]);
+    int status = strcmp(argv[script], "-") == 0 ? load_input(L) : sx_lua_load_source(L, argv[script]);
     if (status == LUA_OK) {
         const int n = argc - script - 1;
         luaL_checkstack(L, n, "too many arguments to the script");
@@ -1011,6 +1011,7 @@ static int pmain(lua_State *L)
     luaL_checkversion(L);
     luaL_openlibs(L);
     list_coroutines(L);
+    sx_lua_source_only(L);
     sx_lua_open(L);
     global_L = L;
     open_library(L);

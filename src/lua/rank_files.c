@@ -475,7 +475,7 @@ static int rank_loadfile(lua_State *L)
     char shadow[PATH_MAX];
     const enum shadow s = lua_type(L, 1) == LUA_TSTRING ? own_file(L, lua_tostring(L, 1), shadow) : NO_SHADOW;
     if (s == NO_SHADOW) return sx_lua_call_own(L, nargs);
-    const char *mode = luaL_optstring(L, 2, "bt");
+    const char *mode = "t"; /* source only, as the executable's loadfile (chunks.c) */
     const bool env = !lua_isnone(L, 3);
     if (load_shadow(L, lua_tostring(L, 1), shadow, s, mode) != LUA_OK) {
         luaL_pushfail(L);
@@ -508,7 +508,7 @@ static int rank_dofile(lua_State *L)
         return dofile_results(L, 0, 0);
     }
     lua_settop(L, 1);
-    if (load_shadow(L, lua_tostring(L, 1), shadow, s, NULL) != LUA_OK) return lua_error(L);
+    if (load_shadow(L, lua_tostring(L, 1), shadow, s, "t") != LUA_OK) return lua_error(L);
     lua_callk(L, 0, LUA_MULTRET, 1, dofile_results);
     return dofile_results(L, 0, 1);
 }

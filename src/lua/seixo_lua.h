@@ -13,6 +13,15 @@ SX_API int luaopen_seixo(lua_State *L);
 /// and as the global `seixo`. Needs the standard libraries opened.
 SX_API void sx_lua_open(lua_State *L);
 
+/// Lua source only: load, loadfile and dofile (and the rank-aware ones
+/// sx_lua_open installs over them) refuse precompiled chunks, which Lua
+/// does not check and a damaged one of which crashes the interpreter.
+/// Call after the standard libraries and before sx_lua_open.
+SX_API void sx_lua_source_only(lua_State *L);
+/// luaL_loadfilex(L, path, "t") (path NULL: standard input), a precompiled
+/// chunk's refusal naming the file.
+SX_API int sx_lua_load_source(lua_State *L, const char *path);
+
 /// Interrupts every cycle running in this process: each stops at its next
 /// step boundary and m:cycle (m:solve) raises "interrupted at step N".
 /// Async-signal-safe. Returns the number of cycles running, or 0 when the
