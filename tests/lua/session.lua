@@ -272,6 +272,20 @@ test("balls placed overlapping are named at the first step, not blamed on the ti
   check(not err:find("lower the timestep", 1, true), err)
 end)
 
+test("an unstable run's advice holds: after it, the automatic timestep is not blamed again", function()
+  -- a robustness tester followed "use the automatic one" and got the same
+  -- "timestep too large" error: the model still held the blown-up state
+  local m = seixo.model{dim = 2, gravity = {0, -9.81}, timestep = 1e-2}
+  m:material("s", {density = 2650, kn = 1e7, ks = 1e7, friction = 0.5})
+  m:wall{kind = "box", min = {0, 0}, max = {0.1, 0.1}}
+  m:generate{count = 300, radius = {1.5e-3, 2.5e-3}, region = {box = {{0, 0}, {0.1, 0.1}}}, seed = 7}
+  raises(function() m:cycle(100) end, "unstable at step", "is too large for the contact stiffness", "from a save")
+  m:set_timestep("auto")
+  local err = raises(function() m:cycle(100) end, "unstable at step", "within the critical one",
+                     "the overlap came from before this step", "load a save")
+  check(not err:find("too large", 1, true), err)
+end)
+
 test("values outside a material's physical range warn once, with the unit expected", function()
   local status, out = T.run("-e " .. T.quote([[
 m = seixo.model{dim = 3}
