@@ -535,7 +535,7 @@ sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e)
                         (long long)b);
     const int nel = m->bonds.fj_nr[s] * m->bonds.fj_na[s];
     if (e < 0 || e >= nel)
-        return sx__fail(m, SX_EINVAL, "flatjoint_unbond: element %d out of range (the joint has %d)", e, nel);
+        return sx__fail(m, SX_EINVAL, "flatjoint_unbond: element %d out of range 0 to %d (from 0)", e, nel - 1);
     uint8_t *st = &m->fjel.state[m->bonds.fj_first[s] + e];
     if (*st == SX_FJ_BONDED) *st = SX_FJ_UNBONDED;
     return SX_OK;

@@ -260,13 +260,23 @@ static int model_flatjoint(lua_State *L)
     return 1;
 }
 
-/* m:flatjoint_unbond(a, b, e): element e (from 1) of the joint becomes a slit. */
+/* m:flatjoint_unbond(a, b, e): element e (from 1) of the joint becomes a
+ * slit. The range is checked here, in the user's numbering (the core's
+ * message counts from 0: "element 4 out of range" for e = 5). */
 static int model_flatjoint_unbond(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    const lua_Integer a = luaL_checkinteger(L, 2), b = luaL_checkinteger(L, 3), e = luaL_checkinteger(L, 4);
-    luaL_argcheck(L, e >= 1 && e <= 64 * 64, 4, "element number out of range");
-    sx_lua_check(L, m, sx_flatjoint_unbond(m, a, b, (int)e - 1), "m:flatjoint_unbond");
+    const lua_Integer a = luaL_checkinteger(L, 2), b = luaL_checkinteger(L, 3);
+    int whole = 0;
+    const lua_Integer e = lua_tointegerx(L, 4, &whole);
+    if (!whole)
+        return luaL_error(L, "m:flatjoint_unbond: the element must be a whole number (got %s)", luaL_tolstring(L, 4, NULL));
+    const int n = sx_flatjoint_get(m, a, b, -1, NULL);
+    if (n > 0 && (e < 1 || e > n))
+        return luaL_error(L, "m:flatjoint_unbond: element %I out of range: the joint between balls %I and %I has "
+                             "elements 1 to %d", e, a, b, n);
+    /* (no joint: the core says so; e is then in no range to pass on) */
+    sx_lua_check(L, m, sx_flatjoint_unbond(m, a, b, n > 0 ? (int)e - 1 : 0), "m:flatjoint_unbond");
     return 0;
 }
 

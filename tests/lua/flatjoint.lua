@@ -45,6 +45,21 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D slit", m:flatjoint(a.id, b.id)[1].state == "unbonded", m:flatjoint(a.id, b.id)[1].state)
   local ok, err = pcall(m.flatjoint_unbond, m, a.id, b.id, 99)
   check(dim .. "D bad element named", not ok and tostring(err):find("element"), err)
+  -- the element past the end and element 0 in the user's numbering, by the
+  -- method's name (once "element 4 out of range (the joint has 4)" for 5,
+  -- and "bad argument #4 to '?'" for 0)
+  local range = string.format("elements 1 to %d", #els)
+  for _, e in ipairs{#els + 1, 0, -1} do
+    ok, err = pcall(m.flatjoint_unbond, m, a.id, b.id, e)
+    local want = string.format("m:flatjoint_unbond: element %d out of range: the joint between balls %d and %d has %s",
+                               e, a.id, b.id, range)
+    check(dim .. "D element " .. e .. " refused by name", not ok and tostring(err):find(want, 1, true), err)
+  end
+  ok, err = pcall(m.flatjoint_unbond, m, a.id, b.id, 2.5)
+  check(dim .. "D a fraction refused by name", not ok and tostring(err):find("m:flatjoint_unbond: the element must be a "
+                                                                            .. "whole number (got 2.5)", 1, true), err)
+  m:flatjoint_unbond(a.id, b.id, #els) -- the last is in range
+  check(dim .. "D last element slit", m:flatjoint(a.id, b.id)[#els].state == "unbonded", "")
   check(dim .. "D no joint elsewhere", m:flatjoint(a.id, 77) == nil, "")
   m:close()
   m2:close()
