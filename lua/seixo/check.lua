@@ -1,8 +1,8 @@
--- seixo.check: the option checks and the log of the lab modules
--- (seixo.lab, seixo.periodic). Every message starts with the function's
--- name as the user calls it ("lab.triaxial: ..."), and is raised at the
--- level of that function's caller (seixo.caller then puts it at the
--- user's line):
+-- seixo.check: the option checks, the log and the loops' limits of the lab
+-- modules (seixo.lab, seixo.periodic, seixo.joints). Every message starts
+-- with the function's name as the user calls it ("lab.triaxial: ..."), and
+-- is raised at the level of that function's caller (seixo.caller then puts
+-- it at the user's line):
 --   local c = require("seixo.check").module("periodic")
 --   c.keys(opts, "shear", {"normal", ...}); c.positive(v, "normal", "shear")
 local check = {}
@@ -58,6 +58,21 @@ function check.module(name)
   end
 
   return c
+end
+
+-- The steps to the next record: every, or fewer where the test ends sooner
+-- -- left steps to max_steps, or strain_left to max_strain at
+-- strain_per_step -- so that max_steps is exact and max_strain is not
+-- overshot by more than the automatic timestep's drift over the record,
+-- whatever every is (both were checked only at the records: with every =
+-- 1e9 a UCS ran 13.6 million steps of its max_steps 5000).
+function check.record_steps(every, left, strain_left, strain_per_step)
+  local n = math.min(every, left)
+  if strain_per_step > 0 and strain_left > 0 then
+    local to_strain = math.ceil(strain_left / strain_per_step)
+    if to_strain < n then n = math.max(1, to_strain) end
+  end
+  return math.tointeger(math.max(1, n))
 end
 
 return check

@@ -12,6 +12,8 @@ local lab = require("seixo.lab")
 
 local joints = {}
 
+local c = require("seixo.check").module("joints")
+
 local function merge(base, over)
   local t = {}
   for k, v in pairs(base) do t[k] = type(v) == "table" and merge(v, {}) or v end
@@ -93,6 +95,8 @@ end
 function joints.direct_tension(spec, opts)
   opts = opts or {}
   check_keys("direct_tension", opts, {strain_rate = true, post_peak = true, every = true, max_steps = true, log = true})
+  local every = c.steps(opts.every or 50, "every", "direct_tension")
+  local max_steps = c.steps(opts.max_steps or 400000, "max_steps", "direct_tension")
   local dim = spec.dim
   if not (dim == 2 and spec.shape == "rect" or dim == 3 and (spec.shape == "cylinder" or spec.shape == "prism")) then
     error("joints.direct_tension: a 2D rect or a 3D cylinder or prism specimen", 2)
@@ -121,14 +125,15 @@ function joints.direct_tension(spec, opts)
   end
   pull(top, 0.5 * rate * h)
   pull(bottom, -0.5 * rate * h)
-  local every, post_peak, max_steps = opts.every or 50, opts.post_peak or 0.5, opts.max_steps or 400000
+  local post_peak = opts.post_peak or 0.5
   local y0 = top[1].pos[ax] - bottom[1].pos[ax]
   local t0, s0 = m:crack_count("tension"), m:crack_count("shear")
   local rows, peak, at, stopped = {}, 0, nil, "max_steps"
   local steps = 0
   while steps < max_steps do
-    m:cycle(every)
-    steps = steps + every
+    local n = math.min(every, max_steps - steps) -- (max_steps exact, whatever every is)
+    m:cycle(n)
+    steps = steps + n
     local ft, fb = 0, 0
     for _, b in ipairs(top) do ft = ft - b.force[ax] end
     for _, b in ipairs(bottom) do fb = fb + b.force[ax] end
@@ -297,6 +302,7 @@ function joints.direct_shear(spec, opts)
   end
   local sn = opts.normal_stress
   if type(sn) ~= "number" or not (sn > 0) then error("joints.direct_shear: normal_stress must be > 0", 2) end
+  local every = c.steps(opts.every or 50, "every", "direct_shear")
   local js = joints.jointed(spec, merge(opts.joint or {}, {angle = 0, path = (opts.out or "direct_shear") .. ".h5"}))
   local m = seixo.load(js.path)
   local ax = dim
@@ -315,7 +321,6 @@ function joints.direct_shear(spec, opts)
     end
   end
   local speed = opts.speed or 0.02
-  local every = opts.every or 50
   local gain = opts.gain or 0.2
   local target = opts.displacement or spec.radius[1]
   local dt = m:timestep()

@@ -38,6 +38,7 @@ local plot_test, plot_brazilian, plot_series -- the figures, at the end
 
 local c = require("seixo.check").module("lab")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
+local record_steps = require("seixo.check").record_steps
 
 -- a specimen of lab.specimen or lab.open: its file and dimension at least
 local function check_spec(spec, fn)
@@ -847,6 +848,16 @@ local function rate_factor(factor, ratio, cracked, target, max_factor)
   return factor
 end
 
+-- A test's peak and moduli are read from its records: an `every` as large as
+-- max_steps leaves a record or two (the last at max_steps), which say
+-- nothing of the peak; the test says so rather than refuse such an every.
+local function few_records(r, every)
+  if #r.rows < 10 then
+    r.warnings[#r.warnings + 1] = string.format("only %d records in %d steps (every = %d): too few to read the peak "
+                                                .. "from; lower every", #r.rows, r.steps, every)
+  end
+end
+
 -- A triaxial (confining > 0) or unconfined compression test.
 local function compression(spec, opts, fn)
   check_spec(spec, fn)
@@ -976,14 +987,15 @@ local function compression(spec, opts, fn)
   local confine_steps = 0
   if sigma3 > 0 then
     local start, tol = m:step(), opts.confine_tol or 0.01
+    local budget = (opts.max_steps or 400000) / 4
     repeat
       servo_lateral()
       local s = section()
       top:servo{target = sigma2, area = s, alpha = 0.5, max_speed = 0.05}
       bottom:servo{target = sigma2, area = s, alpha = 0.5, max_speed = 0.05}
-      m:cycle(200)
+      m:cycle(math.min(200, math.ceil(budget - (m:step() - start))))
       local ok = math.abs(axial_stress() / sigma2 - 1) < tol and lateral_error() < tol
-    until (ok and m:ratio() < 1e-3) or m:step() - start >= (opts.max_steps or 400000) / 4
+    until (ok and m:ratio() < 1e-3) or m:step() - start >= budget
     confine_steps = m:step() - start
     top:servo(nil)
     bottom:servo(nil)
@@ -1018,16 +1030,18 @@ local function compression(spec, opts, fn)
   local max_steps = opts.max_steps or 400000
   local ratio_sum, ratio_n, inertial_max = 0, 0, 0
   local why = "max_strain"
+  local ea = 0
   while true do
     if #lateral > 0 then servo_lateral() end
+    local n = record_steps(every, max_steps - (m:step() - start), max_strain - ea, rate * factor * m:timestep())
     -- the ratio: the mean of four readings over the interval (one reading
     -- swings by a factor of 3 with the specimen's vibrations)
-    local ratio = 0
-    for i = 1, 4 do
-      m:cycle(every // 4 + (i <= every % 4 and 1 or 0))
-      ratio = ratio + 0.25 * m:ratio()
+    local ratio, readings = 0, math.min(4, n)
+    for i = 1, readings do
+      m:cycle(n // readings + (i <= n % readings and 1 or 0))
+      ratio = ratio + m:ratio() / readings
     end
-    local ea = (h0 - height()) / h0
+    ea = (h0 - height()) / h0
     local el = lateral_strain()
     local sa, sl = axial_stress(), lateral_stress()
     local q = sa - sl
@@ -1103,6 +1117,7 @@ local function compression(spec, opts, fn)
   if why == "max_steps" or (why ~= "post_peak" and not spec.granular) then -- (a sand is loaded to max_strain)
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
   end
+  few_records(r, every)
   for _, w in ipairs(r.warnings) do say(opts, "lab.%s: warning: %s", fn, w) end
   say(opts, "lab.%s: sigma3 %.4g MPa: peak %.4g MPa at strain %.4g, E %.4g GPa, nu %.3f, cracks %d tension / %d shear "
       .. "(%d steps, %.1f s; ratio %.2g, inertial number %.2g)", fn, sigma3 / 1e6, r.peak / 1e6, r.peak_strain,
@@ -1215,15 +1230,16 @@ function lab.brazilian(spec, opts)
   local rows, peak, peak_row = {}, -math.huge, nil
   local start, t_start = m:step(), m:time()
   local max_steps = opts.max_steps or 400000
-  local max_strain = opts.max_strain or 0.05
+  local max_strain = positive(opts.max_strain or 0.05, "max_strain", "brazilian")
   local why = "max_strain"
   local header = {"step", "time", "displacement", "force", "tensile_stress", "cracks_tension", "cracks_shear", "ratio",
                   "opening"}
   local cracks0 = m:crack_count()
   local tension0, shear0 = m:crack_count("tension"), m:crack_count("shear")
+  local disp = 0
   while true do
-    m:cycle(every)
-    local disp = d - (top.point[ax] - bottom.point[ax])
+    m:cycle(record_steps(every, max_steps - (m:step() - start), d * max_strain - disp, rate * d * m:timestep()))
+    disp = d - (top.point[ax] - bottom.point[ax])
     local f = 0.5 * (top:load() + bottom:load())
     local st = 2 * f / (pi * d * t)
     rows[#rows + 1] = {m:step(), m:time() - t_start, disp, f, st, m:crack_count("tension") - tension0,
@@ -1261,6 +1277,7 @@ function lab.brazilian(spec, opts)
   if why ~= "post_peak" then
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the force fell past the peak", why)
   end
+  few_records(r, every)
   for _, w in ipairs(r.warnings) do say(opts, "lab.brazilian: warning: %s", w) end
   say(opts, "lab.brazilian: peak force %.4g N, tensile strength %.4g MPa (at the split %s), cracks %d tension / %d shear (%d steps, %.1f s)",
       peak, r.tensile_strength / 1e6, r.split and string.format("%.4g MPa", r.split / 1e6) or "none",

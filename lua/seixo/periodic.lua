@@ -30,6 +30,7 @@ local periodic = {}
 
 local c = require("seixo.check").module("periodic")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
+local record_steps = require("seixo.check").record_steps
 
 local names = {"xx", "yy", "zz"}
 
@@ -49,7 +50,7 @@ end
 local function settle(m, dim, target, tol, ratio, max_steps)
   local start, err = m:step(), math.huge
   repeat
-    m:cycle(200)
+    m:cycle(math.min(200, max_steps - (m:step() - start)))
     local s = m:cell_stress()
     err = 0
     for k = 1, dim do
@@ -82,7 +83,7 @@ function periodic.specimen(opts)
   local bonds = opts.bonds ~= false
   local path = opts.path or fail("periodic.specimen: a path for the specimen file is required")
   check_writable(path, "path", "specimen") -- before the genesis, not at its end
-  local max_steps = opts.max_steps or 50000
+  local max_steps = steps(opts.max_steps or 50000, "max_steps", "specimen")
   local t0 = seixo.clock()
 
   local m = seixo.model{dim = dim}
@@ -167,6 +168,7 @@ function periodic.triaxial(spec, opts)
     fail("periodic.triaxial: post_peak must be in (0, 1) (got %s)", tostring(post_peak))
   end
   local every = steps(opts.every or 100, "every", "triaxial")
+  local max_steps = steps(opts.max_steps or 1000000, "max_steps", "triaxial")
   local rate = opts.strain_rate or 7e-8 / m:timestep() -- seixo.lab's quasi-static default
   positive(rate, "strain_rate", "triaxial")
   local t0 = seixo.clock()
@@ -180,10 +182,12 @@ function periodic.triaxial(spec, opts)
   servo_all(m, dim - 1, lateral, extra)
   local L0 = m:periodic().size
   local rows, peak, peak_row, start, why = {}, -math.huge, nil, m:step(), "max_strain"
+  local ea = 0
   while true do
-    m:cycle(every)
+    m:cycle(record_steps(every, max_steps - (m:step() - start), max_strain - ea, rate * m:timestep()))
     local L, s = m:periodic().size, m:cell_stress()
-    local ea, el, sl = (L0[ax] - L[ax]) / L0[ax], 0, 0
+    local el, sl = 0, 0
+    ea = (L0[ax] - L[ax]) / L0[ax]
     for k = 1, dim - 1 do
       el = el + (L0[k] - L[k]) / L0[k] / (dim - 1)
       sl = sl + s[k][k] / (dim - 1)
@@ -196,7 +200,7 @@ function periodic.triaxial(spec, opts)
     if row.q > peak then peak, peak_row = row.q, #rows end
     if peak > 0 and row.q < post_peak * peak and ea > rows[peak_row].ea then why = "post_peak"; break end
     if ea >= max_strain then break end
-    if m:step() - start >= (opts.max_steps or 1000000) then why = "max_steps"; break end
+    if m:step() - start >= max_steps then why = "max_steps"; break end
   end
   local r = {kind = "periodic triaxial", dim = dim, confining = sigma3, intermediate = sigma2, rows = rows,
              stopped = why, strain_rate = rate, steps = m:step() - start, confine_steps = confine_steps,
@@ -231,13 +235,14 @@ function periodic.shear(spec, opts)
   local start, why = m:step(), "max_strain"
   servo_all(m, 0, nil, {yy = {stress = normal}, xy = {rate = rate}})
   local L0 = m:periodic().size
-  local rows, peak = {}, -math.huge
+  local rows, peak, gamma = {}, -math.huge, 0
   repeat
-    m:cycle(every)
+    m:cycle(record_steps(every, (max_steps or 1000000) - (m:step() - start), max_strain - gamma, rate * m:timestep()))
     local cell, s = m:periodic(), m:cell_stress()
     local row = {step = m:step(), gamma = cell.tilt.xy / cell.size[2], tau = -s[1][2], sn = s[2][2],
                  ev = (L0[2] - cell.size[2]) / L0[2], ratio = m:ratio()}
     rows[#rows + 1] = row
+    gamma = row.gamma
     peak = math.max(peak, row.tau / row.sn)
     if row.gamma < max_strain and m:step() - start >= (max_steps or 1000000) then why = "max_steps"; break end
   until row.gamma >= max_strain

@@ -1,0 +1,84 @@
+-- The lab tests' limits and option checks on tiny specimens (a robustness
+-- tester's findings): max_steps and max_strain hold whatever `every` is.
+local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
+local lab = require "seixo.lab"
+local joints = require "seixo.joints"
+
+-- about 50 disks: a UCS of 1000 steps takes a few hundredths of a second
+local rect = lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3}, seed = 3,
+                          path = T.tmpname(".h5"), log = false}
+local quiet = {log = false, plot = false}
+local function with(o)
+  local t = {}
+  for k, v in pairs(quiet) do t[k] = v end
+  for k, v in pairs(o) do t[k] = v end
+  return t
+end
+
+test("lab.ucs and lab.triaxial stop at max_steps when every is larger", function()
+  -- (every = 200000 ran 200,000 steps of max_steps 1000; every = 1e9 13.6 million)
+  local r = lab.ucs(rect, with{every = 200000, max_steps = 1000})
+  eq(r.stopped, "max_steps")
+  eq(r.steps, 1000)
+  eq(#r.rows, 1)
+  local few = false
+  for _, w in ipairs(r.warnings) do few = few or w:find("only 1 records in 1000 steps", 1, true) ~= nil end
+  check(few, "the test says its records are too few: " .. table.concat(r.warnings, "; "))
+  local t = lab.triaxial(rect, with{confining = 1e5, every = 200000, max_steps = 700})
+  eq(t.steps, 700)
+  eq(t.stopped, "max_steps")
+  -- an every that does not divide max_steps: the last record is cut short
+  local s = lab.ucs(rect, with{every = 30, max_steps = 100})
+  eq(s.steps, 100)
+  eq(#s.rows, 4)
+  eq(s.rows[4][1] - s.rows[3][1], 10)
+end)
+
+test("lab.ucs stops near max_strain when every is larger", function()
+  -- (every = 200000 ran to a strain of 0.014 for max_strain 0.001)
+  local r = lab.ucs(rect, with{every = 200000, max_strain = 0.001})
+  eq(r.stopped, "max_strain")
+  near(r.rows[#r.rows][3], 0.001, 0.05)
+end)
+
+test("lab.brazilian stops at max_steps and near max_strain when every is larger", function()
+  local disk = lab.specimen{dim = 2, shape = "disk", diameter = 0.006, radius = {0.4e-3, 0.66e-3}, seed = 3,
+                            path = T.tmpname(".h5"), log = false}
+  local r = lab.brazilian(disk, with{every = 200000, max_steps = 900})
+  eq(r.steps, 900)
+  eq(r.stopped, "max_steps")
+  r = lab.brazilian(disk, with{every = 200000, max_strain = 0.001})
+  eq(r.stopped, "max_strain")
+  near(r.rows[#r.rows][3] / r.diameter, 0.001, 0.05)
+  raises(function() lab.brazilian(disk, with{max_strain = 0 / 0}) end, "lab.brazilian: max_strain must be a positive")
+end)
+
+test("periodic.triaxial and periodic.shear stop at max_steps and near max_strain when every is larger", function()
+  local cell = lab.periodic.specimen{dim = 2, size = 0.004, radius = {0.4e-3, 0.66e-3}, bonds = false,
+                                     path = T.tmpname(".h5"), log = false}
+  local r = lab.periodic.triaxial(cell, {confining = 1e5, every = 200000, max_steps = 600, log = false})
+  eq(r.steps, 600)
+  eq(r.stopped, "max_steps")
+  r = lab.periodic.triaxial(cell, {confining = 1e5, every = 200000, max_strain = 0.001, strain_rate = 1, log = false})
+  eq(r.stopped, "max_strain")
+  near(r.rows[#r.rows].ea, 0.001, 0.1) -- (within the automatic timestep's drift)
+  local s = lab.periodic.shear(cell, {normal = 1e5, every = 200000, max_steps = 600, log = false})
+  eq(s.steps, 600)
+  eq(s.stopped, "max_steps")
+  raises(function() lab.periodic.triaxial(cell, {max_steps = 0 / 0, log = false}) end,
+         "periodic.triaxial: max_steps must be a whole number of steps >= 1")
+end)
+
+test("joints.direct_tension stops at max_steps when every is larger; every is checked", function()
+  local r = joints.direct_tension(rect, {every = 200000, max_steps = 500})
+  eq(#r.rows, 1)
+  -- the grips part at 7e-8 of strain a step: 500 steps, not 200,000
+  check(r.rows[1][1] < 2 * 500 * 7e-8, "strain " .. r.rows[1][1])
+  raises(function() joints.direct_tension(rect, {every = 0}) end,
+         "joints.direct_tension: every must be a whole number of steps >= 1 (got 0)")
+  raises(function() joints.direct_shear(rect, {normal_stress = 1e6, every = 0.5}) end,
+         "joints.direct_shear: every must be a whole number of steps >= 1 (got 0.5)")
+end)
+
+T.done()
