@@ -7,6 +7,12 @@
 --   c.keys(opts, "shear", {"normal", ...}); c.positive(v, "normal", "shear")
 local check = {}
 
+-- a value in a message: NaN as "nan" (tostring says "-nan" on x86 Linux)
+local function show(v)
+  if v ~= v then return "nan" end
+  return tostring(v)
+end
+
 function check.module(name)
   local c = {}
 
@@ -25,9 +31,18 @@ function check.module(name)
     end
   end
 
+  -- a stress >= 0 Pa, finite (NaN fails every comparison, so passed the
+  -- old `v < 0` checks and failed later under another name)
+  function c.stress(v, what, fn)
+    if type(v) ~= "number" or not (v >= 0 and v < math.huge) then
+      error(string.format("%s.%s: %s must be a stress >= 0 Pa (got %s)", name, fn, what, show(v)), 3)
+    end
+    return v
+  end
+
   function c.positive(v, what, fn)
     if type(v) ~= "number" or not (v > 0) or v == math.huge then
-      error(string.format("%s.%s: %s must be a positive number (got %s)", name, fn, what, tostring(v)), 3)
+      error(string.format("%s.%s: %s must be a positive number (got %s)", name, fn, what, show(v)), 3)
     end
     return v
   end
@@ -35,7 +50,7 @@ function check.module(name)
   -- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
   function c.steps(v, what, fn)
     if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
-      error(string.format("%s.%s: %s must be a whole number of steps >= 1 (got %s)", name, fn, what, tostring(v)), 3)
+      error(string.format("%s.%s: %s must be a whole number of steps >= 1 (got %s)", name, fn, what, show(v)), 3)
     end
     return math.tointeger(v)
   end

@@ -38,7 +38,7 @@ local plot_test, plot_brazilian, plot_series -- the figures, at the end
 
 local c = require("seixo.check").module("lab")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
-local record_steps = require("seixo.check").record_steps
+local stress, record_steps = c.stress, require("seixo.check").record_steps
 
 -- a specimen of lab.specimen or lab.open: its file and dimension at least
 local function check_spec(spec, fn)
@@ -867,12 +867,12 @@ local function compression(spec, opts, fn)
     fail("lab.%s: a %s specimen is for the Brazilian test; make a %s", fn, spec.shape,
          dim == 3 and "cylinder or prism" or "rect")
   end
-  local sigma3 = opts.confining or 0
-  if type(sigma3) ~= "number" or sigma3 < 0 then fail("lab.%s: confining must be a stress >= 0 Pa", fn) end
+  local sigma3 = stress(opts.confining or 0, "confining", fn)
   -- a true triaxial test of a prism: sigma2 on the x faces, sigma3 on the y faces
   local sigma2 = opts.intermediate or sigma3
-  if type(sigma2) ~= "number" or sigma2 < sigma3 then
-    fail("lab.%s: intermediate must be a stress >= confining (got %s)", fn, tostring(opts.intermediate))
+  if type(sigma2) ~= "number" or not (sigma2 >= sigma3 and sigma2 < math.huge) then
+    fail("lab.%s: intermediate must be a stress >= confining (got %s)", fn,
+         sigma2 ~= sigma2 and "nan" or tostring(opts.intermediate))
   end
   if sigma2 ~= sigma3 and not (dim == 3 and spec.shape == "prism") then
     fail("lab.%s: an intermediate stress needs a 3D prism (six planes)", fn)
@@ -1298,6 +1298,14 @@ function lab.mohr_coulomb(points)
     local x, y = p.sigma3 or p[1], p.sigma1 or p[2]
     if type(x) ~= "number" or type(y) ~= "number" then
       error(string.format("lab.mohr_coulomb: point %d needs sigma3 and sigma1 numbers", i), 2)
+    end
+    -- (a NaN, from a failed test or fit, made the sums NaN and was reported
+    -- as "two different confining stresses" needed)
+    for _, v in ipairs{{"sigma3", x}, {"sigma1", y}} do
+      if not (v[2] > -math.huge and v[2] < math.huge) then
+        error(string.format("lab.mohr_coulomb: point %d's %s must be a finite stress (got %s)", i, v[1],
+                            v[2] ~= v[2] and "nan" or tostring(v[2])), 2)
+      end
     end
     sx, sy, sxx, sxy = sx + x, sy + y, sxx + x * x, sxy + x * y
   end

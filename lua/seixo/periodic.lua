@@ -160,7 +160,7 @@ function periodic.triaxial(spec, opts)
   local dim = spec.dim
   local ax = dim
   local sigma3 = positive(opts.confining or spec.sigma0, "confining", "triaxial")
-  local sigma2 = opts.intermediate or sigma3
+  local sigma2 = positive(opts.intermediate or sigma3, "intermediate", "triaxial")
   if dim == 2 and sigma2 ~= sigma3 then fail("periodic.triaxial: an intermediate stress needs a 3D cell") end
   local max_strain = positive(opts.max_strain or 0.02, "max_strain", "triaxial")
   local post_peak = opts.post_peak or 0.7

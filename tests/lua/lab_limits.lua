@@ -54,9 +54,11 @@ test("lab.brazilian stops at max_steps and near max_strain when every is larger"
   raises(function() lab.brazilian(disk, with{max_strain = 0 / 0}) end, "lab.brazilian: max_strain must be a positive")
 end)
 
+-- about 15 disks in a periodic cell
+local cell = lab.periodic.specimen{dim = 2, size = 0.004, radius = {0.4e-3, 0.66e-3}, bonds = false,
+                                   path = T.tmpname(".h5"), log = false}
+
 test("periodic.triaxial and periodic.shear stop at max_steps and near max_strain when every is larger", function()
-  local cell = lab.periodic.specimen{dim = 2, size = 0.004, radius = {0.4e-3, 0.66e-3}, bonds = false,
-                                     path = T.tmpname(".h5"), log = false}
   local r = lab.periodic.triaxial(cell, {confining = 1e5, every = 200000, max_steps = 600, log = false})
   eq(r.steps, 600)
   eq(r.stopped, "max_steps")
@@ -79,6 +81,26 @@ test("joints.direct_tension stops at max_steps when every is larger; every is ch
          "joints.direct_tension: every must be a whole number of steps >= 1 (got 0)")
   raises(function() joints.direct_shear(rect, {normal_stress = 1e6, every = 0.5}) end,
          "joints.direct_shear: every must be a whole number of steps >= 1 (got 0.5)")
+end)
+
+test("a NaN or infinite stress is refused by its name", function()
+  -- (confining = 0/0 said "an intermediate stress needs a 3D prism")
+  raises(function() lab.triaxial(rect, with{confining = 0 / 0}) end,
+         "lab.triaxial: confining must be a stress >= 0 Pa (got nan)")
+  raises(function() lab.triaxial(rect, with{confining = math.huge}) end,
+         "lab.triaxial: confining must be a stress >= 0 Pa (got inf)")
+  raises(function() lab.triaxial(rect, with{confining = 1e5, intermediate = 0 / 0}) end,
+         "lab.triaxial: intermediate must be a stress >= confining (got nan)")
+  raises(function() lab.triaxial(rect, with{confining = 1e5, intermediate = math.huge}) end,
+         "lab.triaxial: intermediate must be a stress >= confining (got inf)")
+  -- (a NaN sigma3 said "the failure states need two different confining stresses")
+  raises(function() lab.mohr_coulomb{{sigma3 = 0 / 0, sigma1 = 1e6}, {sigma3 = 1e6, sigma1 = 2e6}} end,
+         "lab.mohr_coulomb: point 1's sigma3 must be a finite stress (got nan)")
+  raises(function() lab.mohr_coulomb{{0, 1e6}, {1e6, math.huge}} end,
+         "lab.mohr_coulomb: point 2's sigma1 must be a finite stress (got inf)")
+  -- (periodic: a NaN intermediate said "an intermediate stress needs a 3D cell")
+  raises(function() lab.periodic.triaxial(cell, {intermediate = 0 / 0, log = false}) end,
+         "periodic.triaxial: intermediate must be a positive number (got nan)")
 end)
 
 T.done()
