@@ -19,6 +19,18 @@ function check.module(name)
   -- an error at the caller of the function that calls fail
   function c.fail(fmt, ...) error(string.format(fmt, ...), 3) end
 
+  -- a log option: false (silent), nil (print) or a function; checked up
+  -- front, not at the first line said (after a genesis or a whole test)
+  local function check_log(v, fn)
+    if v == nil or v == false or type(v) == "function" then return end
+    local got = (type(v) == "table" or type(v) == "userdata") and type(v) or type(v) .. " " .. tostring(v)
+    error(string.format("%s.%s: log must be false, nil or a function (got %s)", name, fn, got), 4)
+  end
+
+  function c.log(v, fn) check_log(v, fn) end
+
+  -- the options' names, and the log among them (every function that takes
+  -- one calls keys first)
   function c.keys(t, fn, allowed)
     if type(t) ~= "table" then error(string.format("%s.%s: a table of options expected, got %s", name, fn, type(t)), 3) end
     local set = {}
@@ -29,6 +41,7 @@ function check.module(name)
         error(string.format("%s.%s: unknown option '%s' (valid: %s)", name, fn, tostring(k), table.concat(allowed, ", ")), 3)
       end
     end
+    if set.log then check_log(t.log, fn) end
   end
 
   -- a stress >= 0 Pa, finite (NaN fails every comparison, so passed the

@@ -49,6 +49,7 @@ end
 --- rows {ucs, bts, ratio, phi, c}.
 function joints.compare(opts)
   opts = opts or {}
+  c.log(opts.log, "compare") -- (up front: a number was called at the first line said)
   local dim = opts.dim or 2
   local out = opts.out or "joints_compare"
   local radius = opts.radius or {0.4e-3, 0.66e-3}
@@ -95,6 +96,7 @@ end
 function joints.direct_tension(spec, opts)
   opts = opts or {}
   check_keys("direct_tension", opts, {strain_rate = true, post_peak = true, every = true, max_steps = true, log = true})
+  c.log(opts.log, "direct_tension")
   local every = c.steps(opts.every or 50, "every", "direct_tension")
   local max_steps = c.steps(opts.max_steps or 400000, "max_steps", "direct_tension")
   local dim = spec.dim
@@ -246,6 +248,7 @@ end
 --- test (lab.ucs's options), out (path prefix: out.csv, and out.png with
 --- gnuplot), log. Returns {intact =, rows = {{angle, ucs, jaeger}, ...}}.
 function joints.angle_series(spec, opts)
+  c.log(opts.log, "angle_series")
   local angles = opts.angles or {0, 15, 30, 45, 52.5, 60, 67.5, 75, 90}
   local out = opts.out or "angle_series"
   local joint = opts.joint or {}
@@ -302,6 +305,7 @@ function joints.direct_shear(spec, opts)
   end
   local sn = opts.normal_stress
   if type(sn) ~= "number" or not (sn > 0) then error("joints.direct_shear: normal_stress must be > 0", 2) end
+  c.log(opts.log, "direct_shear")
   local every = c.steps(opts.every or 50, "every", "direct_shear")
   local js = joints.jointed(spec, merge(opts.joint or {}, {angle = 0, path = (opts.out or "direct_shear") .. ".h5"}))
   local m = seixo.load(js.path)

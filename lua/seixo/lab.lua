@@ -1453,6 +1453,7 @@ end
 function lab.series(spec, opts)
   check_spec(spec, "series")
   opts = copy(opts or {})
+  c.log(opts.log, "series") -- (before the tests: with jobs > 1 the series says their lines itself)
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
   local jobs = opts.jobs or seixo.cores()

@@ -103,4 +103,34 @@ test("a NaN or infinite stress is refused by its name", function()
          "periodic.triaxial: intermediate must be a positive number (got nan)")
 end)
 
+test("a log that is not false, nil or a function is refused up front, by the option's name", function()
+  -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
+  raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
+                                  path = T.tmpname(".h5"), log = 5} end,
+         "lab.specimen: log must be false, nil or a function (got number 5)")
+  raises(function() lab.ucs(rect, {log = "quiet", max_steps = 100}) end,
+         "lab.ucs: log must be false, nil or a function (got string quiet)")
+  raises(function() lab.triaxial(rect, {confining = 1e5, log = true, max_steps = 100}) end,
+         "lab.triaxial: log must be false, nil or a function (got boolean true)")
+  raises(function() lab.brazilian(rect, {log = {}}) end, "lab.brazilian: log must be false, nil or a function (got table)")
+  -- a series says its tests' lines itself (jobs > 1): refused before any test, not after them
+  local t = seixo.clock()
+  raises(function() lab.series(rect, {confining = {0, 1e5}, log = 5, max_steps = 100000}) end,
+         "lab.series: log must be false, nil or a function (got number 5)")
+  check(seixo.clock() - t < 1, "refused before the tests")
+  raises(function() lab.periodic.specimen{dim = 2, size = 0.004, path = T.tmpname(".h5"), log = 5} end,
+         "periodic.specimen: log must be false, nil or a function (got number 5)")
+  raises(function() lab.periodic.triaxial(cell, {log = 5}) end, "periodic.triaxial: log must be false")
+  raises(function() lab.periodic.shear(cell, {log = 5}) end, "periodic.shear: log must be false")
+  -- seixo.joints: nil is silent there, and a number was called after the test had run
+  raises(function() joints.direct_tension(rect, {log = 5, max_steps = 100}) end,
+         "joints.direct_tension: log must be false, nil or a function (got number 5)")
+  raises(function() joints.direct_shear(rect, {normal_stress = 1e6, log = 5}) end, "joints.direct_shear: log must be")
+  raises(function() joints.angle_series(rect, {log = 5}) end, "joints.angle_series: log must be")
+  raises(function() joints.compare{log = 5} end, "joints.compare: log must be")
+  local lines = {}
+  lab.ucs(rect, {max_steps = 100, plot = false, log = function(l) lines[#lines + 1] = l end})
+  check(#lines > 0, "a function gets the lines")
+end)
+
 T.done()
