@@ -112,6 +112,7 @@ static int set_material(lua_State *L)
     sx_model *m = check_ball(L, &id);
     if (lua_type(L, 3) != LUA_TSTRING)
         return luaL_error(L, "ball field 'material': material name expected, got %s", luaL_typename(L, 3));
+    sx_lua_checkname(L, 3);
     const int mat = find_material(L, m, lua_tostring(L, 3));
     if (mat < 0) return luaL_error(L, "ball field 'material': %s", lua_tostring(L, -1));
     sx_lua_checkfield(L, m, sx_ball_set_material(m, id, mat), "ball");
@@ -230,6 +231,7 @@ static int set_group(lua_State *L)
     sx_model *m = check_ball(L, &id);
     if (!lua_isnil(L, 3) && lua_type(L, 3) != LUA_TSTRING)
         return luaL_error(L, "ball field 'group': group name or nil expected, got %s", luaL_typename(L, 3));
+    if (!lua_isnil(L, 3)) sx_lua_checkname(L, 3);
     lua_getiuservalue(L, 1, 1);
     const int32_t g = lua_isnil(L, 3) ? 0 : sx_lua_group_id(L, lua_gettop(L), lua_tostring(L, 3), true);
     sx_lua_checkfield(L, m, sx_ball_set_group(m, id, g), "ball");

@@ -445,6 +445,9 @@ bool sx_lua_optintfield(lua_State *L, int arg, const char *key, int64_t lo, int6
 bool sx_lua_optrangefield(lua_State *L, int arg, const char *key, double lo, double hi, double *out);
 /// A string field, or NULL when absent; valid while the table holds it.
 const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key);
+/// luaL_checkstring for a name or a path: one with a zero byte in it is an
+/// argument error (C would cut it there).
+const char *sx_lua_checkname(lua_State *L, int arg);
 /// Raises "bad argument #arg to 'f' (field 'key': msg)".
 int sx_lua_fielderror(lua_State *L, int arg, const char *key, const char *msg);
 

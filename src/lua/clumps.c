@@ -255,7 +255,7 @@ static void push_template(lua_State *L, const sx_model *m, int t)
 static int model_clump_template(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = sx_lua_checkname(L, 2);
     const int dim = sx_model_dim(m);
     if (lua_isnoneornil(L, 3)) {
         const int t = sx_clump_template_find(m, name);

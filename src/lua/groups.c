@@ -271,7 +271,7 @@ static int64_t *select_balls(lua_State *L, int arg, int64_t *n)
 static int model_group(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = sx_lua_checkname(L, 2);
     luaL_argcheck(L, *name, 2, "a group name must not be empty");
     const int slot = check_slot(L, 4, 4, 1);
     if (lua_isfunction(L, 3)) {
@@ -511,7 +511,7 @@ static const char *const op_names[] = {"m:sum", "m:mean", "m:min", "m:max"};
 static int reduce(lua_State *L, int op)
 {
     const sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = sx_lua_checkname(L, 2);
     const int qi = sx_lua_find(name, quantity_names);
     if (qi < 0) {
         sx_lua_pushlist(L, quantity_names);

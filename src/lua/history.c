@@ -390,7 +390,7 @@ static int model_histories(lua_State *L)
 static int model_history_remove(lua_State *L)
 {
     sx_lua_checkmodel_scattered(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = sx_lua_checkname(L, 2);
     const lua_Integer at = find_history(L, name);
     if (!at) return luaL_argerror(L, 2, lua_pushfstring(L, "no history named '%s'", name));
     sx_lua_state(L, 1, "histories");
@@ -599,7 +599,7 @@ void sx_lua_histories_restore(lua_State *L, int model, const struct sx_io_histor
 static int model_history_csv(lua_State *L)
 {
     sx_lua_checkmodel(L, 1);
-    const char *path = luaL_checkstring(L, 2);
+    const char *path = sx_lua_checkname(L, 2);
     lua_settop(L, 3);
     /* the histories to write: the given names, else all */
     if (lua_isnil(L, 3)) {

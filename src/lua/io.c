@@ -345,7 +345,7 @@ static int model_save(lua_State *L)
 {
     static const char *const keys[] = {"compression", NULL};
     const sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *path = luaL_checkstring(L, 2);
+    const char *path = sx_lua_checkname(L, 2);
     int64_t level = 0;
     if (!lua_isnoneornil(L, 3)) {
         sx_lua_checkkeys(L, 3, keys);
@@ -431,7 +431,7 @@ static int info_free(lua_State *L)
 static int seixo_load(lua_State *L)
 {
     static const char *const keys[] = {"dim", NULL};
-    const char *path = luaL_checkstring(L, 1);
+    const char *path = sx_lua_checkname(L, 1);
     int64_t dim = 0;
     if (!lua_isnoneornil(L, 2)) {
         sx_lua_checkkeys(L, 2, keys);
@@ -752,7 +752,7 @@ static int model_output(lua_State *L)
  * there; the lab library's files check it as m:save does. */
 static int seixo_replaceable(lua_State *L)
 {
-    const char *why = sx_io_unreplaceable(luaL_checkstring(L, 1));
+    const char *why = sx_io_unreplaceable(sx_lua_checkname(L, 1));
     lua_pushboolean(L, why == NULL);
     if (!why) return 1;
     lua_pushstring(L, why);
@@ -761,7 +761,7 @@ static int seixo_replaceable(lua_State *L)
 
 static int seixo_xdmf(lua_State *L)
 {
-    const char *path = luaL_checkstring(L, 1);
+    const char *path = sx_lua_checkname(L, 1);
     char err[1024];
     if (sx_series_write_xdmf(path, err, sizeof err)) return luaL_error(L, "%s", err);
     return 0;

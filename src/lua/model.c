@@ -465,7 +465,7 @@ static void check_material(lua_State *L, int arg, sx_material_def *d, bool *has_
 static int model_material(lua_State *L)
 {
     sx_model *m = sx_lua_checkmodel(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = sx_lua_checkname(L, 2);
     sx_material_def d;
     bool has_bpm;
     sx_bpm_def bpm;

@@ -238,13 +238,27 @@ bool sx_lua_optrangefield(lua_State *L, int arg, const char *key, double lo, dou
     return true;
 }
 
+#define NUL_IN_NAME "a name or path with a zero byte ('\\0') in it: C would cut it there"
+
 const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key)
 {
     const int t = rawfield(L, arg, key);
     if (t != LUA_TNIL && t != LUA_TSTRING)
         field_error(L, arg, key, lua_pushfstring(L, "string expected, got %s", lua_typename(L, t)));
-    const char *s = lua_tostring(L, -1);
+    size_t len = 0;
+    const char *s = lua_tolstring(L, -1, &len);
+    if (s && strlen(s) != len) field_error(L, arg, key, NUL_IN_NAME);
     lua_pop(L, 1);
+    return s;
+}
+
+/* A name or path reaches C as a C string, cut at a zero byte: "sand\0wet"
+ * and "sand\0dry" were one material, "x.h5\0junk" the file x.h5. */
+const char *sx_lua_checkname(lua_State *L, int arg)
+{
+    size_t len;
+    const char *s = luaL_checklstring(L, arg, &len);
+    if (strlen(s) != len) luaL_argerror(L, arg, NUL_IN_NAME);
     return s;
 }
 

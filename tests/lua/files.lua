@@ -153,5 +153,21 @@ test("Lua source only: a precompiled chunk is refused by name, never run", funct
   eq(env.y, 5)
 end)
 
+test("a name or a path with a zero byte is refused (C cut it there)", function()
+  local m = seixo.model{dim = 2}
+  -- "sand\0wet" and "sand\0dry" were one material, the second redefining the first
+  raises(function() m:material("sand\0wet", {density = 2000}) end, "zero byte")
+  m:material("sand", {density = 2000})
+  raises(function() m:ball{pos = {0, 0}, radius = 0.01, material = "sand\0dry"} end, "field 'material'", "zero byte")
+  local b = m:ball{pos = {0, 0}, radius = 0.01}
+  raises(function() b.group = "top\0x" end, "zero byte")
+  raises(function() b.material = "sand\0x" end, "zero byte")
+  raises(function() m:save(dir .. "/x.h5\0junk") end, "zero byte")
+  raises(function() seixo.load(dir .. "/x.h5\0junk") end, "zero byte")
+  raises(function() m:output{path = dir .. "/s.h5\0junk"} end, "field 'path'", "zero byte")
+  eq(b.group, nil)
+  m:close()
+end)
+
 os.execute("rm -rf '" .. dir .. "'")
 T.done()
