@@ -40,6 +40,7 @@
 #include "series_internal.h"
 #include "state.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -146,6 +147,13 @@ static char *dup_str(const char *s)
 static bool flush_file(hid_t file) { return sx_h5_flush(file, false); }
 static bool sync_file(hid_t file) { return sx_h5_flush(file, true); }
 
+/* The system's cause of a failed flush, when it is the disk's ("No space
+ * left on device"; HDF5's own says "driver flush request failed"), else "". */
+static const char *disk_cause(int e)
+{
+    return e == ENOSPC || e == EDQUOT || e == EIO || e == EFBIG ? strerror(e) : "";
+}
+
 static void fields_text(unsigned f, char *out, size_t len)
 {
     out[0] = 0;
@@ -170,7 +178,10 @@ static bool create_file(sx_h5 *h, const char *path, int dim, const sx_series_opt
     if (f < 0) sx_h5_fail_h5(h, "cannot create a file in its folder");
     sx_h5_close(fapl);
     sx_h5_close(fcpl);
-    if (f < 0) return false;
+    if (f < 0) {
+        remove(tmp); /* a file full disk left empty (the name is this process's alone) */
+        return false;
+    }
     char text[256];
     fields_text(fields, text, sizeof text);
     sx_io_write_provenance(h, f, "series", dim, o ? &o->provenance : NULL);
@@ -492,7 +503,11 @@ static sx_status append(sx_series *s, const sx_model *m, const sx_io_history *x,
         hist_stage(&h, s, x, nh, p);
         /* 2. the snapshot and the rows on disk before anything says they
          * are complete */
-        if (!h.failed && !sync_file(s->file)) sx_h5_fail_h5(&h, "cannot flush the snapshot");
+        errno = 0;
+        if (!h.failed && !sync_file(s->file)) {
+            const int e = errno;
+            sx_h5_fail_h5(&h, "cannot flush the snapshot%s%s", *disk_cause(e) ? ": " : "", disk_cause(e));
+        }
         /* 3. the XDMF that lists it, on disk under a temporary name */
         if (m && !h.failed) {
             sx_io_xmf_step(&s->x, s->base, s->count, &sn);

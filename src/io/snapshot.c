@@ -369,7 +369,10 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
         hid_t fapl = sx_h5_fapl(true);
         hid_t fcpl = sx_h5_fcpl();
         hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
-        if (f < 0) sx_h5_fail_h5(&h, "cannot create a file in its folder");
+        if (f < 0) {
+            sx_h5_fail_h5(&h, "cannot create a file in its folder");
+            remove(tmp); /* a file full disk left empty (the name is this process's alone) */
+        }
         sx_h5_close(fapl);
         sx_h5_close(fcpl);
         if (f >= 0) {

@@ -602,7 +602,8 @@ static int model_history_csv(lua_State *L)
     const char *path = sx_lua_checkname(L, 2);
     lua_settop(L, 3);
     /* the histories to write: the given names, else all */
-    if (lua_isnil(L, 3)) {
+    const bool all = lua_isnil(L, 3);
+    if (all) {
         lua_pushcfunction(L, model_histories);
         lua_pushvalue(L, 1);
         lua_call(L, 1, 1);
@@ -610,6 +611,7 @@ static int model_history_csv(lua_State *L)
     }
     luaL_checktype(L, 3, LUA_TTABLE);
     const lua_Integer nh = (lua_Integer)lua_rawlen(L, 3);
+    if (all && nh == 0) return luaL_error(L, "m:history_csv: the model records no history (add one with m:history)");
     luaL_argcheck(L, nh > 0, 3, "no history to write");
     for (lua_Integer i = 1; i <= nh; i++) {
         lua_rawgeti(L, 3, i);

@@ -230,7 +230,7 @@ test("history_csv: the union of steps, empty cells, a unique temporary name then
   os.remove(path)
   raises(function() m:history_csv("/nonexistent/dir/h.csv") end, HERE, "/nonexistent/dir/h.csv", "cannot create a file in its folder")
   raises(function() m:history_csv(path, {"zz"}) end, HERE, "no history named 'zz'")
-  raises(function() falling():history_csv(path) end, HERE, "no history to write")
+  raises(function() falling():history_csv(path) end, HERE, "records no history")
 end)
 
 T.done()
