@@ -804,7 +804,11 @@ function search(lab, o)
                   objective = best.objective, evaluations = #history, status = status, log = o.log,
                   wall_time = seixo.clock() - t_start, history = {}}
   for i, n in ipairs(o.names) do result.parameters[n] = best.x[i] end
-  for i, c in ipairs(history) do result.history[i] = {objective = c.objective, achieved = c.achieved} end
+  for i, c in ipairs(history) do
+    local p = {}
+    for k, n in ipairs(o.names) do p[n] = c.x[k] end
+    result.history[i] = {parameters = p, objective = c.objective, achieved = c.achieved}
+  end
   result.table = final_table(o, best)
   if not replay then
     o.print(string.format("calibrate: %s after %d evaluations (%.1f s); best:\n%s", status, #history,

@@ -1008,11 +1008,16 @@ bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void
     return kernels(m)->each_contact(m, fn, ud);
 }
 
+/* A contact's force: its law's and its bond's (a parallel bond's or a flat
+ * joint's face), as PFC counts a bonded contact's force. Without the
+ * bond's, a structure that bonds alone carry (a bonded beam, balls bonded
+ * across a gap) had no contact force and a ratio that never settled. */
 static bool add_contact_force(const sx_contact_info *ci, void *ud)
 {
     double *acc = ud;
-    double s2 = ci->fn * ci->fn;
-    for (int k = 0; k < 3; k++) s2 += ci->shear[k] * ci->shear[k];
+    const double fn = ci->fn + ci->pb_fn;
+    double s2 = fn * fn;
+    for (int k = 0; k < 3; k++) s2 += (ci->shear[k] + ci->pb_fs[k]) * (ci->shear[k] + ci->pb_fs[k]);
     acc[0] += sqrt(s2);
     acc[1] += 1;
     return true;

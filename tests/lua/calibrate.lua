@@ -244,7 +244,13 @@ test("a tiny 2D specimen: the modulus that gives a known E is recovered", functi
                           seeds = {1}, workers = 1, tolerance = 1e-2, maxeval = 8, log = fresh("calibrate_2d.csv"),
                           out = "calibrate_2d", plot = false, print = function(s) lines[#lines + 1] = s end}
   check(math.abs(r.parameters.modulus / 40e9 - 1) < 0.02, table.concat(lines, "\n"))
-  check(r.evaluations <= 3, table.concat(lines, "\n"))
+  -- E goes as the modulus: the first step from 80 GPa lands within 2 %
+  -- of 40 GPa (it did in two evaluations, before a change of the loading
+  -- path: each candidate's genesis depends on its modulus chaotically, E
+  -- by about 2 % for a 0.5 % change, so the search then wanders within
+  -- that scatter until the tolerance, 1e-2 on the objective, is met)
+  eq(r.history[1].parameters.modulus, 80e9)
+  check(math.abs(r.history[2].parameters.modulus / 40e9 - 1) < 0.02, table.concat(lines, "\n"))
   check(r.achieved.nu and r.achieved.UCS, "every macro-property of the test is reported")
   -- the curve's misfit: 80 GPa (the start) is far off, the result close
   check(r.history[1].achieved.curve.mean > 0.2, "misfit at the start " .. r.history[1].achieved.curve.mean)

@@ -190,7 +190,7 @@ test("bad options name the problem", function()
   raises(function() lab.triaxial(spec, {confining = 1e6, lateral = "cylinder"}) end, "needs a 3D cylinder")
   raises(function() lab.ucs(spec, {out = {}}) end, "lab.ucs: out must be a path prefix (a string; got table)")
   os.execute("mkdir -p '" .. dir .. "/folder.csv'")
-  raises(function() lab.ucs(spec, {out = dir .. "/folder"}) end, "folder.csv (out): Is a directory")
+  raises(function() lab.ucs(spec, {out = dir .. "/folder"}) end, "folder.csv (out): it is a folder")
   raises(function() lab.lateral_strain(seixo.model{dim = 2}, 3) end, "lab.lateral_strain: axis must be 1 to 2 (got 3)")
   raises(function() lab.specimen{dim = 2, width = 0.004, height = 0.008, radius = {1e-3, 1.5e-3}, path = "x.h5"} end,
          "lab.specimen: the balls are too large for the specimen: its size along x is 0.004 m")

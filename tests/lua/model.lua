@@ -137,6 +137,30 @@ test("with no contact force the ratio is settled only when nothing moves", funct
   eq(m2:ratio(), math.huge)
 end)
 
+test("a bond's force is a contact force of the ratio, as PFC counts it", function()
+  -- two balls bonded across a 1 nm gap carry a load by the bond alone: the
+  -- ratio had no contact force to compare with and never settled
+  local R = 1e-3
+  local m = seixo.model{dim = 3}
+  m:material("g", {density = 2650, kn = 1e6, ks = 1e6, damping = 0.7,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 1, tensile_strength = 1e20,
+                           cohesion = 1e20}})
+  local a = m:ball{pos = {0, 0, 0}, radius = R}
+  local b = m:ball{pos = {2 * R + 1e-9, 0, 0}, radius = R}
+  eq(m:bond{kind = "parallel", gap = 1e-8}, 1)
+  a.fix = "all"
+  b.applied_force = {1e-3, 0, 0}
+  local why, ratio = m:solve{ratio = 1e-6, steps = 20000}
+  eq(why, "ratio")
+  check(ratio <= 1e-6, "ratio " .. ratio)
+  local c = m:contacts()()
+  eq(c.fn, 0)
+  -- the mean unbalanced force (b's over the two balls: a's is balanced by
+  -- its fixity) over the mean contact force (the bond's 1 mN)
+  near(ratio, b.force:norm() / 2 / 1e-3, 1e-6)
+  near(-c.pb_fn, 1e-3, 1e-6)
+end)
+
 test("solve with no limit uses ratio 1e-5; the first of several limits wins", function()
   local m = column(3, 2)
   local why, ratio = m:solve()
