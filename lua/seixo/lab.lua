@@ -566,7 +566,11 @@ function lab.specimen(opts)
     genesis_time = seixo.clock() - t0, diameter = opts.diameter, height = opts.height, width = opts.width,
     depth = opts.depth, thickness = opts.thickness,
   }
-  m:vars().lab_specimen = copy(spec)
+  -- the file holds no clock time (genesis_time: the returned table's), so
+  -- that the same genesis saves the same file
+  local saved = copy(spec)
+  saved.genesis_time = nil
+  m:vars().lab_specimen = saved
   m:save(path)
   say(opts, "lab.specimen: %d balls, %d bonds, porosity %.3f, saved to %s (%.1f s)", spec.balls, spec.bonds,
       spec.porosity, path, spec.genesis_time)

@@ -116,10 +116,11 @@ function periodic.specimen(opts)
   for k = 1, dim do volume = volume * cell.size[k] end
   local spec = {path = path, dim = dim, size = cell.size, radius = radius, psd = opts.psd, balls = m:ball_count(),
                 bonds = m:bond_count(), porosity = 1 - m:sum("volume") / volume, sigma0 = sigma0, material = mat,
-                seed = seed, genesis_steps = m:step(), genesis_time = seixo.clock() - t0, periodic = true,
+                seed = seed, genesis_steps = m:step(), periodic = true,
                 floaters_found = gen.floaters_found, floaters_left = left}
   m:vars().lab_specimen = spec -- lab.open's key: a specimen of either kind
-  m:save(path)
+  m:save(path) -- (with no clock time: the same genesis saves the same file)
+  spec.genesis_time = seixo.clock() - t0
   say(opts, "periodic.specimen: %d balls, %d bonds, porosity %.3f, saved to %s (%.1f s)", spec.balls, spec.bonds,
       spec.porosity, path, spec.genesis_time)
   m:close()

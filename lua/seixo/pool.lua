@@ -36,6 +36,7 @@ function pool.serialize(v)
   elseif t == "table" then
     local parts = {}
     for k, x in pairs(v) do parts[#parts + 1] = "[" .. pool.serialize(k) .. "]=" .. pool.serialize(x) end
+    table.sort(parts) -- the same text on every run and rank (pairs' order is not)
     return "{" .. table.concat(parts, ",") .. "}"
   end
   error("a " .. t .. " cannot pass between processes", 2)

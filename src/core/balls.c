@@ -107,7 +107,7 @@ static bool radius_ok(const sx_model *m, double r, int mat)
 {
     if (!(r > 0) || !isfinite(r)) return false;
     const double rho = m->mats[mat].def.density;
-    const double mass = (m->dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r) * rho;
+    const double mass = sx__ball_volume(m->dim, r) * rho;
     const double inertia = mass * r * r;
     return mass > 0 && isfinite(mass) && inertia > 0 && isfinite(inertia) && isfinite(1 / inertia);
 }
@@ -117,14 +117,8 @@ void sx__ball_update_mass(sx_model *m, int64_t i)
     sx_balls *b = &m->balls;
     if (b->clump && b->clump[i]) return; /* a pebble carries its clump's mass (clumps.c) */
     const double r = b->rad[i], rho = m->mats[b->mat[i]].def.density;
-    double mass, inertia;
-    if (m->dim == 3) {
-        mass = 4.0 / 3.0 * SX_PI * r * r * r * rho;
-        inertia = 0.4 * mass * r * r;
-    } else {
-        mass = SX_PI * r * r * rho;
-        inertia = 0.5 * mass * r * r;
-    }
+    const double mass = sx__ball_volume(m->dim, r) * rho;
+    const double inertia = (m->dim == 3 ? 0.4 : 0.5) * mass * r * r; /* a solid sphere's, a disk's */
     b->inv_mass[i] = 1.0 / mass;
     b->inv_inertia[i] = 1.0 / inertia;
 }

@@ -267,7 +267,7 @@ sx_status sx__clump_mass_props(sx_model *m, sx_clump_tpl *t, int64_t lines)
     /* exact sums about the centroid of the spheres (disks), c0 */
     double c0[3] = {0, 0, 0}, vsum = 0;
     for (int64_t i = 0; i < n; i++) {
-        const double v = d == 3 ? 4.0 / 3.0 * SX_PI * rad[i] * rad[i] * rad[i] : SX_PI * rad[i] * rad[i];
+        const double v = sx__ball_volume(d, rad[i]);
         vsum += v;
         for (int k = 0; k < d; k++) c0[k] += v * pos[i * d + k];
     }
@@ -277,7 +277,7 @@ sx_status sx__clump_mass_props(sx_model *m, sx_clump_tpl *t, int64_t lines)
     memset(&e, 0, sizeof e);
     for (int64_t i = 0; i < n; i++) {
         const double r = rad[i];
-        const double v = d == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r;
+        const double v = sx__ball_volume(d, r);
         /* a sphere's own second moment is v r^2 / 5 per axis, a disk's v r^2 / 4 */
         const double self = v * r * r / (d == 3 ? 5.0 : 4.0);
         double x[3] = {0, 0, 0};

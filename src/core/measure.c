@@ -101,7 +101,7 @@ sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out)
         if (!(region->radius > 0) || !isfinite(region->radius))
             return sx__fail(m, SX_EINVAL, "measure: the region's radius must be > 0 m (got %g)", region->radius);
         const double r = region->radius;
-        out->volume = dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r;
+        out->volume = sx__ball_volume(dim, r);
     } else if (region->shape == SX_SHAPE_BOX) {
         out->volume = 1;
         for (int k = 0; k < dim; k++) {
@@ -116,7 +116,7 @@ sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out)
     for (int64_t i = 0; i < b->n; i++) {
         if (!inside(region, b->x + i * dim, dim)) continue;
         const double r = b->rad[i];
-        double v = dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r, centre[3];
+        double v = sx__ball_volume(dim, r), centre[3];
         if (b->clump && b->clump[i]) sx__pebble_body(m, i, centre, &v); /* its share of the union */
         out->solid += v;
         out->balls++;

@@ -490,6 +490,10 @@ struct sx_model {
 };
 
 /* Ball i's local damping: its own, or its material's. */
+/* The volume of a ball of radius r: a sphere's, or a disk's of unit
+ * thickness in 2D. */
+static inline double sx__ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r; }
+
 static inline double sx__ball_damping(const sx_model *m, int64_t i)
 {
     return m->balls.alpha ? m->balls.alpha[i] : m->mats[m->balls.mat[i]].def.damping;

@@ -125,6 +125,11 @@ test("a grading curve (psd) through the genesis, walled and periodic", function(
   frac, se = volume_below(cell.path, 0.32e-3)
   check(math.abs(frac - 0.6) < 4 * se, string.format("periodic: volume below 0.32 mm: %g (se %g)", frac, se))
   eq(lab.periodic.open(cell.path).psd[2][2], 0.6)
+  -- the files hold no clock time (the same genesis saves the same file);
+  -- the returned tables do
+  check(spec.genesis_time > 0 and cell.genesis_time > 0, "the genesis's time is returned")
+  eq(lab.open(spec.path).genesis_time, nil)
+  eq(lab.periodic.open(cell.path).genesis_time, nil)
   T.raises(function() lab.specimen{dim = 2, width = 0.008, height = 0.016, psd = psd, radius = {1e-3, 2e-3}, path = dir .. "/x.h5"} end,
            "radius or psd")
   T.raises(function() lab.periodic.specimen{dim = 2, psd = {}, path = dir .. "/x.h5"} end, "psd must be a grading curve")
