@@ -144,11 +144,20 @@ sx_status sx__cell_check(sx_model *m)
         if (!m->cell->axis[k]) continue;
         const double t = sx__cell_thickness(m->cell, m->dim, k);
         /* an image nearer than the reach on both sides would pair twice */
-        if (!(t > 2 * reach))
+        if (!(t > 2 * reach)) {
+            /* a tilt thins the cell across its other axes (a sheared cell:
+             * the message had said only "make the cell larger") */
+            bool tilted = false;
+            for (int a = 0; a < m->dim; a++)
+                for (int i = 0; i < m->dim; i++) tilted |= i != a && m->cell->h[a][i] != 0;
             return sx__fail(m, SX_EINVAL,
                             "periodic space: the cell is %g m thick across axis %c, less than twice the contact "
-                            "reach (2 x (2 x largest radius %g m + skin %g m) = %g m); make the cell larger",
-                            t, "xyz"[k], rmax, skin, 2 * reach);
+                            "reach (2 x (2 x largest radius %g m + skin %g m) = %g m); %s",
+                            t, "xyz"[k], rmax, skin, 2 * reach,
+                            tilted ? "its tilt thins it (a simple shear to a strain of about the cell's aspect "
+                                     "ratio or more): shear less, or start from a taller cell"
+                                   : "make the cell larger");
+        }
     }
     return SX_OK;
 }

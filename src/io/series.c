@@ -258,6 +258,9 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
         sx_h5_fail(&h, "dim must be 2 or 3");
     } else if (sx_io_series_open_at(path)) {
         sx_h5_fail(&h, "an output series open in this session writes this file: close it first (o:close())");
+    } else if (strlen(path) >= 4 && strcmp(path + strlen(path) - 4, ".xmf") == 0) {
+        /* the HDF5 data went into a.xmf and its XDMF into a.xmf.xmf */
+        sx_h5_fail(&h, "give the series' .h5 path: its .xmf is written beside it");
     } else if (!(s->path = dup_str(path)) || !(s->xmf = sx_io_xmf_path(path))) {
         sx_h5_fail(&h, "out of memory");
     } else {

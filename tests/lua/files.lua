@@ -71,6 +71,8 @@ test("an open output series' file is not taken by another writer", function()
   -- a second output on the path (this model's or another's), or a save to
   -- it, replaced the file while the first went on counting snapshots lost
   raises(function() other:output{path = path} end, "an output series open in this session writes this file")
+  -- a path ending .xmf put the HDF5 data in a.xmf and the XDMF in a.xmf.xmf
+  raises(function() other:output{path = dir .. "/a.xmf"} end, "give the series' .h5 path")
   raises(function() m:output{path = path, append = true} end, "close it first")
   raises(function() other:save(path) end, "an output series open in this session writes this file")
   raises(function() m:history_csv(path) end, "an output series open")

@@ -384,4 +384,20 @@ T.test("bad periodic input is a clear error", function()
   T.eq(m:periodic(), nil)
 end)
 
+T.test("a cell too thin by its tilt says so (it said only 'make the cell larger')", function()
+  local m = seixo.model{dim = 2, timestep = 1e-3}
+  m:material("s", {kn = 1e7, ks = 1e7})
+  m:periodic{min = {0, 0}, max = {0.1, 0.1}}
+  m:ball{pos = {0.05, 0.05}, radius = 1e-3}
+  m:cell_control{xy = {rate = 1e4}}
+  T.raises(function() m:cycle(50) end, "thick across axis x", "its tilt thins it")
+  local u = seixo.model{dim = 2, timestep = 1e-3}
+  u:material("s", {kn = 1e7, ks = 1e7})
+  u:periodic{min = {0, 0}, max = {0.1, 0.1}}
+  u:ball{pos = {0.05, 0.05}, radius = 1e-3}
+  u:cell_control{xx = {rate = -100}}
+  local err = T.raises(function() u:cycle(50) end, "thick across axis x", "make the cell larger")
+  T.check(not err:find("tilt", 1, true), err)
+end)
+
 T.done()
