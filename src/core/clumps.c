@@ -29,7 +29,7 @@ static int64_t lookup(const sx_model *m, int64_t id, const char *fn)
 /* Clump c's pebbles from its body (the dimension's kernel, kernels/clump_motion.c). */
 static double place_pebbles(sx_model *m, int64_t c, const double *R)
 {
-    return (m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d)->place_pebbles(m, c, R);
+    return sx__kernels(m)->place_pebbles(m, c, R);
 }
 
 /* Mass and principal moments of clump c from its template, scale and

@@ -1,6 +1,6 @@
 /* The step's kernels, compiled once per dimension (SEIXO_DIM = 2 or 3) so
  * that every vector loop has a constant trip count and a 2D scene never
- * touches a third component. The dimension-independent layer (model.c)
+ * touches a third component. The dimension-independent layer (cycle.c)
  * calls them through sx_kernels_2d / sx_kernels_3d.
  *
  * Broad phase: a uniform grid of cells at least one diameter plus the skin

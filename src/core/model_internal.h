@@ -530,7 +530,7 @@ static inline int32_t sx__bw_row(const sx_model *m, int64_t c)
     return m->bw.touching[c] ? m->bw.cmodel[c] : sx__cmodel_pick_wall(m, m->bw.a[c], m->bw.b[c]);
 }
 /* Law of a ball of material `mat` against a wall (wall stiffness in series;
- * model.c), and of a ball of material ball against a wall of definition w
+ * material.c), and of a ball of material ball against a wall of definition w
  * and material wm (NULL: none), the same rules. */
 sx_pair_law sx__wall_law(const sx_model *m, int mat, const sx_wall *w);
 sx_pair_law sx__wall_law_of(const sx_material *ball, const sx_material *wm, const sx_wall_def *w);
@@ -552,7 +552,7 @@ bool sx__cmodel_store(sx_model *m, sx_pairs *p);
 bool sx__cmodel_any(const sx_model *m, bool walls);
 /* A row's derived constants and its contact's law (on adding it, on a restore). */
 void sx__cmodel_derive(sx_cmodel_row *r);
-/* The mixed pair law of two materials (model.c). */
+/* The mixed pair law of two materials (material.c). */
 sx_pair_law sx__pair_law_of(const sx_material *ma, const sx_material *mb);
 /* The law of ball-ball pair c for queries: its row's, or mixed from the
  * materials as they are (into *buf); a pointer, as queries run it for every
@@ -583,7 +583,7 @@ static inline int64_t sx__first_at(const int32_t *a, int64_t n, int64_t key)
     return lo;
 }
 
-/* The first rule d breaks (its value in *bad), or NULL (model.c). */
+/* The first rule d breaks (its value in *bad), or NULL (material.c). */
 const char *sx__material_invalid(const sx_material_def *d, char *why, size_t len);
 
 /* error helper: formats into m->err and returns status */
@@ -632,6 +632,8 @@ typedef struct sx_kernels {
 } sx_kernels;
 
 extern const sx_kernels sx_kernels_2d, sx_kernels_3d;
+/* The kernels of m's dimension. */
+static inline const sx_kernels *sx__kernels(const sx_model *m) { return m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d; }
 
 /* storage helpers (balls.c, walls.c) */
 sx_status sx__balls_reserve(sx_model *m, int64_t cap);
@@ -696,7 +698,7 @@ sx_status sx__bonds_reserve_pairs(sx_model *m); /* allocates pairs.bond when bon
 /* Re-expresses a bond's vectors for the reversed pair orientation (b -> a). */
 void sx__bond_flip(sx_model *m, int32_t slot);
 void sx__bonds_free(sx_model *m);
-/* The monotonic clock, in seconds (model.c): the profile's stages, a
+/* The monotonic clock, in seconds (cycle.c): the profile's stages, a
  * decomposed rank's pace. */
 double sx__now(void);
 /* domain decomposition (decompose.c): the checks and plan of a cycle's
@@ -745,6 +747,22 @@ void sx__tape_add(sx_tape *t, int64_t k, double v);
 bool sx__dd_energy(sx_model *m);
 /* Laws refreshed and broad phase built if needed (before queries and cycles). */
 sx_status sx__prepare(sx_model *m);
+/* material.c: the pair laws from the materials (before a cycle), and the
+ * check that the pairs' models agree. */
+sx_status sx__refresh_laws(sx_model *m);
+sx_status sx__check_models(sx_model *m);
+/* prepare.c: the skin against the cell and the balls, a failed build's
+ * status, the critical timestep (every rank's minimum under MPI; false
+ * when the ranks fail) and the timestep a cycle's next step takes. */
+sx_status sx__check_skin(sx_model *m);
+sx_status sx__build_failed(sx_model *m, sx_status st);
+bool sx__critical(sx_model *m, double *crit);
+sx_status sx__update_timestep(sx_model *m);
+/* guard.c: the stability guard's baseline, and its check. */
+sx_status sx__guard_start(sx_model *m);
+sx_status sx__guard_check(sx_model *m);
+/* A timestep the user may set: 0 (automatic) or in [1e-15, 1] s. */
+static inline bool sx__timestep_ok(double dt) { return dt == 0 || (dt >= 1e-15 && dt <= 1); }
 /* Law of a contact of materials ma and mb, from the materials as they are
  * (the step reads the table m->law, refreshed before each cycle). */
 sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb);

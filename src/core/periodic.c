@@ -20,8 +20,6 @@
 #include <stdio.h>
 #include <string.h>
 
-/* kernels of the model's dimension (model.c has its own copy of this) */
-static const sx_kernels *kernels_of(const sx_model *m) { return m->dim == 3 ? &sx_kernels_3d : &sx_kernels_2d; }
 
 /* Component c's axes (i, j): a normal one (i, i), a shear one i < j. */
 static void component_axes(int c, int *i, int *j)
@@ -266,7 +264,7 @@ sx_status sx_cell_stress(const sx_model *m, double stress[3][3], double *volume)
     for (int k = 0; k < m->dim; k++)
         if (!m->cell || !m->cell->axis[k])
             return sx__fail((sx_model *)m, SX_EINVAL, "cell_stress: the space must be periodic on every axis");
-    kernels_of(m)->cell_stress(m, stress, NULL);
+    sx__kernels(m)->cell_stress(m, stress, NULL);
     *volume = 1;
     for (int k = 0; k < m->dim; k++) *volume *= m->cell->h[k][k];
     return SX_OK;
@@ -321,7 +319,7 @@ sx_status sx__cell_step(sx_model *m)
     bool servo = false;
     for (int k = 0; k < SX_CELL_COMPONENTS; k++) servo |= c->ctl.mode[k] == SX_CELL_STRESS;
     double stress[3][3], stiff[SX_CELL_COMPONENTS], g[3][3];
-    if (servo && !kernels_of(m)->cell_stress(m, stress, stiff)) /* decomposed: the ranks failed */
+    if (servo && !sx__kernels(m)->cell_stress(m, stress, stiff)) /* decomposed: the ranks failed */
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the cell's stress");
     gradient(m, servo ? stress : NULL, stiff, g);
     /* the cell moves by H' dt, as the balls did (leapfrog: H' at the half
@@ -476,7 +474,7 @@ sx_status sx__cell_finish(sx_model *m)
                 return sx__fail(m, SX_EINVAL, "state: ghost %lld has a bad image", (long long)g);
         }
     }
-    kernels_of(m)->ghosts_refresh(m, true);
+    sx__kernels(m)->ghosts_refresh(m, true);
     return SX_OK;
 }
 

@@ -461,7 +461,7 @@ sx_status sx__state_finish(sx_model *m)
     sx__balls_compact(m);
     /* the ball-ball pass's chunks follow from the pair store alone: planned
      * again they are those the last build made */
-    const sx_kernels *k = m->dim == 2 ? &sx_kernels_2d : &sx_kernels_3d;
+    const sx_kernels *k = sx__kernels(m);
     m->nchunk = 0;
     if (m->balls.n > 0 && !k->plan(m)) return sx__fail(m, SX_ENOMEM, "state: out of memory");
     return SX_OK;
@@ -488,6 +488,25 @@ sx_status sx__state_finish(sx_model *m)
  * Left out: the thread count (results do not depend on it), the number of
  * builds (a statistic), caches rebuilt by every cycle (laws, grid,
  * chunks), the profile. */
+
+/* FNV-1a over bytes, and over doubles with -0 hashed as +0 (the hash and
+ * the ranks' digests). */
+uint64_t sx__fnv(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+uint64_t sx__fnv_doubles(uint64_t h, const double *v, int64_t n, double sign)
+{
+    for (int64_t i = 0; i < n; i++) {
+        const double x = v ? sign * v[i] : 0;
+        const double c = x == 0 ? 0.0 : x; /* -0 as +0: the states continue alike */
+        h = sx__fnv(h, &c, sizeof c);
+    }
+    return h;
+}
 
 typedef struct hasher {
     uint64_t h;

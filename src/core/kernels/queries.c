@@ -126,8 +126,8 @@ static void energy_own_walls(const sx_model *m, int r, double *acc)
 /* The serial sums: balls in dense order (then the clumps), pairs in pair
  * order, then ball-wall pairs in order. Decomposed inside a cycle (the
  * energy guard), the same sums run as chains over the ranks' own balls and
- * pairs (the ghosts current: model.c refreshes them), every rank adding
- * the clumps alike (model.c first takes their state from their owners). */
+ * pairs (the ghosts current: guard.c refreshes them), every rank adding
+ * the clumps alike (guard.c first takes their state from their owners). */
 static bool KERNEL(energy)(const sx_model *m, sx_energy *e)
 {
     *e = m->acc;

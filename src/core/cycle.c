@@ -1,0 +1,233 @@
+/* The step pipeline (sx_model_cycle): broad phase (when needed) ->
+ * timestep (auto) -> contact forces -> law of motion -> walls and the
+ * periodic cell -> time, with the stability guard every GUARD_STEPS steps
+ * and the dimension-specific stages in kernels.c; each stage timed into
+ * the profile. */
+#include "joints.h"
+#include "laws/law.h"
+#include "model_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* How often the energy guard looks at an unforced system. */
+enum { GUARD_STEPS = 64 };
+
+/* ---------------------------------------------------------------- cycle */
+
+/* A cylinder whose radius its radial velocity would take to 0 or below
+ * within the step: an error before the step moves anything (the radius ran
+ * through 0 unseen, and the model then saved could not be loaded). */
+static sx_status check_radii(sx_model *m)
+{
+    for (int64_t i = 0; i < m->nwall; i++) {
+        const sx_wall *w = &m->walls[i];
+        if (w->def.kind != SX_WALL_CYLINDER || w->def.radial_vel >= 0) continue;
+        if (!(w->def.radius + w->def.radial_vel * m->dt > 0))
+            return sx__fail(m, SX_EINVAL,
+                            "cylinder %lld: its radius %g m would reach %g m at step %lld (radial velocity %g m/s); a "
+                            "radius must stay > 0: stop it first (w:set_radial_vel(0))",
+                            (long long)w->id, w->def.radius, w->def.radius + w->def.radial_vel * m->dt,
+                            (long long)m->step + 1, w->def.radial_vel);
+    }
+    return SX_OK;
+}
+
+static void move_walls(sx_model *m, double *max_wall)
+{
+    *max_wall = 0;
+    for (int64_t i = 0; i < m->nwall; i++) {
+        sx_wall *w = &m->walls[i];
+        double s = 0;
+        for (int k = 0; k < m->dim; k++) {
+            w->def.point[k] += w->def.vel[k] * m->dt;
+            s += w->def.vel[k] * w->def.vel[k];
+        }
+        w->moved += sqrt(s) * m->dt;
+        if (w->def.kind == SX_WALL_CYLINDER) {
+            w->def.radius += w->def.radial_vel * m->dt;
+            w->moved += fabs(w->def.radial_vel) * m->dt;
+        }
+        if (w->mesh) { /* a moving mesh: the turn about its point, then its vertices */
+            const double turned = sx__mesh_turn(w, m->dt);
+            w->moved += turned;
+            if (turned > 0 || s > 0) sx__mesh_pose(w);
+        }
+        if (w->moved > *max_wall) *max_wall = w->moved;
+    }
+}
+
+double sx__now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Closes a stage that began at t0; returns the time, the next stage's start. */
+static double stage_end(sx_model *m, sx_stage s, double t0)
+{
+    const double t = sx__now();
+    m->prof.seconds[s] += t - t0;
+    m->prof.calls[s]++;
+    return t;
+}
+
+bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since)
+{
+    /* each sum of a timestep in the run rounds by at most half an ulp of
+     * the time (an ulp <= eps |t|), one more for t_end itself */
+    const double sums = m->step > since ? (double)(m->step - since) : 0;
+    const double rounding = (sums + 1) * DBL_EPSILON * fmax(fabs(m->time), fabs(t_end));
+    return m->time >= t_end - fmin(rounding, 0.5 * m->dt_prev);
+}
+
+/* What a decomposed cycle cannot go on to from the state the last one
+ * left scattered, each rank's own balls current: a build, which lists
+ * from every ball; and the check of bonded pairs' contact-model rows
+ * (sx__cmodel_prepare), which reads every pair. */
+static bool whole_needed(const sx_model *m)
+{
+    return m->build_needed || (m->ncmodel && m->bb.bond && m->bb.cmodel);
+}
+
+sx_status sx_model_gather(sx_model *m)
+{
+    if (!m->dd || !m->dd->scattered) return SX_OK;
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "gather: the model is stepping");
+    return sx__dd_whole(m, sx__kernels(m)->plan);
+}
+
+static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
+{
+    double t = sx__now();
+    const int64_t builds = m->builds;
+    sx_status st = SX_OK;
+    /* decomposed and scattered: the ranks agree on what they hold whole
+     * before any of them gathers (a wall moved on one rank alone would
+     * otherwise leave it gathering while the others resume) */
+    if (m->dd && m->dd->scattered && !(st = sx__dd_agree_replicated(m)) && whole_needed(m)) st = sx_model_gather(m);
+    /* the last cycle's plan goes on (nothing but the walls and settings
+     * changed since: a caller that changes more gathers first) */
+    const bool resume = m->dd && m->dd->scattered;
+    if (!st) st = sx__prepare(m);
+    if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
+    if (st) return st;
+    if (resume) m->dd->active = true, m->prof.resumed++; /* the timestep is then rated rank by rank */
+    if ((st = sx__update_timestep(m))) {
+        if (resume) m->dd->active = false;
+        return st;
+    }
+    const sx_kernels *k = sx__kernels(m);
+    if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
+    sx_dd *dd = m->dd;
+    m->locked = true;
+    /* the energy baseline is taken when the user has changed the system, not
+     * at every call: a script cycling one step at a time is guarded too */
+    if (m->guard_dirty && (st = sx__guard_start(m))) {
+        m->locked = false;
+        if (dd) dd->active = false;
+        return st;
+    }
+    m->guard_dirty = false;
+    double other = sx__now() - t; /* the stages outside the four of the step, summed over the steps */
+    for (int64_t s = 0; s < n; s++) {
+        if (sx_model_time_reached(m, t_end, since)) break; /* the time is global: every rank stops here */
+        t = sx__now();
+        if (sx__interrupted(m)) {
+            st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
+            break;
+        }
+        if ((st = check_radii(m))) break;
+        if (m->build_needed) {
+            if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
+            if (dd && !sx__dd_gather(m)) { /* the serial build, on every rank, from the whole state */
+                st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+                break;
+            }
+            if ((st = sx__check_skin(m))) break; /* as at a cycle's start, however the run is cut */
+            st = k->build(m);
+            if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs: balls migrate */
+            t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
+            if (st) {
+                st = sx__build_failed(m, st);
+                break;
+            }
+        }
+        st = sx__update_timestep(m);
+        double t1 = sx__now();
+        other += t1 - t;
+        if (st) break;
+        if (dd && !sx__dd_halo(m)) {
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange ghosts");
+            break;
+        }
+        const double t_own = dd ? sx__now() : 0; /* decomposed: this rank's computing, for its pace */
+        st = k->contacts(m);
+        t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
+        if (st) break;
+        st = k->walls(m);
+        t1 = stage_end(m, SX_STAGE_WALL_CONTACTS, t1);
+        if (st) break;
+        double max_disp, max_wall;
+        st = k->integrate(m, &max_disp);
+        if (dd) dd->busy += sx__now() - t_own, dd->busy_work += (double)dd->planned;
+        if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
+        if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
+        if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
+        if (!st && m->clumps && dd && !sx__dd_placed(m)) /* the placed pebbles to their owners */
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' places");
+        /* every rank decides the same rebuild (the largest of the ranks' own balls' and pebbles' moves) */
+        if (!st && dd && !dd->x.max(dd->x.ud, &max_disp))
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
+        t = stage_end(m, SX_STAGE_INTEGRATION, t1);
+        if (st) break;
+        sx__walls_servo(m);
+        move_walls(m, &max_wall);
+        if (m->cell && (st = sx__cell_step(m))) break; /* periodic space: the cell deforms */
+        m->time += m->dt;
+        m->dt_prev = m->dt;
+        m->step++;
+        m->prof.steps++;
+        m->prof.calls[SX_STAGE_OTHER]++;
+        /* Verlet criterion: two balls may close the gap by twice the largest
+         * displacement, a ball and a wall by both of their displacements. */
+        if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
+        /* a ghost moves with its owner and with the cell vectors that shift it */
+        if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
+        if (m->step % GUARD_STEPS == 0) st = sx__guard_check(m); /* decomposed: chained sums (kernels/queries.c) */
+        other += sx__now() - t;
+        if (st) break;
+    }
+    m->prof.seconds[SX_STAGE_OTHER] += other;
+    m->locked = false;
+    /* the whole state on every rank again, or lazily not (after an error
+     * the ranks are out of step, the state mixed: the caller stops them) */
+    if (dd && !st) st = sx__dd_end(m, k->plan);
+    if (dd) dd->active = false;
+    if (dd && st) dd->scattered = true;
+    return st;
+}
+
+sx_status sx_model_cycle(sx_model *m, int64_t n) { return sx_model_cycle_until(m, n, INFINITY, m->step); }
+
+sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end, int64_t since)
+{
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
+    if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
+    if (isnan(t_end)) return sx__fail(m, SX_EINVAL, "cycle: the time to stop at is not a number");
+    m->err[0] = 0;
+    m->interrupt = 0;
+    const double t0 = sx__now();
+    const sx_status st = cycle_steps(m, n, t_end, since);
+    m->prof.cycle_seconds += sx__now() - t0;
+    m->prof.cycles++;
+    return st;
+}

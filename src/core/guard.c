@@ -1,0 +1,129 @@
+/* The stability guard: an unforced system (no moving wall, no applied
+ * load, no component moving at an imposed velocity) cannot gain
+ * mechanical energy, so a growth by orders of magnitude is an instability,
+ * reported with the ball that carries the most energy. */
+#include "joints.h"
+#include "laws/law.h"
+#include "model_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* An unforced system whose mechanical energy grows past this many times its
+ * initial scale is numerically unstable. */
+#define GUARD_ENERGY_FACTOR 100.0
+
+/* ---------------------------------------------------------------- guard */
+
+/* An unforced system (no moving wall, no applied load, no fixed velocity
+ * that could inject energy) cannot gain mechanical energy: if it does by
+ * orders of magnitude, the integration is unstable. */
+static bool unforced(const sx_model *m)
+{
+    for (int64_t w = 0; w < m->nwall; w++) {
+        /* a servo sets its wall moving, and a cylinder's radius moves at radial_vel */
+        if (m->walls[w].servo_on || m->walls[w].def.radial_vel != 0) return false;
+        for (int k = 0; k < m->dim; k++)
+            if (m->walls[w].def.vel[k] != 0 || m->walls[w].def.spin[k] != 0) return false;
+    }
+    if (m->balls.fapp) return false;
+    if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
+    /* a fixed component moving at its imposed velocity does work; one held
+     * at rest does none (a ball fixed as an obstacle or a rough floor), so
+     * the guard stays on for it (a physics check: a bonded pair with one
+     * ball fixed at rest, at 5 times the critical timestep, left at 2.8e11
+     * m/s with the guard off) */
+    const sx_balls *B = &m->balls;
+    for (int64_t i = 0; i < B->n; i++) {
+        if (!B->fix[i]) continue;
+        for (int k = 0; k < m->dim; k++)
+            if ((B->fix[i] & (SX_FIX_VX << k)) && B->v[i * m->dim + k] != 0) return false;
+        for (int k = 0; k < m->rdim; k++)
+            if ((B->fix[i] & (SX_FIX_WX << k)) && B->w[i * m->rdim + k] != 0) return false;
+    }
+    if (m->clumps && sx__clumps_forced(m)) return false;
+    return true;
+}
+
+/* Kinetic, potential and the strain stored in contacts and bonds: a bonded
+ * specimen under load holds much of its energy in the bonds. */
+static double mechanical(const sx_energy *e) { return e->kinetic + e->gravitational + e->strain + e->bond_strain; }
+
+static const char *const NO_EXCHANGE = "cycle: the ranks could not exchange the state";
+
+/* Decomposed, inside a cycle: the ghosts, and the clumps' state, where
+ * the last step left their owners, for an energy sum. False: the ranks
+ * could not exchange. */
+static bool refresh_ghosts(sx_model *m) { return sx__dd_halo(m) && (!m->clumps || sx__dd_clumps(m)); }
+
+sx_status sx__guard_start(sx_model *m)
+{
+    m->guard_on = unforced(m);
+    if (!m->guard_on) return SX_OK;
+    sx_energy e;
+    /* decomposed and gone on from a scattered state: the ghosts where the
+     * last step left their owners, as guard_check reads them */
+    const bool resumed = m->dd && m->dd->active && m->dd->scattered;
+    if ((resumed && !refresh_ghosts(m)) || !sx__kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    m->guard_e0 = mechanical(&e);
+    /* the scale: the energy in play, with a floor of each ball's weight over its radius */
+    double floor_e = 0, g = 0;
+    for (int k = 0; k < m->dim; k++) g += m->gravity[k] * m->gravity[k];
+    g = sqrt(g);
+    for (int64_t i = 0; i < m->balls.n; i++) floor_e += g * m->balls.rad[i] / m->balls.inv_mass[i];
+    m->guard_scale = e.kinetic + e.strain + e.bond_strain + floor_e;
+    return SX_OK;
+}
+
+/* The ball with the largest translational kinetic energy, the first in
+ * dense order on a tie: the one to name (-1: none). Decomposed, each rank
+ * its own balls', then the largest of all and, among the ranks that hold
+ * it, the lowest index (maxima: exact). False: the ranks could not
+ * exchange. */
+static bool most_energetic_ball(const sx_model *m, int64_t *id)
+{
+    const sx_balls *b = &m->balls;
+    const sx_dd *dd = m->dd && m->dd->active ? m->dd : NULL;
+    const int64_t i0 = dd ? dd->own[dd->x.rank].lo : 0, i1 = dd ? dd->own[dd->x.rank].hi : b->n;
+    int64_t best = -1;
+    double top = -1;
+    for (int64_t i = i0; i < i1; i++) {
+        double v2 = 0;
+        for (int k = 0; k < m->dim; k++) v2 += b->v[i * m->dim + k] * b->v[i * m->dim + k];
+        const double ke = 0.5 * v2 / b->inv_mass[i];
+        if (ke > top) top = ke, best = i;
+    }
+    if (dd) {
+        double all = top;
+        if (!dd->x.max(dd->x.ud, &all)) return false;
+        double lowest = best >= 0 && top == all ? -(double)best : -INFINITY; /* an index is exact in a double */
+        if (!dd->x.max(dd->x.ud, &lowest)) return false;
+        best = all >= 0 ? (int64_t)-lowest : -1;
+    }
+    *id = best >= 0 ? b->id[best] : -1;
+    return true;
+}
+
+sx_status sx__guard_check(sx_model *m)
+{
+    if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
+    sx_energy e;
+    /* decomposed: the ghosts where the step left their owners, for the pairs' strain */
+    if ((m->dd && m->dd->active && !refresh_ghosts(m)) || !sx__kernels(m)->energy(m, &e))
+        return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    const double gain = mechanical(&e) - m->guard_e0;
+    if (!(gain > GUARD_ENERGY_FACTOR * m->guard_scale)) return SX_OK;
+    int64_t fastest;
+    double crit;
+    if (!most_energetic_ball(m, &fastest) || !sx__critical(m, &crit)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    return sx__fail(m, SX_EUNSTABLE,
+                    "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
+                    "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is too large "
+                    "(critical estimate %g s)",
+                    (long long)m->step, gain, gain / m->guard_scale, m->guard_scale, (long long)fastest, m->dt,
+                    crit);
+}
