@@ -30,10 +30,13 @@ static sx_status check_radii(sx_model *m)
         if (w->def.kind != SX_WALL_CYLINDER || w->def.radial_vel >= 0) continue;
         if (!(w->def.radius + w->def.radial_vel * m->dt > 0))
             return sx__fail(m, SX_EINVAL,
-                            "cylinder %lld: its radius %g m would reach %g m at step %lld (radial velocity %g m/s); a "
-                            "radius must stay > 0: stop it first (w:set_radial_vel(0))",
+                            "cylinder %lld: its radius %g m would reach %g m at step %lld (radial velocity %g m/s%s); a "
+                            "radius must stay > 0: %s",
                             (long long)w->id, w->def.radius, w->def.radius + w->def.radial_vel * m->dt,
-                            (long long)m->step + 1, w->def.radial_vel);
+                            (long long)m->step + 1, w->def.radial_vel, w->servo_on ? ", its servo's" : "",
+                            w->servo_on ? "its servo closes it on nothing to push; lower max_speed, or give it a "
+                                          "specimen to meet"
+                                        : "stop it first (w:set_radial_vel(0))");
     }
     return SX_OK;
 }
@@ -143,7 +146,6 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
         }
-        if ((st = check_radii(m))) break;
         if (m->build_needed) {
             if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
             if (dd && !sx__dd_gather(m)) { /* the serial build, on every rank, from the whole state */
@@ -174,6 +176,13 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
         st = k->walls(m);
         t1 = stage_end(m, SX_STAGE_WALL_CONTACTS, t1);
         if (st) break;
+        /* the walls' and the cell's motion of this step, decided before any
+         * body moves, so that a refusal leaves the step undone: the servos'
+         * speeds (from this step's wall loads), a cylinder's radius kept
+         * above 0, the cell's rates */
+        sx__walls_servo(m);
+        if ((st = check_radii(m))) break;
+        if (m->cell && (st = sx__cell_rate(m))) break;
         double max_disp, max_wall;
         st = k->integrate(m, &max_disp);
         if (dd) dd->busy += sx__now() - t_own, dd->busy_work += (double)dd->planned;
@@ -189,9 +198,8 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
-        sx__walls_servo(m);
         move_walls(m, &max_wall);
-        if (m->cell && (st = sx__cell_step(m))) break; /* periodic space: the cell deforms */
+        if (m->cell) sx__cell_move(m); /* periodic space: the cell deforms */
         m->time += m->dt;
         m->dt_prev = m->dt;
         m->step++;

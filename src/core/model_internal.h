@@ -799,10 +799,12 @@ void sx__cell_wrap_clumps(sx_model *m, int32_t *wrap);
 double sx__cell_thickness(const sx_cell *c, int dim, int k);
 /* SX_EINVAL when the cell is too thin for the balls' contact reach. */
 sx_status sx__cell_check(sx_model *m);
-/* After the step's motion: sets the cell's rates (a servo from the
- * stress) and moves the cell; an error, the cell left as it was, when the
- * move would flatten it or turn it inside out. */
-sx_status sx__cell_step(sx_model *m);
+/* Before the bodies move: sets the cell's rates for the step (a servo from
+ * the stress); an error, the cell left as it was and nothing moved yet,
+ * when the move would flatten the cell or turn it inside out. */
+sx_status sx__cell_rate(sx_model *m);
+/* After the bodies: the cell moves at its rates. */
+void sx__cell_move(sx_model *m);
 uint64_t sx__cell_hash(const sx_model *m, uint64_t h);
 size_t sx__cell_bytes(const sx_model *m);
 /* Room for n ghosts in the table and in the ball slots past base; SX_ENOMEM. */

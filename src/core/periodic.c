@@ -312,7 +312,7 @@ static void gradient(const sx_model *m, const double stress[3][3], const double 
     }
 }
 
-sx_status sx__cell_step(sx_model *m)
+sx_status sx__cell_rate(sx_model *m)
 {
     sx_cell *c = m->cell;
     if (!c->controlled) return SX_OK;
@@ -322,17 +322,17 @@ sx_status sx__cell_step(sx_model *m)
     if (servo && !sx__kernels(m)->cell_stress(m, stress, stiff)) /* decomposed: the ranks failed */
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the cell's stress");
     gradient(m, servo ? stress : NULL, stiff, g);
-    /* the cell moves by H' dt, as the balls did (leapfrog: H' at the half
-     * step); a move that would flatten it or turn it inside out is an error
-     * and leaves it as it was (a rate of -1e4/s had made a cell -0.9 m wide,
-     * and the model saved then could not be loaded) */
+    /* a move that would flatten the cell or turn it inside out is an error
+     * before any body moves, the step undone (a rate of -1e4/s had made a
+     * cell -0.9 m wide, and the model saved then could not be loaded) */
     const sx_cell before = *c;
     c->moved += set_rates(m, g);
+    sx_cell trial = *c;
     for (int k = 0; k < m->dim; k++)
-        for (int i = 0; i < m->dim; i++) c->h[k][i] += c->hdot[k][i] * m->dt;
+        for (int i = 0; i < m->dim; i++) trial.h[k][i] += c->hdot[k][i] * m->dt;
     for (int k = 0; k < m->dim; k++) {
-        const double t = sx__cell_thickness(c, m->dim, k);
-        if (isfinite(t) && t > 0 && isfinite(c->h[k][k])) continue;
+        const double t = sx__cell_thickness(&trial, m->dim, k);
+        if (isfinite(t) && t > 0 && isfinite(trial.h[k][k])) continue;
         *c = before;
         return sx__fail(m, SX_EINVAL,
                         "periodic space: the cell's deformation would make it %g m thick across axis %c at step %lld; "
@@ -340,6 +340,15 @@ sx_status sx__cell_step(sx_model *m)
                         t, "xyz"[k], (long long)m->step + 1);
     }
     return SX_OK;
+}
+
+void sx__cell_move(sx_model *m)
+{
+    sx_cell *c = m->cell;
+    if (!c->controlled) return;
+    /* by H' dt, as the balls moved (leapfrog: H' at the half step) */
+    for (int k = 0; k < m->dim; k++)
+        for (int i = 0; i < m->dim; i++) c->h[k][i] += c->hdot[k][i] * m->dt;
 }
 
 /* ------------------------------------------------------- ghost bookkeeping */

@@ -107,6 +107,17 @@ test("a run stops before a state that could not be saved and loaded", function()
   back:close()
   w:set_radial_vel(0)
   m:cycle(2) -- and it goes on once stopped
+  -- a servo closing the cylinder on nothing (its speed set within the step)
+  local s = seixo.model{dim = 3}
+  s:material("s", {kn = 1e6})
+  local sw = s:wall{kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 1}, radius = 0.01, height = 0.1}
+  s:ball{pos = {0, 0, 0.5}, radius = 0.002} -- above the cylinder: it pushes on nothing
+  sw:servo{target = 1e5, area = 1e-3, max_speed = 1e4}
+  raises(function() s:cycle(10) end, "cylinder 1: its radius", "its servo closes it on nothing")
+  check(sw:radius() > 0, "radius " .. sw:radius())
+  s:save(dir .. "/servo.h5")
+  eq(seixo.load(dir .. "/servo.h5"):step(), s:step())
+  s:close()
   -- gravity whose step velocity overflows its square (the run's state then loaded as damaged)
   raises(function() m:set_gravity{0, 0, 1e308} end, "below 1e100")
   raises(function() seixo.model{dim = 3, gravity = {0, 0, 1e200}} end, "below 1e100")
@@ -124,6 +135,19 @@ test("a run stops before a state that could not be saved and loaded", function()
   eq(q:periodic().size[1], p:periodic().size[1])
   q:close()
   p:close()
+  -- with a ball moving: the refused step is undone whole (the ball had
+  -- moved a step while the clock had not)
+  local c = seixo.model{dim = 2, timestep = 1e-3}
+  c:material("s", {kn = 1e6})
+  c:periodic{min = {0, 0}, max = {1, 1}}
+  local b = c:ball{pos = {0.5, 0.5}, radius = 0.01, vel = {1, 0}}
+  c:cycle(3)
+  local x, t = b.pos[1], c:time()
+  c:cell_control{xx = {rate = -1e6}}
+  raises(function() c:cycle(5) end, "would make it")
+  eq(c:time(), t)
+  eq(b.pos[1], x)
+  c:close()
 end)
 
 test("Lua source only: a precompiled chunk is refused by name, never run", function()
