@@ -108,6 +108,10 @@ sx_status sx_model_gather(sx_model *m)
 
 static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
 {
+    for (int k = 0; k < m->dim; k++)
+        if (!(fabs(m->gravity[k]) < SX_GRAVITY_MAX)) /* a file's from before the limit */
+            return sx__fail(m, SX_EINVAL, "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
+                            m->gravity[k]);
     double t = sx__now();
     const int64_t builds = m->builds;
     sx_status st = SX_OK;

@@ -25,10 +25,6 @@
 #include <string.h>
 #include <time.h>
 
-/* The largest gravity component, as for a ball's fields: a step's velocity
- * g dt must square without overflowing, or the state cannot be saved and
- * loaded (a robustness tester's 1e308 did both, silently). */
-#define SX_GRAVITY_MAX 1e100
 
 sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
 {

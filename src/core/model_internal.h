@@ -489,11 +489,11 @@ struct sx_model {
     int64_t njoint, cap_joint;
 };
 
-/* Ball i's local damping: its own, or its material's. */
 /* The volume of a ball of radius r: a sphere's, or a disk's of unit
  * thickness in 2D. */
 static inline double sx__ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r; }
 
+/* Ball i's local damping: its own, or its material's. */
 static inline double sx__ball_damping(const sx_model *m, int64_t i)
 {
     return m->balls.alpha ? m->balls.alpha[i] : m->mats[m->balls.mat[i]].def.damping;
@@ -761,6 +761,11 @@ sx_status sx__update_timestep(sx_model *m);
 /* guard.c: the stability guard's baseline, and its check. */
 sx_status sx__guard_start(sx_model *m);
 sx_status sx__guard_check(sx_model *m);
+/* The largest gravity component, as for a ball's fields: a step's velocity
+ * g dt must square without overflowing, or the state cannot be saved and
+ * loaded (a robustness tester's 1e308 did both, silently). A file of an
+ * older version may hold more: its cycles refuse it (cycle.c). */
+#define SX_GRAVITY_MAX 1e100
 /* A timestep the user may set: 0 (automatic) or in [1e-15, 1] s. */
 static inline bool sx__timestep_ok(double dt) { return dt == 0 || (dt >= 1e-15 && dt <= 1); }
 /* Law of a contact of materials ma and mb, from the materials as they are

@@ -174,12 +174,13 @@ static bool create_file(sx_h5 *h, const char *path, int dim, const sx_series_opt
     if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path is too long");
     hid_t fapl = sx_h5_fapl(false);
     hid_t fcpl = sx_h5_fcpl();
+    const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
     hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
     if (f < 0) sx_h5_fail_h5(h, "cannot create a file in its folder");
     sx_h5_close(fapl);
     sx_h5_close(fcpl);
     if (f < 0) {
-        remove(tmp); /* a file full disk left empty (the name is this process's alone) */
+        if (!taken) remove(tmp); /* an empty file a full disk left */
         return false;
     }
     char text[256];

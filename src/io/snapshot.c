@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static hid_t mem_type(int t)
 {
@@ -368,10 +369,11 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
     } else {
         hid_t fapl = sx_h5_fapl(true);
         hid_t fcpl = sx_h5_fcpl();
+        const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
         hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
         if (f < 0) {
             sx_h5_fail_h5(&h, "cannot create a file in its folder");
-            remove(tmp); /* a file full disk left empty (the name is this process's alone) */
+            if (!taken) remove(tmp); /* an empty file a full disk left */
         }
         sx_h5_close(fapl);
         sx_h5_close(fcpl);

@@ -36,6 +36,14 @@ int sx_lua_load_source(lua_State *L, const char *path)
 static int text_only(lua_State *L)
 {
     const int at = (int)lua_tointeger(L, lua_upvalueindex(2));
+    /* the arguments checked here, where an error names this function
+     * ('load', 'loadfile'): called from C, Lua's own is '?' */
+    if (at == 3) {
+        if (lua_type(L, 1) != LUA_TSTRING && lua_type(L, 1) != LUA_TFUNCTION) luaL_typeerror(L, 1, "string or function");
+        luaL_optstring(L, 2, NULL);
+    } else {
+        luaL_optstring(L, 1, NULL);
+    }
     if (lua_gettop(L) < at) lua_settop(L, at);
     lua_pushliteral(L, "t");
     lua_replace(L, at);

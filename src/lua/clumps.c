@@ -271,7 +271,7 @@ static int model_clump_template(lua_State *L)
     }
     double *pos = NULL, *rad = NULL;
     int64_t n;
-    if (lua_type(L, 3) == LUA_TSTRING) n = read_sphere_file(L, lua_tostring(L, 3), dim, &pos, &rad);
+    if (lua_type(L, 3) == LUA_TSTRING) n = read_sphere_file(L, sx_lua_checkname(L, 3), dim, &pos, &rad);
     else if (lua_istable(L, 3)) n = read_pebbles(L, 3, dim, &pos, &rad);
     else return luaL_typeerror(L, 3, "table of pebbles or file name");
     const sx_clump_template_def def = {pos, rad, n, lines};

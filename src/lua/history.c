@@ -622,8 +622,17 @@ static int model_history_csv(lua_State *L)
     }
     int n;
     const sx_io_history *h = sx_lua_histories_push(L, 1, 3, 0, &n);
-    char err[1024];
-    if (sx_history_csv_write(path, h, n, err, sizeof err)) return luaL_error(L, "%s", err);
+    char err[1024] = "";
+    /* decomposed over ranks, as m:save: rank 0 writes, every rank gets its
+     * outcome (each rank writing the real path itself passed checks that
+     * rank 0 alone can make, such as its open series', and raced for the
+     * file on a shared disk) */
+    const sx_model *m = sx_lua_tomodel(L, 1);
+    const bool shared = sx_model_ranks(m) > 1;
+    if (shared) sx_lua_check_model_call(L, m, "m:history_csv");
+    if (sx_lua_parallel_writes(shared)) sx_history_csv_write(path, h, n, err, sizeof err);
+    if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
+    sx_lua_rank_file_written(L, path);
     return 0;
 }
 

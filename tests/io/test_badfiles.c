@@ -690,6 +690,25 @@ START_TEST(meaningless_values)
         H5Fclose(f);
         expect_error(p, 3, "the periodic cell's vectors or rates are not finite or too large");
     }
+    /* gravity beyond the limit a model refuses (1e100 m/s^2; a file of an
+     * earlier version may hold it): it loads, and its cycle refuses it
+     * (the velocities' squares had overflowed) */
+    {
+        f = edit(cell, p, sizeof p, "gravity.h5");
+        hid_t g = H5Gopen2(f, "/model", H5P_DEFAULT), a = H5Aopen(g, "gravity", H5P_DEFAULT);
+        const double huge[3] = {0, 0, -1e200};
+        ck_assert(a >= 0 && H5Awrite(a, H5T_NATIVE_DOUBLE, huge) >= 0);
+        H5Aclose(a);
+        H5Gclose(g);
+        H5Fclose(f);
+        char err[1024] = "";
+        sx_model *loaded = sx_snapshot_load(p, 3, NULL, err, sizeof err);
+        ck_assert_msg(loaded != NULL, "%s", err);
+        ck_assert_int_ne(sx_model_cycle(loaded, 1), SX_OK);
+        ck_assert_msg(strstr(sx_model_error(loaded), "beyond 1e100 m/s^2"), "%s", sx_model_error(loaded));
+        ck_assert_int_eq(sx_model_step_count(loaded), 0);
+        sx_model_destroy(loaded);
+    }
     /* a clump's spin of 1e300, finite, as a ball's (above) */
     f = edit(q, p, sizeof p, "clump_w.h5");
     poke_at(f, "/clumps/spin", 0, 1e300);

@@ -78,6 +78,10 @@ test("an open output series' file is not taken by another writer", function()
   raises(function() m:history_csv(path) end, "an output series open")
   os.execute("ln -s series.h5 '" .. dir .. "/alias.h5'")
   raises(function() other:save(dir .. "/alias.h5") end, "symbolic link")
+  -- another spelling of the same file, and a hard link to it: the same file
+  raises(function() other:save(dir .. "/./series.h5") end, "an output series open in this session writes this file")
+  os.execute("ln '" .. path .. "' '" .. dir .. "/hard.h5'")
+  raises(function() other:save(dir .. "/hard.h5") end, "an output series open in this session writes this file")
   o:write()
   eq(o:count(), 4) -- m:output's own first snapshot and three writes: none lost
   o:close()
@@ -174,6 +178,9 @@ test("Lua source only: a precompiled chunk is refused by name, never run", funct
   eq(dofile(dir .. "/source.lua"), 42)
   eq(loadfile(dir .. "/source.lua", "t", {x = 1})(), 3)
   eq(load("return ...", "args")(7), 7)
+  -- the wrappers' argument errors name the function (Lua's own, called from C, said '?')
+  raises(function() load(nil) end, "bad argument #1 to 'load'")
+  raises(function() loadfile({}) end, "bad argument #1 to 'loadfile'")
   local env = {}
   load("y = 5", "env", "t", env)()
   eq(env.y, 5)

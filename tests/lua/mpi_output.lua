@@ -28,6 +28,13 @@ assert(o:count() == 3 and o:path() == file) -- steps 0, 500, 1000
 print("count", o:count(), "path", o:path() == file)
 m:cycle(800)
 o:write()
+-- the open series' file refuses other writers on every rank: only rank 0
+-- opened it, so ranks above 0 had renamed a CSV over it
+ok, err = pcall(m.history_csv, m, file)
+assert(not ok and err:find("an output series open", 1, true), err)
+ok, err = pcall(m.save, m, file)
+assert(not ok and err:find("an output series open", 1, true), err)
+print("the open series' file refused", not ok)
 assert(o:count() == 6 and tostring(o):find("6 snapshots", 1, true)) -- and 1500, 2000, now
 print("count", o:count(), tostring(o):match("%(.*%)"))
 o:close()
