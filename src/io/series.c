@@ -67,6 +67,8 @@ struct sx_series {
     int nheld, capheld;
     dev_t dev;        /* the .h5's file, however its path is spelt */
     ino_t ino;
+    dev_t xdev;       /* the .xmf's folder (the file is renamed over at each write) */
+    ino_t xino;
     sx_series *next;  /* the process's open series */
 };
 
@@ -76,9 +78,35 @@ struct sx_series {
  * into the unnamed old one, counting snapshots that were lost). */
 static sx_series *open_series;
 
+/* The folder of path (its identity) and its last component. */
+static bool folder_of(const char *path, struct stat *st, const char **base)
+{
+    const char *slash = strrchr(path, '/');
+    *base = slash ? slash + 1 : path;
+    char dir[4096];
+    if (!slash) snprintf(dir, sizeof dir, ".");
+    else if (slash == path) snprintf(dir, sizeof dir, "/");
+    else if (snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path) >= (int)sizeof dir) return false;
+    return stat(dir, st) == 0;
+}
+
+/* An open series whose .xmf path names: its folder's identity and name. */
+static const sx_series *xmf_owner(const char *path)
+{
+    struct stat st;
+    const char *base;
+    if (!path || !folder_of(path, &st, &base)) return NULL;
+    for (const sx_series *s = open_series; s; s = s->next) {
+        const char *slash = strrchr(s->xmf, '/');
+        if (s->xdev == st.st_dev && s->xino == st.st_ino && strcmp(slash ? slash + 1 : s->xmf, base) == 0) return s;
+    }
+    return NULL;
+}
+
 bool sx_io_series_open_at(const char *path)
 {
     struct stat st;
+    if (xmf_owner(path)) return true; /* its .xmf, rewritten at each write */
     if (!path || stat(path, &st) != 0) return false;
     for (const sx_series *s = open_series; s; s = s->next)
         if (s->dev == st.st_dev && s->ino == st.st_ino) return true;
@@ -87,10 +115,13 @@ bool sx_io_series_open_at(const char *path)
 
 static void remember_open(sx_series *s)
 {
-    struct stat st;
-    if (stat(s->path, &st) != 0) return;
+    struct stat st, xst;
+    const char *base;
+    if (stat(s->path, &st) != 0 || !folder_of(s->xmf, &xst, &base)) return;
     s->dev = st.st_dev;
     s->ino = st.st_ino;
+    s->xdev = xst.st_dev;
+    s->xino = xst.st_ino;
     s->next = open_series;
     open_series = s;
 }
@@ -264,6 +295,8 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
         sx_h5_fail(&h, "give the series' .h5 path: its .xmf is written beside it");
     } else if (!(s->path = dup_str(path)) || !(s->xmf = sx_io_xmf_path(path))) {
         sx_h5_fail(&h, "out of memory");
+    } else if (xmf_owner(s->xmf)) { /* run.h5 and run.hdf5 share run.xmf */
+        sx_h5_fail(&h, "its .xmf, '%s', is another open output series': close that one first", s->xmf);
     } else {
         const char *slash = strrchr(path, '/');
         s->base = dup_str(slash ? slash + 1 : path);

@@ -80,6 +80,10 @@ test("an open output series' file is not taken by another writer", function()
   raises(function() other:save(dir .. "/alias.h5") end, "symbolic link")
   -- another spelling of the same file, and a hard link to it: the same file
   raises(function() other:save(dir .. "/./series.h5") end, "an output series open in this session writes this file")
+  -- its .xmf, rewritten at each write, by any spelling; and another series that would share it
+  raises(function() other:save(dir .. "/series.xmf") end, "an output series open in this session writes this file")
+  raises(function() other:history_csv(dir .. "/./series.xmf") end, "an output series open")
+  raises(function() other:output{path = dir .. "/series.hdf5"} end, "is another open output series'")
   os.execute("ln '" .. path .. "' '" .. dir .. "/hard.h5'")
   raises(function() other:save(dir .. "/hard.h5") end, "an output series open in this session writes this file")
   o:write()
