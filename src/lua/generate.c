@@ -182,7 +182,7 @@ static void read_psd(lua_State *L, gen *g, const char *size)
         F[i] = lua_tonumber(L, -1);
         lua_pop(L, 3);
         if (!(g->psd_r[i] > 0 && isfinite(g->psd_r[i])) || (i > 0 && !(g->psd_r[i] > g->psd_r[i - 1])))
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the %ss must be finite, > 0 and increasing", i + 1, size));
+            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the sizes (%s) must be finite, > 0 and increasing", i + 1, size));
         if (!(F[i] >= 0 && F[i] <= 1))
             sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: a fraction passing in [0, 1] expected, got %f%s", i + 1,
                                                           F[i], F[i] > 1 && F[i] <= 100 ? " (a percentage? divide by 100)" : ""));
