@@ -88,6 +88,22 @@ function check.module(name)
   return c
 end
 
+-- A loading's quasi-static warnings: its largest inertial number (nil when
+-- the test has none) above 1e-3, or its mean unbalanced-force ratio above
+-- 1e-2 (the lab's tests and the periodic cell's share them).
+function check.balance_warnings(mean_ratio, inertial)
+  local w = {}
+  if inertial and inertial > 1e-3 then
+    w[#w + 1] = string.format("inertial number %.2g > 1e-3: the loading is too fast to be quasi-static; lower "
+                              .. "strain_rate", inertial)
+  end
+  if mean_ratio > 0.01 then
+    w[#w + 1] = string.format("mean unbalanced-force ratio %.2g during loading: the specimen is not near equilibrium; "
+                              .. "lower strain_rate", mean_ratio)
+  end
+  return w
+end
+
 -- The steps to the next record: every, or fewer where the test ends sooner
 -- -- left steps to max_steps, or strain_left to max_strain at
 -- strain_per_step -- so that max_steps is exact and max_strain is not

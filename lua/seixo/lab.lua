@@ -1112,15 +1112,7 @@ local function compression(spec, opts, fn)
   r.mean_ratio = ratio_n > 0 and ratio_sum / ratio_n or m:ratio()
   r.inertial = inertial_max
   r.wall_time = seixo.clock() - t0
-  r.warnings = {}
-  if r.inertial > 1e-3 then
-    r.warnings[#r.warnings + 1] = string.format("inertial number %.2g > 1e-3: the loading is too fast to be "
-                                                .. "quasi-static; lower strain_rate", r.inertial)
-  end
-  if r.mean_ratio > 0.01 then
-    r.warnings[#r.warnings + 1] = string.format("mean unbalanced-force ratio %.2g during loading: the specimen is "
-                                                .. "not near equilibrium; lower strain_rate", r.mean_ratio)
-  end
+  r.warnings = require("seixo.check").balance_warnings(r.mean_ratio, r.inertial)
   if why == "max_steps" or (why ~= "post_peak" and not spec.granular) then -- (a sand is loaded to max_strain)
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
   end

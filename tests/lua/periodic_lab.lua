@@ -69,6 +69,19 @@ T.test("the periodic tests' options are checked (a sand user's findings)", funct
   T.check(seixo.clock() - t0 < 1, "refused before the genesis")
 end)
 
+T.test("a periodic test loaded too fast to be quasi-static says so, as the walled tests do", function()
+  -- a sand user's cell at 20/s read a Poisson's ratio of 3.9 with no word
+  local fast = lab.periodic.triaxial(granular, {confining = 1e5, strain_rate = 20, max_strain = 0.005, log = false})
+  T.check(fast.mean_ratio > 0.01, "mean ratio " .. fast.mean_ratio)
+  T.check(#fast.warnings == 1 and fast.warnings[1]:find("not near equilibrium", 1, true), table.concat(fast.warnings, "; "))
+  local shear = lab.periodic.shear(granular, {normal = 1e5, shear_rate = 50, max_strain = 0.005, log = false})
+  T.check(shear.warnings[1] and shear.warnings[1]:find("lower strain_rate", 1, true), table.concat(shear.warnings, "; "))
+  -- the walled tests' rule, the same words (seixo.check.balance_warnings)
+  local check = require "seixo.check"
+  T.eq(#check.balance_warnings(0.005, 1e-4), 0)
+  T.eq(#check.balance_warnings(0.02, 2e-3), 2)
+end)
+
 T.test("periodic shear stops at max_steps and says so", function()
   local r = lab.periodic.shear(granular, {normal = 1e6, shear_rate = 2, max_strain = 0.5, max_steps = 2000, log = false})
   T.eq(r.stopped, "max_steps")
