@@ -125,6 +125,18 @@ static double ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_
 /* The volume of a generated body of size r: a ball of radius r, or a clump at scale r. */
 static double body_volume(const gen *g, double r) { return g->unit * ball_volume(g->dim, r); }
 
+/* The usual-range warning of the sizes drawn: a ball's radius, or a
+ * clump's equivalent radius (its template's at scale 1 times the scale: a
+ * sieve curve in m given for clumps' scales made pebbles of 0.25 um, with
+ * no word where a ball that small is warned of). */
+static void check_sizes(lua_State *L, const gen *g)
+{
+    const double unit = g->tpl >= 0 ? pow(g->unit, 1.0 / g->dim) : 1;
+    const char *what = g->tpl >= 0 ? "clump size (equivalent radius)" : "radius";
+    sx_lua_check_range(L, 1, what, g->rmax * unit, 1e-6, 1, "m");
+    sx_lua_check_range(L, 1, what, g->rmin * unit, 1e-6, 1, "m");
+}
+
 /* The size range of the bodies: `radius` of balls, `scale` of clumps. */
 static void read_radius(lua_State *L, gen *g, const char *key)
 {
@@ -152,10 +164,7 @@ static void read_radius(lua_State *L, gen *g, const char *key)
     lua_pop(L, 1);
     if (!(g->rmin > 0 && g->rmax >= g->rmin && isfinite(g->rmax)))
         sx_lua_fielderror(L, 2, key, "sizes must be finite, > 0, and min <= max");
-    if (g->tpl < 0) { /* balls, not clumps' scales */
-        sx_lua_check_range(L, 1, "radius", g->rmax, 1e-6, 1, "m");
-        sx_lua_check_range(L, 1, "radius", g->rmin, 1e-6, 1, "m");
-    }
+    check_sizes(L, g);
 }
 
 /* The grading curve {{r1, 0}, ..., {rn, 1}}: F(r), the fraction of the
@@ -306,10 +315,7 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
         read_psd(L, g, size);
         lua_pop(L, 1);
         g->dist = D_PSD;
-        if (!clumps) {
-            sx_lua_check_range(L, 1, "radius", g->rmax, 1e-6, 1, "m");
-            sx_lua_check_range(L, 1, "radius", g->rmin, 1e-6, 1, "m");
-        }
+        check_sizes(L, g);
     }
     g->mean = 0.5 * (g->rmin + g->rmax);
     g->std = (g->rmax - g->rmin) / 6;

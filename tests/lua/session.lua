@@ -305,6 +305,22 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("clumps of a size outside the usual range warn, as balls do", function()
+  -- a sieve curve in m given as clumps' scales (dimensionless) made pebbles
+  -- of 0.25 um with no word, where a ball that small is warned of
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 3}
+m:material("s", {})
+m:clump_template("dimer", {{-0.25e-3, 0, 0, 0.5e-3}, {0.25e-3, 0, 0, 0.5e-3}})
+m:generate{template = "dimer", count = 3, region = {box = {{0, 0, 0}, {0.1, 0.1, 0.1}}}}
+print("scale 1")
+m:generate{template = "dimer", psd = {{0.5e-3, 0}, {1.5e-3, 1}}, count = 3, region = {box = {{1, 1, 1}, {2, 2, 2}}}}
+print("done")]]))
+  eq(status, 0, out)
+  check(not out:sub(1, out:find("scale 1", 1, true)):find("warning", 1, true), out)
+  check(out:find("clump size (equivalent radius) 8.9", 1, true) and out:find("outside the usual range", 1, true), out)
+end)
+
 test("m:generate says when count and porosity together scaled the radii asked for", function()
   local status, out = T.run("-e " .. T.quote([[
 m = seixo.model{dim = 2}
