@@ -8,10 +8,11 @@
 local check = {}
 
 -- a value in a message: NaN as "nan" (tostring says "-nan" on x86 Linux)
-local function show(v)
+function check.show(v)
   if v ~= v then return "nan" end
   return tostring(v)
 end
+local show = check.show
 
 function check.module(name)
   local c = {}

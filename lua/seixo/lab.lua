@@ -36,9 +36,10 @@ local plot_test, plot_brazilian, plot_series -- the figures, at the end
 
 -- ------------------------------------------------------------------ helpers
 
-local c = require("seixo.check").module("lab")
+local check = require "seixo.check"
+local c = check.module("lab")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
-local stress, record_steps = c.stress, require("seixo.check").record_steps
+local stress, record_steps = c.stress, check.record_steps
 
 -- a specimen of lab.specimen or lab.open: its file and dimension at least
 local function check_spec(spec, fn)
@@ -878,8 +879,7 @@ local function compression(spec, opts, fn)
   -- a true triaxial test of a prism: sigma2 on the x faces, sigma3 on the y faces
   local sigma2 = opts.intermediate or sigma3
   if type(sigma2) ~= "number" or not (sigma2 >= sigma3 and sigma2 < math.huge) then
-    fail("lab.%s: intermediate must be a stress >= confining (got %s)", fn,
-         sigma2 ~= sigma2 and "nan" or tostring(opts.intermediate))
+    fail("lab.%s: intermediate must be a stress >= confining (got %s)", fn, check.show(sigma2))
   end
   if sigma2 ~= sigma3 and not (dim == 3 and spec.shape == "prism") then
     fail("lab.%s: an intermediate stress needs a 3D prism (six planes)", fn)
@@ -1112,7 +1112,7 @@ local function compression(spec, opts, fn)
   r.mean_ratio = ratio_n > 0 and ratio_sum / ratio_n or m:ratio()
   r.inertial = inertial_max
   r.wall_time = seixo.clock() - t0
-  r.warnings = require("seixo.check").balance_warnings(r.mean_ratio, r.inertial)
+  r.warnings = check.balance_warnings(r.mean_ratio, r.inertial)
   if why == "max_steps" or (why ~= "post_peak" and not spec.granular) then -- (a sand is loaded to max_strain)
     r.warnings[#r.warnings + 1] = string.format("stopped on %s before the stress fell past the peak", why)
   end
@@ -1303,7 +1303,7 @@ function lab.mohr_coulomb(points)
     for _, v in ipairs{{"sigma3", x}, {"sigma1", y}} do
       if not (v[2] > -math.huge and v[2] < math.huge) then
         error(string.format("lab.mohr_coulomb: point %d's %s must be a finite stress (got %s)", i, v[1],
-                            v[2] ~= v[2] and "nan" or tostring(v[2])), 2)
+                            check.show(v[2])), 2)
       end
     end
     sx, sy, sxx, sxy = sx + x, sy + y, sxx + x * x, sxy + x * y

@@ -28,9 +28,10 @@
 
 local periodic = {}
 
-local c = require("seixo.check").module("periodic")
+local check = require "seixo.check"
+local c = check.module("periodic")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
-local record_steps = require("seixo.check").record_steps
+local record_steps = check.record_steps
 
 local names = {"xx", "yy", "zz"}
 
@@ -159,7 +160,7 @@ local function mean_ratio(rows)
     if row.ratio < math.huge then sum, n = sum + row.ratio, n + 1 end -- (no contact force yet: no ratio)
   end
   local mean = n > 0 and sum / n or 0
-  return mean, require("seixo.check").balance_warnings(mean)
+  return mean, check.balance_warnings(mean)
 end
 
 --- A triaxial test of a periodic cell: the lateral stresses held at
