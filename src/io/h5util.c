@@ -133,7 +133,7 @@ const char *sx_io_unreplaceable(const char *path)
            "replace it";
 }
 
-bool sx_h5_temp_name(const char *path, char *out, size_t len)
+static bool temp_name(const char *path, char *out, size_t len)
 {
     static unsigned counter;
     const char *slash = strrchr(path, '/');
@@ -202,11 +202,38 @@ bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path)
     return sx_h5_rename(h, tmp, path);
 }
 
-bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len)
+bool sx_h5_temp_for(sx_h5 *h, const char *path, char *tmp, size_t len)
 {
     if (h->failed) return false;
-    if (sx_io_unreplaceable(path)) return sx_h5_fail(h, "'%s' %s", path, sx_io_unreplaceable(path));
-    if (!sx_h5_temp_name(path, tmp, len)) return sx_h5_fail(h, "the path of '%s' is too long", path);
+    /* the context names its own file; another one (a series' .xmf) is named here */
+    const bool other = strcmp(path, h->path) != 0;
+    const char *why = sx_io_unreplaceable(path);
+    if (why) return other ? sx_h5_fail(h, "'%s' %s", path, why) : sx_h5_fail(h, "%s", why);
+    if (!temp_name(path, tmp, len))
+        return other ? sx_h5_fail(h, "the path of '%s' is too long", path) : sx_h5_fail(h, "the path is too long");
+    return true;
+}
+
+hid_t sx_h5_create_temp(sx_h5 *h, const char *tmp, bool latest)
+{
+    if (h->failed) return -1;
+    hid_t fapl = sx_h5_fapl(latest);
+    hid_t fcpl = sx_h5_fcpl();
+    const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
+    /* EXCL: a name left by another writer is never written into */
+    hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
+    sx_h5_close(fapl);
+    sx_h5_close(fcpl);
+    if (f < 0) {
+        sx_h5_fail_h5(h, "cannot create a file in its folder");
+        if (!taken) remove(tmp); /* an empty file a full disk left */
+    }
+    return f;
+}
+
+bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len)
+{
+    if (!sx_h5_temp_for(h, path, tmp, len)) return false;
     /* O_EXCL: a name left by another writer is never written into */
     const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
     if (fd < 0) return sx_h5_fail(h, "cannot create '%s': %s", tmp, strerror(errno));

@@ -35,9 +35,6 @@ bool sx_h5_fail_h5(sx_h5 *h, const char *fmt, ...) __attribute__((format(printf,
 
 /* --------------------------------------------------------------- files */
 
-/// A temporary name beside `path` (same folder, so rename is atomic):
-/// "<dir>/.<name>.tmp-<pid>-<n>". False if it does not fit.
-bool sx_h5_temp_name(const char *path, char *out, size_t len);
 /// The file access list of seixo files: with `latest` the 1.10 format
 /// (every piece of metadata checksummed; snapshots), else the 1.8 format
 /// (which a writer killed mid-write leaves openable; series).
@@ -59,6 +56,15 @@ bool sx_h5_commit(sx_h5 *h, const char *tmp, const char *path);
 /// The second half of sx_h5_commit, for a `tmp` already on disk: the
 /// rename and the folder's sync.
 bool sx_h5_rename(sx_h5 *h, const char *tmp, const char *path);
+/// Checks that `path` may be replaced by a rename (sx_io_unreplaceable)
+/// and puts a temporary name beside it in tmp (len bytes): same folder, so
+/// the rename is atomic, "<dir>/.<name>.tmp-<pid>-<n>". False (failed,
+/// the reason named) if not.
+bool sx_h5_temp_for(sx_h5 *h, const char *path, char *tmp, size_t len);
+/// A new HDF5 file named tmp (from sx_h5_temp_for; `latest` as for
+/// sx_h5_fapl), never one another writer made. Negative (failed) on any
+/// error, with no file of its own left behind.
+hid_t sx_h5_create_temp(sx_h5 *h, const char *tmp, bool latest);
 /// Writes n bytes to a new temporary file beside `path` and flushes it to
 /// disk; its name goes to tmp (len bytes). False (failed) on any error, with
 /// nothing left behind.

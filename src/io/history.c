@@ -390,12 +390,10 @@ sx_status sx_history_csv_write(const char *path, const sx_io_history *x, int nh,
         sx_h5_fail(&h, "no history to write");
     } else if (!at) {
         sx_h5_fail(&h, "out of memory");
-    } else if (sx_io_unreplaceable(path)) {
-        sx_h5_fail(&h, "%s", sx_io_unreplaceable(path));
+    } else if (!sx_h5_temp_for(&h, path, tmp, sizeof tmp)) {
+        /* (failed, the reason named) */
     } else if (sx_io_series_open_at(path)) {
         sx_h5_fail(&h, "an output series open in this session writes this file: close it first, or write elsewhere");
-    } else if (!sx_h5_temp_name(path, tmp, sizeof tmp)) {
-        sx_h5_fail(&h, "the path is too long");
     } else if (!(f = fopen(tmp, "wx"))) { /* "x": never into a file another writer made */
         sx_h5_fail(&h, "cannot create a file in its folder: %s", strerror(errno));
     } else {

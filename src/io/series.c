@@ -201,19 +201,9 @@ static void fields_text(unsigned f, char *out, size_t len)
 static bool create_file(sx_h5 *h, const char *path, int dim, const sx_series_opts *o, unsigned fields)
 {
     char tmp[4096];
-    if (sx_io_unreplaceable(path)) return sx_h5_fail(h, "%s", sx_io_unreplaceable(path));
-    if (!sx_h5_temp_name(path, tmp, sizeof tmp)) return sx_h5_fail(h, "the path is too long");
-    hid_t fapl = sx_h5_fapl(false);
-    hid_t fcpl = sx_h5_fcpl();
-    const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
-    hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
-    if (f < 0) sx_h5_fail_h5(h, "cannot create a file in its folder");
-    sx_h5_close(fapl);
-    sx_h5_close(fcpl);
-    if (f < 0) {
-        if (!taken) remove(tmp); /* an empty file a full disk left */
-        return false;
-    }
+    if (!sx_h5_temp_for(h, path, tmp, sizeof tmp)) return false;
+    hid_t f = sx_h5_create_temp(h, tmp, false);
+    if (f < 0) return false;
     char text[256];
     fields_text(fields, text, sizeof text);
     sx_io_write_provenance(h, f, "series", dim, o ? &o->provenance : NULL);

@@ -22,7 +22,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 static hid_t mem_type(int t)
 {
@@ -360,23 +359,12 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
     char tmp[4096];
     if (!path || !*path) {
         sx_h5_fail(&h, "an empty path");
-    } else if (sx_io_unreplaceable(path)) {
-        sx_h5_fail(&h, "%s", sx_io_unreplaceable(path));
+    } else if (!sx_h5_temp_for(&h, path, tmp, sizeof tmp)) {
+        /* (failed, the reason named) */
     } else if (sx_io_series_open_at(path)) {
         sx_h5_fail(&h, "an output series open in this session writes this file: close it first, or save elsewhere");
-    } else if (!sx_h5_temp_name(path, tmp, sizeof tmp)) {
-        sx_h5_fail(&h, "the path is too long");
     } else {
-        hid_t fapl = sx_h5_fapl(true);
-        hid_t fcpl = sx_h5_fcpl();
-        const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
-        hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
-        if (f < 0) {
-            sx_h5_fail_h5(&h, "cannot create a file in its folder");
-            if (!taken) remove(tmp); /* an empty file a full disk left */
-        }
-        sx_h5_close(fapl);
-        sx_h5_close(fcpl);
+        hid_t f = sx_h5_create_temp(&h, tmp, true);
         if (f >= 0) {
             /* the model is only read; the arrays are taken as they are */
             save_all(&h, f, (sx_model *)m, opts);
