@@ -445,6 +445,9 @@ bool sx_lua_optintfield(lua_State *L, int arg, const char *key, int64_t lo, int6
 bool sx_lua_optrangefield(lua_State *L, int arg, const char *key, double lo, double hi, double *out);
 /// A string field, or NULL when absent; valid while the table holds it.
 const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key);
+/// A string field naming one of the NULL-terminated names: its index, or
+/// dflt when absent; an unknown name lists the valid ones.
+int sx_lua_optchoicefield(lua_State *L, int arg, const char *key, const char *const names[], int dflt);
 /// luaL_checkstring for a name or a path: one with a zero byte in it is an
 /// argument error (C would cut it there).
 const char *sx_lua_checkname(lua_State *L, int arg);

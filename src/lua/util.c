@@ -252,6 +252,18 @@ const char *sx_lua_optstrfield(lua_State *L, int arg, const char *key)
     return s;
 }
 
+int sx_lua_optchoicefield(lua_State *L, int arg, const char *key, const char *const names[], int dflt)
+{
+    const char *s = sx_lua_optstrfield(L, arg, key);
+    if (!s) return dflt;
+    const int i = sx_lua_find(s, names);
+    if (i < 0) {
+        sx_lua_pushlist(L, names);
+        field_error(L, arg, key, lua_pushfstring(L, "unknown '%s' (valid: %s)", s, lua_tostring(L, -1)));
+    }
+    return i;
+}
+
 /* A name or path reaches C as a C string, cut at a zero byte: "sand\0wet"
  * and "sand\0dry" were one material, "x.h5\0junk" the file x.h5. */
 const char *sx_lua_checkname(lua_State *L, int arg)
