@@ -19,202 +19,27 @@
  *               then the same relaxation.
  *   lattice     regular packings of touching balls: square or hex (2D),
  *               cubic or fcc (3D); every site whose ball lies in the region.
- * Radii: `radius = r` or `{rmin, rmax}` with distribution "uniform"
- * (default), "normal" or "lognormal" (mean, std of the radius; truncated to
- * [rmin, rmax]), or `psd`, a grading curve: the fraction of the solid
- * volume in balls up to each radius, linear in the radius between its
- * points (a sieve curve's mass passing). When both
- * count and porosity are given (distribute, expand), the drawn radii are
- * scaled by one factor to reach the porosity exactly.
+ * Radii: `radius`, `distribution` or `psd` (sizes.c).
  * Clumps: `template = name` generates clumps of that template instead
  * (method random), `scale` taking the place of the radius (its
  * distribution the same), each with a uniformly random orientation; a
  * clump is placed when every pebble lies in the region and overlaps no
  * ball or pebble there.
  *
- * The RNG is xoshiro256** seeded through splitmix64: the same seed and
- * arguments give bit-identical assemblies on every run. Overlap checks go
- * through a uniform cell grid of the region, so placement is O(N). Every
- * working array is a Lua userdata: an error anywhere frees them. */
+ * The same seed and arguments give bit-identical assemblies on every run
+ * (the RNG: sizes.c). Overlap checks go through a uniform cell grid of the
+ * region, so placement is O(N). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "bindings.h"
-
-enum { MAX_GENERATE = 10000000 };
-
-/* ------------------------------------------------------------------ RNG */
-
-typedef struct rng {
-    uint64_t s[4];
-} rng;
-
-static uint64_t splitmix64(uint64_t *x)
-{
-    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-static void rng_seed(rng *r, uint64_t seed)
-{
-    for (int i = 0; i < 4; i++) r->s[i] = splitmix64(&seed);
-}
-
-static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
-static uint64_t rng_next(rng *r)
-{
-    uint64_t *s = r->s;
-    const uint64_t out = rotl(s[1] * 5, 7) * 9;
-    const uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = rotl(s[3], 45);
-    return out;
-}
-
-/* uniform in [0, 1) */
-static double rng_uniform(rng *r) { return (double)(rng_next(r) >> 11) * 0x1.0p-53; }
-
-/* standard normal (Box-Muller, one value per call) */
-static double rng_normal(rng *r)
-{
-    const double u = 1 - rng_uniform(r);  // (0, 1]
-    const double v = rng_uniform(r);
-    return sqrt(-2 * log(u)) * cos(2 * SX_LUA_PI * v);
-}
+#include "generate.h"
 
 /* ------------------------------------------------------------ parameters */
 
-enum { M_RANDOM, M_DISTRIBUTE, M_EXPAND, M_LATTICE };
 static const char *const method_names[] = {"random", "distribute", "expand", "lattice", NULL};
-enum { P_SQUARE, P_HEX, P_CUBIC, P_FCC };
 static const char *const packing_names[] = {"square", "hex", "cubic", "fcc", NULL};
-enum { D_UNIFORM, D_NORMAL, D_LOGNORMAL, D_PSD };
-static const char *const dist_names[] = {"uniform", "normal", "lognormal", NULL};
-enum { MAX_PSD = 100 };
-
-typedef struct gen {
-    int dim, method, packing, dist, material;
-    int tpl;        /* clump template, -1 for balls */
-    double unit;    /* volume of a body of size 1 over a ball's of radius 1 (1 for balls) */
-    int32_t group;
-    int64_t count, tries;
-    bool has_count, has_porosity;
-    double porosity, rmin, rmax, mean, std;
-    double log_mean, log_std; /* lognormal: of ln r */
-    int psd_points;
-    double psd_r[MAX_PSD];    /* the grading curve's radii, increasing */
-    double psd_count[MAX_PSD]; /* the fraction of the balls' count up to each (by count, not volume) */
-    sx_lua_region region;
-    uint64_t seed;
-    bool relax;
-    int64_t relax_steps, calm;
-    double relax_ratio;
-} gen;
-
-static double ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_LUA_PI * r * r * r : SX_LUA_PI * r * r; }
-
-/* The volume of a generated body of size r: a ball of radius r, or a clump at scale r. */
-static double body_volume(const gen *g, double r) { return g->unit * ball_volume(g->dim, r); }
-
-/* The usual-range warning of the sizes drawn: a ball's radius, or a
- * clump's equivalent radius (its template's at scale 1 times the scale: a
- * sieve curve in m given for clumps' scales made pebbles of 0.25 um, with
- * no word where a ball that small is warned of). */
-static void check_sizes(lua_State *L, const gen *g)
-{
-    const double unit = g->tpl >= 0 ? pow(g->unit, 1.0 / g->dim) : 1;
-    const char *what = g->tpl >= 0 ? "clump size (equivalent radius)" : "radius";
-    sx_lua_check_range(L, 1, what, g->rmax * unit, 1e-6, 1, "m");
-    sx_lua_check_range(L, 1, what, g->rmin * unit, 1e-6, 1, "m");
-}
-
-/* The size range of the bodies: `radius` of balls, `scale` of clumps. */
-static void read_radius(lua_State *L, gen *g, const char *key)
-{
-    lua_pushstring(L, key);
-    const int t = lua_rawget(L, 2);
-    if (t == LUA_TNUMBER) {
-        g->rmin = g->rmax = lua_tonumber(L, -1);
-    } else if (t == LUA_TTABLE && lua_rawlen(L, -1) == 2) {
-        lua_rawgeti(L, -1, 1);
-        lua_rawgeti(L, -2, 2);
-        if (!lua_isnumber(L, -2) || !lua_isnumber(L, -1) || lua_type(L, -1) != LUA_TNUMBER || lua_type(L, -2) != LUA_TNUMBER)
-            sx_lua_fielderror(L, 2, key, "two numbers {min, max} expected");
-        g->rmin = lua_tonumber(L, -2);
-        g->rmax = lua_tonumber(L, -1);
-        lua_pop(L, 2);
-    } else if (t == LUA_TNIL) {
-        if (g->tpl >= 0) { /* clumps at their template's size by default */
-            g->rmin = g->rmax = 1;
-        } else {
-            sx_lua_fielderror(L, 2, "radius", "is required: a radius r or a range {rmin, rmax} in m");
-        }
-    } else {
-        sx_lua_fielderror(L, 2, key, lua_pushfstring(L, "a number or {min, max} expected, got %s", lua_typename(L, t)));
-    }
-    lua_pop(L, 1);
-    if (!(g->rmin > 0 && g->rmax >= g->rmin && isfinite(g->rmax)))
-        sx_lua_fielderror(L, 2, key, "sizes must be finite, > 0, and min <= max");
-    check_sizes(L, g);
-}
-
-/* The grading curve {{r1, 0}, ..., {rn, 1}}: F(r), the fraction of the
- * solid volume in bodies of size up to r, linear in r between points. A
- * ball's volume goes as r^dim, so within a bin the count's density goes as
- * r^-dim; psd_count holds the count's cumulative fraction at each point. */
-static void read_psd(lua_State *L, gen *g, const char *size)
-{
-    const int t = lua_gettop(L);
-    const int n = (int)lua_rawlen(L, t);
-    if (n < 2 || n > MAX_PSD)
-        sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "2 to %d points {r, F} expected, got %d", (int)MAX_PSD, n));
-    double F[MAX_PSD];
-    for (int i = 0; i < n; i++) {
-        lua_rawgeti(L, t, i + 1);
-        const bool pair = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == 2;
-        if (pair) {
-            lua_rawgeti(L, -1, 1);
-            lua_rawgeti(L, -2, 2);
-        }
-        if (!pair || lua_type(L, -1) != LUA_TNUMBER || lua_type(L, -2) != LUA_TNUMBER)
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: {%s, fraction passing} (two numbers) expected", i + 1, size));
-        g->psd_r[i] = lua_tonumber(L, -2);
-        F[i] = lua_tonumber(L, -1);
-        lua_pop(L, 3);
-        if (!(g->psd_r[i] > 0 && isfinite(g->psd_r[i])) || (i > 0 && !(g->psd_r[i] > g->psd_r[i - 1])))
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the sizes (%s) must be finite, > 0 and increasing", i + 1, size));
-        if (!(F[i] >= 0 && F[i] <= 1))
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: a fraction passing in [0, 1] expected, got %f%s", i + 1,
-                                                          F[i], F[i] > 1 && F[i] <= 100 ? " (a percentage? divide by 100)" : ""));
-        if (i > 0 && F[i] < F[i - 1])
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "point %d: the fractions passing must not decrease", i + 1));
-    }
-    if (F[0] != 0 || F[n - 1] != 1)
-        sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "the curve must start at fraction 0 (its smallest %s) and end at 1 "
-                                                          "(its largest), got %f and %f", size, F[0], F[n - 1]));
-    const int k = g->dim;
-    double sum = 0;
-    g->psd_count[0] = 0;
-    for (int i = 1; i < n; i++) {
-        const double a = g->psd_r[i - 1], b = g->psd_r[i];
-        sum += (F[i] - F[i - 1]) / (b - a) * (pow(a, 1 - k) - pow(b, 1 - k)) / (k - 1);
-        g->psd_count[i] = sum;
-    }
-    for (int i = 1; i < n; i++) g->psd_count[i] /= sum;
-    g->psd_count[n - 1] = 1;
-    g->psd_points = n;
-    g->rmin = g->psd_r[0];
-    g->rmax = g->psd_r[n - 1];
-}
 
 static void read_relax(lua_State *L, gen *g)
 {
@@ -283,42 +108,7 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
         if ((g->packing <= P_HEX) != (g->dim == 2))
             sx_lua_fielderror(L, 2, "packing", g->dim == 2 ? "'square' or 'hex' in 2D" : "'cubic' or 'fcc' in 3D");
     }
-    const char *size = clumps ? "scale" : "radius";
-    lua_pushliteral(L, "psd");
-    const int psd_type = lua_rawget(L, 2);
-    if (psd_type == LUA_TNIL) {
-        lua_pop(L, 1);
-        read_radius(L, g, size);
-        g->dist = sx_lua_optchoicefield(L, 2, "distribution", dist_names, D_UNIFORM);
-    } else {
-        if (psd_type != LUA_TTABLE)
-            sx_lua_fielderror(L, 2, "psd", lua_pushfstring(L, "a table of points {r, F} expected, got %s", lua_typename(L, psd_type)));
-        static const char *const by_psd[] = {"radius", "scale", "distribution", NULL};
-        for (int k = 0; by_psd[k]; k++) {
-            lua_pushstring(L, by_psd[k]);
-            const bool given = lua_rawget(L, 2) != LUA_TNIL;
-            lua_pop(L, 1);
-            if (given) sx_lua_fielderror(L, 2, by_psd[k], "the psd gives the sizes and their distribution: leave this out");
-        }
-        read_psd(L, g, size);
-        lua_pop(L, 1);
-        g->dist = D_PSD;
-        check_sizes(L, g);
-    }
-    g->mean = 0.5 * (g->rmin + g->rmax);
-    g->std = (g->rmax - g->rmin) / 6;
-    const bool has_mean = sx_lua_optnumfield(L, 2, "mean", &g->mean), has_std = sx_lua_optnumfield(L, 2, "std", &g->std);
-    const bool parametric = g->dist == D_NORMAL || g->dist == D_LOGNORMAL;
-    if ((has_mean || has_std) && !parametric)
-        sx_lua_fielderror(L, 2, has_mean ? "mean" : "std", "only for distribution = 'normal' or 'lognormal'");
-    if (parametric) {
-        if (!(g->mean >= g->rmin && g->mean <= g->rmax)) sx_lua_fielderror(L, 2, "mean", "must lie in [rmin, rmax]");
-        if (!(g->std >= 0 && isfinite(g->std))) sx_lua_fielderror(L, 2, "std", "must be finite and >= 0");
-    }
-    if (g->dist == D_LOGNORMAL) { /* ln r's parameters for r's mean and std */
-        g->log_std = sqrt(log1p((g->std / g->mean) * (g->std / g->mean)));
-        g->log_mean = log(g->mean) - 0.5 * g->log_std * g->log_std;
-    }
+    sx_lua_read_sizes(L, g);
     g->has_count = sx_lua_optintfield(L, 2, "count", 0, MAX_GENERATE, &g->count);
     g->has_porosity = sx_lua_optnumfield(L, 2, "porosity", &g->porosity);
     if (g->has_porosity && !(g->porosity > 0 && g->porosity < 1))
@@ -351,81 +141,6 @@ static void read_gen(lua_State *L, const sx_model *m, gen *g)
     const int top = lua_gettop(L);
     sx_lua_region_read(L, top, g->dim, 2, "region", &g->region);
     lua_remove(L, top);  // the table; the polygon's storage, if any, stays
-}
-
-/* --------------------------------------------------------------- radii */
-
-/* A size from the grading curve: a bin by the count's fractions, then the
- * inverse of the count's distribution in it, whose density goes as r^-dim. */
-static double draw_psd(const gen *g, rng *r)
-{
-    const double u = rng_uniform(r);
-    int i = 1;
-    while (i < g->psd_points - 1 && !(u < g->psd_count[i])) i++;
-    const double a = g->psd_r[i - 1], b = g->psd_r[i], e = 1 - g->dim;
-    const double pa = pow(a, e), pb = pow(b, e);
-    const double x = pow(pa - rng_uniform(r) * (pa - pb), 1 / e);
-    return fmin(fmax(x, a), b);
-}
-
-static double draw_radius(lua_State *L, const gen *g, rng *r)
-{
-    if (g->rmin == g->rmax) return g->rmin;
-    if (g->dist == D_UNIFORM) return g->rmin + (g->rmax - g->rmin) * rng_uniform(r);
-    if (g->dist == D_PSD) return draw_psd(g, r);
-    for (int k = 0; k < 100000; k++) {
-        const double x = g->dist == D_NORMAL ? g->mean + g->std * rng_normal(r) : exp(g->log_mean + g->log_std * rng_normal(r));
-        if (x >= g->rmin && x <= g->rmax) return x;
-    }
-    luaL_argerror(L, 2, lua_pushfstring(L, "the %s distribution (mean, std) almost never falls in [rmin, rmax]", dist_names[g->dist]));
-    return 0;
-}
-
-/* Draws the radii: `count` of them, or as many as the porosity takes;
- * scaled to the porosity when both are given. Pushes their storage. */
-static double *draw_radii(lua_State *L, gen *g, rng *r)
-{
-    const double target = g->has_porosity ? (1 - g->porosity) * g->region.volume : 0;
-    if (!g->has_count) {
-        /* count the balls first, with a copy of the generator, so one array suffices */
-        rng probe = *r;
-        double solid = 0;
-        int64_t n = 0;
-        while (solid < target) {
-            if (n >= MAX_GENERATE)
-                luaL_argerror(L, 2, lua_pushfstring(L, "this porosity needs more than %d balls of these radii", MAX_GENERATE));
-            solid += body_volume(g, draw_radius(L, g, &probe));
-            n++;
-        }
-        g->count = n;
-    }
-    double *rad = lua_newuserdatauv(L, (size_t)(g->count > 0 ? g->count : 1) * sizeof *rad, 0);
-    double solid = 0;
-    for (int64_t i = 0; i < g->count; i++) {
-        rad[i] = draw_radius(L, g, r);
-        solid += body_volume(g, rad[i]);
-    }
-    if (g->has_count && g->has_porosity && g->count > 0) {
-        const double k = pow(target / solid, 1.0 / g->dim);
-        if (!(k > 0) || !isfinite(k) || !isfinite(g->rmax * k))
-            luaL_argerror(L, 2, "the radii cannot be scaled to this porosity and count (their volume overflows or "
-                                "vanishes)");
-        for (int64_t i = 0; i < g->count; i++) rad[i] *= k;
-        /* the grain size moved: said, since a user asked for those radii (a
-         * sand user's finding: 0.5 ... 0.8 mm became 1.13 ... 1.80 mm, silently) */
-        if (fabs(k - 1) > 0.01 && sx_lua_parallel_says(sx_lua_tomodel(L, 1))) {
-            luaL_where(L, 1);
-            fprintf(stderr,
-                    "seixo: warning: %sm:generate: the radii were scaled by %.4g to reach porosity %g with %lld balls: "
-                    "%g ... %g m instead of %g ... %g m (give count or porosity alone to keep the radii)\n",
-                    lua_tostring(L, -1), k, g->porosity, (long long)g->count, g->rmin * k, g->rmax * k, g->rmin, g->rmax);
-            fflush(stderr);
-            lua_pop(L, 1);
-        }
-        g->rmin *= k;
-        g->rmax *= k;
-    }
-    return rad;
 }
 
 /* ---------------------------------------------------------------- grid */
@@ -602,7 +317,7 @@ static void unit_ball(rng *r, int dim, double *p)
     for (;;) {
         double s = 0;
         for (int k = 0; k < dim; k++) {
-            p[k] = 2 * rng_uniform(r) - 1;
+            p[k] = 2 * sx_lua_rng_uniform(r) - 1;
             s += p[k] * p[k];
         }
         if (s <= 1) return;
@@ -631,7 +346,7 @@ static void sample(const sx_lua_region *g, rng *r, double rad, const double *e1,
     switch (g->kind) {
     case SX_REGION_BOX:
     case SX_REGION_POLYGON:  // the bounding box; the caller checks containment
-        for (int k = 0; k < g->dim; k++) x[k] = g->lo[k] + rad + (g->hi[k] - g->lo[k] - 2 * rad) * rng_uniform(r);
+        for (int k = 0; k < g->dim; k++) x[k] = g->lo[k] + rad + (g->hi[k] - g->lo[k] - 2 * rad) * sx_lua_rng_uniform(r);
         return;
     case SX_REGION_SPHERE:
     case SX_REGION_DISK:
@@ -639,7 +354,7 @@ static void sample(const sx_lua_region *g, rng *r, double rad, const double *e1,
         for (int k = 0; k < g->dim; k++) x[k] = g->c[k] + (g->r - rad) * p[k];
         return;
     case SX_REGION_CYLINDER: {
-        const double t = rad + (g->len - 2 * rad) * rng_uniform(r);
+        const double t = rad + (g->len - 2 * rad) * sx_lua_rng_uniform(r);
         unit_ball(r, 2, p);
         for (int k = 0; k < 3; k++)
             x[k] = g->c[k] + t * g->axis[k] + (g->r - rad) * (p[0] * e1[k] + p[1] * e2[k]);
@@ -948,11 +663,12 @@ static double *lattice(lua_State *L, const gen *g, int64_t *count)
 static void random_orientation(rng *r, int dim, double *q)
 {
     if (dim == 2) {
-        const double a = 2 * SX_LUA_PI * rng_uniform(r);
+        const double a = 2 * SX_LUA_PI * sx_lua_rng_uniform(r);
         q[0] = cos(0.5 * a), q[1] = q[2] = 0, q[3] = sin(0.5 * a);
         return;
     }
-    const double u1 = rng_uniform(r), u2 = 2 * SX_LUA_PI * rng_uniform(r), u3 = 2 * SX_LUA_PI * rng_uniform(r);
+    const double u1 = sx_lua_rng_uniform(r), u2 = 2 * SX_LUA_PI * sx_lua_rng_uniform(r),
+                 u3 = 2 * SX_LUA_PI * sx_lua_rng_uniform(r);
     const double a = sqrt(1 - u1), b = sqrt(u1);
     q[0] = a * sin(u2), q[1] = a * cos(u2), q[2] = b * sin(u3), q[3] = b * cos(u3);
 }
@@ -1066,7 +782,7 @@ static void add_clumps(lua_State *L, sx_model *m, const gen *g, const double *x,
 static int generate_clumps(lua_State *L, const gen *g, rng *r)
 {
     gen sizes = *g;
-    double *s = draw_radii(L, &sizes, r);
+    double *s = sx_lua_draw_radii(L, &sizes, r);
     const int64_t n = sizes.count;
     sort_radii(L, s, n);
     double *x = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * 3 * sizeof *x, 0);
@@ -1203,7 +919,7 @@ static int model_generate(lua_State *L)
      * anywhere in them, cycling or not, stops them (see run.c) */
     sx_lua_run *run = g.method == M_DISTRIBUTE || g.method == M_EXPAND ? sx_lua_run_open(L, 1, "m:generate") : NULL;
     rng r;
-    rng_seed(&r, g.seed);
+    sx_lua_rng_seed(&r, g.seed);
     int64_t n = 0;
     double *x = NULL, *rad = NULL;
     if (g.tpl >= 0) return generate_clumps(L, &g, &r);
@@ -1212,7 +928,7 @@ static int model_generate(lua_State *L)
         rad = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * sizeof *rad, 0);
         for (int64_t i = 0; i < n; i++) rad[i] = g.rmin;
     } else {
-        rad = draw_radii(L, &g, &r);
+        rad = sx_lua_draw_radii(L, &g, &r);
         n = g.count;
         sort_radii(L, rad, n);
         x = lua_newuserdatauv(L, (size_t)(n > 0 ? n : 1) * 3 * sizeof *x, 0);
