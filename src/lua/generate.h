@@ -1,6 +1,7 @@
 /* Private declarations shared by the files of m:generate: generate.c (the
- * arguments, the bodies added, their relaxation, the binding) and sizes.c
- * (the RNG, the sizes and their distributions).
+ * arguments, the bodies added, their relaxation, the binding), sizes.c
+ * (the RNG, the sizes and their distributions) and placement.c (where the
+ * bodies go).
  *
  * Every working array is a Lua userdata on the stack: an error anywhere
  * frees them. */
@@ -59,3 +60,28 @@ void sx_lua_read_sizes(lua_State *L, gen *g);
 /// (setting g->count); scaled to the porosity when both are given (g->rmin
 /// and g->rmax scaled too). Pushes their storage.
 double *sx_lua_draw_radii(lua_State *L, gen *g, rng *r);
+
+/* ------------------------------------------------------- placement.c */
+
+/// Methods random and expand: places n balls of radii rad (sorted, largest
+/// first) without overlaps among them and with the model's balls; writes
+/// the centres to x (3 per ball). Pushes the grid's storage.
+void sx_lua_place_random(lua_State *L, sx_lua_run *run, const sx_model *m, const gen *g, rng *r, const double *rad,
+                         int64_t n, double *x);
+/// Method distribute: centres at random with overlaps, pushed apart until
+/// none exceeds a hundredth of the smaller radius; an error when they stay
+/// above 0.9 of it, or when a ball lies over one of the model's beyond
+/// `limit` (seixo.model{overlap_limit}). Writes the centres to x.
+void sx_lua_place_distributed(lua_State *L, sx_lua_run *run, const gen *g, rng *r, const double *rad, int64_t n,
+                              double *x, double limit);
+/// Method lattice: the sites of g->packing in the region (the first
+/// g->count, an error if fewer fit) into a pushed array of centres (3 per
+/// site); their number in *count.
+double *sx_lua_lattice_sites(lua_State *L, const gen *g, int64_t *count);
+/// Clumps: places n clumps of template g->tpl at scales s (sorted, largest
+/// first), each at a random centroid and orientation where all its pebbles
+/// lie in the region without overlapping one another's or the model's
+/// balls; writes centroids to x (3 per clump) and orientations to q (4 per
+/// clump). Pushes the grid's storage.
+void sx_lua_place_clumps(lua_State *L, const sx_model *m, const gen *g, rng *r, const double *s, int64_t n, double *x,
+                         double *q);
