@@ -463,6 +463,36 @@ hid_t sx_h5_enum(hid_t base, const char *const names[], const int values[], int 
     return t;
 }
 
+/* seixo's own checksum of a dataset's bytes, kept in its attribute
+ * "checksum": HDF5's Fletcher-32 of a chunk zeroed with its checksum (a
+ * block a crash left unwritten) reads as valid. A word at a time (a
+ * multiply and a shift per 8 bytes: a few GB/s), the length folded in. */
+static uint64_t bytes_checksum(const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    uint64_t h = 0x9e3779b97f4a7c15ULL ^ n;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t w;
+        memcpy(&w, p + i, 8);
+        h = (h ^ w) * 0xff51afd7ed558ccdULL;
+        h ^= h >> 32;
+    }
+    uint64_t tail = 0;
+    memcpy(&tail, p + i, n - i);
+    h = (h ^ tail) * 0xc4ceb9fe1a85ec53ULL;
+    return h ^ (h >> 29);
+}
+
+/* The bytes of n rows of `per` values of `mem` when they are the file's
+ * own (the same type: no conversion, so the writer's and the reader's
+ * buffers hold the same bytes); 0 otherwise (not checksummed). */
+static size_t same_bytes(hid_t mem, hid_t file, int64_t n, int per)
+{
+    if (H5Tequal(mem, file) <= 0) return 0;
+    return (size_t)n * (size_t)per * H5Tget_size(mem);
+}
+
 /* About 512 KiB of doubles per chunk: large enough for fast I/O and good
  * compression, small enough for HDF5's default chunk cache. */
 enum { CHUNK_ELEMS = 65536 };
@@ -490,6 +520,8 @@ bool sx_h5_write(sx_h5 *h, hid_t loc, const char *name, hid_t mem, hid_t file, c
     ok = ok && (n == 0 || H5Dwrite(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
     if (!ok) sx_h5_fail_h5(h, "cannot write the dataset '%s'", name);
     if (ok && units) ok = sx_h5_attr_str(h, d, "units", units);
+    const size_t bytes = ok && filters ? same_bytes(mem, file, n, per) : 0;
+    if (bytes) ok = sx_h5_attr_int(h, d, "checksum", (int64_t)bytes_checksum(data, bytes));
     sx_h5_close(d);
     sx_h5_close(p);
     sx_h5_close(s);
@@ -549,8 +581,20 @@ bool sx_h5_read(sx_h5 *h, hid_t loc, const char *where, const char *name, hid_t 
                           (long long)n);
     if (n == 0) return true;
     hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
-    const bool ok = d >= 0 && H5Dread(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0;
+    bool ok = d >= 0 && H5Dread(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0;
     if (!ok) sx_h5_fail_h5(h, "corrupted: the dataset %s/%s cannot be read", where, name);
+    /* (files before the checksum have none; a converted read is not the writer's bytes) */
+    if (ok && H5Aexists(d, "checksum") > 0) {
+        int64_t want = 0;
+        hid_t t = H5Dget_type(d);
+        const size_t bytes = t >= 0 ? same_bytes(mem, t, n, per) : 0;
+        sx_h5_close(t);
+        ok = sx_h5_get_i64(h, d, where, "checksum", &want, 1, true);
+        if (ok && bytes && (uint64_t)want != bytes_checksum(data, bytes))
+            ok = sx_h5_fail(h, "damaged: the dataset %s/%s does not match its checksum (bytes lost or changed on the "
+                            "disk; a dataset changed on purpose with another tool loads once its attribute "
+                            "'checksum' is deleted)", where, name);
+    }
     sx_h5_close(d);
     return ok;
 }

@@ -286,6 +286,11 @@ void io_rmdir(void)
     tmpdir[0] = 0;
 }
 
+void io_drop_checksum(hid_t d)
+{
+    if (H5Aexists(d, "checksum") > 0) ck_assert(H5Adelete(d, "checksum") >= 0);
+}
+
 void io_assert_no_handles(void)
 {
     const ssize_t n = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL);

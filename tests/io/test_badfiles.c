@@ -267,6 +267,43 @@ START_TEST(corrupted)
 }
 END_TEST
 
+/* Bytes set to zero (a block a crash left unwritten) over a whole chunk,
+ * its Fletcher-32 checksum included: HDF5 then reads the chunk as valid,
+ * so seixo's own checksum of each dataset must catch it. */
+static void zero_chunk(const char *path, const char *dataset)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
+    hid_t s = H5Dget_space(d);
+    haddr_t addr = HADDR_UNDEF;
+    hsize_t size = 0;
+    ck_assert(H5Dget_chunk_info(d, s, 0, NULL, NULL, &addr, &size) >= 0);
+    H5Sclose(s);
+    H5Dclose(d);
+    H5Fclose(f);
+    FILE *o = fopen(path, "r+b");
+    ck_assert_ptr_nonnull(o);
+    ck_assert_int_eq(fseek(o, (long)addr, SEEK_SET), 0);
+    for (hsize_t i = 0; i < size; i++) ck_assert_int_ne(fputc(0, o), EOF);
+    fclose(o);
+}
+
+START_TEST(zeroed_chunks)
+{
+    make_good();
+    char p[512];
+    io_path(p, sizeof p, "bad.h5");
+    const char *sets[] = {"/balls/velocity", "/balls/position", "/contacts/ball_ball/shear_force", "/bonds/kind"};
+    for (size_t k = 0; k < sizeof sets / sizeof *sets; k++) {
+        copy_file(good3, p);
+        zero_chunk(p, sets[k]);
+        char what[128];
+        snprintf(what, sizeof what, "the dataset %s", sets[k]);
+        expect_error(p, 0, what);
+    }
+}
+END_TEST
+
 /* Random single-byte flips all over a file (a 2D snapshot, and the
  * format-2 sample with its histories, cylinder and servos): each load
  * either fails with a proper message or (a byte HDF5 never reads) loads a
@@ -422,7 +459,7 @@ START_TEST(incomplete_and_inconsistent)
     H5Fclose(f);
     expect_error(p, 0, "/balls/radius has 3 rows");
 
-    /* a pair referring to a ball that is not there (the checksum is rewritten: only the check catches it) */
+    /* a pair referring to a ball that is not there (HDF5's checksum rewritten and seixo's dropped: only the check catches it) */
     f = edit(good2, p, sizeof p, "pair.h5");
     d = H5Dopen2(f, "/contacts/ball_ball/b", H5P_DEFAULT);
     const int32_t big = 1000000;
@@ -431,6 +468,7 @@ START_TEST(incomplete_and_inconsistent)
     H5Sselect_hyperslab(s, H5S_SELECT_SET, &at, NULL, &one, NULL);
     hid_t ms = H5Screate_simple(1, &one, NULL);
     ck_assert(H5Dwrite(d, H5T_NATIVE_INT32, ms, s, H5P_DEFAULT, &big) >= 0);
+    io_drop_checksum(d);
     H5Sclose(ms);
     H5Sclose(s);
     H5Dclose(d);
@@ -448,6 +486,7 @@ START_TEST(incomplete_and_inconsistent)
     H5Dread(d, H5T_NATIVE_INT32, ms, s, H5P_DEFAULT, ids);
     ids[1] = ids[0];
     H5Dwrite(d, H5T_NATIVE_INT32, ms, s, H5P_DEFAULT, ids);
+    io_drop_checksum(d);
     H5Sclose(ms);
     H5Sclose(s);
     H5Dclose(d);
@@ -456,8 +495,9 @@ START_TEST(incomplete_and_inconsistent)
 }
 END_TEST
 
-/* Writes value v at row `row` of a 1-D dataset (its checksum rewritten:
- * only seixo's own checks can catch it); mem -1: v in the dataset's own
+/* Writes value v at row `row` of a 1-D dataset (HDF5's checksum
+ * rewritten and seixo's dropped: only the loader's checks of the values can
+ * catch it); mem -1: v in the dataset's own
  * type (an enum's raw value). */
 static void poke(hid_t f, const char *dataset, hsize_t row, hid_t mem, const void *v)
 {
@@ -466,6 +506,7 @@ static void poke(hid_t f, const char *dataset, hsize_t row, hid_t mem, const voi
     H5Sselect_hyperslab(s, H5S_SELECT_SET, &row, NULL, &one, NULL);
     hid_t ms = H5Screate_simple(1, &one, NULL);
     ck_assert(H5Dwrite(d, mem < 0 ? t : mem, ms, s, H5P_DEFAULT, v) >= 0);
+    io_drop_checksum(d);
     if (t >= 0) H5Tclose(t);
     H5Sclose(ms);
     H5Sclose(s);
@@ -561,6 +602,7 @@ static void poke_at(hid_t f, const char *dataset, hsize_t i, double v)
     ck_assert(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0);
     buf[i] = v;
     ck_assert(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0);
+    io_drop_checksum(d);
     free(buf);
     H5Sclose(s);
     H5Dclose(d);
@@ -764,6 +806,7 @@ int main(void)
     tcase_set_tags(damaged, "damaged"); /* CK_EXCLUDE_TAGS=damaged leaves it out (the valgrind setup) */
     tcase_set_timeout(damaged, 600);
     tcase_add_test(damaged, corrupted);
+    tcase_add_test(damaged, zeroed_chunks);
     tcase_add_loop_test(damaged, random_flips, 0, 2);
     suite_add_tcase(s, damaged);
     return io_run_suite(s);
