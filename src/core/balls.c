@@ -41,31 +41,45 @@ sx_status sx_ball_reserve(sx_model *m, int64_t count)
     return SX_OK;
 }
 
+int sx__ball_fields(const sx_model *m, sx_balls *b, sx_ball_field *f)
+{
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = (sx_ball_field){(void **)&b->x, d, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->v, d, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->w, r, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->f, d, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->t, r, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->x_build, d, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->rad, 1, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->inv_mass, 1, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->inv_inertia, 1, SX_FIELD_F64, true};
+    f[n++] = (sx_ball_field){(void **)&b->id, 1, SX_FIELD_I32, true};
+    f[n++] = (sx_ball_field){(void **)&b->mat, 1, SX_FIELD_U16, true};
+    f[n++] = (sx_ball_field){(void **)&b->fix, 1, SX_FIELD_U8, true};
+    if (b->alpha) f[n++] = (sx_ball_field){(void **)&b->alpha, 1, SX_FIELD_F64, true};
+    if (b->group) f[n++] = (sx_ball_field){(void **)&b->group, 1, SX_FIELD_I32, true};
+    if (b->clump) f[n++] = (sx_ball_field){(void **)&b->clump, 1, SX_FIELD_I32, true};
+    if (b->fapp) {
+        f[n++] = (sx_ball_field){(void **)&b->fapp, d, SX_FIELD_F64, false};
+        f[n++] = (sx_ball_field){(void **)&b->tapp, r, SX_FIELD_F64, false};
+    }
+    return n;
+}
+
 /* Resizes every per-ball array to exactly cap balls. */
 static sx_status balls_resize(sx_model *m, int64_t cap)
 {
     sx_balls *b = &m->balls;
     if (cap > INT32_MAX / 4) return SX_ENOMEM;
-    const int d = m->dim, r = m->rdim;
-    RESIZE(b, x, d);
-    RESIZE(b, v, d);
-    RESIZE(b, w, r);
-    RESIZE(b, f, d);
-    RESIZE(b, t, r);
-    RESIZE(b, x_build, d);
-    RESIZE(b, rad, 1);
-    RESIZE(b, inv_mass, 1);
-    RESIZE(b, inv_inertia, 1);
-    if (b->alpha) RESIZE(b, alpha, 1);
-    RESIZE(b, id, 1);
-    RESIZE(b, mat, 1);
-    RESIZE(b, fix, 1);
-    if (b->group) RESIZE(b, group, 1);
-    if (b->fapp) {
-        RESIZE(b, fapp, d);
-        RESIZE(b, tapp, r);
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, b, f);
+    for (int k = 0; k < nf; k++) {
+        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(b->cap * f[k].per), (size_t)(cap * f[k].per),
+                                  sx__field_size(f[k].type));
+        if (!q) return SX_ENOMEM;
+        *f[k].data = q;
     }
-    if (b->clump) RESIZE(b, clump, 1);
     b->cap = cap;
     return SX_OK;
 }
@@ -78,24 +92,9 @@ static void free_field(sx_model *m, void *p, int64_t n, size_t size)
 void sx__balls_free(sx_model *m)
 {
     sx_balls *b = &m->balls;
-    const int64_t c = b->cap, d = m->dim, r = m->rdim;
-    free_field(m, b->x, c * d, sizeof(double));
-    free_field(m, b->v, c * d, sizeof(double));
-    free_field(m, b->w, c * r, sizeof(double));
-    free_field(m, b->f, c * d, sizeof(double));
-    free_field(m, b->t, c * r, sizeof(double));
-    free_field(m, b->x_build, c * d, sizeof(double));
-    free_field(m, b->rad, c, sizeof(double));
-    free_field(m, b->inv_mass, c, sizeof(double));
-    free_field(m, b->inv_inertia, c, sizeof(double));
-    free_field(m, b->alpha, b->alpha ? c : 0, sizeof(double));
-    free_field(m, b->id, c, sizeof(int32_t));
-    free_field(m, b->mat, c, sizeof(uint16_t));
-    free_field(m, b->fix, c, sizeof(uint8_t));
-    free_field(m, b->group, b->group ? c : 0, sizeof(int32_t));
-    free_field(m, b->fapp, b->fapp ? c * d : 0, sizeof(double));
-    free_field(m, b->tapp, b->tapp ? c * r : 0, sizeof(double));
-    free_field(m, b->clump, b->clump ? c : 0, sizeof(int32_t));
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, b, f);
+    for (int k = 0; k < nf; k++) free_field(m, *f[k].data, b->cap * f[k].per, sx__field_size(f[k].type));
     free_field(m, b->index_of, b->index_cap, sizeof(int32_t));
     memset(b, 0, sizeof *b);
 }
@@ -212,26 +211,12 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
 static void move_ball(sx_model *m, int64_t to, int64_t from)
 {
     sx_balls *b = &m->balls;
-    const int d = m->dim, r = m->rdim;
-    memcpy(b->x + to * d, b->x + from * d, d * sizeof(double));
-    memcpy(b->v + to * d, b->v + from * d, d * sizeof(double));
-    memcpy(b->f + to * d, b->f + from * d, d * sizeof(double));
-    memcpy(b->x_build + to * d, b->x_build + from * d, d * sizeof(double));
-    memcpy(b->w + to * r, b->w + from * r, r * sizeof(double));
-    memcpy(b->t + to * r, b->t + from * r, r * sizeof(double));
-    if (b->fapp) {
-        memcpy(b->fapp + to * d, b->fapp + from * d, d * sizeof(double));
-        memcpy(b->tapp + to * r, b->tapp + from * r, r * sizeof(double));
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, b, f);
+    for (int k = 0; k < nf; k++) {
+        const size_t row = sx__ball_row(&f[k]);
+        memcpy((char *)*f[k].data + (size_t)to * row, (char *)*f[k].data + (size_t)from * row, row);
     }
-    b->rad[to] = b->rad[from];
-    b->inv_mass[to] = b->inv_mass[from];
-    b->inv_inertia[to] = b->inv_inertia[from];
-    if (b->alpha) b->alpha[to] = b->alpha[from];
-    b->id[to] = b->id[from];
-    b->mat[to] = b->mat[from];
-    b->fix[to] = b->fix[from];
-    if (b->group) b->group[to] = b->group[from];
-    if (b->clump) b->clump[to] = b->clump[from];
     b->index_of[b->id[to]] = (int32_t)to;
 }
 
@@ -320,38 +305,40 @@ sx_status sx_ball_remove_many(sx_model *m, const int64_t *ids, int64_t n)
 
 sx_status sx_ball_remove(sx_model *m, int64_t id) { return sx_ball_remove_many(m, &id, 1); }
 
+/* to[i] = from[order[i]], rows of `row` bytes: a build permutes every
+ * field, so the usual sizes get a copy of constant size (one move; a
+ * memcpy call per element would cost more than the copy). */
+static void gather_rows(void *to, const void *from, const int32_t *order, int64_t n, size_t row)
+{
+    char *t = to;
+    const char *s = from;
+#define ROWS(size)                                                                                         \
+    for (int64_t i = 0; i < n; i++) memcpy(t + (size_t)i * (size), s + (size_t)order[i] * (size), (size)); \
+    break;
+    switch (row) {
+    case 1: ROWS(1)
+    case 2: ROWS(2)
+    case 4: ROWS(4)
+    case 8: ROWS(8)
+    case 16: ROWS(16)
+    case 24: ROWS(24)
+    default: ROWS(row)
+    }
+#undef ROWS
+}
+
 void sx__balls_permute(sx_model *m, const int32_t *order, double *scratch)
 {
     sx_balls *b = &m->balls;
     const int64_t n = b->n;
-    const int d = m->dim, r = m->rdim;
-#define GATHER(field, per, type)                                                   \
-    do {                                                                           \
-        type *tmp = (type *)scratch;                                               \
-        for (int64_t i = 0; i < n; i++)                                            \
-            for (int k = 0; k < (per); k++) tmp[i * (per) + k] = b->field[(int64_t)order[i] * (per) + k]; \
-        memcpy(b->field, tmp, (size_t)(n * (per)) * sizeof(type));                 \
-    } while (0)
-    GATHER(x, d, double);
-    GATHER(v, d, double);
-    GATHER(f, d, double);
-    GATHER(x_build, d, double);
-    GATHER(w, r, double);
-    GATHER(t, r, double);
-    if (b->fapp) {
-        GATHER(fapp, d, double);
-        GATHER(tapp, r, double);
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, b, f);
+    /* scratch holds n rows of the widest field (dim doubles) */
+    for (int k = 0; k < nf; k++) {
+        const size_t row = sx__ball_row(&f[k]);
+        gather_rows(scratch, *f[k].data, order, n, row);
+        memcpy(*f[k].data, scratch, (size_t)n * row);
     }
-    GATHER(rad, 1, double);
-    GATHER(inv_mass, 1, double);
-    GATHER(inv_inertia, 1, double);
-    if (b->alpha) GATHER(alpha, 1, double);
-    GATHER(id, 1, int32_t);
-    GATHER(mat, 1, uint16_t);
-    GATHER(fix, 1, uint8_t);
-    if (b->group) GATHER(group, 1, int32_t);
-    if (b->clump) GATHER(clump, 1, int32_t);
-#undef GATHER
     for (int64_t i = 0; i < n; i++) b->index_of[b->id[i]] = (int32_t)i;
 }
 
@@ -360,27 +347,27 @@ int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f)
     const int d = m->dim;
     const bool walls = p == &m->bw;
     int n = 0;
-    f[n++] = (sx_pair_field){(void **)&p->a, 1, SX_PAIR_I32, false, true, "a", NULL};
-    f[n++] = (sx_pair_field){(void **)&p->b, 1, SX_PAIR_I32, false, true, "b", NULL};
-    f[n++] = (sx_pair_field){(void **)&p->fs, d, SX_PAIR_F64, true, false, "shear_force", "N"};
+    f[n++] = (sx_pair_field){(void **)&p->a, 1, SX_FIELD_I32, false, true, "a", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->b, 1, SX_FIELD_I32, false, true, "b", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->fs, d, SX_FIELD_F64, true, false, "shear_force", "N"};
     /* the last evaluation's geometry: a ball-wall pair's normal, a ball-ball pair's relative position */
-    f[n++] = walls ? (sx_pair_field){(void **)&p->geo, d, SX_PAIR_F64, true, false, "normal", "1"}
-                   : (sx_pair_field){(void **)&p->geo, d, SX_PAIR_F64, true, false, "relative_position", "m"};
-    if (walls) f[n++] = (sx_pair_field){(void **)&p->un, 1, SX_PAIR_F64, false, false, "overlap", "m"};
-    f[n++] = (sx_pair_field){(void **)&p->touching, 1, SX_PAIR_U8, false, false, "touching", NULL};
-    f[n++] = (sx_pair_field){(void **)&p->fn, 1, SX_PAIR_F64, false, false, "normal_force", "N"};
-    if (p->bond) f[n++] = (sx_pair_field){(void **)&p->bond, 1, SX_PAIR_I32, false, false, "bond", NULL};
-    if (p->mr) f[n++] = (sx_pair_field){(void **)&p->mr, m->rdim, SX_PAIR_F64, true, false, "rolling_moment", "N m"};
+    f[n++] = walls ? (sx_pair_field){(void **)&p->geo, d, SX_FIELD_F64, true, false, "normal", "1"}
+                   : (sx_pair_field){(void **)&p->geo, d, SX_FIELD_F64, true, false, "relative_position", "m"};
+    if (walls) f[n++] = (sx_pair_field){(void **)&p->un, 1, SX_FIELD_F64, false, false, "overlap", "m"};
+    f[n++] = (sx_pair_field){(void **)&p->touching, 1, SX_FIELD_U8, false, false, "touching", NULL};
+    f[n++] = (sx_pair_field){(void **)&p->fn, 1, SX_FIELD_F64, false, false, "normal_force", "N"};
+    if (p->bond) f[n++] = (sx_pair_field){(void **)&p->bond, 1, SX_FIELD_I32, false, false, "bond", NULL};
+    if (p->mr) f[n++] = (sx_pair_field){(void **)&p->mr, m->rdim, SX_FIELD_F64, true, false, "rolling_moment", "N m"};
     if (p->us)
-        f[n++] = (sx_pair_field){(void **)&p->us, d, SX_PAIR_F64, true, false, "shear_displacement", "m"};
-    if (p->cmodel) f[n++] = (sx_pair_field){(void **)&p->cmodel, 1, SX_PAIR_I32, false, false, "contact_model", NULL};
+        f[n++] = (sx_pair_field){(void **)&p->us, d, SX_FIELD_F64, true, false, "shear_displacement", "m"};
+    if (p->cmodel) f[n++] = (sx_pair_field){(void **)&p->cmodel, 1, SX_FIELD_I32, false, false, "contact_model", NULL};
     if (!walls && p->joint) { /* smooth joints (laws/smoothjoint.h) */
-        f[n++] = (sx_pair_field){(void **)&p->joint, 1, SX_PAIR_I32, false, false, "joint", NULL};
-        f[n++] = (sx_pair_field){(void **)&p->jnormal, d, SX_PAIR_F64, true, false, "joint_normal", "1"};
-        f[n++] = (sx_pair_field){(void **)&p->jun, 1, SX_PAIR_F64, false, false, "joint_overlap", "m"};
+        f[n++] = (sx_pair_field){(void **)&p->joint, 1, SX_FIELD_I32, false, false, "joint", NULL};
+        f[n++] = (sx_pair_field){(void **)&p->jnormal, d, SX_FIELD_F64, true, false, "joint_normal", "1"};
+        f[n++] = (sx_pair_field){(void **)&p->jun, 1, SX_FIELD_F64, false, false, "joint_overlap", "m"};
     }
     /* a mesh's facet is a third end of a ball-wall pair: listed by the broad phase */
-    if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_PAIR_I32, false, true, "facet", NULL};
+    if (walls && m->mesh_pairs) f[n++] = (sx_pair_field){(void **)&p->facet, 1, SX_FIELD_I32, false, true, "facet", NULL};
     return n;
 }
 
@@ -489,13 +476,11 @@ void sx__pairs_free(sx_model *m, sx_pairs *p)
 size_t sx__balls_bytes(const sx_model *m)
 {
     const sx_balls *b = &m->balls;
-    const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
-    size_t per = (4 * d + 2 * r + 3) * sizeof(double) + sizeof(int32_t) + sizeof(uint16_t) + sizeof(uint8_t);
-    if (b->alpha) per += sizeof(double);
-    if (b->group) per += sizeof(int32_t);
-    if (b->clump) per += sizeof(int32_t);
-    if (b->fapp) per += (d + r) * sizeof(double);
-    return c * per + (size_t)b->index_cap * sizeof(int32_t);
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, (sx_balls *)b, f);
+    size_t per = 0;
+    for (int k = 0; k < nf; k++) per += sx__ball_row(&f[k]);
+    return (size_t)b->cap * per + (size_t)b->index_cap * sizeof(int32_t);
 }
 
 size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p)

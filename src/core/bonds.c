@@ -21,13 +21,38 @@ sx_bond_def sx_bond_default_def(void)
 
 /* ------------------------------------------------------------- storage */
 
-#define GROW(field, per)                                                                     \
-    do {                                                                                     \
-        void *q = sx_alloc_resize(&m->alloc, b->field, (size_t)(b->cap * (per)),             \
-                                  (size_t)(cap * (per)), sizeof *b->field);                  \
-        if (!q) return SX_ENOMEM;                                                            \
-        b->field = q;                                                                        \
-    } while (0)
+int sx__bond_fields(const sx_model *m, sx_bonds *b, sx_bond_field *f)
+{
+    const int d = m->dim, r = m->rdim;
+    int n = 0;
+    f[n++] = (sx_bond_field){(void **)&b->kind, 1, SX_FIELD_U8, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->ida, 1, SX_FIELD_I32, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->idb, 1, SX_FIELD_I32, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->cb_n, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->cb_s, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->rbar, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->kn, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->ks, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->sigma_c, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->tau_c, 1, SX_FIELD_F64, false, false};
+    /* the twist (a scalar about n) and the normal force keep their sign
+     * when a and b swap; the shear force and bending moment on b become
+     * those on a */
+    f[n++] = (sx_bond_field){(void **)&b->fn, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->fs, d, SX_FIELD_F64, true, false};
+    f[n++] = (sx_bond_field){(void **)&b->mn, 1, SX_FIELD_F64, false, false};
+    f[n++] = (sx_bond_field){(void **)&b->ms, r, SX_FIELD_F64, true, false};
+    /* a flat joint keeps the orientation it was installed in */
+    f[n++] = (sx_bond_field){(void **)&b->fj_first, 1, SX_FIELD_I32, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_nr, 1, SX_FIELD_U8, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_na, 1, SX_FIELD_U8, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_mu, 1, SX_FIELD_F64, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_tanphi, 1, SX_FIELD_F64, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_d0, 1, SX_FIELD_F64, false, true};
+    f[n++] = (sx_bond_field){(void **)&b->fj_rot, d - 1, SX_FIELD_F64, false, true};
+    if (d == 3) f[n++] = (sx_bond_field){(void **)&b->fj_axis, 3, SX_FIELD_F64, false, true};
+    return n;
+}
 
 static sx_status bonds_reserve(sx_model *m, int64_t cap)
 {
@@ -36,32 +61,25 @@ static sx_status bonds_reserve(sx_model *m, int64_t cap)
     if (cap < 2 * b->cap) cap = 2 * b->cap;
     if (cap < 256) cap = 256;
     if (cap > INT32_MAX - 1) return SX_ENOMEM;
-    const int d = m->dim, r = m->rdim;
-    GROW(kind, 1);
-    GROW(ida, 1);
-    GROW(idb, 1);
-    GROW(cb_n, 1);
-    GROW(cb_s, 1);
-    GROW(rbar, 1);
-    GROW(kn, 1);
-    GROW(ks, 1);
-    GROW(sigma_c, 1);
-    GROW(tau_c, 1);
-    GROW(fn, 1);
-    GROW(fs, d);
-    GROW(mn, 1);
-    GROW(ms, r);
-    GROW(fj_first, 1);
-    GROW(fj_nr, 1);
-    GROW(fj_na, 1);
-    GROW(fj_mu, 1);
-    GROW(fj_tanphi, 1);
-    GROW(fj_d0, 1);
-    GROW(fj_rot, d - 1);
-    if (d == 3) GROW(fj_axis, 3);
+    sx_bond_field f[SX_BOND_FIELDS_MAX];
+    const int nf = sx__bond_fields(m, b, f);
+    for (int k = 0; k < nf; k++) {
+        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(b->cap * f[k].per), (size_t)(cap * f[k].per),
+                                  sx__field_size(f[k].type));
+        if (!q) return SX_ENOMEM;
+        *f[k].data = q;
+    }
     b->cap = cap;
     return SX_OK;
 }
+
+#define GROW(field, per)                                                                     \
+    do {                                                                                     \
+        void *q = sx_alloc_resize(&m->alloc, b->field, (size_t)(b->cap * (per)),             \
+                                  (size_t)(cap * (per)), sizeof *b->field);                  \
+        if (!q) return SX_ENOMEM;                                                            \
+        b->field = q;                                                                        \
+    } while (0)
 
 /* Room for cap flat-joint elements. */
 static sx_status fjels_reserve(sx_model *m, int64_t cap)
@@ -97,22 +115,10 @@ static void fjels_free(sx_model *m)
 void sx__bonds_free(sx_model *m)
 {
     sx_bonds *b = &m->bonds;
-    const size_t c = (size_t)b->cap, d = (size_t)m->dim, r = (size_t)m->rdim;
     sx_alloc *a = &m->alloc;
-    sx_alloc_free(a, b->kind, c, 1);
-    sx_alloc_free(a, b->ida, c, sizeof(int32_t));
-    sx_alloc_free(a, b->idb, c, sizeof(int32_t));
-    double *scalars[] = {b->cb_n, b->cb_s, b->rbar, b->kn, b->ks, b->sigma_c, b->tau_c, b->fn, b->mn};
-    for (size_t k = 0; k < sizeof scalars / sizeof *scalars; k++) sx_alloc_free(a, scalars[k], c, sizeof(double));
-    sx_alloc_free(a, b->fs, c * d, sizeof(double));
-    sx_alloc_free(a, b->ms, c * r, sizeof(double));
-    sx_alloc_free(a, b->fj_first, c, sizeof(int32_t));
-    sx_alloc_free(a, b->fj_nr, c, 1);
-    sx_alloc_free(a, b->fj_na, c, 1);
-    double *fj[] = {b->fj_mu, b->fj_tanphi, b->fj_d0};
-    for (size_t k = 0; k < sizeof fj / sizeof *fj; k++) sx_alloc_free(a, fj[k], c, sizeof(double));
-    sx_alloc_free(a, b->fj_rot, c * (d - 1), sizeof(double));
-    if (d == 3) sx_alloc_free(a, b->fj_axis, c * 3, sizeof(double));
+    sx_bond_field f[SX_BOND_FIELDS_MAX];
+    const int nf = sx__bond_fields(m, b, f);
+    for (int k = 0; k < nf; k++) sx_alloc_free(a, *f[k].data, (size_t)(b->cap * f[k].per), sx__field_size(f[k].type));
     memset(b, 0, sizeof *b);
     fjels_free(m);
     sx_alloc_free(a, m->cracks.ev, (size_t)m->cracks.cap, sizeof *m->cracks.ev);
@@ -136,13 +142,14 @@ void sx__bond_break(sx_model *m, int32_t slot, unsigned kind)
     if (before && !b->kind[slot]) b->intact--;
 }
 
-/* The twist (a scalar about n) and the normal force keep their sign when
- * a and b swap; the shear force and bending moment on b become those on a. */
+/* A bond's vectors on the pair's b become those on a (sx__bond_fields' sign). */
 void sx__bond_flip(sx_model *m, int32_t slot)
 {
-    sx_bonds *b = &m->bonds;
-    for (int k = 0; k < m->dim; k++) b->fs[slot * m->dim + k] = -b->fs[slot * m->dim + k];
-    for (int k = 0; k < m->rdim; k++) b->ms[slot * m->rdim + k] = -b->ms[slot * m->rdim + k];
+    sx_bond_field f[SX_BOND_FIELDS_MAX];
+    const int nf = sx__bond_fields(m, &m->bonds, f);
+    for (int k = 0; k < nf; k++)
+        if (f[k].sign)
+            for (int e = 0; e < f[k].per; e++) ((double *)*f[k].data)[slot * f[k].per + e] *= -1;
 }
 
 bool sx__crack_log(sx_model *m, const sx_crack *c)

@@ -30,6 +30,15 @@ typedef struct sx_material {
     double derived[SX_LAW_MAX]; /* the registry units' constants of the material (sx__material_derive) */
 } sx_material;
 
+/* The element types of the stores' fields (sx_bond_field, sx_ball_field,
+ * sx_pair_field). */
+typedef enum sx_field_type { SX_FIELD_I32, SX_FIELD_F64, SX_FIELD_U8, SX_FIELD_U16 } sx_field_type;
+/* Bytes of one element of a field. */
+static inline size_t sx__field_size(sx_field_type t)
+{
+    return t == SX_FIELD_F64 ? sizeof(double) : t == SX_FIELD_I32 ? sizeof(int32_t) : t == SX_FIELD_U16 ? 2 : 1;
+}
+
 /* Bonds live apart from pairs, so an unbonded scene stores none. A pair
  * refers to its bond by slot (pairs.bond, allocated with the first bond);
  * slots are never reused. Vectors are expressed for the pair's a -> b
@@ -56,6 +65,21 @@ typedef struct sx_bonds {
     double *fj_rot;         /* relative bend rotation in the face's axes (3D: 2; 2D: 1) */
     double *fj_axis;        /* 3D: the face's first in-plane axis t1 (3), carried with the contact */
 } sx_bonds;
+
+/* The bond store's per-bond arrays, described once (sx__bond_fields):
+ * resizing, freeing, a restart's allocation, turning a bond round, the
+ * bytes and the ranks' digest iterate this table. (The files, the state
+ * hash and the checks of a loaded state list theirs, as formats.) */
+typedef struct sx_bond_field {
+    void **data;           /* the array's address in the store */
+    int per;               /* elements per bond */
+    sx_field_type type;
+    bool sign;             /* a vector on the pair's b: negated when the pair turns round */
+    bool joint;            /* a flat joint's (laws/flatjoint.h) */
+} sx_bond_field;
+#define SX_BOND_FIELDS_MAX 24
+/* The arrays of bond store b, into f; returns their count. */
+int sx__bond_fields(const sx_model *m, sx_bonds *b, sx_bond_field *f);
 
 /* Flat-joint elements: each joint owns fj_nr x fj_na consecutive ones. */
 typedef struct sx_fjels {
@@ -94,6 +118,19 @@ typedef struct sx_balls {
     int32_t *index_of;
     int64_t index_cap, next_id;
 } sx_balls;
+
+/* The ball store's per-ball arrays, described once: resizing, freeing,
+ * moving, permuting, a periodic cell's ghost slots, the store's bytes and
+ * the ranks' digest iterate this table (sx__ball_fields); an optional array
+ * joins it once allocated. (The files and the state hash list theirs: a
+ * file's columns and the hash's canonical order are a format.) */
+typedef struct sx_ball_field {
+    void **data;           /* the array's address in the store */
+    int per;               /* elements per ball */
+    sx_field_type type;
+    bool ghost;            /* a periodic ghost slot carries it (applied loads: only real balls) */
+} sx_ball_field;
+#define SX_BALL_FIELDS_MAX 18
 
 /* A triangle mesh (mesh.c): its shape in its own frame, fixed at creation,
  * and its pose (the wall's point and an orientation); the world vertices
@@ -169,11 +206,10 @@ typedef struct sx_pairs {
  * sorting and freeing a store, its bytes, a build's history transfer and
  * the files (src/io/snapshot.c) iterate this table (sx__pair_fields); a
  * law's history fields join it there. */
-typedef enum sx_pair_type { SX_PAIR_I32, SX_PAIR_F64, SX_PAIR_U8 } sx_pair_type;
 typedef struct sx_pair_field {
     void **data;           /* the array's address in the store */
     int per;               /* elements per pair */
-    sx_pair_type type;
+    sx_field_type type;
     bool sign;             /* a vector of the pair's a -> b orientation: negated when it turns round */
     bool end;              /* a or b: listed by the broad phase, not carried as history */
     const char *name;      /* the files' dataset */
@@ -184,11 +220,12 @@ typedef struct sx_pair_field {
  * moments once a material rolls, the overlap only in the ball-wall store),
  * into f; returns their count. */
 int sx__pair_fields(const sx_model *m, sx_pairs *p, sx_pair_field *f);
-/* Bytes of one element of a field. */
-static inline size_t sx__pair_size(const sx_pair_field *f)
-{
-    return f->type == SX_PAIR_F64 ? sizeof(double) : f->type == SX_PAIR_I32 ? sizeof(int32_t) : 1;
-}
+/* The arrays ball store b has, into f; returns their count. */
+int sx__ball_fields(const sx_model *m, sx_balls *b, sx_ball_field *f);
+/* Bytes of one ball's elements of a field. */
+static inline size_t sx__ball_row(const sx_ball_field *f) { return (size_t)f->per * sx__field_size(f->type); }
+/* Bytes of one element of a pair field. */
+static inline size_t sx__pair_size(const sx_pair_field *f) { return sx__field_size(f->type); }
 
 typedef struct sx_grid {
     /* lo, nc and a cell's coordinates are along the grid's axes: grid axis

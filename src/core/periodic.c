@@ -364,22 +364,19 @@ int64_t sx__cell_owner(const sx_model *m, int64_t j, double *shift)
     return c->owner[j - c->base];
 }
 
-/* The ball arrays' fields a ghost carries, with their elements per ball. */
-#define GHOST_FIELDS(X)                                                                                     \
-    X(x, d) X(v, d) X(w, r) X(f, d) X(t, r) X(x_build, d) X(rad, 1) X(inv_mass, 1) X(inv_inertia, 1)      \
-    X(alpha, 1) X(id, 1) X(mat, 1) X(fix, 1) X(group, 1) X(clump, 1)
-
 void sx__cell_ghosts_move(sx_model *m, int64_t to, bool rename)
 {
     sx_cell *c = m->cell;
-    sx_balls *b = &m->balls;
-    const int64_t from = c->base, n = c->n, d = m->dim, r = m->rdim;
+    const int64_t from = c->base, n = c->n;
     if (to == from) return;
     if (n > 0) {
-#define MOVE(field, per)                                                                                   \
-    if (b->field) memmove(b->field + to * (per), b->field + from * (per), (size_t)(n * (per)) * sizeof *b->field);
-        GHOST_FIELDS(MOVE)
-#undef MOVE
+        sx_ball_field f[SX_BALL_FIELDS_MAX];
+        const int nf = sx__ball_fields(m, &m->balls, f);
+        for (int k = 0; k < nf; k++) {
+            if (!f[k].ghost) continue;
+            const size_t row = sx__ball_row(&f[k]);
+            memmove((char *)*f[k].data + (size_t)to * row, (char *)*f[k].data + (size_t)from * row, (size_t)n * row);
+        }
         for (int64_t q = 0; q < m->bb.n && rename; q++)
             if (m->bb.b[q] >= from) m->bb.b[q] += (int32_t)(to - from);
     }

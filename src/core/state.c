@@ -71,21 +71,10 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
     /* bonds and cracks at exactly their sizes; the stores grow from there */
     sx_bonds *k = &m->bonds;
     const int64_t nb = s->bonds;
-    if (!alloc_array(m, (void **)&k->kind, nb, 1) || !alloc_array(m, (void **)&k->ida, nb, sizeof(int32_t)) ||
-        !alloc_array(m, (void **)&k->idb, nb, sizeof(int32_t)) || !alloc_array(m, (void **)&k->cb_n, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->cb_s, nb, sizeof(double)) || !alloc_array(m, (void **)&k->rbar, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->kn, nb, sizeof(double)) || !alloc_array(m, (void **)&k->ks, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->sigma_c, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->tau_c, nb, sizeof(double)) || !alloc_array(m, (void **)&k->fn, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->fs, nb * d, sizeof(double)) || !alloc_array(m, (void **)&k->mn, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->ms, nb * r, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->fj_first, nb, sizeof(int32_t)) || !alloc_array(m, (void **)&k->fj_nr, nb, 1) ||
-        !alloc_array(m, (void **)&k->fj_na, nb, 1) || !alloc_array(m, (void **)&k->fj_mu, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->fj_tanphi, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->fj_d0, nb, sizeof(double)) ||
-        !alloc_array(m, (void **)&k->fj_rot, nb * (d - 1), sizeof(double)) ||
-        (d == 3 && !alloc_array(m, (void **)&k->fj_axis, nb * 3, sizeof(double))))
-        goto nomem;
+    sx_bond_field bf[SX_BOND_FIELDS_MAX];
+    const int nbf = sx__bond_fields(m, k, bf);
+    for (int j = 0; j < nbf; j++)
+        if (!alloc_array(m, bf[j].data, nb * bf[j].per, sx__field_size(bf[j].type))) goto nomem;
     k->n = k->cap = nb;
     sx_fjels *e = &m->fjel;
     const int64_t ne = s->fj_elements;
@@ -656,11 +645,11 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
             /* the ends are the ids above (a mesh's facet is hashed here); the bond slot below, present or not */
             if (f[j].data == (void **)&p->a || f[j].data == (void **)&p->b || f[j].data == (void **)&p->bond) continue;
             const int64_t at = c * f[j].per;
-            if (f[j].type == SX_PAIR_F64)
+            if (f[j].type == SX_FIELD_F64)
                 put_doubles(&one, (const double *)*f[j].data + at, f[j].per, f[j].sign ? sign : 1);
             else
                 for (int e = 0; e < f[j].per; e++)
-                    put_int(&one, f[j].type == SX_PAIR_I32 ? ((const int32_t *)*f[j].data)[at + e]
+                    put_int(&one, f[j].type == SX_FIELD_I32 ? ((const int32_t *)*f[j].data)[at + e]
                                                            : ((const uint8_t *)*f[j].data)[at + e]);
         }
         const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
@@ -822,26 +811,11 @@ static void digest_array(digest *g, const void *data, int64_t n, size_t size)
 static void digest_balls(digest *g, const sx_model *m)
 {
     const sx_balls *b = &m->balls;
-    const int64_t n = b->n, nd = n * m->dim, nr = n * m->rdim;
-    const uint64_t counts[] = {(uint64_t)n, (uint64_t)b->next_id};
+    const uint64_t counts[] = {(uint64_t)b->n, (uint64_t)b->next_id};
     digest_array(g, counts, 2, sizeof *counts);
-    digest_array(g, b->x, nd, sizeof *b->x);
-    digest_array(g, b->v, nd, sizeof *b->v);
-    digest_array(g, b->w, nr, sizeof *b->w);
-    digest_array(g, b->f, nd, sizeof *b->f);
-    digest_array(g, b->t, nr, sizeof *b->t);
-    digest_array(g, b->x_build, nd, sizeof *b->x_build);
-    digest_array(g, b->rad, n, sizeof *b->rad);
-    digest_array(g, b->inv_mass, n, sizeof *b->inv_mass);
-    digest_array(g, b->inv_inertia, n, sizeof *b->inv_inertia);
-    digest_array(g, b->id, n, sizeof *b->id);
-    digest_array(g, b->mat, n, sizeof *b->mat);
-    digest_array(g, b->fix, n, sizeof *b->fix);
-    digest_array(g, b->alpha, n, sizeof *b->alpha);
-    digest_array(g, b->group, n, sizeof *b->group);
-    digest_array(g, b->clump, n, sizeof *b->clump);
-    digest_array(g, b->fapp, nd, sizeof *b->fapp);
-    digest_array(g, b->tapp, nr, sizeof *b->tapp);
+    sx_ball_field f[SX_BALL_FIELDS_MAX];
+    const int nf = sx__ball_fields(m, (sx_balls *)b, f);
+    for (int k = 0; k < nf; k++) digest_array(g, *f[k].data, b->n * f[k].per, sx__field_size(f[k].type));
 }
 
 /* Every field of the store's schema (the ends too: the build's lists). */
@@ -859,22 +833,10 @@ static void digest_bonds(digest *g, const sx_model *m)
     const sx_fjels *e = &m->fjel;
     const int64_t n = k->n, t = m->dim - 1;
     digest_array(g, &k->n, 1, sizeof k->n);
-    digest_array(g, k->kind, n, sizeof *k->kind);
-    digest_array(g, k->ida, n, sizeof *k->ida);
-    digest_array(g, k->idb, n, sizeof *k->idb);
-    const double *const scalars[] = {k->cb_n, k->cb_s, k->rbar, k->kn, k->ks, k->sigma_c, k->tau_c, k->fn, k->mn};
-    for (size_t j = 0; j < sizeof scalars / sizeof *scalars; j++) digest_array(g, scalars[j], n, sizeof(double));
-    digest_array(g, k->fs, n * m->dim, sizeof *k->fs);
-    digest_array(g, k->ms, n * m->rdim, sizeof *k->ms);
-    if (!e->n) return; /* flat joints (laws/flatjoint.h): each joint's face, its elements */
-    digest_array(g, k->fj_first, n, sizeof *k->fj_first);
-    digest_array(g, k->fj_nr, n, sizeof *k->fj_nr);
-    digest_array(g, k->fj_na, n, sizeof *k->fj_na);
-    digest_array(g, k->fj_mu, n, sizeof *k->fj_mu);
-    digest_array(g, k->fj_tanphi, n, sizeof *k->fj_tanphi);
-    digest_array(g, k->fj_d0, n, sizeof *k->fj_d0);
-    digest_array(g, k->fj_rot, n * t, sizeof *k->fj_rot);
-    digest_array(g, k->fj_axis, m->dim == 3 ? n * 3 : 0, sizeof *k->fj_axis);
+    sx_bond_field f[SX_BOND_FIELDS_MAX];
+    const int nf = sx__bond_fields(m, (sx_bonds *)k, f);
+    for (int j = 0; j < nf; j++) /* a flat joint's only once the model has elements */
+        if (!f[j].joint || e->n) digest_array(g, *f[j].data, n * f[j].per, sx__field_size(f[j].type));
     digest_array(g, &e->n, 1, sizeof e->n);
     digest_array(g, e->state, e->n, sizeof *e->state);
     digest_array(g, e->sigma_c, e->n, sizeof *e->sigma_c);

@@ -105,7 +105,7 @@ static int ball_fields(const sx_model *m, const ball_cols *c, field *f)
  * `overlap`, see relative_from_normal). */
 static int pair_fields(const sx_model *m, const sx_pairs *p, field *f, double *overlap)
 {
-    static const int types[] = {[SX_PAIR_I32] = T_I32, [SX_PAIR_F64] = T_F64, [SX_PAIR_U8] = T_U8};
+    static const int types[] = {[SX_FIELD_I32] = T_I32, [SX_FIELD_F64] = T_F64, [SX_FIELD_U8] = T_U8};
     sx_pair_field s[SX_PAIR_FIELDS_MAX];
     const int ns = sx__pair_fields(m, (sx_pairs *)p, s);
     int n = 0;
