@@ -113,12 +113,39 @@ function pool.writable(path)
   return true
 end
 
+-- The process id of a job's command, from its shell's file (written just
+-- after the job starts: a job begun a moment ago is waited for, up to 5 s).
+local function pid_of(stem)
+  for _ = 1, 500 do
+    local pid = (pool.read_all(stem .. ".pid") or ""):match("^(%d+)\n")
+    if pid then return pid end
+    os.execute("sleep 0.01")
+  end
+end
+
+-- Interrupts a worker (seixo stops at a SIGINT as at Ctrl-C), once a
+-- second until it has gone: a worker that has only just started ignores
+-- the signal until seixo sets its handler (a background command's SIGINT
+-- is ignored by the shell that starts it).
+local function interrupt(pid)
+  for _ = 1, 30 do
+    os.execute("kill -INT " .. pid .. " 2>/dev/null")
+    for _ = 1, 10 do
+      local alive = os.execute("kill -0 " .. pid .. " 2>/dev/null")
+      if not alive then return end
+      os.execute("sleep 0.1")
+    end
+  end
+end
+
 --- Runs o.jobs (serializable tables) in processes, o.workers at a time:
 --- job i is written to <prefix>.job<i>.lua and o.command(that file) is a
 --- shell command running the worker (its output goes to a file). As each
 --- job ends, in the order they end, o.done(i, answer, output, code) gets
 --- what the worker answered (nil if it died first), its output and its
---- exit code. The job files are removed.
+--- exit code. The job files are removed. o.command must give a simple
+--- command (variables, a program, its arguments): it runs in the
+--- background so that its process id is known.
 function pool.run(o)
   local q = pool.quote
   -- the FIFO in the temporary directory, where a FIFO can be made (the
@@ -133,8 +160,8 @@ function pool.run(o)
   local function start(i)
     local s = stem(i)
     pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out"}))
-    local h, why = io.popen(string.format("{ ( %s ) > %s 2>&1; echo %d $? > %s; }", o.command(s .. ".lua"),
-                                          q(s .. ".txt"), i, q(fifo)))
+    local h, why = io.popen(string.format("{ %s > %s 2>&1 & echo $! > %s; wait $!; echo %d $? > %s; }",
+                                          o.command(s .. ".lua"), q(s .. ".txt"), q(s .. ".pid"), i, q(fifo)))
     if not h then error("seixo.pool: cannot start a process: " .. tostring(why), 0) end
     running[i], count = h, count + 1
   end
@@ -145,7 +172,9 @@ function pool.run(o)
         next_job = next_job + 1
       end
       local line = events:read("l")
-      -- (a SIGINT interrupts the read: the workers, in our process group, stop too)
+      -- (a SIGINT interrupts the read; one sent to the process group, as
+      -- a terminal's Ctrl-C is, reaches the workers too, and one sent to
+      -- this process alone is passed on to them below)
       if not line then error("seixo.pool: interrupted while waiting for the jobs", 0) end
       local i, code = line:match("^(%d+) (%d+)$")
       i, code = tonumber(i), tonumber(code)
@@ -154,14 +183,19 @@ function pool.run(o)
       local s = stem(i)
       local answer = pool.deserialize(pool.read_all(s .. ".out") or "")
       local output = pool.read_all(s .. ".txt") or ""
-      for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(s .. ext) end
+      for _, ext in ipairs({".lua", ".out", ".txt", ".pid"}) do os.remove(s .. ext) end
       o.done(i, answer, output, code)
     end
   end)
-  -- on an error (a done callback's): the jobs still running are waited for
+  -- on an error (an interrupt, a done callback's) the jobs still running
+  -- are interrupted, then waited for: their answers would be dropped, and
+  -- a `kill -INT` of this process alone (a scheduler's) had let them run
+  -- to their end
   for i, h in pairs(running) do
+    local pid = pid_of(stem(i))
+    if pid then interrupt(pid) end
     h:close()
-    for _, ext in ipairs({".lua", ".out", ".txt"}) do os.remove(stem(i) .. ext) end
+    for _, ext in ipairs({".lua", ".out", ".txt", ".pid"}) do os.remove(stem(i) .. ext) end
   end
   events:close()
   os.remove(fifo)

@@ -119,7 +119,7 @@ test("seixo.pool: jobs in processes, the next started as soon as any ends; answe
   pool.run{jobs = {{s = 1.5}, {s = 0.05}, {s = 0.05}, {s = 0, code = 3}}, workers = 2, prefix = prefix,
            command = function(job_file)
              local e = pool.take(job_file)
-             return string.format("sleep %g; exit %d", e.job.s, e.job.code or 0)
+             return string.format("sh -c 'sleep %g; exit %d'", e.job.s, e.job.code or 0)
            end,
            done = function(i, answer, output, code)
              order[#order + 1], codes[i] = i, code
@@ -139,11 +139,25 @@ test("seixo.pool: jobs in processes, the next started as soon as any ends; answe
   T.vec_eq(got[1].value, {1.5, 6})
   eq(got[2].ok, false)
   check(got[2].error:find("util.add", 1, true), got[2].error)
-  -- a done callback's error comes through, after the jobs still running end; no file is left
+  -- a done callback's error comes through, the jobs still running
+  -- interrupted (seixo workers, which stop at a SIGINT) and waited for; no file is left
+  local busy = pool.quote(seixo.executable()) .. " -e " .. pool.quote("local t = os.time() while os.time() - t < 60 do end")
+  local began = os.time()
   raises(function()
-    pool.run{jobs = {{s = 0}, {s = 0.2}}, workers = 2, prefix = prefix, command = function() return "sleep 0" end,
+    pool.run{jobs = {{s = 0}, {s = 0.2}}, workers = 2, prefix = prefix,
+             command = function(job_file) return pool.take(job_file).job.s == 0 and "sleep 0" or busy end,
              done = function() error("stop here") end}
   end, "stop here")
+  check(os.time() - began < 30, "the running worker was waited for to its end")
+  -- a SIGINT to this process alone (not its group, as a terminal's Ctrl-C
+  -- is: a batch scheduler's, `timeout`'s) stops the workers as well
+  began = os.time()
+  raises(function()
+    os.execute("(sleep 1; kill -INT $PPID) &") -- (the shell's parent: this process)
+    pool.run{jobs = {{}, {}}, workers = 2, prefix = prefix, command = function() return busy end,
+             done = function() end}
+  end, "interrupted")
+  check(os.time() - began < 30, "the workers ran on after the interrupt")
   os.remove(prefix)
   local left = io.popen("ls " .. pool.quote(prefix) .. ".* 2>/dev/null"):read("a")
   eq(left, "")
