@@ -336,6 +336,10 @@ bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, 
 /// Warns on stderr (once per model and `what`) when v != 0 lies outside
 /// [lo, hi] in magnitude, naming the unit expected.
 void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit);
+/// Warns once per model for `key` (the caller's line, then the message);
+/// only rank 0 prints.
+void sx_lua_warn_once(lua_State *L, int model, const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 
 /* ----------------------------------------------------------- run.c */
 

@@ -22,6 +22,7 @@
 #include "bindings.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -173,20 +174,30 @@ void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bo
 
 /* --------------------------------------------------------------- units */
 
-void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit)
+void sx_lua_warn_once(lua_State *L, int model, const char *key, const char *fmt, ...)
 {
-    if (!(v != 0 && (fabs(v) < lo || fabs(v) > hi))) return;
     sx_lua_state(L, model, "warned");
-    if (lua_getfield(L, -1, what) == LUA_TNIL) {
+    if (lua_getfield(L, -1, key) == LUA_TNIL) {
         lua_pushboolean(L, 1);
-        lua_setfield(L, -3, what);
+        lua_setfield(L, -3, key);
         luaL_where(L, 1);
         if (sx_lua_parallel_says(sx_lua_tomodel(L, model))) {
-            fprintf(stderr, "seixo: warning: %s%s %g is outside the usual range for DEM, %g ... %g %s (seixo's unit is %s)\n",
-                    lua_tostring(L, -1), what, v, lo, hi, unit, unit);
+            char text[512];
+            va_list ap;
+            va_start(ap, fmt);
+            vsnprintf(text, sizeof text, fmt, ap);
+            va_end(ap);
+            fprintf(stderr, "seixo: warning: %s%s\n", lua_tostring(L, -1), text);
             fflush(stderr);
         }
         lua_pop(L, 1);
     }
     lua_pop(L, 2);
+}
+
+void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit)
+{
+    if (!(v != 0 && (fabs(v) < lo || fabs(v) > hi))) return;
+    sx_lua_warn_once(L, model, what, "%s %g is outside the usual range for DEM, %g ... %g %s (seixo's unit is %s)", what,
+                     v, lo, hi, unit, unit);
 }

@@ -445,6 +445,11 @@ static void warn_unusual(lua_State *L, const sx_material_def *d)
     sx_lua_check_range(L, 1, "density", d->density, 100, 3e4, "kg/m^3");
     sx_lua_check_range(L, 1, "modulus", d->modulus, 1e5, 1e12, "Pa");
     sx_lua_check_range(L, 1, "shear_modulus", d->shear_modulus, 1e5, 1e12, "Pa");
+    if (d->friction > 2) /* (a rough rock joint's is about 1) */
+        sx_lua_warn_once(L, 1, "friction",
+                         "friction %g is a coefficient, the tangent of the friction angle, usually 0 ... 1: an angle of "
+                         "30 degrees is friction = math.tan(math.rad(30)) = 0.577",
+                         d->friction);
 }
 
 /* The material table at arg (if any) into d and bpm, its keys checked. */

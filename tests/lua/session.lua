@@ -295,6 +295,8 @@ m:material("rock", {modulus = 40, stiffness_ratio = 2})
 m:material("fine", {density = 2650, modulus = 40e9})
 w = m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
 w:servo{target = 10, area = 1}
+m:material("sand", {friction = 30})
+m:material("sand2", {friction = 0.5})
 print("done")]]))
   eq(status, 0, out)
   check(out:find("seixo: warning: (command line):2: density 2.5 is outside the usual range for DEM, 100 ... 30000 kg/m^3 (seixo's unit is kg/m^3)", 1, true), out)
@@ -302,6 +304,9 @@ print("done")]]))
   eq(count, 1, "once per model")
   check(out:find("(command line):4: modulus 40 is outside the usual range for DEM, 100000 ... 1e+12 Pa", 1, true), out)
   check(out:find("(command line):7: servo target stress 10 is outside the usual range for DEM, 1000 ... 1e+10 Pa (seixo's unit is Pa)", 1, true), out)
+  -- a friction angle given for the coefficient
+  check(out:find("(command line):8: friction 30 is a coefficient, the tangent of the friction angle", 1, true), out)
+  check(not out:find("(command line):9:", 1, true), "the coefficient 0.5 is usual: " .. out)
   check(out:find("done\n$"), out)
 end)
 
