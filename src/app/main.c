@@ -180,6 +180,11 @@ static void on_sigint(int sig)
     }
 }
 
+/* SIGINT, and serially SIGTERM too: a batch scheduler's (SLURM's scancel,
+ * `timeout`) is then a Ctrl-C, which a script can catch to save its state,
+ * and which lets a save under way finish instead of leaving its temporary
+ * file. (Under mpirun a SIGTERM is the launcher ending the job: it keeps
+ * its default.) */
 static void set_sigint(void (*handler)(int))
 {
     struct sigaction sa;
@@ -187,6 +192,7 @@ static void set_sigint(void (*handler)(int))
     sa.sa_handler = handler;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
+    if (sx_lua_parallel_ranks() == 1) sigaction(SIGTERM, &sa, NULL);
 }
 
 /* coroutine.resume, listing the coroutine while it runs (upvalue 1: the

@@ -626,6 +626,7 @@ void sx_lua_parallel_fail(const char *message)
 }
 
 int sx_lua_parallel_rank(void) { return world_rank; }
+int sx_lua_parallel_ranks(void) { return world_size; }
 
 /* Every rank must make the same calls, and a collective call that some
  * ranks skip (a save under `if seixo.rank() == 0`) would leave the ranks

@@ -63,6 +63,8 @@ SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 
 /// This process's MPI rank (0 without mpirun).
 SX_API int sx_lua_parallel_rank(void);
+/// The number of MPI ranks (1 without mpirun).
+SX_API int sx_lua_parallel_ranks(void);
 
 /// Text rank 0 makes, on every rank: under mpirun rank 0 calls read(ud,
 /// len, mark) and sends what it returns (len bytes, malloc'ed and

@@ -206,5 +206,33 @@ test("a name or a path with a zero byte is refused (C cut it there)", function()
   m:close()
 end)
 
+test("a SIGTERM (a batch scheduler's, timeout's) interrupts a run as Ctrl-C does: the script saves its state", function()
+  -- it had ended seixo at once: the state since the last save lost, and a
+  -- save under way left its temporary file
+  local path = dir .. "/term.h5"
+  local script = string.format([[
+m = seixo.model{dim = 2}
+m:material("r", {kn = 1e7, density = 2600, damping = 0.7})
+m:wall{kind = "box", min = {0, 0}, max = {0.1, 0.1}}
+m:generate{count = 300, radius = {1.5e-3, 2.5e-3}, region = {box = {{0, 0}, {0.1, 0.1}}}, seed = 3}
+m:set_gravity{0, -9.81}
+print("cycling") io.stdout:flush()
+local ok, e = pcall(function() while true do m:cycle(100) end end)
+print(ok, e)
+m:save(%q)
+print("saved at step", m:step())]], path)
+  local shell = string.format("%s -e %s & p=$!; sleep 1.5; kill -TERM $p; wait $p; echo status $?",
+                              T.quote(T.seixo), T.quote(script))
+  local h = io.popen(shell .. " 2>&1")
+  local out = h:read("a")
+  h:close()
+  check(out:find("false\t[^\n]*interrupted"), out)
+  check(out:find("saved at step\t%d+"), out)
+  check(out:find("status 0\n"), out)
+  local m = seixo.load(path)
+  eq(tostring(m:step()), out:match("saved at step\t(%d+)"))
+  eq(io.popen("ls -a '" .. dir .. "' | grep -c tmp"):read("a"), "0\n")
+end)
+
 os.execute("rm -rf '" .. dir .. "'")
 T.done()
