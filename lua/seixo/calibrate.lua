@@ -36,7 +36,10 @@
 -- on. Every run is logged (a CSV rewritten atomically, one row per run),
 -- and a calibration started again reads its log first: the search is
 -- deterministic, so it passes through the same candidates, finds their runs
--- in the log and only runs what the log lacks.
+-- in the log and only runs what the log lacks. What else a run's result
+-- depends on (the base material, the specimen's recipe, the tests) is kept
+-- beside the log (log .. ".settings"): a log made with other settings is
+-- refused, not read as this calibration's runs.
 
 local util = require("seixo.util")
 local pool = require("seixo.pool")
@@ -296,11 +299,104 @@ local function log_header(o)
   return h
 end
 
--- The runs of an earlier start of this calibration: key -> record.
+-- A number as the shortest text that reads back as the same number.
+local function exact(v)
+  local s
+  for digits = 15, 17 do
+    s = string.format("%." .. digits .. "g", v)
+    if tonumber(s) == v then break end
+  end
+  return s
+end
+
+-- What a run's result depends on besides its parameters and seed, as
+-- "key = value" lines (sorted): the base material (a free parameter scales
+-- the fields of its group from it), and when the lab evaluates, the
+-- specimen's recipe, the test's options, the series' confining stresses
+-- and the Brazilian disk's recipe, less what each run sets itself (seed,
+-- material, path, log); and which targets are measured (they choose the
+-- tests, and a run lacking one failed) with a curve's points. A target's
+-- value is not among them: it only weighs the logged results, so a log
+-- serves a calibration to another value.
+local function settings_of(o, lab_evaluates)
+  local lines = {}
+  local function put(key, v)
+    if type(v) == "table" then
+      for k, x in pairs(v) do put(math.type(k) == "integer" and key .. "[" .. k .. "]" or key .. "." .. tostring(k), x) end
+    elseif type(v) == "number" then
+      lines[#lines + 1] = key .. " = " .. exact(v)
+    elseif type(v) == "string" then
+      lines[#lines + 1] = key .. " = " .. string.format("%q", v):gsub("\\\n", "\\n")
+    elseif v ~= nil then
+      lines[#lines + 1] = key .. " = " .. (type(v) == "boolean" and tostring(v) or "a " .. type(v))
+    end
+  end
+  local function without_run(t)
+    local r = copy(t or {})
+    r.seed, r.material, r.path, r.log = nil, nil, nil, nil
+    return r
+  end
+  put("material", o.material)
+  put("targets", table.concat(o.target_names, " "))
+  put("targets.curve", o.targets.curve)
+  if lab_evaluates then
+    put("specimen", without_run(o.specimen))
+    put("test", without_run(o.test))
+    if o.targets.c or o.targets.phi then put("confining", o.confining) end
+    if o.disk then put("brazilian", without_run(o.disk)) end
+  end
+  table.sort(lines)
+  return lines
+end
+
+local function settings_path(o) return o.log .. ".settings" end
+
+-- Fails unless the log's settings file holds this calibration's settings,
+-- naming the first that differ.
+local function check_settings(o)
+  local f = io.open(settings_path(o), "r")
+  if not f then
+    fail("the log %s has no settings file %s (an older seixo's log, or the file was removed): its runs may have "
+         .. "been made with another material, specimen or test; delete the log or give another path (log = ...)",
+         o.log, settings_path(o))
+  end
+  local logged, now = {}, {}
+  for line in f:lines() do
+    local k, v = line:match("^([^#].-) = (.*)$")
+    if k then logged[k] = v end
+  end
+  f:close()
+  for _, line in ipairs(o.settings) do
+    local k, v = line:match("^(.-) = (.*)$")
+    now[k] = v
+  end
+  local keys = {}
+  for k in pairs(now) do if logged[k] ~= now[k] then keys[#keys + 1] = k end end
+  for k in pairs(logged) do if now[k] == nil then keys[#keys + 1] = k end end
+  if #keys == 0 then return end
+  table.sort(keys)
+  local differ = {}
+  for i = 1, math.min(3, #keys) do
+    local k = keys[i]
+    differ[i] = string.format("%s %s in the log, %s now", k, logged[k] or "unset", now[k] or "unset")
+  end
+  if #keys > 3 then differ[#differ + 1] = string.format("and %d more", #keys - 3) end
+  fail("the log %s holds runs made with other settings (%s; see %s): delete the log or give another path (log = ...)",
+       o.log, table.concat(differ, "; "), settings_path(o))
+end
+
+-- Writes the settings file of a new log (before its first run).
+local function write_settings(o)
+  pool.write_file(settings_path(o), string.format("# lab.calibrate: what the runs logged in %s depend on besides "
+                  .. "their parameters and seed\n%s\n", o.log, table.concat(o.settings, "\n")))
+end
+
+-- The runs of an earlier start of this calibration: key -> record; nil
+-- when there is no log yet.
 local function read_log(o)
   local cache, rows = {}, {}
   local f = io.open(o.log, "r")
-  if not f then return cache, rows end
+  if not f then return nil end
   f:close()
   local csv = util.read_csv(o.log)
   local header = log_header(o)
@@ -308,6 +404,7 @@ local function read_log(o)
     fail("the log %s has the columns %s, not this calibration's %s; remove it or name another log", o.log,
          table.concat(csv.header, ","), table.concat(header, ","))
   end
+  check_settings(o)
   for i = 1, csv.rows do
     local x = {}
     for j, n in ipairs(o.names) do x[j] = csv.columns[n][i] end
@@ -602,6 +699,7 @@ local function check_options(lab, opts)
     fail("print must be a function or false (got %s)", type(opts.print))
   end
   o.print = opts.print == false and function() end or opts.print or print
+  o.settings = settings_of(o, opts.evaluate == nil)
   return o
 end
 
@@ -641,7 +739,7 @@ function search(lab, o)
   -- the files written, checked before hours of runs, not after them (on
   -- rank 0 alone, which writes them: another rank may come here before
   -- rank 0 made their folder)
-  for _, path in ipairs(replay and {} or {o.log, o.out .. "_convergence.csv"}) do
+  for _, path in ipairs(replay and {} or {o.log, settings_path(o), o.out .. "_convergence.csv"}) do
     local ok, why = pool.writable(path)
     if not ok then fail("cannot write %s: %s", path, why) end
   end
@@ -649,6 +747,10 @@ function search(lab, o)
   if mode == "serial" then o.workers = 1 end
 
   local cache, log_rows = read_log(o)
+  if not cache then
+    cache, log_rows = {}, {}
+    if not replay then write_settings(o) end
+  end
   local history, best = {}, nil
   local t_start = seixo.clock()
 

@@ -8,7 +8,7 @@
 -- serves: hence the calibrations that use processes come first, and the
 -- logs are removed only by the parent.
 local T = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "harness.lua")
-local test, check, eq, near = T.test, T.check, T.eq, T.near
+local test, check, eq, near, raises = T.test, T.check, T.eq, T.near, T.raises
 local lab = require("seixo.lab")
 local util = require("seixo.util")
 
@@ -218,6 +218,49 @@ test("the log's columns hold their targets' values when targets before them are 
   local again = run() -- every run from the log
   eq(again.objective, first.objective)
   eq(again.achieved.BTS.mean, first.achieved.BTS.mean)
+end)
+
+test("a log made with another material, specimen or test is refused, naming what differs", function()
+  -- (a 2D calibration at friction 0.5, then 0.9 with the same log, took
+  -- the second's runs "from the log" of the first: a silent wrong result)
+  local log = fresh("calibrate_settings.csv")
+  local function run(over)
+    local o = {targets = {E = 60e9}, parameters = {modulus = {10e9, 200e9}}, material = {friction = 0.5},
+               evaluate = synthetic, seeds = {1}, workers = 1, maxeval = 2, log = log,
+               out = log:gsub("%.csv$", ""), plot = false, print = false}
+    for k, v in pairs(over) do o[k] = v end
+    return lab.calibrate(o)
+  end
+  run{}
+  local f = io.open(log .. ".settings")
+  check(f and f:read("a"):find("material.friction = 0.5\n", 1, true), "the settings beside the log")
+  if f then f:close() end
+  local err = raises(function() run{material = {friction = 0.9}} end,
+                     "lab.calibrate: the log " .. log .. " holds runs made with other settings (material.friction 0.5 "
+                     .. "in the log, 0.9 now; see " .. log .. ".settings): delete the log or give another path")
+  check(err:find("^[^\n]*calibrate%.lua:%d+:") and not err:find("seixo/", 1, true), "at the caller's line: " .. err)
+  -- a target's value only weighs the logged runs: they serve another value
+  local lines = {}
+  run{targets = {E = 70e9}, print = function(s) lines[#lines + 1] = s end}
+  check(lines[1]:find("from the log", 1, true), lines[1])
+  -- which targets are measured chooses the tests (and a run lacking one failed)
+  raises(function() run{targets = {E = 60e9, UCS = 150e6}} end, 'targets "E" in the log, "E UCS" now')
+  -- the lab's recipe: a specimen too small for its balls fails at once, its run logged as failed
+  local recipe = {dim = 2, width = 0.001, height = 0.002, radius = {0.4e-3, 0.6e-3}}
+  local lab_log = fresh("calibrate_settings_lab.csv")
+  local function lab_run(specimen, test)
+    return lab.calibrate{targets = {E = 60e9}, parameters = {modulus = {10e9, 200e9}}, specimen = specimen,
+                         test = test, seeds = {1}, workers = 1, maxeval = 1, log = lab_log,
+                         out = lab_log:gsub("%.csv$", ""), plot = false, print = false}
+  end
+  lab_run(recipe)
+  eq(util.read_csv(lab_log).columns.status[1], 0, "the run failed")
+  raises(function() lab_run({dim = 2, width = 0.002, height = 0.002, radius = {0.4e-3, 0.6e-3}}) end,
+         "(specimen.width 0.001 in the log, 0.002 now; see")
+  raises(function() lab_run(recipe, {strain_rate = 1}) end, "(test.strain_rate unset in the log, 1 now; see")
+  -- a log without its settings (an older seixo's) cannot be told apart: refused
+  os.remove(log .. ".settings")
+  raises(function() run{} end, "the log " .. log .. " has no settings file " .. log .. ".settings")
 end)
 
 test("a tiny 2D specimen: the modulus that gives a known E is recovered", function()
