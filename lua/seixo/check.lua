@@ -14,6 +14,15 @@ function check.show(v)
 end
 local show = check.show
 
+-- a value of the wrong type in a message: its type, and a string quoted (a
+-- stress given as the string '5e6' was "not a stress >= 0 Pa (got 5e6)")
+function check.got(v)
+  if type(v) == "string" then return string.format("string '%s'", v) end
+  if type(v) == "number" or type(v) == "boolean" then return type(v) .. " " .. show(v) end
+  return type(v)
+end
+local got = check.got
+
 function check.module(name)
   local c = {}
 
@@ -24,8 +33,7 @@ function check.module(name)
   -- front, not at the first line said (after a genesis or a whole test)
   local function check_log(v, fn)
     if v == nil or v == false or type(v) == "function" then return end
-    local got = (type(v) == "table" or type(v) == "userdata") and type(v) or type(v) .. " " .. tostring(v)
-    error(string.format("%s.%s: log must be false, nil or a function (got %s)", name, fn, got), 4)
+    error(string.format("%s.%s: log must be false, nil or a function (got %s)", name, fn, got(v)), 4)
   end
 
   function c.log(v, fn) check_log(v, fn) end
@@ -45,29 +53,42 @@ function check.module(name)
     if set.log then check_log(t.log, fn) end
   end
 
-  -- a stress >= 0 Pa, finite (NaN fails every comparison, so passed the
-  -- old `v < 0` checks and failed later under another name)
-  function c.stress(v, what, fn)
-    if type(v) ~= "number" or not (v >= 0 and v < math.huge) then
-      error(string.format("%s.%s: %s must be a stress >= 0 Pa (got %s)", name, fn, what, show(v)), 3)
+  -- What is wrong with v, an option that must be a number for which ok(v)
+  -- holds (rule says which), or nil; a value of another type is named as
+  -- one, not compared with the rule.
+  local function wrong_number(v, what, fn, rule, ok)
+    if type(v) ~= "number" then
+      return string.format("%s.%s: %s must be a number, got %s (%s)", name, fn, what, got(v), rule)
     end
+    if not ok(v) then return string.format("%s.%s: %s must be %s (got %s)", name, fn, what, rule, show(v)) end
+  end
+
+  -- v, a number for which ok(v) holds (rule: what that is, in words)
+  function c.number(v, what, fn, rule, ok)
+    local why = wrong_number(v, what, fn, rule, ok)
+    if why then error(why, 3) end
     return v
   end
 
-  function c.positive(v, what, fn)
-    if type(v) ~= "number" or not (v > 0) or v == math.huge then
-      error(string.format("%s.%s: %s must be a positive number (got %s)", name, fn, what, show(v)), 3)
+  -- A check of a kind of number: function(v, what, fn) -> v (as convert
+  -- makes it); NaN fails every comparison, so each rule is written to fail
+  -- it (it passed the old `v < 0` checks and failed later under another name).
+  local function number_check(rule, ok, convert)
+    return function(v, what, fn)
+      local why = wrong_number(v, what, fn, rule, ok)
+      if why then error(why, 3) end
+      return convert and convert(v) or v
     end
-    return v
   end
+
+  -- a stress >= 0 Pa, finite
+  c.stress = number_check("a stress >= 0 Pa", function(v) return v >= 0 and v < math.huge end)
+
+  c.positive = number_check("a positive number", function(v) return v > 0 and v < math.huge end)
 
   -- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
-  function c.steps(v, what, fn)
-    if type(v) ~= "number" or not (v >= 1) or v == math.huge or v ~= math.floor(v) then
-      error(string.format("%s.%s: %s must be a whole number of steps >= 1 (got %s)", name, fn, what, show(v)), 3)
-    end
-    return math.tointeger(v)
-  end
+  c.steps = number_check("a whole number of steps >= 1",
+                         function(v) return v >= 1 and v < math.huge and v == math.floor(v) end, math.tointeger)
 
   -- Fails unless a file can be made at path (an output's, checked before
   -- the work that would end by writing it).

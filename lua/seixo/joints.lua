@@ -303,8 +303,7 @@ function joints.direct_shear(spec, opts)
   if dim == 3 and spec.shape ~= "prism" or dim == 2 and spec.shape ~= "rect" then
     error("joints.direct_shear: a 2D rect or a 3D prism specimen", 2)
   end
-  local sn = opts.normal_stress
-  if type(sn) ~= "number" or not (sn > 0) then error("joints.direct_shear: normal_stress must be > 0", 2) end
+  local sn = c.positive(opts.normal_stress, "normal_stress", "direct_shear")
   c.log(opts.log, "direct_shear")
   local every = c.steps(opts.every or 50, "every", "direct_shear")
   local js = joints.jointed(spec, merge(opts.joint or {}, {angle = 0, path = (opts.out or "direct_shear") .. ".h5"}))

@@ -39,7 +39,7 @@ local plot_test, plot_brazilian, plot_series -- the figures, at the end
 local check = require "seixo.check"
 local c = check.module("lab")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
-local stress, record_steps = c.stress, check.record_steps
+local stress, number, record_steps = c.stress, c.number, check.record_steps
 
 -- a specimen of lab.specimen or lab.open: its file and dimension at least
 local function check_spec(spec, fn)
@@ -757,10 +757,8 @@ local function open_test(spec, opts, fn)
     check_writable(opts.out .. ".csv", "out", fn)
   end
   local dim, ax = spec.dim, axis_of(spec.dim)
-  local scale = opts.density_scale or 1
-  if type(scale) ~= "number" or not (scale >= 1 and scale <= 1e6) then
-    fail("lab.%s: density_scale must be a factor in [1, 1e6] (got %s)", fn, tostring(opts.density_scale))
-  end
+  local scale = number(opts.density_scale or 1, "density_scale", fn, "a factor in [1, 1e6]",
+                       function(v) return v >= 1 and v <= 1e6 end)
   local m = seixo.load(spec.path)
   -- density scaling: the balls' density (so mass and inertia) times scale,
   -- the automatic timestep sqrt(m / k) times sqrt(scale); a quasi-static
@@ -820,13 +818,10 @@ local function rate_control(opts, rate, fn)
     if opts.max_rate then fail("lab.%s: max_rate is the rate control's; target_ratio = false turns it off", fn) end
     return nil, rate
   end
-  if type(target) ~= "number" or not (target > 0 and target < 1) then
-    fail("lab.%s: target_ratio must be a ratio in (0, 1) or false (got %s)", fn, tostring(opts.target_ratio))
-  end
-  local max_rate = opts.max_rate or 8 * rate
-  if type(max_rate) ~= "number" or not (max_rate >= rate and max_rate < math.huge) then
-    fail("lab.%s: max_rate must be a strain rate >= strain_rate = %g 1/s (got %s)", fn, rate, tostring(opts.max_rate))
-  end
+  number(target, "target_ratio", fn, "a ratio in (0, 1) or false", function(v) return v > 0 and v < 1 end)
+  local max_rate = number(opts.max_rate or 8 * rate, "max_rate", fn,
+                          string.format("a strain rate >= strain_rate = %g 1/s", rate),
+                          function(v) return v >= rate and v < math.huge end)
   return target, max_rate
 end
 
@@ -877,10 +872,8 @@ local function compression(spec, opts, fn)
   end
   local sigma3 = stress(opts.confining or 0, "confining", fn)
   -- a true triaxial test of a prism: sigma2 on the x faces, sigma3 on the y faces
-  local sigma2 = opts.intermediate or sigma3
-  if type(sigma2) ~= "number" or not (sigma2 >= sigma3 and sigma2 < math.huge) then
-    fail("lab.%s: intermediate must be a stress >= confining (got %s)", fn, check.show(sigma2))
-  end
+  local sigma2 = number(opts.intermediate or sigma3, "intermediate", fn, "a stress >= confining",
+                        function(v) return v >= sigma3 and v < math.huge end)
   if sigma2 ~= sigma3 and not (dim == 3 and spec.shape == "prism") then
     fail("lab.%s: an intermediate stress needs a 3D prism (six planes)", fn)
   end
@@ -898,8 +891,7 @@ local function compression(spec, opts, fn)
   end
   if opts.strain_rate ~= nil then positive(opts.strain_rate, "strain_rate", fn) end
   local max_strain = positive(opts.max_strain or 0.02, "max_strain", fn)
-  local post_peak = opts.post_peak or 0.7
-  if not (post_peak > 0 and post_peak < 1) then fail("lab.%s: post_peak must be in (0, 1)", fn) end
+  local post_peak = number(opts.post_peak or 0.7, "post_peak", fn, "in (0, 1)", function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", fn)
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", fn) end
   local t0 = seixo.clock()
@@ -1203,7 +1195,8 @@ function lab.brazilian(spec, opts)
     fail("lab.brazilian: the specimen must be a %s (got a %s)", dim == 3 and "disc" or "disk", spec.shape)
   end
   if opts.strain_rate ~= nil then positive(opts.strain_rate, "strain_rate", "brazilian") end
-  local post_peak = opts.post_peak or 0.5
+  local post_peak = number(opts.post_peak or 0.5, "post_peak", "brazilian", "in (0, 1)",
+                           function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", "brazilian")
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", "brazilian") end
   local t0 = seixo.clock()
@@ -1455,10 +1448,8 @@ function lab.series(spec, opts)
   c.log(opts.log, "series") -- (before the tests: with jobs > 1 the series says their lines itself)
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
-  local jobs = opts.jobs or seixo.cores()
-  if math.type(jobs) == nil or jobs ~= math.floor(jobs) or jobs < 1 or jobs == math.huge then
-    fail("lab.series: jobs must be a whole number of processes >= 1 (got %s)", tostring(opts.jobs))
-  end
+  local jobs = number(opts.jobs or seixo.cores(), "jobs", "series", "a whole number of processes >= 1",
+                      function(v) return v >= 1 and v < math.huge and v == math.floor(v) end)
   -- under mpirun, with the ranks sharing the models, the tests go to the
   -- ranks unless jobs = 1 asks for them in turn (each then decomposed);
   -- ranks on their own (seixo.decompose(false)) and a stock lua5.4, which
@@ -1468,15 +1459,13 @@ function lab.series(spec, opts)
   if not over_ranks and (seixo.ranks() > 1 or (jobs > 1 and not pool.can_serve())) then jobs = 1 end
   local tolerance = opts.quasi_static == true and 0.02 or opts.quasi_static
   if tolerance and (type(tolerance) ~= "number" or not (tolerance > 0 and tolerance < 1)) then
-    fail("lab.series: quasi_static must be true, false or a tolerance in (0, 1) (got %s)", tostring(opts.quasi_static))
+    fail("lab.series: quasi_static must be true, false or a tolerance in (0, 1) (got %s)", check.got(opts.quasi_static))
   end
   opts.jobs, opts.quasi_static = nil, nil
   local out = opts.out
   local tests = {}
   for i, s3 in ipairs(list) do
-    if type(s3) ~= "number" or not (s3 >= 0 and s3 < math.huge) then
-      fail("lab.series: confining[%d] must be a stress >= 0 Pa (got %s)", i, tostring(s3))
-    end
+    stress(s3, string.format("confining[%d]", i), "series")
     if spec.granular and s3 == 0 then -- (refused before any test starts)
       fail("lab.series: confining[%d] is 0: a granular specimen needs confining > 0 (nothing holds it together)", i)
     end

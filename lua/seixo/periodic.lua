@@ -177,10 +177,8 @@ function periodic.triaxial(spec, opts)
   local sigma2 = positive(opts.intermediate or sigma3, "intermediate", "triaxial")
   if dim == 2 and sigma2 ~= sigma3 then fail("periodic.triaxial: an intermediate stress needs a 3D cell") end
   local max_strain = positive(opts.max_strain or 0.02, "max_strain", "triaxial")
-  local post_peak = opts.post_peak or 0.7
-  if type(post_peak) ~= "number" or not (post_peak > 0 and post_peak < 1) then
-    fail("periodic.triaxial: post_peak must be in (0, 1) (got %s)", tostring(post_peak))
-  end
+  local post_peak = c.number(opts.post_peak or 0.7, "post_peak", "triaxial", "in (0, 1)",
+                             function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", "triaxial")
   local max_steps = steps(opts.max_steps or 1000000, "max_steps", "triaxial")
   local rate = opts.strain_rate or 7e-8 / m:timestep() -- seixo.lab's quasi-static default

@@ -52,6 +52,9 @@ test("lab.brazilian stops at max_steps and near max_strain when every is larger"
   eq(r.stopped, "max_strain")
   near(r.rows[#r.rows][3] / r.diameter, 0.001, 0.05)
   raises(function() lab.brazilian(disk, with{max_strain = 0 / 0}) end, "lab.brazilian: max_strain must be a positive")
+  -- (a string was compared with a number: "attempt to compare")
+  raises(function() lab.brazilian(disk, with{post_peak = "0.5"}) end,
+         "lab.brazilian: post_peak must be a number, got string '0.5' (in (0, 1))")
 end)
 
 -- about 15 disks in a periodic cell
@@ -103,13 +106,40 @@ test("a NaN or infinite stress is refused by its name", function()
          "periodic.triaxial: intermediate must be a positive number (got nan)")
 end)
 
+test("a number given as a string is named as one, not as a number out of range", function()
+  -- (confining = '5e6' said "confining must be a stress >= 0 Pa (got 5e6)")
+  raises(function() lab.triaxial(rect, with{confining = "5e6"}) end,
+         "lab.triaxial: confining must be a number, got string '5e6' (a stress >= 0 Pa)")
+  raises(function() lab.triaxial(rect, with{confining = 1e5, intermediate = "2e5"}) end,
+         "lab.triaxial: intermediate must be a number, got string '2e5' (a stress >= confining)")
+  raises(function() lab.ucs(rect, with{strain_rate = "1"}) end,
+         "lab.ucs: strain_rate must be a number, got string '1' (a positive number)")
+  raises(function() lab.ucs(rect, with{every = "100"}) end,
+         "lab.ucs: every must be a number, got string '100' (a whole number of steps >= 1)")
+  raises(function() lab.ucs(rect, with{post_peak = "0.5"}) end, "lab.ucs: post_peak must be a number, got string '0.5'")
+  raises(function() lab.ucs(rect, with{density_scale = "4"}) end,
+         "lab.ucs: density_scale must be a number, got string '4' (a factor in [1, 1e6])")
+  raises(function() lab.ucs(rect, with{target_ratio = true}) end,
+         "lab.ucs: target_ratio must be a number, got boolean true (a ratio in (0, 1) or false)")
+  raises(function() lab.series(rect, with{confining = {0, "5e6"}}) end,
+         "lab.series: confining[2] must be a number, got string '5e6' (a stress >= 0 Pa)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, jobs = "2"}) end,
+         "lab.series: jobs must be a number, got string '2'")
+  raises(function() lab.periodic.triaxial(cell, {confining = "1e5", log = false}) end,
+         "periodic.triaxial: confining must be a number, got string '1e5' (a positive number)")
+  raises(function() lab.periodic.triaxial(cell, {post_peak = "0.5", log = false}) end,
+         "periodic.triaxial: post_peak must be a number, got string '0.5'")
+  raises(function() joints.direct_shear(rect, {normal_stress = "1e6"}) end,
+         "joints.direct_shear: normal_stress must be a number, got string '1e6' (a positive number)")
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
                                   path = T.tmpname(".h5"), log = 5} end,
          "lab.specimen: log must be false, nil or a function (got number 5)")
   raises(function() lab.ucs(rect, {log = "quiet", max_steps = 100}) end,
-         "lab.ucs: log must be false, nil or a function (got string quiet)")
+         "lab.ucs: log must be false, nil or a function (got string 'quiet')")
   raises(function() lab.triaxial(rect, {confining = 1e5, log = true, max_steps = 100}) end,
          "lab.triaxial: log must be false, nil or a function (got boolean true)")
   raises(function() lab.brazilian(rect, {log = {}}) end, "lab.brazilian: log must be false, nil or a function (got table)")

@@ -121,7 +121,7 @@ test("a series in processes gives the series run in turn, bit for bit, with its 
   -- a test that fails in its process fails the series with its message
   raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 2, max_strain = -1, log = false}) end, "max_strain")
   raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 0}) end, "jobs must be")
-  raises(function() lab.series(spec, {confining = {0, "2e6"}}) end, "confining[2] must be a stress")
+  raises(function() lab.series(spec, {confining = {0, "2e6"}}) end, "confining[2] must be a number, got string '2e6'")
   raises(function() lab.series(spec, {confining = {0, 2e6}, quasi_static = 2}) end, "quasi_static must be")
 end)
 
