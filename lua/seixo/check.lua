@@ -1,10 +1,12 @@
--- seixo.check: the option checks, the log and the loops' limits of the lab
--- modules (seixo.lab, seixo.periodic, seixo.joints). Every message starts
+-- seixo.check: the option checks, the specimen tables' checks, the log and
+-- the loops' limits of the lab modules (seixo.lab, seixo.periodic,
+-- seixo.joints). Every message starts
 -- with the function's name as the user calls it ("lab.triaxial: ..."), and
 -- is raised at the level of that function's caller (seixo.caller then puts
 -- it at the user's line):
 --   local c = require("seixo.check").module("periodic")
 --   c.keys(opts, "shear", {"normal", ...}); c.positive(v, "normal", "shear")
+local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
 local check = {}
 
 -- a value in a message: NaN as "nan" (tostring says "-nan" on x86 Linux)
@@ -23,8 +25,63 @@ function check.got(v)
 end
 local got = check.got
 
-function check.module(name)
+-- The shapes of lab.specimen, by dimension.
+check.shapes = {
+  [3] = {cylinder = true, prism = true, disc = true},
+  [2] = {rect = true, disk = true},
+}
+
+-- Why mat is not a material m:material takes (its first fault, as
+-- seixo.check_material words it), or nil.
+function check.material_error(mat)
+  local ok, why = pcall(seixo.check_material, mat)
+  if ok then return nil end
+  return (tostring(why):gsub("^.-bad argument #%d+ to '[^']*' %((.*)%)$", "%1"):gsub("^.-seixo.check_material: ", ""))
+end
+
+-- The fields of a specimen table (lab.specimen's, periodic.specimen's or
+-- joints.jointed's, as lab.open reads them back) that the tests read: what
+-- each must be, and whether v is that in the table spec (false and why,
+-- when the value alone does not say). Each test checks those it reads
+-- before it starts: a table changed by hand was used as it came (without
+-- wall_kn a UCS ran against platens of no stiffness, 23 MPa instead of
+-- 154; a string for it failed in an internal m:wall call). A shape is
+-- checked against dim once the file has said which dim is right (c.load).
+local function bounded(v) return type(v) == "number" and v > 0 and v < math.huge end
+local function shown(v) return type(v) == "number" and show(v) or check.got(v) end
+local function corner(v, spec)
+  if type(v) ~= "table" then return false end
+  for k = 1, spec.dim do
+    if type(v[k]) ~= "number" or not (v[k] > -math.huge and v[k] < math.huge) then return false end
+  end
+  return true
+end
+local specimen_fields = {
+  path = {"a string, its file's path", function(v) return type(v) == "string" end},
+  dim = {"2 or 3", function(v) return v == 2 or v == 3 end},
+  shape = {"rect or disk (2D), cylinder, prism or disc (3D)",
+           function(v) return check.shapes[2][v] or check.shapes[3][v] or false end},
+  wall_kn = {"a number > 0, N/m", bounded},
+  sigma0 = {"a stress > 0, Pa", bounded},
+  radius = {"{rmin, rmax}, 0 < rmin <= rmax, m",
+            function(v) return type(v) == "table" and bounded(v[1]) and bounded(v[2]) and v[1] <= v[2] end},
+  lo = {"its box's lower corner, dim numbers, m", corner},
+  hi = {"its box's upper corner, dim numbers, m", corner},
+  material = {"a material table with a density > 0", function(v)
+    if type(v) ~= "table" then return false end
+    if v.density == nil then return false, "it has no density" end
+    if not bounded(v.density) then return false, "its density is " .. shown(v.density) end
+    local why = check.material_error(v)
+    return why == nil, why
+  end},
+  granular = {"true or false", function(v) return type(v) == "boolean" end, optional = true},
+}
+
+-- An options' checker for a module's functions. from: the functions whose
+-- specimen tables its tests take (default: name.specimen or lab.open).
+function check.module(name, from)
   local c = {}
+  from = from or name .. ".specimen or lab.open"
 
   -- an error at the caller of the function that calls fail
   function c.fail(fmt, ...) error(string.format(fmt, ...), 3) end
@@ -89,6 +146,47 @@ function check.module(name)
   -- a number of steps: a whole number >= 1 (0 or NaN would cycle nothing, forever)
   c.steps = number_check("a whole number of steps >= 1",
                          function(v) return v >= 1 and v < math.huge and v == math.floor(v) end, math.tointeger)
+
+  -- Fails unless spec is a specimen table whose fields (specimen_fields'
+  -- names, in the order given: dim before the corners) are what the
+  -- function fn reads, naming the first that is not.
+  function c.specimen(spec, fn, fields)
+    if type(spec) ~= "table" then
+      error(string.format("%s.%s: a specimen (from %s) expected, got %s", name, fn, from, got(spec)), 3)
+    end
+    for _, field in ipairs(fields) do
+      local f, v = specimen_fields[field], spec[field]
+      if v == nil and not f.optional then
+        error(string.format("%s.%s: the specimen has no %s (%s): give the table %s returned", name, fn, field, f[1],
+                            from), 3)
+      end
+      local ok, why = true, nil
+      if v ~= nil then ok, why = f[2](v, spec) end
+      if not ok then
+        error(string.format("%s.%s: the specimen's %s must be %s%s: give the table %s returned", name, fn, field,
+                            f[1], why and ": " .. why or " (got " .. shown(v) .. ")", from), 3)
+      end
+    end
+  end
+
+  -- The model of a checked specimen, from its file, whose dimension must
+  -- be the table's (a 2D file tested as dim = 3 failed in arithmetic on
+  -- nil), as its shape's.
+  function c.load(spec, fn)
+    local m = seixo.load(spec.path)
+    local dim = m:dim()
+    local why
+    if dim ~= spec.dim then
+      why = string.format("the specimen's dim is %d but its file %s holds a %dD model", spec.dim, spec.path, dim)
+    elseif spec.shape ~= nil and not check.shapes[dim][spec.shape] then
+      why = string.format("the specimen's shape %s is not a %dD shape, as its file %s is", spec.shape, dim, spec.path)
+    end
+    if why then
+      m:close()
+      error(string.format("%s.%s: %s: give the table %s returned", name, fn, why, from), 3)
+    end
+    return m
+  end
 
   -- Fails unless a file can be made at path (an output's, checked before
   -- the work that would end by writing it).

@@ -12,7 +12,7 @@ local lab = require("seixo.lab")
 
 local joints = {}
 
-local c = require("seixo.check").module("joints")
+local c = require("seixo.check").module("joints", "lab.specimen, joints.jointed or lab.open")
 
 local function merge(base, over)
   local t = {}
@@ -99,11 +99,12 @@ function joints.direct_tension(spec, opts)
   c.log(opts.log, "direct_tension")
   local every = c.steps(opts.every or 50, "every", "direct_tension")
   local max_steps = c.steps(opts.max_steps or 400000, "max_steps", "direct_tension")
+  c.specimen(spec, "direct_tension", {"path", "dim", "shape", "lo", "hi"})
   local dim = spec.dim
   if not (dim == 2 and spec.shape == "rect" or dim == 3 and (spec.shape == "cylinder" or spec.shape == "prism")) then
     error("joints.direct_tension: a 2D rect or a 3D cylinder or prism specimen", 2)
   end
-  local m = seixo.load(spec.path)
+  local m = c.load(spec, "direct_tension")
   local ax = dim
   local lo, hi = spec.lo[ax], spec.hi[ax]
   local h = hi - lo
@@ -191,6 +192,9 @@ local function joint_def(spec, opts, point, normal)
           cohesion = opts.cohesion, friction_angle = opts.friction_angle, radius_multiplier = opts.radius_multiplier}
 end
 
+-- the fields of a specimen that joints.jointed reads (check.lua's names)
+local jointed_fields = {"path", "dim", "lo", "hi", "material", "radius"}
+
 --- A jointed specimen: spec (lab.specimen's) with a smooth joint through
 --- its centre (or `point`) whose normal makes `angle` degrees (beta) with
 --- the loading axis (y in 2D, z in 3D; turned towards x), saved to `path`.
@@ -206,8 +210,9 @@ function joints.jointed(spec, opts)
     error("joints.jointed: angle must be a number of degrees in [0, 90]", 2)
   end
   if type(opts.path) ~= "string" then error("joints.jointed: path (the jointed specimen's file) is required", 2) end
+  c.specimen(spec, "jointed", jointed_fields)
   local dim = spec.dim
-  local m = seixo.load(spec.path)
+  local m = c.load(spec, "jointed")
   local point = opts.point
   if not point then
     point = {}
@@ -249,6 +254,8 @@ end
 --- gnuplot), log. Returns {intact =, rows = {{angle, ucs, jaeger}, ...}}.
 function joints.angle_series(spec, opts)
   c.log(opts.log, "angle_series")
+  -- (those of lab.ucs and joints.jointed: all before the intact specimen's test)
+  c.specimen(spec, "angle_series", {"path", "dim", "shape", "wall_kn", "material", "radius", "granular", "lo", "hi"})
   local angles = opts.angles or {0, 15, 30, 45, 52.5, 60, 67.5, 75, 90}
   local out = opts.out or "angle_series"
   local joint = opts.joint or {}
@@ -299,6 +306,7 @@ end
 --- out (CSV prefix), log. Returns {peak, residual (the mean over the last
 --- fifth), normal_stress, rows = {{disp, tau, sigma_n, dilation}, ...}}.
 function joints.direct_shear(spec, opts)
+  c.specimen(spec, "direct_shear", {"path", "dim", "shape", "lo", "hi", "material", "radius"})
   local dim = spec.dim
   if dim == 3 and spec.shape ~= "prism" or dim == 2 and spec.shape ~= "rect" then
     error("joints.direct_shear: a 2D rect or a 3D prism specimen", 2)

@@ -41,12 +41,15 @@ local c = check.module("lab")
 local fail, check_keys, check_writable, positive, steps, say = c.fail, c.keys, c.writable, c.positive, c.steps, c.say
 local stress, number, record_steps = c.stress, c.number, check.record_steps
 
--- a specimen of lab.specimen or lab.open: its file and dimension at least
-local function check_spec(spec, fn)
-  if type(spec) ~= "table" or type(spec.path) ~= "string" or (spec.dim ~= 2 and spec.dim ~= 3) then
-    error(string.format("lab.%s: a specimen (from lab.specimen or lab.open) expected, got %s", fn,
-                        type(spec) == "table" and "a table without its path or dim" or type(spec)), 3)
+-- a specimen of lab.specimen or lab.open with the fields the test fn reads
+-- (check.lua's names), up front
+local compression_fields = {"path", "dim", "shape", "wall_kn", "material", "radius", "granular"}
+local brazilian_fields = {"path", "dim", "shape", "wall_kn", "material"}
+local function check_spec(spec, fn, fields)
+  if type(spec) == "table" and spec.periodic then
+    fail("lab.%s: a periodic specimen is tested by lab.periodic's tests (no walls)", fn)
   end
+  c.specimen(spec, fn, fields)
 end
 
 local function copy(t)
@@ -127,12 +130,8 @@ function lab.rock(over)
   local mat = merge(dim == 3 and granite3d or granite2d, over)
   -- its keys and values checked now, as m:material checks them (a
   -- misspelt key was otherwise named only by the lab.specimen it reached)
-  local ok, why = pcall(seixo.check_material, mat)
-  if not ok then
-    why = tostring(why):gsub("^.-bad argument #%d+ to '[^']*' %((.*)%)$", "%1")
-                       :gsub("^.-seixo.check_material: ", "")
-    error("lab.rock: " .. why, 2)
-  end
+  local why = check.material_error(mat)
+  if why then error("lab.rock: " .. why, 2) end
   return mat
 end
 
@@ -309,11 +308,7 @@ end
 
 -- --------------------------------------------------------------- specimens
 
-
-local shapes = {
-  [3] = {cylinder = true, prism = true, disc = true},
-  [2] = {rect = true, disk = true},
-}
+local shapes = check.shapes
 
 -- The box a shape fills, the axis of its cylindrical vessel (3D cylinder:
 -- z; disc: y), and for a 2D disk the circle it is trimmed to.
@@ -751,7 +746,6 @@ local function polling(poll, fn, ...)
 end
 
 local function open_test(spec, opts, fn)
-  if spec.periodic then fail("lab: a periodic specimen is tested by lab.periodic's tests (no walls)") end
   if opts.out ~= nil then
     if type(opts.out) ~= "string" then fail("lab.%s: out must be a path prefix (a string; got %s)", fn, type(opts.out)) end
     check_writable(opts.out .. ".csv", "out", fn)
@@ -759,7 +753,7 @@ local function open_test(spec, opts, fn)
   local dim, ax = spec.dim, axis_of(spec.dim)
   local scale = number(opts.density_scale or 1, "density_scale", fn, "a factor in [1, 1e6]",
                        function(v) return v >= 1 and v <= 1e6 end)
-  local m = seixo.load(spec.path)
+  local m = c.load(spec, fn)
   -- density scaling: the balls' density (so mass and inertia) times scale,
   -- the automatic timestep sqrt(m / k) times sqrt(scale); a quasi-static
   -- test's stresses do not depend on the mass, only its dynamics do
@@ -863,7 +857,7 @@ end
 
 -- A triaxial (confining > 0) or unconfined compression test.
 local function compression(spec, opts, fn)
-  check_spec(spec, fn)
+  check_spec(spec, fn, compression_fields)
   check_keys(opts, fn, test_keys)
   local dim, ax = spec.dim, axis_of(spec.dim)
   if spec.shape == "disc" or spec.shape == "disk" then
@@ -1187,7 +1181,7 @@ end
 --- the peak (tensile_strength) and at the split (split).
 function lab.brazilian(spec, opts)
   opts = opts or {}
-  check_spec(spec, "brazilian")
+  check_spec(spec, "brazilian", brazilian_fields)
   check_keys(opts, "brazilian", {"strain_rate", "post_peak", "every", "out", "plot", "log", "max_steps", "max_strain",
                                  "density_scale"})
   local dim, ax = spec.dim, axis_of(spec.dim)
@@ -1209,7 +1203,7 @@ function lab.brazilian(spec, opts)
   -- turned 0.05 to 0.09 rad and lost the load before a bond broke; with
   -- friction 0.06 and 0.14 mrad before the first crack). At the rock's 0.5
   -- the contacts stick (1.0 gives the same bits); below 0.25 they slide.
-  local mat = spec.material or {}
+  local mat = spec.material
   for _, w in ipairs{top, bottom} do
     w.ks, w.friction = spec.wall_kn / (mat.stiffness_ratio or 1), mat.friction or 0.5
   end
@@ -1443,7 +1437,8 @@ end
 --- processes at once (default: the machine's cores; 1: one after another
 --- in this process), with the same results bit for bit.
 function lab.series(spec, opts)
-  check_spec(spec, "series")
+  check_spec(spec, "series", compression_fields)
+  c.load(spec, "series"):close() -- (its file's dim: before any test, which may run in another process)
   opts = copy(opts or {})
   c.log(opts.log, "series") -- (before the tests: with jobs > 1 the series says their lines itself)
   local list = opts.confining

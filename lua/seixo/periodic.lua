@@ -133,7 +133,8 @@ function periodic.open(path) return require("seixo.lab").open(path) end
 
 local function open_test(spec, fn)
   if type(spec) ~= "table" or not spec.periodic then fail("periodic.%s: a periodic specimen expected", fn) end
-  return seixo.load(spec.path)
+  c.specimen(spec, fn, {"path", "dim", "sigma0"})
+  return c.load(spec, fn)
 end
 
 -- The secant modulus and Poisson's ratio at half the peak of column q,

@@ -51,13 +51,16 @@ do
   -- issue 18: errors raised inside seixo.lab point at the caller's line,
   -- and a test that would cycle nothing forever (every = 0) is refused
   local lab = require("seixo.lab")
+  -- a specimen table with every field the tests read, of no file: the options fail first
+  local rect = {dim = 2, shape = "rect", path = "none.h5", wall_kn = 1e9, material = lab.rock(), radius = {1e-3, 2e-3}}
+  local disk = {dim = 2, shape = "disk", path = "none.h5", wall_kn = 1e9, material = lab.rock()}
   local here = "lab.lua:" .. (debug.getinfo(1, "l").currentline + 2) .. ": "
   local cases = {
-    {"ucs every = 0", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {every = 0}) end, "every must be a whole number"},
-    {"ucs every = NaN", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {every = 0 / 0}) end, "every must be"},
-    {"ucs max_steps = 0.5", function() lab.ucs({dim = 2, shape = "rect", path = "none.h5"}, {max_steps = 0.5}) end, "max_steps must be"},
-    {"brazilian every = 0", function() lab.brazilian({dim = 2, shape = "disk", path = "none.h5"}, {every = 0}) end, "every must be"},
-    {"triaxial unknown option", function() lab.triaxial({dim = 2, shape = "rect", path = "none.h5"}, {bogus = 1}) end, "unknown option"},
+    {"ucs every = 0", function() lab.ucs(rect, {every = 0}) end, "every must be a whole number"},
+    {"ucs every = NaN", function() lab.ucs(rect, {every = 0 / 0}) end, "every must be"},
+    {"ucs max_steps = 0.5", function() lab.ucs(rect, {max_steps = 0.5}) end, "max_steps must be"},
+    {"brazilian every = 0", function() lab.brazilian(disk, {every = 0}) end, "every must be"},
+    {"triaxial unknown option", function() lab.triaxial(rect, {bogus = 1}) end, "unknown option"},
     {"mohr_coulomb", function() lab.mohr_coulomb(5) end, "two failure states"},
     {"a number for a specimen", function() lab.ucs(5) end, "a specimen (from lab.specimen or lab.open) expected"},
     {"write_csv to a table", function() lab.write_csv({}, {"a"}, {}) end, "its path must be a string, not a table"},

@@ -133,6 +133,53 @@ test("a number given as a string is named as one, not as a number out of range",
          "joints.direct_shear: normal_stress must be a number, got string '1e6' (a positive number)")
 end)
 
+test("a specimen table with a missing or wrong field is refused before the test, by the field's name", function()
+  -- (without wall_kn a UCS ran and gave 23 MPa instead of 154; without
+  -- material or radius, or with dim = 3 on a 2D file, Lua's own errors;
+  -- wall_kn = '8e10' an error of an internal m:wall call)
+  local function changed(field, value)
+    local s = lab.open(rect.path)
+    s[field] = value
+    return s
+  end
+  local from = ": give the table lab.specimen or lab.open returned"
+  local err = raises(function() lab.ucs(changed("wall_kn", nil), quiet) end,
+                     "lab.ucs: the specimen has no wall_kn (a number > 0, N/m)" .. from)
+  check(err:find("^[^\n]*lab_limits%.lua:%d+: ") and not err:find("seixo/", 1, true), "at the caller's line: " .. err)
+  raises(function() lab.ucs(changed("wall_kn", "8e10"), quiet) end,
+         "lab.ucs: the specimen's wall_kn must be a number > 0, N/m (got string '8e10')" .. from)
+  raises(function() lab.ucs(changed("material", nil), quiet) end, "lab.ucs: the specimen has no material")
+  raises(function() lab.ucs({path = rect.path, dim = 2}, quiet) end, "lab.ucs: the specimen has no shape")
+  raises(function() lab.ucs(changed("radius", nil), quiet) end, "lab.ucs: the specimen has no radius")
+  raises(function() lab.ucs(changed("dim", 3), quiet) end,
+         "lab.ucs: the specimen's dim is 3 but its file " .. rect.path .. " holds a 2D model" .. from)
+  raises(function() lab.ucs(changed("shape", "prism"), quiet) end, "lab.ucs: the specimen's shape prism is not a 2D shape")
+  raises(function() lab.triaxial(changed("radius", {2e-3, 1e-3}), with{confining = 1e5}) end,
+         "lab.triaxial: the specimen's radius must be {rmin, rmax}, 0 < rmin <= rmax, m (got table)")
+  local heavy = changed("material", lab.rock())
+  heavy.material.density = "2630"
+  raises(function() lab.ucs(heavy, quiet) end,
+         "lab.ucs: the specimen's material must be a material table with a density > 0: its density is string '2630'")
+  raises(function() lab.brazilian(changed("wall_kn", 0), quiet) end,
+         "lab.brazilian: the specimen's wall_kn must be a number > 0, N/m (got 0)")
+  raises(function() lab.series(changed("wall_kn", nil), with{confining = {0, 1e5}}) end,
+         "lab.series: the specimen has no wall_kn")
+  raises(function() lab.series(changed("dim", 3), with{confining = {0, 1e5}}) end, "lab.series: the specimen's dim is 3")
+  raises(function() joints.direct_tension(changed("lo", nil), {}) end, "joints.direct_tension: the specimen has no lo "
+         .. "(its box's lower corner, dim numbers, m): give the table lab.specimen, joints.jointed or lab.open returned")
+  raises(function() joints.jointed(changed("material", nil), {angle = 30, path = T.tmpname(".h5")}) end,
+         "joints.jointed: the specimen has no material")
+  raises(function() joints.direct_shear(changed("radius", nil), {normal_stress = 1e6}) end,
+         "joints.direct_shear: the specimen has no radius")
+  raises(function() joints.angle_series(changed("hi", nil), {log = false}) end, "joints.angle_series: the specimen has no hi")
+  local loose = lab.open(cell.path)
+  loose.sigma0 = "1e5"
+  raises(function() lab.periodic.triaxial(loose, {log = false}) end, "periodic.triaxial: the specimen's sigma0 must be a "
+         .. "stress > 0, Pa (got string '1e5'): give the table periodic.specimen or lab.open returned")
+  loose.sigma0, loose.dim = cell.sigma0, 3
+  raises(function() lab.periodic.shear(loose, {log = false}) end, "periodic.shear: the specimen's dim is 3 but its file")
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
