@@ -745,14 +745,20 @@ local function polling(poll, fn, ...)
   return fn(...)
 end
 
-local function open_test(spec, opts, fn)
+-- The options of open_test and finish, checked before a test (fn) starts:
+-- out, a path prefix that can be written, and density_scale.
+local function check_out_and_scale(opts, fn)
   if opts.out ~= nil then
     if type(opts.out) ~= "string" then fail("lab.%s: out must be a path prefix (a string; got %s)", fn, type(opts.out)) end
     check_writable(opts.out .. ".csv", "out", fn)
   end
+  number(opts.density_scale or 1, "density_scale", fn, "a factor in [1, 1e6]", function(v) return v >= 1 and v <= 1e6 end)
+end
+
+-- (its options checked: check_out_and_scale)
+local function open_test(spec, opts, fn)
   local dim, ax = spec.dim, axis_of(spec.dim)
-  local scale = number(opts.density_scale or 1, "density_scale", fn, "a factor in [1, 1e6]",
-                       function(v) return v >= 1 and v <= 1e6 end)
+  local scale = opts.density_scale or 1
   local m = c.load(spec, fn)
   -- density scaling: the balls' density (so mass and inertia) times scale,
   -- the automatic timestep sqrt(m / k) times sqrt(scale); a quasi-static
@@ -855,11 +861,13 @@ local function few_records(r, every)
   end
 end
 
--- A triaxial (confining > 0) or unconfined compression test.
-local function compression(spec, opts, fn)
-  check_spec(spec, fn, compression_fields)
+-- The options of a compression test, checked before it starts, in the
+-- name of fn, the function the user called (lab.series checks its tests'
+-- so, before the first). Returns sigma3, sigma2, max_strain, post_peak
+-- and every.
+local function test_options(spec, opts, fn)
   check_keys(opts, fn, test_keys)
-  local dim, ax = spec.dim, axis_of(spec.dim)
+  local dim = spec.dim
   if spec.shape == "disc" or spec.shape == "disk" then
     fail("lab.%s: a %s specimen is for the Brazilian test; make a %s", fn, spec.shape,
          dim == 3 and "cylinder or prism" or "rect")
@@ -888,6 +896,15 @@ local function compression(spec, opts, fn)
   local post_peak = number(opts.post_peak or 0.7, "post_peak", fn, "in (0, 1)", function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", fn)
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", fn) end
+  check_out_and_scale(opts, fn)
+  return sigma3, sigma2, max_strain, post_peak, every
+end
+
+-- A triaxial (confining > 0) or unconfined compression test.
+local function compression(spec, opts, fn)
+  check_spec(spec, fn, compression_fields)
+  local sigma3, sigma2, max_strain, post_peak, every = test_options(spec, opts, fn)
+  local dim, ax = spec.dim, axis_of(spec.dim)
   local t0 = seixo.clock()
 
   local m, lo, hi, centre, bottom, top = open_test(spec, opts, fn)
@@ -1193,6 +1210,7 @@ function lab.brazilian(spec, opts)
                            function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", "brazilian")
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", "brazilian") end
+  check_out_and_scale(opts, "brazilian")
   local t0 = seixo.clock()
   local m, lo, hi, centre, bottom, top = open_test(spec, opts, "brazilian")
   -- The platens have the rock's friction and shear stiffness (kn /
@@ -1436,11 +1454,14 @@ end
 --- again at half the strain rate. jobs: the tests run in that many
 --- processes at once (default: the machine's cores; 1: one after another
 --- in this process), with the same results bit for bit.
+local series_keys = {"jobs", "quasi_static"}
+for _, k in ipairs(test_keys) do series_keys[#series_keys + 1] = k end
+
 function lab.series(spec, opts)
   check_spec(spec, "series", compression_fields)
-  c.load(spec, "series"):close() -- (its file's dim: before any test, which may run in another process)
   opts = copy(opts or {})
-  c.log(opts.log, "series") -- (before the tests: with jobs > 1 the series says their lines itself)
+  -- (and its log before the tests: with jobs > 1 the series says their lines itself)
+  check_keys(opts, "series", series_keys)
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
   local jobs = number(opts.jobs or seixo.cores(), "jobs", "series", "a whole number of processes >= 1",
@@ -1468,17 +1489,20 @@ function lab.series(spec, opts)
     o.confining = s3
     o.out = out and series_out(out, s3)
     o.plot = false
+    test_options(spec, o, "series") -- (as the test will, in the series' name and before any test)
     tests[i] = {call = s3 > 0 and "triaxial" or "ucs", opts = o}
   end
+  -- the rate control's options against the strain rate the tests will
+  -- take (the file's timestep), as they will check them
+  local first = tests[1]
+  local m = open_test(spec, first.opts, "series")
+  local rate = first.opts.strain_rate or default_rate(m)
+  m:close()
+  local target, max_rate = rate_control(first.opts, rate, "series")
   if tolerance then
     -- the first test at half the rate: every speed of the loading-rate
     -- control halved, and the unbalanced-force ratio it allows too (the
-    -- ratio grows with the speed); its rate as that test will take it
-    local first = tests[1]
-    local m = open_test(spec, first.opts, "series")
-    local rate = first.opts.strain_rate or default_rate(m)
-    m:close()
-    local target, max_rate = rate_control(first.opts, rate, "series")
+    -- ratio grows with the speed)
     local o = copy(first.opts)
     o.strain_rate, o.max_rate, o.target_ratio = rate / 2, target and max_rate / 2 or nil, target and target / 2
     o.out = o.out and o.out .. "_half_rate"

@@ -180,6 +180,29 @@ test("a specimen table with a missing or wrong field is refused before the test,
   raises(function() lab.periodic.shear(loose, {log = false}) end, "periodic.shear: the specimen's dim is 3 but its file")
 end)
 
+test("lab.series checks its options and its tests' before the first test, in its own name", function()
+  -- (confinement = {...} said "confining = {sigma3, ...} with two values or
+  -- more", and strain_rte = 1 "lab.ucs: unknown option 'strain_rte'")
+  local t = seixo.clock()
+  raises(function() lab.series(rect, with{confinement = {0, 5e6}}) end,
+         "lab.series: unknown option 'confinement' (valid: confine_tol, confining, density_scale, every, intermediate, "
+         .. "jobs, lateral, log, max_rate, max_steps, max_strain, name, out, plot, post_peak, quasi_static, strain_rate, "
+         .. "target_ratio)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, strain_rte = 1}) end,
+         "lab.series: unknown option 'strain_rte'")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, strain_rate = -1}) end,
+         "lab.series: strain_rate must be a positive number (got -1)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, post_peak = 2}) end,
+         "lab.series: post_peak must be in (0, 1) (got 2)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, target_ratio = 2}) end,
+         "lab.series: target_ratio must be a ratio in (0, 1) or false (got 2)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, strain_rate = 1, max_rate = 0.5}) end,
+         "lab.series: max_rate must be a strain rate >= strain_rate = 1 1/s (got 0.5)")
+  raises(function() lab.series(rect, with{confining = {0, 5e6}, out = "no/such/folder/series"}) end,
+         "lab.series: cannot write no/such/folder/series_ucs.csv (out)")
+  check(seixo.clock() - t < 1, "refused before the tests")
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},

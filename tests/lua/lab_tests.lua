@@ -119,7 +119,11 @@ test("a series in processes gives the series run in turn, bit for bit, with its 
   check(text:find("lab.ucs: sigma3 0 MPa", 1, true) and text:find("lab.triaxial: sigma3 2 MPa", 1, true)
         and text:find("lab.series: quasi-static check", 1, true), text)
   -- a test that fails in its process fails the series with its message
-  raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 2, max_strain = -1, log = false}) end, "max_strain")
+  -- (its options are the series', checked before: its end state cannot be
+  -- saved, a folder having the name of its .h5)
+  os.execute("mkdir -p '" .. dir .. "/failing_triaxial_2.h5'")
+  raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 2, max_steps = 200, out = dir .. "/failing",
+                                      plot = false, log = false}) end, "failing_triaxial_2.h5': is a folder")
   raises(function() lab.series(spec, {confining = {0, 2e6}, jobs = 0}) end, "jobs must be")
   raises(function() lab.series(spec, {confining = {0, "2e6"}}) end, "confining[2] must be a number, got string '2e6'")
   raises(function() lab.series(spec, {confining = {0, 2e6}, quasi_static = 2}) end, "quasi_static must be")
