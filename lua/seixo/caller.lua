@@ -3,8 +3,11 @@
 -- from inside seixo's Lua files (their helpers raise at a fixed level,
 -- which is the caller's only for some call paths). An error raised in
 -- another of seixo's modules counts as the library's.
+-- A warning names the caller's line too (caller.where; the core's warnings
+-- ask it when this module is loaded).
 --   local caller = require "seixo.caller"
 --   caller.wrap(module_table)   -- every function of the table
+--   caller.where()              -- "file:line: " of the user's line
 local caller = {}
 
 local own = {lab = true, check = true, pool = true, calibrate = true, periodic = true, plot = true, util = true, genesis = true, caller = true,
@@ -23,6 +26,30 @@ function caller.at_caller(f)
     if inner and own[module] then error(inner, 2) end
     if e:match("^[^\n:]+:%d+: ") then error(e, 0) end -- another file's (a user's callback)
     error(e, 2) -- no position (a helper's level fell on a tail call)
+  end
+end
+
+-- The library's own files: the modules of `own`, beside this one.
+local dir = debug.getinfo(1, "S").source:match("^@(.*[/\\])") or ""
+local function library(source)
+  local module = source:sub(1, #dir + 1) == "@" .. dir and source:sub(#dir + 2):match("^([%w_]+)%.lua$")
+  return module and own[module]
+end
+
+-- "file:line: " of the innermost function on the stack that is neither
+-- C nor one of the library's, the user's line a warning names (a value
+-- given to seixo.lab and passed on to the core was named at the lab's
+-- line that passed it); nil when there is none (a worker process running
+-- a library call).
+function caller.where()
+  local level = 2
+  while true do
+    local info = debug.getinfo(level, "Sl")
+    if not info then return nil end
+    if info.what ~= "C" and info.currentline > 0 and not library(info.source) then
+      return info.short_src .. ":" .. info.currentline .. ": "
+    end
+    level = level + 1
   end
 end
 

@@ -333,8 +333,12 @@ void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bo
 /// with the message (without the script's place) pushed, or false. Clears
 /// ud->unchecked.
 bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
+/// Pushes "file:line: " of the script's line a warning names: the
+/// innermost outside seixo's Lua library (seixo.caller's where(), when the
+/// library is loaded), else luaL_where(L, 1)'s.
+void sx_lua_where(lua_State *L);
 /// Warns on stderr (once per model and `what`) when v != 0 lies outside
-/// [lo, hi] in magnitude, naming the unit expected.
+/// [lo, hi] in magnitude, naming the unit expected, at sx_lua_where's line.
 void sx_lua_check_range(lua_State *L, int model, const char *what, double v, double lo, double hi, const char *unit);
 /// Warns once per model for `key` (the caller's line, then the message);
 /// only rank 0 prints.

@@ -174,13 +174,32 @@ void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bo
 
 /* --------------------------------------------------------------- units */
 
+/* A value the lab passes on (a servo target from lab.triaxial's confining,
+ * a material from lab.specimen's) was named at the line of lab.lua that
+ * passed it, not at the script's call: seixo.caller knows the library's
+ * files. Without it (no Lua library loaded), or when no line is outside
+ * them, the caller's line. */
+void sx_lua_where(lua_State *L)
+{
+    const int top = lua_gettop(L);
+    if (lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE) == LUA_TTABLE
+        && lua_getfield(L, -1, "seixo.caller") == LUA_TTABLE && lua_getfield(L, -1, "where") == LUA_TFUNCTION
+        && lua_pcall(L, 0, 1, 0) == LUA_OK && lua_type(L, -1) == LUA_TSTRING) {
+        lua_replace(L, top + 1);
+        lua_settop(L, top + 1);
+        return;
+    }
+    lua_settop(L, top);
+    luaL_where(L, 1);
+}
+
 void sx_lua_warn_once(lua_State *L, int model, const char *key, const char *fmt, ...)
 {
     sx_lua_state(L, model, "warned");
     if (lua_getfield(L, -1, key) == LUA_TNIL) {
         lua_pushboolean(L, 1);
         lua_setfield(L, -3, key);
-        luaL_where(L, 1);
+        sx_lua_where(L);
         if (sx_lua_parallel_says(sx_lua_tomodel(L, model))) {
             char text[512];
             va_list ap;

@@ -255,7 +255,7 @@ double *sx_lua_draw_radii(lua_State *L, gen *g, rng *r)
         /* the grain size moved: said, since a user asked for those radii (a
          * sand user's finding: 0.5 ... 0.8 mm became 1.13 ... 1.80 mm, silently) */
         if (fabs(k - 1) > 0.01 && sx_lua_parallel_says(sx_lua_tomodel(L, 1))) {
-            luaL_where(L, 1);
+            sx_lua_where(L);
             fprintf(stderr,
                     "seixo: warning: %sm:generate: the radii were scaled by %.4g to reach porosity %g with %lld balls: "
                     "%g ... %g m instead of %g ... %g m (give count or porosity alone to keep the radii)\n",

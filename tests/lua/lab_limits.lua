@@ -203,6 +203,23 @@ test("lab.series checks its options and its tests' before the first test, in its
   check(seixo.clock() - t < 1, "refused before the tests")
 end)
 
+test("a unit warning about a value the lab passes on names the script's line", function()
+  -- (confining = 10 was warned of at the line of lab.lua giving the servo its target)
+  local script = T.tmpname(".lua")
+  local f = assert(io.open(script, "w"))
+  f:write(string.format([[
+local lab = require "seixo.lab"
+local s = lab.open(%q)
+lab.triaxial(s, {confining = 10, max_steps = 200, log = false, plot = false})
+]], rect.path))
+  f:close()
+  local status, out = T.run(T.quote(script))
+  eq(status, 0, out)
+  local name = script:match("[^/]*$")
+  check(out:find(name .. ":3: servo target stress 10 is outside the usual range for DEM, 1000 ... 1e+10 Pa", 1, true)
+        and not out:find("seixo/", 1, true), out)
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
