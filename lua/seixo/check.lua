@@ -147,6 +147,18 @@ function check.module(name, from)
   c.steps = number_check("a whole number of steps >= 1",
                          function(v) return v >= 1 and v < math.huge and v == math.floor(v) end, math.tointeger)
 
+  -- Warns of a stress far outside DEM's usual range, most likely a slip of
+  -- the unit (sigma0 = 0.1 meant in MPa), as the core warns of a servo's
+  -- target (lab.triaxial's confining): its range and words, at the user's
+  -- line, by rank 0 alone when the ranks share the models.
+  function c.warn_stress(v, what, fn)
+    if v == 0 or (v >= 1e3 and v <= 1e10) then return end
+    if seixo.ranks() > 1 and seixo.decompose() and seixo.rank() > 0 then return end
+    io.stderr:write(string.format("seixo: warning: %s%s.%s: %s %g is outside the usual range for DEM, %g ... %g Pa "
+                                  .. "(seixo's unit is Pa)\n", require("seixo.caller").where() or "", name, fn, what, v,
+                                  1e3, 1e10))
+  end
+
   -- Fails unless spec is a specimen table whose fields (specimen_fields'
   -- names, in the order given: dim before the corners) are what the
   -- function fn reads, naming the first that is not.

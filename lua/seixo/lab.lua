@@ -387,6 +387,7 @@ function lab.specimen(opts)
   local mat = lab.rock(opts.material)
   local sigma0 = opts.sigma0 or 0.1e6
   positive(sigma0, "sigma0", "specimen")
+  c.warn_stress(sigma0, "sigma0", "specimen")
   -- clumps: the porosity at which the vessel has its nominal size (see below)
   local porosity = opts.porosity or (dim == 3 and 0.35 or (grain and 0.14 or 0.16))
   local seed = opts.seed or 1

@@ -76,6 +76,7 @@ function periodic.specimen(opts)
   local radius, sizes = require("seixo.genesis").sizes(opts, "periodic.specimen", {0.4e-3, 0.66e-3})
   local mat = lab.rock(opts.material)
   local sigma0 = positive(opts.sigma0 or 0.1e6, "sigma0", "specimen")
+  c.warn_stress(sigma0, "sigma0", "specimen")
   local porosity = opts.porosity or (dim == 3 and 0.35 or 0.16) -- seixo.lab's
   local seed = opts.seed or 1
   if opts.bonds ~= nil and type(opts.bonds) ~= "boolean" then
@@ -176,6 +177,9 @@ function periodic.triaxial(spec, opts)
   local ax = dim
   local sigma3 = positive(opts.confining or spec.sigma0, "confining", "triaxial")
   local sigma2 = positive(opts.intermediate or sigma3, "intermediate", "triaxial")
+  -- (the cell's servo, unlike a wall's, does not warn of its target)
+  c.warn_stress(sigma3, "confining", "triaxial")
+  if opts.intermediate then c.warn_stress(sigma2, "intermediate", "triaxial") end
   if dim == 2 and sigma2 ~= sigma3 then fail("periodic.triaxial: an intermediate stress needs a 3D cell") end
   local max_strain = positive(opts.max_strain or 0.02, "max_strain", "triaxial")
   local post_peak = c.number(opts.post_peak or 0.7, "post_peak", "triaxial", "in (0, 1)",
@@ -239,6 +243,7 @@ function periodic.shear(spec, opts)
   local m = open_test(spec, "shear")
   local dim = spec.dim
   local normal = positive(opts.normal or spec.sigma0, "normal", "shear")
+  c.warn_stress(normal, "normal", "shear")
   local max_strain = positive(opts.max_strain or 0.05, "max_strain", "shear")
   local rate = opts.shear_rate or 7e-8 / m:timestep()
   positive(rate, "shear_rate", "shear")

@@ -220,6 +220,32 @@ lab.triaxial(s, {confining = 10, max_steps = 200, log = false, plot = false})
         and not out:find("seixo/", 1, true), out)
 end)
 
+test("sigma0 and the periodic tests' stresses in MPa warn, as confining does", function()
+  -- (lab.specimen{sigma0 = 0.1} had no word, where confining = 10 warned)
+  local script = T.tmpname(".lua")
+  local f = assert(io.open(script, "w"))
+  f:write(string.format([[
+local lab = require "seixo.lab"
+lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3}, seed = 3, sigma0 = 0.1, path = %q, log = false}
+local cell = lab.periodic.specimen{dim = 2, size = 0.004, radius = {0.4e-3, 0.66e-3}, bonds = false, sigma0 = 0.2,
+                                   path = %q, log = false, max_steps = 2000}
+lab.periodic.triaxial(cell, {confining = 5, log = false, max_steps = 100})
+lab.periodic.shear(cell, {normal = 2e11, log = false, max_steps = 100})
+lab.periodic.triaxial(cell, {confining = 5e6, log = false, max_steps = 100})
+]], T.tmpname(".h5"), T.tmpname(".h5")))
+  f:close()
+  local status, out = T.run(T.quote(script))
+  eq(status, 0, out)
+  local name = script:match("[^/]*$")
+  local range = " is outside the usual range for DEM, 1000 ... 1e+10 Pa (seixo's unit is Pa)"
+  for _, line in ipairs{":2: lab.specimen: sigma0 0.1", ":3: periodic.specimen: sigma0 0.2",
+                        ":5: periodic.triaxial: confining 5", ":6: periodic.shear: normal 2e+11"} do
+    check(out:find(name .. line .. range, 1, true), out)
+  end
+  local _, warnings = out:gsub("seixo: warning:", "")
+  eq(warnings, 4, out)
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
