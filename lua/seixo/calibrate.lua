@@ -692,6 +692,8 @@ local function check_options(lab, opts)
       fail("%s must be a path (a string; got %s)", k, type(opts[k]))
     end
   end
+  local folder = opts.out and require("seixo.check").prefix_error(opts.out, "calibration")
+  if folder then fail("%s", folder) end
   o.out = opts.out or "calibration"
   o.log = opts.log or (o.out .. ".csv")
   o.plot = opts.plot

@@ -77,6 +77,23 @@ local specimen_fields = {
   granular = {"true or false", function(v) return type(v) == "boolean" end, optional = true},
 }
 
+-- Why out, the path prefix of a function's files (out.csv, out.h5, ...),
+-- is a folder's name, or nil: lab.ucs(s, {out = 'dir/'}) wrote the hidden
+-- files dir/.csv and dir/.h5. stem: a file's name for the example.
+function check.prefix_error(out, stem)
+  local folder = out == "" or out:sub(-1) == "/"
+  local f = not folder and io.open(out, "r") -- (a folder opens, and reads as one)
+  if f then
+    local _, _, code = f:read(0)
+    f:close()
+    folder = code == 21
+  end
+  if not folder then return nil end
+  local dir = (out == "" or out:sub(-1) == "/") and out or out .. "/"
+  return string.format("out must be a path prefix, the files' names without their endings (.csv, .h5, ...), not a "
+                       .. "folder (got '%s'): give one such as '%s%s1'", out, dir, stem)
+end
+
 -- An options' checker for a module's functions. from: the functions whose
 -- specimen tables its tests take (default: name.specimen or lab.open).
 function check.module(name, from)
@@ -198,6 +215,15 @@ function check.module(name, from)
       error(string.format("%s.%s: %s: give the table %s returned", name, fn, why, from), 3)
     end
     return m
+  end
+
+  -- out, a path prefix (a string naming no folder: check.prefix_error)
+  function c.prefix(out, fn)
+    if type(out) ~= "string" then
+      error(string.format("%s.%s: out must be a path prefix (a string; got %s)", name, fn, type(out)), 3)
+    end
+    local why = check.prefix_error(out, fn)
+    if why then error(string.format("%s.%s: %s", name, fn, why), 3) end
   end
 
   -- Fails unless a file can be made at path (an output's, checked before

@@ -51,6 +51,7 @@ function joints.compare(opts)
   opts = opts or {}
   c.log(opts.log, "compare") -- (up front: a number was called at the first line said)
   local dim = opts.dim or 2
+  if opts.out ~= nil then c.prefix(opts.out, "compare") end
   local out = opts.out or "joints_compare"
   local radius = opts.radius or {0.4e-3, 0.66e-3}
   local confining = opts.confining or {0, 5e6, 10e6}
@@ -257,6 +258,7 @@ function joints.angle_series(spec, opts)
   -- (those of lab.ucs and joints.jointed: all before the intact specimen's test)
   c.specimen(spec, "angle_series", {"path", "dim", "shape", "wall_kn", "material", "radius", "granular", "lo", "hi"})
   local angles = opts.angles or {0, 15, 30, 45, 52.5, 60, 67.5, 75, 90}
+  if opts.out ~= nil then c.prefix(opts.out, "angle_series") end
   local out = opts.out or "angle_series"
   local joint = opts.joint or {}
   local test = merge(opts.test or {}, {log = opts.log})
@@ -307,6 +309,7 @@ end
 --- fifth), normal_stress, rows = {{disp, tau, sigma_n, dilation}, ...}}.
 function joints.direct_shear(spec, opts)
   c.specimen(spec, "direct_shear", {"path", "dim", "shape", "lo", "hi", "material", "radius"})
+  if opts.out ~= nil then c.prefix(opts.out, "direct_shear") end
   local dim = spec.dim
   if dim == 3 and spec.shape ~= "prism" or dim == 2 and spec.shape ~= "rect" then
     error("joints.direct_shear: a 2D rect or a 3D prism specimen", 2)

@@ -750,7 +750,7 @@ end
 -- out, a path prefix that can be written, and density_scale.
 local function check_out_and_scale(opts, fn)
   if opts.out ~= nil then
-    if type(opts.out) ~= "string" then fail("lab.%s: out must be a path prefix (a string; got %s)", fn, type(opts.out)) end
+    c.prefix(opts.out, fn)
     check_writable(opts.out .. ".csv", "out", fn)
   end
   number(opts.density_scale or 1, "density_scale", fn, "a factor in [1, 1e6]", function(v) return v >= 1 and v <= 1e6 end)
@@ -1480,6 +1480,7 @@ function lab.series(spec, opts)
   end
   opts.jobs, opts.quasi_static = nil, nil
   local out = opts.out
+  if out ~= nil then c.prefix(out, "series") end -- (its tests' are its own with endings: out_ucs)
   local tests = {}
   for i, s3 in ipairs(list) do
     stress(s3, string.format("confining[%d]", i), "series")

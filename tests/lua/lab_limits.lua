@@ -246,6 +246,27 @@ lab.periodic.triaxial(cell, {confining = 5e6, log = false, max_steps = 100})
   eq(warnings, 4, out)
 end)
 
+test("an out that names a folder is refused: it is a path prefix", function()
+  -- (out = 'dir/' wrote the hidden files dir/.csv and dir/.h5)
+  local dir = T.tmpname(".d")
+  os.execute("mkdir -p " .. T.quote(dir))
+  local prefix = "out must be a path prefix, the files' names without their endings (.csv, .h5, ...), not a folder"
+  raises(function() lab.ucs(rect, with{out = dir .. "/"}) end,
+         "lab.ucs: " .. prefix .. " (got '" .. dir .. "/'): give one such as '" .. dir .. "/ucs1'")
+  raises(function() lab.triaxial(rect, with{confining = 1e5, out = dir}) end,
+         "lab.triaxial: " .. prefix .. " (got '" .. dir .. "'): give one such as '" .. dir .. "/triaxial1'")
+  raises(function() lab.ucs(rect, with{out = "no/such/folder/"}) end, "lab.ucs: " .. prefix)
+  raises(function() lab.series(rect, with{confining = {0, 1e5}, out = dir .. "/"}) end, "lab.series: " .. prefix)
+  raises(function() joints.direct_shear(rect, {normal_stress = 1e6, out = dir .. "/"}) end,
+         "joints.direct_shear: " .. prefix)
+  raises(function() lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, evaluate = function() end,
+                                  out = dir .. "/"} end, "lab.calibrate: " .. prefix)
+  local r = lab.ucs(rect, with{out = dir .. "/ucs1", max_steps = 100})
+  eq(r.steps, 100)
+  check(io.open(dir .. "/ucs1.csv") and not io.open(dir .. "/.csv"), "the files in the folder, named")
+  os.execute("rm -rf " .. T.quote(dir))
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
