@@ -1523,8 +1523,10 @@ function lab.series(spec, opts)
   local points = {}
   for i, s3 in ipairs(list) do points[i] = {sigma3 = s3, sigma1 = results[i].peak} end
   local fit = lab.mohr_coulomb(points)
-  say(opts, "lab.series: Mohr-Coulomb c %.4g MPa, phi %.2f deg (UCS of the fit %.4g MPa, R^2 %.4f, rms %.3g MPa)",
-      fit.c / 1e6, fit.phi, fit.intercept / 1e6, fit.r2, fit.rms / 1e6)
+  -- (a slope below 1 has no c and phi: its warning, not "c -nan MPa")
+  local envelope = fit.warning and ": " .. fit.warning or string.format(" c %.4g MPa, phi %.2f deg", fit.c / 1e6, fit.phi)
+  say(opts, "lab.series: Mohr-Coulomb%s (UCS of the fit %.4g MPa, R^2 %.4f, rms %.3g MPa)", envelope,
+      fit.intercept / 1e6, fit.r2, fit.rms / 1e6)
   local s = {tests = {table.unpack(results, 1, #list)}, fit = fit, jobs = jobs, ran_on = ran_on}
   if tolerance then
     local slow, fast = results[#tests], results[1]

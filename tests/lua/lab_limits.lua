@@ -267,6 +267,17 @@ test("an out that names a folder is refused: it is a path prefix", function()
   os.execute("rm -rf " .. T.quote(dir))
 end)
 
+test("a series whose fitted slope is below 1 says so in its log line, not c and phi NaN", function()
+  -- (it said "Mohr-Coulomb c -nan MPa, phi -nan deg")
+  local lines = {}
+  local s = lab.series(rect, with{confining = {0, 1e6}, max_steps = 200, jobs = 1,
+                                  log = function(line) lines[#lines + 1] = line end})
+  check(s.fit.warning, "the slope of these peaks is below 1")
+  local text = table.concat(lines, "\n")
+  check(text:find("lab.series: Mohr-Coulomb: " .. s.fit.warning .. " (UCS of the fit", 1, true)
+        and not text:find("nan", 1, true), text)
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
