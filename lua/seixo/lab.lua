@@ -897,6 +897,9 @@ local function test_options(spec, opts, fn)
   local post_peak = number(opts.post_peak or 0.7, "post_peak", fn, "in (0, 1)", function(v) return v > 0 and v < 1 end)
   local every = steps(opts.every or 100, "every", fn)
   if opts.max_steps ~= nil then steps(opts.max_steps, "max_steps", fn) end
+  if opts.name ~= nil and type(opts.name) ~= "string" then
+    fail("lab.%s: name must be a string, the test's label (got %s)", fn, check.got(opts.name))
+  end
   check_out_and_scale(opts, fn)
   return sigma3, sigma2, max_strain, post_peak, every
 end
@@ -1087,7 +1090,7 @@ local function compression(spec, opts, fn)
              rows = rows,
              columns = columns, stopped = why, steps = m:step() - start, confine_steps = confine_steps,
              strain_rate = rate, platen_speed = speed, target_ratio = control or false, max_rate = max_rate,
-             density_scale = opts.density_scale or 1, timestep = m:timestep()}
+             density_scale = opts.density_scale or 1, timestep = m:timestep(), name = opts.name}
   local pr = rows[peak_row]
   r.peak_deviator = peak
   r.peak = peak + sigma3            -- sigma1 at failure
@@ -1586,7 +1589,7 @@ function plot_test(r, out)
   local csv = out .. ".csv"
   local script = terminal .. string.format([[
 set output '@s@'
-set title '%s, confining %.4g MPa'
+set title '%s%s, confining %.4g MPa'
 set xlabel 'axial strain (%%)'
 set ylabel 'deviator stress (MPa)'
 set y2label 'volumetric strain (%%)'
@@ -1598,7 +1601,7 @@ set ylabel 'cracks'
 unset y2label
 unset y2tics
 plot '%s' using ($3*100):9 with lines lw 2 title 'tension', '' using ($3*100):10 with lines lw 2 title 'shear'
-]], r.kind, r.confining / 1e6, csv, csv)
+]], r.name and r.name:gsub("'", "''") .. ": " or "", r.kind, r.confining / 1e6, csv, csv) -- (gnuplot's quote in quotes)
   return gnuplot(script, {{key = "s", path = out .. "_stress.png"}, {key = "c", path = out .. "_cracks.png"}})
 end
 

@@ -278,6 +278,17 @@ test("a series whose fitted slope is below 1 says so in its log line, not c and 
         and not text:find("nan", 1, true), text)
 end)
 
+test("name labels a compression test: its result and its figures' titles", function()
+  local dir = T.tmpname(".d")
+  os.execute("mkdir -p " .. T.quote(dir))
+  local r = lab.ucs(rect, {name = "Sample 'A'", max_steps = 100, log = false, out = dir .. "/ucs"})
+  eq(r.name, "Sample 'A'")
+  if lab.have_gnuplot() then check(io.open(dir .. "/ucs_stress.png"), "the figure of a name with quotes") end
+  os.execute("rm -rf " .. T.quote(dir))
+  raises(function() lab.triaxial(rect, with{confining = 1e5, name = 5}) end,
+         "lab.triaxial: name must be a string, the test's label (got number 5)")
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
