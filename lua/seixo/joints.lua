@@ -385,4 +385,7 @@ function joints.direct_shear(spec, opts)
   return {peak = peak, residual = res, normal_stress = sn, rows = rows}
 end
 
+-- errors point at the caller's line, not into this file or lab.lua (seixo.caller)
+require("seixo.caller").wrap(joints)
+
 return joints

@@ -289,6 +289,13 @@ test("name labels a compression test: its result and its figures' titles", funct
          "lab.triaxial: name must be a string, the test's label (got number 5)")
 end)
 
+test("an error of a lab test that seixo.joints runs is at the caller's line", function()
+  -- (it was at the line of joints.lua calling lab.ucs)
+  local err = raises(function() joints.angle_series(rect, {test = {every = 0}, log = false}) end,
+                     "lab.ucs: every must be a whole number of steps >= 1 (got 0)")
+  check(err:find("^[^\n]*lab_limits%.lua:%d+: ") and not err:find("seixo/", 1, true), err)
+end)
+
 test("a log that is not false, nil or a function is refused up front, by the option's name", function()
   -- (lab.specimen{log = 5} said "attempt to call a number value" at its first line)
   raises(function() lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3},
