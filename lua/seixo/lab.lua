@@ -810,6 +810,16 @@ local test_keys = {"confining", "intermediate", "strain_rate", "max_strain", "po
 local columns = {"step", "time", "axial_strain", "lateral_strain", "volumetric_strain", "axial_stress",
                  "lateral_stress", "deviator", "cracks_tension", "cracks_shear", "ratio", "inertial", "strain_rate"}
 
+-- A test stopped while loading (Ctrl-C, a SIGTERM, an error): with
+-- opts.out its records so far go to out.csv, which the message names,
+-- before the error goes on (they were lost with the test).
+local function keep_records(err, opts, rows)
+  if opts.out and #rows > 0 and pcall(lab.write_csv, opts.out .. ".csv", columns, rows) then
+    err = string.format("%s (the test's %d records so far are in %s.csv)", tostring(err), #rows, opts.out)
+  end
+  error(err, 0)
+end
+
 -- The loading-rate control's options: the unbalanced-force ratio it keeps
 -- the loading under (false: a constant strain rate) and the fastest rate.
 local function rate_control(opts, rate, fn)
@@ -1045,45 +1055,48 @@ local function compression(spec, opts, fn)
   local ratio_sum, ratio_n, inertial_max = 0, 0, 0
   local why = "max_strain"
   local ea = 0
-  while true do
-    if #lateral > 0 then servo_lateral() end
-    local n = record_steps(every, max_steps - (m:step() - start), max_strain - ea, rate * factor * m:timestep())
-    -- the ratio: the mean of four readings over the interval (one reading
-    -- swings by a factor of 3 with the specimen's vibrations)
-    local ratio, readings = 0, math.min(4, n)
-    for i = 1, readings do
-      m:cycle(n // readings + (i <= n % readings and 1 or 0))
-      ratio = ratio + m:ratio() / readings
+  local loaded, err = pcall(function()
+    while true do
+      if #lateral > 0 then servo_lateral() end
+      local n = record_steps(every, max_steps - (m:step() - start), max_strain - ea, rate * factor * m:timestep())
+      -- the ratio: the mean of four readings over the interval (one reading
+      -- swings by a factor of 3 with the specimen's vibrations)
+      local ratio, readings = 0, math.min(4, n)
+      for i = 1, readings do
+        m:cycle(n // readings + (i <= n % readings and 1 or 0))
+        ratio = ratio + m:ratio() / readings
+      end
+      ea = (h0 - height()) / h0
+      local el = lateral_strain()
+      local sa, sl = axial_stress(), lateral_stress()
+      local q = sa - sl
+      local p = (sa + (dim - 1) * sl) / dim
+      local inertial = inertial_number(rate * factor, spec, p, opts.density_scale or 1)
+      if m:step() - start > 10 * every then -- past the first contact transients
+        ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
+        if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
+      end
+      local row = {m:step(), m:time() - t_start, ea, el, 1 - (1 - ea) * (1 - el) ^ (dim - 1), sa, sl, q,
+                   m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial,
+                   rate * factor}
+      rows[#rows + 1] = row
+      if control then
+        local cracked = row[9] + row[10] > (rows[#rows - 1] and rows[#rows - 1][9] + rows[#rows - 1][10] or 0)
+        local f = rate_factor(factor, ratio, cracked, control, max_rate / rate)
+        if f ~= factor then factor = f; drive(top, bottom, dim, speed * factor) end
+      end
+      if q > peak then peak, peak_row = q, #rows end
+      -- past the peak: a bonded specimen loses strength only by cracking, so
+      -- a drop without cracks is a transient (the platens seating)
+      if peak > 0 and q < post_peak * peak and ea > rows[peak_row][3] and row[9] + row[10] > 0 then
+        why = "post_peak"
+        break
+      end
+      if ea >= max_strain then break end
+      if m:step() - start >= max_steps then why = "max_steps"; break end
     end
-    ea = (h0 - height()) / h0
-    local el = lateral_strain()
-    local sa, sl = axial_stress(), lateral_stress()
-    local q = sa - sl
-    local p = (sa + (dim - 1) * sl) / dim
-    local inertial = inertial_number(rate * factor, spec, p, opts.density_scale or 1)
-    if m:step() - start > 10 * every then -- past the first contact transients
-      ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
-      if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
-    end
-    local row = {m:step(), m:time() - t_start, ea, el, 1 - (1 - ea) * (1 - el) ^ (dim - 1), sa, sl, q,
-                 m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial,
-                 rate * factor}
-    rows[#rows + 1] = row
-    if control then
-      local cracked = row[9] + row[10] > (rows[#rows - 1] and rows[#rows - 1][9] + rows[#rows - 1][10] or 0)
-      local f = rate_factor(factor, ratio, cracked, control, max_rate / rate)
-      if f ~= factor then factor = f; drive(top, bottom, dim, speed * factor) end
-    end
-    if q > peak then peak, peak_row = q, #rows end
-    -- past the peak: a bonded specimen loses strength only by cracking, so
-    -- a drop without cracks is a transient (the platens seating)
-    if peak > 0 and q < post_peak * peak and ea > rows[peak_row][3] and row[9] + row[10] > 0 then
-      why = "post_peak"
-      break
-    end
-    if ea >= max_strain then break end
-    if m:step() - start >= max_steps then why = "max_steps"; break end
-  end
+  end)
+  if not loaded then keep_records(err, opts, rows) end
 
   -- results: peak, secant modulus and Poisson's ratio at half the peak
   local r = {kind = sigma3 > 0 and "triaxial" or "ucs", confining = sigma3, intermediate = sigma2, dim = dim,

@@ -326,4 +326,24 @@ test("a log that is not false, nil or a function is refused up front, by the opt
   check(#lines > 0, "a function gets the lines")
 end)
 
+test("a compression test interrupted while loading keeps its records so far in out.csv, and says so", function()
+  -- (Ctrl-C or a SIGTERM had lost the records with the test)
+  local out = T.tmpname("")
+  local script = string.format([[
+local lab = require "seixo.lab"
+local ok, e = pcall(lab.ucs, lab.open(%q), {out = %q, log = false, plot = false, max_steps = 100000000,
+                                           max_strain = 10, strain_rate = 1e-3, target_ratio = false})
+print(e)]], rect.path, out)
+  local shell = string.format("%s -e %s & p=$!; sleep 2; kill -INT $p; wait $p", T.quote(T.seixo), T.quote(script))
+  local h = io.popen(shell .. " 2>&1")
+  local said = h:read("a")
+  h:close()
+  local n = tonumber(said:match("interrupted.*the test's (%d+) records so far are in " .. out:gsub("%p", "%%%0") .. "%.csv"))
+  check(n and n > 0, said)
+  local lines = 0
+  for _ in io.lines(out .. ".csv") do lines = lines + 1 end
+  eq(lines, n + 1) -- (and the header)
+  os.remove(out .. ".csv")
+end)
+
 T.done()
