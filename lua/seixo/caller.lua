@@ -11,7 +11,19 @@
 local caller = {}
 
 local own = {lab = true, check = true, pool = true, calibrate = true, periodic = true, plot = true, util = true, genesis = true, caller = true,
-             joints = true}
+             joints = true,
+             -- seixo.lab's parts (lua/seixo/lab/)
+             ["lab/tables"] = true, ["lab/csv"] = true, ["lab/material"] = true}
+
+-- The message of an error raised in one of the library's files (its
+-- position, "seixo/lab.lua:12: " or "seixo/lab/material.lua:34: ", taken
+-- off), or nil.
+local function own_message(e)
+  for _, file in ipairs{"[%w_]+", "[%w_]+/[%w_]+"} do
+    local module, inner = e:match("^[^\n]-seixo/(" .. file .. ")%.lua:%d+: (.*)$")
+    if inner and own[module] then return inner end
+  end
+end
 
 function caller.at_caller(f)
   return function(...)
@@ -22,17 +34,17 @@ function caller.at_caller(f)
     local info = debug.getinfo(2, "Sl")
     local here = info and info.currentline > 0 and (info.short_src .. ":" .. info.currentline .. ": ")
     if here and e:sub(1, #here) == here then error(e, 0) end -- already the caller's
-    local module, inner = e:match("^[^\n]-seixo/([%w_]+)%.lua:%d+: (.*)$")
-    if inner and own[module] then error(inner, 2) end
+    local inner = own_message(e)
+    if inner then error(inner, 2) end
     if e:match("^[^\n:]+:%d+: ") then error(e, 0) end -- another file's (a user's callback)
     error(e, 2) -- no position (a helper's level fell on a tail call)
   end
 end
 
--- The library's own files: the modules of `own`, beside this one.
+-- The library's own files: the modules of `own`, beside this one and in lab/.
 local dir = debug.getinfo(1, "S").source:match("^@(.*[/\\])") or ""
 local function library(source)
-  local module = source:sub(1, #dir + 1) == "@" .. dir and source:sub(#dir + 2):match("^([%w_]+)%.lua$")
+  local module = source:sub(1, #dir + 1) == "@" .. dir and source:sub(#dir + 2):match("^([%w_/]+)%.lua$")
   return module and own[module]
 end
 

@@ -29,6 +29,9 @@
 local seixo = require "seixo"  -- a global in the executable, not under a stock lua5.4
 local pool = require "seixo.pool"
 local genesis = require "seixo.genesis"
+local tables = require "seixo.lab.tables"
+local csv = require "seixo.lab.csv"
+local material = require "seixo.lab.material"
 local lab = {}
 
 local pi = math.pi
@@ -52,20 +55,7 @@ local function check_spec(spec, fn, fields)
   c.specimen(spec, fn, fields)
 end
 
-local function copy(t)
-  if type(t) ~= "table" then return t end
-  local r = {}
-  for k, v in pairs(t) do r[k] = copy(v) end
-  return r
-end
-
-local function merge(base, over)
-  local r = copy(base)
-  for k, v in pairs(over or {}) do
-    if type(v) == "table" and type(r[k]) == "table" then r[k] = merge(r[k], v) else r[k] = copy(v) end
-  end
-  return r
-end
+local copy, merge = tables.copy, tables.merge
 
 -- The balls' bounding box including their radii, and the mean radius.
 local function extents(m)
@@ -82,64 +72,12 @@ local function extents(m)
   return lo, hi
 end
 
--- Files written whole or not at all (a temporary name, renamed when complete)
-local write_file = pool.write_file
-
---- Writes rows (arrays of numbers) under a header to a CSV file, atomically.
-function lab.write_csv(path, header, rows)
-  local out = {table.concat(header, ",")}
-  for _, row in ipairs(rows) do
-    local cells = {}
-    for k = 1, #header do cells[k] = row[k] == nil and "" or string.format("%.10g", row[k]) end
-    out[#out + 1] = table.concat(cells, ",")
-  end
-  write_file(path, table.concat(out, "\n") .. "\n")
-end
+lab.write_csv = csv.write
 
 -- -------------------------------------------------------------- materials
 
--- Potyondy & Cundall's (2004) PFC2D micro-parameters of Lac du Bonnet
--- granite (their Table 1): in 2D they give the granite's E and UCS
--- (docs/potyondy-cundall.md).
-local granite2d = {
-  density = 2630, modulus = 62e9, stiffness_ratio = 2.5, friction = 0.5, damping = 0.7,
-  bond = {radius_multiplier = 1, modulus = 62e9, stiffness_ratio = 2.5,
-          tensile_strength = 157e6, tensile_strength_sd = 36e6, cohesion = 157e6, cohesion_sd = 36e6},
-}
-
--- The same granite calibrated in 3D: with the 2D moduli a sphere packing
--- is softer (E 50 instead of 69 GPa) and weaker (UCS 150 instead of 200
--- MPa), so the moduli and strengths are scaled by the BPM's scalings (E
--- with Ec = Ec-bar, the UCS with sigma-bar_c = tau-bar_c, the ratios and
--- the coefficient of variation kept): seixo's calibration, measured in
--- docs/potyondy-cundall.md, not P&C's PFC3D table.
-local granite3d = merge(granite2d, {
-  modulus = 87e9,
-  bond = {modulus = 87e9, tensile_strength = 227e6, tensile_strength_sd = 52e6, cohesion = 227e6, cohesion_sd = 52e6},
-})
-
---- Bonded-particle micro-parameters (4-49 ... 4-53) of a granite-like rock
---- after Potyondy & Cundall (2004, Lac du Bonnet granite), with overrides.
---- over.dim = 3 starts from the set calibrated in 3D, 2 (or none) from
---- P&C's PFC2D set.
-function lab.rock(over)
-  if over ~= nil and type(over) ~= "table" then error("lab.rock: a table of overrides expected, got " .. type(over), 2) end
-  local dim = over and over.dim
-  if dim ~= nil and dim ~= 2 and dim ~= 3 then error("lab.rock: dim must be 2 or 3 (got " .. tostring(dim) .. ")", 2) end
-  if dim then over = copy(over); over.dim = nil end
-  local mat = merge(dim == 3 and granite3d or granite2d, over)
-  -- its keys and values checked now, as m:material checks them (a
-  -- misspelt key was otherwise named only by the lab.specimen it reached)
-  local why = check.material_error(mat)
-  if why then error("lab.rock: " .. why, 2) end
-  return mat
-end
-
--- The normal stiffness of a ball of radius r of material mat (4-49), for walls.
-local function ball_kn(mat, r, dim)
-  if mat.modulus and mat.modulus > 0 then return dim == 3 and 4 * r * mat.modulus or 2 * mat.modulus end
-  return mat.kn
-end
+lab.rock = material.rock
+local ball_kn = material.ball_kn
 
 -- ---------------------------------------------------------------- vessels
 
