@@ -64,8 +64,8 @@ local function fail(fmt, ...)
   error(string.format("lab.calibrate: " .. fmt, ...), level)
 end
 
-local copy -- lab.lua's deep copy, given at install
-local polling -- lab.lua's polling, given at install: fn(...) while handing out work
+local copy -- seixo.lab.tables' deep copy, given at install
+local polling -- seixo.lab.frame's polling, given at install: fn(...) while handing out work
 
 -- ------------------------------------------------------- the parameters
 
@@ -922,8 +922,8 @@ function search(lab, o)
   return result
 end
 
---- Installs lab.calibrate; lab.lua hands over its gnuplot runner (the
---- figures of the lab look the same) and its deep copy.
+--- Installs lab.calibrate; lab.lua hands over the lab's gnuplot runner
+--- (the figures of the lab look the same), its deep copy and its polling.
 function M.install(lab, helpers)
   copy = helpers.copy
   polling = helpers.polling

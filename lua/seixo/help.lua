@@ -260,7 +260,7 @@ local entries = {
   ["util.print"] = {"util.print(...)", "Prints values with util.show."},
   ["util.read_csv"] = {"util.read_csv(path) -> {header, columns, rows}", "Reads a CSV written by m:history_csv."},
 
-  -- seixo.lab (lua/seixo/lab.lua)
+  -- seixo.lab (lua/seixo/lab.lua and its parts in lua/seixo/lab/)
   ["lab.rock"] = {"lab.rock([over]) -> material", "Bonded-particle micro-parameters of a granite-like rock (Potyondy & Cundall 2004, seed 4.4), with the fields of over replacing the defaults; over.dim = 3 starts from the set calibrated in 3D (Ec = 87 GPa, bonds 227 +- 52 MPa), 2 or none from P&C's PFC2D set."},
   ["lab.specimen"] = {"lab.specimen{dim =, shape = 'cylinder' | 'prism' | 'disk', diameter =, height =, path =, material =, ...} -> spec",
     "Material genesis of a bonded specimen (radius expansion, servo to an isotropic stress, bonds, relaxation, trimming), saved to path [m, Pa]."},

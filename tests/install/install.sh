@@ -14,8 +14,8 @@ meson install -C "$build" --destdir "$dest" --no-rebuild --quiet > "$dest/instal
 root=$dest$prefix
 case $libdir in /*) lib=$dest$libdir ;; *) lib=$root/$libdir ;; esac
 for f in "$root/include/seixo/seixo.h" "$lib/libseixo.so" "$lib/pkgconfig/seixo.pc" "$root/lib/lua/5.4/seixo.so" \
-         "$root/share/lua/5.4/seixo/lab.lua" "$root/share/lua/5.4/seixo/help.lua" "$root/bin/seixo" \
-         "$root/share/seixo/render" "$root/share/seixo/render.py" "$root/share/seixo/xvfb.sh"; do
+         "$root/share/lua/5.4/seixo/lab.lua" "$root/share/lua/5.4/seixo/lab/series.lua" "$root/share/lua/5.4/seixo/help.lua" \
+         "$root/bin/seixo" "$root/share/seixo/render" "$root/share/seixo/render.py" "$root/share/seixo/xvfb.sh"; do
     [ -f "$f" ] || { echo "not installed: $f"; find "$dest" -type f; exit 1; }
 done
 # `seixo render` finds its script in the installed share/seixo (a first

@@ -1,7 +1,7 @@
 -- A triaxial series under mpirun (issue 16; test lua_mpi_series through
 -- mpi_same.sh): the specimen's genesis runs decomposed over the ranks, and
 -- lab.series hands its tests to the ranks, each test whole on one rank
--- (lab.lua, run_ranks), as lab.series{jobs} runs them in processes. Prints
+-- (lab/series.lua, run_ranks), as lab.series{jobs} runs them in processes. Prints
 -- every test's results to the bit, the fit, the quasi-static check, the
 -- log lines the script's log function saw (sorted: the tests end in an
 -- order of the ranks' pace), a file a test wrote over an older one, and a
