@@ -15,7 +15,8 @@ local own = {lab = true, check = true, pool = true, calibrate = true, periodic =
              -- seixo.lab's parts (lua/seixo/lab/)
              ["lab/tables"] = true, ["lab/csv"] = true, ["lab/material"] = true, ["lab/vessel"] = true,
              ["lab/specimen"] = true, ["lab/strain"] = true, ["lab/frame"] = true, ["lab/compression"] = true,
-             ["lab/brazilian"] = true, ["lab/mohr_coulomb"] = true, ["lab/series"] = true, ["lab/plots"] = true}
+             ["lab/brazilian"] = true, ["lab/mohr_coulomb"] = true, ["lab/series"] = true, ["lab/plots"] = true,
+             ["lab/polling"] = true}
 
 -- The message of an error raised in one of the library's files (its
 -- position, "seixo/lab.lua:12: " or "seixo/lab/material.lua:34: ", taken

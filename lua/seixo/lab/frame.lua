@@ -5,6 +5,7 @@
 local check = require "seixo.check"
 local tables = require "seixo.lab.tables"
 local csv = require "seixo.lab.csv"
+local polling = require "seixo.lab.polling"
 local extents = require("seixo.lab.specimen").extents
 
 local c = check.module("lab")
@@ -35,21 +36,6 @@ local function default_rate(m) return 7e-8 / m:timestep() end
 local function inertial_number(rate, spec, p, scale)
   if not (p > 0) then return math.huge end
   return rate * (spec.radius[1] + spec.radius[2]) * math.sqrt(scale * spec.material.density / p)
-end
-
--- Set while rank 0 runs work of its own and hands out the rest over the
--- MPI ranks (polling): called with each model a test or a genesis opens.
-local on_model_open
-local POLL_STEPS = 500
-
--- fn(...), with poll() called every POLL_STEPS steps of each model a lab
--- test or genesis opens meanwhile (a callback: no bit changes), so that
--- rank 0 hands out work to the ranks that end while it runs its own.
-local function polling(poll, fn, ...)
-  local was = on_model_open
-  local _ <close> = setmetatable({}, {__close = function() on_model_open = was end})
-  on_model_open = function(m) m:on("after", poll, {every = POLL_STEPS}) end
-  return fn(...)
 end
 
 -- The options of open_test and finish, checked before a test (fn) starts:
@@ -84,7 +70,7 @@ local function open_test(spec, opts, fn)
   local kind = dim == 3 and "plane" or "line"
   local bottom = m:wall{kind = kind, point = p_lo, normal = up, kn = spec.wall_kn, ks = 0, friction = 0}
   local top = m:wall{kind = kind, point = p_hi, normal = down, kn = spec.wall_kn, ks = 0, friction = 0}
-  if on_model_open then on_model_open(m) end
+  polling.opened(m)
   return m, lo, hi, centre, bottom, top
 end
 
@@ -123,5 +109,5 @@ local function few_records(r, every)
 end
 
 return {check_spec = check_spec, axis_of = axis_of, default_rate = default_rate, inertial_number = inertial_number,
-        polling = polling, check_out_and_scale = check_out_and_scale, open = open_test, drive = drive,
+        polling = polling.run, check_out_and_scale = check_out_and_scale, open = open_test, drive = drive,
         finish = finish, few_records = few_records}

@@ -22,6 +22,7 @@ local check = require "seixo.check"
 local tables = require "seixo.lab.tables"
 local material = require "seixo.lab.material"
 local vessel = require "seixo.lab.vessel"
+local polling = require "seixo.lab.polling"
 local specimen = {}
 
 local pi = math.pi
@@ -137,7 +138,7 @@ function specimen.make(opts)
   if not grain then check_size(size, cyl_axis, radius[2]) end -- (a clump's radii: from its template, below)
 
   local m = seixo.model{dim = dim}
-  if on_model_open then on_model_open(m) end
+  polling.opened(m) -- (it read a global of that name, never set: a calibration's genesis never polled)
   -- genesis is frictionless (a dense packing); the rock's friction comes back before bonding
   m:material("rock", merge(mat, {friction = 0}))
   if grain then -- the pebbles' radii, scaled: the sizes the tests and the bond gap use
