@@ -213,7 +213,12 @@ end
 -- One run, protected: {status = 1, values = {...}} or {status = 0, error = why}.
 local function run_job(o, x, seed)
   local t0 = seixo.clock()
+  local interrupts = seixo.interrupts()
   local ok, values = pcall(o.evaluate, o.material_of(x), seed)
+  -- an interrupt (Ctrl-C, a scheduler's SIGTERM) ends the calibration: as
+  -- a failed run it went into the log, was never run again, and the
+  -- search went on
+  if not ok and seixo.interrupts() > interrupts then error(values, 0) end
   if ok and type(values) ~= "table" then ok, values = false, "evaluate returned " .. type(values) end
   if ok then
     for _, k in ipairs(o.target_names) do

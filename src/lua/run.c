@@ -182,8 +182,15 @@ int sx_lua_interrupt_pending(void) { return sx_interrupt_pending(); }
 
 void sx_lua_interrupt_clear(void) { sx_interrupt_clear(); }
 
+/* Interrupts requested so far (seixo.interrupts): code that catches errors
+ * to go on (lab.calibrate's runs) tells an interrupt from a failure. */
+static atomic_uint interrupts;
+
+unsigned sx_lua_interrupt_count(void) { return atomic_load(&interrupts); }
+
 int sx_lua_interrupt_all(void)
 {
+    atomic_fetch_add(&interrupts, 1);
     sx_interrupt_request();
     const int n = atomic_load(&nruns);
     for (int i = 0; i < n; i++) {

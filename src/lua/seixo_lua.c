@@ -55,6 +55,13 @@ static int seixo_clock(lua_State *L)
     return 1;
 }
 
+/* seixo.interrupts(): how many interrupts (Ctrl-C, SIGTERM) came so far. */
+static int seixo_interrupts(lua_State *L)
+{
+    lua_pushinteger(L, (lua_Integer)sx_lua_interrupt_count());
+    return 1;
+}
+
 int luaopen_seixo(lua_State *L)
 {
     static const luaL_Reg functions[] = {
@@ -63,6 +70,7 @@ int luaopen_seixo(lua_State *L)
         {"check_material", sx_lua_check_material},
         {"progress", seixo_progress},
         {"clock", seixo_clock},
+        {"interrupts", seixo_interrupts},
         {NULL, NULL},
     };
     sx_lua_model_register(L, model_methods);

@@ -36,6 +36,9 @@ SX_API int sx_lua_interrupt_pending(void);
 /// Forgets a pending Ctrl-C: the caller answered it (the executable's hook
 /// raised "interrupted"), or no code was left to stop.
 SX_API void sx_lua_interrupt_clear(void);
+/// The interrupts requested so far (sx_lua_interrupt_all's calls):
+/// seixo.interrupts(), for code that catches errors to go on.
+SX_API unsigned sx_lua_interrupt_count(void);
 
 /// The progress display of long cycles (steps, time, steps/s, ETA on stderr).
 enum {

@@ -141,6 +141,29 @@ test("a failing run is recorded and skipped; a candidate with no run left costs 
   eq(p.evaluations, 4)
 end)
 
+test("an interrupted run (Ctrl-C, a scheduler's SIGTERM) ends the calibration, not logged as a failed run", function()
+  -- it had been logged as failed (never run again on a restart) and the search went on
+  local log = fresh("calibrate_interrupt.csv")
+  local runs = 0
+  raises(function()
+    lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, seeds = 1, workers = 1, maxeval = 4,
+                  log = log, plot = false, print = false,
+                  evaluate = function()
+                    runs = runs + 1
+                    os.execute("(sleep 0.2; kill -INT $PPID) &") -- (the shell's parent: this process)
+                    local t = seixo.clock()
+                    while seixo.clock() - t < 30 do end
+                    return {E = 1e9}
+                  end}
+  end, "interrupted")
+  eq(runs, 1)
+  local f = io.open(log)
+  if f then
+    f:close()
+    eq(util.read_csv(log).rows, 0, "no run logged")
+  end
+end)
+
 test("a calibration killed in the middle resumes from its log without repeating a run", function()
   local log = fresh("calibrate_resume.csv")
   local script = os.tmpname()
