@@ -147,7 +147,7 @@ test("an interrupted run (Ctrl-C, a scheduler's SIGTERM) ends the calibration, n
   local runs = 0
   raises(function()
     lab.calibrate{targets = {E = 1e9}, parameters = {modulus = {1e9, 2e9}}, seeds = 1, workers = 1, maxeval = 4,
-                  log = log, plot = false, print = false,
+                  log = log, out = "calibrate_interrupt", plot = false, print = false,
                   evaluate = function()
                     runs = runs + 1
                     os.execute("(sleep 0.2; kill -INT $PPID) &") -- (the shell's parent: this process)
