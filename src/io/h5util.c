@@ -222,12 +222,11 @@ hid_t sx_h5_create_temp(sx_h5 *h, const char *tmp, bool latest)
     const bool taken = access(tmp, F_OK) == 0; /* another writer's: never removed */
     /* EXCL: a name left by another writer is never written into */
     hid_t f = fapl >= 0 && fcpl >= 0 ? H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl) : -1;
+    /* (before any other HDF5 call, which would clear the reason from its stack) */
+    if (f < 0) sx_h5_fail_h5(h, "cannot create a file in its folder");
     sx_h5_close(fapl);
     sx_h5_close(fcpl);
-    if (f < 0) {
-        sx_h5_fail_h5(h, "cannot create a file in its folder");
-        if (!taken) remove(tmp); /* an empty file a full disk left */
-    }
+    if (f < 0 && !taken) remove(tmp); /* an empty file a full disk left */
     return f;
 }
 

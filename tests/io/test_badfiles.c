@@ -575,6 +575,7 @@ START_TEST(save_errors)
     ck_assert_int_ne(sx_snapshot_save(m, p, NULL, err, sizeof err), SX_OK);
     printf("  %s\n", err);
     ck_assert(strstr(err, p) && strstr(err, "cannot create a file in its folder") && !strchr(err, '\n'));
+    ck_assert_msg(strstr(err, "No such file or directory"), "the reason is named: %s", err);
     /* a folder in the way: refused before any write, nothing is left behind */
     char dir[400];
     io_path(dir, sizeof dir, "clean");
