@@ -462,34 +462,74 @@ hid_t sx_h5_enum(hid_t base, const char *const names[], const int values[], int 
     return t;
 }
 
-/* seixo's own checksum of a dataset's bytes, kept in its attribute
+/* seixo's own checksum of a dataset's values, kept in its attribute
  * "checksum": HDF5's Fletcher-32 of a chunk zeroed with its checksum (a
- * block a crash left unwritten) reads as valid. A word at a time (a
- * multiply and a shift per 8 bytes: a few GB/s), the length folded in. */
-static uint64_t bytes_checksum(const void *data, size_t n)
+ * block a crash left unwritten) reads as valid. Taken over the values as
+ * the file stores them (its type, little-endian), read a word at a time in
+ * that order, so any host computes the same (a multiply and a shift per 8
+ * bytes: a few GB/s), the length folded in. */
+static uint64_t bytes_checksum(const unsigned char *p, size_t n)
 {
-    const unsigned char *p = data;
     uint64_t h = 0x9e3779b97f4a7c15ULL ^ n;
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        uint64_t w;
-        memcpy(&w, p + i, 8);
+    for (size_t i = 0; i < n; i += 8) {
+        uint64_t w = 0;
+        for (size_t b = 0; b < 8 && i + b < n; b++) w |= (uint64_t)p[i + b] << (8 * b);
         h = (h ^ w) * 0xff51afd7ed558ccdULL;
         h ^= h >> 32;
     }
-    uint64_t tail = 0;
-    memcpy(&tail, p + i, n - i);
-    h = (h ^ tail) * 0xc4ceb9fe1a85ec53ULL;
+    h *= 0xc4ceb9fe1a85ec53ULL;
     return h ^ (h >> 29);
 }
 
-/* The bytes of n rows of `per` values of `mem` when they are the file's
- * own (the same type: no conversion, so the writer's and the reader's
- * buffers hold the same bytes); 0 otherwise (not checksummed). */
-static size_t same_bytes(hid_t mem, hid_t file, int64_t n, int per)
+/* The checksum of n values of `mem` (data) as stored in the dataset's type
+ * `file`: converted to it first when the two differ (an enum written from
+ * native ints, a host of the other byte order). False when they cannot be. */
+static bool file_checksum(hid_t mem, hid_t file, size_t n, const void *data, uint64_t *sum)
 {
-    if (H5Tequal(mem, file) <= 0) return 0;
-    return (size_t)n * (size_t)per * H5Tget_size(mem);
+    const size_t ms = H5Tget_size(mem), fs = H5Tget_size(file);
+    if (!ms || !fs) return false;
+    if (H5Tequal(mem, file) > 0) {
+        *sum = bytes_checksum(data, n * fs);
+        return true;
+    }
+    unsigned char *buf = malloc(n * (ms > fs ? ms : fs) + 1);
+    bool ok = buf != NULL;
+    if (ok) memcpy(buf, data, n * ms);
+    ok = ok && H5Tconvert(mem, file, n, buf, NULL, H5P_DEFAULT) >= 0;
+    if (ok) *sum = bytes_checksum(buf, n * fs);
+    free(buf);
+    return ok;
+}
+
+bool sx_h5_seal(sx_h5 *h, hid_t d, hid_t mem, const void *data, int64_t n)
+{
+    if (h->failed) return false;
+    hid_t t = H5Dget_type(d);
+    uint64_t sum = 0;
+    /* (a type HDF5 cannot convert gets no checksum: its values' own checks remain) */
+    const bool sealed = t >= 0 && n > 0 && file_checksum(mem, t, (size_t)n, data, &sum);
+    sx_h5_close(t);
+    H5Eclear2(H5E_DEFAULT);
+    return !sealed || sx_h5_attr_int(h, d, "checksum", (int64_t)sum);
+}
+
+bool sx_h5_check_seal(sx_h5 *h, hid_t d, const char *where, const char *name, hid_t mem, const void *data, int64_t n)
+{
+    if (h->failed) return false;
+    /* (files before the checksum have none) */
+    if (n <= 0 || H5Aexists(d, "checksum") <= 0) return true;
+    int64_t want = 0;
+    if (!sx_h5_get_i64(h, d, where, "checksum", &want, 1, true)) return false;
+    hid_t t = H5Dget_type(d);
+    uint64_t sum = 0;
+    const bool known = t >= 0 && file_checksum(mem, t, (size_t)n, data, &sum);
+    sx_h5_close(t);
+    H5Eclear2(H5E_DEFAULT);
+    if (known && sum != (uint64_t)want)
+        return sx_h5_fail(h, "damaged: the dataset %s/%s does not match its checksum (bytes lost or changed on the "
+                          "disk; a dataset changed on purpose with another tool loads once its attribute "
+                          "'checksum' is deleted)", where, name);
+    return true;
 }
 
 /* About 512 KiB of doubles per chunk: large enough for fast I/O and good
@@ -519,8 +559,7 @@ bool sx_h5_write(sx_h5 *h, hid_t loc, const char *name, hid_t mem, hid_t file, c
     ok = ok && (n == 0 || H5Dwrite(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
     if (!ok) sx_h5_fail_h5(h, "cannot write the dataset '%s'", name);
     if (ok && units) ok = sx_h5_attr_str(h, d, "units", units);
-    const size_t bytes = ok && filters ? same_bytes(mem, file, n, per) : 0;
-    if (bytes) ok = sx_h5_attr_int(h, d, "checksum", (int64_t)bytes_checksum(data, bytes));
+    if (ok && filters) ok = sx_h5_seal(h, d, mem, data, n * per);
     sx_h5_close(d);
     sx_h5_close(p);
     sx_h5_close(s);
@@ -582,18 +621,7 @@ bool sx_h5_read(sx_h5 *h, hid_t loc, const char *where, const char *name, hid_t 
     hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
     bool ok = d >= 0 && H5Dread(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0;
     if (!ok) sx_h5_fail_h5(h, "corrupted: the dataset %s/%s cannot be read", where, name);
-    /* (files before the checksum have none; a converted read is not the writer's bytes) */
-    if (ok && H5Aexists(d, "checksum") > 0) {
-        int64_t want = 0;
-        hid_t t = H5Dget_type(d);
-        const size_t bytes = t >= 0 ? same_bytes(mem, t, n, per) : 0;
-        sx_h5_close(t);
-        ok = sx_h5_get_i64(h, d, where, "checksum", &want, 1, true);
-        if (ok && bytes && (uint64_t)want != bytes_checksum(data, bytes))
-            ok = sx_h5_fail(h, "damaged: the dataset %s/%s does not match its checksum (bytes lost or changed on the "
-                            "disk; a dataset changed on purpose with another tool loads once its attribute "
-                            "'checksum' is deleted)", where, name);
-    }
+    ok = ok && sx_h5_check_seal(h, d, where, name, mem, data, n * per);
     sx_h5_close(d);
     return ok;
 }

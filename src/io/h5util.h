@@ -70,6 +70,14 @@ hid_t sx_h5_create_temp(sx_h5 *h, const char *tmp, bool latest);
 /// nothing left behind.
 bool sx_h5_write_temp(sx_h5 *h, const char *path, const void *data, size_t n, char *tmp, size_t len);
 
+/// Gives dataset d its attribute "checksum": of the n values of `mem` at
+/// data (the dataset's whole contents), as the file stores them.
+bool sx_h5_seal(sx_h5 *h, hid_t d, hid_t mem, const void *data, int64_t n);
+/// Compares the n values of `mem` just read from dataset d (where/name, for
+/// the message) with its "checksum", if it has one: false (failed) if they
+/// differ.
+bool sx_h5_check_seal(sx_h5 *h, hid_t d, const char *where, const char *name, hid_t mem, const void *data, int64_t n);
+
 /* ---------------------------------------------------------- attributes */
 
 bool sx_h5_attr_str(sx_h5 *h, hid_t obj, const char *name, const char *value);

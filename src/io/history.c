@@ -141,10 +141,11 @@ static bool get_column(sx_h5 *h, hid_t g, const char *where, const char *name, h
     if (h->failed || k == 0) return !h->failed;
     hid_t d = H5Dopen2(g, name, H5P_DEFAULT), fs = -1, ms = -1;
     hsize_t start = 0, count = (hsize_t)k;
-    const bool ok = d >= 0 && (fs = H5Dget_space(d)) >= 0 && (ms = H5Screate_simple(1, &count, NULL)) >= 0 &&
+    bool ok = d >= 0 && (fs = H5Dget_space(d)) >= 0 && (ms = H5Screate_simple(1, &count, NULL)) >= 0 &&
                     H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &count, NULL) >= 0 &&
                     H5Dread(d, mem, ms, fs, H5P_DEFAULT, data) >= 0;
     if (!ok) sx_h5_fail_h5(h, "corrupted: the dataset %s/%s cannot be read", where, name);
+    ok = ok && sx_h5_check_seal(h, d, where, name, mem, data, k);
     sx_h5_close(ms);
     sx_h5_close(fs);
     sx_h5_close(d);
@@ -173,6 +174,17 @@ bool sx_io_history_tail(sx_h5 *h, hid_t g, const char *where, int64_t *count, in
     return ok;
 }
 
+/* A snapshot's column, written whole, gets its checksum (a series' grows
+ * in place: none). */
+static void seal_column(sx_h5 *h, hid_t g, const char *name, hid_t mem, const void *data, int64_t n)
+{
+    if (h->failed) return;
+    hid_t d = H5Dopen2(g, name, H5P_DEFAULT);
+    if (d < 0) sx_h5_fail_h5(h, "cannot open the dataset '%s' of a history", name);
+    else sx_h5_seal(h, d, mem, data, n);
+    sx_h5_close(d);
+}
+
 bool sx_io_histories_write(sx_h5 *h, hid_t file, const sx_io_history *x, int n)
 {
     if (h->failed || n <= 0) return !h->failed;
@@ -183,6 +195,9 @@ bool sx_io_histories_write(sx_h5 *h, hid_t file, const sx_io_history *x, int n)
         hid_t q = sx_io_history_create(h, g, &x[i], i, chunk);
         sx_io_history_put(h, q, &x[i], 0, 0);
         sx_h5_attr_int(h, q, "count", x[i].n);
+        seal_column(h, q, "step", H5T_NATIVE_INT64, x[i].steps, x[i].n);
+        seal_column(h, q, "time", H5T_NATIVE_DOUBLE, x[i].times, x[i].n);
+        seal_column(h, q, "value", H5T_NATIVE_DOUBLE, x[i].values, x[i].n);
         sx_h5_close(q);
     }
     sx_h5_close(g);

@@ -301,6 +301,30 @@ START_TEST(zeroed_chunks)
         snprintf(what, sizeof what, "the dataset %s", sets[k]);
         expect_error(p, 0, what);
     }
+    /* an enum written from native ints (a Hertz material's law read back as
+     * linear) and a history's samples (read back as zeros) */
+    sx_model *m = io_scene_hertz(3);
+    int64_t steps[100];
+    double times[100], values[100];
+    for (int i = 0; i < 100; i++) steps[i] = i + 1, times[i] = 1e-6 * (i + 1), values[i] = 1.5 + i;
+    sx_io_history x = {.name = "kinetic", .every = 1, .source = SX_IO_SOURCE_BUILTIN, .builtin = "kinetic",
+                       .n = 100, .steps = steps, .times = times, .values = values};
+    sx_snapshot_opts o;
+    memset(&o, 0, sizeof o);
+    o.histories = &x;
+    o.nhistories = 1;
+    char good[512], err[512];
+    io_path(good, sizeof good, "hertz.h5");
+    ck_assert_msg(sx_snapshot_save(m, good, &o, err, sizeof err) == SX_OK, "%s", err);
+    sx_model_destroy(m);
+    const char *more[] = {"/materials/model", "/histories/kinetic/value", "/histories/kinetic/step"};
+    for (size_t k = 0; k < sizeof more / sizeof *more; k++) {
+        copy_file(good, p);
+        zero_chunk(p, more[k]);
+        char what[128];
+        snprintf(what, sizeof what, "the dataset %s", more[k]);
+        expect_error(p, 0, what);
+    }
 }
 END_TEST
 
