@@ -123,16 +123,24 @@ local function pid_of(stem)
   end
 end
 
--- Interrupts a worker (seixo stops at a SIGINT as at Ctrl-C), once a
--- second until it has gone: a worker that has only just started ignores
--- the signal until seixo sets its handler (a background command's SIGINT
--- is ignored by the shell that starts it).
-local function interrupt(pid)
+-- Interrupts the workers (seixo stops at a SIGINT as at Ctrl-C), once a
+-- second until they have gone, for up to 30 s in all: a worker that has
+-- only just started ignores the signal until seixo sets its handler (a
+-- background command's SIGINT is ignored by the shell that starts it).
+local function interrupt(pids)
+  local function alive(list)
+    local left = {}
+    for _, pid in ipairs(list) do
+      if os.execute("kill -0 " .. pid .. " 2>/dev/null") then left[#left + 1] = pid end
+    end
+    return left
+  end
   for _ = 1, 30 do
-    os.execute("kill -INT " .. pid .. " 2>/dev/null")
+    pids = alive(pids)
+    if #pids == 0 then return end
+    os.execute("kill -INT " .. table.concat(pids, " ") .. " 2>/dev/null")
     for _ = 1, 10 do
-      local alive = os.execute("kill -0 " .. pid .. " 2>/dev/null")
-      if not alive then return end
+      if #alive(pids) == 0 then return end
       os.execute("sleep 0.1")
     end
   end
@@ -191,9 +199,10 @@ function pool.run(o)
   -- are interrupted, then waited for: their answers would be dropped, and
   -- a `kill -INT` of this process alone (a scheduler's) had let them run
   -- to their end
+  local pids = {}
+  for i in pairs(running) do pids[#pids + 1] = pid_of(stem(i)) end
+  interrupt(pids)
   for i, h in pairs(running) do
-    local pid = pid_of(stem(i))
-    if pid then interrupt(pid) end
     h:close()
     for _, ext in ipairs({".lua", ".out", ".txt", ".pid"}) do os.remove(stem(i) .. ext) end
   end

@@ -180,11 +180,12 @@ static void on_sigint(int sig)
     }
 }
 
-/* SIGINT, and serially SIGTERM too: a batch scheduler's (SLURM's scancel,
- * `timeout`) is then a Ctrl-C, which a script can catch to save its state,
- * and which lets a save under way finish instead of leaving its temporary
- * file. (Under mpirun a SIGTERM is the launcher ending the job: it keeps
- * its default.) */
+/* SIGINT, and on one rank SIGTERM too: a batch scheduler's (SLURM's
+ * scancel, `timeout`) is then a Ctrl-C, which a script can catch to save
+ * its state, and which lets a save under way finish instead of leaving its
+ * temporary file (while os.execute waits for a command, as for Ctrl-C, it
+ * takes effect when the command ends). (With more ranks a SIGTERM is the
+ * launcher ending the job: it keeps its default.) */
 static void set_sigint(void (*handler)(int))
 {
     struct sigaction sa;

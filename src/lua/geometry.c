@@ -20,6 +20,7 @@
  * in g/cm^3, a stress in MPa) warn on stderr once per model and kind of
  * value, with the unit expected: they may be intended (a scaled model). */
 #include "bindings.h"
+#include "seixo_lua.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -182,12 +183,17 @@ void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bo
 void sx_lua_where(lua_State *L)
 {
     const int top = lua_gettop(L);
+    const unsigned interrupts = sx_lua_interrupt_count();
     if (lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE) == LUA_TTABLE
-        && lua_getfield(L, -1, "seixo.caller") == LUA_TTABLE && lua_getfield(L, -1, "where") == LUA_TFUNCTION
-        && lua_pcall(L, 0, 1, 0) == LUA_OK && lua_type(L, -1) == LUA_TSTRING) {
-        lua_replace(L, top + 1);
-        lua_settop(L, top + 1);
-        return;
+        && lua_getfield(L, -1, "seixo.caller") == LUA_TTABLE && lua_getfield(L, -1, "where") == LUA_TFUNCTION) {
+        const int status = lua_pcall(L, 0, 1, 0);
+        if (status == LUA_OK && lua_type(L, -1) == LUA_TSTRING) {
+            lua_replace(L, top + 1);
+            lua_settop(L, top + 1);
+            return;
+        }
+        /* a Ctrl-C that stopped where() is the script's to answer, not lost here */
+        if (status != LUA_OK && sx_lua_interrupt_count() != interrupts) lua_error(L);
     }
     lua_settop(L, top);
     luaL_where(L, 1);
