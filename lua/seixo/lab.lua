@@ -17,6 +17,7 @@
 --   plots.lua         the figures (gnuplot), lab.have_gnuplot
 --   csv.lua           lab.write_csv
 --   tables.lua        deep copies and merges of tables
+--   polling.lua       rank 0's polling of the MPI ranks while it runs a test or a genesis
 -- lab.calibrate is seixo.calibrate's, lab.periodic seixo.periodic.
 --
 -- Stresses are compression positive; strains are compression positive
