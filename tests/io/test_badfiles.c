@@ -115,15 +115,16 @@ START_TEST(truncated)
 }
 END_TEST
 
-/* The file offset of the first chunk of a dataset. */
-static haddr_t chunk_address(const char *path, const char *dataset)
+/* The file offset of the first chunk of a dataset (its bytes in *size, if given). */
+static haddr_t chunk_address(const char *path, const char *dataset, hsize_t *size)
 {
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
     hid_t s = H5Dget_space(d);
     haddr_t addr = HADDR_UNDEF;
-    hsize_t size = 0;
-    ck_assert(H5Dget_chunk_info(d, s, 0, NULL, NULL, &addr, &size) >= 0);
+    hsize_t bytes = 0;
+    ck_assert(H5Dget_chunk_info(d, s, 0, NULL, NULL, &addr, &bytes) >= 0);
+    if (size) *size = bytes;
     H5Sclose(s);
     H5Dclose(d);
     H5Fclose(f);
@@ -254,11 +255,11 @@ START_TEST(corrupted)
     io_path(p, sizeof p, "bad.h5");
     /* a byte of ball positions: the dataset's checksum catches it */
     copy_file(good3, p);
-    flip(p, (long)chunk_address(p, "/balls/position") + 40);
+    flip(p, (long)chunk_address(p, "/balls/position", NULL) + 40);
     expect_error(p, 0, "corrupted: the dataset /balls/position");
     /* a byte of the pair store's history */
     copy_file(good3, p);
-    flip(p, (long)chunk_address(p, "/contacts/ball_ball/shear_force") + 3);
+    flip(p, (long)chunk_address(p, "/contacts/ball_ball/shear_force", NULL) + 3);
     expect_error(p, 0, "corrupted");
     /* the superblock */
     copy_file(good3, p);
@@ -272,20 +273,26 @@ END_TEST
  * so seixo's own checksum of each dataset must catch it. */
 static void zero_chunk(const char *path, const char *dataset)
 {
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
-    hid_t s = H5Dget_space(d);
-    haddr_t addr = HADDR_UNDEF;
     hsize_t size = 0;
-    ck_assert(H5Dget_chunk_info(d, s, 0, NULL, NULL, &addr, &size) >= 0);
-    H5Sclose(s);
-    H5Dclose(d);
-    H5Fclose(f);
+    const haddr_t addr = chunk_address(path, dataset, &size);
     FILE *o = fopen(path, "r+b");
     ck_assert_ptr_nonnull(o);
     ck_assert_int_eq(fseek(o, (long)addr, SEEK_SET), 0);
     for (hsize_t i = 0; i < size; i++) ck_assert_int_ne(fputc(0, o), EOF);
     fclose(o);
+}
+
+/* A copy of `good` at p with a chunk of each dataset zeroed in turn is
+ * refused, naming the dataset. */
+static void expect_zeroed_refused(const char *good, const char *p, const char *const *sets, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        copy_file(good, p);
+        zero_chunk(p, sets[k]);
+        char what[128];
+        snprintf(what, sizeof what, "the dataset %s", sets[k]);
+        expect_error(p, 0, what);
+    }
 }
 
 START_TEST(zeroed_chunks)
@@ -294,13 +301,7 @@ START_TEST(zeroed_chunks)
     char p[512];
     io_path(p, sizeof p, "bad.h5");
     const char *sets[] = {"/balls/velocity", "/balls/position", "/contacts/ball_ball/shear_force", "/bonds/kind"};
-    for (size_t k = 0; k < sizeof sets / sizeof *sets; k++) {
-        copy_file(good3, p);
-        zero_chunk(p, sets[k]);
-        char what[128];
-        snprintf(what, sizeof what, "the dataset %s", sets[k]);
-        expect_error(p, 0, what);
-    }
+    expect_zeroed_refused(good3, p, sets, sizeof sets / sizeof *sets);
     /* an enum written from native ints (a Hertz material's law read back as
      * linear) and a history's samples (read back as zeros) */
     sx_model *m = io_scene_hertz(3);
@@ -318,13 +319,7 @@ START_TEST(zeroed_chunks)
     ck_assert_msg(sx_snapshot_save(m, good, &o, err, sizeof err) == SX_OK, "%s", err);
     sx_model_destroy(m);
     const char *more[] = {"/materials/model", "/histories/kinetic/value", "/histories/kinetic/step"};
-    for (size_t k = 0; k < sizeof more / sizeof *more; k++) {
-        copy_file(good, p);
-        zero_chunk(p, more[k]);
-        char what[128];
-        snprintf(what, sizeof what, "the dataset %s", more[k]);
-        expect_error(p, 0, what);
-    }
+    expect_zeroed_refused(good, p, more, sizeof more / sizeof *more);
 }
 END_TEST
 
