@@ -9,6 +9,18 @@ local joints = require "seixo.joints"
 local rect = lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3}, seed = 3,
                           path = T.tmpname(".h5"), log = false}
 local quiet = {log = false, plot = false}
+
+-- Runs text as a script file of its own (warnings name its lines), which
+-- must succeed; returns the file's name and the output.
+local function run_script(text)
+  local script = T.tmpname(".lua")
+  local f = assert(io.open(script, "w"))
+  f:write(text)
+  f:close()
+  local status, out = T.run(T.quote(script))
+  eq(status, 0, out)
+  return script:match("[^/]*$"), out
+end
 local function with(o)
   local t = {}
   for k, v in pairs(quiet) do t[k] = v end
@@ -205,26 +217,18 @@ end)
 
 test("a unit warning about a value the lab passes on names the script's line", function()
   -- (confining = 10 was warned of at the line of lab.lua giving the servo its target)
-  local script = T.tmpname(".lua")
-  local f = assert(io.open(script, "w"))
-  f:write(string.format([[
+  local name, out = run_script(string.format([[
 local lab = require "seixo.lab"
 local s = lab.open(%q)
 lab.triaxial(s, {confining = 10, max_steps = 200, log = false, plot = false})
 ]], rect.path))
-  f:close()
-  local status, out = T.run(T.quote(script))
-  eq(status, 0, out)
-  local name = script:match("[^/]*$")
   check(out:find(name .. ":3: servo target stress 10 is outside the usual range for DEM, 1000 ... 1e+10 Pa", 1, true)
         and not out:find("seixo/", 1, true), out)
 end)
 
 test("sigma0 and the periodic tests' stresses in MPa warn, as confining does", function()
   -- (lab.specimen{sigma0 = 0.1} had no word, where confining = 10 warned)
-  local script = T.tmpname(".lua")
-  local f = assert(io.open(script, "w"))
-  f:write(string.format([[
+  local name, out = run_script(string.format([[
 local lab = require "seixo.lab"
 lab.specimen{dim = 2, width = 0.005, height = 0.01, radius = {0.4e-3, 0.66e-3}, seed = 3, sigma0 = 0.1, path = %q, log = false}
 local cell = lab.periodic.specimen{dim = 2, size = 0.004, radius = {0.4e-3, 0.66e-3}, bonds = false, sigma0 = 0.2,
@@ -233,10 +237,6 @@ lab.periodic.triaxial(cell, {confining = 5, log = false, max_steps = 100})
 lab.periodic.shear(cell, {normal = 2e11, log = false, max_steps = 100})
 lab.periodic.triaxial(cell, {confining = 5e6, log = false, max_steps = 100})
 ]], T.tmpname(".h5"), T.tmpname(".h5")))
-  f:close()
-  local status, out = T.run(T.quote(script))
-  eq(status, 0, out)
-  local name = script:match("[^/]*$")
   local range = " is outside the usual range for DEM, 1000 ... 1e+10 Pa (seixo's unit is Pa)"
   for _, line in ipairs{":2: lab.specimen: sigma0 0.1", ":3: periodic.specimen: sigma0 0.2",
                         ":5: periodic.triaxial: confining 5", ":6: periodic.shear: normal 2e+11"} do
