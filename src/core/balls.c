@@ -74,12 +74,8 @@ static sx_status balls_resize(sx_model *m, int64_t cap)
     if (cap > INT32_MAX / 4) return SX_ENOMEM;
     sx_ball_field f[SX_BALL_FIELDS_MAX];
     const int nf = sx__ball_fields(m, b, f);
-    for (int k = 0; k < nf; k++) {
-        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(b->cap * f[k].per), (size_t)(cap * f[k].per),
-                                  sx__field_size(f[k].type));
-        if (!q) return SX_ENOMEM;
-        *f[k].data = q;
-    }
+    for (int k = 0; k < nf; k++)
+        if (!sx__field_resize(&m->alloc, f[k].data, f[k].per, f[k].type, b->cap, cap)) return SX_ENOMEM;
     b->cap = cap;
     return SX_OK;
 }
@@ -390,12 +386,8 @@ static sx_status pairs_resize(sx_model *m, sx_pairs *p, int64_t cap)
     if (cap > INT32_MAX) return SX_ENOMEM;
     sx_pair_field f[SX_PAIR_FIELDS_MAX];
     const int nf = sx__pair_fields(m, p, f);
-    for (int k = 0; k < nf; k++) {
-        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(p->cap * f[k].per), (size_t)(cap * f[k].per),
-                                  sx__pair_size(&f[k]));
-        if (!q) return SX_ENOMEM;
-        *f[k].data = q;
-    }
+    for (int k = 0; k < nf; k++)
+        if (!sx__field_resize(&m->alloc, f[k].data, f[k].per, f[k].type, p->cap, cap)) return SX_ENOMEM;
     p->cap = cap;
     return SX_OK;
 }

@@ -63,12 +63,8 @@ static sx_status bonds_reserve(sx_model *m, int64_t cap)
     if (cap > INT32_MAX - 1) return SX_ENOMEM;
     sx_bond_field f[SX_BOND_FIELDS_MAX];
     const int nf = sx__bond_fields(m, b, f);
-    for (int k = 0; k < nf; k++) {
-        void *q = sx_alloc_resize(&m->alloc, *f[k].data, (size_t)(b->cap * f[k].per), (size_t)(cap * f[k].per),
-                                  sx__field_size(f[k].type));
-        if (!q) return SX_ENOMEM;
-        *f[k].data = q;
-    }
+    for (int k = 0; k < nf; k++)
+        if (!sx__field_resize(&m->alloc, f[k].data, f[k].per, f[k].type, b->cap, cap)) return SX_ENOMEM;
     b->cap = cap;
     return SX_OK;
 }

@@ -38,6 +38,14 @@ static inline size_t sx__field_size(sx_field_type t)
 {
     return t == SX_FIELD_F64 ? sizeof(double) : t == SX_FIELD_I32 ? sizeof(int32_t) : t == SX_FIELD_U16 ? 2 : 1;
 }
+/* Resizes a store's field, `per` elements of type t a row, from `from`
+ * rows to `to`; false (the array as it was) out of memory. */
+static inline bool sx__field_resize(sx_alloc *a, void **data, int per, sx_field_type t, int64_t from, int64_t to)
+{
+    void *q = sx_alloc_resize(a, *data, (size_t)(from * per), (size_t)(to * per), sx__field_size(t));
+    if (q) *data = q;
+    return q != NULL;
+}
 
 /* Bonds live apart from pairs, so an unbonded scene stores none. A pair
  * refers to its bond by slot (pairs.bond, allocated with the first bond);
