@@ -481,9 +481,9 @@ static uint64_t bytes_checksum(const unsigned char *p, size_t n)
     return h ^ (h >> 29);
 }
 
-/* The checksum of n values of `mem` (data) as stored in the dataset's type
- * `file`: converted to it first when the two differ (an enum written from
- * native ints, a host of the other byte order). False when they cannot be. */
+/* The checksum of n values of `mem` (data) as stored in the type `file`:
+ * converted to it first when the two differ (an enum written from native
+ * ints, a host of the other byte order). False when they cannot be. */
 static bool file_checksum(hid_t mem, hid_t file, size_t n, const void *data, uint64_t *sum)
 {
     const size_t ms = H5Tget_size(mem), fs = H5Tget_size(file);
@@ -501,16 +501,23 @@ static bool file_checksum(hid_t mem, hid_t file, size_t n, const void *data, uin
     return ok;
 }
 
+/* The checksum of dataset d's n values, given as `mem` at data (its whole
+ * contents), as the file stores them; false when it cannot be taken (a
+ * type HDF5 cannot convert: its values' own checks remain). */
+static bool dataset_checksum(hid_t d, hid_t mem, const void *data, int64_t n, uint64_t *sum)
+{
+    hid_t t = H5Dget_type(d);
+    const bool known = t >= 0 && n > 0 && file_checksum(mem, t, (size_t)n, data, sum);
+    sx_h5_close(t);
+    H5Eclear2(H5E_DEFAULT);
+    return known;
+}
+
 bool sx_h5_seal(sx_h5 *h, hid_t d, hid_t mem, const void *data, int64_t n)
 {
     if (h->failed) return false;
-    hid_t t = H5Dget_type(d);
     uint64_t sum = 0;
-    /* (a type HDF5 cannot convert gets no checksum: its values' own checks remain) */
-    const bool sealed = t >= 0 && n > 0 && file_checksum(mem, t, (size_t)n, data, &sum);
-    sx_h5_close(t);
-    H5Eclear2(H5E_DEFAULT);
-    return !sealed || sx_h5_attr_int(h, d, "checksum", (int64_t)sum);
+    return !dataset_checksum(d, mem, data, n, &sum) || sx_h5_attr_int(h, d, "checksum", (int64_t)sum);
 }
 
 bool sx_h5_check_seal(sx_h5 *h, hid_t d, const char *where, const char *name, hid_t mem, const void *data, int64_t n)
@@ -520,12 +527,8 @@ bool sx_h5_check_seal(sx_h5 *h, hid_t d, const char *where, const char *name, hi
     if (n <= 0 || H5Aexists(d, "checksum") <= 0) return true;
     int64_t want = 0;
     if (!sx_h5_get_i64(h, d, where, "checksum", &want, 1, true)) return false;
-    hid_t t = H5Dget_type(d);
     uint64_t sum = 0;
-    const bool known = t >= 0 && file_checksum(mem, t, (size_t)n, data, &sum);
-    sx_h5_close(t);
-    H5Eclear2(H5E_DEFAULT);
-    if (known && sum != (uint64_t)want)
+    if (dataset_checksum(d, mem, data, n, &sum) && sum != (uint64_t)want)
         return sx_h5_fail(h, "damaged: the dataset %s/%s does not match its checksum (bytes lost or changed on the "
                           "disk; a dataset changed on purpose with another tool loads once its attribute "
                           "'checksum' is deleted)", where, name);
