@@ -121,6 +121,17 @@ void sx__bonds_free(sx_model *m)
     memset(&m->cracks, 0, sizeof m->cracks);
 }
 
+size_t sx__bonds_bytes(const sx_model *m)
+{
+    sx_bond_field f[SX_BOND_FIELDS_MAX];
+    const int nf = sx__bond_fields(m, (sx_bonds *)&m->bonds, f);
+    size_t per_bond = 0;
+    for (int j = 0; j < nf; j++) per_bond += (size_t)f[j].per * sx__field_size(f[j].type);
+    const size_t per_element = 1 + (4 + (size_t)(m->dim - 1)) * sizeof(double);
+    return (size_t)m->bonds.cap * per_bond + (size_t)m->fjel.cap * per_element +
+           (size_t)m->cracks.cap * sizeof(sx_crack);
+}
+
 /* Only ball-ball pairs carry bonds. */
 sx_status sx__bonds_reserve_pairs(sx_model *m)
 {

@@ -124,14 +124,7 @@ sx_memory sx_model_memory(const sx_model *m)
     r.peak = m->alloc.peak;
     r.balls = sx__balls_bytes(m);
     r.contacts = sx__pairs_bytes(m, &m->bb) + sx__pairs_bytes(m, &m->bw) + sx__cell_bytes(m) + sx__joints_bytes(m);
-    const sx_bonds *k = &m->bonds;
-    const size_t d = (size_t)m->dim;
-    sx_bond_field f[SX_BOND_FIELDS_MAX];
-    const int nf = sx__bond_fields(m, (sx_bonds *)k, f);
-    size_t per_bond = 0;
-    for (int j = 0; j < nf; j++) per_bond += (size_t)f[j].per * sx__field_size(f[j].type);
-    const size_t per_element = 1 + (4 + (d - 1)) * sizeof(double);
-    r.bonds = (size_t)k->cap * per_bond + (size_t)m->fjel.cap * per_element + (size_t)m->cracks.cap * sizeof(sx_crack);
+    r.bonds = sx__bonds_bytes(m);
     r.work = r.total - r.balls - r.contacts - r.bonds;
     r.ball_count = m->balls.n;
     r.pair_count = m->bb.n + m->bw.n;

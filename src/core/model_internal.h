@@ -702,6 +702,8 @@ void sx__pair_flip(sx_model *m, sx_pairs *p, int64_t k); /* swap a and b, re-exp
 /* Bytes of the ball arrays (with the id map and the grid's per-ball cells), of a pair store. */
 size_t sx__balls_bytes(const sx_model *m);
 size_t sx__pairs_bytes(const sx_model *m, const sx_pairs *p);
+/* The bond store's bytes: the bonds, the flat joints' elements and the crack log. */
+size_t sx__bonds_bytes(const sx_model *m);
 /* Sorts the store by a, stably (a no-op when it is); false when out of memory. */
 bool sx__pairs_sort(sx_model *m, sx_pairs *p);
 void sx__walls_free(sx_model *m);
