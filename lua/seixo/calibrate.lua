@@ -64,8 +64,9 @@ local function fail(fmt, ...)
   error(string.format("lab.calibrate: " .. fmt, ...), level)
 end
 
-local copy -- seixo.lab.tables' deep copy, given at install
-local polling -- seixo.lab.frame's polling, given at install: fn(...) while handing out work
+local copy = require("seixo.lab.tables").copy
+local polling = require("seixo.lab.polling").run -- fn(...) while handing out work
+local gnuplot = require("seixo.lab.plots").gnuplot -- (the figures of the lab look the same)
 
 -- ------------------------------------------------------- the parameters
 
@@ -519,7 +520,7 @@ set y2tics
 set key outside bottom center horizontal
 plot 1 lc rgb 'black' notitle, %s
 ]], table.concat(lines, ", "))
-  o.gnuplot(script, {{key = "p", path = o.out .. "_convergence.png"}})
+  gnuplot(script, {{key = "p", path = o.out .. "_convergence.png"}})
 end
 
 local function final_table(o, best)
@@ -714,9 +715,8 @@ end
 
 local search -- below: the search of a calibration, on rank 0
 
-local function calibrate(lab, helpers, opts)
+local function calibrate(lab, opts)
   local o = check_options(lab, opts)
-  o.gnuplot = helpers.gnuplot
   -- over MPI ranks every rank runs specimens of its own, not one model
   -- decomposed: the models made from here on are each rank's (seixo.decompose)
   if seixo.ranks() > 1 then seixo.decompose(false) end
@@ -927,18 +927,15 @@ function search(lab, o)
   return result
 end
 
---- Installs lab.calibrate; lab.lua hands over the lab's gnuplot runner
---- (the figures of the lab look the same), its deep copy and its polling.
-function M.install(lab, helpers)
-  copy = helpers.copy
-  polling = helpers.polling
+--- Installs lab.calibrate in the lab's table.
+function M.install(lab)
   -- the ranks' own models (seixo.decompose(false)) for the calibration's
   -- runs only: the script's models after it are decomposed again, and its
   -- files rank 0's again (each rank wrote the same files after it)
   lab.calibrate = function(opts)
     local shared = seixo.decompose()
     local _ <close> = setmetatable({}, {__close = function() seixo.decompose(shared) end})
-    return calibrate(lab, helpers, opts)
+    return calibrate(lab, opts)
   end
 end
 

@@ -27,12 +27,10 @@
 -- drifts at large ones: a sand's 25 %). In 2D (disks of unit
 -- thickness) stresses are per unit thickness, i.e. N/m over m: Pa.
 
-local tables = require "seixo.lab.tables"
 local csv = require "seixo.lab.csv"
 local material = require "seixo.lab.material"
 local specimen = require "seixo.lab.specimen"
 local strain = require "seixo.lab.strain"
-local frame = require "seixo.lab.frame"
 local compression = require "seixo.lab.compression"
 local brazilian = require "seixo.lab.brazilian"
 local mohr_coulomb = require "seixo.lab.mohr_coulomb"
@@ -54,7 +52,7 @@ local lab = {
 }
 
 -- lab.calibrate (calibrate.lua): the search for micro-parameters, with the lab's figures
-require("seixo.calibrate").install(lab, {gnuplot = plots.gnuplot, copy = tables.copy, polling = frame.polling})
+require("seixo.calibrate").install(lab)
 
 -- periodic cells, without walls (lua/seixo/periodic.lua)
 lab.periodic = require "seixo.periodic"

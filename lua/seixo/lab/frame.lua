@@ -109,5 +109,5 @@ local function few_records(r, every)
 end
 
 return {check_spec = check_spec, axis_of = axis_of, default_rate = default_rate, inertial_number = inertial_number,
-        polling = polling.run, check_out_and_scale = check_out_and_scale, open = open_test, drive = drive,
+        check_out_and_scale = check_out_and_scale, open = open_test, drive = drive,
         finish = finish, few_records = few_records}

@@ -15,7 +15,8 @@ local series = {}
 local c = check.module("lab")
 local fail, check_keys, say, stress, number = c.fail, c.keys, c.say, c.stress, c.number
 local copy = tables.copy
-local check_spec, polling, open_test, default_rate = frame.check_spec, frame.polling, frame.open, frame.default_rate
+local check_spec, open_test, default_rate = frame.check_spec, frame.open, frame.default_rate
+local polling = require("seixo.lab.polling").run
 local compression_fields, test_keys, test_options, rate_control = compression.fields, compression.keys,
                                                                   compression.options, compression.rate_control
 
