@@ -34,7 +34,8 @@ typedef struct rank_ctx {
     int64_t crossing, moved; /* clumps: pebbles routed to another rank's clump; clumps whose owner changed */
     int64_t first_own, last_own; /* the balls of the first and of the last rank, at cycle B's last plan */
     double pace[MAX_RANKS];      /* the ranks' paces after cycle C */
-    int64_t builds;              /* cycle B's builds (all but a first one inside the cycle, the ranks listing in parts) */
+    int64_t builds; /* cycle B's builds (but a first one, inside the cycle, the ranks listing in parts); lazily all */
+    int64_t gathers;             /* cycle B's exchanges of the whole state (its end's alone: a build migrates) */
     bool lazy;                   /* the cycles in short runs that leave the state scattered, gathered at the end */
     int64_t runs, resumed;       /* lazy: the runs, and those that went on from a scattered state */
     uint64_t hash;
@@ -193,8 +194,8 @@ static sx_model *clump_bed(int dim)
 enum { STEPS_A = 150, STEPS_B = 250 };
 
 /* Lazily: cycles A and B in runs of 1 to 7 steps, each going on from the
- * state the last left scattered (builds inside them and between them, the
- * plan kept over the runs), the whole state gathered once at the end. */
+ * state the last left scattered (builds inside them and at their starts,
+ * the plan kept over the runs), the whole state gathered once at the end. */
 static void run_lazily(rank_ctx *c, sx_model *m)
 {
     sx_model_gather_lazily(m, true);
@@ -204,6 +205,7 @@ static void run_lazily(rank_ctx *c, sx_model *m)
         if (!c->st && !sx_model_scattered(m)) c->st = SX_EINVAL; /* a lazy cycle must not gather */
     }
     c->resumed = sx_model_profile(m).resumed;
+    c->builds = m->builds;
     if (!c->st) c->st = sx_model_gather(m);
     if (!c->st && sx_model_scattered(m)) c->st = SX_EINVAL;
     c->hash = sx_model_state_hash(m);
@@ -228,9 +230,9 @@ static void *run_rank(void *arg)
     /* cycle B is cut as if the ranks above ran slower and slower (their
      * paces, which every rank holds alike): uneven slabs, the same bits */
     for (int r = 0; d && r < c->w->ranks; r++) d->pace[r] = 1 + 3 * r;
-    c->builds = m->builds;
+    c->builds = m->builds, c->gathers = sx_model_profile(m).gathers;
     if (!c->st) c->st = sx_model_cycle(m, STEPS_B);
-    c->builds = m->builds - c->builds;
+    c->builds = m->builds - c->builds, c->gathers = sx_model_profile(m).gathers - c->gathers;
     if (d) c->first_own = d->own[0].hi - d->own[0].lo, c->last_own = d->own[c->w->ranks - 1].hi - d->own[c->w->ranks - 1].lo;
     if (owner) {
         c->crossing = d->fwd.n;
@@ -297,10 +299,11 @@ START_TEST(ranks_give_the_serial_bits)
             }
             printf("%dD%s lazily, %d ranks: %lld of %lld runs went on from a scattered state\n", dim,
                    bonded ? " bonded" : clumped ? " clumps" : "", ranks, (long long)c[0].resumed, (long long)c[0].runs);
-            /* most runs go on from a scattered state; those after a build's step gather first */
-            ck_assert_msg(c[0].resumed > c[0].runs / 2 && c[0].resumed < c[0].runs,
-                          "%dD lazily, %d ranks: %lld of %lld runs went on from a scattered state", dim, ranks,
-                          (long long)c[0].resumed, (long long)c[0].runs);
+            /* every run but the first goes on from a scattered state, those
+             * that must build first too (the build takes what it reads) */
+            ck_assert_msg(c[0].resumed == c[0].runs - 1 && c[0].builds >= 2,
+                          "%dD lazily, %d ranks: %lld of %lld runs went on from a scattered state (%lld builds)", dim,
+                          ranks, (long long)c[0].resumed, (long long)c[0].runs, (long long)c[0].builds);
         }
         for (int ranks = 2; ranks <= MAX_RANKS; ranks++) {
             world w = {.ranks = ranks};
@@ -329,6 +332,8 @@ START_TEST(ranks_give_the_serial_bits)
             }
             ck_assert_msg(c[0].builds >= 2, "%dD, %d ranks: cycle B must build inside the cycle (%lld builds)", dim,
                           ranks, (long long)c[0].builds);
+            ck_assert_msg(c[0].gathers == 1, "%dD, %d ranks: cycle B's %lld builds must not gather the whole state "
+                          "(%lld gathers)", dim, ranks, (long long)c[0].builds, (long long)c[0].gathers);
             ck_assert_msg(c[0].first_own > 2 * c[0].last_own, "%dD, %d ranks: the paces must skew the cut (%lld, %lld balls)",
                           dim, ranks, (long long)c[0].first_own, (long long)c[0].last_own);
             if (clumped) {

@@ -38,6 +38,6 @@ m:cycle(steps)
 local seconds = seixo.clock() - t0
 local p = m:profile{print = false}
 local builds = p.broad_phase.calls
-print(string.format("falling_bed n=%d ranks=%d threads=%d steps=%d seconds=%.3f builds=%d ms_per_build=%.1f hash=%s", n,
-                    m:ranks(), seixo.threads or 1, steps, seconds, builds,
-                    builds > 0 and 1e3 * p.broad_phase.seconds / builds or 0, m:hash()))
+print(string.format("falling_bed n=%d ranks=%d threads=%d steps=%d seconds=%.3f builds=%d ms_per_build=%.1f " ..
+                    "bytes_in_per_step=%.0f hash=%s", n, m:ranks(), seixo.threads or 1, steps, seconds, builds,
+                    builds > 0 and 1e3 * p.broad_phase.seconds / builds or 0, p.received / steps, m:hash()))

@@ -450,10 +450,11 @@ bool sx__pairs_sort(sx_model *m, sx_pairs *p)
         for (int64_t e = 0; e < n; e++) memcpy(q + (size_t)pos[e] * row, data + (size_t)e * row, row);
         memcpy(data, q, (size_t)n * row);
     }
+    const bool ok = sx__dd_sources_sort(m, p == &m->bw, pos, n);
     free(pos);
     free(count);
     free(tmp);
-    return true;
+    return ok;
 }
 
 void sx__pairs_free(sx_model *m, sx_pairs *p)

@@ -91,12 +91,32 @@ bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since)
 }
 
 /* What a decomposed cycle cannot go on to from the state the last one
- * left scattered, each rank's own balls current: a build, which lists
- * from every ball; and the check of bonded pairs' contact-model rows
- * (sx__cmodel_prepare), which reads every pair. */
+ * left scattered, each rank's own balls current: a build in periodic
+ * space, which copies every ball into its ghosts' slots (elsewhere a
+ * build takes what it reads: step_build); and the check of bonded pairs'
+ * contact-model rows (sx__cmodel_prepare), which reads every pair. */
 static bool whole_needed(const sx_model *m)
 {
-    return m->build_needed || (m->ncmodel && m->bb.bond && m->bb.cmodel);
+    return (m->build_needed && m->cell) || (m->ncmodel && m->bb.bond && m->bb.cmodel);
+}
+
+/* A build at a step of a cycle (or at the start of a decomposed one that
+ * goes on from a scattered state): decomposed, the serial build on every
+ * rank from what it reads, then the new cut, to which the balls, pairs
+ * and bonds move (decompose.c). */
+static sx_status step_build(sx_model *m, const sx_kernels *k)
+{
+    sx_dd *dd = m->dd;
+    sx_status st;
+    if (m->cell && (st = sx__cell_check(m))) return st; /* the cell may have shrunk */
+    if (dd && !sx__dd_build(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+    if ((st = sx__check_skin(m))) return st; /* as at a cycle's start, however the run is cut */
+    st = k->build(m);
+    if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs */
+    if (st) return sx__build_failed(m, st);
+    if (dd && !sx__dd_migrate(m)) /* balls, pairs and bonds to the ranks that now step them */
+        return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+    return SX_OK;
 }
 
 sx_status sx_model_gather(sx_model *m)
@@ -122,15 +142,19 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     /* the last cycle's plan goes on (nothing but the walls and settings
      * changed since: a caller that changes more gathers first) */
     const bool resume = m->dd && m->dd->scattered;
-    if (!st) st = sx__prepare(m);
+    const sx_kernels *k = sx__kernels(m);
+    if (!st) st = resume ? sx__prepare_laws(m) : sx__prepare(m);
+    if (!st && resume) m->dd->active = true, m->prof.resumed++; /* the timestep is then rated rank by rank */
+    if (!st && resume && m->build_needed) st = step_build(m, k); /* as at a step, from the ranks' own state */
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
-    if (st) return st;
-    if (resume) m->dd->active = true, m->prof.resumed++; /* the timestep is then rated rank by rank */
+    if (st) {
+        if (resume) m->dd->active = false;
+        return st;
+    }
     if ((st = sx__update_timestep(m))) {
         if (resume) m->dd->active = false;
         return st;
     }
-    const sx_kernels *k = sx__kernels(m);
     if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
     sx_dd *dd = m->dd;
     m->locked = true;
@@ -151,19 +175,9 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
             break;
         }
         if (m->build_needed) {
-            if (m->cell && (st = sx__cell_check(m))) break; /* the cell may have shrunk */
-            if (dd && !sx__dd_gather(m)) { /* the serial build, on every rank, from the whole state */
-                st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
-                break;
-            }
-            if ((st = sx__check_skin(m))) break; /* as at a cycle's start, however the run is cut */
-            st = k->build(m);
-            if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs: balls migrate */
+            st = step_build(m, k);
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
-            if (st) {
-                st = sx__build_failed(m, st);
-                break;
-            }
+            if (st) break;
         }
         st = sx__update_timestep(m);
         double t1 = sx__now();

@@ -32,12 +32,16 @@
  *     the terms of such a sum on a tape and adds them onto the sum the
  *     lower ranks pass it), and every rank adds them in the serial order.
  * The energy guard sums its energy in chains over the ranks' own balls and
- * pairs (sx__dd_chain), in the serial order. A build and the end of the
- * cycle first gather the whole state on every rank (each ball from its
- * owner, each pair from the owner of its first ball, each bond, and a flat
- * joint's face and elements, from the owner of its pair, and the ranks'
- * cracks merged in the serial order); the build itself is the serial one,
- * on every rank. A smooth joint's state is its pair's and its bond's; a
+ * pairs (sx__dd_chain), in the serial order. The end of the cycle
+ * gathers the whole state on every rank (each ball from its owner, each
+ * pair from the owner of its first ball, each bond, and a flat joint's
+ * face and elements, from the owner of its pair, and the ranks' cracks
+ * merged in the serial order). A build inside the cycle is the serial one,
+ * on every rank, from what it reads alone (the positions, the pairs'
+ * contact flags and bond links, the bonds' kinds, the clumps' places:
+ * sx__dd_build); after its plan the balls, pairs and bonds the new cut
+ * gives another rank move to it (sx__dd_migrate), and the rest stays
+ * where it was stepped. A smooth joint's state is its pair's and its bond's; a
  * mesh wall is a wall (its rows of a ball lie in the ball's block), moved
  * and turned alike by every rank. Clumps: each is stepped by its owner
  * (the owner of its pebble nearest its centroid), the pebbles of other
@@ -75,6 +79,10 @@ void sx__dd_free(sx_model *m)
     free(d->pace);
     free(d->xchunk.cracks);
     free(d->tape.e);
+    free(d->was);
+    free(d->slot_was);
+    free(d->src_bb);
+    free(d->src_bw);
     free(d);
     m->dd = NULL;
 }
@@ -91,8 +99,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
     /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, cl_own,
-     * gho_own, fwd.own, back.own; and the routes' needs (r per rank) */
-    enum { SPANS = 13 + SX_DD_NEED };
+     * gho_own, fwd.own, back.own, bb_was, bw_was; and the routes' needs (r per rank) */
+    enum { SPANS = 15 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(2 * r * r, sizeof *routes) : NULL;
     double *pace = routes ? calloc(3 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r) */
     if (!pace) {
@@ -107,8 +115,10 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->pairs = s, d->wblk = s + r, d->wrun = s + 2 * r, d->bb_own = s + 3 * r, d->bw_own = s + 4 * r;
     d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->cl_own = s + 8 * r;
     d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
+    d->bb_was = s + 12 * r, d->bw_was = s + 13 * r;
     d->fwd.need = routes, d->back.need = routes + r * r;
     d->pace = pace, d->sample = pace + r;
+    d->received = &m->prof.received;
     m->dd = d;
     return SX_OK;
 }
@@ -561,7 +571,59 @@ static const sx_span *everything(sx_dd *d, int64_t count)
 
 static bool share(sx_dd *d, void *data, size_t size, const sx_span *own, const sx_span *need, int per)
 {
+    const int me = d->x.rank;
+    int64_t in = 0; /* the entries this rank receives: its needs that others hold */
+    for (int k = 0; k < per; k++)
+        for (int r = 0; r < d->x.ranks; r++) {
+            const sx_span want = need[me * per + k];
+            const int64_t lo = want.lo > own[r].lo ? want.lo : own[r].lo, hi = want.hi < own[r].hi ? want.hi : own[r].hi;
+            if (r != me && hi > lo) in += hi - lo;
+        }
+    *d->received += in * (int64_t)size;
     return d->x.share(d->x.ud, data, size, own, need, per);
+}
+
+/* Rows of per-entry arrays between ranks: field[k] has row[k] bytes an
+ * entry, and the rows moved are base + list[e] for the entries e < n of
+ * the buffer. Each rank packs the entries own[rank], they are shared
+ * (need: nper spans per rank), and each rank unpacks those it needs. */
+enum { ROWS_MAX = SX_PAIR_FIELDS_MAX };
+typedef struct sx_rows {
+    void *field[ROWS_MAX];
+    size_t row[ROWS_MAX];
+    int nf;
+} sx_rows;
+
+static void add_row(sx_rows *f, void *field, size_t row)
+{
+    if (row) f->field[f->nf] = field, f->row[f->nf++] = row;
+}
+
+static bool move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t base, int64_t n, const sx_span *own,
+                      const sx_span *need, int nper)
+{
+    size_t w = 0;
+    for (int k = 0; k < f->nf; k++) w += f->row[k];
+    if (!n || !w) return true;
+    char *buf = malloc((size_t)n * w);
+    if (!buf) return false;
+    const int me = d->x.rank;
+    bool ok = true;
+    for (int pass = 0; ok && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
+        const sx_span s = pass ? need[me * nper + pass - 1] : own[me];
+        for (int64_t e = s.lo; e < s.hi; e++) {
+            char *q = buf + (size_t)e * w;
+            for (int k = 0; k < f->nf; k++) {
+                char *v = (char *)f->field[k] + (size_t)(base + list[e]) * f->row[k];
+                if (pass) memcpy(v, q, f->row[k]);
+                else memcpy(q, v, f->row[k]);
+                q += f->row[k];
+            }
+        }
+        if (!pass) ok = share(d, buf, w, own, need, nper);
+    }
+    free(buf);
+    return ok;
 }
 
 bool sx__dd_halo(sx_model *m)
@@ -584,38 +646,34 @@ static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
     return true;
 }
 
-/* The bonds' state the step changes (kind, fn, mn, fs, ms), each bond
- * from the owner of its pair's first ball; packed as doubles in the
- * plan's order (a kind is a small integer: exact). The intact count is
- * counted again: each rank took off the bonds it saw break, its ghost
- * pairs' included. */
-static bool gather_bonds(sx_model *m)
+/* The bonds' state the step changes (kind; unless kinds_only fn, mn, fs,
+ * ms) of the slots list[e], e < n, each rank's entries own[r], to every
+ * rank. */
+static bool share_bonds(sx_model *m, const int32_t *list, int64_t n, const sx_span *own, bool kinds_only)
 {
-    sx_dd *d = m->dd;
     sx_bonds *b = &m->bonds;
-    const int D = m->dim, RD = m->rdim, w = 3 + D + RD;
-    const int64_t nb = d->nbslot;
-    double *buf = nb ? malloc((size_t)(nb * w) * sizeof *buf) : NULL;
-    if (nb && !buf) return false;
-    const sx_span mine = d->bs_own[d->x.rank];
-    for (int64_t e = mine.lo; e < mine.hi; e++) {
-        const int32_t s = d->bslot[e];
-        double *q = buf + e * w;
-        q[0] = b->kind[s], q[1] = b->fn[s], q[2] = b->mn[s];
-        memcpy(q + 3, b->fs + s * D, (size_t)D * sizeof *q);
-        memcpy(q + 3 + D, b->ms + s * RD, (size_t)RD * sizeof *q);
-    }
-    const bool ok = !nb || share(d, buf, (size_t)w * sizeof *buf, d->bs_own, everything(d, nb), 1);
-    for (int64_t e = 0; ok && e < nb; e++) {
-        const int32_t s = d->bslot[e];
-        const double *q = buf + e * w;
-        b->kind[s] = (uint8_t)q[0], b->fn[s] = q[1], b->mn[s] = q[2];
-        memcpy(b->fs + s * D, q + 3, (size_t)D * sizeof *q);
-        memcpy(b->ms + s * RD, q + 3 + D, (size_t)RD * sizeof *q);
-    }
-    free(buf);
+    const size_t v = sizeof(double), D = (size_t)m->dim * v, RD = (size_t)m->rdim * v;
+    sx_rows f = {.nf = 0};
+    add_row(&f, b->kind, sizeof *b->kind);
+    if (!kinds_only) add_row(&f, b->fn, v), add_row(&f, b->mn, v), add_row(&f, b->fs, D), add_row(&f, b->ms, RD);
+    return move_rows(m->dd, &f, list, 0, n, own, everything(m->dd, n), 1);
+}
+
+/* Each rank took off the intact count the bonds it saw break, its ghost
+ * pairs' included: counted again once the kinds are shared. */
+static void count_intact(sx_model *m)
+{
+    sx_bonds *b = &m->bonds;
     b->intact = 0;
     for (int64_t s = 0; s < b->n; s++) b->intact += b->kind[s] != 0;
+}
+
+/* Every bond of the plan from the owner of its pair's first ball. */
+static bool gather_bonds(sx_model *m)
+{
+    const sx_dd *d = m->dd;
+    const bool ok = share_bonds(m, d->bslot, d->nbslot, d->bs_own, false);
+    count_intact(m);
     return ok;
 }
 
@@ -628,30 +686,29 @@ static bool gather_bonds(sx_model *m)
  * unchanged, and the owner's copy is everyone's) are packed as doubles in
  * plan order, each rank's a contiguous run (a state is a small integer:
  * exact). */
-static bool gather_fjoints(sx_model *m)
+static bool share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx_span *own)
 {
     sx_dd *d = m->dd;
     sx_bonds *b = &m->bonds;
     sx_fjels *E = &m->fjel;
     const int D = m->dim, T = D - 1, face = T + (D == 3 ? 3 : 0), el = 2 + T;
-    const int64_t nb = d->nbslot;
     int64_t *at = malloc((size_t)(nb + 1) * sizeof *at); /* entry e's first double */
     if (!at) return false;
     at[0] = 0;
     for (int64_t e = 0; e < nb; e++) {
-        const int32_t s = d->bslot[e];
+        const int32_t s = slot[e];
         const int nel = b->fj_nr[s] * b->fj_na[s];
         at[e + 1] = at[e] + (nel ? face + nel * el : 0);
     }
     const int64_t total = at[nb];
     double *buf = total ? malloc((size_t)total * sizeof *buf) : NULL;
     bool ok = !total || buf;
-    for (int r = 0; ok && r < d->x.ranks; r++) d->scratch[r] = (sx_span){at[d->bs_own[r].lo], at[d->bs_own[r].hi]};
+    for (int r = 0; ok && r < d->x.ranks; r++) d->scratch[r] = (sx_span){at[own[r].lo], at[own[r].hi]};
     for (int pass = 0; ok && total && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
-        const sx_span mine = d->bs_own[d->x.rank];
+        const sx_span mine = own[d->x.rank];
         const int64_t e0 = pass ? 0 : mine.lo, e1 = pass ? nb : mine.hi;
         for (int64_t e = e0; e < e1; e++) {
-            const int32_t s = d->bslot[e];
+            const int32_t s = slot[e];
             const int nel = b->fj_nr[s] * b->fj_na[s];
             if (!nel) continue;
             double *q = buf + at[e], *rot = b->fj_rot + s * T, *axis = D == 3 ? b->fj_axis + s * 3 : NULL;
@@ -679,6 +736,8 @@ static bool gather_fjoints(sx_model *m)
     free(at);
     return ok;
 }
+
+static bool gather_fjoints(sx_model *m) { return share_fjoints(m, m->dd->bslot, m->dd->nbslot, m->dd->bs_own); }
 
 /* A list made in parts, one a rank, joined in rank order on every rank (a
  * decomposed build's pairs, a gather's cracks): the ranks' counts are
@@ -750,41 +809,16 @@ static bool gather_cracks(sx_model *m)
     return ok;
 }
 
-/* Rows of per-entry arrays between ranks: field[k] has per[k] doubles an
- * entry, and the rows moved are base + list[e] for the entries e < n of
- * the buffer. Each rank packs the entries own[rank], they are shared
- * (need: nper spans per rank), and each rank unpacks those it needs. */
-typedef struct sx_rows {
-    double *const *field;
-    const int *per;
-    int nf;
-} sx_rows;
-
-static bool move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t base, int64_t n, const sx_span *own,
-                      const sx_span *need, int nper)
+/* A ball's state the step changes: its velocity, spin, force and moment,
+ * and (with_position) its position. */
+static sx_rows ball_motion(const sx_model *m, bool with_position)
 {
-    int w = 0;
-    for (int k = 0; k < f->nf; k++) w += f->per[k];
-    if (!n || !w) return true;
-    double *buf = malloc((size_t)(n * w) * sizeof *buf);
-    if (!buf) return false;
-    const int me = d->x.rank;
-    bool ok = true;
-    for (int pass = 0; ok && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
-        const sx_span s = pass ? need[me * nper + pass - 1] : own[me];
-        for (int64_t e = s.lo; e < s.hi; e++) {
-            double *q = buf + e * w;
-            for (int k = 0; k < f->nf; k++) {
-                double *v = f->field[k] + (base + list[e]) * f->per[k];
-                if (pass) memcpy(v, q, (size_t)f->per[k] * sizeof *q);
-                else memcpy(q, v, (size_t)f->per[k] * sizeof *q);
-                q += f->per[k];
-            }
-        }
-        if (!pass) ok = share(d, buf, (size_t)w * sizeof *buf, own, need, nper);
-    }
-    free(buf);
-    return ok;
+    const sx_balls *B = &m->balls;
+    const size_t D = (size_t)m->dim * sizeof(double), RD = (size_t)m->rdim * sizeof(double);
+    sx_rows f = {.nf = 0};
+    if (with_position) add_row(&f, B->x, D);
+    add_row(&f, B->v, D), add_row(&f, B->f, D), add_row(&f, B->w, RD), add_row(&f, B->t, RD);
+    return f;
 }
 
 /* Periodic space: every ghost's slot (position, velocity, spin, force,
@@ -792,11 +826,7 @@ static bool move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
 static bool gather_ghosts(sx_model *m)
 {
     sx_dd *d = m->dd;
-    sx_balls *B = &m->balls;
-    const int D = m->dim, RD = m->rdim;
-    double *const field[5] = {B->x, B->v, B->f, B->w, B->t};
-    const int per[5] = {D, D, D, RD, RD};
-    const sx_rows f = {field, per, 5};
+    const sx_rows f = ball_motion(m, true);
     return move_rows(d, &f, d->gho, m->cell->base, d->ngho, d->gho_own, everything(d, d->ngho), 1);
 }
 
@@ -806,10 +836,10 @@ bool sx__dd_clumps(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_clumps *C = m->clumps;
-    const int D = m->dim, RD = m->rdim;
-    double *const field[7] = {C->x, C->v, C->w, C->f, C->t, C->q, C->L};
-    const int per[7] = {D, D, RD, D, RD, D == 3 ? 4 : 1, D == 3 ? 3 : 0};
-    const sx_rows f = {field, per, D == 3 ? 7 : 6};
+    const size_t D = (size_t)m->dim * sizeof(double), RD = (size_t)m->rdim * sizeof(double);
+    sx_rows f = {.nf = 0};
+    add_row(&f, C->x, D), add_row(&f, C->v, D), add_row(&f, C->w, RD), add_row(&f, C->f, D), add_row(&f, C->t, RD);
+    add_row(&f, C->q, (m->dim == 3 ? 4 : 1) * sizeof(double)), add_row(&f, C->L, m->dim == 3 ? 3 * sizeof(double) : 0);
     return move_rows(d, &f, d->cl, 0, d->ncl, d->cl_own, everything(d, d->ncl), 1);
 }
 
@@ -849,6 +879,7 @@ bool sx__dd_gather(sx_model *m)
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
     const size_t v = (size_t)m->dim * sizeof(double), w = (size_t)m->rdim * sizeof(double);
+    m->prof.gathers++;
     if (!share_pace(m)) return false;
     const sx_span *all = everything(d, B->n);
     return share(d, B->x, v, d->own, all, 1) && share(d, B->v, v, d->own, all, 1) &&
@@ -857,6 +888,218 @@ bool sx__dd_gather(sx_model *m)
            gather_pairs(m, &m->bw, d->bw_own) && (!m->bonds.n || (gather_bonds(m) && gather_cracks(m))) &&
            (!m->fjel.n || gather_fjoints(m)) &&
            (!m->cell || !m->cell->n || gather_ghosts(m)) && (!m->clumps || !m->clumps->n || sx__dd_clumps(m));
+}
+
+/* Room for n entries in *a (capacity *cap). */
+static bool room(int32_t **a, int64_t *cap, int64_t n)
+{
+    if (*cap >= n) return true;
+    int32_t *q = realloc(*a, (size_t)n * sizeof *q);
+    if (!q) return false;
+    *a = q, *cap = n;
+    return true;
+}
+
+/* The rank whose span holds entry k, of spans that cut [0, n) in rank
+ * order (an empty span's rank owns nothing). */
+static int span_owner(const sx_span *s, int R, int64_t k)
+{
+    int lo = 0, hi = R - 1;
+    while (lo < hi) {
+        const int mid = (lo + hi + 1) / 2;
+        if (s[mid].lo <= k) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* A pair store's contact flags and bond links, from the owners of their
+ * pairs: the build's transfer reads them (which old pairs carry a
+ * history, which bonds hold), so every rank must see the same. */
+static bool share_flags(sx_model *m, sx_pairs *p, const sx_span *own)
+{
+    sx_dd *d = m->dd;
+    return !p->n || (share(d, p->touching, sizeof *p->touching, own, everything(d, p->n), 1) &&
+                     (!p->bond || share(d, p->bond, sizeof *p->bond, own, everything(d, p->n), 1)));
+}
+
+/* The build inside a cycle is the serial build, on every rank, but not
+ * from the whole state: it reads of the step's state only the positions,
+ * the pairs' contact flags and bond links, the bonds' kinds and the
+ * clumps' places, which every rank takes here (with the cracks, whose
+ * owners follow the balls); the rest stays where the ranks stepped it,
+ * and what the new cut gives another rank moves after the plan
+ * (sx__dd_migrate). About 24 bytes a ball and 5 a pair instead of the
+ * whole state (some 100 a ball and 60 a pair in 3D). Periodic space
+ * gathers the whole state: a build copies the balls into their ghosts'
+ * slots. */
+bool sx__dd_build(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    d->migrating = false;
+    if (m->cell) return sx__dd_gather(m);
+    const sx_balls *B = &m->balls;
+    const int R = d->x.ranks;
+    const int64_t nb = m->bonds.n;
+    if (!share_pace(m) || !share(d, B->x, (size_t)m->dim * sizeof(double), d->own, everything(d, B->n), 1) ||
+        !share_flags(m, &m->bb, d->bb_own) || !share_flags(m, &m->bw, d->bw_own) ||
+        (nb && (!share_bonds(m, d->bslot, d->nbslot, d->bs_own, true) || !gather_cracks(m))) ||
+        (m->clumps && m->clumps->n && !sx__dd_clumps(m)))
+        return false;
+    count_intact(m);
+    /* the last plan's owners, by what the build does not renumber */
+    if (!room(&d->was, &d->cap_was, B->index_cap) || !room(&d->slot_was, &d->cap_slot_was, nb)) return false;
+    for (int r = 0; r < R; r++)
+        for (int64_t i = d->own[r].lo; i < d->own[r].hi; i++) d->was[B->id[i]] = r;
+    for (int64_t k = 0; k < nb; k++) d->slot_was[k] = -1;
+    for (int r = 0; r < R; r++)
+        for (int64_t e = d->bs_own[r].lo; e < d->bs_own[r].hi; e++) d->slot_was[d->bslot[e]] = r;
+    memcpy(d->bb_was, d->bb_own, (size_t)R * sizeof *d->bb_was);
+    memcpy(d->bw_was, d->bw_own, (size_t)R * sizeof *d->bw_was);
+    d->nsrc_bb = d->nsrc_bw = 0;
+    d->migrating = true;
+    return true;
+}
+
+bool sx__dd_keep_sources(sx_model *m, bool walls, const int32_t *src, int64_t n)
+{
+    sx_dd *d = m->dd;
+    if (!d || !d->active || !d->migrating) return true;
+    int64_t *len = walls ? &d->nsrc_bw : &d->nsrc_bb;
+    *len = 0; /* none: no pair had a history, every new pair's is zeros */
+    if (!src || !n) return true;
+    if (!room(walls ? &d->src_bw : &d->src_bb, walls ? &d->cap_src_bw : &d->cap_src_bb, n)) return false;
+    memcpy(walls ? d->src_bw : d->src_bb, src, (size_t)n * sizeof *src);
+    *len = n;
+    return true;
+}
+
+bool sx__dd_sources_sort(sx_model *m, bool walls, const int32_t *pos, int64_t n)
+{
+    sx_dd *d = m->dd;
+    if (!d || !d->migrating || (walls ? d->nsrc_bw : d->nsrc_bb) != n) return true;
+    int32_t *src = walls ? d->src_bw : d->src_bb, *to = malloc((size_t)n * sizeof *to);
+    if (!to) return false;
+    for (int64_t c = 0; c < n; c++) to[pos[c]] = src[c];
+    memcpy(src, to, (size_t)n * sizeof *to);
+    free(to);
+    return true;
+}
+
+/* The fields of a pair store that are not its ends. */
+static sx_rows pair_rows(sx_model *m, sx_pairs *p)
+{
+    sx_pair_field f[SX_PAIR_FIELDS_MAX];
+    const int nf = sx__pair_fields(m, p, f);
+    sx_rows r = {.nf = 0};
+    for (int k = 0; k < nf; k++)
+        if (!f[k].end) add_row(&r, *f[k].data, sx__pair_size(&f[k]) * (size_t)f[k].per);
+    return r;
+}
+
+/* The entries k < n with from[k] >= 0, by from (each rank's a run, in
+ * entry order): into list, its runs into runs; their count. */
+static int64_t list_by_owner(const sx_dd *d, const int32_t *from, int64_t n, int32_t *list, sx_span *runs)
+{
+    const int R = d->x.ranks;
+    for (int r = 0; r < R; r++) runs[r] = (sx_span){0, 0};
+    for (int64_t k = 0; k < n; k++)
+        if (from[k] >= 0) runs[from[k]].hi++;
+    int64_t at = 0;
+    for (int r = 0; r < R; r++) {
+        const int64_t len = runs[r].hi;
+        runs[r] = (sx_span){at, at}; /* hi: the run's next entry, then its end */
+        at += len;
+    }
+    for (int64_t k = 0; k < n; k++)
+        if (from[k] >= 0) list[runs[from[k]].hi++] = (int32_t)k;
+    return at;
+}
+
+/* Rank r steps the ball-ball pairs pairs[r] and the ball-wall pairs of
+ * the balls of its wall blocks wrun[r]. */
+static sx_span wall_pairs_run(const sx_model *m, int r)
+{
+    const sx_span run = m->dd->wrun[r];
+    if (run.hi <= run.lo) return (sx_span){0, 0};
+    const int64_t lo = m->blocks[run.lo].b0, hi = m->blocks[run.hi - 1].b1;
+    return (sx_span){sx__first_at(m->bw.a, m->bw.n, lo), sx__first_at(m->bw.a, m->bw.n, hi)};
+}
+
+/* from[c] for the new pairs a rank steps whose old pair another rank
+ * stepped: that rank, which holds its history. */
+static void pairs_from(const sx_model *m, const sx_span *run, const int32_t *src, int64_t nsrc, const sx_span *was,
+                       int32_t *from, int64_t n, bool walls)
+{
+    const sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    for (int64_t c = 0; c < n; c++) from[c] = -1;
+    for (int r = 0; r < R; r++) {
+        const sx_span s = walls ? wall_pairs_run(m, r) : run[r];
+        for (int64_t c = s.lo; c < s.hi && c < nsrc; c++) {
+            if (!src[c]) continue;
+            const int o = span_owner(was, R, (src[c] > 0 ? src[c] : -src[c]) - 1);
+            if (o != r) from[c] = o;
+        }
+    }
+}
+
+/* After the build's plan: to the ranks that now step them, the balls
+ * whose owner changed (velocity, spin, force, moment: the positions every
+ * rank took before the build), the pairs whose history another rank
+ * holds, and the bonds (with a flat joint's face and elements) another
+ * rank stepped, or that left the plan (broken: their last state to every
+ * rank). Every rank lists the same entries (from what all hold alike),
+ * and each sends the entries it held; every rank receives them all. */
+bool sx__dd_migrate(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    if (!d->migrating) return true;
+    d->migrating = false;
+    const sx_balls *B = &m->balls;
+    const sx_bonds *bs = &m->bonds;
+    const int R = d->x.ranks;
+    int64_t most = B->n > m->bb.n ? B->n : m->bb.n;
+    if (m->bw.n > most) most = m->bw.n;
+    if (bs->n > most) most = bs->n;
+    int32_t *from = malloc((size_t)(most + 1) * sizeof *from), *list = malloc((size_t)(most + 1) * sizeof *list);
+    sx_span *runs = malloc((size_t)R * sizeof *runs);
+    bool ok = from && list && runs;
+    if (ok) { /* the balls */
+        for (int64_t i = 0; i < B->n; i++) {
+            const int32_t o = d->was[B->id[i]];
+            from[i] = o != owner_of(d, i, B->n) ? o : -1;
+        }
+        const sx_rows f = ball_motion(m, false);
+        const int64_t k = list_by_owner(d, from, B->n, list, runs);
+        ok = move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+    }
+    if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
+        pairs_from(m, d->pairs, d->src_bb, d->nsrc_bb, d->bb_was, from, m->bb.n, false);
+        sx_rows f = pair_rows(m, &m->bb);
+        int64_t k = list_by_owner(d, from, m->bb.n, list, runs);
+        ok = move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+        pairs_from(m, NULL, d->src_bw, d->nsrc_bw, d->bw_was, from, m->bw.n, true);
+        f = pair_rows(m, &m->bw);
+        k = list_by_owner(d, from, m->bw.n, list, runs);
+        ok = ok && move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+    }
+    if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
+        for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
+        for (int64_t c = 0; c < m->bb.n; c++) /* in a pair of this plan: stays where it is, unless... */
+            if (m->bb.bond[c]) from[m->bb.bond[c] - 1] = -1;
+        for (int r = 0; r < R; r++)
+            for (int64_t c = d->pairs[r].lo; c < d->pairs[r].hi; c++) { /* ...a rank steps it that did not */
+                const int32_t s = m->bb.bond[c] - 1;
+                if (s >= 0 && d->slot_was[s] >= 0 && d->slot_was[s] != r) from[s] = d->slot_was[s];
+            }
+        const int64_t k = list_by_owner(d, from, bs->n, list, runs);
+        ok = share_bonds(m, list, k, runs, false) && (!m->fjel.n || share_fjoints(m, list, k, runs));
+    }
+    free(runs);
+    free(list);
+    free(from);
+    return ok;
 }
 
 /* Only a servo and energy tracking read the walls' resultants inside a
@@ -886,10 +1129,12 @@ bool sx__dd_pebbles(sx_model *m, double *sums, int64_t n)
 {
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
-    double *const field[4] = {sums ? sums : B->f, sums ? sums + n : B->t, sums ? sums + 2 * n : NULL,
-                              sums ? sums + 3 * n : NULL};
-    const int forces[2] = {m->dim, m->rdim}, rates[4] = {1, 1, 1, 1};
-    const sx_rows f = {field, sums ? rates : forces, sums ? 4 : 2};
+    const size_t v = sizeof(double);
+    sx_rows f = {.nf = 0};
+    if (sums)
+        for (int k = 0; k < 4; k++) add_row(&f, sums + k * n, v);
+    else
+        add_row(&f, B->f, (size_t)m->dim * v), add_row(&f, B->t, (size_t)m->rdim * v);
     return move_rows(d, &f, d->fwd.item, 0, d->fwd.n, d->fwd.own, d->fwd.need, d->x.ranks);
 }
 
@@ -900,9 +1145,9 @@ bool sx__dd_placed(sx_model *m)
 {
     sx_dd *d = m->dd;
     sx_balls *B = &m->balls;
-    double *const field[3] = {B->x, B->v, B->w};
-    const int per[3] = {m->dim, m->dim, m->rdim};
-    const sx_rows f = {field, per, 3};
+    const size_t v = sizeof(double);
+    sx_rows f = {.nf = 0};
+    add_row(&f, B->x, (size_t)m->dim * v), add_row(&f, B->v, (size_t)m->dim * v), add_row(&f, B->w, (size_t)m->rdim * v);
     return move_rows(d, &f, d->back.item, 0, d->back.n, d->back.own, d->back.need, d->x.ranks);
 }
 

@@ -451,6 +451,17 @@ typedef struct sx_dd {
     double *pace, *sample;
     double busy, busy_work;
     int64_t planned;
+    /* a build inside a cycle from what each rank holds current (sx__dd_build,
+     * sx__dd_migrate): the last plan's owner of each ball by its id (was),
+     * of each bond slot (slot_was; -1: in no pair of the plan) and its
+     * pair stores' owner spans (bb_was, bw_was); the build's old pair of
+     * each new pair (src_bb, src_bw: + 1, negated when turned round, 0
+     * none), kept from its transfer while migrating */
+    bool migrating;
+    int64_t *received; /* the model's profile's count of the bytes this rank received */
+    int32_t *was, *slot_was, *src_bb, *src_bw;
+    int64_t cap_was, cap_slot_was, nsrc_bb, nsrc_bw, cap_src_bb, cap_src_bw;
+    sx_span *bb_was, *bw_was;
 } sx_dd;
 
 struct sx_model {
@@ -762,6 +773,19 @@ sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *));
 bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
+/* A build inside a decomposed cycle without the whole state: before it,
+ * sx__dd_build shares what every rank's build reads (the positions, the
+ * pairs' contact flags and bond links, the bonds' kinds, the cracks, the
+ * clumps; periodic space: the whole state); the build keeps each new
+ * pair's old one (sx__dd_keep_sources); after the plan, sx__dd_migrate
+ * moves to the ranks that now step them the balls, pairs and bonds the
+ * cut gave another rank. False: the exchange failed, or out of memory. */
+bool sx__dd_build(sx_model *m);
+bool sx__dd_keep_sources(sx_model *m, bool walls, const int32_t *src, int64_t n);
+/* The kept sources follow their store's sort (pos: each pair's new place;
+ * sx__pairs_sort, after the build). False: out of memory. */
+bool sx__dd_sources_sort(sx_model *m, bool walls, const int32_t *pos, int64_t n);
+bool sx__dd_migrate(sx_model *m);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n
@@ -792,8 +816,11 @@ sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *));
  * ones, added to m->acc in the serial order. */
 void sx__tape_add(sx_tape *t, int64_t k, double v);
 bool sx__dd_energy(sx_model *m);
-/* Laws refreshed and broad phase built if needed (before queries and cycles). */
+/* Laws refreshed and broad phase built if needed (before queries and
+ * cycles); sx__prepare_laws: the laws alone (a decomposed cycle that goes
+ * on from a scattered state builds inside the cycle). */
 sx_status sx__prepare(sx_model *m);
+sx_status sx__prepare_laws(sx_model *m);
 /* material.c: the pair laws from the materials (before a cycle), and the
  * check that the pairs' models agree. */
 sx_status sx__refresh_laws(sx_model *m);

@@ -59,11 +59,17 @@ sx_status sx__build_failed(sx_model *m, sx_status st)
 }
 
 /* Broad phase and laws up to date, so timestep queries see current contacts. */
-sx_status sx__prepare(sx_model *m)
+sx_status sx__prepare_laws(sx_model *m)
 {
     sx_status st = sx__refresh_laws(m);
     if (!st) st = sx__check_models(m);
     if (!st && m->ncmodel) st = sx__cmodel_prepare(m);
+    return st;
+}
+
+sx_status sx__prepare(sx_model *m)
+{
+    sx_status st = sx__prepare_laws(m);
     if (!st && m->build_needed) st = sx__check_skin(m);
     if (st) return st;
     if (m->build_needed && m->cell && (st = sx__cell_check(m))) return st;

@@ -65,6 +65,10 @@ int sx_profile_format(const sx_profile *p, int64_t balls, char *buf, size_t len)
     if (p->resumed > 0)
         OUT("%lld of the cycles went on from the last one's scattered state, without a gather\n",
             (long long)p->resumed);
+    if (p->gathers > 0) OUT("%lld exchanges of the whole state between the ranks (gathers)\n", (long long)p->gathers);
+    if (p->received > 0 && p->steps > 0)
+        OUT("%.4g bytes received from the other ranks, %.4g a step\n", (double)p->received,
+            (double)p->received / (double)p->steps);
 #undef OUT
     return need;
 }

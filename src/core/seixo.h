@@ -206,6 +206,9 @@ typedef struct sx_profile {
     int64_t cycles;                 ///< sx_model_cycle calls
     int64_t steps;                  ///< steps taken
     int64_t resumed;                ///< decomposed: cycles that went on from a scattered state (no gather)
+    int64_t gathers;                ///< decomposed: exchanges of the whole state (a cycle's end, a gather
+                                    ///< before a call that reads the balls, a build in periodic space)
+    int64_t received;               ///< decomposed: bytes this rank received from the others
 } sx_profile;
 
 /// The profile accumulated since the model was created or last reset.

@@ -889,6 +889,10 @@ static int model_profile(lua_State *L)
     lua_setfield(L, -2, "cycles");
     lua_pushinteger(L, (lua_Integer)p.resumed);
     lua_setfield(L, -2, "resumed");
+    lua_pushinteger(L, (lua_Integer)p.gathers);
+    lua_setfield(L, -2, "gathers");
+    lua_pushinteger(L, (lua_Integer)p.received);
+    lua_setfield(L, -2, "received");
     lua_pushinteger(L, sx_model_threads(m));
     lua_setfield(L, -2, "threads");
     if (reset) sx_model_profile_reset(m);

@@ -69,7 +69,7 @@ if scene == "events" then
   print(string.format("probe %d samples, last %.17g", #h.values, h.values[#h.values]))
 end
 print(string.format("step %d hash %s", m:step(), m:hash()))
--- decomposed, the servo's cycles go on from each other but for those after a build
+-- decomposed, the servo's cycles go on from each other (those that build at their start too)
 local resumed, cycles = p.resumed - p0.resumed, p.cycles - p0.cycles
 if scene == "servo" and m:ranks() > 1 and resumed < 0.9 * cycles then
   error(string.format("%d of %d cycles went on from the last one's scattered state", resumed, cycles))

@@ -247,6 +247,8 @@ static bool transfer_store(sx_model *m, sx_pairs *p, transfer *tr)
         return false;
     }
     p->n = tr->n, p->cap = tr->cap;
+    /* decomposed: each new pair's old one, for the history the ranks move after the plan */
+    if (!sx__dd_keep_sources(m, p == &m->bw, tr->src, tr->n)) return false;
     /* the list starts afresh for the next store */
     sx_alloc_free(&m->alloc, tr->src, (size_t)tr->cap, sizeof *tr->src);
     tr->src = NULL;
