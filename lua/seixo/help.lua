@@ -22,7 +22,7 @@ local entries = {
   ["seixo.progress"] = {"seixo.progress([mode[, every]]) -> previous mode",
     "The progress of long cycles on stderr (steps, time, steps/s, ETA): false, true (a line rewritten in place: the default on a terminal) or 'log' (a plain line every `every` s, default 10: the default otherwise)."},
   ["seixo.clock"] = {"seixo.clock() -> seconds", "Wall-clock seconds from a monotonic clock: the difference of two readings times a run."},
-  ["seixo.interrupts"] = {"seixo.interrupts() -> count", "How many interrupts (Ctrl-C, SIGTERM) came so far: tells an interrupt from a failure caught by pcall."},
+  ["seixo.interrupts"] = {"seixo.interrupts() -> count", "How many interrupts (Ctrl-C, SIGUSR1; SIGTERM serially) came so far (under mpirun: those the ranks' cycles stopped on alike, and those a rank's own run answered): tells an interrupt from a failure caught by pcall."},
   ["seixo.threads"] = {"seixo.threads", "OpenMP threads for the step of each new model: --threads N (default 1); results do not depend on it."},
   ["seixo.optimize"] = {"seixo.optimize(f, {x0 =, lower =, upper =, algorithm = 'bobyqa', maxeval = 200, xtol = 1e-4, ftol = 0, stopval =, step =, seed = 1}) -> x, fmin, {evaluations =, status =}",
     "Minimises f(x) (x an array, f a number) within bounds by an NLopt derivative-free local algorithm: 'bobyqa', 'neldermead', 'sbplx' or 'cobyla'. xtol, ftol relative; an error in f stops the search and is raised."},

@@ -166,13 +166,18 @@ static void stop_hook(lua_State *L, lua_Debug *ar)
 static void on_sigint(int sig)
 {
     (void)sig;
-    if (sx_lua_interrupt_pending()) {
+    /* (under mpirun a request waits for a cycle the ranks stop alike; the
+     * job is ended by mpirun's own Ctrl-C or a SIGTERM) */
+    if (sx_lua_interrupt_pending() && sx_lua_parallel_ranks() == 1) {
         static const char msg[] = "\nseixo: interrupted again before the running code stopped; exiting\n";
         ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
         (void)w;
         _exit(130);
     }
-    if (sx_lua_interrupt_all() == 0) {
+    /* under mpirun a cycle stops where the ranks agree, every rank alike
+     * (sx_interrupts_agreed); Lua code that a rank's own hook stopped would
+     * leave the ranks out of step */
+    if (sx_lua_interrupt_all() == 0 && sx_lua_parallel_ranks() == 1) {
         const int mask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
         const int n = nresumed;
         for (int i = 0; i < n && i < MAX_RESUMED; i++) lua_sethook(resumed[i], stop_hook, mask, 1);
@@ -180,20 +185,41 @@ static void on_sigint(int sig)
     }
 }
 
-/* SIGINT, and on one rank SIGTERM too: a batch scheduler's (SLURM's
- * scancel, `timeout`) is then a Ctrl-C, which a script can catch to save
- * its state, and which lets a save under way finish instead of leaving its
- * temporary file (while os.execute waits for a command, as for Ctrl-C, it
- * takes effect when the command ends). (With more ranks a SIGTERM is the
- * launcher ending the job: it keeps its default.) */
+/* Under mpirun a SIGTERM ends the rank (the launcher's, ending the job),
+ * but first removes the rank's private copies of the script's files,
+ * which the end of the run would have removed (they piled up in $TMPDIR,
+ * as large as what the script wrote, at every job mpirun or a scheduler
+ * ended). */
+static void on_rank_sigterm(int sig)
+{
+    sx_lua_rank_files_remove_now();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* SIGINT and SIGUSR1, and on one rank SIGTERM too: a batch scheduler's
+ * (SLURM's scancel, `timeout`; SLURM's --signal=USR1@seconds before the
+ * wall time, which mpirun forwards to every rank) is then a Ctrl-C, which
+ * a script can catch to save its state, and which lets a save under way
+ * finish instead of leaving its temporary file (while os.execute waits
+ * for a command, as for Ctrl-C, it takes effect when the command ends).
+ * (With more ranks a SIGTERM is the launcher ending the job: it ends the
+ * rank, on_rank_sigterm; and mpirun ends the job on a Ctrl-C of its own.) */
 static void set_sigint(void (*handler)(int))
 {
+    const bool ranks = sx_lua_parallel_ranks() > 1;
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = handler;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
-    if (sx_lua_parallel_ranks() == 1) sigaction(SIGTERM, &sa, NULL);
+    /* under mpirun a SIGUSR1 is always a request, kept for the next
+     * cycle, and it restarts the calls it lands in: a read failing on one
+     * rank alone would set the ranks apart */
+    if (ranks) sa.sa_handler = on_sigint, sa.sa_flags = SA_RESTART;
+    sigaction(SIGUSR1, &sa, NULL);
+    if (ranks) sa.sa_handler = on_rank_sigterm;
+    sigaction(SIGTERM, &sa, NULL);
 }
 
 /* coroutine.resume, listing the coroutine while it runs (upvalue 1: the
@@ -1141,6 +1167,7 @@ int main(int argc, char **argv)
     /* a subcommand, before MPI or Lua: ./render runs a script named render */
     if (argc > 1 && strcmp(argv[1], "render") == 0) return run_render(argc, argv);
     sx_lua_parallel_start(&argc, &argv);  // MPI_Init under mpirun, before anything reads argv
+    set_sigint(SIG_DFL);                   // under mpirun: SIGUSR1 a request, SIGTERM's clean-up, from here on
     switch (parse(argc, argv, &o)) {
     case DONE: sx_lua_parallel_stop(1); return EXIT_SUCCESS;
     case BAD: /* every rank parsed the same command line: under mpirun rank 0 says why */

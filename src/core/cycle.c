@@ -170,7 +170,12 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     for (int64_t s = 0; s < n; s++) {
         if (sx_model_time_reached(m, t_end, since)) break; /* the time is global: every rank stops here */
         t = sx__now();
-        if (sx__interrupted(m)) {
+        bool stop = false; /* decomposed: where the ranks agree (sx__dd_stop) */
+        if (dd && !sx__dd_stop(m, &stop)) {
+            st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their interrupts");
+            break;
+        }
+        if (dd ? stop : sx__interrupted(m)) {
             st = sx__fail(m, SX_EINTERRUPT, "interrupted at step %lld", (long long)m->step);
             break;
         }
@@ -235,10 +240,14 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     m->prof.seconds[SX_STAGE_OTHER] += other;
     m->locked = false;
     /* the whole state on every rank again, or lazily not (after an error
-     * the ranks are out of step, the state mixed: the caller stops them) */
-    if (dd && !st) st = sx__dd_end(m, k->plan);
+     * the ranks are out of step, the state mixed: the caller stops them;
+     * an interrupt stops them in step, sx__dd_stop) */
+    if (dd && (!st || st == SX_EINTERRUPT)) {
+        const sx_status end = sx__dd_end(m, k->plan);
+        if (end) st = end;
+    }
     if (dd) dd->active = false;
-    if (dd && st) dd->scattered = true;
+    if (dd && st && st != SX_EINTERRUPT) dd->scattered = true;
     return st;
 }
 

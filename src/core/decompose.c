@@ -38,7 +38,7 @@
  * face and elements, from the owner of its pair, and the ranks' cracks
  * merged in the serial order). A build inside the cycle is the serial one,
  * on every rank, from what it reads alone (the positions, the pairs'
- * contact flags and bond links, the bonds' kinds, the clumps' places:
+ * contact flags and bond links, the bonds' kinds, the clumps' state:
  * sx__dd_build); after its plan the balls, pairs and bonds the new cut
  * gives another rank move to it (sx__dd_migrate), and the rest stays
  * where it was stepped. A smooth joint's state is its pair's and its bond's; a
@@ -102,7 +102,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
      * gho_own, fwd.own, back.own, bb_was, bw_was; and the routes' needs (r per rank) */
     enum { SPANS = 15 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(2 * r * r, sizeof *routes) : NULL;
-    double *pace = routes ? calloc(3 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r) */
+    double *pace = routes ? calloc(5 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r), stopping (2 r) */
     if (!pace) {
         free(routes);
         free(s);
@@ -117,7 +117,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
     d->bb_was = s + 12 * r, d->bw_was = s + 13 * r;
     d->fwd.need = routes, d->back.need = routes + r * r;
-    d->pace = pace, d->sample = pace + r;
+    d->pace = pace, d->sample = pace + r, d->stopping = pace + 3 * r;
     d->received = &m->prof.received;
     m->dd = d;
     return SX_OK;
@@ -926,7 +926,7 @@ static bool share_flags(sx_model *m, sx_pairs *p, const sx_span *own)
 /* The build inside a cycle is the serial build, on every rank, but not
  * from the whole state: it reads of the step's state only the positions,
  * the pairs' contact flags and bond links, the bonds' kinds and the
- * clumps' places, which every rank takes here (with the cracks, whose
+ * clumps' state, which every rank takes here (with the cracks, whose
  * owners follow the balls); the rest stays where the ranks stepped it,
  * and what the new cut gives another rank moves after the plan
  * (sx__dd_migrate). About 24 bytes a ball and 5 a pair instead of the
@@ -1100,6 +1100,37 @@ bool sx__dd_migrate(sx_model *m)
     free(list);
     free(from);
     return ok;
+}
+
+/* An interrupt stops every rank at the same step. Every STOP_EVERY steps
+ * the ranks share the number of their process's last unanswered interrupt
+ * request and of the last one a stop answered (a Ctrl-C or a SIGUSR1 that
+ * mpirun forwards to each rank reaches each at its own step; a rank's run
+ * that is not decomposed may have answered its own), and a request above
+ * every rank's answered level stops the cycle on every rank there, in
+ * step: the cycle ends as any cycle does, and the interruption can be
+ * reported, and caught, alike on every rank. The decision is made from
+ * the shared numbers alone, so ranks that are threads of one process
+ * (tests/test_decompose.c) decide alike too. A rank's late copy of a
+ * signal a stop answered is not a new request. One small exchange every
+ * STOP_EVERY steps: a running cycle stops within that many steps of the
+ * signal. */
+enum { STOP_EVERY = 16 };
+
+bool sx__dd_stop(sx_model *m, bool *stop)
+{
+    sx_dd *d = m->dd;
+    *stop = false;
+    if (m->step % STOP_EVERY) return true;
+    const int R = d->x.ranks, me = d->x.rank;
+    double *s = d->stopping;
+    s[2 * me] = (double)sx__interrupts_unanswered(), s[2 * me + 1] = (double)sx__interrupts_level();
+    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
+    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
+    double request = 0, level = 0;
+    for (int r = 0; r < R; r++) request = s[2 * r] > request ? s[2 * r] : request, level = s[2 * r + 1] > level ? s[2 * r + 1] : level;
+    if (request > level) sx__interrupts_stopped((unsigned)request), *stop = true;
+    return true;
 }
 
 /* Only a servo and energy tracking read the walls' resultants inside a

@@ -133,16 +133,54 @@ sx_memory sx_model_memory(const sx_model *m)
     r.bytes_per_contact = r.contact_count ? (double)r.contacts / (double)r.contact_count : 0;
     return r;
 }
-void sx_model_interrupt(sx_model *m) { m->interrupt = 1; }
-
-/* A signal handler sets it, the core's long loops read it: lock-free */
+/* A signal handler sets it, the core's long loops read it: lock-free. And
+ * for decomposed cycles, which stop alike on every rank (sx__dd_stop), the
+ * requests numbered: the process's count; the number of the last one
+ * answered here (cleared: by a run not decomposed, or after a stop); the
+ * number of the last one a decomposed stop answered (the largest any rank
+ * had: another rank's copy of a signal up to there, come late, is not a
+ * new one); and the stops. */
 static atomic_int interrupt_requested;
+static atomic_uint requests, answered_here, answered_level, stops;
 
-void sx_interrupt_request(void) { atomic_store(&interrupt_requested, 1); }
+void sx_model_interrupt(sx_model *m)
+{
+    m->interrupt = 1;
+    if (m->dd) atomic_fetch_add(&requests, 1); /* a decomposed cycle stops on the ranks' requests alone */
+}
+
+void sx_interrupt_request(void)
+{
+    atomic_store(&interrupt_requested, 1);
+    atomic_fetch_add(&requests, 1);
+}
 
 int sx_interrupt_pending(void) { return atomic_load(&interrupt_requested); }
 
-void sx_interrupt_clear(void) { atomic_store(&interrupt_requested, 0); }
+void sx_interrupt_clear(void)
+{
+    atomic_store(&interrupt_requested, 0);
+    atomic_store(&answered_here, atomic_load(&requests));
+}
+
+unsigned sx__interrupts_unanswered(void)
+{
+    const unsigned n = atomic_load(&requests), here = atomic_load(&answered_here),
+                   level = atomic_load(&answered_level);
+    return n > here && n > level ? n : 0;
+}
+
+unsigned sx__interrupts_level(void) { return atomic_load(&answered_level); }
+
+void sx__interrupts_stopped(unsigned level)
+{
+    unsigned old = atomic_load(&answered_level);
+    while (level > old && !atomic_compare_exchange_weak(&answered_level, &old, level)) {}
+    atomic_fetch_add(&stops, 1);
+    if (atomic_load(&requests) <= level) atomic_store(&interrupt_requested, 0); /* every one here answered */
+}
+
+unsigned sx_interrupts_agreed(void) { return atomic_load(&stops); }
 
 bool sx__speed_rated(const sx_model *m)
 {
@@ -154,8 +192,16 @@ bool sx__speed_rated(const sx_model *m)
     return false;
 }
 
-/* a model's own flag only while it cycles: it stays set after the cycle it stopped */
-bool sx__interrupted(const sx_model *m) { return (m->locked && m->interrupt) || atomic_load(&interrupt_requested); }
+/* a model's own flag only while it cycles: it stays set after the cycle it
+ * stopped. Decomposed, never: a signal reaches each rank at its own time,
+ * and one rank stopping alone would leave the ranks out of step (a cycle
+ * stops on the ranks' agreement, sx__dd_stop; the loops outside cycles
+ * run to their end). */
+bool sx__interrupted(const sx_model *m)
+{
+    if (m->dd) return false;
+    return (m->locked && m->interrupt) || atomic_load(&interrupt_requested);
+}
 
 sx_status sx_model_set_threads(sx_model *m, int threads)
 {

@@ -449,6 +449,7 @@ typedef struct sx_dd {
      * this rank's computing seconds and planned work since its last
      * sample, and its planned work per step (the cut's) */
     double *pace, *sample;
+    double *stopping; /* sx__dd_stop's exchange: per rank its last unanswered interrupt and answered level */
     double busy, busy_work;
     int64_t planned;
     /* a build inside a cycle from what each rank holds current (sx__dd_build,
@@ -649,6 +650,13 @@ sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
 /* A Ctrl-C for the core's long loops to stop at (sx_interrupt_request, or
  * the model's sx_model_interrupt while it cycles) (model.c). */
 bool sx__interrupted(const sx_model *m);
+/* Decomposed cycles' interrupts (model.c, sx__dd_stop): the number of the
+ * process's last request if neither answered here (sx_interrupt_clear) nor
+ * by a stop (the level), else 0; the level; a stop that answered every
+ * request up to level. */
+unsigned sx__interrupts_unanswered(void);
+unsigned sx__interrupts_level(void);
+void sx__interrupts_stopped(unsigned level);
 /* Whether the automatic timestep rates a ball by its speed: some material's
  * own law or a contact-model row stiffens with the overlap (Hertz: its
  * tangent stiffness is not its secant; kernels/timestep.c). A velocity set
@@ -786,6 +794,9 @@ bool sx__dd_keep_sources(sx_model *m, bool walls, const int32_t *src, int64_t n)
  * sx__pairs_sort, after the build). False: out of memory. */
 bool sx__dd_sources_sort(sx_model *m, bool walls, const int32_t *pos, int64_t n);
 bool sx__dd_migrate(sx_model *m);
+/* Decomposed: whether the ranks stop the cycle at this step for an
+ * interrupt (*stop), the same on every rank. False: the exchange failed. */
+bool sx__dd_stop(sx_model *m, bool *stop);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n

@@ -102,6 +102,13 @@ SX_API void sx_model_interrupt(sx_model *m);
 SX_API void sx_interrupt_request(void);
 SX_API int sx_interrupt_pending(void);
 SX_API void sx_interrupt_clear(void);
+/// Decomposed cycles do not stop on a rank's own request: every 16 steps
+/// the ranks share their unanswered requests (sx_interrupt_clear answers
+/// a process's, as does a stop), and one on any rank stops the cycle on
+/// every rank at that step, with SX_EINTERRUPT (the state as at any
+/// cycle's end). sx_model_interrupt of a decomposed model is a request.
+/// The stops so far (the same on every rank).
+SX_API unsigned sx_interrupts_agreed(void);
 
 /// PFC's mean unbalanced-force ratio: the mean over bodies (free balls and clumps) of |F + m g| (free
 /// components) over the mean contact force magnitude; 0 when at rest with no

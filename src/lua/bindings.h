@@ -116,6 +116,10 @@ const char *sx_lua_rank_file(lua_State *L, const char *path);
 /// rank_files.c: removes this rank's folder of shadows (at exit, and when
 /// the run fails, before mpirun's abort can kill the rank).
 void sx_lua_rank_files_remove(void);
+/* run.c: an interrupt answered by this process alone (an error raised
+ * from a run or a call that is not a decomposed cycle): cleared, and
+ * under mpirun counted for seixo.interrupts() beside the ranks' stops. */
+void sx_lua_interrupt_answered(void);
 /// rank_files.c: the names this rank wrote, removed or renamed itself
 /// while the ranks did not share files (seixo.decompose(false)), each with
 /// its NUL, sorted, in a malloc'ed block of *len bytes (NULL: no memory);

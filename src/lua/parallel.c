@@ -192,7 +192,10 @@ static int seixo_send(lua_State *L)
     size_t len;
     const char *text = luaL_checklstring(L, 2, &len);
     check_ranks(L, "send");
-    luaL_argcheck(L, to >= 0 && to < world_size && to != world_rank, 1, "another rank expected");
+    if (!(to >= 0 && to < world_size && to != world_rank))
+        return luaL_argerror(L, 1,
+                             lua_pushfstring(L, "another rank expected (0 to %d, not this one, %d), got %I",
+                                             world_size - 1, world_rank, to));
     if (len > (size_t)0x7fffffff) return luaL_error(L, "seixo.send: message too long");
 #ifdef SX_HAVE_MPI
     MPI_Send(text, (int)len, MPI_CHAR, (int)to, MESSAGE_TAG, MPI_COMM_WORLD);
@@ -655,7 +658,8 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
     if (other < world_size)
         snprintf(err, size,
                  "%s: the ranks made different calls: rank 0 is in %.*s, rank %d in %.*s (every rank runs the "
-                 "script and must make the same calls: one under `if seixo.rank() == 0`?)",
+                 "script and must make the same calls: one under `if seixo.rank() == 0`, or after a decision "
+                 "on the clock, which differs between the ranks?)",
                  what, CALL_NAME, all, other, CALL_NAME, all + (size_t)other * CALL_NAME);
     free(all);
     return other >= world_size;
@@ -677,7 +681,7 @@ int64_t sx_lua_parallel_root_value(int64_t v)
 {
 #ifdef SX_HAVE_MPI
     if (mpi_started && world_size > 1 && MPI_Bcast(&v, 1, MPI_INT64_T, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
-        sx_lua_parallel_fail("the ranks could not agree on where a cycle's chunk ends");
+        sx_lua_parallel_fail("the ranks could not share rank 0's value");
 #endif
     return v;
 }

@@ -242,6 +242,26 @@ void sx_lua_rank_files_remove(void)
     rmdir(shadow_dir);
 }
 
+void sx_lua_rank_files_remove_now(void)
+{
+    if (!shadow_dir[0]) return;
+    char path[PATH_MAX + 16];
+    const size_t n = strlen(shadow_dir);
+    memcpy(path, shadow_dir, n);
+    path[n] = '/';
+    for (unsigned k = 0; k < shadow_count; k++) { /* the shadows' names are their numbers */
+        char digit[16];
+        int d = 0;
+        unsigned v = k;
+        do digit[d++] = (char)('0' + v % 10);
+        while ((v /= 10));
+        for (int i = 0; i < d; i++) path[n + 1 + (size_t)i] = digit[d - 1 - i];
+        path[n + 1 + (size_t)d] = '\0';
+        unlink(path);
+    }
+    rmdir(shadow_dir);
+}
+
 /* Whether rank 0 may open path with mode, found without changing the file:
  * false with errno as its fopen would set it. */
 static bool may_write(const char *path, const char *mode)

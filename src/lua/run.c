@@ -183,10 +183,22 @@ int sx_lua_interrupt_pending(void) { return sx_interrupt_pending(); }
 void sx_lua_interrupt_clear(void) { sx_interrupt_clear(); }
 
 /* Interrupts requested so far (seixo.interrupts): code that catches errors
- * to go on (lab.calibrate's runs) tells an interrupt from a failure. */
-static atomic_uint interrupts;
+ * to go on (lab.calibrate's runs) tells an interrupt from a failure. Under
+ * mpirun those the ranks' cycles stopped on alike (sx_interrupts_agreed):
+ * a signal reaches each rank at its own time, and the ranks must count
+ * alike. */
+static atomic_uint interrupts, answered_alone;
 
-unsigned sx_lua_interrupt_count(void) { return atomic_load(&interrupts); }
+unsigned sx_lua_interrupt_count(void)
+{
+    return sx_lua_parallel_ranks() > 1 ? sx_interrupts_agreed() + atomic_load(&answered_alone) : atomic_load(&interrupts);
+}
+
+void sx_lua_interrupt_answered(void)
+{
+    if (sx_lua_parallel_ranks() > 1) atomic_fetch_add(&answered_alone, 1);
+    sx_interrupt_clear();
+}
 
 int sx_lua_interrupt_all(void)
 {
@@ -197,7 +209,9 @@ int sx_lua_interrupt_all(void)
         run *r = atomic_load(&runs[i]);
         if (!r) continue;
         atomic_store(&r->interrupted, 1);
-        sx_model_interrupt(r->m);
+        /* a decomposed model's cycle stops on the ranks' requests: this
+         * one is counted already, and must count once */
+        if (!r->ud->decomposed) sx_model_interrupt(r->m);
     }
     /* a callback running Lua code is stopped by the caller's hook */
     run *inner = n > 0 ? atomic_load(&runs[n - 1]) : NULL;
@@ -262,16 +276,22 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     return r;
 }
 
-/* The Ctrl-C is answered: by the error raised now. */
+/* The Ctrl-C is answered: by the error raised now (a decomposed cycle's,
+ * on every rank alike; else by this process alone). */
 static void interrupted(lua_State *L, sx_lua_run *r)
 {
-    sx_interrupt_clear();
+    if (r && r->ud->decomposed) sx_interrupt_clear();
+    else sx_lua_interrupt_answered();
     if (r) luaL_error(L, "interrupted at step %I", (lua_Integer)sx_model_step_count(r->m));
     luaL_error(L, "interrupted");
 }
 
 void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
 {
+    /* under mpirun the work every rank does alike stops where the ranks
+     * agree, in a decomposed cycle (sx_interrupts_agreed): a rank's own
+     * signal would stop it alone */
+    if (sx_lua_parallel_ranks() > 1 && (!r || r->ud->decomposed)) return;
     if ((r && atomic_load(&r->interrupted)) || sx_interrupt_pending()) interrupted(L, r);
 }
 
@@ -283,7 +303,10 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle_until(r->m, n, t_end, r->since);
-    if (st != SX_OK && r->ud->decomposed) { /* the ranks are out of step: all stop, with the message */
+    /* an interrupt stops the ranks in step (every rank raises it, and a
+     * script can catch it); after any other error they are out of step:
+     * all stop, with the message */
+    if (st != SX_OK && st != SX_EINTERRUPT && r->ud->decomposed) {
         char msg[1024];
         luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
         /* the first step since a placement failed: the placement is named,
@@ -294,7 +317,7 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
             snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), r->what, sx_lua_core_message(sx_model_error(r->m)));
         sx_lua_parallel_fail(msg);
     }
-    if (st == SX_EINTERRUPT || (st == SX_OK && atomic_load(&r->interrupted))) interrupted(L, r);
+    if (st == SX_EINTERRUPT || (st == SX_OK && !r->ud->decomposed && atomic_load(&r->interrupted))) interrupted(L, r);
     /* the first step since balls or walls were placed (run_model takes it alone) */
     if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
     sx_lua_check(L, r->m, st, r->what);
@@ -348,8 +371,8 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
     if (ud->callback == 0) sx_lua_apply_removals(L, model);
     if (status != LUA_OK) {
         /* a Ctrl-C that stopped the callback reads like one that stopped the cycle */
-        if (mine && atomic_load(&r->interrupted)) {
-            sx_interrupt_clear();
+        if (mine && !r->ud->decomposed && atomic_load(&r->interrupted)) {
+            sx_lua_interrupt_answered();
             luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
         }
         if (lua_type(L, -1) == LUA_TSTRING && ud->m) {

@@ -68,6 +68,10 @@ SX_API void sx_lua_parallel_start(int *argc, char ***argv);
 SX_API int sx_lua_parallel_rank(void);
 /// The number of MPI ranks (1 without mpirun).
 SX_API int sx_lua_parallel_ranks(void);
+/// Removes this rank's folder of private copies of the script's files
+/// (rank_files.c) from a signal handler that ends the rank: only
+/// async-signal-safe calls.
+SX_API void sx_lua_rank_files_remove_now(void);
 
 /// Text rank 0 makes, on every rank: under mpirun rank 0 calls read(ud,
 /// len, mark) and sends what it returns (len bytes, malloc'ed and
