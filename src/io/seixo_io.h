@@ -199,6 +199,9 @@ sx_status sx_series_write(sx_series *s, const sx_model *m, const sx_io_history *
 sx_status sx_series_write_histories(sx_series *s, const sx_io_history *h, int nh, char *err, size_t errlen);
 /// Snapshots in the series.
 int64_t sx_series_count(const sx_series *s);
+/// Appending: the step of the series' last snapshot when it was opened
+/// (-1: none, or a new series).
+int64_t sx_series_opened_at(const sx_series *s);
 const char *sx_series_path(const sx_series *s);
 /// The .xmf beside a series' .h5: path with its .h5 / .hdf5 / .hdf
 /// extension replaced by .xmf (or .xmf appended); malloc'd, NULL when out

@@ -62,6 +62,7 @@ struct sx_series {
     unsigned fields;
     int compression;
     int64_t count;    /* complete snapshots */
+    int64_t opened_at; /* appending: the last snapshot's step when opened (-1: none) */
     xdoc x;           /* the XDMF: a grid per block and complete snapshot */
     held *held;       /* histories met so far */
     int nheld, capheld;
@@ -161,6 +162,8 @@ unsigned sx_series_field_bit(const char *name)
 }
 
 int64_t sx_series_count(const sx_series *s) { return s->count; }
+
+int64_t sx_series_opened_at(const sx_series *s) { return s->opened_at; }
 const char *sx_series_path(const sx_series *s) { return s->path; }
 
 /* -------------------------------------------------------- the series */
@@ -244,7 +247,7 @@ static herr_t history_end(hid_t g, const char *name, const H5L_info_t *info, voi
 /* The last step a series holds: its last complete snapshot's or, if
  * later, a history's (written at close, past the last snapshot); -1 for
  * none. *what says which. What cannot be read is skipped. */
-static int64_t series_end(hid_t file, const char *path, int64_t count, const char **what)
+static int64_t series_end(hid_t file, const char *path, int64_t count, const char **what, int64_t *snapshot)
 {
     char err[16], name[48];
     sx_h5 probe;
@@ -256,6 +259,7 @@ static int64_t series_end(hid_t file, const char *path, int64_t count, const cha
     if (g < 0 || !sx_h5_get_i64(&probe, g, name, "step", &step, 1, true)) step = -1;
     sx_h5_close(g);
     sx_h5_end(&probe);
+    *snapshot = step;
     tails t = {step, path};
     hid_t hs = H5Lexists(file, "/histories", H5P_DEFAULT) > 0 ? H5Gopen2(file, "/histories", H5P_DEFAULT) : -1;
     if (hs >= 0) H5Literate(hs, H5_INDEX_NAME, H5_ITER_INC, NULL, history_end, &t);
@@ -270,7 +274,7 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
     sx_h5 h;
     sx_h5_begin(&h, path ? path : "", err, errlen);
     sx_series *s = calloc(1, sizeof *s);
-    if (s) s->file = -1;
+    if (s) s->file = -1, s->opened_at = -1;
     const unsigned fields = o && o->fields ? o->fields : SX_OUT_DEFAULT;
     if (!s) {
         sx_h5_fail(&h, "out of memory");
@@ -301,7 +305,9 @@ sx_series *sx_series_open(const char *path, int dim, const sx_series_opts *o, ch
             s->file = sx_io_open(&h, path, true, "series", dim, &d, &version);
             if (s->file >= 0) sx_h5_get_i64(&h, s->file, "/", "count", &s->count, 1, true);
             const char *ends = "snapshots";
-            const int64_t last = s->file >= 0 && !h.failed && o->check_step ? series_end(s->file, path, s->count, &ends) : -1;
+            const int64_t last = s->file >= 0 && !h.failed && o->check_step
+                                     ? series_end(s->file, path, s->count, &ends, &s->opened_at)
+                                     : -1;
             if (o->check_step && o->step < last)
                 /* a model loaded from a save older than the series' end:
                  * its snapshots and samples would follow later ones, their

@@ -32,6 +32,7 @@
 #include "seixo_io.h"
 
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -341,6 +342,19 @@ static int job_free(lua_State *L)
     return 0;
 }
 
+/* m:save's name in the ranks' same-call check, with its path, which every
+ * rank must give alike (a rank's number or its clock in the name had rank
+ * 0 write its file alone): the path's last 40 characters and a digest of
+ * the whole (the check compares the first 96 characters). */
+static const char *save_call(char *name, size_t size, const char *path)
+{
+    uint32_t h = 2166136261u;
+    for (const char *c = path; *c; c++) h = (h ^ (unsigned char)*c) * 16777619u;
+    const size_t n = strlen(path), keep = 40;
+    snprintf(name, size, "m:save '%s%s' (%08x)", n > keep ? "..." : "", path + (n > keep ? n - keep : 0), (unsigned)h);
+    return name;
+}
+
 static int model_save(lua_State *L)
 {
     static const char *const keys[] = {"compression", NULL};
@@ -414,7 +428,8 @@ static int model_save(lua_State *L)
      * file is there, or every rank raises rank 0's error: the I/O layer
      * writes a message to err with every failure) */
     const bool shared = sx_model_ranks(m) > 1;
-    if (shared) sx_lua_check_model_call(L, m, "m:save");
+    char call[96];
+    if (shared) sx_lua_check_model_call(L, m, save_call(call, sizeof call, path));
     if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     sx_lua_rank_file_written(L, path); /* rank 0 wrote it: no shadow stands for it */
@@ -732,7 +747,11 @@ static int model_output(lua_State *L)
     lua_pushstring(L, o->s ? sx_series_path(o->s) : path);
     lua_setiuservalue(L, 3, 4);
     lua_settop(L, 3);
-    write_now(L, 3, 1, m, true);
+    /* appending at the step of the series' last snapshot (a model loaded
+     * from the save made there), that snapshot is not written twice */
+    int64_t again = o->s && sx_series_opened_at(o->s) == so.step;
+    if (o->shared) again = sx_lua_parallel_root_value(again);
+    if (!again) write_now(L, 3, 1, m, true);
     /* m:on("after", callback, {every = every}) */
     lua_getfield(L, 1, "on");
     lua_pushvalue(L, 1);

@@ -90,7 +90,12 @@ test("an open output series' file is not taken by another writer", function()
   eq(o:count(), 4) -- m:output's own first snapshot and three writes: none lost
   o:close()
   -- closed, the file is the user's to replace or to append to
+  -- appended at the step of its last snapshot (a restart from a save made
+  -- there): that snapshot is not written twice (its time came twice in the .xmf)
   local again = m:output{path = path, append = true}
+  eq(again:count(), 4)
+  m:cycle(1)
+  again:write()
   eq(again:count(), 5)
   again:close()
   other:save(path)

@@ -23,6 +23,9 @@
 --   receive  seixo.receive on rank 0 alone, the others cycling: no
 --            message can come (it hung); serially no receive
 --   receives seixo.receive on every rank, none sending (it hung)
+--   path     m:save on every rank, each to a path of its own (a rank's
+--            number or its clock in the name): rank 0 wrote its file
+--            alone, and a later load failed on the others
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -60,9 +63,12 @@ elseif scene == "receive" then
   m:cycle(100)
 elseif scene == "receives" then
   if seixo.ranks() > 1 then seixo.receive() end
+elseif scene == "path" then
+  m:save(base .. "_" .. seixo.rank() .. ".h5")
+  m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive or receives expected, "
-        .. "got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive, receives or path "
+        .. "expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
-for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf"} do os.remove(base .. suffix) end
+for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf", "_0.h5"} do os.remove(base .. suffix) end

@@ -86,6 +86,10 @@ see(m:ranks())
 print("a model after it:", m:step(), m:hash())
 -- every rank's view against rank 0's
 local digest = table.concat(seen, "\n")
+if R > 1 then -- a rank out of range is named with the range
+  local ok, e = pcall(seixo.send, R, "x")
+  assert(not ok and e:match("another rank expected %(0 to " .. R - 1 .. ", not this one, %d+%), got " .. R), e)
+end
 if seixo.rank() > 0 then
   seixo.send(0, digest)
 else
