@@ -120,6 +120,9 @@ void sx_lua_rank_files_remove(void);
  * from a run or a call that is not a decomposed cycle): cleared, and
  * under mpirun counted for seixo.interrupts() beside the ranks' stops. */
 void sx_lua_interrupt_answered(void);
+/* parallel.c: the error a seixo call is raising on this rank (under
+ * mpirun): named by the same-call check if the ranks then part. */
+void sx_lua_parallel_note_error(const char *message);
 /// rank_files.c: the names this rank wrote, removed or renamed itself
 /// while the ranks did not share files (seixo.decompose(false)), each with
 /// its NUL, sorted, in a malloc'ed block of *len bytes (NULL: no memory);

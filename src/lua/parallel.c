@@ -640,6 +640,41 @@ int sx_lua_parallel_ranks(void) { return world_size; }
  * rank 0 hears a rank that failed alone: fail_heard); when they differ,
  * every rank of the check fails with the message, which names two of
  * them. */
+/* The last error a seixo call raised on this rank: when the ranks part
+ * and their last errors differ (a rank caught one with pcall and went on,
+ * the others did not raise it), the check's message names it. */
+enum { LAST_ERROR = 240 };
+static char last_error[LAST_ERROR];
+
+void sx_lua_parallel_note_error(const char *message)
+{
+    if (world_size > 1 && message) snprintf(last_error, sizeof last_error, "%s", message);
+}
+
+#ifdef SX_HAVE_MPI
+/* After calls that differ (every rank is here): the first rank, from
+ * `first` on and round, whose last error is not every rank's, and that
+ * error, appended to err. */
+static void name_caught(char *err, size_t size, int first)
+{
+    char *errs = malloc((size_t)world_size * LAST_ERROR);
+    if (!errs) return;
+    if (MPI_Allgather(last_error, LAST_ERROR, MPI_CHAR, errs, LAST_ERROR, MPI_CHAR, MPI_COMM_WORLD) == MPI_SUCCESS)
+        for (int k = 0; k < world_size; k++) {
+            const int r = (first + k) % world_size;
+            const char *e = errs + (size_t)r * LAST_ERROR;
+            bool alone = false;
+            for (int q = 0; q < world_size && !alone; q++) alone = memcmp(e, errs + (size_t)q * LAST_ERROR, LAST_ERROR) != 0;
+            if (!e[0] || !alone) continue;
+            const size_t at = strlen(err);
+            snprintf(err + at, size - at, "; rank %d's last error, which not every rank raised (caught with pcall?): %.*s",
+                     r, LAST_ERROR, e);
+            break;
+        }
+    free(errs);
+}
+#endif
+
 bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
 {
 #ifdef SX_HAVE_MPI
@@ -655,12 +690,14 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
         sx_lua_parallel_fail("the ranks could not compare their calls");
     int other = 1;
     while (other < world_size && memcmp(all, all + (size_t)other * CALL_NAME, CALL_NAME) == 0) other++;
-    if (other < world_size)
+    if (other < world_size) {
         snprintf(err, size,
                  "%s: the ranks made different calls: rank 0 is in %.*s, rank %d in %.*s (every rank runs the "
                  "script and must make the same calls: one under `if seixo.rank() == 0`, or after a decision "
                  "on the clock, which differs between the ranks?)",
                  what, CALL_NAME, all, other, CALL_NAME, all + (size_t)other * CALL_NAME);
+        name_caught(err, size, other);
+    }
     free(all);
     return other >= world_size;
 #else
@@ -673,7 +710,7 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
 
 void sx_lua_parallel_check_call(lua_State *L, const char *what)
 {
-    char err[512];
+    char err[1024];
     if (!sx_lua_parallel_same_call(what, err, sizeof err)) luaL_error(L, "%s", err);
 }
 

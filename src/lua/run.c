@@ -376,11 +376,14 @@ void sx_lua_user_call(lua_State *L, int model, int nargs, int nres)
             luaL_error(L, "interrupted at step %I (in a callback)", (lua_Integer)sx_model_step_count(r->m));
         }
         if (lua_type(L, -1) == LUA_TSTRING && ud->m) {
-            if (fn.what[0] == 'C')
-                luaL_error(L, "a callback (a C function) failed at step %I: %s", (lua_Integer)sx_model_step_count(ud->m),
-                           lua_tostring(L, -1));
-            luaL_error(L, "the callback defined at %s:%d failed at step %I: %s", fn.short_src, fn.linedefined,
-                       (lua_Integer)sx_model_step_count(ud->m), lua_tostring(L, -1));
+            const lua_Integer step = (lua_Integer)sx_model_step_count(ud->m);
+            const char *msg =
+                fn.what[0] == 'C'
+                    ? lua_pushfstring(L, "a callback (a C function) failed at step %I: %s", step, lua_tostring(L, -1))
+                    : lua_pushfstring(L, "the callback defined at %s:%d failed at step %I: %s", fn.short_src,
+                                      fn.linedefined, step, lua_tostring(L, -1));
+            sx_lua_parallel_note_error(msg);
+            luaL_error(L, "%s", msg);
         }
         lua_error(L);
     }

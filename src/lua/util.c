@@ -28,7 +28,10 @@ const char *sx_lua_core_message(const char *msg)
 void sx_lua_check(lua_State *L, const sx_model *m, sx_status st, const char *what)
 {
     if (st == SX_EINTERRUPT) sx_lua_interrupt_answered(); /* the Ctrl-C is answered by this error */
-    if (st != SX_OK) luaL_error(L, "%s: %s", what, sx_lua_core_message(sx_model_error(m)));
+    if (st == SX_OK) return;
+    const char *msg = lua_pushfstring(L, "%s: %s", what, sx_lua_core_message(sx_model_error(m)));
+    sx_lua_parallel_note_error(msg);
+    luaL_error(L, "%s", msg);
 }
 
 void sx_lua_checkfield(lua_State *L, const sx_model *m, sx_status st, const char *kind)

@@ -23,6 +23,10 @@
 --   receive  seixo.receive on rank 0 alone, the others cycling: no
 --            message can come (it hung); serially no receive
 --   receives seixo.receive on every rank, none sending (it hung)
+--   caught   a callback failing on the last rank alone, its error caught
+--            with pcall there and the script going on: the ranks' calls
+--            part at the script's end, and the message names the caught
+--            error (it named only the calls that differed)
 --   path     m:save on every rank, each to a path of its own (a rank's
 --            number or its clock in the name): rank 0 wrote its file
 --            alone, and a later load failed on the others
@@ -63,11 +67,18 @@ elseif scene == "receive" then
   m:cycle(100)
 elseif scene == "receives" then
   if seixo.ranks() > 1 then seixo.receive() end
+elseif scene == "caught" then
+  local at = m:step() + 50
+  m:on("after", function()
+    if m:step() == at and seixo.rank() == seixo.ranks() - 1 then error("boom") end
+  end)
+  pcall(m.cycle, m, 100)
+  m:cycle(100)
 elseif scene == "path" then
   m:save(base .. "_" .. seixo.rank() .. ".h5")
   m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive, receives or path "
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive, receives, caught or path "
         .. "expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
