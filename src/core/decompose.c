@@ -626,6 +626,14 @@ static bool move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
     return ok;
 }
 
+/* An all-gather: entry r of data (size bytes each), rank r's, to every
+ * rank. */
+static bool share_by_rank(sx_dd *d, void *data, size_t size)
+{
+    for (int r = 0; r < d->x.ranks; r++) d->scratch[r] = (sx_span){r, r + 1};
+    return share(d, data, size, d->scratch, everything(d, d->x.ranks), 1);
+}
+
 bool sx__dd_halo(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -750,8 +758,7 @@ bool sx__dd_parts(sx_model *m, int64_t count, sx_span *mine, int64_t *total)
     int64_t *counts = calloc((size_t)R, sizeof *counts);
     if (!counts) return false;
     counts[d->x.rank] = count;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
-    const bool ok = share(d, counts, sizeof *counts, d->scratch, everything(d, R), 1);
+    const bool ok = share_by_rank(d, counts, sizeof *counts);
     int64_t sum = 0;
     for (int r = 0; ok && r < R; r++) {
         d->scratch[r] = (sx_span){sum, sum + counts[r]};
@@ -865,8 +872,7 @@ static bool share_pace(sx_model *m)
     double *s = d->sample;
     s[2 * me] = d->busy;
     s[2 * me + 1] = d->busy_work > 0 ? d->busy / d->busy_work : 0;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
-    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
+    if (!share_by_rank(d, s, 2 * sizeof *s)) return false;
     for (int r = 0; r < R; r++)
         if (!(s[2 * r] >= PACE_MIN_S && s[2 * r + 1] > 0)) return true; /* measuring on */
     for (int r = 0; r < R; r++) d->pace[r] = d->pace[r] > 0 ? 0.5 * (d->pace[r] + s[2 * r + 1]) : s[2 * r + 1];
@@ -1016,6 +1022,14 @@ static int64_t list_by_owner(const sx_dd *d, const int32_t *from, int64_t n, int
     return at;
 }
 
+/* The rows f of the entries k < n with from[k] >= 0, from rank from[k]
+ * to every rank (list and runs: room for n entries and for the ranks). */
+static bool move_from(sx_dd *d, const sx_rows *f, const int32_t *from, int64_t n, int32_t *list, sx_span *runs)
+{
+    const int64_t k = list_by_owner(d, from, n, list, runs);
+    return move_rows(d, f, list, 0, k, runs, everything(d, k), 1);
+}
+
 /* Rank r steps the ball-ball pairs pairs[r] and the ball-wall pairs of
  * the balls of its wall blocks wrun[r]. */
 static sx_span wall_pairs_run(const sx_model *m, int r)
@@ -1071,18 +1085,15 @@ bool sx__dd_migrate(sx_model *m)
             from[i] = o != owner_of(d, i, B->n) ? o : -1;
         }
         const sx_rows f = ball_motion(m, false);
-        const int64_t k = list_by_owner(d, from, B->n, list, runs);
-        ok = move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+        ok = move_from(d, &f, from, B->n, list, runs);
     }
     if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
         pairs_from(m, d->pairs, d->src_bb, d->nsrc_bb, d->bb_was, from, m->bb.n, false);
-        sx_rows f = pair_rows(m, &m->bb);
-        int64_t k = list_by_owner(d, from, m->bb.n, list, runs);
-        ok = move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+        const sx_rows fb = pair_rows(m, &m->bb);
+        ok = move_from(d, &fb, from, m->bb.n, list, runs);
         pairs_from(m, NULL, d->src_bw, d->nsrc_bw, d->bw_was, from, m->bw.n, true);
-        f = pair_rows(m, &m->bw);
-        k = list_by_owner(d, from, m->bw.n, list, runs);
-        ok = ok && move_rows(d, &f, list, 0, k, runs, everything(d, k), 1);
+        const sx_rows fw = pair_rows(m, &m->bw);
+        ok = ok && move_from(d, &fw, from, m->bw.n, list, runs);
     }
     if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
         for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
@@ -1125,8 +1136,7 @@ bool sx__dd_stop(sx_model *m, bool *stop)
     const int R = d->x.ranks, me = d->x.rank;
     double *s = d->stopping;
     s[2 * me] = (double)sx__interrupts_unanswered(), s[2 * me + 1] = (double)sx__interrupts_level();
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1};
-    if (!share(d, s, 2 * sizeof *s, d->scratch, everything(d, R), 1)) return false;
+    if (!share_by_rank(d, s, 2 * sizeof *s)) return false;
     double request = 0, level = 0;
     for (int r = 0; r < R; r++) request = s[2 * r] > request ? s[2 * r] : request, level = s[2 * r + 1] > level ? s[2 * r + 1] : level;
     if (request > level) sx__interrupts_stopped((unsigned)request), *stop = true;
