@@ -103,7 +103,7 @@ static bool whole_needed(const sx_model *m)
 /* A build at a step of a cycle (or at the start of a decomposed one that
  * goes on from a scattered state): decomposed, the serial build on every
  * rank from what it reads, then the new cut, to which the balls, pairs
- * and bonds move (decompose.c). */
+ * and bonds move (dd_migrate.c). */
 static sx_status step_build(sx_model *m, const sx_kernels *k)
 {
     sx_dd *dd = m->dd;

@@ -259,7 +259,7 @@ typedef struct sx_chunk {
     int64_t first, last;   /* pair range [first, last) */
     int64_t own_lo, own_hi;/* balls [own_lo, own_hi): the a's of its pairs */
     int64_t clear_lo, clear_hi; /* balls whose forces it starts from the applied loads (or zero) */
-    /* decomposed with energy tracking (decompose.c, sx__dd_energy): from
+    /* decomposed with energy tracking (dd_energy.c, sx__dd_energy): from
      * pair tape_at on (-1: never) the chunk's energy terms are this rank's
      * part of a chunk begun on a lower rank, and go to its tape (taping);
      * part: what this rank gives the chunk's energy sums (SX_DD_PART_*) */
@@ -372,7 +372,7 @@ typedef struct sx_cell {
 enum { SX_DD_NEED = 4 };
 /* Decomposed with energy tracking: the energy terms of a rank's part of
  * a chunk or block begun on a lower rank, in the order the step makes
- * them, each with the index of its sum (decompose.c, sx__dd_energy). */
+ * them, each with the index of its sum (dd_energy.c, sx__dd_energy). */
 typedef struct sx_tape {
     struct sx_tape_term {
         double v;
@@ -443,7 +443,7 @@ typedef struct sx_dd {
      * second ball it or above), and the work of the balls before it */
     int32_t *low_a, *cross;
     int64_t *work, cap_cut;
-    /* the cut's balance by measured pace (decompose.c, share_pace): per
+    /* the cut's balance by measured pace (dd_share.c, sx__dd_share_pace): per
      * rank its seconds of computing per unit of the cut's work, smoothed
      * (0: not measured yet), and the ranks' last samples (2 per rank);
      * this rank's computing seconds and planned work since its last

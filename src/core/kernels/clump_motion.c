@@ -71,7 +71,7 @@ static double KERNEL(place_pebbles)(sx_model *m, int64_t c, const double *R)
 }
 
 /* A term of the clump step's energy sums: onto the block's sum *work, or,
- * decomposed, into slot k of the clump's terms (decompose.c sums them in
+ * decomposed, into slot k of the clump's terms (dd_energy.c sums them in
  * the serial order). The serial step passes terms NULL: inlined, the
  * branch goes. */
 static inline __attribute__((always_inline)) void energy_term(double *work, double *terms, int k, double v)

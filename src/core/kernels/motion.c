@@ -22,7 +22,7 @@ static void blame_non_finite(const sx_model *m, sx_block *o, double check)
 
 /* An energy term of the block's sum (k: 0 damping, 1 loads, 2 the
  * dashpots' share), or, decomposed in a block begun on a lower rank, of
- * the rank's tape (decompose.c). */
+ * the rank's tape (dd_energy.c). */
 static inline void motion_energy(sx_model *m, const sx_block *o, int k, double *sum, double x)
 {
     if (o->tape_k >= 0) sx__tape_add(&m->dd->tape, o->tape_k + k, x);
@@ -246,7 +246,7 @@ static sx_status KERNEL(integrate)(sx_model *m, double *max_disp)
         if (o->bad >= 0)
             return KERNEL(nonfinite)(m, "ball", m->balls.id[o->bad]);
         if (o->worst > worst) worst = o->worst;
-        if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (decompose.c, sx__dd_energy) */
+        if (m->track_energy && !dd) { /* decomposed: the ranks' to chain (dd_energy.c, sx__dd_energy) */
             m->acc.local_damping -= o->damp_work;
             m->acc.boundary_work += o->load_work;
             m->acc.viscous += o->visc_work;

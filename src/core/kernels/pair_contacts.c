@@ -195,7 +195,7 @@ static void log_crack(sx_model *m, sx_chunk *o, const double *xc, sx_crack_mode 
 }
 
 /* An energy term of the chunk's current pair: to the chunk's sum k, or,
- * decomposed past its tape_at, to the rank's tape (decompose.c). A zero
+ * decomposed past its tape_at, to the rank's tape (dd_energy.c). A zero
  * changes no sum (a sum from +0 never reaches -0), so it is not kept. */
 enum { E_SLIP, E_VISCOUS, E_RELEASED };
 static inline void chunk_energy(sx_model *m, sx_chunk *o, int k, double x)
@@ -957,7 +957,7 @@ static sx_status KERNEL(contacts)(sx_model *m)
     }
     if (dd && (st = far_pairs(m, dd->nxlow, dd->nxpair))) return st;
     if (m->cell) fold_ghosts(m);
-    /* decomposed: the energy sums are the ranks' to chain (decompose.c, sx__dd_energy) */
+    /* decomposed: the energy sums are the ranks' to chain (dd_energy.c, sx__dd_energy) */
     const bool sums = !m->dd || !m->dd->active;
     for (int64_t c = 0; c < nchunk; c++) {
         sx_chunk *o = &m->chunks[c];

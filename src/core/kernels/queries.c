@@ -108,7 +108,7 @@ static void energy_walls(const sx_model *m, int64_t c0, int64_t c1, double *e)
     free(wall_laws);
 }
 
-/* Rank r's terms of the energy's chained sums (decompose.c, sx__dd_chain):
+/* Rank r's terms of the energy's chained sums (dd_energy.c, sx__dd_chain):
  * its own balls' kinetic and gravitational energy and its own pairs'
  * strains (acc: kinetic, gravitational, strain, bond strain); then, the
  * pairs' strain summed, its own ball-wall pairs' (acc: strain). */

@@ -584,7 +584,7 @@ static sx_status KERNEL(walls)(sx_model *m)
                             "a ball of radius %g m (coarsen it)",
                             (long long)o->err_ball, o->err_un, (long long)o->err_wall, MESH_ROWS_MAX, o->err_r);
         if (o->st) return overlap_error(m, "ball", "wall", o->err_ball, o->err_wall, o->err_un, o->err_r);
-        if (!dd) { /* decomposed: the energy sums are the ranks' to chain (decompose.c, sx__dd_energy) */
+        if (!dd) { /* decomposed: the energy sums are the ranks' to chain (dd_energy.c, sx__dd_energy) */
             m->acc.slip += o->slip;
             m->acc.viscous += o->viscous;
         }
