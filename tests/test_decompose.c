@@ -349,12 +349,101 @@ START_TEST(ranks_give_the_serial_bits)
 }
 END_TEST
 
+/* An instability one rank meets in its own part of a step (a timestep far
+ * above the critical one drives balls into each other, into the walls, or
+ * clumps' pebbles together) ends the cycle on every rank at the serial
+ * run's step with the serial run's error, agreed at the step's last
+ * exchange: each rank returns it, and the state is whole. (Before, the
+ * failing rank left the cycle alone and the others waited for it at the
+ * next exchange: here a hang.) */
+typedef struct unstable_ctx {
+    world *w;
+    int rank, scene;
+    bool agreed, scattered;
+    sx_status st;
+    int64_t step;
+    char err[SX_ERRLEN];
+} unstable_ctx;
+
+static sx_model *unstable_bed(int scene)
+{
+    if (scene == 0) { /* the last ball (top row: the last rank's) shot down through the one below it */
+        sx_model *m = bed(2, false);
+        const double v[3] = {0, -3000, 0};
+        ck_assert_int_eq(sx_ball_set_vec(m, sx_ball_count(m), SX_BALL_VEL, v), SX_OK);
+        return m;
+    }
+    sx_model *m = scene == 2 ? clump_bed(2) : bed(3, false);
+    ck_assert_int_eq(sx_model_set_timestep(m, 20 * sx_model_critical_timestep(m)), SX_OK);
+    return m;
+}
+
+static void *run_unstable(void *arg)
+{
+    unstable_ctx *c = arg;
+    sx_model *m = unstable_bed(c->scene);
+    const sx_exchange x = {c->rank, c->w->ranks, c, share, largest, agree};
+    c->st = sx_model_decompose(m, &x);
+    if (!c->st) c->st = sx_model_cycle(m, 400);
+    c->agreed = sx_model_error_agreed(m);
+    c->scattered = sx_model_scattered(m);
+    c->step = sx_model_step_count(m);
+    snprintf(c->err, sizeof c->err, "%s", sx_model_error(m));
+    sx_model_destroy(m);
+    return NULL;
+}
+
+/* The error's step and cause: up to the critical estimate, the failing
+ * rank's own (kernels/timestep.c, estimate_dt). */
+static size_t cause_length(const char *err) { return strcspn(err, ";,("); }
+
+START_TEST(a_rank_instability_stops_every_rank)
+{
+    static const char *const name[] = {"2D, a ball shot down", "3D", "2D clumps"};
+    for (int scene = 0; scene < 3; scene++) {
+        sx_model *serial = unstable_bed(scene);
+        const sx_status st = sx_model_cycle(serial, 400);
+        const int64_t step = sx_model_step_count(serial);
+        char err[SX_ERRLEN];
+        snprintf(err, sizeof err, "%s", sx_model_error(serial));
+        sx_model_destroy(serial);
+        ck_assert_msg(st == SX_EUNSTABLE && strncmp(err, "unstable at step", 16) == 0,
+                      "%s: the serial run must be unstable (%d: %s)", name[scene], st, err);
+        printf("%s, serially: %.*s\n", name[scene], (int)cause_length(err), err);
+        for (int ranks = 2; ranks <= 4; ranks++) {
+            world w = {.ranks = ranks};
+            pthread_barrier_init(&w.bar, NULL, (unsigned)ranks);
+            unstable_ctx c[MAX_RANKS];
+            pthread_t t[MAX_RANKS];
+            for (int r = 0; r < ranks; r++) {
+                c[r] = (unstable_ctx){.w = &w, .rank = r, .scene = scene};
+                ck_assert_int_eq(pthread_create(&t[r], NULL, run_unstable, &c[r]), 0);
+            }
+            for (int r = 0; r < ranks; r++) pthread_join(t[r], NULL);
+            pthread_barrier_destroy(&w.bar);
+            for (int r = 0; r < ranks; r++) {
+                ck_assert_msg(c[r].st == st && c[r].agreed && !c[r].scattered && c[r].step == step,
+                              "%s, %d ranks: rank %d must stop with the serial error at step %lld, agreed, the "
+                              "state whole (%d at step %lld, agreed %d, scattered %d: %s)",
+                              name[scene], ranks, r, (long long)step, c[r].st, (long long)c[r].step, c[r].agreed,
+                              c[r].scattered, c[r].err);
+                ck_assert_msg(cause_length(c[r].err) == cause_length(err) &&
+                                  strncmp(c[r].err, err, cause_length(err)) == 0,
+                              "%s, %d ranks: rank %d's error differs from the serial run's:\n  %s\n  %s", name[scene],
+                              ranks, r, c[r].err, err);
+            }
+        }
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("decompose");
     TCase *tc = tcase_create("threads as ranks");
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, ranks_give_the_serial_bits);
+    tcase_add_test(tc, a_rank_instability_stops_every_rank);
     suite_add_tcase(s, tc);
     return scene_run_suite(s);
 }

@@ -126,12 +126,48 @@ sx_status sx_model_gather(sx_model *m)
     return sx__dd_whole(m, sx__kernels(m)->plan);
 }
 
+/* Decomposed, an error in a rank's own part of the step (its pairs, its
+ * wall blocks, its balls' or clumps' motion) is kept, the first, and the
+ * rank goes on through the step's exchanges, moving nothing more, to where
+ * the ranks agree on it (dd_agree.c). */
+typedef struct {
+    sx_status st;
+    sx_fail_part part;
+    char err[SX_ERRLEN];
+} kept_error;
+
+/* After a part of the step that may fail on one rank: true to go on (no
+ * error, or decomposed: kept). Serially the step stops at the error. */
+static bool go_on(sx_model *m, kept_error *e, sx_status *st, sx_fail_part part)
+{
+    if (!*st) return true;
+    if (!m->dd) return false;
+    if (!e->st) {
+        e->st = *st, e->part = part;
+        memcpy(e->err, m->err, sizeof e->err);
+        m->dd->failed = true;
+    }
+    *st = SX_OK;
+    return true;
+}
+
+/* Where every rank stops together (an error all decide alike, st, or the
+ * displacements' exchange telling of a rank's), decomposed: the error the
+ * ranks agree on, from this rank's kept one or st. */
+static sx_status stop_together(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+{
+    if (!m->dd) return st;
+    if (!e->st && st) e->st = st, e->part = part, memcpy(e->err, m->err, sizeof e->err);
+    return sx__dd_agree_failure(m, e->st, e->part, e->err);
+}
+
 static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
 {
     for (int k = 0; k < m->dim; k++)
         if (!(fabs(m->gravity[k]) < SX_GRAVITY_MAX)) /* a file's from before the limit */
             return sx__fail(m, SX_EINVAL, "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
                             m->gravity[k]);
+    if (m->dd) m->dd->failed = m->dd->agreed = false;
     double t = sx__now();
     const int64_t builds = m->builds;
     sx_status st = SX_OK;
@@ -157,6 +193,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     }
     if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
     sx_dd *dd = m->dd;
+    kept_error kept = {.st = SX_OK};
     m->locked = true;
     /* the energy baseline is taken when the user has changed the system, not
      * at every call: a script cycling one step at a time is guarded too */
@@ -195,30 +232,43 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
         const double t_own = dd ? sx__now() : 0; /* decomposed: this rank's computing, for its pace */
         st = k->contacts(m);
         t1 = stage_end(m, SX_STAGE_BALL_CONTACTS, t1);
-        if (st) break;
+        if (!go_on(m, &kept, &st, SX_FAIL_CONTACTS)) break;
         st = k->walls(m);
         t1 = stage_end(m, SX_STAGE_WALL_CONTACTS, t1);
-        if (st) break;
+        if (!go_on(m, &kept, &st, SX_FAIL_WALLS)) break;
         /* the walls' and the cell's motion of this step, decided before any
          * body moves, so that a refusal leaves the step undone: the servos'
          * speeds (from this step's wall loads), a cylinder's radius kept
-         * above 0, the cell's rates */
+         * above 0, the cell's rates (every rank decides them alike) */
         sx__walls_servo(m);
-        if ((st = check_radii(m))) break;
-        if (m->cell && (st = sx__cell_rate(m))) break;
-        double max_disp, max_wall;
-        st = k->integrate(m, &max_disp);
+        if ((st = check_radii(m))) {
+            st = stop_together(m, &kept, st, SX_FAIL_RADII);
+            break;
+        }
+        if (m->cell && (st = sx__cell_rate(m))) {
+            st = stop_together(m, &kept, st, SX_FAIL_CELL);
+            break;
+        }
+        double max_disp = INFINITY, max_wall; /* infinite: this rank failed (decomposed) */
+        if (!kept.st) st = k->integrate(m, &max_disp);
+        if (!go_on(m, &kept, &st, SX_FAIL_MOTION)) break;
         if (dd) dd->busy += sx__now() - t_own, dd->busy_work += (double)dd->planned;
-        if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
+        if (dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
         if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
-        if (!st && m->clumps) st = k->clumps_step(m, &max_disp); /* kernels/clump_motion.c: the bodies move their pebbles */
+        if (!st && m->clumps) { /* kernels/clump_motion.c: the bodies move their pebbles */
+            st = k->clumps_step(m, &max_disp);
+            if (st && !go_on(m, &kept, &st, SX_FAIL_CLUMPS)) break;
+        }
         if (!st && m->clumps && dd && !sx__dd_placed(m)) /* the placed pebbles to their owners */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' places");
-        /* every rank decides the same rebuild (the largest of the ranks' own balls' and pebbles' moves) */
+        if (kept.st) max_disp = INFINITY;
+        /* every rank decides the same rebuild (the largest of the ranks' own
+         * balls' and pebbles' moves), and learns of a rank's error */
         if (!st && dd && !dd->x.max(dd->x.ud, &max_disp))
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their displacements");
+        if (!st && dd && !(max_disp < INFINITY)) st = stop_together(m, &kept, SX_OK, SX_FAIL_MOTION);
         t = stage_end(m, SX_STAGE_INTEGRATION, t1);
         if (st) break;
         move_walls(m, &max_wall);
@@ -233,21 +283,25 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
         if (2 * max_disp > m->skin || max_disp + max_wall > m->skin) m->build_needed = true;
         /* a ghost moves with its owner and with the cell vectors that shift it */
         if (m->cell && 2 * max_disp + m->cell->moved > m->skin) m->build_needed = true;
-        if (m->step % GUARD_STEPS == 0) st = sx__guard_check(m); /* decomposed: chained sums (kernels/queries.c) */
+        /* decomposed: chained sums (kernels/queries.c), the same decision on every rank */
+        if (m->step % GUARD_STEPS == 0 && (st = sx__guard_check(m)) == SX_EUNSTABLE)
+            st = stop_together(m, &kept, st, SX_FAIL_GUARD);
         other += sx__now() - t;
         if (st) break;
     }
     m->prof.seconds[SX_STAGE_OTHER] += other;
     m->locked = false;
-    /* the whole state on every rank again, or lazily not (after an error
-     * the ranks are out of step, the state mixed: the caller stops them;
-     * an interrupt stops them in step, sx__dd_stop) */
-    if (dd && (!st || st == SX_EINTERRUPT)) {
+    /* the whole state on every rank again, or lazily not (an interrupt and
+     * an error the ranks agreed on stop them in step, sx__dd_stop and
+     * sx__dd_agree_failure; after any other error the ranks are out of
+     * step, the state mixed: the caller stops them) */
+    const bool in_step = dd && (!st || st == SX_EINTERRUPT || dd->agreed);
+    if (in_step) {
         const sx_status end = sx__dd_end(m, k->plan);
-        if (end) st = end;
+        if (end) st = end, dd->agreed = false;
     }
-    if (dd) dd->active = false;
-    if (dd && st && st != SX_EINTERRUPT) dd->scattered = true;
+    if (dd) dd->active = dd->failed = false;
+    if (dd && !in_step) dd->scattered = true;
     return st;
 }
 

@@ -1,6 +1,10 @@
 /* What the ranks of a decomposed step agree on (decompose.h): to stop on
- * an interrupt, at the same step on every rank. */
+ * an interrupt, at the same step on every rank, and the error one of them
+ * met. */
 #include "decompose.h"
+
+#include <stdio.h>
+#include <stdlib.h>
 
 /* An interrupt stops every rank at the same step. Every STOP_EVERY steps
  * the ranks share the number of their process's last unanswered interrupt
@@ -32,3 +36,50 @@ bool sx__dd_stop(sx_model *m, bool *stop)
     return true;
 }
 
+/* An error one rank met in its own part of a step (its pairs' contacts,
+ * its wall blocks, its balls' or clumps' motion) does not stop it there:
+ * the other ranks would wait in the step's next exchange. The rank moves
+ * nothing more and keeps to the step's exchanges to the last, the largest
+ * displacement (infinite from a failing rank), where every rank learns of
+ * it; or the ranks stop together where they all decide alike (a
+ * cylinder's radius, the cell's rates, the energy guard). There each rank
+ * shares its error, if any, with the part of the step it came from, and
+ * the serial run's, the earliest part's on the lowest rank (the ranks'
+ * pairs and balls follow one another in the serial order), becomes every
+ * rank's. The cycle then ends as any cycle does (sx_model_error_agreed):
+ * a script can catch the error on every rank alike. */
+typedef struct {
+    int32_t st, part;
+    char err[SX_ERRLEN];
+} rank_error;
+
+sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, const char *err)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    rank_error *all = calloc((size_t)R, sizeof *all);
+    if (!all) return sx__fail(m, SX_ENOMEM, "cycle: out of memory to share the ranks' errors");
+    rank_error *mine = &all[d->x.rank];
+    mine->st = st, mine->part = st ? (int32_t)part : 0;
+    if (st) snprintf(mine->err, sizeof mine->err, "%s", err);
+    if (!sx__dd_share_by_rank(d, all, sizeof *all)) {
+        free(all);
+        return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their errors");
+    }
+    int pick = -1;
+    for (int r = 0; r < R; r++)
+        if (all[r].st && (pick < 0 || all[r].part < all[pick].part)) pick = r;
+    sx_status agreed;
+    if (pick < 0) /* a displacement no rank's error explains */
+        agreed = sx__fail(m, SX_EUNSTABLE, "unstable at step %lld: a ball's displacement is not finite",
+                          (long long)m->step);
+    else if (R > 1 && all[pick].part <= SX_FAIL_WALLS) /* the other ranks' balls moved on */
+        agreed = sx__fail(m, all[pick].st,
+                          "%s (under mpirun the other ranks' balls went on through this step: load a save to go on)",
+                          all[pick].err);
+    else
+        agreed = sx__fail(m, all[pick].st, "%s", all[pick].err);
+    free(all);
+    d->agreed = true;
+    return agreed;
+}

@@ -625,3 +625,5 @@ void sx_model_gather_lazily(sx_model *m, bool lazily)
 }
 
 bool sx_model_scattered(const sx_model *m) { return m->dd && m->dd->scattered; }
+
+bool sx_model_error_agreed(const sx_model *m) { return m->dd && m->dd->agreed; }

@@ -15,7 +15,7 @@
 #include <math.h>
 #include <signal.h>
 
-#define SX_ERRLEN 512
+#define SX_ERRLEN 1024
 
 /* pi to double precision (M_PI is not C11) */
 #define SX_PI 3.14159265358979323846
@@ -402,6 +402,8 @@ typedef struct sx_dd {
     bool walls_stale;       /* the walls' resultants lag their blocks' sums (sx__dd_walls) */
     bool lazy;              /* a cycle leaves the state scattered (sx_model_gather_lazily) */
     bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
+    bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
+    bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
     /* periodic space: this rank's pairs outside pairs[rank] whose b is a
      * ghost of one of its balls, in pair order (the first nxlow below
@@ -797,6 +799,19 @@ bool sx__dd_migrate(sx_model *m);
 /* Decomposed: whether the ranks stop the cycle at this step for an
  * interrupt (*stop), the same on every rank. False: the exchange failed. */
 bool sx__dd_stop(sx_model *m, bool *stop);
+/* the parts of a step whose errors the ranks agree on, in the step's order
+ * (sx__dd_agree_failure: the earliest part's, the lowest rank's, is every
+ * rank's; a rank without one passes SX_OK) */
+typedef enum {
+    SX_FAIL_CONTACTS = 1,
+    SX_FAIL_WALLS,
+    SX_FAIL_RADII,
+    SX_FAIL_CELL,
+    SX_FAIL_MOTION,
+    SX_FAIL_CLUMPS,
+    SX_FAIL_GUARD
+} sx_fail_part;
+sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, const char *err);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n

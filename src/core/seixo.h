@@ -164,6 +164,14 @@ SX_API int sx_model_ranks(const sx_model *m);
 SX_API void sx_model_gather_lazily(sx_model *m, bool lazily);
 /// Whether the last cycle left m's state scattered (see above).
 SX_API bool sx_model_scattered(const sx_model *m);
+/// Decomposed: whether the last cycle's error is every rank's. An error a
+/// rank meets in its own part of a step (an overlap deeper than a radius, a
+/// non-finite motion), or one every rank meets alike (a cylinder's radius,
+/// the energy guard), ends the cycle on every rank at the same step, with
+/// the error the serial run would give and the state whole (or scattered,
+/// lazily) as after any cycle: the caller can report it or go on. False
+/// serially, and after an error that left the ranks out of step.
+SX_API bool sx_model_error_agreed(const sx_model *m);
 /// Makes the whole state current on every rank after a lazy cycle. A
 /// collective call: every rank calls it at the same point. SX_OK at once
 /// when not scattered; SX_ELOCKED while m is stepping; SX_EINVAL when the

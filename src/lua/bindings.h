@@ -77,6 +77,12 @@ bool sx_lua_parallel_says(const sx_model *m);
 /// ranks, which wait for it. True if the work failed. Not shared: only
 /// reads err. A collective call: never from __gc, whose time differs between ranks.
 bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count);
+/// parallel.c: ranks sharing files (seixo.decompose on), each having read
+/// one itself (seixo.load): whether every rank succeeded; else err (size
+/// bytes) becomes the lowest failing rank's on every rank. No rank returns
+/// before every rank has read, so none removes or rewrites the file under
+/// another's read. A collective call. Serially, or alone: ok.
+bool sx_lua_parallel_all_read(bool ok, char *err, size_t size);
 /// parallel.c: the start of each collective call of the Lua layer (what
 /// names it: "m:save"): true if every rank is in a call of that name; else
 /// false, with a message naming two ranks' calls in err (then every rank

@@ -342,16 +342,17 @@ static int job_free(lua_State *L)
     return 0;
 }
 
-/* m:save's name in the ranks' same-call check, with its path, which every
- * rank must give alike (a rank's number or its clock in the name had rank
- * 0 write its file alone): the path's last 40 characters and a digest of
- * the whole (the check compares the first 96 characters). */
-static const char *save_call(char *name, size_t size, const char *path)
+/* m:save's and seixo.load's name (call) in the ranks' same-call check,
+ * with its path, which every rank must give alike (a rank's number or its
+ * clock in the name had rank 0 write its file alone): the path's last 40
+ * characters and a digest of the whole (the check compares the first 96
+ * characters). */
+static const char *path_call(char *name, size_t size, const char *call, const char *path)
 {
     uint32_t h = 2166136261u;
     for (const char *c = path; *c; c++) h = (h ^ (unsigned char)*c) * 16777619u;
     const size_t n = strlen(path), keep = 40;
-    snprintf(name, size, "m:save '%s%s' (%08x)", n > keep ? "..." : "", path + (n > keep ? n - keep : 0), (unsigned)h);
+    snprintf(name, size, "%s '%s%s' (%08x)", call, n > keep ? "..." : "", path + (n > keep ? n - keep : 0), (unsigned)h);
     return name;
 }
 
@@ -429,7 +430,7 @@ static int model_save(lua_State *L)
      * writes a message to err with every failure) */
     const bool shared = sx_model_ranks(m) > 1;
     char call[96];
-    if (shared) sx_lua_check_model_call(L, m, save_call(call, sizeof call, path));
+    if (shared) sx_lua_check_model_call(L, m, path_call(call, sizeof call, "m:save", path));
     if (sx_lua_parallel_writes(shared)) sx_snapshot_save(m, path, &o, err, sizeof err);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
     sx_lua_rank_file_written(L, path); /* rank 0 wrote it: no shadow stands for it */
@@ -453,6 +454,9 @@ static int seixo_load(lua_State *L)
         sx_lua_optintfield(L, 2, "dim", 2, 3, &dim);
     }
     lua_settop(L, 2);
+    /* ranks sharing the model read the file each: every rank, the same path */
+    char call[96];
+    if (sx_lua_parallel_sharing()) sx_lua_parallel_check_call(L, path_call(call, sizeof call, "seixo.load", path));
     sx_lua_model_threads(L, NULL, "seixo.load"); /* a bad seixo.threads, named here */
     /* the userdata first, so the loaded model always has an owner */
     lua_pushcfunction(L, sx_lua_model_new);
@@ -468,7 +472,10 @@ static int seixo_load(lua_State *L)
     lua_toclose(L, 4);
     char err[1024];
     sx_model *m = sx_snapshot_load(path, (int)dim, info, err, sizeof err);
-    if (!m) return luaL_error(L, "%s", err);
+    if (!sx_lua_parallel_all_read(m != NULL, err, sizeof err)) {
+        sx_model_destroy(m); /* read here, not on another rank */
+        return luaL_error(L, "%s", err);
+    }
     const sx_model *placeholder = u->m;
     sx_model_destroy(u->m);
     u->m = m;

@@ -785,6 +785,32 @@ bool sx_lua_parallel_outcome(bool shared, char *err, size_t size, int64_t *count
     return size > 0 && err[0] != '\0';
 }
 
+bool sx_lua_parallel_all_read(bool ok, char *err, size_t size)
+{
+#ifdef SX_HAVE_MPI
+    if (!sx_lua_parallel_sharing() || world_size < 2 || size == 0 || size > INT_MAX) return ok;
+    int first = ok ? world_size : world_rank, failed = world_size; /* the lowest failing rank */
+    if (MPI_Allreduce(&first, &failed, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD) != MPI_SUCCESS) {
+        snprintf(err, size, "rank %d of %d: the ranks failed to exchange a file's outcome", world_rank, world_size);
+        return false;
+    }
+    if (failed == world_size) return true;
+    if (failed != 0 && failed == world_rank) { /* named, as a rank's own trouble (a node without the file) */
+        char mine[1024];
+        snprintf(mine, sizeof mine, "%s", err);
+        snprintf(err, size, "rank %d of %d: %s", world_rank, world_size, mine);
+    }
+    if (MPI_Bcast(err, (int)size, MPI_CHAR, failed, MPI_COMM_WORLD) != MPI_SUCCESS)
+        snprintf(err, size, "rank %d of %d: the ranks failed to exchange a file's outcome", world_rank, world_size);
+    err[size - 1] = '\0';
+    return false;
+#else
+    (void)err;
+    (void)size;
+    return ok;
+#endif
+}
+
 bool sx_lua_parallel_alone(void)
 {
 #ifdef SX_HAVE_MPI

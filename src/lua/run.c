@@ -303,10 +303,11 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     sx_lua_run_poll(L, r);
     const sx_status st = sx_model_cycle_until(r->m, n, t_end, r->since);
-    /* an interrupt stops the ranks in step (every rank raises it, and a
-     * script can catch it); after any other error they are out of step:
+    /* an interrupt, and an error the ranks agreed on (an instability one
+     * rank found, say), stop the ranks in step: every rank raises it, and
+     * a script can catch it; after any other error they are out of step:
      * all stop, with the message */
-    if (st != SX_OK && st != SX_EINTERRUPT && r->ud->decomposed) {
+    if (st != SX_OK && st != SX_EINTERRUPT && r->ud->decomposed && !sx_model_error_agreed(r->m)) {
         char msg[1024];
         luaL_where(L, 1); /* the script's line, which the serial run's error gives too */
         /* the first step since a placement failed: the placement is named,

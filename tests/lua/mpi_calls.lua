@@ -30,6 +30,8 @@
 --   path     m:save on every rank, each to a path of its own (a rank's
 --            number or its clock in the name): rank 0 wrote its file
 --            alone, and a later load failed on the others
+--   load     seixo.load on rank 0 alone (every rank reads the file
+--            itself, and none goes on before all have)
 local scene = arg and arg[1] or "save"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 local first = seixo.rank() == 0
@@ -77,9 +79,13 @@ elseif scene == "caught" then
 elseif scene == "path" then
   m:save(base .. "_" .. seixo.rank() .. ".h5")
   m:cycle(100)
+elseif scene == "load" then -- every rank reads the file: rank 0 alone cannot
+  m:save(base .. ".h5")
+  if seixo.rank() == 0 then seixo.load(base .. ".h5") end
+  m:cycle(100)
 else
-  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive, receives, caught or path "
-        .. "expected, got " .. tostring(scene))
+  error("mpi_calls.lua: scene save, output, tmpname, cycle, query, handler, time, models, receive, receives, caught, "
+        .. "path or load expected, got " .. tostring(scene))
 end
 print("ended " .. scene)
 for _, suffix in ipairs{"", ".h5", "_series.h5", "_series.xmf", "_0.h5"} do os.remove(base .. suffix) end

@@ -224,7 +224,9 @@ enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
 /* Decomposed: this rank steps its own clumps (decompose.c), from their
  * pebbles' forces (those of other ranks' pebbles sent by their owners);
  * with energy tracking each clump's terms go to the serial sums
- * (sx__dd_clump_energy), in the serial step's blocks. */
+ * (sx__dd_clump_energy), in the serial step's blocks. A rank that failed
+ * earlier in the step, or fails here, moves no more clumps but still
+ * takes part in that exchange (the ranks agree on the error after it). */
 static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t size)
 {
     sx_dd *d = m->dd;
@@ -236,10 +238,10 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
     const step_env env = step_env_of(m);
     double worst = *max_disp * *max_disp, work[2] = {0, 0};
     int64_t bad = -1;
-    for (int64_t e = own.lo; e < own.hi; e++)
+    for (int64_t e = own.lo; e < own.hi && !d->failed; e++)
         if (!step_clump(m, &env, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
     *max_disp = sqrt(worst);
-    const bool ok = bad >= 0 || !terms || sx__dd_clump_energy(m, W, D + RD, size);
+    const bool ok = !terms || sx__dd_clump_energy(m, W, D + RD, size);
     if (bad >= 0) return KERNEL(nonfinite)(m, "clump", m->clumps->id[bad]);
     return ok ? SX_OK : sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the clumps' energies");
 }
