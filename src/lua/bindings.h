@@ -374,6 +374,9 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
 /// an interrupt ("interrupted at step N") or a failure is a Lua error;
 /// decomposed, the whole state is on every rank after it (sx_lua_gather).
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end);
+/// run.c: warns, once a model (at index model), of a timestep below a
+/// thousandth of the critical estimate (a fixed one set in the wrong unit).
+void sx_lua_check_timestep(lua_State *L, int model, sx_model *m);
 /// Raises "interrupted at step N" when the run was interrupted, and
 /// "interrupted" when r is NULL and a Ctrl-C is pending: long C work (between
 /// cycles, or outside any run) calls it so that a Ctrl-C stops it too.

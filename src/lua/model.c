@@ -726,6 +726,7 @@ static int model_set_timestep(lua_State *L)
         dt = luaL_optnumber(L, 2, 0);
     }
     sx_lua_check(L, m, sx_model_set_timestep(m, dt), "m:set_timestep");
+    sx_lua_check_timestep(L, 1, m);
     return 0;
 }
 

@@ -543,6 +543,23 @@ static const char *const reason_names[] = {"steps", "time", "ratio"};
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
  * and the last ratio measured (NaN when none was) in *ratio. */
+/* A fixed timestep far below the critical one (a slip of units: 1e-9 s
+ * for 1e-6 s) makes every run take that many times the steps it needs,
+ * with no other sign: said once a model (model: its index), after
+ * m:set_timestep and before the first run since balls were placed. */
+enum { TINY_TIMESTEP = 1000 };
+
+void sx_lua_check_timestep(lua_State *L, int model, sx_model *m)
+{
+    if (sx_ball_count(m) == 0) return;
+    const double dt = sx_model_timestep(m), crit = sx_model_critical_timestep(m);
+    if (dt > 0 && crit > 0 && dt * TINY_TIMESTEP < crit)
+        sx_lua_warn_once(L, model, "timestep",
+                         "the timestep %g s is 1/%.0f of the critical estimate %g s: every run takes that many "
+                         "times the steps it needs (m:set_timestep('auto') sets the automatic one)",
+                         dt, crit / dt, crit);
+}
+
 static enum reason run_model(lua_State *L, const limits *lim, double *ratio, const char *what)
 {
     run *r = sx_lua_run_open(L, 1, what);
@@ -553,6 +570,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     progress *p = &r->progress;
     progress_start(L, p, m, what, r->ud->decomposed);
     sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
+    if (r->ud->unchecked && !sx_model_scattered(m)) sx_lua_check_timestep(L, 1, m);
     *ratio = NAN;
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {

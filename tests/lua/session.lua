@@ -310,6 +310,32 @@ print("done")]]))
   check(out:find("done\n$"), out)
 end)
 
+test("a fixed timestep far below the critical one warns once, given before or after the balls", function()
+  -- a timestep in the wrong unit (1e-9 for 1e-6 s) ran a thousand times the
+  -- steps needed with no word (a new user's first day)
+  local status, out = T.run("-e " .. T.quote([[
+m = seixo.model{dim = 2, timestep = 1e-11}
+m:material("g", {density = 2500, kn = 1e6, ks = 1e6})
+m:generate{count = 50, radius = {1e-3, 1.5e-3}, region = {box = {{0, 0}, {0.03, 0.03}}}, seed = 2}
+m:cycle(3)
+m:cycle(3)
+n = seixo.model{dim = 2}
+n:material("g", {density = 2500, kn = 1e6, ks = 1e6})
+n:generate{count = 50, radius = {1e-3, 1.5e-3}, region = {box = {{0, 0}, {0.03, 0.03}}}, seed = 2}
+n:set_timestep(0.5 * n:critical_timestep())
+n:cycle(3)
+n:set_timestep(1e-3 * n:critical_timestep() / 2)
+print("done")]]))
+  eq(status, 0, out)
+  check(out:find("seixo: warning: %(command line%):4: the timestep 1e%-11 s is 1/[0-9]+ of the critical estimate [0-9.e-]+ s: "
+                 .. "every run takes that many times the steps it needs %(m:set_timestep%('auto'%) sets the automatic one%)"), out)
+  local _, count = out:gsub("the timestep 1e%-11", "")
+  eq(count, 1, "once per model")
+  check(not out:find(":9:", 1, true), "half the critical timestep is usual: " .. out)
+  check(out:find("%(command line%):11: the timestep [0-9.e-]+ s is 1/2000 of the critical estimate"), out)
+  check(out:find("done\n$"), out)
+end)
+
 test("clumps of a size outside the usual range warn, as balls do", function()
   -- a sieve curve in m given as clumps' scales (dimensionless) made pebbles
   -- of 0.25 um with no word, where a ball that small is warned of
