@@ -10,13 +10,18 @@
 --   caller.where()              -- "file:line: " of the user's line
 local caller = {}
 
-local own = {lab = true, check = true, pool = true, calibrate = true, periodic = true, plot = true, util = true, genesis = true, caller = true,
-             joints = true,
-             -- seixo.lab's parts (lua/seixo/lab/)
-             ["lab/tables"] = true, ["lab/csv"] = true, ["lab/material"] = true, ["lab/vessel"] = true,
-             ["lab/specimen"] = true, ["lab/strain"] = true, ["lab/frame"] = true, ["lab/compression"] = true,
-             ["lab/brazilian"] = true, ["lab/mohr_coulomb"] = true, ["lab/series"] = true, ["lab/plots"] = true,
-             ["lab/polling"] = true}
+-- The library's directory (this file's), and whether a module ("lab",
+-- "lab/series") is one of its files: any file there is the library's, so a
+-- new module needs no list kept by hand (package.searchpath looks with
+-- C's fopen, never the ranks' shared io.open under mpirun).
+local dir = debug.getinfo(1, "S").source:match("^@(.*[/\\])") or ""
+local known = {}
+local function own(module)
+  if known[module] == nil then
+    known[module] = dir ~= "" and package.searchpath(module, dir .. "?.lua", "", "") ~= nil
+  end
+  return known[module]
+end
 
 -- The message of an error raised in one of the library's files (its
 -- position, "seixo/lab.lua:12: " or "seixo/lab/material.lua:34: ", taken
@@ -24,7 +29,7 @@ local own = {lab = true, check = true, pool = true, calibrate = true, periodic =
 local function own_message(e)
   for _, file in ipairs{"[%w_]+", "[%w_]+/[%w_]+"} do
     local module, inner = e:match("^[^\n]-seixo/(" .. file .. ")%.lua:%d+: (.*)$")
-    if inner and own[module] then return inner end
+    if inner and own(module) then return inner end
   end
 end
 
@@ -44,11 +49,10 @@ function caller.at_caller(f)
   end
 end
 
--- The library's own files: the modules of `own`, beside this one and in lab/.
-local dir = debug.getinfo(1, "S").source:match("^@(.*[/\\])") or ""
+-- The library's own files: beside this one and in lab/.
 local function library(source)
   local module = source:sub(1, #dir + 1) == "@" .. dir and source:sub(#dir + 2):match("^([%w_/]+)%.lua$")
-  return module and own[module]
+  return module and own(module)
 end
 
 -- "file:line: " of the innermost function on the stack that is neither
