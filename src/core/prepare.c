@@ -141,6 +141,8 @@ double sx_model_timestep(sx_model *m)
     return dt;
 }
 
+double sx_model_fixed_timestep(const sx_model *m) { return m->dt_user; }
+
 sx_status sx_model_set_timestep(sx_model *m, double dt)
 {
     if (!sx__timestep_ok(dt))

@@ -65,6 +65,9 @@ SX_API double sx_model_timestep(sx_model *m);
 SX_API double sx_model_critical_timestep(sx_model *m);
 /// Sets a fixed timestep (s > 0), or 0 to return to the automatic one.
 SX_API sx_status sx_model_set_timestep(sx_model *m, double dt);
+/// The fixed timestep set (s), or 0 when it is the automatic one: a read,
+/// which (unlike sx_model_timestep) never prepares the model.
+SX_API double sx_model_fixed_timestep(const sx_model *m);
 
 SX_API void sx_model_gravity(const sx_model *m, double out[3]);
 SX_API sx_status sx_model_set_gravity(sx_model *m, const double g[3]);

@@ -173,6 +173,7 @@ typedef struct sx_lua_model {
     int callback;          ///< depth of user callbacks being run (removals are queued while > 0)
     double overlap_limit;  ///< seixo.model{overlap_limit}: the largest overlap placed, a fraction of the radius
     bool unchecked;        ///< a ball or wall was added since the last placement check (geometry.c)
+    bool timestep_unchecked; ///< the fixed timestep was set since the last check of it (run.c, sx_lua_check_timestep)
     int64_t fresh_lo, fresh_hi; ///< the ids of the balls m:generate made since that check, their overlaps among themselves its relaxation's, not checked (0, 0: none; ids are from 1)
     bool decomposed;       ///< its cycles run decomposed over the MPI ranks (parallel.c)
 } sx_lua_model;
@@ -223,9 +224,10 @@ void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has
 /// bonds.c: pushes the `bond` table (the bond kinds' micro-parameters, from their registry) of material index
 /// `material` and returns true, or pushes nothing and returns false when they are all zero.
 bool sx_lua_push_bpm(lua_State *L, const sx_model *m, int material);
-/// Appends the registry's law parameter keys (each once) to keys[0..n), up to cap;
-/// returns the new count.
-int sx_lua_law_keys(const char **keys, int n, int cap);
+/// Appends the registry's law parameter keys (each once) to keys[0..n) and
+/// ends the list with NULL; a list of `room` entries too small for them is
+/// a Lua error (never keys dropped, then refused as unknown).
+void sx_lua_law_keys(lua_State *L, const char **keys, int n, int room);
 
 /* ------------------------------------------------ balls.c, walls.c */
 
@@ -374,9 +376,6 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
 /// an interrupt ("interrupted at step N") or a failure is a Lua error;
 /// decomposed, the whole state is on every rank after it (sx_lua_gather).
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end);
-/// run.c: warns, once a model (at index model), of a timestep below a
-/// thousandth of the critical estimate (a fixed one set in the wrong unit).
-void sx_lua_check_timestep(lua_State *L, int model, sx_model *m);
 /// Raises "interrupted at step N" when the run was interrupted, and
 /// "interrupted" when r is NULL and a Ctrl-C is pending: long C work (between
 /// cycles, or outside any run) calls it so that a Ctrl-C stops it too.

@@ -47,16 +47,21 @@ bool sx_lua_push_bpm(lua_State *L, const sx_model *m, int material)
     return true;
 }
 
-int sx_lua_law_keys(const char **keys, int n, int cap)
+void sx_lua_law_keys(lua_State *L, const char **keys, int n, int room)
 {
     for (int law = 0; law < sx_law_count(); law++)
         for (int k = 0; k < sx_law_param_count(law); k++) {
             const char *key = sx_law_param_name(law, k, NULL);
             bool seen = false;
             for (int j = 0; j < n && !seen; j++) seen = strcmp(keys[j], key) == 0;
-            if (!seen && n < cap) keys[n++] = key;
+            if (seen) continue;
+            /* a law registered with more parameters than the list has room
+             * for: its keys would be refused as unknown */
+            if (n + 1 >= room) luaL_error(L, "seixo: the contact laws' parameters outgrew a key list (%d entries): "
+                                             "enlarge it in src/lua/model.c", room);
+            keys[n++] = key;
         }
-    return n;
+    keys[n] = NULL;
 }
 
 void sx_lua_material_extras(lua_State *L, int arg, sx_material_def *d, bool *has_bpm, sx_bpm_def *bpm)

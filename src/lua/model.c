@@ -224,6 +224,7 @@ int sx_lua_model_new(lua_State *L)
     sx_lua_model *u = lua_newuserdatauv(L, sizeof *u, 1);
     memset(u, 0, sizeof *u);
     u->overlap_limit = overlap_limit;
+    u->timestep_unchecked = d.timestep > 0;
     luaL_setmetatable(L, SX_LUA_MODEL);
     lua_newtable(L);
     lua_setiuservalue(L, -2, 1);
@@ -458,7 +459,7 @@ static void check_material(lua_State *L, int arg, sx_material_def *d, bool *has_
     const char *keys[48] = {"kn",      "ks",             "friction",      "density", "damping",
                             "viscous_normal", "viscous_shear", "model", "modulus", "stiffness_ratio",
                             "bond"};
-    keys[sx_lua_law_keys(keys, 11, 47)] = NULL; /* and the laws' parameters */
+    sx_lua_law_keys(L, keys, 11, 48); /* and the laws' parameters */
     *d = sx_material_default_def();
     *has_bpm = false;
     memset(bpm, 0, sizeof *bpm);
@@ -553,7 +554,7 @@ static int model_contact_model(lua_State *L)
     const char *keys[56] = {"kn",      "ks",      "friction", "density",  "damping",    "viscous_normal",
                             "viscous_shear", "model", "modulus", "stiffness_ratio", "groups", "materials",
                             "default", "material", "name", "wall"};
-    keys[sx_lua_law_keys(keys, 16, 55)] = NULL; /* and the laws' parameters */
+    sx_lua_law_keys(L, keys, 16, 56); /* and the laws' parameters */
     sx_model *m = sx_lua_checkmodel(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     sx_lua_checkkeys(L, 2, keys);
@@ -726,7 +727,7 @@ static int model_set_timestep(lua_State *L)
         dt = luaL_optnumber(L, 2, 0);
     }
     sx_lua_check(L, m, sx_model_set_timestep(m, dt), "m:set_timestep");
-    sx_lua_check_timestep(L, 1, m);
+    sx_lua_modelud(L, 1)->timestep_unchecked = dt > 0; /* rated after the next run's first step */
     return 0;
 }
 

@@ -166,6 +166,7 @@ struct sx_lua_run {
     atomic_int in_lua;       // a user callback is running
     int slot;                // its place in runs[], -1 when not listed
     int saved_callback;      // ud->callback when the run started
+    int model;               // the model's index on the stack
     const char *what;        // the Lua call, in messages ("m:solve")
     int64_t since;           // the model's step count when the run began
     bool open;               // not closed yet
@@ -252,6 +253,7 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     memset(r, 0, sizeof *r);
     r->m = m;
     r->ud = ud;
+    r->model = model;
     r->slot = -1;
     r->what = what;
     r->since = sx_model_step_count(m);
@@ -295,6 +297,27 @@ void sx_lua_run_poll(lua_State *L, sx_lua_run *r)
     if ((r && atomic_load(&r->interrupted)) || sx_interrupt_pending()) interrupted(L, r);
 }
 
+/* A fixed timestep far below the critical one (a slip of units: 1e-9 s
+ * for 1e-6 s) makes every run take that many times the steps it needs,
+ * with no other sign: said once a model, after the first step since it was
+ * set or balls were placed (rated then from the contacts the step built:
+ * asked before, the rating would build outside the cycle). */
+enum { TINY_TIMESTEP = 1000 };
+
+static void check_timestep(lua_State *L, run *r)
+{
+    r->ud->timestep_unchecked = false;
+    const double dt = sx_model_fixed_timestep(r->m);
+    if (!(dt > 0) || sx_ball_count(r->m) == 0) return;
+    sx_lua_gather(L, r->m, "m"); /* decomposed: every rank alike (the model's calls are) */
+    const double crit = sx_model_critical_timestep(r->m);
+    if (crit > 0 && dt * TINY_TIMESTEP < crit)
+        sx_lua_warn_once(L, r->model, "timestep",
+                         "the timestep %g s is 1/%.0f of the critical estimate %g s: every run takes that many "
+                         "times the steps it needs (m:set_timestep('auto') sets the automatic one)",
+                         dt, crit / dt, crit);
+}
+
 /* Decomposed, a collective call: the caller has checked that every rank
  * makes it (sx_lua_parallel_check_call). The cycle leaves the state
  * scattered: what follows gathers it when it needs more than the walls
@@ -320,15 +343,17 @@ static void run_chunk(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
     }
     if (st == SX_EINTERRUPT || (st == SX_OK && !r->ud->decomposed && atomic_load(&r->interrupted))) interrupted(L, r);
     /* the first step since balls or walls were placed (run_model takes it alone) */
-    if (r->ud->unchecked && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
+    const bool placed = r->ud->unchecked;
+    if (placed && (st == SX_OK || st == SX_EUNSTABLE)) sx_lua_check_placement(L, r->ud, r->what, st != SX_OK);
     sx_lua_check(L, r->m, st, r->what);
+    if (placed || r->ud->timestep_unchecked) check_timestep(L, r);
 }
 
 void sx_lua_run_cycle(lua_State *L, sx_lua_run *r, int64_t n, double t_end)
 {
     /* the first step since balls or walls were placed alone, as run_model
      * takes it: its check sweeps the balls as placed */
-    if (r->ud->unchecked && n > 1) {
+    if ((r->ud->unchecked || r->ud->timestep_unchecked) && n > 1) {
         run_chunk(L, r, 1, t_end);
         n--;
     }
@@ -543,23 +568,6 @@ static const char *const reason_names[] = {"steps", "time", "ratio"};
 
 /* Runs the model at stack index 1 until a limit stops it: returns why,
  * and the last ratio measured (NaN when none was) in *ratio. */
-/* A fixed timestep far below the critical one (a slip of units: 1e-9 s
- * for 1e-6 s) makes every run take that many times the steps it needs,
- * with no other sign: said once a model (model: its index), after
- * m:set_timestep and before the first run since balls were placed. */
-enum { TINY_TIMESTEP = 1000 };
-
-void sx_lua_check_timestep(lua_State *L, int model, sx_model *m)
-{
-    if (sx_ball_count(m) == 0) return;
-    const double dt = sx_model_timestep(m), crit = sx_model_critical_timestep(m);
-    if (dt > 0 && crit > 0 && dt * TINY_TIMESTEP < crit)
-        sx_lua_warn_once(L, model, "timestep",
-                         "the timestep %g s is 1/%.0f of the critical estimate %g s: every run takes that many "
-                         "times the steps it needs (m:set_timestep('auto') sets the automatic one)",
-                         dt, crit / dt, crit);
-}
-
 static enum reason run_model(lua_State *L, const limits *lim, double *ratio, const char *what)
 {
     run *r = sx_lua_run_open(L, 1, what);
@@ -570,7 +578,6 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     progress *p = &r->progress;
     progress_start(L, p, m, what, r->ud->decomposed);
     sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
-    if (r->ud->unchecked && !sx_model_scattered(m)) sx_lua_check_timestep(L, 1, m);
     *ratio = NAN;
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {
