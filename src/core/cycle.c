@@ -126,27 +126,33 @@ sx_status sx_model_gather(sx_model *m)
     return sx__dd_whole(m, sx__kernels(m)->plan);
 }
 
-/* Decomposed, an error in a rank's own part of the step (its pairs, its
- * wall blocks, its balls' or clumps' motion) is kept, the first, and the
- * rank goes on through the step's exchanges, moving nothing more, to where
- * the ranks agree on it (dd_agree.c). */
+/* Decomposed, an instability a rank finds in its own part of the step
+ * (its pairs, its wall blocks, its balls' or clumps' motion) is kept, the
+ * first, and the rank goes on through the step's exchanges, moving
+ * nothing more, to where the ranks agree on it (dd_agree.c). Any other
+ * error (out of memory, an exchange that failed) may come before a
+ * stage's own exchange: the rank stops there, out of step, as serially. */
 typedef struct {
     sx_status st;
     sx_fail_part part;
+    int64_t order; /* its place in the part's serial order, where that is not the ranks' (a clump's index) */
     char err[SX_ERRLEN];
 } kept_error;
 
+static void keep(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+{
+    e->st = st, e->part = part, e->order = m->dd->fail_order;
+    memcpy(e->err, m->err, sizeof e->err);
+}
+
 /* After a part of the step that may fail on one rank: true to go on (no
- * error, or decomposed: kept). Serially the step stops at the error. */
+ * error, or decomposed: an instability, kept). */
 static bool go_on(sx_model *m, kept_error *e, sx_status *st, sx_fail_part part)
 {
     if (!*st) return true;
-    if (!m->dd) return false;
-    if (!e->st) {
-        e->st = *st, e->part = part;
-        memcpy(e->err, m->err, sizeof e->err);
-        m->dd->failed = true;
-    }
+    if (!m->dd || *st != SX_EUNSTABLE) return false;
+    if (!e->st) keep(m, e, *st, part);
+    m->dd->failed = true;
     *st = SX_OK;
     return true;
 }
@@ -157,8 +163,22 @@ static bool go_on(sx_model *m, kept_error *e, sx_status *st, sx_fail_part part)
 static sx_status stop_together(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
 {
     if (!m->dd) return st;
-    if (!e->st && st) e->st = st, e->part = part, memcpy(e->err, m->err, sizeof e->err);
-    return sx__dd_agree_failure(m, e->st, e->part, e->err);
+    if (!e->st && st) keep(m, e, st, part);
+    return sx__dd_agree_failure(m, e->st, e->part, e->order, e->err);
+}
+
+/* Decomposed, a stop before the step's energy chain (a cylinder's radius,
+ * the cell's rates): the serial step has added its contacts' and walls'
+ * energy sums by then, and none of the law of motion, which has not run
+ * (the blocks' terms are the last step's): the chain of those sums. */
+static sx_status stop_before_motion(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+{
+    if (m->dd && m->track_energy) {
+        for (int64_t b = 0; b < m->nblock; b++) m->blocks[b].damp_work = m->blocks[b].load_work = m->blocks[b].visc_work = 0;
+        if (!sx__dd_energy(m))
+            return sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
+    }
+    return stop_together(m, e, st, part);
 }
 
 static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since)
@@ -167,7 +187,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
         if (!(fabs(m->gravity[k]) < SX_GRAVITY_MAX)) /* a file's from before the limit */
             return sx__fail(m, SX_EINVAL, "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
                             m->gravity[k]);
-    if (m->dd) m->dd->failed = m->dd->agreed = false;
+    if (m->dd) m->dd->failed = false, m->dd->fail_order = 0;
     double t = sx__now();
     const int64_t builds = m->builds;
     sx_status st = SX_OK;
@@ -242,24 +262,24 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
          * above 0, the cell's rates (every rank decides them alike) */
         sx__walls_servo(m);
         if ((st = check_radii(m))) {
-            st = stop_together(m, &kept, st, SX_FAIL_RADII);
+            st = stop_before_motion(m, &kept, st, SX_FAIL_RADII);
             break;
         }
         if (m->cell && (st = sx__cell_rate(m))) {
-            st = stop_together(m, &kept, st, SX_FAIL_CELL);
+            st = stop_before_motion(m, &kept, st, SX_FAIL_CELL);
             break;
         }
         double max_disp = INFINITY, max_wall; /* infinite: this rank failed (decomposed) */
         if (!kept.st) st = k->integrate(m, &max_disp);
-        if (!go_on(m, &kept, &st, SX_FAIL_MOTION)) break;
+        go_on(m, &kept, &st, SX_FAIL_MOTION); /* serially an error stays in st, the step's end below */
         if (dd) dd->busy += sx__now() - t_own, dd->busy_work += (double)dd->planned;
-        if (dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
+        if (!st && dd && m->track_energy && !sx__dd_energy(m)) /* the step's energy sums, in the serial order */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the step's energies (out of memory?)");
         if (!st && m->clumps && dd && !sx__dd_pebbles(m, NULL, 0)) /* to the clumps' owners, who step them */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' forces");
         if (!st && m->clumps) { /* kernels/clump_motion.c: the bodies move their pebbles */
             st = k->clumps_step(m, &max_disp);
-            if (st && !go_on(m, &kept, &st, SX_FAIL_CLUMPS)) break;
+            go_on(m, &kept, &st, SX_FAIL_CLUMPS);
         }
         if (!st && m->clumps && dd && !sx__dd_placed(m)) /* the placed pebbles to their owners */
             st = sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the pebbles' places");
@@ -309,6 +329,7 @@ sx_status sx_model_cycle(sx_model *m, int64_t n) { return sx_model_cycle_until(m
 
 sx_status sx_model_cycle_until(sx_model *m, int64_t n, double t_end, int64_t since)
 {
+    if (m->dd && !m->locked) m->dd->agreed = false; /* the error this call returns is its own */
     if (m->locked) return sx__fail(m, SX_ELOCKED, "cycle: the model is already stepping");
     if (n < 0) return sx__fail(m, SX_EINVAL, "cycle: the number of steps must be >= 0 (got %lld)", (long long)n);
     if (isnan(t_end)) return sx__fail(m, SX_EINVAL, "cycle: the time to stop at is not a number");

@@ -45,22 +45,30 @@ bool sx__dd_stop(sx_model *m, bool *stop)
  * cylinder's radius, the cell's rates, the energy guard). There each rank
  * shares its error, if any, with the part of the step it came from, and
  * the serial run's, the earliest part's on the lowest rank (the ranks'
- * pairs and balls follow one another in the serial order), becomes every
- * rank's. The cycle then ends as any cycle does (sx_model_error_agreed):
+ * pairs, wall blocks and balls follow one another in the serial order; a
+ * clump's error carries its index, as the clumps' owners do not), becomes
+ * every rank's. The cycle then ends as any cycle does (sx_model_error_agreed):
  * a script can catch the error on every rank alike. */
 typedef struct {
     int32_t st, part;
+    int64_t order;
     char err[SX_ERRLEN];
 } rank_error;
 
-sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, const char *err)
+/* Whether rank a's error comes before rank b's (a < b) in the serial step. */
+static bool before(const rank_error *a, const rank_error *b)
+{
+    return a->part < b->part || (a->part == b->part && a->order < b->order);
+}
+
+sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int64_t order, const char *err)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks;
     rank_error *all = calloc((size_t)R, sizeof *all);
     if (!all) return sx__fail(m, SX_ENOMEM, "cycle: out of memory to share the ranks' errors");
     rank_error *mine = &all[d->x.rank];
-    mine->st = st, mine->part = st ? (int32_t)part : 0;
+    mine->st = st, mine->part = st ? (int32_t)part : 0, mine->order = st ? order : 0;
     if (st) snprintf(mine->err, sizeof mine->err, "%s", err);
     if (!sx__dd_share_by_rank(d, all, sizeof *all)) {
         free(all);
@@ -68,17 +76,24 @@ sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, con
     }
     int pick = -1;
     for (int r = 0; r < R; r++)
-        if (all[r].st && (pick < 0 || all[r].part < all[pick].part)) pick = r;
+        if (all[r].st && (pick < 0 || before(&all[r], &all[pick]))) pick = r;
     sx_status agreed;
     if (pick < 0) /* a displacement no rank's error explains */
         agreed = sx__fail(m, SX_EUNSTABLE, "unstable at step %lld: a ball's displacement is not finite",
                           (long long)m->step);
-    else if (R > 1 && all[pick].part <= SX_FAIL_WALLS) /* the other ranks' balls moved on */
+    else if (R > 1 && (all[pick].part <= SX_FAIL_WALLS || all[pick].part == SX_FAIL_MOTION ||
+                       all[pick].part == SX_FAIL_CLUMPS)) /* one rank's: the others' balls or clumps moved on */
         agreed = sx__fail(m, all[pick].st,
-                          "%s (under mpirun the other ranks' balls went on through this step: load a save to go on)",
+                          "%s (under mpirun the other ranks' balls may have gone on through this step: load a save "
+                          "to go on)",
                           all[pick].err);
     else
         agreed = sx__fail(m, all[pick].st, "%s", all[pick].err);
+    /* the balls that moved are not known to the rebuild's criterion (a
+     * failing rank gives an infinite displacement): the next step builds */
+    if (pick < 0 || all[pick].part <= SX_FAIL_WALLS || all[pick].part == SX_FAIL_MOTION ||
+        all[pick].part == SX_FAIL_CLUMPS)
+        m->build_needed = true;
     free(all);
     d->agreed = true;
     return agreed;

@@ -403,6 +403,7 @@ typedef struct sx_dd {
     bool lazy;              /* a cycle leaves the state scattered (sx_model_gather_lazily) */
     bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
     bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
+    int64_t fail_order;     /* its error's place in the serial order where that is not the ranks' (a clump's index) */
     bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
     /* periodic space: this rank's pairs outside pairs[rank] whose b is a
@@ -800,8 +801,9 @@ bool sx__dd_migrate(sx_model *m);
  * interrupt (*stop), the same on every rank. False: the exchange failed. */
 bool sx__dd_stop(sx_model *m, bool *stop);
 /* the parts of a step whose errors the ranks agree on, in the step's order
- * (sx__dd_agree_failure: the earliest part's, the lowest rank's, is every
- * rank's; a rank without one passes SX_OK) */
+ * (sx__dd_agree_failure: the earliest part's, then the lowest order's
+ * (a clump's index; else 0), then the lowest rank's, is every rank's; a
+ * rank without one passes SX_OK) */
 typedef enum {
     SX_FAIL_CONTACTS = 1,
     SX_FAIL_WALLS,
@@ -811,7 +813,7 @@ typedef enum {
     SX_FAIL_CLUMPS,
     SX_FAIL_GUARD
 } sx_fail_part;
-sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, const char *err);
+sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int64_t order, const char *err);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n

@@ -13,6 +13,13 @@
 --               (mpi_energy.lua guard 3 4): the energy guard, every rank's
 --               decision, trips after a whole step; its whole message, and
 --               the state it left, hash and all
+--   periodic D  a granular gas compressed in a periodic cell, likewise (a rank also
+--               runs the pairs of its balls' ghosts, whose errors are their
+--               owners' to report)
+--   radius      a bed in a cylinder with energy tracking, the cylinder
+--               set to close through a zero radius in one step: every rank
+--               refuses the step before any ball moves; the state and the
+--               energies are the serial run's, then and after going on
 --   clumps      a pour of clumps at a hundred times the critical timestep
 --               (mpi_clumps.lua ... unstable): the clumps' exchanges with a
 --               rank that failed
@@ -39,19 +46,62 @@ elseif scene == "guard" then
   return
 end
 
+if scene == "radius" then -- a bed in a cylinder, energy tracked; the cylinder set to close through 0 at once
+  local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
+  m:material("bead", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.2, viscous_normal = 0.1})
+  local cyl = m:wall{kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 1}, radius = 0.03, height = 0.1}
+  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  m:generate{count = 1200, radius = {1.5e-3, 2.5e-3}, region = {cylinder = {p1 = {0, 0, 0.002}, p2 = {0, 0, 0.06}, radius = 0.026}},
+             seed = 5}
+  for b in m:balls() do -- thrown about: contacts, slip and dashpots from the start
+    local k = b.id
+    b.vel = {(k * 7 % 11 - 5) * 0.2, (k * 5 % 13 - 6) * 0.2, (k * 3 % 7 - 3) * 0.2}
+  end
+  m:track_energy(true)
+  m:cycle(400)
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+  cyl:set_radial_vel(-1e4)
+  local ok, err = pcall(m.cycle, m, 100)
+  print("caught", not ok, tostring(err):match("cylinder .*"))
+  -- decided alike on every rank before any ball moved: the serial state, energies and all
+  local function report(what)
+    local e = m:energy()
+    print(what, m:step(), m:hash(), string.format("%a %a %a %a", e.slip, e.viscous, e.local_damping, e.boundary_work))
+  end
+  report("left")
+  cyl:set_radial_vel(0)
+  m:cycle(300)
+  report("again")
+  return
+end
+
 local function along(g) return dim == 3 and {0, 0, g} or {0, g} end
-local m = seixo.model{dim = dim, gravity = along(-9.81)}
-m:material("bead", {density = 2500, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.1})
-local r = 2e-3
-local nx, ny, nz = dim == 3 and 6 or 24, dim == 3 and 6 or 16, dim == 3 and 8 or 1
-m:wall{kind = "box", min = dim == 3 and {0, 0, 0} or {0, 0},
-       max = dim == 3 and {2 * nx * r, 2 * ny * r, 4 * nz * r} or {2 * nx * r, 4 * ny * r}}
-for k = 0, nz - 1 do
-  for j = 0, ny - 1 do
-    for i = 0, nx - 1 do
-      local x = (2 * i + 1) * r
-      m:ball{pos = dim == 3 and {x, (2 * j + 1) * r, (2 * k + 1) * r * 1.001} or {x, (2 * j + 1) * r * 1.001},
-             radius = r * (1 - 0.05 * ((i * 5 + j * 11 + k * 3) % 7) / 7)}
+local m
+if scene == "periodic" then -- a granular gas in a cell periodic on every axis
+  m = seixo.model{dim = dim}
+  m:material("grain", {density = 2000, kn = 1e7, ks = 5e6, friction = 0.5, damping = 0.7})
+  local L = dim == 3 and 0.06 or 0.2
+  local zero, size = dim == 3 and {0, 0, 0} or {0, 0}, dim == 3 and {L, L, L} or {L, L}
+  m:periodic{min = zero, max = size}
+  m:generate{count = dim == 3 and 700 or 900, radius = {2.2e-3, 3.3e-3}, region = {box = {zero, size}}, seed = 7}
+  local target = dim == 3 and 2e5 or 4e3 -- compressed into contact
+  local servo = {xx = {stress = target}, yy = {stress = target}, max_rate = dim == 3 and 80 or 30}
+  if dim == 3 then servo.zz = {stress = target} end
+  m:cell_control(servo)
+else
+  m = seixo.model{dim = dim, gravity = along(-9.81)}
+  m:material("bead", {density = 2500, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.1})
+  local r = 2e-3
+  local nx, ny, nz = dim == 3 and 6 or 24, dim == 3 and 6 or 16, dim == 3 and 8 or 1
+  m:wall{kind = "box", min = dim == 3 and {0, 0, 0} or {0, 0},
+         max = dim == 3 and {2 * nx * r, 2 * ny * r, 4 * nz * r} or {2 * nx * r, 4 * ny * r}}
+  for k = 0, nz - 1 do
+    for j = 0, ny - 1 do
+      for i = 0, nx - 1 do
+        local x = (2 * i + 1) * r
+        m:ball{pos = dim == 3 and {x, (2 * j + 1) * r, (2 * k + 1) * r * 1.001} or {x, (2 * j + 1) * r * 1.001},
+               radius = r * (1 - 0.05 * ((i * 5 + j * 11 + k * 3) % 7) / 7)}
+      end
     end
   end
 end

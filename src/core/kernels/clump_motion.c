@@ -225,8 +225,9 @@ enum { CLUMP_BLOCK = 512, CLUMP_BLOCKS = 64 };
  * pebbles' forces (those of other ranks' pebbles sent by their owners);
  * with energy tracking each clump's terms go to the serial sums
  * (sx__dd_clump_energy), in the serial step's blocks. A rank that failed
- * earlier in the step, or fails here, moves no more clumps but still
- * takes part in that exchange (the ranks agree on the error after it). */
+ * earlier in the step moves no clump but still takes part in that
+ * exchange; one that fails here names its first bad clump in clump order,
+ * whose index places its error among the ranks' (dd_agree.c). */
 static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t size)
 {
     sx_dd *d = m->dd;
@@ -242,7 +243,10 @@ static sx_status KERNEL(clumps_step_own)(sx_model *m, double *max_disp, int64_t 
         if (!step_clump(m, &env, d->cl[e], &worst, work, terms ? terms + (e - own.lo) * W : NULL) && bad < 0) bad = d->cl[e];
     *max_disp = sqrt(worst);
     const bool ok = !terms || sx__dd_clump_energy(m, W, D + RD, size);
-    if (bad >= 0) return KERNEL(nonfinite)(m, "clump", m->clumps->id[bad]);
+    if (bad >= 0) {
+        d->fail_order = bad;
+        return KERNEL(nonfinite)(m, "clump", m->clumps->id[bad]);
+    }
     return ok ? SX_OK : sx__fail(m, SX_EINVAL, "cycle: the ranks could not sum the clumps' energies");
 }
 

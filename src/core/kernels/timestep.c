@@ -215,5 +215,7 @@ static double KERNEL(critical_dt)(sx_model *m) { return KERNEL(rate_dt)(m, true)
 
 /* The critical estimate an instability message gives. Decomposed, it is
  * the failing rank's own (its balls, and its clumps from the pebble sums it
- * holds): the rank stops at once, with no exchange to wait for. */
+ * holds), at least the serial one: the rank rates it where it fails, with
+ * no exchange the others would have to meet (they agree on the error at
+ * the step's end, dd_agree.c). */
 static double KERNEL(estimate_dt)(sx_model *m) { return KERNEL(rate_dt)(m, false); }
