@@ -75,7 +75,6 @@ if scene == "radius" then -- a bed in a cylinder, energy tracked; the cylinder s
   return
 end
 
-local function along(g) return dim == 3 and {0, 0, g} or {0, g} end
 local m
 if scene == "periodic" then -- a granular gas in a cell periodic on every axis
   m = seixo.model{dim = dim}
@@ -89,21 +88,7 @@ if scene == "periodic" then -- a granular gas in a cell periodic on every axis
   if dim == 3 then servo.zz = {stress = target} end
   m:cell_control(servo)
 else
-  m = seixo.model{dim = dim, gravity = along(-9.81)}
-  m:material("bead", {density = 2500, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.1})
-  local r = 2e-3
-  local nx, ny, nz = dim == 3 and 6 or 24, dim == 3 and 6 or 16, dim == 3 and 8 or 1
-  m:wall{kind = "box", min = dim == 3 and {0, 0, 0} or {0, 0},
-         max = dim == 3 and {2 * nx * r, 2 * ny * r, 4 * nz * r} or {2 * nx * r, 4 * ny * r}}
-  for k = 0, nz - 1 do
-    for j = 0, ny - 1 do
-      for i = 0, nx - 1 do
-        local x = (2 * i + 1) * r
-        m:ball{pos = dim == 3 and {x, (2 * j + 1) * r, (2 * k + 1) * r * 1.001} or {x, (2 * j + 1) * r * 1.001},
-               radius = r * (1 - 0.05 * ((i * 5 + j * 11 + k * 3) % 7) / 7)}
-      end
-    end
-  end
+  m = dofile(dir .. "mpi_stack.lua")(dim, dim == 3 and 6 or 24, dim == 3 and 6 or 16, 8)
 end
 m:cycle(640)
 io.stderr:write(string.format("ranks %d\n", m:ranks()))

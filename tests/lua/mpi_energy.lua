@@ -108,21 +108,8 @@ if scene == "track" then
   end
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
 elseif scene == "guard" then
-  local m = seixo.model{dim = dim, gravity = along(-9.81)}
-  m:material("bead", {density = 2500, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.1})
-  local r = 2e-3
-  local nx, ny, nz = dim == 3 and 8 or 30, dim == 3 and 8 or 20, dim == 3 and 10 or 1
-  local hi = dim == 3 and {2 * nx * r, 2 * ny * r, 4 * nz * r} or {2 * nx * r, 4 * ny * r}
-  m:wall{kind = "box", min = dim == 3 and {0, 0, 0} or {0, 0}, max = hi}
-  for k = 0, nz - 1 do -- a column of balls resting on each other, a little apart sideways
-    for j = 0, ny - 1 do
-      for i = 0, nx - 1 do
-        local x = (2 * i + 1) * r
-        m:ball{pos = dim == 3 and {x, (2 * j + 1) * r, (2 * k + 1) * r * 1.001} or {x, (2 * j + 1) * r * 1.001},
-               radius = r * (1 - 0.05 * ((i * 5 + j * 11 + k * 3) % 7) / 7)}
-      end
-    end
-  end
+  local dir = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
+  local m = dofile(dir .. "mpi_stack.lua")(dim, dim == 3 and 8 or 30, dim == 3 and 8 or 20, 10)
   m:cycle(640) -- settling with the automatic timestep: the guard checks and passes ten times
   report(m, "settled")
   io.stderr:write(string.format("ranks %d\n", m:ranks()))
