@@ -84,8 +84,8 @@ sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int
     else if (R > 1 && (all[pick].part <= SX_FAIL_WALLS || all[pick].part == SX_FAIL_MOTION ||
                        all[pick].part == SX_FAIL_CLUMPS)) /* one rank's: the others' balls or clumps moved on */
         agreed = sx__fail(m, all[pick].st,
-                          "%s (under mpirun the other ranks' balls may have gone on through this step: load a save "
-                          "to go on)",
+                          "%s (under mpirun the state is as this step found it on the failing rank only: the "
+                          "other ranks' balls may have gone on through the step; load a save to go on)",
                           all[pick].err);
     else
         agreed = sx__fail(m, all[pick].st, "%s", all[pick].err);

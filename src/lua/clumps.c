@@ -111,7 +111,13 @@ static int64_t read_pebbles(lua_State *L, int idx, int dim, double **pos, double
             sx_lua_checkvecfield(L, p, "pos", dim, v);
             v[dim] = sx_lua_checknumfield(L, p, "radius");
         } else {
-            const char *bad = sx_lua_tovec(L, p, dim + 1, v);
+            /* (the length checked here: sx_lua_tovec's message would name a
+             * 3D model for a 2D pebble's three numbers) */
+            const lua_Unsigned len = lua_rawlen(L, p);
+            const char *bad = len != (lua_Unsigned)dim + 1
+                                  ? lua_pushfstring(L, "%d numbers expected in a %dD model, got %I", dim + 1, dim,
+                                                    (lua_Integer)len)
+                                  : sx_lua_tovec(L, p, dim + 1, v);
             if (bad)
                 luaL_argerror(L, 3, lua_pushfstring(L, "pebble %I: {x, y%s, r}: %s", (lua_Integer)i, dim == 3 ? ", z" : "", bad));
         }

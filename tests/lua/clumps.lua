@@ -206,6 +206,8 @@ test("2D: templates, clumps, orientation as an angle, generation", function()
   local m = model(2)
   local t = m:clump_template("bar", {{-0.01, 0, 0.008}, {0.01, 0, 0.008}})
   eq(type(t.inertia), "number")
+  -- a 3D pebble in a 2D model: the message names the model's dimension
+  raises(function() m:clump_template("x", {{0, 0, 0, 1e-3}}) end, HERE, "{x, y, r}: 3 numbers expected in a 2D model, got 4")
   local c = m:clump{template = "bar", pos = {0.5, 0.5}, orientation = 0.3, spin = 2}
   near(c.orientation, 0.3, 1e-14)
   eq(c.spin, 2)
