@@ -59,6 +59,7 @@ const sx_kernels KERNEL(sx_kernels) = {
     .walls = KERNEL(walls),
     .integrate = KERNEL(integrate),
     .critical_dt = KERNEL(critical_dt),
+    .own_dt = KERNEL(own_dt),
     .clumps_step = KERNEL(clumps_step),
     .place_pebbles = KERNEL(place_pebbles),
     .energy = KERNEL(energy),

@@ -679,6 +679,7 @@ typedef struct sx_kernels {
     sx_status (*walls)(sx_model *m);             /* ball-wall forces */
     sx_status (*integrate)(sx_model *m, double *max_disp); /* law of motion */
     double (*critical_dt)(sx_model *m);          /* min sqrt(m/k) over balls */
+    double (*own_dt)(const sx_model *m);         /* an upper bound of it from the balls' own ratings alone */
     /* the clumps after the balls' law of motion (kernels/clump_motion.c): sums
      * the pebbles' forces, integrates (4-42 ... 4-48), places the pebbles;
      * raises *max_disp to the largest pebble move since the last build */

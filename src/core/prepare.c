@@ -143,6 +143,12 @@ double sx_model_timestep(sx_model *m)
 
 double sx_model_fixed_timestep(const sx_model *m) { return m->dt_user; }
 
+double sx_model_critical_timestep_bound(sx_model *m)
+{
+    if (sx__prepare_laws(m)) return NAN;
+    return sx__kernels(m)->own_dt(m);
+}
+
 sx_status sx_model_set_timestep(sx_model *m, double dt)
 {
     if (!sx__timestep_ok(dt))

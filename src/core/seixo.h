@@ -68,6 +68,10 @@ SX_API sx_status sx_model_set_timestep(sx_model *m, double dt);
 /// The fixed timestep set (s), or 0 when it is the automatic one: a read,
 /// which (unlike sx_model_timestep) never prepares the model.
 SX_API double sx_model_fixed_timestep(const sx_model *m);
+/// An upper bound of sx_model_critical_timestep (s) from each ball's own
+/// rating alone (a contact with a ball like itself, at rest): no contact
+/// sums, so neither a build nor memory of a few doubles a ball.
+SX_API double sx_model_critical_timestep_bound(sx_model *m);
 
 SX_API void sx_model_gravity(const sx_model *m, double out[3]);
 SX_API sx_status sx_model_set_gravity(sx_model *m, const double g[3]);

@@ -309,6 +309,11 @@ static void check_timestep(lua_State *L, run *r)
     r->ud->timestep_unchecked = false;
     const double dt = sx_model_fixed_timestep(r->m);
     if (!(dt > 0) || sx_ball_count(r->m) == 0) return;
+    /* the usual case settled by an upper bound of the estimate that needs
+     * no memory (the estimate's contact sums take five doubles a ball, a
+     * peak a fixed timestep's run would not otherwise reach), from what
+     * every rank holds alike (the balls' radii, masses and materials) */
+    if (!(dt * TINY_TIMESTEP < sx_model_critical_timestep_bound(r->m))) return;
     sx_lua_gather(L, r->m, "m"); /* decomposed: every rank alike (the model's calls are) */
     const double crit = sx_model_critical_timestep(r->m);
     if (crit > 0 && dt * TINY_TIMESTEP < crit)

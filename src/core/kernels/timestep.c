@@ -213,6 +213,25 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
 
 static double KERNEL(critical_dt)(sx_model *m) { return KERNEL(rate_dt)(m, true); }
 
+/* An upper bound of critical_dt from each ball's own rating alone (a
+ * contact with a ball like itself, at rest): no contact sums, so no
+ * memory, and only what every rank holds alike (radii, masses, materials).
+ * critical_dt takes at least that stiffness (more with its contacts, its
+ * speed and a wall's, a contact-model row, a joint; a dashpot lowers it
+ * further), and its rotation's rating is the lower. */
+static double KERNEL(own_dt)(const sx_model *m)
+{
+    const sx_balls *B = &m->balls;
+    double best = INFINITY;
+    for (int64_t i = 0; i < B->n; i++) {
+        const double mass = 1.0 / B->inv_mass[i];
+        double kn, ks;
+        self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], B->rad[i], mass, 0, &kn, &ks);
+        if (kn + ks > 0) best = fmin(best, sqrt(mass / (kn + ks)));
+    }
+    return best;
+}
+
 /* The critical estimate an instability message gives. Decomposed, it is
  * the failing rank's own (its balls, and its clumps from the pebble sums it
  * holds), at least the serial one: the rank rates it where it fails, with
