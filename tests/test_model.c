@@ -279,6 +279,8 @@ START_TEST(auto_timestep_free_ball)
         if (c == 1 && dim == 3) ck_assert(rot < tr);
         ck_assert_rel(sx_model_critical_timestep(m), crit, 4 * DBL_EPSILON);
         ck_assert_rel(sx_model_timestep(m), 0.8 * crit, 4 * DBL_EPSILON);
+        /* the bound from the ball's own rating alone: its translation's, at least the estimate */
+        ck_assert_rel(sx_model_critical_timestep_bound(m), tr, 4 * DBL_EPSILON);
         /* cycling uses it */
         ck_assert_cycle(m, 10);
         ck_assert_rel(sx_model_time(m), 10 * 0.8 * crit, 16 * DBL_EPSILON);
@@ -353,6 +355,10 @@ static void timestep_contacts(int dim, double ks)
     ck_assert_rel(sx_model_critical_timestep(m), crit, 4 * DBL_EPSILON);
     ck_assert_rel(sx_model_timestep(m), 0.8 * crit, 4 * DBL_EPSILON);
     ck_assert(sx_model_timestep(m) < dt_free);
+    /* the bound ignores the contacts (what makes it cheap): the lone ball's
+     * translational rating, above the estimate they lower */
+    ck_assert_rel(sx_model_critical_timestep_bound(m), sqrt(mass / (kn + ks)), 4 * DBL_EPSILON);
+    ck_assert(sx_model_critical_timestep_bound(m) > crit);
     /* it is the centre ball that governs: its estimate alone, translational
      * or rotational as the stiffness ratio says */
     const double centre_tr = sqrt(mass / (nc * (Kn + Ks))), centre_rot = sqrt(inertia / (nc * Ks * R * R));
