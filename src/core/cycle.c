@@ -132,14 +132,7 @@ sx_status sx_model_gather(sx_model *m)
  * nothing more, to where the ranks agree on it (dd_agree.c). Any other
  * error (out of memory, an exchange that failed) may come before a
  * stage's own exchange: the rank stops there, out of step, as serially. */
-typedef struct {
-    sx_status st;
-    sx_fail_part part;
-    int64_t order; /* its place in the part's serial order, where that is not the ranks' (a clump's index) */
-    char err[SX_ERRLEN];
-} kept_error;
-
-static void keep(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+static void keep(sx_model *m, sx_step_error *e, sx_status st, sx_fail_part part)
 {
     e->st = st, e->part = part, e->order = m->dd->fail_order;
     memcpy(e->err, m->err, sizeof e->err);
@@ -147,7 +140,7 @@ static void keep(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
 
 /* After a part of the step that may fail on one rank: true to go on (no
  * error, or decomposed: an instability, kept). */
-static bool go_on(sx_model *m, kept_error *e, sx_status *st, sx_fail_part part)
+static bool go_on(sx_model *m, sx_step_error *e, sx_status *st, sx_fail_part part)
 {
     if (!*st) return true;
     if (!m->dd || *st != SX_EUNSTABLE) return false;
@@ -160,18 +153,18 @@ static bool go_on(sx_model *m, kept_error *e, sx_status *st, sx_fail_part part)
 /* Where every rank stops together (an error all decide alike, st, or the
  * displacements' exchange telling of a rank's), decomposed: the error the
  * ranks agree on, from this rank's kept one or st. */
-static sx_status stop_together(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+static sx_status stop_together(sx_model *m, sx_step_error *e, sx_status st, sx_fail_part part)
 {
     if (!m->dd) return st;
     if (!e->st && st) keep(m, e, st, part);
-    return sx__dd_agree_failure(m, e->st, e->part, e->order, e->err);
+    return sx__dd_agree_failure(m, e);
 }
 
 /* Decomposed, a stop before the step's energy chain (a cylinder's radius,
  * the cell's rates): the serial step has added its contacts' and walls'
  * energy sums by then, and none of the law of motion, which has not run
  * (the blocks' terms are the last step's): the chain of those sums. */
-static sx_status stop_before_motion(sx_model *m, kept_error *e, sx_status st, sx_fail_part part)
+static sx_status stop_before_motion(sx_model *m, sx_step_error *e, sx_status st, sx_fail_part part)
 {
     if (m->dd && m->track_energy) {
         for (int64_t b = 0; b < m->nblock; b++) m->blocks[b].damp_work = m->blocks[b].load_work = m->blocks[b].visc_work = 0;
@@ -213,7 +206,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     }
     if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
     sx_dd *dd = m->dd;
-    kept_error kept = {.st = SX_OK};
+    sx_step_error kept = {.st = SX_OK};
     m->locked = true;
     /* the energy baseline is taken when the user has changed the system, not
      * at every call: a script cycling one step at a time is guarded too */

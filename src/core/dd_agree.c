@@ -3,7 +3,6 @@
  * met. */
 #include "decompose.h"
 
-#include <stdio.h>
 #include <stdlib.h>
 
 /* An interrupt stops every rank at the same step. Every STOP_EVERY steps
@@ -49,27 +48,26 @@ bool sx__dd_stop(sx_model *m, bool *stop)
  * clump's error carries its index, as the clumps' owners do not), becomes
  * every rank's. The cycle then ends as any cycle does (sx_model_error_agreed):
  * a script can catch the error on every rank alike. */
-typedef struct {
-    int32_t st, part;
-    int64_t order;
-    char err[SX_ERRLEN];
-} rank_error;
-
 /* Whether rank a's error comes before rank b's (a < b) in the serial step. */
-static bool before(const rank_error *a, const rank_error *b)
+static bool before(const sx_step_error *a, const sx_step_error *b)
 {
     return a->part < b->part || (a->part == b->part && a->order < b->order);
 }
 
-sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int64_t order, const char *err)
+/* An error in a rank's own part of the step: the other ranks' balls and
+ * clumps may have moved on through it. */
+static bool one_ranks(sx_fail_part part)
+{
+    return part == SX_FAIL_CONTACTS || part == SX_FAIL_WALLS || part == SX_FAIL_MOTION || part == SX_FAIL_CLUMPS;
+}
+
+sx_status sx__dd_agree_failure(sx_model *m, const sx_step_error *mine)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks;
-    rank_error *all = calloc((size_t)R, sizeof *all);
+    sx_step_error *all = calloc((size_t)R, sizeof *all);
     if (!all) return sx__fail(m, SX_ENOMEM, "cycle: out of memory to share the ranks' errors");
-    rank_error *mine = &all[d->x.rank];
-    mine->st = st, mine->part = st ? (int32_t)part : 0, mine->order = st ? order : 0;
-    if (st) snprintf(mine->err, sizeof mine->err, "%s", err);
+    all[d->x.rank] = *mine;
     if (!sx__dd_share_by_rank(d, all, sizeof *all)) {
         free(all);
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange their errors");
@@ -81,8 +79,7 @@ sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int
     if (pick < 0) /* a displacement no rank's error explains */
         agreed = sx__fail(m, SX_EUNSTABLE, "unstable at step %lld: a ball's displacement is not finite",
                           (long long)m->step);
-    else if (R > 1 && (all[pick].part <= SX_FAIL_WALLS || all[pick].part == SX_FAIL_MOTION ||
-                       all[pick].part == SX_FAIL_CLUMPS)) /* one rank's: the others' balls or clumps moved on */
+    else if (R > 1 && one_ranks(all[pick].part))
         agreed = sx__fail(m, all[pick].st,
                           "%s (under mpirun the state is as this step found it on the failing rank only: the "
                           "other ranks' balls may have gone on through the step; load a save to go on)",
@@ -91,9 +88,7 @@ sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int
         agreed = sx__fail(m, all[pick].st, "%s", all[pick].err);
     /* the balls that moved are not known to the rebuild's criterion (a
      * failing rank gives an infinite displacement): the next step builds */
-    if (pick < 0 || all[pick].part <= SX_FAIL_WALLS || all[pick].part == SX_FAIL_MOTION ||
-        all[pick].part == SX_FAIL_CLUMPS)
-        m->build_needed = true;
+    if (pick < 0 || one_ranks(all[pick].part)) m->build_needed = true;
     free(all);
     d->agreed = true;
     return agreed;

@@ -814,7 +814,16 @@ typedef enum {
     SX_FAIL_CLUMPS,
     SX_FAIL_GUARD
 } sx_fail_part;
-sx_status sx__dd_agree_failure(sx_model *m, sx_status st, sx_fail_part part, int64_t order, const char *err);
+/* A rank's error in a step (st SX_OK: none; all zero then): its part, its
+ * place in the part's serial order where that is not the ranks' (a
+ * clump's index; else 0), its message. */
+typedef struct sx_step_error {
+    sx_status st;
+    sx_fail_part part;
+    int64_t order;
+    char err[SX_ERRLEN];
+} sx_step_error;
+sx_status sx__dd_agree_failure(sx_model *m, const sx_step_error *mine);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n
