@@ -704,9 +704,16 @@ static char *read_line(const char *prompt, bool *cancelled)
 /* What a line read at the prompt is (sx_lua_parallel_root_text's mark). */
 enum { LINE_TYPED, LINE_CANCELLED };
 
+/* How the prompt is shown: at a terminal, readline's when built with it;
+ * under mpirun, whose ranks never have a terminal whatever mpirun's own
+ * input is, always (rank 0 reads mpirun's input), and on stdout: mpirun
+ * forwards stdout and stderr apart, so a prompt on stderr could come
+ * before the output of the statement it follows. */
+typedef enum { PROMPT_NONE, PROMPT_TTY, PROMPT_LAUNCHED } prompt_kind;
+
 typedef struct prompt_read {
     const char *prompt;
-    bool tty;
+    prompt_kind kind;
 } prompt_read;
 
 /* One line from standard input, its newline dropped (NULL at the end of
@@ -716,7 +723,7 @@ static char *read_prompt_line(void *ud, size_t *len, int *mark)
     const prompt_read *p = ud;
     *mark = LINE_TYPED;
 #ifdef SX_HAVE_READLINE
-    if (p->tty) {
+    if (p->kind == PROMPT_TTY) {
         bool cancelled = false;
         char *line = read_line(p->prompt, &cancelled);
         if (cancelled) {
@@ -728,7 +735,7 @@ static char *read_prompt_line(void *ud, size_t *len, int *mark)
         return line;
     }
 #endif
-    if (p->tty) {
+    if (p->kind != PROMPT_NONE) {
         fputs(p->prompt, stdout);
         fflush(stdout);
     }
@@ -747,9 +754,9 @@ static char *read_prompt_line(void *ud, size_t *len, int *mark)
 /* Reads one line onto the stack (under mpirun, rank 0's, on every rank);
  * false at the end of input. A Ctrl-C at the prompt gives an empty line
  * and sets *cancelled. */
-static bool push_line(lua_State *L, bool first, bool tty, bool *cancelled)
+static bool push_line(lua_State *L, bool first, prompt_kind kind, bool *cancelled)
 {
-    prompt_read p = {first ? "> " : ">> ", tty};
+    prompt_read p = {first ? "> " : ">> ", kind};
     size_t len;
     int mark;
     char *line = sx_lua_parallel_root_text("the prompt", read_prompt_line, &p, &len, &mark);
@@ -783,14 +790,14 @@ static bool incomplete(lua_State *L, int status)
 
 /* Compiles the text at the stack top as a statement, reading more lines
  * while it is incomplete; leaves the whole text and the chunk (or message). */
-static int multiline(lua_State *L, bool tty)
+static int multiline(lua_State *L, prompt_kind kind)
 {
     for (;;) {
         size_t len;
         const char *code = lua_tolstring(L, -1, &len);
         const int status = luaL_loadbuffer(L, code, len, "=stdin");
         bool cancelled = false;
-        if (!incomplete(L, status) || !push_line(L, false, tty, &cancelled)) return status;
+        if (!incomplete(L, status) || !push_line(L, false, kind, &cancelled)) return status;
         if (cancelled) {  // Ctrl-C abandons the whole statement
             lua_settop(L, 0);
             lua_pushliteral(L, "");
@@ -805,15 +812,15 @@ static int multiline(lua_State *L, bool tty)
 
 /* Reads and compiles one entry: -1 at the end of input, else the load
  * status with the chunk (or message) as the only value on the stack. */
-static int load_entry(lua_State *L, bool tty)
+static int load_entry(lua_State *L, prompt_kind kind)
 {
     lua_settop(L, 0);
     bool cancelled;
-    if (!push_line(L, true, tty, &cancelled)) return -1;
+    if (!push_line(L, true, kind, &cancelled)) return -1;
     int status = try_return(L);
-    if (status != LUA_OK) status = multiline(L, tty);
+    if (status != LUA_OK) status = multiline(L, kind);
 #ifdef SX_HAVE_READLINE
-    if (tty && lua_rawlen(L, 1) > 0) remember(lua_tostring(L, 1));
+    if (kind == PROMPT_TTY && lua_rawlen(L, 1) > 0) remember(lua_tostring(L, 1));
 #endif
     lua_remove(L, 1);
     return status;
@@ -923,7 +930,14 @@ static int show(lua_State *L)
 static void repl(lua_State *L)
 {
     const bool tty = isatty(STDIN_FILENO);
+    /* under a launcher (one rank or more) rank 0 reads mpirun's input */
+    const bool launched = getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE");
+    const prompt_kind kind = tty ? PROMPT_TTY : launched ? PROMPT_LAUNCHED : PROMPT_NONE;
     if (tty) printf("seixo %s (%s); help() for help, Ctrl-D quits, Ctrl-C stops a cycle\n", SX_VERSION, LUA_RELEASE);
+    else if (launched && sx_lua_parallel_rank() == 0)
+        printf("seixo %s (%s) on %d rank%s; help() for help, Ctrl-D quits; a SIGUSR1 to mpirun stops a cycle "
+               "(Ctrl-C is mpirun's: it ends the job)\n",
+               SX_VERSION, LUA_RELEASE, sx_lua_parallel_ranks(), sx_lua_parallel_ranks() == 1 ? "" : "s");
 #ifdef SX_HAVE_READLINE
     if (tty) {
         global_L = L;
@@ -935,7 +949,7 @@ static void repl(lua_State *L)
     }
 #endif
     int status;
-    while ((status = load_entry(L, tty)) != -1) {
+    while ((status = load_entry(L, kind)) != -1) {
         if (status == LUA_OK) status = docall_keeping_locals(L, 0, LUA_MULTRET, "=stdin");
         if (status == LUA_OK && lua_gettop(L) > 0) {
             lua_pushcfunction(L, show);
@@ -951,6 +965,7 @@ static void repl(lua_State *L)
     }
     lua_settop(L, 0);
     if (tty) putchar('\n');
+    else if (kind == PROMPT_LAUNCHED && sx_lua_parallel_rank() == 0) putchar('\n');
 #ifdef SX_HAVE_READLINE
     close_history();
     clear_matches();

@@ -3,7 +3,8 @@
 # read from it (`seixo - ARGS`) and an interactive session fed to
 # `seixo -i` run alike on every rank (rank 0 reads, the others take its
 # input) and print what the serial run prints, serially and with 1 to 4
-# ranks (the session's errors reported once), each run within a time
+# ranks (the session's errors reported once; its banner and prompts,
+# which a serial run reading a pipe does not show), each run within a time
 # limit (a rank waiting for input it never gets would hang), and a line
 # failing on one rank alone ends the session with its message; and a bad
 # option is refused with its message once; --profile prints a table per
@@ -38,6 +39,17 @@ for mode in script session; do
     if [ $status -ne 0 ]; then
       echo "$mode, -np $np: exit status $status ($([ $status -eq 124 ] && echo 'a hang: stopped after 300 s'))"
       cat "$dir/err"; fail=1; continue
+    fi
+    # the session under mpirun, whose ranks have no terminal, shows its
+    # banner and prompts (on stdout: mpirun forwards stderr apart, out of
+    # order with it); the rest is what the serial run prints
+    if [ $mode = session ]; then
+      if ! head -n 1 "$dir/out" | grep -q "^seixo .* on $np ranks\{0,1\}; help() for help, Ctrl-D quits" ||
+         ! grep -q "^> \(> \)*>> >> " "$dir/out"; then
+        echo "$mode, -np $np: no banner, or no prompts (> and >> for the lines of a statement):"
+        head -n 3 "$dir/out"; fail=1
+      fi
+      sed -e 1d -e 's/^\(>>* \)*//' "$dir/out" | sed -e '${/^$/d;}' >"$dir/bare" && mv "$dir/bare" "$dir/out"
     fi
     same_as_serial "$mode, -np $np" "$np"
     # the session's error, met by every rank, reported once (by rank 0)
