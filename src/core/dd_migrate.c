@@ -133,12 +133,59 @@ static int64_t list_by_owner(const sx_dd *d, const int32_t *from, int64_t n, int
     return at;
 }
 
-/* The rows f of the entries k < n with from[k] >= 0, from rank from[k]
- * to every rank (list and runs: room for n entries and for the ranks). */
-static bool move_from(sx_dd *d, const sx_rows *f, const int32_t *from, int64_t n, int32_t *list, sx_span *runs)
+/* Rows that move from one rank to another: entry k (of a store's rows)
+ * from rank `from` to rank `to`. A ball has one new owner; a pair may
+ * have two new steppers (the ranks of both its balls). */
+typedef struct route {
+    int32_t k, from, to;
+} route;
+
+typedef struct routes {
+    route *r;
+    int64_t n, cap;
+} routes;
+
+static bool add_route(routes *q, int64_t k, int from, int to)
 {
-    const int64_t k = list_by_owner(d, from, n, list, runs);
-    return sx__dd_move_rows(d, f, list, 0, k, runs, sx__dd_everything(d, k), 1);
+    if (q->n == q->cap) {
+        const int64_t cap = q->cap ? 2 * q->cap : 1024;
+        route *r = realloc(q->r, (size_t)cap * sizeof *r);
+        if (!r) return false;
+        q->r = r, q->cap = cap;
+    }
+    q->r[q->n++] = (route){(int32_t)k, from, to};
+    return true;
+}
+
+/* The rows f of the routes q, each to its rank alone. The entries are
+ * listed by source, then by destination: each source's a run (what it
+ * packs), each (source, destination) a span of it (what the destination
+ * unpacks), so the exchange sends a row once to each rank that needs it,
+ * where an all-gather sent it to every rank. spans: R * (R + 1). */
+static bool move_routes(sx_dd *d, const sx_rows *f, const routes *q, sx_span *spans)
+{
+    const int R = d->x.ranks;
+    if (!q->n) return true;
+    int32_t *list = malloc((size_t)q->n * sizeof *list);
+    if (!list) return false;
+    sx_span *need = spans, *own = spans + (size_t)R * R; /* need[t * R + s]: from s to t */
+    for (int64_t k = 0; k < (int64_t)R * R; k++) need[k] = (sx_span){0, 0};
+    for (int64_t e = 0; e < q->n; e++) need[(int64_t)q->r[e].to * R + q->r[e].from].hi++;
+    int64_t at = 0;
+    for (int s = 0; s < R; s++) {
+        own[s].lo = at;
+        for (int t = 0; t < R; t++) {
+            sx_span *e = &need[(int64_t)t * R + s];
+            const int64_t len = e->hi;
+            *e = (sx_span){at, at}; /* hi: the span's next entry, then its end */
+            at += len;
+        }
+        own[s].hi = at;
+    }
+    for (int64_t e = 0; e < q->n; e++) list[need[(int64_t)q->r[e].to * R + q->r[e].from].hi++] = q->r[e].k;
+    const bool ok = sx__dd_move_rows(d, f, list, 0, at, own, need, R);
+    free(list);
+    return ok;
 }
 
 /* Rank r steps the ball-ball pairs pairs[r] and the ball-wall pairs of
@@ -151,22 +198,25 @@ static sx_span wall_pairs_run(const sx_model *m, int r)
     return (sx_span){sx__first_at(m->bw.a, m->bw.n, lo), sx__first_at(m->bw.a, m->bw.n, hi)};
 }
 
-/* from[c] for the new pairs a rank steps whose old pair another rank
- * stepped: that rank, which holds its history. */
-static void pairs_from(const sx_model *m, const sx_span *run, const int32_t *src, int64_t nsrc, const sx_span *was,
-                       int32_t *from, int64_t n, bool walls)
+/* The new pairs a rank steps whose old pair another rank stepped, from
+ * that rank (the owner of the old pair's first ball, which holds its
+ * history) to each rank that steps the new pair (a pair whose balls two
+ * ranks own is stepped by both). */
+static bool pair_routes(const sx_model *m, const sx_span *run, const int32_t *src, int64_t nsrc, const sx_span *was,
+                        routes *q, bool walls)
 {
     const sx_dd *d = m->dd;
     const int R = d->x.ranks;
-    for (int64_t c = 0; c < n; c++) from[c] = -1;
+    q->n = 0;
     for (int r = 0; r < R; r++) {
         const sx_span s = walls ? wall_pairs_run(m, r) : run[r];
         for (int64_t c = s.lo; c < s.hi && c < nsrc; c++) {
             if (!src[c]) continue;
             const int o = span_owner(was, R, (src[c] > 0 ? src[c] : -src[c]) - 1);
-            if (o != r) from[c] = o;
+            if (o != r && !add_route(q, c, o, r)) return false;
         }
     }
+    return true;
 }
 
 /* After the build's plan: to the ranks that now step them, the balls
@@ -174,8 +224,11 @@ static void pairs_from(const sx_model *m, const sx_span *run, const int32_t *src
  * rank took before the build), the pairs whose history another rank
  * holds, and the bonds (with a flat joint's face and elements) another
  * rank stepped, or that left the plan (broken: their last state to every
- * rank). Every rank lists the same entries (from what all hold alike),
- * and each sends the entries it held; every rank receives them all. */
+ * rank). Every rank lists the same entries (from what all hold alike);
+ * each sends the balls and pairs it held to the rank that now steps them
+ * alone (the other ranks' copies are stale, and none reads them: a ghost's
+ * motion comes with the step's halo, a pair's history from the rank that
+ * stepped it last), and the bonds to every rank. */
 bool sx__dd_migrate(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -184,27 +237,22 @@ bool sx__dd_migrate(sx_model *m)
     const sx_balls *B = &m->balls;
     const sx_bonds *bs = &m->bonds;
     const int R = d->x.ranks;
-    int64_t most = B->n > m->bb.n ? B->n : m->bb.n;
-    if (m->bw.n > most) most = m->bw.n;
-    if (bs->n > most) most = bs->n;
-    int32_t *from = malloc((size_t)(most + 1) * sizeof *from), *list = malloc((size_t)(most + 1) * sizeof *list);
-    sx_span *runs = malloc((size_t)R * sizeof *runs);
-    bool ok = from && list && runs;
+    int32_t *from = malloc((size_t)(bs->n + 1) * sizeof *from), *list = malloc((size_t)(bs->n + 1) * sizeof *list);
+    sx_span *spans = malloc((size_t)R * (size_t)(R + 1) * sizeof *spans);
+    routes q = {NULL, 0, 0};
+    bool ok = from && list && spans;
     if (ok) { /* the balls */
-        for (int64_t i = 0; i < B->n; i++) {
-            const int32_t o = d->was[B->id[i]];
-            from[i] = o != sx__dd_owner_of(d, i, B->n) ? o : -1;
+        for (int64_t i = 0; i < B->n && ok; i++) {
+            const int32_t o = d->was[B->id[i]], to = sx__dd_owner_of(d, i, B->n);
+            if (o != to) ok = add_route(&q, i, o, to);
         }
         const sx_rows f = sx__dd_ball_motion(m, false);
-        ok = move_from(d, &f, from, B->n, list, runs);
+        ok = ok && move_routes(d, &f, &q, spans);
     }
     if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
-        pairs_from(m, d->pairs, d->src_bb, d->nsrc_bb, d->bb_was, from, m->bb.n, false);
-        const sx_rows fb = pair_rows(m, &m->bb);
-        ok = move_from(d, &fb, from, m->bb.n, list, runs);
-        pairs_from(m, NULL, d->src_bw, d->nsrc_bw, d->bw_was, from, m->bw.n, true);
-        const sx_rows fw = pair_rows(m, &m->bw);
-        ok = ok && move_from(d, &fw, from, m->bw.n, list, runs);
+        const sx_rows fb = pair_rows(m, &m->bb), fw = pair_rows(m, &m->bw);
+        ok = pair_routes(m, d->pairs, d->src_bb, d->nsrc_bb, d->bb_was, &q, false) && move_routes(d, &fb, &q, spans) &&
+             pair_routes(m, NULL, d->src_bw, d->nsrc_bw, d->bw_was, &q, true) && move_routes(d, &fw, &q, spans);
     }
     if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
         for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
@@ -215,10 +263,14 @@ bool sx__dd_migrate(sx_model *m)
                 const int32_t s = m->bb.bond[c] - 1;
                 if (s >= 0 && d->slot_was[s] >= 0 && d->slot_was[s] != r) from[s] = d->slot_was[s];
             }
-        const int64_t k = list_by_owner(d, from, bs->n, list, runs);
-        ok = sx__dd_share_bonds(m, list, k, runs, false) && (!m->fjel.n || sx__dd_share_fjoints(m, list, k, runs));
+        /* to every rank: a bond that left the plan is no rank's to step,
+         * and every rank's copy is its last state (few move: a bond's pair
+         * changes rank when a cut moves across it) */
+        const int64_t k = list_by_owner(d, from, bs->n, list, spans);
+        ok = sx__dd_share_bonds(m, list, k, spans, false) && (!m->fjel.n || sx__dd_share_fjoints(m, list, k, spans));
     }
-    free(runs);
+    free(q.r);
+    free(spans);
     free(list);
     free(from);
     return ok;
