@@ -11,11 +11,12 @@
  * terms in clump order) to m->acc in block order. The owners' terms
  * (w a clump at its entry cl_at, the first nd its damping's, a term
  * absent from the serial sum a zero: adding +0 to a sum from +0 changes
- * no bit) go to rank 0, which folds them in the serial order; the block
- * sums go to every rank, which adds them in block order: two messages a
- * step per rank, only with energy tracking. The owners write their
- * clumps' terms where the exchange sends them from (sx__dd_clump_terms),
- * in a buffer kept from step to step. */
+ * no bit) go to the rank that sums their block (the blocks cut evenly
+ * over the ranks, in order), and the block sums to every rank, which adds
+ * them in block order: two messages a step per pair of ranks, only with
+ * energy tracking, each term sent once. The owners write their clumps'
+ * terms where the exchange sends them from (sx__dd_clump_terms), in a
+ * buffer kept from step to step. */
 double *sx__dd_clump_terms(sx_model *m, int w, int64_t size)
 {
     sx_dd *d = m->dd;
@@ -30,16 +31,36 @@ double *sx__dd_clump_terms(sx_model *m, int w, int64_t size)
     return d->cterm + own.lo * w;
 }
 
+/* The first entry of the run s (in clump order) whose clump is c or after. */
+static int64_t first_clump_at(const sx_dd *d, sx_span s, int64_t c)
+{
+    int64_t lo = s.lo, hi = s.hi;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (d->cl[mid] < c) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
 {
     sx_dd *d = m->dd;
-    const int R = d->x.ranks;
+    const int R = d->x.ranks, me = d->x.rank;
     const int64_t nc = m->clumps->n, nblk = (nc + size - 1) / size;
     if (!nc) return true; /* every clump removed: no block, on every rank */
     double *t = d->cterm, *sum = t + d->ncl * w;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){0, r ? 0 : d->ncl}; /* rank 0 needs them all */
-    bool ok = sx__dd_share(d, t, (size_t)w * sizeof *t, d->cl_own, d->scratch, 1);
-    for (int64_t k = 0; ok && !d->x.rank && k < nblk; k++) {
+    sx_span *need = malloc((size_t)R * (size_t)R * sizeof *need); /* need[r * R + s]: rank s's terms of r's blocks */
+    if (!need) return false;
+    for (int r = 0; r < R; r++) { /* rank r sums the blocks [nblk r / R, nblk (r + 1) / R) */
+        d->scratch[r] = (sx_span){nblk * r / R, nblk * (r + 1) / R};
+        const int64_t c0 = d->scratch[r].lo * size, c1 = d->scratch[r].hi * size;
+        for (int s = 0; s < R; s++)
+            need[r * R + s] = (sx_span){first_clump_at(d, d->cl_own[s], c0), first_clump_at(d, d->cl_own[s], c1)};
+    }
+    bool ok = sx__dd_share(d, t, (size_t)w * sizeof *t, d->cl_own, need, R);
+    free(need);
+    for (int64_t k = d->scratch[me].lo; ok && k < d->scratch[me].hi; k++) {
         double damp = 0, load = 0;
         for (int64_t c = k * size; c < (k + 1) * size && c < nc; c++) {
             const double *q = t + (int64_t)d->cl_at[c] * w;
@@ -48,8 +69,7 @@ bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
         }
         sum[2 * k] = damp, sum[2 * k + 1] = load;
     }
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){0, r ? 0 : 2 * nblk}; /* rank 0's sums, to all */
-    ok = ok && sx__dd_share(d, sum, sizeof *sum, d->scratch, sx__dd_everything(d, 2 * nblk), 1);
+    ok = ok && sx__dd_share(d, sum, 2 * sizeof *sum, d->scratch, sx__dd_everything(d, nblk), 1);
     for (int64_t k = 0; ok && k < nblk; k++) {
         m->acc.local_damping -= sum[2 * k];
         m->acc.boundary_work += sum[2 * k + 1];
