@@ -927,14 +927,23 @@ static int show(lua_State *L)
     return 0;
 }
 
+/* The first process a launcher started (mpirun's rank 0, one rank or
+ * more), which reads mpirun's input; by the launcher's word, so that a
+ * build without MPI, whose every process is rank 0 of its own run, shows
+ * the prompt in one process alone. */
+static bool launched_first(void)
+{
+    const char *r = getenv("OMPI_COMM_WORLD_RANK");
+    if (!r) r = getenv("PMI_RANK");
+    return r && strcmp(r, "0") == 0;
+}
+
 static void repl(lua_State *L)
 {
     const bool tty = isatty(STDIN_FILENO);
-    /* under a launcher (one rank or more) rank 0 reads mpirun's input */
-    const bool launched = getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE");
-    const prompt_kind kind = tty ? PROMPT_TTY : launched ? PROMPT_LAUNCHED : PROMPT_NONE;
+    const prompt_kind kind = tty ? PROMPT_TTY : launched_first() ? PROMPT_LAUNCHED : PROMPT_NONE;
     if (tty) printf("seixo %s (%s); help() for help, Ctrl-D quits, Ctrl-C stops a cycle\n", SX_VERSION, LUA_RELEASE);
-    else if (launched && sx_lua_parallel_rank() == 0)
+    else if (kind == PROMPT_LAUNCHED)
         printf("seixo %s (%s) on %d rank%s; help() for help, Ctrl-D quits; a SIGUSR1 to mpirun stops a cycle "
                "(Ctrl-C is mpirun's: it ends the job)\n",
                SX_VERSION, LUA_RELEASE, sx_lua_parallel_ranks(), sx_lua_parallel_ranks() == 1 ? "" : "s");
@@ -965,7 +974,7 @@ static void repl(lua_State *L)
     }
     lua_settop(L, 0);
     if (tty) putchar('\n');
-    else if (kind == PROMPT_LAUNCHED && sx_lua_parallel_rank() == 0) putchar('\n');
+    else if (kind == PROMPT_LAUNCHED) putchar('\n');
 #ifdef SX_HAVE_READLINE
     close_history();
     clear_matches();
