@@ -47,14 +47,15 @@ static bool share_flags(sx_model *m, sx_pairs *p, const sx_span *own)
  * owners follow the balls); the rest stays where the ranks stepped it,
  * and what the new cut gives another rank moves after the plan
  * (sx__dd_migrate). About 24 bytes a ball and 5 a pair instead of the
- * whole state (some 100 a ball and 60 a pair in 3D). Periodic space
- * gathers the whole state: a build copies the balls into their ghosts'
- * slots. */
+ * whole state (some 100 a ball and 60 a pair in 3D). In periodic space
+ * the build copies the balls into their ghosts' slots, the motion stale
+ * where the rank does not own the ball: before a contact pass reads a
+ * ghost, the step copies it again from its ball (kernels/ghosts.c), which
+ * the halo has brought. */
 bool sx__dd_build(sx_model *m)
 {
     sx_dd *d = m->dd;
     d->migrating = false;
-    if (m->cell) return sx__dd_gather(m);
     const sx_balls *B = &m->balls;
     const int R = d->x.ranks;
     const int64_t nb = m->bonds.n;
@@ -198,21 +199,57 @@ static sx_span wall_pairs_run(const sx_model *m, int r)
     return (sx_span){sx__first_at(m->bw.a, m->bw.n, lo), sx__first_at(m->bw.a, m->bw.n, hi)};
 }
 
-/* The new pairs a rank steps whose old pair another rank stepped, from
- * that rank (the owner of the old pair's first ball, which holds its
- * history) to each rank that steps the new pair (a pair whose balls two
- * ranks own is stepped by both). */
-static bool pair_routes(const sx_model *m, const sx_span *run, const int32_t *src, int64_t nsrc, const sx_span *was,
-                        routes *q, bool walls)
+/* The ranks that step a ball-ball pair: the owners of its balls (the
+ * ball a periodic ghost images for its b), both alike when a cut lies
+ * between them; the other pairs of a rank's run lie between two of its
+ * ghosts and are not its to step. *nr: 0 (a ghost whose ball was
+ * removed), 1 or 2. */
+static int pair_steppers(const sx_model *m, int64_t c, int *r)
+{
+    const sx_dd *d = m->dd;
+    const int64_t n = m->balls.n, a = m->bb.a[c];
+    const int64_t b = m->bb.b[c] < n ? m->bb.b[c] : m->cell->owner[m->bb.b[c] - m->cell->base];
+    if (b < 0) return 0;
+    r[0] = sx__dd_owner_of(d, a, n), r[1] = sx__dd_owner_of(d, b, n);
+    return r[1] == r[0] ? 1 : 2;
+}
+
+/* The new ball-ball pairs a rank steps whose old pair it did not step,
+ * from the rank that holds the old pair's history (the owner of its first
+ * ball) to each rank that steps the new pair. A rank that owned either
+ * ball of the old pair stepped it, so its copy is current. */
+static bool ball_pair_routes(const sx_model *m, routes *q)
+{
+    const sx_dd *d = m->dd;
+    const int32_t *src = d->src_bb, *id = m->balls.id;
+    const int64_t n = d->nsrc_bb < m->bb.n ? d->nsrc_bb : m->bb.n;
+    q->n = 0;
+    for (int64_t c = 0; c < n; c++) {
+        if (!src[c]) continue;
+        int r[2];
+        const int k = pair_steppers(m, c, r);
+        const int o = span_owner(d->bb_was, d->x.ranks, (src[c] > 0 ? src[c] : -src[c]) - 1);
+        for (int j = 0; j < k; j++)
+            if (r[j] != o && d->was[id[m->bb.a[c]]] != r[j] && d->was[id[m->bb.b[c]]] != r[j] &&
+                !add_route(q, c, o, r[j]))
+                return false;
+    }
+    return true;
+}
+
+/* The same for the ball-wall pairs, which every rank steps whose wall
+ * blocks hold their ball (a block across a cut, by both), from the owner
+ * of the old pair's ball, to each such rank but that one. */
+static bool wall_pair_routes(const sx_model *m, routes *q)
 {
     const sx_dd *d = m->dd;
     const int R = d->x.ranks;
     q->n = 0;
     for (int r = 0; r < R; r++) {
-        const sx_span s = walls ? wall_pairs_run(m, r) : run[r];
-        for (int64_t c = s.lo; c < s.hi && c < nsrc; c++) {
-            if (!src[c]) continue;
-            const int o = span_owner(was, R, (src[c] > 0 ? src[c] : -src[c]) - 1);
+        const sx_span s = wall_pairs_run(m, r);
+        for (int64_t c = s.lo; c < s.hi && c < d->nsrc_bw; c++) {
+            if (!d->src_bw[c]) continue;
+            const int o = span_owner(d->bw_was, R, (d->src_bw[c] > 0 ? d->src_bw[c] : -d->src_bw[c]) - 1);
             if (o != r && !add_route(q, c, o, r)) return false;
         }
     }
@@ -251,18 +288,20 @@ bool sx__dd_migrate(sx_model *m)
     }
     if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
         const sx_rows fb = pair_rows(m, &m->bb), fw = pair_rows(m, &m->bw);
-        ok = pair_routes(m, d->pairs, d->src_bb, d->nsrc_bb, d->bb_was, &q, false) && move_routes(d, &fb, &q, spans) &&
-             pair_routes(m, NULL, d->src_bw, d->nsrc_bw, d->bw_was, &q, true) && move_routes(d, &fw, &q, spans);
+        ok = ball_pair_routes(m, &q) && move_routes(d, &fb, &q, spans) && wall_pair_routes(m, &q) &&
+             move_routes(d, &fw, &q, spans);
     }
     if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
         for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
         for (int64_t c = 0; c < m->bb.n; c++) /* in a pair of this plan: stays where it is, unless... */
             if (m->bb.bond[c]) from[m->bb.bond[c] - 1] = -1;
-        for (int r = 0; r < R; r++)
-            for (int64_t c = d->pairs[r].lo; c < d->pairs[r].hi; c++) { /* ...a rank steps it that did not */
-                const int32_t s = m->bb.bond[c] - 1;
-                if (s >= 0 && d->slot_was[s] >= 0 && d->slot_was[s] != r) from[s] = d->slot_was[s];
-            }
+        for (int64_t c = 0; c < m->bb.n; c++) { /* ...a rank steps it that did not */
+            const int32_t s = m->bb.bond[c] - 1;
+            int r[2];
+            const int k = s >= 0 && d->slot_was[s] >= 0 ? pair_steppers(m, c, r) : 0;
+            for (int j = 0; j < k; j++)
+                if (d->slot_was[s] != r[j]) from[s] = d->slot_was[s];
+        }
         /* to every rank: a bond that left the plan is no rank's to step,
          * and every rank's copy is its last state (few move: a bond's pair
          * changes rank when a cut moves across it) */
