@@ -91,14 +91,10 @@ bool sx_model_time_reached(const sx_model *m, double t_end, int64_t since)
 }
 
 /* What a decomposed cycle cannot go on to from the state the last one
- * left scattered, each rank's own balls current: a build in periodic
- * space, which copies every ball into its ghosts' slots (elsewhere a
- * build takes what it reads: step_build); and the check of bonded pairs'
- * contact-model rows (sx__cmodel_prepare), which reads every pair. */
-static bool whole_needed(const sx_model *m)
-{
-    return (m->build_needed && m->cell) || (m->ncmodel && m->bb.bond && m->bb.cmodel);
-}
+ * left scattered, each rank's own balls current: the check of bonded
+ * pairs' contact-model rows (sx__cmodel_prepare), which reads every pair.
+ * (A build takes what it reads, periodic space's too: step_build.) */
+static bool whole_needed(const sx_model *m) { return m->ncmodel && m->bb.bond && m->bb.cmodel; }
 
 /* A build at a step of a cycle (or at the start of a decomposed one that
  * goes on from a scattered state): decomposed, the serial build on every

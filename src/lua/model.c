@@ -846,11 +846,13 @@ static void push_profile_text(lua_State *L, const sx_model *m)
     luaL_pushresultsize(&b, (size_t)need);
 }
 
-/* m:profile([{print = true, reset = false}]) -> {broad_phase = {seconds =, calls =}, ..., total =} */
+/* m:profile([{print = true, reset = false}]) -> {broad_phase = {seconds =, calls =}, ..., total =}
+ * This rank's own figures: under MPI no gather (a gather would count in
+ * them) and no collective call, so rank 0 alone may ask. */
 static int model_profile(lua_State *L)
 {
     static const char *const keys[] = {"print", "reset", NULL};
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
     bool print = true, reset = false;
     if (!lua_isnoneornil(L, 2)) {
         sx_lua_checkkeys(L, 2, keys);
