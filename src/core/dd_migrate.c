@@ -216,23 +216,42 @@ static int pair_steppers(const sx_model *m, int64_t c, int *r)
 
 /* The new ball-ball pairs a rank steps whose old pair it did not step,
  * from the rank that holds the old pair's history (the owner of its first
- * ball) to each rank that steps the new pair. A rank that owned either
- * ball of the old pair stepped it, so its copy is current. */
-static bool ball_pair_routes(const sx_model *m, routes *q)
+ * ball) to each rank that steps the new pair (pair_steppers). A rank that
+ * owned either ball of the old pair stepped it, so its copy is current.
+ * old[i]: ball i's owner in the last plan. Every rank lists every pair, so
+ * the walk is kept cheap: the pairs run in the order of a, so a's owner
+ * follows it, and b's is found from a's; the old pair's holder is sought
+ * only for a pair that moves. */
+static bool ball_pair_routes(const sx_model *m, const int32_t *old, routes *q)
 {
     const sx_dd *d = m->dd;
-    const int32_t *src = d->src_bb, *id = m->balls.id;
-    const int64_t n = d->nsrc_bb < m->bb.n ? d->nsrc_bb : m->bb.n;
+    const sx_pairs *p = &m->bb;
+    const int32_t *src = d->src_bb;
+    const int64_t n = d->nsrc_bb < p->n ? d->nsrc_bb : p->n, nb = m->balls.n;
+    const int R = d->x.ranks;
+    int ra = 0;
     q->n = 0;
     for (int64_t c = 0; c < n; c++) {
         if (!src[c]) continue;
-        int r[2];
-        const int k = pair_steppers(m, c, r);
-        const int o = span_owner(d->bb_was, d->x.ranks, (src[c] > 0 ? src[c] : -src[c]) - 1);
-        for (int j = 0; j < k; j++)
-            if (r[j] != o && d->was[id[m->bb.a[c]]] != r[j] && d->was[id[m->bb.b[c]]] != r[j] &&
-                !add_route(q, c, o, r[j]))
-                return false;
+        const int64_t a = p->a[c];
+        while (d->own[ra].hi <= a) ra++;
+        int64_t b = p->b[c];
+        int rb = ra;
+        if (b >= nb) { /* a periodic ghost: its ball's owner steps the pair too */
+            b = m->cell->owner[b - m->cell->base];
+            if (b < 0) continue;
+            rb = sx__dd_owner_of(d, b, nb);
+        } else if (b >= d->own[ra].lo) {
+            while (d->own[rb].hi <= b) rb++;
+        } else {
+            rb = sx__dd_owner_of(d, b, nb);
+        }
+        const int r[2] = {ra, rb};
+        for (int j = 0; j < (ra == rb ? 1 : 2); j++) {
+            if (old[a] == r[j] || old[b] == r[j]) continue;
+            const int o = span_owner(d->bb_was, R, (src[c] > 0 ? src[c] : -src[c]) - 1);
+            if (o != r[j] && !add_route(q, c, o, r[j])) return false;
+        }
     }
     return true;
 }
@@ -274,21 +293,24 @@ bool sx__dd_migrate(sx_model *m)
     const sx_balls *B = &m->balls;
     const sx_bonds *bs = &m->bonds;
     const int R = d->x.ranks;
-    int32_t *from = malloc((size_t)(bs->n + 1) * sizeof *from), *list = malloc((size_t)(bs->n + 1) * sizeof *list);
+    int32_t *from = malloc((size_t)(bs->n + 1) * sizeof *from), *list = malloc((size_t)(bs->n + 1) * sizeof *list),
+            *old = malloc((size_t)(B->n + 1) * sizeof *old);
     sx_span *spans = malloc((size_t)R * (size_t)(R + 1) * sizeof *spans);
     routes q = {NULL, 0, 0};
-    bool ok = from && list && spans;
+    bool ok = from && list && old && spans;
     if (ok) { /* the balls */
+        int to = 0;
         for (int64_t i = 0; i < B->n && ok; i++) {
-            const int32_t o = d->was[B->id[i]], to = sx__dd_owner_of(d, i, B->n);
-            if (o != to) ok = add_route(&q, i, o, to);
+            while (d->own[to].hi <= i) to++;
+            old[i] = d->was[B->id[i]];
+            if (old[i] != to) ok = add_route(&q, i, old[i], to);
         }
         const sx_rows f = sx__dd_ball_motion(m, false);
         ok = ok && move_routes(d, &f, &q, spans);
     }
     if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
         const sx_rows fb = pair_rows(m, &m->bb), fw = pair_rows(m, &m->bw);
-        ok = ball_pair_routes(m, &q) && move_routes(d, &fb, &q, spans) && wall_pair_routes(m, &q) &&
+        ok = ball_pair_routes(m, old, &q) && move_routes(d, &fb, &q, spans) && wall_pair_routes(m, &q) &&
              move_routes(d, &fw, &q, spans);
     }
     if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
@@ -310,6 +332,7 @@ bool sx__dd_migrate(sx_model *m)
     }
     free(q.r);
     free(spans);
+    free(old);
     free(list);
     free(from);
     return ok;
