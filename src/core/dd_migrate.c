@@ -134,58 +134,34 @@ static int64_t list_by_owner(const sx_dd *d, const int32_t *from, int64_t n, int
     return at;
 }
 
-/* Rows that move from one rank to another: entry k (of a store's rows)
- * from rank `from` to rank `to`. A ball has one new owner; a pair may
- * have two new steppers (the ranks of both its balls). */
-typedef struct route {
-    int32_t k, from, to;
-} route;
-
-typedef struct routes {
-    route *r;
+/* The rows to move, as hops (decompose.h): a ball has one new owner; a
+ * pair may have two new steppers (the ranks of both its balls). */
+typedef struct hops {
+    sx_hop *h;
     int64_t n, cap;
-} routes;
+} hops;
 
-static bool add_route(routes *q, int64_t k, int from, int to)
+static bool add_hop(hops *q, int64_t k, int from, int to)
 {
     if (q->n == q->cap) {
         const int64_t cap = q->cap ? 2 * q->cap : 1024;
-        route *r = realloc(q->r, (size_t)cap * sizeof *r);
-        if (!r) return false;
-        q->r = r, q->cap = cap;
+        sx_hop *h = realloc(q->h, (size_t)cap * sizeof *h);
+        if (!h) return false;
+        q->h = h, q->cap = cap;
     }
-    q->r[q->n++] = (route){(int32_t)k, from, to};
+    q->h[q->n++] = (sx_hop){(int32_t)k, from, to};
     return true;
 }
 
-/* The rows f of the routes q, each to its rank alone. The entries are
- * listed by source, then by destination: each source's a run (what it
- * packs), each (source, destination) a span of it (what the destination
- * unpacks), so the exchange sends a row once to each rank that needs it,
- * where an all-gather sent it to every rank. spans: R * (R + 1). */
-static bool move_routes(sx_dd *d, const sx_rows *f, const routes *q, sx_span *spans)
+/* The rows f of the hops q, each to its rank alone (sx__dd_route), so
+ * the exchange sends a row once to each rank that needs it, where an
+ * all-gather sent it to every rank. spans: R * (R + 1). */
+static bool move_hops(sx_dd *d, const sx_rows *f, const hops *q, sx_span *spans)
 {
     const int R = d->x.ranks;
-    if (!q->n) return true;
-    int32_t *list = malloc((size_t)q->n * sizeof *list);
-    if (!list) return false;
-    sx_span *need = spans, *own = spans + (size_t)R * R; /* need[t * R + s]: from s to t */
-    for (int64_t k = 0; k < (int64_t)R * R; k++) need[k] = (sx_span){0, 0};
-    for (int64_t e = 0; e < q->n; e++) need[(int64_t)q->r[e].to * R + q->r[e].from].hi++;
-    int64_t at = 0;
-    for (int s = 0; s < R; s++) {
-        own[s].lo = at;
-        for (int t = 0; t < R; t++) {
-            sx_span *e = &need[(int64_t)t * R + s];
-            const int64_t len = e->hi;
-            *e = (sx_span){at, at}; /* hi: the span's next entry, then its end */
-            at += len;
-        }
-        own[s].hi = at;
-    }
-    for (int64_t e = 0; e < q->n; e++) list[need[(int64_t)q->r[e].to * R + q->r[e].from].hi++] = q->r[e].k;
-    const bool ok = sx__dd_move_rows(d, f, list, 0, at, own, need, R);
-    free(list);
+    sx_route rt = {NULL, 0, 0, spans + (size_t)R * R, spans};
+    const bool ok = !q->n || (sx__dd_route(d, q->h, q->n, &rt) && sx__dd_move_rows(d, f, rt.item, 0, rt.n, rt.own, rt.need, R));
+    free(rt.item);
     return ok;
 }
 
@@ -202,8 +178,8 @@ static sx_span wall_pairs_run(const sx_model *m, int r)
 /* The ranks that step a ball-ball pair: the owners of its balls (the
  * ball a periodic ghost images for its b), both alike when a cut lies
  * between them; the other pairs of a rank's run lie between two of its
- * ghosts and are not its to step. *nr: 0 (a ghost whose ball was
- * removed), 1 or 2. */
+ * ghosts and are not its to step. Into r, their count: 0 (a ghost whose
+ * ball was removed), 1 or 2. */
 static int pair_steppers(const sx_model *m, int64_t c, int *r)
 {
     const sx_dd *d = m->dd;
@@ -222,7 +198,7 @@ static int pair_steppers(const sx_model *m, int64_t c, int *r)
  * the walk is kept cheap: the pairs run in the order of a, so a's owner
  * follows it, and b's is found from a's; the old pair's holder is sought
  * only for a pair that moves. */
-static bool ball_pair_routes(const sx_model *m, const int32_t *old, routes *q)
+static bool ball_pair_hops(const sx_model *m, const int32_t *old, hops *q)
 {
     const sx_dd *d = m->dd;
     const sx_pairs *p = &m->bb;
@@ -250,7 +226,7 @@ static bool ball_pair_routes(const sx_model *m, const int32_t *old, routes *q)
         for (int j = 0; j < (ra == rb ? 1 : 2); j++) {
             if (old[a] == r[j] || old[b] == r[j]) continue;
             const int o = span_owner(d->bb_was, R, (src[c] > 0 ? src[c] : -src[c]) - 1);
-            if (o != r[j] && !add_route(q, c, o, r[j])) return false;
+            if (o != r[j] && !add_hop(q, c, o, r[j])) return false;
         }
     }
     return true;
@@ -259,7 +235,7 @@ static bool ball_pair_routes(const sx_model *m, const int32_t *old, routes *q)
 /* The same for the ball-wall pairs, which every rank steps whose wall
  * blocks hold their ball (a block across a cut, by both), from the owner
  * of the old pair's ball, to each such rank but that one. */
-static bool wall_pair_routes(const sx_model *m, routes *q)
+static bool wall_pair_hops(const sx_model *m, hops *q)
 {
     const sx_dd *d = m->dd;
     const int R = d->x.ranks;
@@ -269,7 +245,7 @@ static bool wall_pair_routes(const sx_model *m, routes *q)
         for (int64_t c = s.lo; c < s.hi && c < d->nsrc_bw; c++) {
             if (!d->src_bw[c]) continue;
             const int o = span_owner(d->bw_was, R, (d->src_bw[c] > 0 ? d->src_bw[c] : -d->src_bw[c]) - 1);
-            if (o != r && !add_route(q, c, o, r)) return false;
+            if (o != r && !add_hop(q, c, o, r)) return false;
         }
     }
     return true;
@@ -296,22 +272,22 @@ bool sx__dd_migrate(sx_model *m)
     int32_t *from = malloc((size_t)(bs->n + 1) * sizeof *from), *list = malloc((size_t)(bs->n + 1) * sizeof *list),
             *old = malloc((size_t)(B->n + 1) * sizeof *old);
     sx_span *spans = malloc((size_t)R * (size_t)(R + 1) * sizeof *spans);
-    routes q = {NULL, 0, 0};
+    hops q = {NULL, 0, 0};
     bool ok = from && list && old && spans;
     if (ok) { /* the balls */
         int to = 0;
         for (int64_t i = 0; i < B->n && ok; i++) {
             while (d->own[to].hi <= i) to++;
             old[i] = d->was[B->id[i]];
-            if (old[i] != to) ok = add_route(&q, i, old[i], to);
+            if (old[i] != to) ok = add_hop(&q, i, old[i], to);
         }
         const sx_rows f = sx__dd_ball_motion(m, false);
-        ok = ok && move_routes(d, &f, &q, spans);
+        ok = ok && move_hops(d, &f, &q, spans);
     }
     if (ok) { /* the ball-ball pairs, then the ball-wall pairs */
         const sx_rows fb = pair_rows(m, &m->bb), fw = pair_rows(m, &m->bw);
-        ok = ball_pair_routes(m, old, &q) && move_routes(d, &fb, &q, spans) && wall_pair_routes(m, &q) &&
-             move_routes(d, &fw, &q, spans);
+        ok = ball_pair_hops(m, old, &q) && move_hops(d, &fb, &q, spans) && wall_pair_hops(m, &q) &&
+             move_hops(d, &fw, &q, spans);
     }
     if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
         for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
@@ -330,7 +306,7 @@ bool sx__dd_migrate(sx_model *m)
         const int64_t k = list_by_owner(d, from, bs->n, list, spans);
         ok = sx__dd_share_bonds(m, list, k, spans, false) && (!m->fjel.n || sx__dd_share_fjoints(m, list, k, spans));
     }
-    free(q.r);
+    free(q.h);
     free(spans);
     free(old);
     free(list);

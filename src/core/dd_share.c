@@ -61,6 +61,34 @@ bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
     return ok;
 }
 
+/* (decompose.h) A counting sort on (source, destination). */
+bool sx__dd_route(sx_dd *d, const sx_hop *hop, int64_t n, sx_route *rt)
+{
+    const int R = d->x.ranks;
+    if (rt->cap < n) {
+        int32_t *q = realloc(rt->item, (size_t)n * sizeof *q);
+        if (!q) return false;
+        rt->item = q, rt->cap = n;
+    }
+    sx_span *need = rt->need; /* need[t * R + s]: from s to t */
+    for (int64_t k = 0; k < (int64_t)R * R; k++) need[k] = (sx_span){0, 0};
+    for (int64_t e = 0; e < n; e++) need[(int64_t)hop[e].to * R + hop[e].from].hi++;
+    int64_t at = 0;
+    for (int s = 0; s < R; s++) {
+        rt->own[s].lo = at;
+        for (int t = 0; t < R; t++) {
+            sx_span *e = &need[(int64_t)t * R + s];
+            const int64_t len = e->hi;
+            *e = (sx_span){at, at}; /* hi: the span's next entry, then its end */
+            at += len;
+        }
+        rt->own[s].hi = at;
+    }
+    for (int64_t e = 0; e < n; e++) rt->item[need[(int64_t)hop[e].to * R + hop[e].from].hi++] = hop[e].item;
+    rt->n = n;
+    return true;
+}
+
 /* An all-gather: entry r of data (size bytes each), rank r's, to every
  * rank. */
 bool sx__dd_share_by_rank(sx_dd *d, void *data, size_t size)

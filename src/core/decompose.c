@@ -173,45 +173,31 @@ static int64_t pebble_of(const sx_model *m, int64_t c, int64_t k)
 static int64_t pebbles(const sx_model *m, int64_t c) { return m->clumps->tpl[m->clumps->tpl_of[c]].n; }
 
 /* The route of the pebbles whose owner is not their clump's: from their
- * owners to their clumps' owners, or (back) the other way. Each source
- * rank's entries a run, within it a span per destination, each in clump
- * order then pebble order (a counting sort on source and destination);
- * every rank plans every rank's alike. False: out of memory. */
+ * owners to their clumps' owners, or (back) the other way, each (source,
+ * destination) in clump order then pebble order (sx__dd_route); every
+ * rank plans every rank's alike. False: out of memory. */
 static bool plan_route(sx_model *m, sx_route *rt, bool back)
 {
     sx_dd *d = m->dd;
     const sx_clumps *C = m->clumps;
-    const int R = d->x.ranks;
     const int64_t n = m->balls.n;
-    int64_t *at = calloc((size_t)(R * R + 1), sizeof *at); /* per (source, destination): its first entry */
-    if (!at) return false;
-    for (int pass = 0; pass < 2; pass++) { /* count, then place */
+    int64_t k = 0;
+    sx_hop *hop = NULL;
+    for (int pass = 0; pass < 2; pass++) { /* count, then list */
+        if (pass && !(hop = malloc((size_t)(k + 1) * sizeof *hop))) return false;
+        k = 0;
         for (int64_t c = 0; c < C->n; c++)
-            for (int64_t k = 0; k < pebbles(m, c); k++) {
-                const int64_t i = pebble_of(m, c, k);
+            for (int64_t j = 0; j < pebbles(m, c); j++) {
+                const int64_t i = pebble_of(m, c, j);
                 const int po = sx__dd_owner_of(d, i, n), co = d->cown[c];
                 if (po == co) continue;
-                const int key = back ? co * R + po : po * R + co;
-                if (pass) rt->item[at[key]++] = (int32_t)i;
-                else at[key + 1]++;
+                if (pass) hop[k] = (sx_hop){(int32_t)i, back ? co : po, back ? po : co};
+                k++;
             }
-        if (pass) break;
-        for (int key = 0; key < R * R; key++) at[key + 1] += at[key];
-        rt->n = at[R * R];
-        if (rt->cap < rt->n) {
-            int32_t *q = realloc(rt->item, (size_t)rt->n * sizeof *q);
-            if (!q) {
-                free(at);
-                return false;
-            }
-            rt->item = q, rt->cap = rt->n;
-        }
-        for (int src = 0; src < R; src++)
-            for (int dst = 0; dst < R; dst++) rt->need[dst * R + src] = (sx_span){at[src * R + dst], at[src * R + dst + 1]};
     }
-    for (int src = 0; src < R; src++) rt->own[src] = (sx_span){rt->need[src].lo, rt->need[(R - 1) * R + src].hi};
-    free(at);
-    return true;
+    const bool ok = sx__dd_route(d, hop, k, rt);
+    free(hop);
+    return ok;
 }
 
 /* Clumps: each is stepped by one rank, its owner: the owner of its pebble

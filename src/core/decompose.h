@@ -29,6 +29,14 @@ bool sx__dd_share(sx_dd *d, void *data, size_t size, const sx_span *own, const s
 bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t base, int64_t n, const sx_span *own,
                       const sx_span *need, int nper);
 bool sx__dd_share_by_rank(sx_dd *d, void *data, size_t size); /* entry r, rank r's, to every rank */
+/* An entry (a row index) to move from one rank to another. */
+typedef struct sx_hop {
+    int32_t item, from, to;
+} sx_hop;
+/* The route of the hops (model_internal.h, sx_route): their items by
+ * source, then by destination, each (source, destination) in the hops'
+ * order; rt's own and need have room for the ranks. False: out of memory. */
+bool sx__dd_route(sx_dd *d, const sx_hop *hop, int64_t n, sx_route *rt);
 int sx__dd_owner_of(const sx_dd *d, int64_t i, int64_t n);    /* the rank owning ball i of n */
 sx_rows sx__dd_ball_motion(const sx_model *m, bool with_position);
 /* the bonds' state of the slots list[e], each rank's entries own[r], to
