@@ -50,8 +50,7 @@ bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
     const int64_t nc = m->clumps->n, nblk = (nc + size - 1) / size;
     if (!nc) return true; /* every clump removed: no block, on every rank */
     double *t = d->cterm, *sum = t + d->ncl * w;
-    sx_span *need = malloc((size_t)R * (size_t)R * sizeof *need); /* need[r * R + s]: rank s's terms of r's blocks */
-    if (!need) return false;
+    sx_span *need = d->cterm_need; /* need[r * R + s]: rank s's terms of r's blocks */
     for (int r = 0; r < R; r++) { /* rank r sums the blocks [nblk r / R, nblk (r + 1) / R) */
         d->scratch[r] = (sx_span){nblk * r / R, nblk * (r + 1) / R};
         const int64_t c0 = d->scratch[r].lo * size, c1 = d->scratch[r].hi * size;
@@ -59,7 +58,6 @@ bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
             need[r * R + s] = (sx_span){first_clump_at(d, d->cl_own[s], c0), first_clump_at(d, d->cl_own[s], c1)};
     }
     bool ok = sx__dd_share(d, t, (size_t)w * sizeof *t, d->cl_own, need, R);
-    free(need);
     for (int64_t k = d->scratch[me].lo; ok && k < d->scratch[me].hi; k++) {
         double damp = 0, load = 0;
         for (int64_t c = k * size; c < (k + 1) * size && c < nc; c++) {

@@ -180,12 +180,13 @@ static sx_span wall_pairs_run(const sx_model *m, int r)
  * between them; the other pairs of a rank's run lie between two of its
  * ghosts and are not its to step. Into r, their count: 0 (a ghost whose
  * ball was removed), 1 or 2. */
-static int pair_steppers(const sx_model *m, int64_t c, int *r)
+static int pair_steppers(const sx_model *m, int64_t c, int *r, int64_t *ball)
 {
     const sx_dd *d = m->dd;
     const int64_t n = m->balls.n, a = m->bb.a[c];
     const int64_t b = m->bb.b[c] < n ? m->bb.b[c] : m->cell->owner[m->bb.b[c] - m->cell->base];
     if (b < 0) return 0;
+    ball[0] = a, ball[1] = b;
     r[0] = sx__dd_owner_of(d, a, n), r[1] = sx__dd_owner_of(d, b, n);
     return r[1] == r[0] ? 1 : 2;
 }
@@ -251,16 +252,64 @@ static bool wall_pair_hops(const sx_model *m, hops *q)
     return true;
 }
 
+/* The bonds of this plan's pairs that a rank now steps and did not (it
+ * owned neither ball of the old pair, whose steppers both held the bond
+ * current), from the rank whose run held the old pair, as hops; and into
+ * from[s] that rank for each bond that left the plan (-1 for the others). */
+static bool bond_hops(const sx_model *m, const int32_t *old, int32_t *from, hops *q)
+{
+    const sx_dd *d = m->dd;
+    const sx_pairs *p = &m->bb;
+    q->n = 0;
+    for (int64_t s = 0; s < m->bonds.n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
+    for (int64_t c = 0; c < p->n; c++)
+        if (p->bond[c]) from[p->bond[c] - 1] = -1;
+    for (int64_t c = 0; c < p->n; c++) {
+        const int32_t s = p->bond[c] - 1;
+        int r[2];
+        int64_t ball[2];
+        const int k = s >= 0 && d->slot_was[s] >= 0 ? pair_steppers(m, c, r, ball) : 0;
+        for (int j = 0; j < k; j++)
+            if (d->slot_was[s] != r[j] && old[ball[0]] != r[j] && old[ball[1]] != r[j] && !add_hop(q, s, d->slot_was[s], r[j]))
+                return false;
+    }
+    return true;
+}
+
+/* The bonds' state (with a flat joint's face and elements) another rank
+ * stepped, to each rank that now steps it alone; a bond that left the plan
+ * (broken, its pair gone) to every rank, as it is no rank's to step and
+ * every rank's copy is its last state. from, list: room for the bonds. */
+static bool move_bonds(sx_model *m, const int32_t *old, int32_t *from, int32_t *list, sx_span *spans, hops *q)
+{
+    sx_dd *d = m->dd;
+    const int64_t nb = m->bonds.n;
+    const int R = d->x.ranks;
+    const bool joints = m->fjel.n > 0;
+    if (!bond_hops(m, old, from, q)) return false;
+    sx_route rt = {NULL, 0, 0, spans + (size_t)R * R, spans};
+    const sx_rows f = sx__dd_bond_rows(m, false);
+    bool ok = !q->n || (sx__dd_route(d, q->h, q->n, &rt) && sx__dd_move_rows(d, &f, rt.item, 0, rt.n, rt.own, rt.need, R) &&
+                        (!joints || sx__dd_share_fjoints(m, rt.item, rt.n, rt.own, rt.need, R)));
+    free(rt.item);
+    if (ok) {
+        const int64_t k = list_by_owner(d, from, nb, list, spans);
+        ok = sx__dd_share_bonds(m, list, k, spans, false) &&
+             (!joints || sx__dd_share_fjoints(m, list, k, spans, sx__dd_everything(d, k), 1));
+    }
+    return ok;
+}
+
 /* After the build's plan: to the ranks that now step them, the balls
  * whose owner changed (velocity, spin, force, moment: the positions every
  * rank took before the build), the pairs whose history another rank
  * holds, and the bonds (with a flat joint's face and elements) another
  * rank stepped, or that left the plan (broken: their last state to every
  * rank). Every rank lists the same entries (from what all hold alike);
- * each sends the balls and pairs it held to the rank that now steps them
- * alone (the other ranks' copies are stale, and none reads them: a ghost's
- * motion comes with the step's halo, a pair's history from the rank that
- * stepped it last), and the bonds to every rank. */
+ * each sends the rows it held to the ranks that now step them alone (the
+ * other ranks' copies are stale, and none reads them: a ghost's motion
+ * comes with the step's halo, a pair's or a bond's state from the rank
+ * that stepped it last), and a bond that left the plan to every rank. */
 bool sx__dd_migrate(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -289,23 +338,7 @@ bool sx__dd_migrate(sx_model *m)
         ok = ball_pair_hops(m, old, &q) && move_hops(d, &fb, &q, spans) && wall_pair_hops(m, &q) &&
              move_hops(d, &fw, &q, spans);
     }
-    if (ok && bs->n && m->bb.bond) { /* the bonds: of a pair another rank stepped, or left the plan */
-        for (int64_t s = 0; s < bs->n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
-        for (int64_t c = 0; c < m->bb.n; c++) /* in a pair of this plan: stays where it is, unless... */
-            if (m->bb.bond[c]) from[m->bb.bond[c] - 1] = -1;
-        for (int64_t c = 0; c < m->bb.n; c++) { /* ...a rank steps it that did not */
-            const int32_t s = m->bb.bond[c] - 1;
-            int r[2];
-            const int k = s >= 0 && d->slot_was[s] >= 0 ? pair_steppers(m, c, r) : 0;
-            for (int j = 0; j < k; j++)
-                if (d->slot_was[s] != r[j]) from[s] = d->slot_was[s];
-        }
-        /* to every rank: a bond that left the plan is no rank's to step,
-         * and every rank's copy is its last state (few move: a bond's pair
-         * changes rank when a cut moves across it) */
-        const int64_t k = list_by_owner(d, from, bs->n, list, spans);
-        ok = sx__dd_share_bonds(m, list, k, spans, false) && (!m->fjel.n || sx__dd_share_fjoints(m, list, k, spans));
-    }
+    if (ok && bs->n && m->bb.bond) ok = move_bonds(m, old, from, list, spans, &q);
     free(q.h);
     free(spans);
     free(old);

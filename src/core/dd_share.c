@@ -120,13 +120,19 @@ static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
 /* The bonds' state the step changes (kind; unless kinds_only fn, mn, fs,
  * ms) of the slots list[e], e < n, each rank's entries own[r], to every
  * rank. */
-bool sx__dd_share_bonds(sx_model *m, const int32_t *list, int64_t n, const sx_span *own, bool kinds_only)
+sx_rows sx__dd_bond_rows(const sx_model *m, bool kinds_only)
 {
-    sx_bonds *b = &m->bonds;
+    const sx_bonds *b = &m->bonds;
     const size_t v = sizeof(double), D = (size_t)m->dim * v, RD = (size_t)m->rdim * v;
     sx_rows f = {.nf = 0};
     sx__rows_add(&f, b->kind, sizeof *b->kind);
     if (!kinds_only) sx__rows_add(&f, b->fn, v), sx__rows_add(&f, b->mn, v), sx__rows_add(&f, b->fs, D), sx__rows_add(&f, b->ms, RD);
+    return f;
+}
+
+bool sx__dd_share_bonds(sx_model *m, const int32_t *list, int64_t n, const sx_span *own, bool kinds_only)
+{
+    const sx_rows f = sx__dd_bond_rows(m, kinds_only);
     return sx__dd_move_rows(m->dd, &f, list, 0, n, own, sx__dd_everything(m->dd, n), 1);
 }
 
@@ -156,8 +162,8 @@ static bool gather_bonds(sx_model *m)
  * this cycle included; a slot a smooth joint took keeps its elements
  * unchanged, and the owner's copy is everyone's) are packed as doubles in
  * plan order, each rank's a contiguous run (a state is a small integer:
- * exact). */
-bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx_span *own)
+ * exact); a rank unpacks the entries of its need spans (nper of them). */
+bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx_span *own, const sx_span *need, int nper)
 {
     sx_dd *d = m->dd;
     sx_bonds *b = &m->bonds;
@@ -172,13 +178,15 @@ bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx
         at[e + 1] = at[e] + (nel ? face + nel * el : 0);
     }
     const int64_t total = at[nb];
+    const int R = d->x.ranks, me = d->x.rank;
     double *buf = total ? malloc((size_t)total * sizeof *buf) : NULL;
-    bool ok = !total || buf;
-    for (int r = 0; ok && r < d->x.ranks; r++) d->scratch[r] = (sx_span){at[own[r].lo], at[own[r].hi]};
-    for (int pass = 0; ok && total && pass < 2; pass++) { /* pack this rank's, then unpack everyone's */
-        const sx_span mine = own[d->x.rank];
-        const int64_t e0 = pass ? 0 : mine.lo, e1 = pass ? nb : mine.hi;
-        for (int64_t e = e0; e < e1; e++) {
+    sx_span *dneed = malloc((size_t)R * (size_t)nper * sizeof *dneed); /* need, in doubles */
+    bool ok = (!total || buf) && dneed;
+    for (int r = 0; ok && r < R; r++) d->scratch[r] = (sx_span){at[own[r].lo], at[own[r].hi]};
+    for (int64_t k = 0; ok && k < (int64_t)R * nper; k++) dneed[k] = (sx_span){at[need[k].lo], at[need[k].hi]};
+    for (int pass = 0; ok && total && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
+        const sx_span s = pass ? need[me * nper + pass - 1] : own[me];
+        for (int64_t e = s.lo; e < s.hi; e++) {
             const int32_t s = slot[e];
             const int nel = b->fj_nr[s] * b->fj_na[s];
             if (!nel) continue;
@@ -201,14 +209,19 @@ bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx
                 }
             }
         }
-        if (!pass) ok = sx__dd_share(d, buf, sizeof *buf, d->scratch, sx__dd_everything(d, total), 1);
+        if (!pass) ok = sx__dd_share(d, buf, sizeof *buf, d->scratch, dneed, nper);
     }
+    free(dneed);
     free(buf);
     free(at);
     return ok;
 }
 
-static bool gather_fjoints(sx_model *m) { return sx__dd_share_fjoints(m, m->dd->bslot, m->dd->nbslot, m->dd->bs_own); }
+static bool gather_fjoints(sx_model *m)
+{
+    sx_dd *d = m->dd;
+    return sx__dd_share_fjoints(m, d->bslot, d->nbslot, d->bs_own, sx__dd_everything(d, d->nbslot), 1);
+}
 
 /* A list made in parts, one a rank, joined in rank order on every rank (a
  * decomposed build's pairs, a gather's cracks): the ranks' counts are

@@ -103,9 +103,9 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
     /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, cl_own,
-     * gho_own, fwd.own, back.own, bb_was, bw_was; and the routes' needs (r per rank) */
+     * gho_own, fwd.own, back.own, bb_was, bw_was; and the routes' needs and the clumps' energy's (r per rank) */
     enum { SPANS = 15 + SX_DD_NEED };
-    sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(2 * r * r, sizeof *routes) : NULL;
+    sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(3 * r * r, sizeof *routes) : NULL;
     double *pace = routes ? calloc(5 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r), stopping (2 r) */
     if (!pace) {
         free(routes);
@@ -120,7 +120,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->cl_own = s + 8 * r;
     d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
     d->bb_was = s + 12 * r, d->bw_was = s + 13 * r;
-    d->fwd.need = routes, d->back.need = routes + r * r;
+    d->fwd.need = routes, d->back.need = routes + r * r, d->cterm_need = routes + 2 * r * r;
     d->pace = pace, d->sample = pace + r, d->stopping = pace + 3 * r;
     d->received = &m->prof.received;
     m->dd = d;

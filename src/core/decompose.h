@@ -39,10 +39,14 @@ typedef struct sx_hop {
 bool sx__dd_route(sx_dd *d, const sx_hop *hop, int64_t n, sx_route *rt);
 int sx__dd_owner_of(const sx_dd *d, int64_t i, int64_t n);    /* the rank owning ball i of n */
 sx_rows sx__dd_ball_motion(const sx_model *m, bool with_position);
+/* the bonds' state a step changes (kinds_only: their kinds alone) */
+sx_rows sx__dd_bond_rows(const sx_model *m, bool kinds_only);
 /* the bonds' state of the slots list[e], each rank's entries own[r], to
- * every rank (kinds_only: their kinds alone); a flat joint's likewise */
+ * every rank */
 bool sx__dd_share_bonds(sx_model *m, const int32_t *list, int64_t n, const sx_span *own, bool kinds_only);
-bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx_span *own);
+/* a flat joint's state of the slots slot[e], each rank's entries own[r],
+ * to the ranks whose need spans (nper per rank) hold them */
+bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx_span *own, const sx_span *need, int nper);
 void sx__dd_count_intact(sx_model *m);
 bool sx__dd_gather_cracks(sx_model *m);
 bool sx__dd_share_pace(sx_model *m);

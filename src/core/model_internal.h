@@ -440,6 +440,7 @@ typedef struct sx_dd {
      * sums (sx__dd_clump_terms), kept from step to step */
     double *cterm;
     int64_t cap_cterm;
+    sx_span *cterm_need; /* which terms each rank takes from each (r per rank) */
     sx_tape tape; /* energy tracking: this step's terms (sx__dd_energy) */
     /* the cut (decompose.c, cut_by_work): per ball the lowest first ball of
      * a pair reaching it, the pairs crossing it (first ball below it,
