@@ -39,6 +39,9 @@ typedef struct rank_ctx {
     bool lazy;                   /* the cycles in short runs that leave the state scattered, gathered at the end */
     int64_t runs, resumed;       /* lazy: the runs, and those that went on from a scattered state */
     uint64_t hash;
+    uint64_t scattered_hash; /* lazy: the hash before the gather, each rank summing its own rows' digests */
+    double scattered_ratio;  /* and the unbalanced-force ratio (chained), the bonds and cracks (summed) */
+    int64_t scattered_counts[3];
     sx_energy energy;
     sx_status st;
 } rank_ctx;
@@ -206,6 +209,12 @@ static void run_lazily(rank_ctx *c, sx_model *m)
     }
     c->resumed = sx_model_profile(m).resumed;
     c->builds = m->builds;
+    const int64_t gathers = sx_model_profile(m).gathers;
+    c->scattered_hash = sx_model_state_hash(m);
+    c->scattered_ratio = sx_model_unbalanced_ratio(m);
+    if (!sx_model_bond_counts(m, c->scattered_counts)) c->st = SX_ENOMEM;
+    if (!c->st && (!sx_model_scattered(m) || sx_model_profile(m).gathers != gathers))
+        c->st = SX_EINVAL; /* these queries of a scattered model gather nothing */
     if (!c->st) c->st = sx_model_gather(m);
     if (!c->st && sx_model_scattered(m)) c->st = SX_EINVAL;
     c->hash = sx_model_state_hash(m);
@@ -268,6 +277,11 @@ START_TEST(ranks_give_the_serial_bits)
         ck_assert_msg(clumped ? contacts > 20 : contacts > sx_ball_count(serial),
                       "%dD: the bed must be dense, or the clumps collide (%lld contacts)", dim, (long long)contacts);
         const uint64_t hash = sx_model_state_hash(serial);
+        const double ratio = sx_model_unbalanced_ratio(serial);
+        int64_t counts[3];
+        ck_assert(sx_model_bond_counts(serial, counts));
+        ck_assert_msg(counts[0] == sx_bond_count(serial) && counts[1] + counts[2] == sx_crack_count(serial),
+                      "%dD: the counts must be the model's", dim);
         const sx_energy e = sx_model_energy(serial);
         ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
         ck_assert_msg(!clumped || e.boundary_work != 0, "%dD: the loads must work on the clumps", dim);
@@ -294,6 +308,19 @@ START_TEST(ranks_give_the_serial_bits)
                 ck_assert_msg(c[r].st == SX_OK, "%dD lazily, %d ranks: rank %d failed (%d)", dim, ranks, r, c[r].st);
                 ck_assert_msg(c[r].hash == hash, "%dD lazily, %d ranks: rank %d's state differs from the serial run's",
                               dim, ranks, r);
+                ck_assert_msg(c[r].scattered_hash == hash,
+                              "%dD lazily, %d ranks: rank %d's hash of the scattered state differs from the serial run's",
+                              dim, ranks, r);
+                /* clumps: no ratio of a scattered model (the caller gathers first) */
+                ck_assert_msg(clumped ? isnan(c[r].scattered_ratio) : memcmp(&c[r].scattered_ratio, &ratio, sizeof ratio) == 0,
+                              "%dD lazily, %d ranks: rank %d's ratio of the scattered state %.17g, serially %.17g", dim,
+                              ranks, r, c[r].scattered_ratio, ratio);
+                ck_assert_msg(memcmp(c[r].scattered_counts, counts, sizeof counts) == 0,
+                              "%dD lazily, %d ranks: rank %d's bonds and cracks of the scattered state (%lld, %lld, %lld) "
+                              "differ from the serial run's (%lld, %lld, %lld)", dim, ranks, r,
+                              (long long)c[r].scattered_counts[0], (long long)c[r].scattered_counts[1],
+                              (long long)c[r].scattered_counts[2], (long long)counts[0], (long long)counts[1],
+                              (long long)counts[2]);
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD lazily, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
             }

@@ -7,6 +7,7 @@
 #include "model_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 sx_bond_def sx_bond_default_def(void)
@@ -175,6 +176,21 @@ bool sx__crack_log(sx_model *m, const sx_crack *c)
 
 int64_t sx_bond_count(const sx_model *m) { return m->bonds.intact; }
 int64_t sx_crack_count(const sx_model *m) { return m->cracks.n; }
+
+bool sx_model_bond_counts(const sx_model *m, int64_t counts[3])
+{
+    sx_rows_held held = {.all = true};
+    uint64_t v[4] = {0, 0, 0, 0}; /* intact, tension, shear; the ranks that ran out of memory */
+    const bool scattered = sx_model_scattered(m);
+    if (scattered && !sx__dd_rows_held(m, &held)) v[3] = 1;
+    for (int64_t s = 0; !v[3] && s < m->bonds.n; s++) v[0] += (held.all || held.bond[s]) && m->bonds.kind[s];
+    for (int64_t i = 0; !v[3] && i < m->cracks.n; i++)
+        if (sx__holds_crack(m, &held, i)) v[m->cracks.ev[i].mode == SX_CRACK_TENSION ? 1 : 2]++;
+    free(held.bond);
+    if ((scattered && !sx__dd_sum(m, v, 4)) || v[3]) return false;
+    for (int k = 0; k < 3; k++) counts[k] = (int64_t)v[k];
+    return true;
+}
 
 sx_status sx_crack_get(const sx_model *m, int64_t i, sx_crack *out)
 {

@@ -281,12 +281,13 @@ sx_status sx__clumps_finish(sx_model *m)
 }
 
 /* What a restart restores of the clumps (the snapshot's /clumps): every
- * template, then every clump in id order (its pebbles as ball ids), each
- * double with -0 as +0, as the state hash takes the rest (state.c). */
+ * template, the clumps' count, and (sx__clumps_bag) each clump's digest
+ * (its pebbles as ball ids), each double with -0 as +0, as the state hash
+ * takes the rest (state.c). */
 uint64_t sx__clumps_hash(const sx_model *m, uint64_t h)
 {
     const sx_clumps *C = m->clumps;
-    const int d = m->dim, r = m->rdim;
+    const int d = m->dim;
     h = sx__fnv(h, &C->ntpl, sizeof C->ntpl);
     for (int i = 0; i < C->ntpl; i++) {
         const sx_clump_tpl *t = &C->tpl[i];
@@ -304,11 +305,17 @@ uint64_t sx__clumps_hash(const sx_model *m, uint64_t h)
         h = sx__fnv_doubles(h, C->tp_body + t->first * d, t->n * d, 1);
     }
     h = sx__fnv(h, &C->n, sizeof C->n);
-    h = sx__fnv(h, &C->next_id, sizeof C->next_id);
-    for (int64_t id = 1; id < C->next_id && id < C->index_cap; id++) {
-        const int64_t c = C->index_of[id];
-        if (c < 0) continue;
-        h = sx__fnv(h, C->id + c, sizeof *C->id); /* = id, in a consistent state */
+    return sx__fnv(h, &C->next_id, sizeof C->next_id);
+}
+
+/* (model_internal.h) Each clump's digest: its id and state, its pebbles. */
+void sx__clumps_bag(const sx_model *m, const sx_rows_held *part, sx_hash_bag *out)
+{
+    const sx_clumps *C = m->clumps;
+    const int d = m->dim, r = m->rdim;
+    for (int64_t c = 0; c < C->n; c++) {
+        if (!part->all && part->clump_owner[c] != part->rank) continue;
+        uint64_t h = sx__fnv(SX_FNV_BASIS, C->id + c, sizeof *C->id);
         h = sx__fnv(h, C->tpl_of + c, sizeof *C->tpl_of);
         h = sx__fnv(h, C->mat + c, sizeof *C->mat);
         h = sx__fnv(h, C->fix + c, sizeof *C->fix);
@@ -324,6 +331,6 @@ uint64_t sx__clumps_hash(const sx_model *m, uint64_t h)
         h = sx__fnv_doubles(h, C->t + c * r, r, 1);
         const int64_t np = C->tpl[C->tpl_of[c]].n;
         h = sx__fnv(h, C->pebble + C->first[c], (size_t)np * sizeof *C->pebble);
+        sx__hash_bag_add(out, h);
     }
-    return h;
 }

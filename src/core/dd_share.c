@@ -97,6 +97,24 @@ bool sx__dd_share_by_rank(sx_dd *d, void *data, size_t size)
     return sx__dd_share(d, data, size, d->scratch, sx__dd_everything(d, d->x.ranks), 1);
 }
 
+/* (model_internal.h) An all-gather of the ranks' values, each rank adding
+ * them alike (integers: in any order). */
+bool sx__dd_sum(const sx_model *m, uint64_t *v, int n)
+{
+    sx_dd *d = m->dd;
+    const int R = d->x.ranks;
+    uint64_t *all = calloc((size_t)R * (size_t)n, sizeof *all);
+    if (!all) return false;
+    memcpy(all + (size_t)d->x.rank * (size_t)n, v, (size_t)n * sizeof *v);
+    const bool ok = sx__dd_share_by_rank(d, all, (size_t)n * sizeof *all);
+    for (int k = 0; ok && k < n; k++) {
+        v[k] = 0;
+        for (int r = 0; r < R; r++) v[k] += all[(size_t)r * (size_t)n + (size_t)k];
+    }
+    free(all);
+    return ok;
+}
+
 bool sx__dd_halo(sx_model *m)
 {
     sx_dd *d = m->dd;
@@ -185,8 +203,8 @@ bool sx__dd_share_fjoints(sx_model *m, const int32_t *slot, int64_t nb, const sx
     for (int r = 0; ok && r < R; r++) d->scratch[r] = (sx_span){at[own[r].lo], at[own[r].hi]};
     for (int64_t k = 0; ok && k < (int64_t)R * nper; k++) dneed[k] = (sx_span){at[need[k].lo], at[need[k].hi]};
     for (int pass = 0; ok && total && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
-        const sx_span s = pass ? need[me * nper + pass - 1] : own[me];
-        for (int64_t e = s.lo; e < s.hi; e++) {
+        const sx_span span = pass ? need[me * nper + pass - 1] : own[me];
+        for (int64_t e = span.lo; e < span.hi; e++) {
             const int32_t s = slot[e];
             const int nel = b->fj_nr[s] * b->fj_na[s];
             if (!nel) continue;

@@ -612,4 +612,23 @@ void sx_model_gather_lazily(sx_model *m, bool lazily)
 
 bool sx_model_scattered(const sx_model *m) { return m->dd && m->dd->scattered; }
 
+/* (model_internal.h) The last plan's (a scattered model keeps it, as a
+ * resumed cycle does): a rank holds its balls current, their pairs, the
+ * bonds of its pairs and the clumps it owns; a bond in no pair of the plan
+ * is every rank's last state alike, rank 0's to hash. */
+bool sx__dd_rows_held(const sx_model *m, sx_rows_held *part)
+{
+    const sx_dd *d = m->dd;
+    const int me = d->x.rank;
+    *part = (sx_rows_held){.all = false, .first = me == 0, .balls = d->own[me], .bb = d->bb_own[me],
+                           .bw = d->bw_own[me], .crack0 = d->crack0, .clump_owner = d->cown, .rank = me};
+    const int64_t nb = m->bonds.n;
+    if (!nb) return true;
+    part->bond = malloc((size_t)nb);
+    if (!part->bond) return false;
+    memset(part->bond, part->first, (size_t)nb);
+    for (int64_t e = 0; e < d->nbslot; e++) part->bond[d->bslot[e]] = e >= d->bs_own[me].lo && e < d->bs_own[me].hi;
+    return true;
+}
+
 bool sx_model_error_agreed(const sx_model *m) { return m->dd && m->dd->agreed; }

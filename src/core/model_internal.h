@@ -690,7 +690,9 @@ typedef struct sx_kernels {
     /* decomposed inside a cycle: own balls and pairs summed in a chain (the
      * ghosts current); false: the ranks could not exchange */
     bool (*energy)(const sx_model *m, sx_energy *e);
-    bool (*each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
+    /* the contacts of the pairs [lo, hi) of the ball-ball or (walls) the ball-wall store, in order */
+    bool (*each_contact)(const sx_model *m, bool walls, int64_t lo, int64_t hi, bool (*fn)(const sx_contact_info *, void *),
+                         void *ud);
     int64_t (*count_contacts)(const sx_model *m);
     bool (*plan)(sx_model *m);                  /* chunks of the ball-ball pass for the pair store as it is (a restore) */
     /* periodic space: the ghosts' positions, velocities and spins from their owners (a restore) */
@@ -889,7 +891,35 @@ sx_pair_law sx__pair_law(const sx_model *m, int ma, int mb);
 const char *sx__law_check(const sx_material_def *d, char *why, size_t len);
 /* Derives the registry units' constants of material t from its definition (laws.c). */
 void sx__material_derive(sx_material *t);
-/* FNV-1a over n bytes, continuing h (the state hash). */
+/* An order-free sum of digests (state.c: the state hash's balls, pairs,
+ * bonds, cracks and clumps): their count and two sums of the mixed
+ * digests, so that rows hash in any order, and in parts on the ranks that
+ * hold them, then added. */
+typedef struct sx_hash_bag {
+    uint64_t n, sum[2];
+} sx_hash_bag;
+void sx__hash_bag_add(sx_hash_bag *b, uint64_t h);
+/* The rows a rank counts in a sum over the model (the state hash, the
+ * bond and crack counts): all of them, or, of a decomposed model left
+ * scattered by a lazy cycle, those it holds current (sx__dd_rows_held):
+ * its own balls, their pairs, the bonds of its pairs, the cracks it logged
+ * of its balls since the last merge and the clumps it owns; rank 0 (first)
+ * also what every rank holds alike (the bonds out of the plan, the merged
+ * cracks). */
+typedef struct sx_rows_held {
+    bool all, first;
+    sx_span balls, bb, bw;
+    int64_t crack0;             /* the crack log's merged entries */
+    uint8_t *bond;              /* per slot: 1 if this rank's to hash (freed by the caller) */
+    const int32_t *clump_owner; /* per clump: its rank */
+    int rank;
+} sx_rows_held;
+bool sx__dd_rows_held(const sx_model *m, sx_rows_held *part); /* false: out of memory */
+bool sx__holds_crack(const sx_model *m, const sx_rows_held *part, int64_t i); /* crack log entry i (state.c) */
+bool sx__dd_sum(const sx_model *m, uint64_t *v, int n);      /* each v[k] summed over the ranks (mod 2^64) */
+void sx__clumps_bag(const sx_model *m, const sx_rows_held *part, sx_hash_bag *out); /* each clump's digest */
+/* FNV-1a over n bytes, continuing h (the state hash), from SX_FNV_BASIS. */
+#define SX_FNV_BASIS 0xcbf29ce484222325ULL
 uint64_t sx__fnv(uint64_t h, const void *data, size_t n);
 /* The same over n doubles times sign (zeros when v is NULL), -0 hashed as +0. */
 uint64_t sx__fnv_doubles(uint64_t h, const double *v, int64_t n, double sign);

@@ -36,7 +36,8 @@ int64_t sx_contact_count(const sx_model *m) { return sx__kernels(m)->count_conta
 
 bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    return sx__kernels(m)->each_contact(m, fn, ud);
+    const sx_kernels *k = sx__kernels(m);
+    return k->each_contact(m, false, 0, m->bb.n, fn, ud) && k->each_contact(m, true, 0, m->bw.n, fn, ud);
 }
 
 /* A contact's force: its law's and its bond's (a parallel bond's or a flat
@@ -54,14 +55,20 @@ static bool add_contact_force(const sx_contact_info *ci, void *ud)
     return true;
 }
 
-/* Something moves: a ball, a wall or the periodic cell. */
-static bool anything_moves(const sx_model *m)
+/* One of the balls [lo, hi) moves. */
+static bool balls_move(const sx_model *m, int64_t lo, int64_t hi)
 {
     const sx_balls *b = &m->balls;
-    for (int64_t i = 0; i < b->n * m->dim; i++)
+    for (int64_t i = lo * m->dim; i < hi * m->dim; i++)
         if (b->v[i] != 0) return true;
-    for (int64_t i = 0; i < b->n * m->rdim; i++)
+    for (int64_t i = lo * m->rdim; i < hi * m->rdim; i++)
         if (b->w[i] != 0) return true;
+    return false;
+}
+
+/* A wall or the periodic cell moves. */
+static bool frame_moves(const sx_model *m)
+{
     for (int64_t i = 0; i < m->nwall; i++) {
         const sx_wall *w = &m->walls[i];
         if (w->servo_on || w->def.radial_vel != 0) return true;
@@ -71,29 +78,67 @@ static bool anything_moves(const sx_model *m)
     return m->cell && m->cell->controlled;
 }
 
-double sx_model_unbalanced_ratio(const sx_model *m)
+/* The balls [lo, hi)'s unbalanced forces |F + m g| (free components),
+ * added to *sum in order; a pebble is balanced with its clump
+ * (sx__clumps_unbalanced). */
+static void add_unbalanced(const sx_model *m, int64_t lo, int64_t hi, double *sum)
 {
     const sx_balls *b = &m->balls;
     const int d = m->dim;
-    double unbalanced = 0;
-    int64_t bodies = b->n;
-    for (int64_t i = 0; i < b->n; i++) {
-        if (b->clump && b->clump[i]) continue; /* a pebble is balanced with its clump, below */
+    for (int64_t i = lo; i < hi; i++) {
+        if (b->clump && b->clump[i]) continue;
         double s2 = 0;
         for (int k = 0; k < d; k++) {
             if (b->fix[i] & (SX_FIX_VX << k)) continue; /* a fixed component is balanced by its fixity */
             const double f = b->f[i * d + k] + m->gravity[k] / b->inv_mass[i];
             s2 += f * f;
         }
-        unbalanced += sqrt(s2);
+        *sum += sqrt(s2);
     }
-    if (m->clumps) sx__clumps_unbalanced(m, &unbalanced, &bodies);
-    double acc[2] = {0, 0};
-    sx_contact_each(m, add_contact_force, acc);
+}
+
+/* The ratio's sums: the unbalanced forces, the contact forces and their
+ * count, and (a scattered model) the balls that move. */
+enum { R_UNBALANCED, R_FORCES, R_CONTACTS, R_MOVING, R_SUMS };
+
+/* Of a decomposed model left scattered by a lazy cycle, rank r's part of
+ * the sums over its own balls and ball-ball pairs (current there), then
+ * over its ball-wall pairs: sx__dd_chain adds the ranks' parts in rank
+ * order, the serial order of every sum. */
+static void ratio_balls_part(const sx_model *m, int r, double *acc)
+{
+    const sx_dd *d = m->dd;
+    add_unbalanced(m, d->own[r].lo, d->own[r].hi, &acc[R_UNBALANCED]);
+    acc[R_MOVING] += balls_move(m, d->own[r].lo, d->own[r].hi);
+    sx__kernels(m)->each_contact(m, false, d->bb_own[r].lo, d->bb_own[r].hi, add_contact_force, acc + R_FORCES);
+}
+
+static void ratio_walls_part(const sx_model *m, int r, double *acc)
+{
+    const sx_dd *d = m->dd;
+    sx__kernels(m)->each_contact(m, true, d->bw_own[r].lo, d->bw_own[r].hi, add_contact_force, acc + R_FORCES);
+}
+
+double sx_model_unbalanced_ratio(const sx_model *m)
+{
+    double acc[R_SUMS] = {0, 0, 0, 0};
+    int64_t bodies = m->balls.n;
+    const bool clumps = sx_clump_count(m) > 0;
+    if (sx_model_scattered(m)) { /* the ranks' sums in a chain, each rank's own rows */
+        if (clumps || !sx__dd_chain(m, acc, R_SUMS, ratio_balls_part) || !sx__dd_chain(m, acc, R_SUMS, ratio_walls_part))
+            return NAN;
+    } else {
+        add_unbalanced(m, 0, m->balls.n, &acc[R_UNBALANCED]);
+        if (clumps) sx__clumps_unbalanced(m, &acc[R_UNBALANCED], &bodies);
+        sx_contact_each(m, add_contact_force, acc + R_FORCES);
+    }
     if (bodies == 0) return 0;
     /* no contact force to compare with: settled only when nothing moves (a
      * cloud of balls a servo is closing on is not; issue: m:solve{ratio}
      * stopped at once there) */
-    if (acc[1] == 0 || acc[0] == 0) return unbalanced > 0 || anything_moves(m) ? INFINITY : 0;
-    return (unbalanced / (double)bodies) / (acc[0] / acc[1]);
+    if (acc[R_CONTACTS] == 0 || acc[R_FORCES] == 0) {
+        const bool moves = (sx_model_scattered(m) ? acc[R_MOVING] > 0 : balls_move(m, 0, m->balls.n)) || frame_moves(m);
+        return acc[R_UNBALANCED] > 0 || moves ? INFINITY : 0;
+    }
+    return (acc[R_UNBALANCED] / (double)bodies) / (acc[R_FORCES] / acc[R_CONTACTS]);
 }

@@ -119,13 +119,21 @@ SX_API unsigned sx_interrupts_agreed(void);
 
 /// PFC's mean unbalanced-force ratio: the mean over bodies (free balls and clumps) of |F + m g| (free
 /// components) over the mean contact force magnitude; 0 when at rest with no
-/// contacts, infinity when forces act but no contact carries any.
+/// contacts, infinity when forces act but no contact carries any. Of a
+/// decomposed model left scattered (sx_model_scattered), a collective call:
+/// the ranks' sums over their own balls and contacts chained in the serial
+/// order (the serial bits); NAN if it has clumps (gather it first) or the
+/// ranks could not exchange.
 SX_API double sx_model_unbalanced_ratio(const sx_model *m);
 
 /// A 64-bit hash of everything a restart restores, in a canonical form
-/// (balls by id, contacts in no order, -0 as +0, what the next cycle
-/// derives first as derived; docs/lua-api.md, m:hash(), lists it): equal
-/// hashes mean states that continue bit-identically. Queries leave it as it is.
+/// (balls, contacts, bonds, cracks and clumps as digests summed in no
+/// order, -0 as +0, what the next cycle derives first as derived;
+/// docs/lua-api.md, m:hash(), lists it): equal hashes mean states that
+/// continue bit-identically. Queries leave it as it is. Of a decomposed
+/// model left scattered (sx_model_scattered) it is a collective call: each
+/// rank hashes what it holds current and the ranks add their sums (0 if a
+/// rank ran out of memory).
 SX_API uint64_t sx_model_state_hash(const sx_model *m);
 
 /// Domain decomposition (issue 16; docs/developer.md, "MPI domain
@@ -676,6 +684,13 @@ typedef struct sx_crack {
 } sx_crack;
 
 SX_API int64_t sx_crack_count(const sx_model *m);
+/// The intact bonds, the tension cracks and the shear cracks, into
+/// counts[0..2]. Of a decomposed model left scattered
+/// (sx_model_scattered), where the crack log and the intact count are each
+/// rank's part, a collective call: each rank counts the rows it holds
+/// current and the ranks add them. False: out of memory, or the ranks
+/// could not exchange.
+SX_API bool sx_model_bond_counts(const sx_model *m, int64_t counts[3]);
 
 /// State of a flat-joint element.
 typedef enum sx_fj_state {

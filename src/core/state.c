@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* An array of n elements of `size` bytes, zeroed; false when out of memory. */
@@ -462,11 +463,13 @@ sx_status sx__state_finish(sx_model *m)
  * canonical form, so that equal hashes mean states that continue
  * bit-identically, and states that differ only in representation hash
  * alike:
- *  - balls in id order, not dense order (a broad-phase build re-sorts them);
- *  - contact histories as per-pair digests summed (order-free, each digest
- *    mixed before the sum so that no cancellation is cheap), each pair
- *    oriented from its smaller ball id (a re-sort can flip a pair, which
- *    negates its vectors, sx__pair_flip);
+ *  - balls, contact histories, bond slots, cracks and clumps as per-row
+ *    digests summed (order-free, each digest mixed before the sum so that
+ *    no cancellation is cheap: sx_hash_bag), not in dense order (a
+ *    broad-phase build re-sorts balls and pairs), so that the ranks of a
+ *    scattered model sum their own rows' and add the sums;
+ *  - each pair oriented from its smaller ball id (a re-sort can flip a
+ *    pair, which negates its vectors, sx__pair_flip);
  *  - -0 hashed as +0;
  *  - what the next cycle derives before its first step hashed as derived:
  *    with a broad-phase build pending, the build positions are the
@@ -517,7 +520,21 @@ static uint64_t mix(uint64_t z)
     return z ^ (z >> 31);
 }
 
-static const uint64_t FNV_BASIS = 0xcbf29ce484222325ULL;
+
+/* (model_internal.h) Each digest mixed before the sum, so that no
+ * cancellation is cheap. */
+void sx__hash_bag_add(sx_hash_bag *b, uint64_t h)
+{
+    b->sum[0] += mix(h);
+    b->sum[1] += mix(h ^ 0x9e3779b97f4a7c15ULL);
+    b->n++;
+}
+
+static void put_bag(hasher *s, const sx_hash_bag *b)
+{
+    put_int(s, (int64_t)b->n);
+    put(s, b->sum, sizeof b->sum);
+}
 
 static void hash_scalars(hasher *s, const sx_model *m)
 {
@@ -588,15 +605,15 @@ static void hash_materials(hasher *s, const sx_model *m)
     }
 }
 
-static void hash_balls(hasher *s, const sx_model *m)
+/* Each ball's digest: its id and state. */
+static void bag_balls(sx_hash_bag *out, const sx_model *m, const sx_rows_held *part)
 {
     const sx_balls *b = &m->balls;
     const int d = m->dim, r = m->rdim;
-    put_int(s, b->n);
-    for (int64_t id = 1; id < b->index_cap && id < b->next_id; id++) {
-        const int64_t i = b->index_of[id];
-        if (i < 0) continue;
-        put_int(s, id);
+    const int64_t lo = part->all ? 0 : part->balls.lo, hi = part->all ? b->n : part->balls.hi;
+    for (int64_t i = lo; i < hi; i++) {
+        hasher s1 = {SX_FNV_BASIS}, *s = &s1;
+        put_int(s, b->id[i]);
         put_doubles(s, b->x + i * d, d, 1);
         put_doubles(s, (m->build_needed ? b->x : b->x_build) + i * d, d, 1);
         put_doubles(s, b->v + i * d, d, 1);
@@ -610,21 +627,21 @@ static void hash_balls(hasher *s, const sx_model *m)
         put_int(s, b->mat[i]);
         put_int(s, b->fix[i]);
         put_int(s, b->group ? b->group[i] : 0);
+        sx__hash_bag_add(out, s1.h);
     }
 }
 
 /* The order-free sum of the digests of the pairs with a live history:
  * every field of the store's schema (sx__pair_fields: a law's history
  * fields join it there), its vectors from the pair's smaller id. */
-static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool walls)
+static void bag_pairs(sx_hash_bag *out, const sx_model *m, const sx_pairs *p, bool walls, const sx_rows_held *part)
 {
     const int d = m->dim, r = m->rdim;
     const sx_bonds *k = &m->bonds;
     sx_pair_field f[SX_PAIR_FIELDS_MAX];
     const int nf = sx__pair_fields(m, (sx_pairs *)p, f);
-    uint64_t sum[2] = {0, 0};
-    int64_t live = 0;
-    for (int64_t c = 0; c < p->n; c++) {
+    const sx_span rows = part->all ? (sx_span){0, p->n} : walls ? part->bw : part->bb;
+    for (int64_t c = rows.lo; c < rows.hi; c++) {
         if (!p->touching[c]) continue;
         int64_t ia = m->balls.id[p->a[c]], ib = walls ? m->walls[p->b[c]].id : m->balls.id[p->b[c]];
         /* a ball-ball pair from its smaller id: the vectors of b -> a are the negated ones */
@@ -634,7 +651,7 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
             ia = ib;
             ib = t;
         }
-        hasher one = {FNV_BASIS};
+        hasher one = {SX_FNV_BASIS};
         put_int(&one, ia);
         put_int(&one, ib);
         if (!walls && m->cell && p->b[c] >= m->cell->base) { /* b is a ghost: the image it is seen through */
@@ -658,55 +675,68 @@ static void hash_pairs(hasher *s, const sx_model *m, const sx_pairs *p, bool wal
             put_doubles(&one, k->fs + (int64_t)slot * d, d, sign);
             put_doubles(&one, k->ms + (int64_t)slot * r, r, sign);
         }
-        sum[0] += mix(one.h);
-        sum[1] += mix(one.h ^ 0x9e3779b97f4a7c15ULL);
-        live++;
+        sx__hash_bag_add(out, one.h);
     }
-    put_int(s, live);
-    put(s, sum, sizeof sum);
 }
 
-static void hash_bonds(hasher *s, const sx_model *m)
+/* Each bond's digest: its slot (slots are never reused: canonical) and
+ * state, with a flat joint's face and its elements. */
+static void bag_bonds(sx_hash_bag *out, const sx_model *m, const sx_rows_held *part)
 {
     const sx_bonds *k = &m->bonds;
-    const int d = m->dim;
-    put_int(s, k->n);
-    for (int64_t i = 0; i < k->n; i++) { /* slots are never reused: their order is canonical */
+    const sx_fjels *e = &m->fjel;
+    const int t = m->dim - 1;
+    for (int64_t i = 0; i < k->n; i++) {
+        if (!part->all && !part->bond[i]) continue;
+        hasher s1 = {SX_FNV_BASIS}, *s = &s1;
+        put_int(s, i);
         put_int(s, k->kind[i]);
         put_int(s, k->ida[i]);
         put_int(s, k->idb[i]);
         const double v[] = {k->cb_n[i], k->cb_s[i], k->rbar[i], k->kn[i],
                             k->ks[i],   k->sigma_c[i], k->tau_c[i], k->fn[i], k->mn[i]};
         put_doubles(s, v, sizeof v / sizeof *v, 1);
-    }
-    if (m->fjel.n > 0) { /* flat joints (laws/flatjoint.h): each joint's face and its elements */
-        const int t = d - 1;
-        for (int64_t i = 0; i < k->n; i++) {
-            if (!(k->kind[i] & SX_BOND_FLATJOINT)) continue;
-            put_int(s, k->fj_first[i]);
-            put_int(s, k->fj_nr[i]);
-            put_int(s, k->fj_na[i]);
-            const double v[] = {k->fj_mu[i], k->fj_tanphi[i], k->fj_d0[i]};
-            put_doubles(s, v, 3, 1);
-            put_doubles(s, k->fj_rot + i * t, t, 1);
-            if (d == 3) put_doubles(s, k->fj_axis + i * 3, 3, 1);
+        if (e->n > 0) { /* flat joints (laws/flatjoint.h): the face, then the elements */
+            const int64_t nel = (int64_t)k->fj_nr[i] * k->fj_na[i];
+            if (k->kind[i] & SX_BOND_FLATJOINT) {
+                put_int(s, k->fj_first[i]);
+                put_int(s, k->fj_nr[i]);
+                put_int(s, k->fj_na[i]);
+                const double f[] = {k->fj_mu[i], k->fj_tanphi[i], k->fj_d0[i]};
+                put_doubles(s, f, 3, 1);
+                put_doubles(s, k->fj_rot + i * t, t, 1);
+                if (m->dim == 3) put_doubles(s, k->fj_axis + i * 3, 3, 1);
+            }
+            for (int64_t x = k->fj_first[i]; x < k->fj_first[i] + nel; x++) {
+                put_int(s, e->state[x]);
+                const double g[] = {e->sigma_c[x], e->coh[x], e->gap0[x], e->fn[x]};
+                put_doubles(s, g, 4, 1);
+                put_doubles(s, e->fs + x * t, t, 1);
+            }
         }
-        const sx_fjels *e = &m->fjel;
-        put_int(s, e->n);
-        for (int64_t i = 0; i < e->n; i++) {
-            put_int(s, e->state[i]);
-            const double v[] = {e->sigma_c[i], e->coh[i], e->gap0[i], e->fn[i]};
-            put_doubles(s, v, 4, 1);
-            put_doubles(s, e->fs + i * t, t, 1);
-        }
+        sx__hash_bag_add(out, s1.h);
     }
 }
 
-static void hash_cracks(hasher *s, const sx_model *m)
+/* Of a scattered model, rank 0 holds the merged entries, and each rank
+ * those of its own balls' bonds that it logged since (the other ranks
+ * that stepped the bond logged it too). */
+bool sx__holds_crack(const sx_model *m, const sx_rows_held *part, int64_t i)
 {
-    put_int(s, m->cracks.n);
+    if (part->all) return true;
+    if (i < part->crack0) return part->first;
+    const int64_t a = sx__ball_index(m, m->cracks.ev[i].a);
+    return a >= part->balls.lo && a < part->balls.hi;
+}
+
+/* Each crack's digest (order-free: the ranks hold the log's newest
+ * entries in parts until a gather merges them in the serial order). */
+static void bag_cracks(sx_hash_bag *out, const sx_model *m, const sx_rows_held *part)
+{
     for (int64_t i = 0; i < m->cracks.n; i++) {
         const sx_crack *c = &m->cracks.ev[i];
+        if (!sx__holds_crack(m, part, i)) continue;
+        hasher s1 = {SX_FNV_BASIS}, *s = &s1;
         put_int(s, c->step);
         put_int(s, c->mode);
         put_int(s, c->kind);
@@ -714,6 +744,7 @@ static void hash_cracks(hasher *s, const sx_model *m)
         put_int(s, c->b);
         const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
         put_doubles(s, v, sizeof v / sizeof *v, 1);
+        sx__hash_bag_add(out, s1.h);
     }
 }
 
@@ -746,27 +777,61 @@ static void hash_walls(hasher *s, const sx_model *m)
     }
 }
 
-/* The clumps, the periodic cell and the smooth joints, each hashed by its module. */
-static void hash_stores(hasher *s, const sx_model *m)
+/* The clumps, the periodic cell and the smooth joints, each hashed by its
+ * module (the clumps' own digests summed in clumps). */
+static bool has_clumps(const sx_model *m)
 {
     /* an empty clump store (a template that was refused) is no clumps */
-    if (m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0)) s->h = sx__clumps_hash(m, s->h);
+    return m->clumps && (m->clumps->ntpl > 0 || m->clumps->n > 0);
+}
+
+static void hash_stores(hasher *s, const sx_model *m, const sx_hash_bag *clumps)
+{
+    if (has_clumps(m)) {
+        s->h = sx__clumps_hash(m, s->h);
+        put_bag(s, clumps);
+    }
     if (m->cell) s->h = sx__cell_hash(m, s->h);
     if (m->njoint) s->h = sx__joints_hash(m, s->h);
 }
 
+enum { BAG_BALLS, BAG_BB, BAG_BW, BAG_BONDS, BAG_CRACKS, BAG_CLUMPS, BAGS };
+
+/* The rows go into order-free sums, so that a decomposed model left
+ * scattered by a lazy cycle hashes without a gather: each rank sums the
+ * digests of the rows it holds current (sx__dd_rows_held), and the sums
+ * are added over the ranks (a collective call then). Every rank that
+ * could not take part makes the hash 0 on every rank. */
 uint64_t sx_model_state_hash(const sx_model *m)
 {
-    hasher s = {FNV_BASIS};
+    sx_rows_held part = {.all = true};
+    sx_hash_bag b[BAGS + 1] = {{0, {0, 0}}}; /* the last: a count of the ranks that failed */
+    const bool scattered = sx_model_scattered(m);
+    if (scattered && !sx__dd_rows_held(m, &part)) b[BAGS].n = 1;
+    if (!b[BAGS].n) {
+        bag_balls(&b[BAG_BALLS], m, &part);
+        bag_pairs(&b[BAG_BB], m, &m->bb, false, &part);
+        bag_pairs(&b[BAG_BW], m, &m->bw, true, &part);
+        bag_bonds(&b[BAG_BONDS], m, &part);
+        bag_cracks(&b[BAG_CRACKS], m, &part);
+        if (has_clumps(m)) sx__clumps_bag(m, &part, &b[BAG_CLUMPS]);
+    }
+    free(part.bond);
+    if (scattered && !sx__dd_sum(m, (uint64_t *)b, (int)(sizeof b / (sizeof(uint64_t))))) return 0;
+    if (b[BAGS].n) return 0;
+    hasher s = {SX_FNV_BASIS};
     hash_scalars(&s, m);
     hash_materials(&s, m);
-    hash_balls(&s, m);
+    put_int(&s, m->balls.n);
+    put_bag(&s, &b[BAG_BALLS]);
     hash_walls(&s, m);
-    hash_pairs(&s, m, &m->bb, false);
-    hash_pairs(&s, m, &m->bw, true);
-    hash_bonds(&s, m);
-    hash_cracks(&s, m);
-    hash_stores(&s, m);
+    put_bag(&s, &b[BAG_BB]);
+    put_bag(&s, &b[BAG_BW]);
+    put_int(&s, m->bonds.n);
+    put_int(&s, m->fjel.n);
+    put_bag(&s, &b[BAG_BONDS]);
+    put_bag(&s, &b[BAG_CRACKS]); /* its count is the log's (a scattered rank holds a part beyond crack0) */
+    hash_stores(&s, m, &b[BAG_CLUMPS]);
     return s.h;
 }
 
@@ -856,18 +921,22 @@ static void hash_replicated(hasher *s, const sx_model *m)
 
 uint64_t sx__replicated_digest(const sx_model *m)
 {
-    hasher s = {FNV_BASIS};
+    hasher s = {SX_FNV_BASIS};
     hash_replicated(&s, m);
     return mix(s.h);
 }
 
 uint64_t sx__state_digest(const sx_model *m)
 {
-    hasher s = {FNV_BASIS};
+    hasher s = {SX_FNV_BASIS};
     hash_replicated(&s, m);
-    hash_cracks(&s, m);
-    hash_stores(&s, m);
-    digest g = {{s.h, FNV_BASIS, ~FNV_BASIS, s.h ^ 0x9e3779b97f4a7c15ULL}};
+    const sx_rows_held all = {.all = true};
+    sx_hash_bag cracks = {0, {0, 0}}, clumps = {0, {0, 0}};
+    bag_cracks(&cracks, m, &all);
+    put_bag(&s, &cracks);
+    if (has_clumps(m)) sx__clumps_bag(m, &all, &clumps);
+    hash_stores(&s, m, &clumps);
+    digest g = {{s.h, SX_FNV_BASIS, ~SX_FNV_BASIS, s.h ^ 0x9e3779b97f4a7c15ULL}};
     digest_balls(&g, m);
     digest_pairs(&g, m, &m->bb);
     digest_pairs(&g, m, &m->bw);

@@ -207,6 +207,13 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx);
 /// function as called on `self`, "m" or "b": m:save, b.pos); a failed
 /// exchange stops every rank.
 void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
+/// Like sx_lua_checkmodel for a query the core answers of a scattered
+/// model with a small collective exchange of its own (the ranks' sums over
+/// the rows they hold: sx_model_state_hash, sx_model_bond_counts,
+/// sx_model_unbalanced_ratio): behind the same-call check, named `what`,
+/// without a gather; unless `whole`, the query needs the whole state (a
+/// gather) all the same.
+sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole);
 /// The userdata at idx (a Lua error if it is not a model, closed or not).
 sx_lua_model *sx_lua_modelud(lua_State *L, int idx);
 /// Pushes the table `field` of the state of the model userdata at idx,

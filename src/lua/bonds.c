@@ -171,9 +171,19 @@ static int model_bond(lua_State *L)
     return 1;
 }
 
+/* The intact bonds and the cracks by mode (sx_model_bond_counts: without
+ * a gather under mpirun). */
+static void bond_counts(lua_State *L, const char *what, int64_t counts[3])
+{
+    const sx_model *m = sx_lua_checkmodel_summed(L, 1, what, false);
+    if (!sx_model_bond_counts(m, counts)) luaL_error(L, "%s: out of memory, or the ranks could not exchange", what);
+}
+
 static int model_bond_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_bond_count(sx_lua_checkmodel(L, 1)));
+    int64_t counts[3];
+    bond_counts(L, "m:bond_count", counts);
+    lua_pushinteger(L, (lua_Integer)counts[0]);
     return 1;
 }
 
@@ -215,20 +225,10 @@ static int model_cracks(lua_State *L)
 static int model_crack_count(lua_State *L)
 {
     static const char *const modes[] = {"tension", "shear", NULL};
-    const sx_model *m = sx_lua_checkmodel(L, 1);
-    const int64_t n = sx_crack_count(m);
-    if (lua_isnoneornil(L, 2)) {
-        lua_pushinteger(L, (lua_Integer)n);
-        return 1;
-    }
-    const sx_crack_mode want = luaL_checkoption(L, 2, NULL, modes) == 0 ? SX_CRACK_TENSION : SX_CRACK_SHEAR;
-    int64_t count = 0;
-    for (int64_t i = 0; i < n; i++) {
-        sx_crack c;
-        sx_lua_check(L, m, sx_crack_get(m, i, &c), "m:crack_count");
-        count += c.mode == want;
-    }
-    lua_pushinteger(L, (lua_Integer)count);
+    const int mode = lua_isnoneornil(L, 2) ? -1 : luaL_checkoption(L, 2, NULL, modes);
+    int64_t counts[3];
+    bond_counts(L, "m:crack_count", counts);
+    lua_pushinteger(L, (lua_Integer)(mode < 0 ? counts[1] + counts[2] : counts[1 + mode]));
     return 1;
 }
 

@@ -53,6 +53,15 @@ void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
     }
 }
 
+sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole)
+{
+    sx_model *m = sx_lua_checkmodel_scattered(L, idx);
+    if (!sx_model_scattered(m)) return m;
+    if (whole) sx_lua_gather(L, m, "m");
+    else sx_lua_check_model_call(L, m, what);
+    return m;
+}
+
 sx_model *sx_lua_checkmodel(lua_State *L, int idx)
 {
     sx_model *m = sx_lua_checkmodel_scattered(L, idx);
@@ -759,7 +768,8 @@ static int model_contact_count(lua_State *L)
 
 static int model_ratio(lua_State *L)
 {
-    lua_pushnumber(L, sx_model_unbalanced_ratio(sx_lua_checkmodel(L, 1)));
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
+    lua_pushnumber(L, sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:ratio", sx_clump_count(m) > 0)));
     return 1;
 }
 
@@ -783,11 +793,13 @@ static int model_energy(lua_State *L)
 }
 
 /* The core's state hash, with the group slots 2 and up (Lua state that a
- * restart restores) folded in when a ball has one. */
+ * restart restores) folded in when a ball has one. A model left scattered
+ * by a lazy cycle hashes without a gather, its ranks' sums added: a
+ * collective call, behind the same-call check as a gather. */
 static int model_hash(lua_State *L)
 {
     char hex[17];
-    uint64_t h = sx_model_state_hash(sx_lua_checkmodel(L, 1));
+    uint64_t h = sx_model_state_hash(sx_lua_checkmodel_summed(L, 1, "m:hash", false));
     const uint64_t slots = sx_lua_slots_digest(L, 1);
     if (slots) h = (h ^ slots) * 0x9e3779b97f4a7c15u + 1;
     snprintf(hex, sizeof hex, "%016" PRIx64, h);

@@ -602,8 +602,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             break;
         }
         if (lim->ratio > 0 && !first && taken % lim->every == 0) {
-            sx_lua_gather(L, m, "m");
-            *ratio = sx_model_unbalanced_ratio(m);
+            *ratio = sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:solve (ratio)", sx_clump_count(m) > 0));
             if (*ratio <= lim->ratio) {
                 why = BY_RATIO;
                 break;
@@ -700,8 +699,8 @@ static int model_solve(lua_State *L)
     double ratio;
     const enum reason why = run_model(L, &lim, &ratio, "m:solve");
     lua_pushstring(L, reason_names[why]);
-    if (isnan(ratio)) sx_lua_gather(L, m, "m");
-    lua_pushnumber(L, isnan(ratio) ? sx_model_unbalanced_ratio(m) : ratio);
+    if (isnan(ratio)) ratio = sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:solve (ratio)", sx_clump_count(m) > 0));
+    lua_pushnumber(L, ratio);
     lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));
     return 3;
 }

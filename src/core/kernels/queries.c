@@ -210,12 +210,12 @@ static bool report(const sx_model *m, const sx_pairs *p, int64_t c, bool is_wall
     return fn(&ci, ud);
 }
 
-static bool KERNEL(each_contact)(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
+static bool KERNEL(each_contact)(const sx_model *m, bool walls, int64_t lo, int64_t hi,
+                                 bool (*fn)(const sx_contact_info *, void *), void *ud)
 {
-    for (int64_t c = 0; c < m->bb.n; c++)
-        if (m->bb.touching[c] && !report(m, &m->bb, c, false, fn, ud)) return false;
-    for (int64_t c = 0; c < m->bw.n; c++)
-        if (m->bw.touching[c] && !report(m, &m->bw, c, true, fn, ud)) return false;
+    const sx_pairs *p = walls ? &m->bw : &m->bb;
+    for (int64_t c = lo; c < hi; c++)
+        if (p->touching[c] && !report(m, p, c, walls, fn, ud)) return false;
     return true;
 }
 
