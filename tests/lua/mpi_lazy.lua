@@ -50,6 +50,8 @@ m:on("after", function()
   lid.vel = {0, v}
 end)
 local broken, first, h = 0, nil, nil
+-- a history of the ratio: its records gather nothing (the ranks' sums chained)
+m:history("ratio", "ratio", {every = 50})
 if scene == "events" then
   m:on("bond_break", function(_, e)
     broken = broken + 1
@@ -69,6 +71,8 @@ if m:ranks() > 1 and m:profile{print = false}.gathers ~= p.gathers then
 end
 print(string.format("lid at %.17g m, force %.17g N, %d bonds, %d broken (first at step %s)", lid.point[2],
                     lid.force[2], m:bond_count(), broken, tostring(first)))
+h = m:history("ratio")
+print(string.format("ratio %d samples, last %.17g", #h.values, h.values[#h.values]))
 if scene == "events" then
   h = m:history("probe_y")
   print(string.format("probe %d samples, last %.17g", #h.values, h.values[#h.values]))
@@ -78,6 +82,9 @@ print(string.format("step %d hash %s", m:step(), hash))
 local resumed, cycles = p.resumed - p0.resumed, p.cycles - p0.cycles
 if scene == "servo" and m:ranks() > 1 and resumed < 0.9 * cycles then
   error(string.format("%d of %d cycles went on from the last one's scattered state", resumed, cycles))
+end
+if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the ratio's history read no ball
+  error(string.format("the servo's cycle gathered the state %d times", p.gathers - p0.gathers))
 end
 local why, ratio, steps = m:solve{ratio = 1e-2, steps = 2000}
 print(string.format("solve: %s ratio %.17g after %d steps; hash %s", why, ratio, steps, m:hash()))
