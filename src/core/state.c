@@ -385,6 +385,11 @@ static sx_status check_bonds(sx_model *m)
         if (k->kind[s] & ~(unsigned)(SX_BOND_CONTACT | SX_BOND_PARALLEL | SX_BOND_FLATJOINT | SX_BOND_SMOOTHJOINT) ||
             ((k->kind[s] & SX_BOND_SMOOTHJOINT) && k->kind[s] != SX_BOND_SMOOTHJOINT))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has an unknown kind %d", (long long)s, k->kind[s]);
+        /* a broken flat joint keeps its elements, which the hash reads */
+        const int64_t nel = m->fjel.n > 0 ? (int64_t)k->fj_nr[s] * k->fj_na[s] : 0;
+        if (nel && (k->fj_first[s] < 0 || k->fj_first[s] + nel > m->fjel.n))
+            return sx__fail(m, SX_EINVAL, "state: bond %lld's flat-joint elements (%d x %d from %d) lie outside the %lld elements",
+                            (long long)s, k->fj_nr[s], k->fj_na[s], k->fj_first[s], (long long)m->fjel.n);
         if (!k->kind[s]) continue; /* broken: its balls may be gone */
         if (!m->bb.bond) return sx__fail(m, SX_EINVAL, "state: intact bonds but no bond slots in the pair store");
         if (sx__ball_index(m, k->ida[s]) < 0 || sx__ball_index(m, k->idb[s]) < 0 || k->ida[s] == k->idb[s])
@@ -406,9 +411,7 @@ static sx_status check_bonds(sx_model *m)
             !sx__state_length_finite(k->mn + s, 1) || !sx__state_length_finite(k->ms + s * m->rdim, m->rdim))
             return sx__fail(m, SX_EINVAL, "state: bond %lld has a non-finite force or moment", (long long)s);
         if (k->kind[s] & SX_BOND_FLATJOINT) {
-            const int64_t nel = (int64_t)k->fj_nr[s] * k->fj_na[s];
-            if (k->kind[s] != SX_BOND_FLATJOINT || nel < 1 || (m->dim == 2 && k->fj_na[s] != 1) || k->fj_first[s] < 0 ||
-                k->fj_first[s] + nel > m->fjel.n)
+            if (k->kind[s] != SX_BOND_FLATJOINT || nel < 1 || (m->dim == 2 && k->fj_na[s] != 1))
                 return sx__fail(m, SX_EINVAL, "state: flat joint %lld has bad elements (%d x %d from %d of %lld)",
                                 (long long)s, k->fj_nr[s], k->fj_na[s], k->fj_first[s], (long long)m->fjel.n);
             if (!(k->fj_mu[s] >= 0) || !(k->fj_tanphi[s] >= 0) || !sx__state_length_finite(k->fj_mu + s, 1) ||

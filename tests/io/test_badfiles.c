@@ -733,6 +733,14 @@ START_TEST(meaningless_values)
         H5Fclose(f);
         expect_error(p, 3, fjcases[k].error);
     }
+    /* a broken flat joint keeps its elements, which the state hash reads:
+     * their range is checked too (found by a review: the hash read past
+     * the elements, a crash) */
+    f = edit(fj, p, sizeof p, "fj_broken.h5");
+    poke_at(f, "/bonds/kind", 0, 0);
+    poke_at(f, "/flatjoints/first_element", 0, 1e8);
+    H5Fclose(f);
+    expect_error(p, 3, "bond 0's flat-joint elements (");
     /* a periodic cell whose vector or rate is a finite 1e300: its volume and products overflow */
     m = io_scene_granular(3, 50);
     const sx_periodic_def pd = {{true, true, true}, {-1, -1, -1}, {2, 2, 2}, {0, 0, 0}};
