@@ -41,7 +41,7 @@ typedef struct rank_ctx {
     uint64_t hash;
     uint64_t scattered_hash; /* lazy: the hash before the gather, each rank summing its own rows' digests */
     double scattered_ratio;  /* and the unbalanced-force ratio (chained), the bonds and cracks (summed) */
-    int64_t scattered_counts[3];
+    int64_t scattered_counts[4]; /* bonds, tension and shear cracks, contacts */
     sx_energy energy;
     sx_status st;
 } rank_ctx;
@@ -213,6 +213,7 @@ static void run_lazily(rank_ctx *c, sx_model *m)
     c->scattered_hash = sx_model_state_hash(m);
     c->scattered_ratio = sx_model_unbalanced_ratio(m);
     if (!sx_model_bond_counts(m, c->scattered_counts)) c->st = SX_ENOMEM;
+    c->scattered_counts[3] = sx_contact_count(m);
     if (!c->st && (!sx_model_scattered(m) || sx_model_profile(m).gathers != gathers))
         c->st = SX_EINVAL; /* these queries of a scattered model gather nothing */
     if (!c->st) c->st = sx_model_gather(m);
@@ -278,8 +279,9 @@ START_TEST(ranks_give_the_serial_bits)
                       "%dD: the bed must be dense, or the clumps collide (%lld contacts)", dim, (long long)contacts);
         const uint64_t hash = sx_model_state_hash(serial);
         const double ratio = sx_model_unbalanced_ratio(serial);
-        int64_t counts[3];
+        int64_t counts[4];
         ck_assert(sx_model_bond_counts(serial, counts));
+        counts[3] = contacts;
         ck_assert_msg(counts[0] == sx_bond_count(serial) && counts[1] + counts[2] == sx_crack_count(serial),
                       "%dD: the counts must be the model's", dim);
         const sx_energy e = sx_model_energy(serial);
@@ -316,11 +318,11 @@ START_TEST(ranks_give_the_serial_bits)
                               "%dD lazily, %d ranks: rank %d's ratio of the scattered state %.17g, serially %.17g", dim,
                               ranks, r, c[r].scattered_ratio, ratio);
                 ck_assert_msg(memcmp(c[r].scattered_counts, counts, sizeof counts) == 0,
-                              "%dD lazily, %d ranks: rank %d's bonds and cracks of the scattered state (%lld, %lld, %lld) "
-                              "differ from the serial run's (%lld, %lld, %lld)", dim, ranks, r,
+                              "%dD lazily, %d ranks: rank %d's bonds, cracks and contacts of the scattered state (%lld, "
+                              "%lld, %lld, %lld) differ from the serial run's (%lld, %lld, %lld, %lld)", dim, ranks, r,
                               (long long)c[r].scattered_counts[0], (long long)c[r].scattered_counts[1],
-                              (long long)c[r].scattered_counts[2], (long long)counts[0], (long long)counts[1],
-                              (long long)counts[2]);
+                              (long long)c[r].scattered_counts[2], (long long)c[r].scattered_counts[3],
+                              (long long)counts[0], (long long)counts[1], (long long)counts[2], (long long)counts[3]);
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD lazily, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
             }

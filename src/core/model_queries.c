@@ -32,7 +32,18 @@ void sx_model_track_energy(sx_model *m, bool on)
     memset(&m->acc, 0, sizeof m->acc);
 }
 
-int64_t sx_contact_count(const sx_model *m) { return sx__kernels(m)->count_contacts(m); }
+/* Of a scattered model, each rank counts its own pairs' (current there),
+ * and the ranks add their counts. */
+int64_t sx_contact_count(const sx_model *m)
+{
+    if (!sx_model_scattered(m)) return sx__kernels(m)->count_contacts(m);
+    const sx_dd *d = m->dd;
+    const sx_span bb = d->bb_own[d->x.rank], bw = d->bw_own[d->x.rank];
+    uint64_t n = 0;
+    for (int64_t c = bb.lo; c < bb.hi; c++) n += m->bb.touching[c];
+    for (int64_t c = bw.lo; c < bw.hi; c++) n += m->bw.touching[c];
+    return sx__dd_sum(m, &n, 1) ? (int64_t)n : -1;
+}
 
 bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud)
 {

@@ -567,7 +567,10 @@ SX_API sx_status sx_wall_load(const sx_model *m, int64_t id, double *normal_forc
 
 /* ------------------------------------------------------------- contacts */
 
-/// Number of ball-ball and ball-wall contacts of the last step's force evaluation.
+/// Number of ball-ball and ball-wall contacts of the last step's force
+/// evaluation. Of a decomposed model left scattered (sx_model_scattered), a
+/// collective call: each rank counts its own pairs' and the ranks add them
+/// (-1: they could not exchange).
 SX_API int64_t sx_contact_count(const sx_model *m);
 
 typedef struct sx_contact_info {

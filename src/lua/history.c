@@ -175,10 +175,10 @@ void sx_lua_history_record(lua_State *L, int model)
             lua_getfield(L, e, "field");
             lua_getfield(L, e, "comp");
             /* a wall's field, the time, the step and the ball count every rank holds after a lazy cycle;
-             * the ratio the ranks sum without a gather (but of clumps) */
+             * the ratio and the contacts the ranks sum without a gather (the ratio of clumps gathers) */
             const int b = (int)lua_tointeger(L, e + 1);
-            if (src == SRC_BUILTIN && b == B_RATIO)
-                sx_lua_checkmodel_summed(L, model, "m:history (ratio)", sx_clump_count(m) > 0);
+            if (src == SRC_BUILTIN && (b == B_RATIO || b == B_CONTACTS))
+                sx_lua_checkmodel_summed(L, model, "m:history (ratio, contacts)", b == B_RATIO && sx_clump_count(m) > 0);
             else if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
                 sx_lua_gather(L, m, "m");
             if (src == SRC_BUILTIN)

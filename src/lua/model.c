@@ -762,7 +762,7 @@ static int model_set_gravity(lua_State *L)
 
 static int model_contact_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_contact_count(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, (lua_Integer)sx_contact_count(sx_lua_checkmodel_summed(L, 1, "m:contact_count", false)));
     return 1;
 }
 
