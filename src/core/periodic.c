@@ -264,7 +264,8 @@ sx_status sx_cell_stress(const sx_model *m, double stress[3][3], double *volume)
     for (int k = 0; k < m->dim; k++)
         if (!m->cell || !m->cell->axis[k])
             return sx__fail((sx_model *)m, SX_EINVAL, "cell_stress: the space must be periodic on every axis");
-    sx__kernels(m)->cell_stress(m, stress, NULL);
+    if (!sx__kernels(m)->cell_stress(m, stress, NULL))
+        return sx__fail((sx_model *)m, SX_EINVAL, "cell_stress: the ranks could not exchange");
     *volume = 1;
     for (int k = 0; k < m->dim; k++) *volume *= m->cell->h[k][k];
     return SX_OK;

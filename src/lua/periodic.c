@@ -13,9 +13,10 @@ static const char *const components[] = {"xx", "yy", "zz", "xy", "xz", "yz", NUL
 
 static int model_periodic(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
     const int dim = sx_model_dim(m);
     sx_periodic_def d;
+    if (!lua_isnone(L, 2)) sx_lua_gather(L, m, "m"); /* a change; the query reads the cell every rank holds */
     if (lua_isnone(L, 2)) { /* the query */
         if (!sx_model_periodic(m, &d)) {
             lua_pushnil(L);
@@ -131,7 +132,7 @@ static int model_cell_control(lua_State *L)
 
 static int model_cell_stress(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:cell_stress", false);
     double s[3][3], volume;
     sx_lua_check(L, m, sx_cell_stress(m, s, &volume), "m:cell_stress");
     sx_lua_push_tensor(L, s, sx_model_dim(m));

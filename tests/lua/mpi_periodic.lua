@@ -58,9 +58,13 @@ if scene == "cell" then
   if m:ranks() > 1 and (p.broad_phase.calls < 2 or p.gathers > 0) then
     error(string.format("mpi_periodic.lua cell: %d builds made %d gathers", p.broad_phase.calls, p.gathers))
   end
+  -- the cell and its stress (the ranks' own pairs' terms chained) without a gather
+  local c, s = m:periodic(), m:cell_stress()
+  if m:ranks() > 1 and m:profile{print = false}.gathers ~= p.gathers then
+    error("mpi_periodic.lua cell: m:periodic() or m:cell_stress() gathered")
+  end
+  print(string.format("stress xx %.17g yy %.17g xy %.17g size %.17g", s[1][1], s[2][2], s[1][2], c.size[1]))
   report(m, "sheared")
-  local s = m:cell_stress()
-  print(string.format("stress xx %.17g yy %.17g xy %.17g", s[1][1], s[2][2], s[1][2]))
   for i, c in ipairs(m:cracks()) do
     print(string.format("crack %d step %d %s balls %d %d", i, c.step, c.kind, c.a, c.b))
   end

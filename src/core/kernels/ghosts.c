@@ -270,14 +270,15 @@ static void KERNEL(stress_terms_stiff)(const sx_model *m, int r, double *acc)
 }
 
 /* The cell's average stress, (1/V) sum F (x) l (stress_terms), compression
- * positive; with stiff, the servo's K per component. Decomposed, the sum
- * runs over the ranks in pair order (sx__dd_chain). False: the ranks
- * could not exchange. */
+ * positive; with stiff, the servo's K per component. Decomposed (inside a
+ * cycle, the servo's; or of a state a lazy cycle left scattered, each rank
+ * its own pairs current), the sum runs over the ranks in pair order
+ * (sx__dd_chain), the serial bits. False: the ranks could not exchange. */
 static bool KERNEL(cell_stress)(const sx_model *m, double stress[3][3], double stiff[6])
 {
     double acc[9 + 6] = {0};
-    if (m->dd && m->dd->active) { /* inside a cycle: the servo's */
-        if (!stiff || !sx__dd_chain(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
+    if (m->dd && (m->dd->active || m->dd->scattered)) {
+        if (!sx__dd_chain(m, acc, 9 + 6, KERNEL(stress_terms_stiff))) return false;
     } else {
         stress_terms(m, 0, m->bb.n, acc, stiff != NULL);
     }
