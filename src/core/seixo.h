@@ -822,6 +822,8 @@ SX_API sx_status sx_cell_control_get(const sx_model *m, sx_cell_control *c);
 /// over every ball-ball contact, bonds included, branch vectors through the
 /// boundary), Pa (2D: N/m), compression positive, and the cell's volume
 /// (m^3; 2D: m^2). SX_EINVAL when the space is not periodic on every axis.
+/// Of a decomposed model left scattered (sx_model_scattered), a collective
+/// call: the ranks' own contacts' terms chained in the serial order.
 SX_API sx_status sx_cell_stress(const sx_model *m, double stress[3][3], double *volume);
 
 /* ---------------------------------------------------------- measurement */

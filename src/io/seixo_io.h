@@ -125,9 +125,8 @@ typedef struct sx_snapshot_opts {
 /// Writes the complete state of m to path: to a temporary file in the same
 /// folder, flushed to disk, then renamed over path, so a save that fails or
 /// is killed never damages an existing file. A decomposed model left
-/// scattered by a lazy cycle (sx_model_scattered) must be gathered first
-/// (sx_model_gather, on every rank): the file's state hash would be a
-/// collective call.
+/// scattered by a lazy cycle (sx_model_scattered) is refused: gather it
+/// first (sx_model_gather, on every rank).
 sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapshot_opts *opts, char *err,
                            size_t errlen);
 

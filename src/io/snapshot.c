@@ -359,6 +359,8 @@ sx_status sx_snapshot_save(const sx_model *m, const char *path, const sx_snapsho
     char tmp[4096];
     if (!path || !*path) {
         sx_h5_fail(&h, "an empty path");
+    } else if (sx_model_scattered(m)) { /* its state hash would be a collective call */
+        sx_h5_fail(&h, "the model is scattered over the ranks: gather it first (sx_model_gather, on every rank)");
     } else if (!sx_h5_temp_for(&h, path, tmp, sizeof tmp)) {
         /* (failed, the reason named) */
     } else if (sx_io_series_open_at(path)) {

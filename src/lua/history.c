@@ -75,7 +75,10 @@ static double sample_builtin(sx_model *m, int b)
     case B_STEP: return (double)sx_model_step_count(m);
     case B_TIMESTEP: return sx_model_timestep(m);
     case B_RATIO: return sx_model_unbalanced_ratio(m);
-    case B_CONTACTS: return (double)sx_contact_count(m);
+    case B_CONTACTS: {
+        const int64_t n = sx_contact_count(m);
+        return n < 0 ? NAN : (double)n; /* (-1: the ranks could not exchange) */
+    }
     case B_BALLS: return (double)sx_ball_count(m);
     default: return energy_term(m, b - B_ENERGY0);
     }
@@ -178,7 +181,8 @@ void sx_lua_history_record(lua_State *L, int model)
              * the ratio and the contacts the ranks sum without a gather (the ratio of clumps gathers) */
             const int b = (int)lua_tointeger(L, e + 1);
             if (src == SRC_BUILTIN && (b == B_RATIO || b == B_CONTACTS))
-                sx_lua_checkmodel_summed(L, model, "m:history (ratio, contacts)", b == B_RATIO && sx_clump_count(m) > 0);
+                sx_lua_checkmodel_summed(L, model, b == B_RATIO ? "m:history (ratio)" : "m:history (contacts)",
+                                         b == B_RATIO && sx_clump_count(m) > 0);
             else if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
                 sx_lua_gather(L, m, "m");
             if (src == SRC_BUILTIN)

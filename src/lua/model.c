@@ -762,7 +762,9 @@ static int model_set_gravity(lua_State *L)
 
 static int model_contact_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_contact_count(sx_lua_checkmodel_summed(L, 1, "m:contact_count", false)));
+    const int64_t n = sx_contact_count(sx_lua_checkmodel_summed(L, 1, "m:contact_count", false));
+    if (n < 0) return luaL_error(L, "m:contact_count: the ranks could not exchange their counts");
+    lua_pushinteger(L, (lua_Integer)n);
     return 1;
 }
 
