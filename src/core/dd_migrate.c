@@ -262,13 +262,13 @@ static bool bond_hops(const sx_model *m, const int32_t *old, int32_t *from, hops
     const sx_pairs *p = &m->bb;
     q->n = 0;
     for (int64_t s = 0; s < m->bonds.n; s++) from[s] = d->slot_was[s]; /* -1: in no pair of the last plan */
-    for (int64_t c = 0; c < p->n; c++)
-        if (p->bond[c]) from[p->bond[c] - 1] = -1;
     for (int64_t c = 0; c < p->n; c++) {
         const int32_t s = p->bond[c] - 1;
+        if (s < 0) continue;
+        from[s] = -1; /* in a pair of this plan */
         int r[2];
         int64_t ball[2];
-        const int k = s >= 0 && d->slot_was[s] >= 0 ? pair_steppers(m, c, r, ball) : 0;
+        const int k = d->slot_was[s] >= 0 ? pair_steppers(m, c, r, ball) : 0;
         for (int j = 0; j < k; j++)
             if (d->slot_was[s] != r[j] && old[ball[0]] != r[j] && old[ball[1]] != r[j] && !add_hop(q, s, d->slot_was[s], r[j]))
                 return false;

@@ -523,7 +523,6 @@ static uint64_t mix(uint64_t z)
     return z ^ (z >> 31);
 }
 
-
 /* (model_internal.h) Each digest mixed before the sum, so that no
  * cancellation is cheap. */
 void sx__hash_bag_add(sx_hash_bag *b, uint64_t h)
@@ -732,23 +731,25 @@ bool sx__holds_crack(const sx_model *m, const sx_rows_held *part, int64_t i)
     return a >= part->balls.lo && a < part->balls.hi;
 }
 
+static uint64_t crack_digest(const sx_crack *c)
+{
+    hasher s = {SX_FNV_BASIS};
+    put_int(&s, c->step);
+    put_int(&s, c->mode);
+    put_int(&s, c->kind);
+    put_int(&s, c->a);
+    put_int(&s, c->b);
+    const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
+    put_doubles(&s, v, sizeof v / sizeof *v, 1);
+    return s.h;
+}
+
 /* Each crack's digest (order-free: the ranks hold the log's newest
  * entries in parts until a gather merges them in the serial order). */
 static void bag_cracks(sx_hash_bag *out, const sx_model *m, const sx_rows_held *part)
 {
-    for (int64_t i = 0; i < m->cracks.n; i++) {
-        const sx_crack *c = &m->cracks.ev[i];
-        if (!sx__holds_crack(m, part, i)) continue;
-        hasher s1 = {SX_FNV_BASIS}, *s = &s1;
-        put_int(s, c->step);
-        put_int(s, c->mode);
-        put_int(s, c->kind);
-        put_int(s, c->a);
-        put_int(s, c->b);
-        const double v[] = {c->time, c->pos[0], c->pos[1], c->pos[2], c->fn, c->fs, c->mn, c->ms};
-        put_doubles(s, v, sizeof v / sizeof *v, 1);
-        sx__hash_bag_add(out, s1.h);
-    }
+    for (int64_t i = 0; i < m->cracks.n; i++)
+        if (sx__holds_crack(m, part, i)) sx__hash_bag_add(out, crack_digest(&m->cracks.ev[i]));
 }
 
 static void hash_walls(hasher *s, const sx_model *m)
@@ -933,10 +934,11 @@ uint64_t sx__state_digest(const sx_model *m)
 {
     hasher s = {SX_FNV_BASIS};
     hash_replicated(&s, m);
+    /* the crack log in its order (the ranks hold it whole and alike here) */
+    put_int(&s, m->cracks.n);
+    for (int64_t i = 0; i < m->cracks.n; i++) put_int(&s, (int64_t)crack_digest(&m->cracks.ev[i]));
     const sx_rows_held all = {.all = true};
-    sx_hash_bag cracks = {0, {0, 0}}, clumps = {0, {0, 0}};
-    bag_cracks(&cracks, m, &all);
-    put_bag(&s, &cracks);
+    sx_hash_bag clumps = {0, {0, 0}};
     if (has_clumps(m)) sx__clumps_bag(m, &all, &clumps);
     hash_stores(&s, m, &clumps);
     digest g = {{s.h, SX_FNV_BASIS, ~SX_FNV_BASIS, s.h ^ 0x9e3779b97f4a7c15ULL}};

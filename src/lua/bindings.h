@@ -214,6 +214,10 @@ void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
 /// without a gather; unless `whole`, the query needs the whole state (a
 /// gather) all the same.
 sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole);
+/// model.c: sx_lua_checkmodel_summed for the unbalanced-force ratio, which
+/// a model with clumps computes from the whole state (their owners are not
+/// in clump order), then the ratio.
+double sx_lua_ratio(lua_State *L, int idx, const char *what);
 /// The userdata at idx (a Lua error if it is not a model, closed or not).
 sx_lua_model *sx_lua_modelud(lua_State *L, int idx);
 /// Pushes the table `field` of the state of the model userdata at idx,

@@ -68,13 +68,13 @@ static double energy_term(sx_model *m, int k)
     return terms[k];
 }
 
+/* A builtin but the ratio (sx_lua_ratio: it may gather). */
 static double sample_builtin(sx_model *m, int b)
 {
     switch (b) {
     case B_TIME: return sx_model_time(m);
     case B_STEP: return (double)sx_model_step_count(m);
     case B_TIMESTEP: return sx_model_timestep(m);
-    case B_RATIO: return sx_model_unbalanced_ratio(m);
     case B_CONTACTS: {
         const int64_t n = sx_contact_count(m);
         return n < 0 ? NAN : (double)n; /* (-1: the ranks could not exchange) */
@@ -180,16 +180,17 @@ void sx_lua_history_record(lua_State *L, int model)
             /* a wall's field, the time, the step and the ball count every rank holds after a lazy cycle;
              * the ratio and the contacts the ranks sum without a gather (the ratio of clumps gathers) */
             const int b = (int)lua_tointeger(L, e + 1);
-            if (src == SRC_BUILTIN && (b == B_RATIO || b == B_CONTACTS))
-                sx_lua_checkmodel_summed(L, model, b == B_RATIO ? "m:history (ratio)" : "m:history (contacts)",
-                                         b == B_RATIO && sx_clump_count(m) > 0);
-            else if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
-                sx_lua_gather(L, m, "m");
-            if (src == SRC_BUILTIN)
-                value = sample_builtin(m, (int)lua_tointeger(L, e + 1));
-            else
-                value = sample_entity(m, src, (int64_t)lua_tointeger(L, e + 2), (int)lua_tointeger(L, e + 3),
-                                      (int)lua_tointeger(L, e + 4));
+            if (src == SRC_BUILTIN && b == B_RATIO) {
+                value = sx_lua_ratio(L, model, "m:history (ratio)");
+            } else {
+                if (src == SRC_BUILTIN && b == B_CONTACTS)
+                    sx_lua_checkmodel_summed(L, model, "m:history (contacts)", false);
+                else if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
+                    sx_lua_gather(L, m, "m");
+                value = src == SRC_BUILTIN ? sample_builtin(m, b)
+                                           : sample_entity(m, src, (int64_t)lua_tointeger(L, e + 2),
+                                                           (int)lua_tointeger(L, e + 3), (int)lua_tointeger(L, e + 4));
+            }
             lua_settop(L, e);
         }
         append(L, e, "steps", (lua_Number)sx_model_step_count(m), true);

@@ -62,6 +62,12 @@ sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool
     return m;
 }
 
+double sx_lua_ratio(lua_State *L, int idx, const char *what)
+{
+    const bool clumps = sx_clump_count(sx_lua_checkmodel_scattered(L, idx)) > 0;
+    return sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, idx, what, clumps));
+}
+
 sx_model *sx_lua_checkmodel(lua_State *L, int idx)
 {
     sx_model *m = sx_lua_checkmodel_scattered(L, idx);
@@ -770,8 +776,7 @@ static int model_contact_count(lua_State *L)
 
 static int model_ratio(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
-    lua_pushnumber(L, sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:ratio", sx_clump_count(m) > 0)));
+    lua_pushnumber(L, sx_lua_ratio(L, 1, "m:ratio"));
     return 1;
 }
 

@@ -602,7 +602,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
             break;
         }
         if (lim->ratio > 0 && !first && taken % lim->every == 0) {
-            *ratio = sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:solve (ratio)", sx_clump_count(m) > 0));
+            *ratio = sx_lua_ratio(L, 1, "m:solve (ratio)");
             if (*ratio <= lim->ratio) {
                 why = BY_RATIO;
                 break;
@@ -699,7 +699,7 @@ static int model_solve(lua_State *L)
     double ratio;
     const enum reason why = run_model(L, &lim, &ratio, "m:solve");
     lua_pushstring(L, reason_names[why]);
-    if (isnan(ratio)) ratio = sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, 1, "m:solve (ratio)", sx_clump_count(m) > 0));
+    if (isnan(ratio)) ratio = sx_lua_ratio(L, 1, "m:solve (ratio)");
     lua_pushnumber(L, ratio);
     lua_pushinteger(L, (lua_Integer)(sx_model_step_count(m) - start));
     return 3;
