@@ -42,6 +42,8 @@ typedef struct rank_ctx {
     uint64_t scattered_hash; /* lazy: the hash before the gather, each rank summing its own rows' digests */
     double scattered_ratio;  /* and the unbalanced-force ratio (chained), the bonds and cracks (summed) */
     int64_t scattered_counts[4]; /* bonds, tension and shear cracks, contacts */
+    sx_energy scattered_energy;  /* and the energies (chained), the automatic timestep (the ranks' least) */
+    double scattered_dt;
     sx_energy energy;
     sx_status st;
 } rank_ctx;
@@ -214,6 +216,11 @@ static void run_lazily(rank_ctx *c, sx_model *m)
     c->scattered_ratio = sx_model_unbalanced_ratio(m);
     if (!sx_model_bond_counts(m, c->scattered_counts)) c->st = SX_ENOMEM;
     c->scattered_counts[3] = sx_contact_count(m);
+    c->scattered_energy = sx_model_energy(m);
+    /* the automatic timestep (the scenes' is fixed), then the fixed one again */
+    if (!c->st) c->st = sx_model_set_timestep(m, 0);
+    c->scattered_dt = sx_model_timestep(m);
+    if (!c->st) c->st = sx_model_set_timestep(m, 1e-5);
     if (!c->st && (!sx_model_scattered(m) || sx_model_profile(m).gathers != gathers))
         c->st = SX_EINVAL; /* these queries of a scattered model gather nothing */
     if (!c->st) c->st = sx_model_gather(m);
@@ -285,6 +292,10 @@ START_TEST(ranks_give_the_serial_bits)
         ck_assert_msg(counts[0] == sx_bond_count(serial) && counts[1] + counts[2] == sx_crack_count(serial),
                       "%dD: the counts must be the model's", dim);
         const sx_energy e = sx_model_energy(serial);
+        ck_assert_int_eq(sx_model_set_timestep(serial, 0), SX_OK);
+        const double dt = sx_model_timestep(serial);
+        ck_assert_msg(dt > 0 && dt < 1e-3, "%dD: an automatic timestep (%g s)", dim, dt);
+        ck_assert_int_eq(sx_model_set_timestep(serial, 1e-5), SX_OK);
         ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
         ck_assert_msg(!clumped || e.boundary_work != 0, "%dD: the loads must work on the clumps", dim);
         if (bonded) {
@@ -325,6 +336,13 @@ START_TEST(ranks_give_the_serial_bits)
                               (long long)counts[0], (long long)counts[1], (long long)counts[2], (long long)counts[3]);
                 ck_assert_msg(memcmp(&c[r].energy, &e, sizeof e) == 0,
                               "%dD lazily, %d ranks: rank %d's energies differ from the serial run's", dim, ranks, r);
+                ck_assert_msg(memcmp(&c[r].scattered_energy, &e, sizeof e) == 0,
+                              "%dD lazily, %d ranks: rank %d's energies of the scattered state differ from the serial "
+                              "run's (kinetic %.17g, strain %.17g; serially %.17g, %.17g)", dim, ranks, r,
+                              c[r].scattered_energy.kinetic, c[r].scattered_energy.strain, e.kinetic, e.strain);
+                ck_assert_msg(memcmp(&c[r].scattered_dt, &dt, sizeof dt) == 0,
+                              "%dD lazily, %d ranks: rank %d's timestep of the scattered state %.17g, serially %.17g",
+                              dim, ranks, r, c[r].scattered_dt, dt);
             }
             printf("%dD%s lazily, %d ranks: %lld of %lld runs went on from a scattered state\n", dim,
                    bonded ? " bonded" : clumped ? " clumps" : "", ranks, (long long)c[0].resumed, (long long)c[0].runs);

@@ -115,6 +115,18 @@ static sx_status step_build(sx_model *m, const sx_kernels *k)
     return SX_OK;
 }
 
+sx_status sx__prepare_scattered(sx_model *m)
+{
+    sx_status st = sx__dd_agree_replicated(m);
+    if (!st && whole_needed(m)) st = sx_model_gather(m);
+    if (st) return st;
+    if (!m->dd->scattered) return sx__prepare(m);
+    if ((st = sx__prepare_laws(m))) return st;
+    m->dd->active = true;
+    if (m->build_needed && (st = step_build(m, sx__kernels(m)))) m->dd->active = false; /* as at a step */
+    return st;
+}
+
 sx_status sx_model_gather(sx_model *m)
 {
     if (!m->dd || !m->dd->scattered) return SX_OK;
@@ -183,19 +195,16 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     /* decomposed and scattered: the ranks agree on what they hold whole
      * before any of them gathers (a wall moved on one rank alone would
      * otherwise leave it gathering while the others resume) */
-    if (m->dd && m->dd->scattered && !(st = sx__dd_agree_replicated(m)) && whole_needed(m)) st = sx_model_gather(m);
-    /* the last cycle's plan goes on (nothing but the walls and settings
-     * changed since: a caller that changes more gathers first) */
-    const bool resume = m->dd && m->dd->scattered;
     const sx_kernels *k = sx__kernels(m);
-    if (!st) st = resume ? sx__prepare_laws(m) : sx__prepare(m);
-    if (!st && resume) m->dd->active = true, m->prof.resumed++; /* the timestep is then rated rank by rank */
-    if (!st && resume && m->build_needed) st = step_build(m, k); /* as at a step, from the ranks' own state */
+    if (m->dd && m->dd->scattered) st = sx__prepare_scattered(m);
+    else st = sx__prepare(m);
+    /* the last cycle's plan goes on (nothing but the walls and settings
+     * changed since: a caller that changes more gathers first), the
+     * timestep rated rank by rank */
+    const bool resume = !st && m->dd && m->dd->active;
+    if (resume) m->prof.resumed++;
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
-    if (st) {
-        if (resume) m->dd->active = false;
-        return st;
-    }
+    if (st) return st;
     if ((st = sx__update_timestep(m))) {
         if (resume) m->dd->active = false;
         return st;

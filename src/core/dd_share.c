@@ -124,6 +124,9 @@ bool sx__dd_halo(sx_model *m)
            sx__dd_share(d, B->w, w, d->own, d->need, SX_DD_NEED);
 }
 
+/* (model_internal.h) */
+bool sx__dd_refresh(sx_model *m) { return sx__dd_halo(m) && (!m->clumps || sx__dd_clumps(m)); }
+
 static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
 {
     sx_dd *d = m->dd;

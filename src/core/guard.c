@@ -55,11 +55,6 @@ static double mechanical(const sx_energy *e) { return e->kinetic + e->gravitatio
 
 static const char *const NO_EXCHANGE = "cycle: the ranks could not exchange the state";
 
-/* Decomposed, inside a cycle: the ghosts, and the clumps' state, where
- * the last step left their owners, for an energy sum. False: the ranks
- * could not exchange. */
-static bool refresh_ghosts(sx_model *m) { return sx__dd_halo(m) && (!m->clumps || sx__dd_clumps(m)); }
-
 sx_status sx__guard_start(sx_model *m)
 {
     m->guard_on = unforced(m);
@@ -68,7 +63,7 @@ sx_status sx__guard_start(sx_model *m)
     /* decomposed and gone on from a scattered state: the ghosts where the
      * last step left their owners, as guard_check reads them */
     const bool resumed = m->dd && m->dd->active && m->dd->scattered;
-    if ((resumed && !refresh_ghosts(m)) || !sx__kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    if ((resumed && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     m->guard_e0 = mechanical(&e);
     /* the scale: the energy in play, with a floor of each ball's weight over its radius */
     double floor_e = 0, g = 0;
@@ -113,7 +108,7 @@ sx_status sx__guard_check(sx_model *m)
     if (!m->guard_on || m->guard_scale <= 0) return SX_OK;
     sx_energy e;
     /* decomposed: the ghosts where the step left their owners, for the pairs' strain */
-    if ((m->dd && m->dd->active && !refresh_ghosts(m)) || !sx__kernels(m)->energy(m, &e))
+    if ((m->dd && m->dd->active && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e))
         return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     const double gain = mechanical(&e) - m->guard_e0;
     if (!(gain > GUARD_ENERGY_FACTOR * m->guard_scale)) return SX_OK;

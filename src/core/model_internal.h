@@ -788,6 +788,11 @@ sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *));
 bool sx__dd_plan(sx_model *m);
 bool sx__dd_halo(sx_model *m);
 bool sx__dd_gather(sx_model *m);
+/* The ghosts' motion and every clump's state where the last step left
+ * their owners: what a sum over a rank's own rows reads of the others
+ * (the energy guard's, an energy query's). False: the ranks could not
+ * exchange. */
+bool sx__dd_refresh(sx_model *m);
 /* A build inside a decomposed cycle without the whole state: before it,
  * sx__dd_build shares what every rank's build reads (the positions, the
  * pairs' contact flags and bond links, the bonds' kinds, the cracks, the
@@ -862,6 +867,15 @@ bool sx__dd_energy(sx_model *m);
  * on from a scattered state builds inside the cycle). */
 sx_status sx__prepare(sx_model *m);
 sx_status sx__prepare_laws(sx_model *m);
+/* The same of a model a lazy cycle left scattered (cycle.c), as a cycle
+ * that goes on from it prepares it: the ranks agree on what they hold
+ * whole; the whole state gathered if a check must read every pair (then
+ * sx__prepare); else the laws, and a build when one is due, from the
+ * ranks' own state, the last plan active. On SX_OK with the state still
+ * scattered it leaves the plan active (the caller ends it): each rank
+ * then rates its own rows, and the kernels chain or reduce the ranks'
+ * parts in the serial order, as inside a cycle. A collective call. */
+sx_status sx__prepare_scattered(sx_model *m);
 /* material.c: the pair laws from the materials (before a cycle), and the
  * check that the pairs' models agree. */
 sx_status sx__refresh_laws(sx_model *m);

@@ -17,12 +17,19 @@ sx_energy sx_model_energy(sx_model *m)
     memset(&e, 0, sizeof e);
     /* materials or positions may have changed since the last cycle: the
      * broad phase the next cycle would build anyway sees every overlap */
-    if (sx__prepare(m)) { /* no energy rather than a silent zero */
+    sx_status st = sx_model_scattered(m) ? sx__prepare_scattered(m) : sx__prepare(m);
+    /* scattered (a lazy cycle's): each rank sums its own rows in chains
+     * over the ranks, as the energy guard inside a cycle, the ghosts and
+     * clumps first where their owners left them; else the serial sums,
+     * which cannot fail */
+    const bool split = !st && m->dd && m->dd->active;
+    if (!st && ((split && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)))
+        st = sx__fail(m, SX_EINVAL, "energy: the ranks could not exchange");
+    if (split) m->dd->active = false;
+    if (st) { /* no energy rather than a silent zero */
         double *t = (double *)&e;
         for (size_t k = 0; k < sizeof e / sizeof(double); k++) t[k] = NAN;
-        return e;
     }
-    sx__kernels(m)->energy(m, &e); /* between cycles: the serial sums, which cannot fail */
     return e;
 }
 

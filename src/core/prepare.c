@@ -137,8 +137,12 @@ double sx_model_timestep(sx_model *m)
 {
     if (m->dt_user > 0) return m->dt_user;
     double dt = NAN;
-    if (sx__prepare(m) || next_timestep(m, &dt)) return NAN;
-    return dt;
+    /* scattered (a lazy cycle's): rated rank by rank, as at a resumed cycle's start */
+    sx_status st = sx_model_scattered(m) ? sx__prepare_scattered(m) : sx__prepare(m);
+    const bool split = !st && m->dd && m->dd->active;
+    if (!st) st = next_timestep(m, &dt);
+    if (split) m->dd->active = false;
+    return st ? NAN : dt;
 }
 
 double sx_model_fixed_timestep(const sx_model *m) { return m->dt_user; }

@@ -178,14 +178,19 @@ void sx_lua_history_record(lua_State *L, int model)
             lua_getfield(L, e, "field");
             lua_getfield(L, e, "comp");
             /* a wall's field, the time, the step and the ball count every rank holds after a lazy cycle;
-             * the ratio and the contacts the ranks sum without a gather (the ratio of clumps gathers) */
+             * the ratio, the contacts, the timestep and the energies the ranks reduce without a gather
+             * (the ratio of clumps gathers) */
             const int b = (int)lua_tointeger(L, e + 1);
             if (src == SRC_BUILTIN && b == B_RATIO) {
                 value = sx_lua_ratio(L, model, "m:history (ratio)");
             } else {
-                if (src == SRC_BUILTIN && b == B_CONTACTS)
-                    sx_lua_checkmodel_summed(L, model, "m:history (contacts)", false);
-                else if (src == SRC_BALL || (src == SRC_BUILTIN && b != B_TIME && b != B_STEP && b != B_BALLS))
+                if (src == SRC_BUILTIN && (b == B_CONTACTS || b == B_TIMESTEP || b >= B_ENERGY0))
+                    sx_lua_checkmodel_summed(L, model,
+                                             b == B_CONTACTS   ? "m:history (contacts)"
+                                             : b == B_TIMESTEP ? "m:history (timestep)"
+                                                               : "m:history (energy)",
+                                             false);
+                else if (src == SRC_BALL)
                     sx_lua_gather(L, m, "m");
                 value = src == SRC_BUILTIN ? sample_builtin(m, b)
                                            : sample_entity(m, src, (int64_t)lua_tointeger(L, e + 2),

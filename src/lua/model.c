@@ -721,7 +721,7 @@ static int push_timestep(lua_State *L, const sx_model *m, double dt, const char 
 
 static int model_timestep(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:timestep", false); /* scattered: the ranks' least rating */
     return push_timestep(L, m, sx_model_timestep(m), "m:timestep");
 }
 
@@ -782,7 +782,7 @@ static int model_ratio(lua_State *L)
 
 static int model_energy(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:energy", false); /* scattered: the ranks' sums chained */
     const sx_energy e = sx_model_energy(m);
     if (isnan(e.kinetic)) sx_lua_check(L, m, SX_EINVAL, "m:energy");
     const struct {

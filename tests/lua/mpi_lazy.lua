@@ -50,8 +50,10 @@ m:on("after", function()
   lid.vel = {0, v}
 end)
 local broken, first, h = 0, nil, nil
--- a history of the ratio: its records gather nothing (the ranks' sums chained)
+-- histories of the ratio, energies and the timestep: their records gather
+-- nothing (the ranks' sums chained, the least rating)
 m:history("ratio", "ratio", {every = 50})
+for _, name in ipairs{"kinetic", "strain", "bond_strain", "timestep"} do m:history(name, name, {every = 50}) end
 if scene == "events" then
   m:on("bond_break", function(_, e)
     broken = broken + 1
@@ -69,10 +71,23 @@ local hash = m:hash()
 if m:ranks() > 1 and m:profile{print = false}.gathers ~= p.gathers then
   error("m:hash() gathered the scattered state")
 end
+-- nor its energies and timestep: chained, the ghosts where their owners left them
+local e, dt = m:energy(), m:timestep()
+if m:ranks() > 1 and m:profile{print = false}.gathers ~= p.gathers then
+  error("m:energy() or m:timestep() gathered the scattered state")
+end
+print(string.format("energy: kinetic %.17g strain %.17g bond strain %.17g; timestep %.17g", e.kinetic, e.strain,
+                    e.bond_strain, dt))
 print(string.format("lid at %.17g m, force %.17g N, %d bonds, %d broken (first at step %s)", lid.point[2],
                     lid.force[2], m:bond_count(), broken, tostring(first)))
 h = m:history("ratio")
 print(string.format("ratio %d samples, last %.17g", #h.values, h.values[#h.values]))
+for _, name in ipairs{"kinetic", "strain", "bond_strain", "timestep"} do
+  h = m:history(name)
+  local sum = 0
+  for _, v in ipairs(h.values) do sum = sum + v end
+  print(string.format("%s %d samples, sum %.17g, last %.17g", name, #h.values, sum, h.values[#h.values]))
+end
 if scene == "events" then
   h = m:history("probe_y")
   print(string.format("probe %d samples, last %.17g", #h.values, h.values[#h.values]))
@@ -83,7 +98,7 @@ local resumed, cycles = p.resumed - p0.resumed, p.cycles - p0.cycles
 if scene == "servo" and m:ranks() > 1 and resumed < 0.9 * cycles then
   error(string.format("%d of %d cycles went on from the last one's scattered state", resumed, cycles))
 end
-if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the ratio's history read no ball
+if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the histories read no ball
   error(string.format("the servo's cycle gathered the state %d times", p.gathers - p0.gathers))
 end
 local why, ratio, steps = m:solve{ratio = 1e-2, steps = 2000}
