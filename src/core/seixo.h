@@ -59,7 +59,8 @@ SX_API double sx_model_time(const sx_model *m);        ///< s
 SX_API int64_t sx_model_step_count(const sx_model *m); ///< steps taken
 
 /// The timestep the next step will use (s): the user's value, or the
-/// automatic one computed from the current contacts.
+/// automatic one computed from the current contacts. On a model a lazy
+/// cycle left scattered, a collective call (the ranks' least rating).
 SX_API double sx_model_timestep(sx_model *m);
 /// The critical timestep estimate sqrt(m/k) over balls, without safety factor (s).
 SX_API double sx_model_critical_timestep(sx_model *m);
@@ -868,7 +869,9 @@ typedef struct sx_energy {
 
 /// Energies of the current state (computed on demand, O(N + contacts)) and
 /// the accumulated terms; every term NaN when the model cannot be prepared
-/// (sx_model_error says why: a skin refused, materials that cannot meet).
+/// (sx_model_error says why: a skin refused, materials that cannot meet,
+/// ranks that could not exchange). On a model a lazy cycle left
+/// scattered, a collective call (the ranks' sums chained: the serial bits).
 SX_API sx_energy sx_model_energy(sx_model *m);
 /// Switches tracking of the accumulated terms on (reset to zero) or off.
 SX_API void sx_model_track_energy(sx_model *m, bool on);
