@@ -496,6 +496,22 @@ int64_t sx_ball_id_at(const sx_model *m, int64_t i)
 
 bool sx_ball_exists(const sx_model *m, int64_t id) { return sx__ball_index(m, id) >= 0; }
 
+/* A ball's rows are cheaper to fetch one at a time than the whole state
+ * for a few balls; a script that reads more (a loop over the balls) is
+ * served by one gather. */
+enum { FETCH_MAX = 16 };
+
+sx_status sx_ball_fetch(sx_model *m, int64_t id)
+{
+    if (!sx_model_scattered(m) || !sx_ball_exists(m, id)) return SX_OK;
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "ball %lld: the model is stepping", (long long)id);
+    /* a pebble's motion is its clump's, stepped by the clump's owner */
+    if (sx_clump_count(m) > 0 || ++m->dd->fetched > FETCH_MAX) return sx_model_gather(m);
+    if (!sx__dd_fetch_ball(m, sx__ball_index(m, id)))
+        return sx__fail(m, SX_EINVAL, "ball %lld: the ranks could not exchange its state", (long long)id);
+    return SX_OK;
+}
+
 /* Resolves an id or fails with a message naming the caller. */
 static int64_t lookup(const sx_model *m, int64_t id, const char *fn)
 {

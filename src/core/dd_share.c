@@ -127,6 +127,15 @@ bool sx__dd_halo(sx_model *m)
 /* (model_internal.h) */
 bool sx__dd_refresh(sx_model *m) { return sx__dd_halo(m) && (!m->clumps || sx__dd_clumps(m)); }
 
+bool sx__dd_fetch_ball(sx_model *m, int64_t i)
+{
+    sx_dd *d = m->dd;
+    const int32_t list[1] = {(int32_t)i};
+    for (int r = 0; r < d->x.ranks; r++) d->scratch[r] = (sx_span){0, i >= d->own[r].lo && i < d->own[r].hi};
+    const sx_rows f = sx__dd_ball_motion(m, true);
+    return sx__dd_move_rows(d, &f, list, 0, 1, d->scratch, sx__dd_everything(d, 1), 1);
+}
+
 static bool gather_pairs(sx_model *m, sx_pairs *p, const sx_span *own)
 {
     sx_dd *d = m->dd;

@@ -602,6 +602,7 @@ sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
     d->scattered = true;
+    d->fetched = 0;
     return d->lazy ? SX_OK : sx__dd_whole(m, replan);
 }
 

@@ -402,6 +402,7 @@ typedef struct sx_dd {
     bool walls_stale;       /* the walls' resultants lag their blocks' sums (sx__dd_walls) */
     bool lazy;              /* a cycle leaves the state scattered (sx_model_gather_lazily) */
     bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
+    int fetched;            /* scattered: the balls' rows fetched since the cycle's end (sx_ball_fetch) */
     bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
     int64_t fail_order;     /* its error's place in the serial order where that is not the ranks' (a clump's index) */
     bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */
@@ -793,6 +794,10 @@ bool sx__dd_gather(sx_model *m);
  * (the energy guard's, an energy query's). False: the ranks could not
  * exchange. */
 bool sx__dd_refresh(sx_model *m);
+/* The motion of ball i (position, velocity, spin, force, moment) from the
+ * rank that owns it in the last plan to every rank. False: the ranks
+ * could not exchange. */
+bool sx__dd_fetch_ball(sx_model *m, int64_t i);
 /* A build inside a decomposed cycle without the whole state: before it,
  * sx__dd_build shares what every rank's build reads (the positions, the
  * pairs' contact flags and bond links, the bonds' kinds, the cracks, the

@@ -12,6 +12,18 @@ const sx_lua_kind sx_lua_ball_kind = {"seixo.ball", "ball", sx_ball_exists, "ext
 
 /* The ball of the handle at index 1: live, in an open model. */
 static sx_model *check_ball(lua_State *L, int64_t *id) { return sx_lua_checkhandle(L, 1, &ball_kind, id); }
+/* A read of a field every rank holds whole after a decomposed cycle (the
+ * radius, material, fixity, group, applied loads: changed only by calls
+ * that gather first). */
+static sx_model *check_ball_whole(lua_State *L, int64_t *id) { return sx_lua_checkhandle_whole(L, 1, &ball_kind, id); }
+/* A read of its motion, which a lazy cycle leaves current on its rank
+ * alone: fetched from there (sx_lua_fetch_ball). */
+static sx_model *check_ball_motion(lua_State *L, int64_t *id)
+{
+    sx_model *m = check_ball_whole(L, id);
+    sx_lua_fetch_ball(L, m, "b", *id);
+    return m;
+}
 
 /* The index of the named material, or -1 with the message pushed. */
 static int find_material(lua_State *L, const sx_model *m, const char *name)
@@ -32,7 +44,8 @@ static int vec_len(const sx_model *m, sx_ball_vec which)
 static int get_vec(lua_State *L, sx_ball_vec which)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const bool motion = which != SX_BALL_APPLIED_FORCE && which != SX_BALL_APPLIED_MOMENT;
+    const sx_model *m = motion ? check_ball_motion(L, &id) : check_ball_whole(L, &id);
     double v[3];
     sx_lua_checkfield(L, m, sx_ball_get_vec(m, id, which, v), "ball");
     sx_lua_pushvec(L, v, vec_len(m, which));
@@ -52,7 +65,7 @@ static int set_vec(lua_State *L, sx_ball_vec which)
 static int get_scalar(lua_State *L, sx_ball_scalar which)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     double v;
     sx_lua_checkfield(L, m, sx_ball_get(m, id, which, &v), "ball");
     lua_pushnumber(L, v);
@@ -91,7 +104,7 @@ static int set_damping(lua_State *L) { return set_scalar(L, SX_BALL_DAMPING); }
 static int get_id(lua_State *L)
 {
     int64_t id;
-    check_ball(L, &id);
+    check_ball_whole(L, &id);
     lua_pushinteger(L, (lua_Integer)id);
     return 1;
 }
@@ -99,7 +112,7 @@ static int get_id(lua_State *L)
 static int get_material(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     int mat;
     sx_lua_checkfield(L, m, sx_ball_material(m, id, &mat), "ball");
     lua_pushstring(L, sx_material_name(m, mat));
@@ -184,7 +197,7 @@ void sx_lua_pushfixmask(lua_State *L, unsigned mask)
 static int get_fix(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     unsigned mask;
     sx_lua_checkfield(L, m, sx_ball_fixity(m, id, &mask), "ball");
     sx_lua_pushfixmask(L, mask);
@@ -195,7 +208,7 @@ static int get_fix(lua_State *L)
 static int get_clump(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     const int64_t c = sx_ball_clump(m, id);
     if (!c) return 0;
     lua_getiuservalue(L, 1, 1);
@@ -217,7 +230,7 @@ static int set_fix(lua_State *L)
 static int get_group(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     int32_t g;
     sx_lua_checkfield(L, m, sx_ball_group(m, id, &g), "ball");
     lua_getiuservalue(L, 1, 1);
@@ -242,7 +255,7 @@ static int set_group(lua_State *L)
 static int get_groups(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_whole(L, &id);
     lua_getiuservalue(L, 1, 1);
     const int model = lua_gettop(L);
     lua_newtable(L);
@@ -366,7 +379,7 @@ static int ball_remove(lua_State *L)
 static int get_disp(lua_State *L)
 {
     int64_t id;
-    const sx_model *m = check_ball(L, &id);
+    const sx_model *m = check_ball_motion(L, &id);
     return sx_lua_ball_disp(L, m, id);
 }
 

@@ -207,6 +207,10 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx);
 /// function as called on `self`, "m" or "b": m:save, b.pos); a failed
 /// exchange stops every rank.
 void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
+/// A scattered model's ball `id`: its motion from the rank that holds it
+/// to every rank (sx_ball_fetch; the whole state after a few balls), a
+/// collective call behind the same check as sx_lua_gather.
+void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id);
 /// Like sx_lua_checkmodel for a query the core answers of a scattered
 /// model with a small collective exchange of its own (the ranks' sums over
 /// the rows they hold: sx_model_state_hash, sx_model_bond_counts,
@@ -515,6 +519,9 @@ void sx_lua_pushhandle(lua_State *L, int model, const sx_lua_kind *k, int64_t id
 /// The id of the handle at idx and its model; a closed model or a removed
 /// object is a Lua error.
 sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id);
+/// The same without the gather: for a read of what every rank holds whole
+/// after a decomposed cycle (a ball's radius, material, fixity, ...).
+sx_model *sx_lua_checkhandle_whole(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id);
 /// Reads a handle of kind k of the model userdata at `model`, or an integer
 /// id, at idx into *id: returns NULL, or pushes and returns what is wrong (a
 /// handle of another model is refused, not read as a plain id).

@@ -190,8 +190,8 @@ void sx_lua_history_record(lua_State *L, int model)
                                              : b == B_TIMESTEP ? "m:history (timestep)"
                                                                : "m:history (energy)",
                                              false);
-                else if (src == SRC_BALL)
-                    sx_lua_gather(L, m, "m");
+                else if (src == SRC_BALL) /* its motion from its rank (a few balls; then a gather) */
+                    sx_lua_fetch_ball(L, m, "m", (int64_t)lua_tointeger(L, e + 2));
                 value = src == SRC_BUILTIN ? sample_builtin(m, b)
                                            : sample_entity(m, src, (int64_t)lua_tointeger(L, e + 2),
                                                            (int)lua_tointeger(L, e + 3), (int)lua_tointeger(L, e + 4));

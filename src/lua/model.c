@@ -29,28 +29,46 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx)
     return m;
 }
 
-void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
+/* A collective step of a scattered model's call, checked under the call's
+ * name as the script wrote it (m:save, b.pos: a field, through __index)
+ * and marked with the step (gather, fetch), so that a rank in one step of
+ * a call never meets another rank's other step of the same call; a failed
+ * exchange stops every rank. */
+static void collective(lua_State *L, sx_model *m, const char *self, const char *step,
+                       sx_status (*fn)(sx_model *m, int64_t id), int64_t id)
 {
-    if (!sx_model_scattered(m)) return;
-    /* named as the script wrote the call (m:save, b.pos: a field, through
-     * __index) and marked, so that a rank gathering inside a call never
-     * meets another rank's other collective step of the same call */
     lua_Debug ar;
     const bool named = lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.name;
     char what[96];
     if (named && strcmp(ar.namewhat, "metamethod") == 0 && lua_type(L, 2) == LUA_TSTRING)
-        snprintf(what, sizeof what, "%s.%s (gather)", self, lua_tostring(L, 2));
+        snprintf(what, sizeof what, "%s.%s (%s)", self, lua_tostring(L, 2), step);
     else if (named)
-        snprintf(what, sizeof what, "%s:%s (gather)", self, ar.name);
+        snprintf(what, sizeof what, "%s:%s (%s)", self, ar.name, step);
     else
-        snprintf(what, sizeof what, "a query of %s (gather)", self);
+        snprintf(what, sizeof what, "a query of %s (%s)", self, step);
     sx_lua_check_model_call(L, m, what);
-    if (sx_model_gather(m) != SX_OK) {
+    if (fn(m, id) != SX_OK) {
         char msg[1024];
         luaL_where(L, 1);
         snprintf(msg, sizeof msg, "%s%s: %s", lua_tostring(L, -1), what, sx_lua_core_message(sx_model_error(m)));
         sx_lua_parallel_fail(msg);
     }
+}
+
+static sx_status gather(sx_model *m, int64_t unused)
+{
+    (void)unused;
+    return sx_model_gather(m);
+}
+
+void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
+{
+    if (sx_model_scattered(m)) collective(L, m, self, "gather", gather, 0);
+}
+
+void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id)
+{
+    if (sx_model_scattered(m)) collective(L, m, self, "fetch", sx_ball_fetch, id);
 }
 
 sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole)
@@ -65,7 +83,12 @@ sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool
 double sx_lua_ratio(lua_State *L, int idx, const char *what)
 {
     const bool clumps = sx_clump_count(sx_lua_checkmodel_scattered(L, idx)) > 0;
-    return sx_model_unbalanced_ratio(sx_lua_checkmodel_summed(L, idx, what, clumps));
+    sx_model *m = sx_lua_checkmodel_summed(L, idx, what, clumps);
+    const bool scattered = sx_model_scattered(m);
+    const double ratio = sx_model_unbalanced_ratio(m);
+    /* NaN only from the ranks' chain (a serial ratio is a number or infinite) */
+    if (scattered && isnan(ratio)) luaL_error(L, "%s: the ranks could not sum the ratio (out of memory?)", what);
+    return ratio;
 }
 
 sx_model *sx_lua_checkmodel(lua_State *L, int idx)
@@ -806,7 +829,11 @@ static int model_energy(lua_State *L)
 static int model_hash(lua_State *L)
 {
     char hex[17];
-    uint64_t h = sx_model_state_hash(sx_lua_checkmodel_summed(L, 1, "m:hash", false));
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:hash", false);
+    uint64_t h = sx_model_state_hash(m);
+    /* 0: a rank could not hash its part or the ranks could not add them
+     * (a serial hash is 0 with odds of 2^-64) */
+    if (!h && sx_model_scattered(m)) return luaL_error(L, "m:hash: the ranks could not hash the state (out of memory?)");
     const uint64_t slots = sx_lua_slots_digest(L, 1);
     if (slots) h = (h ^ slots) * 0x9e3779b97f4a7c15u + 1;
     snprintf(hex, sizeof hex, "%016" PRIx64, h);

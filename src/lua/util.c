@@ -443,15 +443,21 @@ static sx_model *tohandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *
     return m;
 }
 
-sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id)
+sx_model *sx_lua_checkhandle_whole(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id)
 {
     sx_model *m = tohandle(L, idx, k, id);
     if (!m) luaL_error(L, "the model has been closed");
+    if (!k->exists(m, *id)) luaL_error(L, "%s %I has been removed", k->name, (lua_Integer)*id);
+    return m;
+}
+
+sx_model *sx_lua_checkhandle(lua_State *L, int idx, const sx_lua_kind *k, int64_t *id)
+{
+    sx_model *m = sx_lua_checkhandle_whole(L, idx, k, id); /* the ids every rank holds alike */
     if (!k->replicated) {
         const char self[2] = {k->name[0], 0}; /* b.pos, b:remove: as the manual writes a ball's calls */
         sx_lua_gather(L, m, self);
     }
-    if (!k->exists(m, *id)) luaL_error(L, "%s %I has been removed", k->name, (lua_Integer)*id);
     return m;
 }
 

@@ -10,7 +10,7 @@
 --   tmpname  os.tmpname on rank 0 alone
 --   cycle    a cycle on the last rank alone, the others at the script's end
 --   query    a ball's position read on rank 0 alone after a cycle, which
---            left each rank its own balls: the read gathers them
+--            left each rank its own balls: the read fetches it from its rank
 --   handler  a bond_break handler set on rank 0 alone, the model whole on
 --            every rank (registering it then makes no collective call):
 --            its cycles end at multiples of 100 steps, the others' do not
@@ -48,7 +48,7 @@ elseif scene == "tmpname" then
 elseif scene == "cycle" then
   if seixo.rank() == seixo.ranks() - 1 then m:cycle(100) end
 elseif scene == "handler" then
-  local _ = m:ball(1).pos -- every rank: the state whole again
+  local _ = m:contacts() -- every rank: the state whole again
   if first then m:on("bond_break", function() end) end
   m:cycle(300)
 elseif scene == "time" then

@@ -20,8 +20,9 @@ if arg and arg[1] == "wall" then
   print("not stopped")
   return
 end
+local _ = m:contacts() -- every rank: a query of every contact gathers the state the cycle left on each
 local b = m:ball(57)
-local v = b.vel:copy() -- every rank: a query gathers the state the cycle left on each
+local v = b.vel:copy()
 if seixo.rank() > 0 then
   v[1] = v[1] ~= 0 and v[1] * (1 + 2 ^ -52) or 2 ^ -1074
   b.vel = v

@@ -54,6 +54,11 @@ local broken, first, h = 0, nil, nil
 -- nothing (the ranks' sums chained, the least rating)
 m:history("ratio", "ratio", {every = 50})
 for _, name in ipairs{"kinetic", "strain", "bond_strain", "timestep"} do m:history(name, name, {every = 50}) end
+-- and of two balls' motion, one through a function: each read fetches its
+-- ball's row from its rank
+m:history("ball_vy", {ball = 400, field = "vel", component = "y"}, {every = 50})
+local watched = m:ball(799)
+m:history("ball_x", function() return watched.pos[1] + watched.force[2] end, {every = 50})
 if scene == "events" then
   m:on("bond_break", function(_, e)
     broken = broken + 1
@@ -82,7 +87,7 @@ print(string.format("lid at %.17g m, force %.17g N, %d bonds, %d broken (first a
                     lid.force[2], m:bond_count(), broken, tostring(first)))
 h = m:history("ratio")
 print(string.format("ratio %d samples, last %.17g", #h.values, h.values[#h.values]))
-for _, name in ipairs{"kinetic", "strain", "bond_strain", "timestep"} do
+for _, name in ipairs{"kinetic", "strain", "bond_strain", "timestep", "ball_vy", "ball_x"} do
   h = m:history(name)
   local sum = 0
   for _, v in ipairs(h.values) do sum = sum + v end
@@ -100,6 +105,14 @@ if scene == "servo" and m:ranks() > 1 and resumed < 0.9 * cycles then
 end
 if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the histories read no ball
   error(string.format("the servo's cycle gathered the state %d times", p.gathers - p0.gathers))
+end
+-- a loop over many balls' motion fetches 16 balls' rows, then gathers once
+if scene == "servo" then
+  local before, sum = m:profile{print = false}.gathers, 0
+  for id = 1, 40 do sum = sum + m:ball(id).pos[2] end
+  local gathers = m:profile{print = false}.gathers - before
+  if m:ranks() > 1 and gathers ~= 1 then error(string.format("40 balls' positions read with %d gathers", gathers)) end
+  print(string.format("40 heights: %.17g", sum))
 end
 local why, ratio, steps = m:solve{ratio = 1e-2, steps = 2000}
 print(string.format("solve: %s ratio %.17g after %d steps; hash %s", why, ratio, steps, m:hash()))
