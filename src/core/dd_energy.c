@@ -82,27 +82,22 @@ bool sx__dd_clump_energy(sx_model *m, int w, int nd, int64_t size)
  * before it, in a chain from rank 0 (which starts from acc as given), and
  * the last rank's total goes to every rank: the serial sum's every
  * rounding, in R steps of one message. part(m, r, acc) adds rank r's
- * terms to acc (len doubles). False: the ranks could not exchange. */
+ * terms to acc (len doubles). The running sum moves in acc itself (each
+ * step's one entry: rank k's, to rank k + 1, the last to all), so nothing
+ * is allocated. False: the ranks could not exchange. */
 bool sx__dd_chain(const sx_model *m, double *acc, int len, void (*part)(const sx_model *m, int rank, double *acc))
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks, me = d->x.rank;
-    double *buf = calloc((size_t)R * (size_t)len, sizeof *buf);
-    if (!buf) return false;
-    for (int r = 0; r < R; r++) d->scratch[r] = (sx_span){r, r + 1}; /* rank r's running sum: entry r */
     bool ok = true;
     for (int k = 0; ok && k < R; k++) {
-        if (k == me) {
-            if (k) memcpy(acc, buf + (k - 1) * len, (size_t)len * sizeof *acc);
-            part(m, k, acc);
-            memcpy(buf + k * len, acc, (size_t)len * sizeof *acc);
+        if (k == me) part(m, k, acc); /* onto the sum rank k - 1 sent (rank 0: acc as given) */
+        for (int r = 0; r < R; r++) {
+            d->scratch[r] = r == k ? (sx_span){0, 1} : (sx_span){0, 0};
+            d->all[r] = k + 1 == R || r == k + 1 ? (sx_span){0, 1} : (sx_span){0, 0};
         }
-        for (int r = 0; r < R; r++) /* the next rank takes rank k's sum; the total goes to all */
-            d->all[r] = k + 1 == R || r == k + 1 ? (sx_span){k, k + 1} : (sx_span){0, 0};
-        ok = sx__dd_share(d, buf, (size_t)len * sizeof *buf, d->scratch, d->all, 1);
+        ok = sx__dd_share(d, acc, (size_t)len * sizeof *acc, d->scratch, d->all, 1);
     }
-    if (ok) memcpy(acc, buf + (R - 1) * len, (size_t)len * sizeof *acc);
-    free(buf);
     return ok;
 }
 
@@ -163,8 +158,8 @@ bool sx__dd_energy(sx_model *m)
 {
     sx_dd *d = m->dd;
     const int64_t K = m->nchunk, nb = m->nblock, len = 3 * K + 5 * nb;
-    double *s = calloc((size_t)len, sizeof *s);
-    const bool ok = s && !d->tape.lost && sx__dd_chain(m, s, (int)len, energy_part);
+    double s[3 * SX_CHUNKS_MAX + 5 * SX_MOTION_BLOCKS] = {0}; /* no allocation in a step's exchange */
+    const bool ok = !d->tape.lost && sx__dd_chain(m, s, (int)len, energy_part);
     d->tape.n = 0;
     for (int64_t c = 0; ok && c < K; c++) {
         m->acc.slip += s[3 * c];
@@ -180,6 +175,5 @@ bool sx__dd_energy(sx_model *m)
         m->acc.boundary_work += s[3 * K + 2 * nb + 3 * b + 1];
         m->acc.viscous += s[3 * K + 2 * nb + 3 * b + 2];
     }
-    free(s);
     return ok;
 }

@@ -4,6 +4,7 @@
 #include "clumps.h"
 #include "decompose.h"
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -103,15 +104,14 @@ bool sx__dd_sum(const sx_model *m, uint64_t *v, int n)
 {
     sx_dd *d = m->dd;
     const int R = d->x.ranks;
-    uint64_t *all = calloc((size_t)R * (size_t)n, sizeof *all);
-    if (!all) return false;
+    assert(n <= SX_DD_SUM_MAX);
+    uint64_t *all = d->sums; /* kept from the decomposition: nothing to allocate, nothing to fail alone */
     memcpy(all + (size_t)d->x.rank * (size_t)n, v, (size_t)n * sizeof *v);
     const bool ok = sx__dd_share_by_rank(d, all, (size_t)n * sizeof *all);
     for (int k = 0; ok && k < n; k++) {
         v[k] = 0;
         for (int r = 0; r < R; r++) v[k] += all[(size_t)r * (size_t)n + (size_t)k];
     }
-    free(all);
     return ok;
 }
 

@@ -81,6 +81,7 @@ void sx__dd_free(sx_model *m)
     free(d->cross);
     free(d->work);
     free(d->pace);
+    free(d->sums);
     free(d->xchunk.cracks);
     free(d->tape.e);
     free(d->was);
@@ -107,7 +108,9 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     enum { SPANS = 15 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(3 * r * r, sizeof *routes) : NULL;
     double *pace = routes ? calloc(5 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r), stopping (2 r) */
-    if (!pace) {
+    uint64_t *sums = pace ? calloc(SX_DD_SUM_MAX * r, sizeof *sums) : NULL;
+    if (!sums) {
+        free(pace);
         free(routes);
         free(s);
         free(d);
@@ -122,6 +125,7 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->bb_was = s + 12 * r, d->bw_was = s + 13 * r;
     d->fwd.need = routes, d->back.need = routes + r * r, d->cterm_need = routes + 2 * r * r;
     d->pace = pace, d->sample = pace + r, d->stopping = pace + 3 * r;
+    d->sums = sums;
     d->received = &m->prof.received;
     m->dd = d;
     return SX_OK;

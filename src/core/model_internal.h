@@ -286,6 +286,7 @@ typedef struct sx_wall_acc {
 } sx_wall_acc;
 
 #define SX_MOTION_BLOCKS 64 /* at most this many blocks */
+#define SX_CHUNKS_MAX 16    /* the ball-ball pass's chunks, at most */
 
 typedef struct sx_block {
     int64_t b0, b1;        /* balls [b0, b1) */
@@ -455,6 +456,7 @@ typedef struct sx_dd {
      * sample, and its planned work per step (the cut's) */
     double *pace, *sample;
     double *stopping; /* sx__dd_stop's exchange: per rank its last unanswered interrupt and answered level */
+    uint64_t *sums;   /* sx__dd_sum's exchange: SX_DD_SUM_MAX a rank */
     double busy, busy_work;
     int64_t planned;
     /* a build inside a cycle from what each rank holds current (sx__dd_build,
@@ -935,7 +937,9 @@ typedef struct sx_rows_held {
 } sx_rows_held;
 bool sx__dd_rows_held(const sx_model *m, sx_rows_held *part); /* false: out of memory */
 bool sx__holds_crack(const sx_model *m, const sx_rows_held *part, int64_t i); /* crack log entry i (state.c) */
-bool sx__dd_sum(const sx_model *m, uint64_t *v, int n);      /* each v[k] summed over the ranks (mod 2^64) */
+/* each v[k], k < n <= SX_DD_SUM_MAX, summed over the ranks (mod 2^64) */
+#define SX_DD_SUM_MAX 24
+bool sx__dd_sum(const sx_model *m, uint64_t *v, int n);
 void sx__clumps_bag(const sx_model *m, const sx_rows_held *part, sx_hash_bag *out); /* each clump's digest */
 /* FNV-1a over n bytes, continuing h (the state hash), from SX_FNV_BASIS. */
 #define SX_FNV_BASIS 0xcbf29ce484222325ULL

@@ -837,7 +837,7 @@ static void ball_chunk_below(sx_model *m, sx_chunk *o)
  * of at least CHUNK_PAIRS pairs, at most MAX_CHUNKS; MAX_CHUNKS / 2 bounds
  * the useful thread count of that pass, MOTION_BLOCKS that of the per-ball
  * passes. */
-enum { CHUNK_PAIRS = 1024, MAX_CHUNKS = 16, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
+enum { CHUNK_PAIRS = 1024, MAX_CHUNKS = SX_CHUNKS_MAX, MOTION_BLOCKS = SX_MOTION_BLOCKS, MOTION_MIN = 256 };
 
 static bool plan_chunks(sx_model *m)
 {
