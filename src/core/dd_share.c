@@ -41,8 +41,14 @@ bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
     size_t w = 0;
     for (int k = 0; k < f->nf; k++) w += f->row[k];
     if (!n || !w) return true;
-    char *buf = malloc((size_t)n * w);
-    if (!buf) return false;
+    /* kept from call to call (a step's exchanges move rows of about the
+     * same sizes every step): grown, never allocated anew each time */
+    if ((size_t)n * w > d->cap_rowbuf) {
+        char *q = realloc(d->rowbuf, (size_t)n * w);
+        if (!q) return false;
+        d->rowbuf = q, d->cap_rowbuf = (size_t)n * w;
+    }
+    char *buf = d->rowbuf;
     const int me = d->x.rank;
     bool ok = true;
     for (int pass = 0; ok && pass < 1 + nper; pass++) { /* pack this rank's, then unpack each span it needs */
@@ -58,7 +64,6 @@ bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
         }
         if (!pass) ok = sx__dd_share(d, buf, w, own, need, nper);
     }
-    free(buf);
     return ok;
 }
 

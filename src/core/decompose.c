@@ -82,6 +82,7 @@ void sx__dd_free(sx_model *m)
     free(d->work);
     free(d->pace);
     free(d->sums);
+    free(d->rowbuf);
     free(d->xchunk.cracks);
     free(d->tape.e);
     free(d->was);

@@ -457,6 +457,8 @@ typedef struct sx_dd {
     double *pace, *sample;
     double *stopping; /* sx__dd_stop's exchange: per rank its last unanswered interrupt and answered level */
     uint64_t *sums;   /* sx__dd_sum's exchange: SX_DD_SUM_MAX a rank */
+    char *rowbuf;     /* sx__dd_move_rows' packed rows, kept */
+    size_t cap_rowbuf;
     double busy, busy_work;
     int64_t planned;
     /* a build inside a cycle from what each rank holds current (sx__dd_build,
