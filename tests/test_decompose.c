@@ -43,7 +43,7 @@ typedef struct rank_ctx {
     double scattered_ratio;  /* and the unbalanced-force ratio (chained), the bonds and cracks (summed) */
     int64_t scattered_counts[4]; /* bonds, tension and shear cracks, contacts */
     sx_energy scattered_energy;  /* and the energies (chained), the automatic timestep (the ranks' least) */
-    double scattered_dt;
+    double scattered_dt, scattered_crit; /* and the critical estimate */
     bool cut_off;                /* the exchanges fail (every rank alike) */
     char cut_off_error[SX_ERRLEN]; /* an energy query's error then */
     sx_energy energy;
@@ -223,6 +223,7 @@ static void run_lazily(rank_ctx *c, sx_model *m)
     /* the automatic timestep (the scenes' is fixed), then the fixed one again */
     if (!c->st) c->st = sx_model_set_timestep(m, 0);
     c->scattered_dt = sx_model_timestep(m);
+    c->scattered_crit = sx_model_critical_timestep(m);
     if (!c->st) c->st = sx_model_set_timestep(m, 1e-5);
     /* ranks that cannot exchange: no hash, ratio or energy, and an error rather than a number */
     c->cut_off = true;
@@ -303,7 +304,7 @@ START_TEST(ranks_give_the_serial_bits)
                       "%dD: the counts must be the model's", dim);
         const sx_energy e = sx_model_energy(serial);
         ck_assert_int_eq(sx_model_set_timestep(serial, 0), SX_OK);
-        const double dt = sx_model_timestep(serial);
+        const double dt = sx_model_timestep(serial), crit = sx_model_critical_timestep(serial);
         ck_assert_msg(dt > 0 && dt < 1e-3, "%dD: an automatic timestep (%g s)", dim, dt);
         ck_assert_int_eq(sx_model_set_timestep(serial, 1e-5), SX_OK);
         ck_assert_msg(e.slip > 0 && e.viscous > 0 && e.local_damping > 0, "every dissipation must act");
@@ -353,6 +354,9 @@ START_TEST(ranks_give_the_serial_bits)
                 ck_assert_msg(strstr(c[r].cut_off_error, "could not exchange"),
                               "%dD lazily, %d ranks: rank %d's energy without exchanges: '%s'", dim, ranks, r,
                               c[r].cut_off_error);
+                ck_assert_msg(memcmp(&c[r].scattered_crit, &crit, sizeof crit) == 0,
+                              "%dD lazily, %d ranks: rank %d's critical timestep of the scattered state %.17g, "
+                              "serially %.17g", dim, ranks, r, c[r].scattered_crit, crit);
                 ck_assert_msg(memcmp(&c[r].scattered_dt, &dt, sizeof dt) == 0,
                               "%dD lazily, %d ranks: rank %d's timestep of the scattered state %.17g, serially %.17g",
                               dim, ranks, r, c[r].scattered_dt, dt);

@@ -496,19 +496,27 @@ int64_t sx_ball_id_at(const sx_model *m, int64_t i)
 
 bool sx_ball_exists(const sx_model *m, int64_t id) { return sx__ball_index(m, id) >= 0; }
 
-/* A ball's rows are cheaper to fetch one at a time than the whole state
- * for a few balls; a script that reads more (a loop over the balls) is
- * served by one gather. */
+/* A ball's row is cheaper to fetch alone than every ball's motion for a
+ * few balls; a script that reads more (a loop over the balls) is served
+ * by one exchange of every ball's motion, which then holds until the next
+ * cycle. */
 enum { FETCH_MAX = 16 };
 
 sx_status sx_ball_fetch(sx_model *m, int64_t id)
 {
-    if (!sx_model_scattered(m) || !sx_ball_exists(m, id)) return SX_OK;
+    sx_dd *d = m->dd;
+    if (!sx_model_scattered(m) || d->motion_whole) return SX_OK;
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball %lld: the model is stepping", (long long)id);
-    /* a pebble's motion is its clump's, stepped by the clump's owner */
-    if (sx_clump_count(m) > 0 || ++m->dd->fetched > FETCH_MAX) return sx_model_gather(m);
-    if (!sx__dd_fetch_ball(m, sx__ball_index(m, id)))
+    if (sx_clump_count(m) > 0) return sx_model_gather(m); /* a pebble's motion is its clump's, stepped by its owner */
+    /* ranks reading the same field of different balls at once (a loop
+     * over pairs() of a table, whose order each process draws) are served
+     * by a gather, as they were before any fetch: the same on every rank */
+    if (!d->x.agree(d->x.ud, (uint64_t)id)) return sx_model_gather(m);
+    if (!sx_ball_exists(m, id)) return SX_OK;
+    const bool every = ++d->fetched > FETCH_MAX;
+    if (!sx__dd_fetch_ball(m, every ? -1 : sx__ball_index(m, id)))
         return sx__fail(m, SX_EINVAL, "ball %lld: the ranks could not exchange its state", (long long)id);
+    d->motion_whole = every;
     return SX_OK;
 }
 

@@ -142,6 +142,7 @@ static void energy_part(const sx_model *m, int r, double *acc)
             motion[3 * b] = o->damp_work, motion[3 * b + 1] = o->load_work, motion[3 * b + 2] = o->visc_work;
     }
     for (int64_t e = 0; e < d->tape.n; e++) acc[d->tape.e[e].k] += d->tape.e[e].v;
+    acc[3 * K + 5 * nb] += d->tape.lost; /* the ranks whose tape ran out of memory: every rank learns of them */
 }
 
 /* The serial step adds its chunks' energy sums to m->acc in chunk order,
@@ -158,8 +159,9 @@ bool sx__dd_energy(sx_model *m)
 {
     sx_dd *d = m->dd;
     const int64_t K = m->nchunk, nb = m->nblock, len = 3 * K + 5 * nb;
-    double s[3 * SX_CHUNKS_MAX + 5 * SX_MOTION_BLOCKS] = {0}; /* no allocation in a step's exchange */
-    const bool ok = !d->tape.lost && sx__dd_chain(m, s, (int)len, energy_part);
+    double s[3 * SX_CHUNKS_MAX + 5 * SX_MOTION_BLOCKS + 1] = {0}; /* no allocation in a step's exchange */
+    const bool ok = sx__dd_chain(m, s, (int)len + 1, energy_part) && s[len] == 0;
+    d->tape.lost = false;
     d->tape.n = 0;
     for (int64_t c = 0; ok && c < K; c++) {
         m->acc.slip += s[3 * c];

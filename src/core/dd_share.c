@@ -41,8 +41,9 @@ bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
     size_t w = 0;
     for (int k = 0; k < f->nf; k++) w += f->row[k];
     if (!n || !w) return true;
-    /* kept from call to call (a step's exchanges move rows of about the
-     * same sizes every step): grown, never allocated anew each time */
+    /* kept from call to call inside a cycle (a step's exchanges move rows
+     * of about the same sizes every step): grown, not allocated anew each
+     * time; freed at the cycle's end (sx__dd_end) */
     if ((size_t)n * w > d->cap_rowbuf) {
         char *q = realloc(d->rowbuf, (size_t)n * w);
         if (!q) return false;
@@ -135,9 +136,15 @@ bool sx__dd_refresh(sx_model *m) { return sx__dd_halo(m) && (!m->clumps || sx__d
 bool sx__dd_fetch_ball(sx_model *m, int64_t i)
 {
     sx_dd *d = m->dd;
+    const sx_rows f = sx__dd_ball_motion(m, true);
+    if (i < 0) { /* every ball's, field by field from the owners' slabs */
+        const int64_t n = d->own[d->x.ranks - 1].hi; /* the balls the slabs cover (not a periodic cell's ghost slots) */
+        for (int k = 0; k < f.nf; k++)
+            if (!sx__dd_share(d, f.field[k], f.row[k], d->own, sx__dd_everything(d, n), 1)) return false;
+        return true;
+    }
     const int32_t list[1] = {(int32_t)i};
     for (int r = 0; r < d->x.ranks; r++) d->scratch[r] = (sx_span){0, i >= d->own[r].lo && i < d->own[r].hi};
-    const sx_rows f = sx__dd_ball_motion(m, true);
     return sx__dd_move_rows(d, &f, list, 0, 1, d->scratch, sx__dd_everything(d, 1), 1);
 }
 

@@ -591,10 +591,20 @@ sx_status sx__dd_agree_replicated(sx_model *m)
     return agree(m, sx__replicated_digest(m), "the walls or settings differ", "a branch on seixo.rank()");
 }
 
+/* The moves' buffer serves a cycle's steps, not the model's life: a
+ * build's migration or a gather may have grown it to the whole state. */
+static void drop_rowbuf(sx_dd *d)
+{
+    free(d->rowbuf);
+    d->rowbuf = NULL, d->cap_rowbuf = 0;
+}
+
 sx_status sx__dd_whole(sx_model *m, bool (*replan)(sx_model *))
 {
     sx_dd *d = m->dd;
-    if (!sx__dd_gather(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
+    const bool ok = sx__dd_gather(m);
+    drop_rowbuf(d);
+    if (!ok) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
     d->scattered = false;
     if (!replan(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     return SX_OK;
@@ -607,7 +617,8 @@ sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
     d->scattered = true;
-    d->fetched = 0;
+    d->fetched = 0, d->motion_whole = false;
+    drop_rowbuf(d);
     return d->lazy ? SX_OK : sx__dd_whole(m, replan);
 }
 

@@ -403,7 +403,8 @@ typedef struct sx_dd {
     bool walls_stale;       /* the walls' resultants lag their blocks' sums (sx__dd_walls) */
     bool lazy;              /* a cycle leaves the state scattered (sx_model_gather_lazily) */
     bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
-    int fetched;            /* scattered: the balls' rows fetched since the cycle's end (sx_ball_fetch) */
+    int fetched;            /* scattered: the balls' rows fetched since the cycle's end (sx_ball_fetch), */
+    bool motion_whole;      /* and whether every ball's motion has been shared since */
     bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
     int64_t fail_order;     /* its error's place in the serial order where that is not the ranks' (a clump's index) */
     bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */
@@ -799,8 +800,8 @@ bool sx__dd_gather(sx_model *m);
  * exchange. */
 bool sx__dd_refresh(sx_model *m);
 /* The motion of ball i (position, velocity, spin, force, moment) from the
- * rank that owns it in the last plan to every rank. False: the ranks
- * could not exchange. */
+ * rank that owns it in the last plan to every rank; of every ball when i
+ * is negative. False: the ranks could not exchange. */
 bool sx__dd_fetch_ball(sx_model *m, int64_t i);
 /* A build inside a decomposed cycle without the whole state: before it,
  * sx__dd_build shares what every rank's build reads (the positions, the
@@ -885,6 +886,10 @@ sx_status sx__prepare_laws(sx_model *m);
  * then rates its own rows, and the kernels chain or reduce the ranks'
  * parts in the serial order, as inside a cycle. A collective call. */
 sx_status sx__prepare_scattered(sx_model *m);
+/* A query's start (energy, timestep, critical timestep): sx__prepare, or
+ * of a scattered model sx__prepare_scattered; *split: the last plan is
+ * left active, which the caller ends (m->dd->active = false). */
+sx_status sx__prepare_query(sx_model *m, bool *split);
 /* material.c: the pair laws from the materials (before a cycle), and the
  * check that the pairs' models agree. */
 sx_status sx__refresh_laws(sx_model *m);

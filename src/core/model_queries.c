@@ -17,12 +17,12 @@ sx_energy sx_model_energy(sx_model *m)
     memset(&e, 0, sizeof e);
     /* materials or positions may have changed since the last cycle: the
      * broad phase the next cycle would build anyway sees every overlap */
-    sx_status st = sx_model_scattered(m) ? sx__prepare_scattered(m) : sx__prepare(m);
+    bool split;
+    sx_status st = sx__prepare_query(m, &split);
     /* scattered (a lazy cycle's): each rank sums its own rows in chains
      * over the ranks, as the energy guard inside a cycle, the ghosts and
      * clumps first where their owners left them; else the serial sums,
      * which cannot fail */
-    const bool split = !st && m->dd && m->dd->active;
     if (!st && ((split && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)))
         st = sx__fail(m, SX_EINVAL, "energy: the ranks could not exchange");
     if (split) m->dd->active = false;

@@ -125,10 +125,24 @@ sx_status sx__update_timestep(sx_model *m)
     return st;
 }
 
+sx_status sx__prepare_query(sx_model *m, bool *split)
+{
+    const sx_status st = sx_model_scattered(m) ? sx__prepare_scattered(m) : sx__prepare(m);
+    *split = !st && m->dd && m->dd->active;
+    return st;
+}
+
 double sx_model_critical_timestep(sx_model *m)
 {
-    if (sx__prepare(m)) return NAN;
-    return sx__kernels(m)->critical_dt(m);
+    bool split;
+    double crit = NAN;
+    /* scattered: each rank rates its own balls, the ghosts where their owners left them */
+    if (!sx__prepare_query(m, &split) && ((split && !sx__dd_halo(m)) || !sx__critical(m, &crit))) {
+        sx__fail(m, SX_EINVAL, "critical timestep: the ranks could not exchange");
+        crit = NAN;
+    }
+    if (split) m->dd->active = false;
+    return crit;
 }
 
 /* A query: the timestep is computed, not stored, so that asking for it
@@ -137,9 +151,8 @@ double sx_model_timestep(sx_model *m)
 {
     if (m->dt_user > 0) return m->dt_user;
     double dt = NAN;
-    /* scattered (a lazy cycle's): rated rank by rank, as at a resumed cycle's start */
-    sx_status st = sx_model_scattered(m) ? sx__prepare_scattered(m) : sx__prepare(m);
-    const bool split = !st && m->dd && m->dd->active;
+    bool split; /* scattered (a lazy cycle's): rated rank by rank, as at a resumed cycle's start */
+    sx_status st = sx__prepare_query(m, &split);
     if (!st) st = next_timestep(m, &dt);
     if (split) m->dd->active = false;
     return st ? NAN : dt;

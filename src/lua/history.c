@@ -42,7 +42,7 @@ static const char *const ball_fields[] = {"pos",    "vel",    "spin",    "force"
 static const int ball_which[] = {SX_BALL_POS, SX_BALL_VEL, SX_BALL_SPIN, SX_BALL_FORCE, SX_BALL_MOMENT,
                                  SX_BALL_APPLIED_FORCE, SX_BALL_APPLIED_MOMENT, SX_BALL_RADIUS, SX_BALL_MASS,
                                  SX_BALL_INERTIA, SX_BALL_DAMPING};
-enum { BALL_FIRST_SCALAR = 7 };
+enum { BALL_FIRST_LOAD = 5, BALL_FIRST_SCALAR = 7 }; /* the motion (a step's), the loads, the properties */
 static const char *const wall_fields[] = {"force", "moment", "vel", "point", NULL};
 static const char *const comp_names[] = {"x", "y", "z", NULL};
 
@@ -190,7 +190,7 @@ void sx_lua_history_record(lua_State *L, int model)
                                              : b == B_TIMESTEP ? "m:history (timestep)"
                                                                : "m:history (energy)",
                                              false);
-                else if (src == SRC_BALL) /* its motion from its rank (a few balls; then a gather) */
+                else if (src == SRC_BALL && lua_tointeger(L, e + 3) < BALL_FIRST_LOAD) /* its motion from its rank */
                     sx_lua_fetch_ball(L, m, "m", (int64_t)lua_tointeger(L, e + 2));
                 value = src == SRC_BUILTIN ? sample_builtin(m, b)
                                            : sample_entity(m, src, (int64_t)lua_tointeger(L, e + 2),

@@ -86,8 +86,8 @@ double sx_lua_ratio(lua_State *L, int idx, const char *what)
     sx_model *m = sx_lua_checkmodel_summed(L, idx, what, clumps);
     const bool scattered = sx_model_scattered(m);
     const double ratio = sx_model_unbalanced_ratio(m);
-    /* NaN only from the ranks' chain (a serial ratio is a number or infinite) */
-    if (scattered && isnan(ratio)) luaL_error(L, "%s: the ranks could not sum the ratio (out of memory?)", what);
+    /* NaN from the ranks' chain (a cycle ends on a force that is not finite) */
+    if (scattered && isnan(ratio)) luaL_error(L, "%s: the ranks could not sum the ratio", what);
     return ratio;
 }
 
@@ -750,7 +750,7 @@ static int model_timestep(lua_State *L)
 
 static int model_critical_timestep(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:critical_timestep", false); /* scattered: the ranks' least */
     return push_timestep(L, m, sx_model_critical_timestep(m), "m:critical_timestep");
 }
 

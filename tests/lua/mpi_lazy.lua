@@ -106,13 +106,17 @@ end
 if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the histories read no ball
   error(string.format("the servo's cycle gathered the state %d times", p.gathers - p0.gathers))
 end
--- a loop over many balls' motion fetches 16 balls' rows, then gathers once
+-- a loop over many balls' motion fetches 16 balls' rows, then every
+-- ball's motion at once (no gather)
 if scene == "servo" then
   local before, sum = m:profile{print = false}.gathers, 0
-  for id = 1, 40 do sum = sum + m:ball(id).pos[2] end
+  for id = 1, 40 do
+    local b = m:ball(id)
+    sum = sum + b.pos[2] + b.vel[1] + b.force[2]
+  end
   local gathers = m:profile{print = false}.gathers - before
-  if m:ranks() > 1 and gathers ~= 1 then error(string.format("40 balls' positions read with %d gathers", gathers)) end
-  print(string.format("40 heights: %.17g", sum))
+  if m:ranks() > 1 and gathers ~= 0 then error(string.format("40 balls' motion read with %d gathers", gathers)) end
+  print(string.format("40 balls' heights, velocities and forces: %.17g", sum))
 end
 local why, ratio, steps = m:solve{ratio = 1e-2, steps = 2000}
 print(string.format("solve: %s ratio %.17g after %d steps; hash %s", why, ratio, steps, m:hash()))
