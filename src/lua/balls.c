@@ -430,11 +430,11 @@ static int next_ball(lua_State *L) { return sx_lua_nexthandle(L, &ball_kind); }
 /* m:balls([filter]): an iterator over a snapshot of the balls (that pass the filter). */
 static int model_balls(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
-    if (lua_isnoneornil(L, 2)) {
+    if (lua_isnoneornil(L, 2)) { /* the ids every rank holds (a read of a ball's motion fetches it) */
         sx_lua_pushiterator(L, 1, sx_ball_count, sx_ball_id_at, next_ball);
         return 1;
     }
+    const sx_model *m = sx_lua_checkmodel(L, 1); /* a filter may read the balls' places */
     sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     sx_lua_filter f;
     sx_lua_filter_read(L, 1, 2, &f);
