@@ -314,7 +314,8 @@ static void check_timestep(lua_State *L, run *r)
      * peak a fixed timestep's run would not otherwise reach), from what
      * every rank holds alike (the balls' radii, masses and materials) */
     if (!(dt * TINY_TIMESTEP < sx_model_critical_timestep_bound(r->m))) return;
-    sx_lua_gather(L, r->m, "m"); /* decomposed: every rank alike (the model's calls are) */
+    /* decomposed and scattered: the ranks' least rating, a collective call (every rank alike, as the model's calls are) */
+    if (sx_model_scattered(r->m)) sx_lua_check_model_call(L, r->m, "m:cycle (critical timestep)");
     const double crit = sx_model_critical_timestep(r->m);
     if (crit > 0 && dt * TINY_TIMESTEP < crit)
         sx_lua_warn_once(L, r->model, "timestep",
