@@ -806,7 +806,7 @@ bool sx__dd_fetch_ball(sx_model *m, int64_t i);
 /* A build inside a decomposed cycle without the whole state: before it,
  * sx__dd_build shares what every rank's build reads (the positions, the
  * pairs' contact flags and bond links, the bonds' kinds, the cracks, the
- * clumps; periodic space: the whole state); the build keeps each new
+ * clumps; periodic space too); the build keeps each new
  * pair's old one (sx__dd_keep_sources); after the plan, sx__dd_migrate
  * moves to the ranks that now step them the balls, pairs and bonds the
  * cut gave another rank. False: the exchange failed, or out of memory. */
