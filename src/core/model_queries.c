@@ -143,8 +143,13 @@ double sx_model_unbalanced_ratio(const sx_model *m)
     int64_t bodies = m->balls.n;
     const bool clumps = sx_clump_count(m) > 0;
     if (sx_model_scattered(m)) { /* the ranks' sums in a chain, each rank's own rows */
-        if (clumps || !sx__dd_chain(m, acc, R_SUMS, ratio_balls_part) || !sx__dd_chain(m, acc, R_SUMS, ratio_walls_part))
-            return NAN;
+        /* the clumps after the balls, as serially: their resultants from
+         * their owners to every rank (which refreshes the copies of other
+         * ranks' clumps: the state is as it was), every rank adding all of
+         * them in clump order */
+        if (!sx__dd_chain(m, acc, R_SUMS, ratio_balls_part) || (clumps && !sx__dd_clumps((sx_model *)m))) return NAN;
+        if (clumps) sx__clumps_unbalanced(m, &acc[R_UNBALANCED], &bodies);
+        if (!sx__dd_chain(m, acc, R_SUMS, ratio_walls_part)) return NAN;
     } else {
         add_unbalanced(m, 0, m->balls.n, &acc[R_UNBALANCED]);
         if (clumps) sx__clumps_unbalanced(m, &acc[R_UNBALANCED], &bodies);

@@ -123,8 +123,8 @@ SX_API unsigned sx_interrupts_agreed(void);
 /// contacts, infinity when forces act but no contact carries any. Of a
 /// decomposed model left scattered (sx_model_scattered), a collective call:
 /// the ranks' sums over their own balls and contacts chained in the serial
-/// order (the serial bits); NAN if it has clumps (gather it first) or the
-/// ranks could not exchange.
+/// order, the clumps' resultants from their owners (the serial bits); NAN
+/// if the ranks could not exchange.
 SX_API double sx_model_unbalanced_ratio(const sx_model *m);
 
 /// A 64-bit hash of everything a restart restores, in a canonical form

@@ -214,13 +214,11 @@ void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id);
 /// Like sx_lua_checkmodel for a query the core answers of a scattered
 /// model with a small collective exchange of its own (the ranks' sums over
 /// the rows they hold: sx_model_state_hash, sx_model_bond_counts,
-/// sx_model_unbalanced_ratio): behind the same-call check, named `what`,
-/// without a gather; unless `whole`, the query needs the whole state (a
-/// gather) all the same.
-sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole);
-/// model.c: sx_lua_checkmodel_summed for the unbalanced-force ratio, which
-/// a model with clumps computes from the whole state (their owners are not
-/// in clump order), then the ratio.
+/// sx_model_unbalanced_ratio, sx_model_energy, ...): behind the same-call
+/// check, named `what`, without a gather.
+sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what);
+/// model.c: the unbalanced-force ratio behind sx_lua_checkmodel_summed, a
+/// Lua error when the ranks could not sum it.
 double sx_lua_ratio(lua_State *L, int idx, const char *what);
 /// The userdata at idx (a Lua error if it is not a model, closed or not).
 sx_lua_model *sx_lua_modelud(lua_State *L, int idx);

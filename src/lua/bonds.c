@@ -175,7 +175,7 @@ static int model_bond(lua_State *L)
  * a gather under mpirun). */
 static void bond_counts(lua_State *L, const char *what, int64_t counts[3])
 {
-    const sx_model *m = sx_lua_checkmodel_summed(L, 1, what, false);
+    const sx_model *m = sx_lua_checkmodel_summed(L, 1, what);
     if (!sx_model_bond_counts(m, counts)) luaL_error(L, "%s: out of memory, or the ranks could not exchange", what);
 }
 

@@ -178,8 +178,7 @@ void sx_lua_history_record(lua_State *L, int model)
             lua_getfield(L, e, "field");
             lua_getfield(L, e, "comp");
             /* a wall's field, the time, the step and the ball count every rank holds after a lazy cycle;
-             * the ratio, the contacts, the timestep and the energies the ranks reduce without a gather
-             * (the ratio of clumps gathers) */
+             * the ratio, the contacts, the timestep and the energies the ranks reduce without a gather */
             const int b = (int)lua_tointeger(L, e + 1);
             if (src == SRC_BUILTIN && b == B_RATIO) {
                 value = sx_lua_ratio(L, model, "m:history (ratio)");
@@ -188,8 +187,7 @@ void sx_lua_history_record(lua_State *L, int model)
                     sx_lua_checkmodel_summed(L, model,
                                              b == B_CONTACTS   ? "m:history (contacts)"
                                              : b == B_TIMESTEP ? "m:history (timestep)"
-                                                               : "m:history (energy)",
-                                             false);
+                                                               : "m:history (energy)");
                 else if (src == SRC_BALL && lua_tointeger(L, e + 3) < BALL_FIRST_LOAD) /* its motion from its rank */
                     sx_lua_fetch_ball(L, m, "m", (int64_t)lua_tointeger(L, e + 2));
                 value = src == SRC_BUILTIN ? sample_builtin(m, b)

@@ -71,19 +71,16 @@ void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id)
     if (sx_model_scattered(m)) collective(L, m, self, "fetch", sx_ball_fetch, id);
 }
 
-sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what, bool whole)
+sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what)
 {
     sx_model *m = sx_lua_checkmodel_scattered(L, idx);
-    if (!sx_model_scattered(m)) return m;
-    if (whole) sx_lua_gather(L, m, "m");
-    else sx_lua_check_model_call(L, m, what);
+    if (sx_model_scattered(m)) sx_lua_check_model_call(L, m, what);
     return m;
 }
 
 double sx_lua_ratio(lua_State *L, int idx, const char *what)
 {
-    const bool clumps = sx_clump_count(sx_lua_checkmodel_scattered(L, idx)) > 0;
-    sx_model *m = sx_lua_checkmodel_summed(L, idx, what, clumps);
+    sx_model *m = sx_lua_checkmodel_summed(L, idx, what);
     const bool scattered = sx_model_scattered(m);
     const double ratio = sx_model_unbalanced_ratio(m);
     /* NaN from the ranks' chain (a cycle ends on a force that is not finite) */
@@ -744,13 +741,13 @@ static int push_timestep(lua_State *L, const sx_model *m, double dt, const char 
 
 static int model_timestep(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:timestep", false); /* scattered: the ranks' least rating */
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:timestep"); /* scattered: the ranks' least rating */
     return push_timestep(L, m, sx_model_timestep(m), "m:timestep");
 }
 
 static int model_critical_timestep(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:critical_timestep", false); /* scattered: the ranks' least */
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:critical_timestep"); /* scattered: the ranks' least */
     return push_timestep(L, m, sx_model_critical_timestep(m), "m:critical_timestep");
 }
 
@@ -791,7 +788,7 @@ static int model_set_gravity(lua_State *L)
 
 static int model_contact_count(lua_State *L)
 {
-    const int64_t n = sx_contact_count(sx_lua_checkmodel_summed(L, 1, "m:contact_count", false));
+    const int64_t n = sx_contact_count(sx_lua_checkmodel_summed(L, 1, "m:contact_count"));
     if (n < 0) return luaL_error(L, "m:contact_count: the ranks could not exchange their counts");
     lua_pushinteger(L, (lua_Integer)n);
     return 1;
@@ -805,7 +802,7 @@ static int model_ratio(lua_State *L)
 
 static int model_energy(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:energy", false); /* scattered: the ranks' sums chained */
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:energy"); /* scattered: the ranks' sums chained */
     const sx_energy e = sx_model_energy(m);
     if (isnan(e.kinetic)) sx_lua_check(L, m, SX_EINVAL, "m:energy");
     const struct {
@@ -829,7 +826,7 @@ static int model_energy(lua_State *L)
 static int model_hash(lua_State *L)
 {
     char hex[17];
-    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:hash", false);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:hash");
     uint64_t h = sx_model_state_hash(m);
     /* 0: a rank could not hash its part or the ranks could not add them
      * (a serial hash is 0 with odds of 2^-64) */

@@ -132,7 +132,7 @@ static int model_cell_control(lua_State *L)
 
 static int model_cell_stress(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:cell_stress", false);
+    sx_model *m = sx_lua_checkmodel_summed(L, 1, "m:cell_stress");
     double s[3][3], volume;
     sx_lua_check(L, m, sx_cell_stress(m, s, &volume), "m:cell_stress");
     sx_lua_push_tensor(L, s, sx_model_dim(m));
