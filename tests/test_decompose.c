@@ -44,6 +44,7 @@ typedef struct rank_ctx {
     int64_t scattered_counts[4]; /* bonds, tension and shear cracks, contacts */
     sx_energy scattered_energy;  /* and the energies (chained), the automatic timestep (the ranks' least) */
     double scattered_dt, scattered_crit; /* and the critical estimate */
+    double motion[4][9];         /* balls' position, velocity and force read after sx_ball_fetch (motion_of) */
     bool cut_off;                /* the exchanges fail (every rank alike) */
     char cut_off_error[SX_ERRLEN]; /* an energy query's error then */
     sx_energy energy;
@@ -201,6 +202,23 @@ static sx_model *clump_bed(int dim)
 
 enum { STEPS_A = 150, STEPS_B = 250 };
 
+/* Four balls' position, velocity and force (ids spread over the ranks'
+ * slabs), each read as a script reads it: fetched first (the fourth after
+ * 16 other fetches, which share every ball's motion). */
+static sx_status motion_of(sx_model *m, double out[4][9])
+{
+    const int64_t n = sx_ball_count(m), id[4] = {1, n / 2, n, n / 3};
+    sx_status st = SX_OK;
+    for (int k = 0; k < 4 && !st; k++) {
+        for (int64_t extra = 0; k == 3 && extra < 16 && !st; extra++) st = sx_ball_fetch(m, 2 + extra);
+        if (!st) st = sx_ball_fetch(m, id[k]);
+        if (!st) st = sx_ball_get_vec(m, id[k], SX_BALL_POS, out[k]);
+        if (!st) st = sx_ball_get_vec(m, id[k], SX_BALL_VEL, out[k] + 3);
+        if (!st) st = sx_ball_get_vec(m, id[k], SX_BALL_FORCE, out[k] + 6);
+    }
+    return st;
+}
+
 /* Lazily: cycles A and B in runs of 1 to 7 steps, each going on from the
  * state the last left scattered (builds inside them and at their starts,
  * the plan kept over the runs), the whole state gathered once at the end. */
@@ -220,6 +238,7 @@ static void run_lazily(rank_ctx *c, sx_model *m)
     if (!sx_model_bond_counts(m, c->scattered_counts)) c->st = SX_ENOMEM;
     c->scattered_counts[3] = sx_contact_count(m);
     c->scattered_energy = sx_model_energy(m);
+    if (!c->st) c->st = motion_of(m, c->motion);
     /* the automatic timestep (the scenes' is fixed), then the fixed one again */
     if (!c->st) c->st = sx_model_set_timestep(m, 0);
     c->scattered_dt = sx_model_timestep(m);
@@ -303,6 +322,9 @@ START_TEST(ranks_give_the_serial_bits)
         ck_assert_msg(counts[0] == sx_bond_count(serial) && counts[1] + counts[2] == sx_crack_count(serial),
                       "%dD: the counts must be the model's", dim);
         const sx_energy e = sx_model_energy(serial);
+        double motion[4][9];
+        memset(motion, 0, sizeof motion);
+        ck_assert_int_eq(motion_of(serial, motion), SX_OK);
         ck_assert_int_eq(sx_model_set_timestep(serial, 0), SX_OK);
         const double dt = sx_model_timestep(serial), crit = sx_model_critical_timestep(serial);
         ck_assert_msg(dt > 0 && dt < 1e-3, "%dD: an automatic timestep (%g s)", dim, dt);
@@ -350,6 +372,9 @@ START_TEST(ranks_give_the_serial_bits)
                               "%dD lazily, %d ranks: rank %d's energies of the scattered state differ from the serial "
                               "run's (kinetic %.17g, strain %.17g; serially %.17g, %.17g)", dim, ranks, r,
                               c[r].scattered_energy.kinetic, c[r].scattered_energy.strain, e.kinetic, e.strain);
+                ck_assert_msg(memcmp(c[r].motion, motion, sizeof motion) == 0,
+                              "%dD lazily, %d ranks: rank %d's balls' motion read from the scattered state differs "
+                              "from the serial run's", dim, ranks, r);
                 ck_assert_msg(strstr(c[r].cut_off_error, "could not exchange"),
                               "%dD lazily, %d ranks: rank %d's energy without exchanges: '%s'", dim, ranks, r,
                               c[r].cut_off_error);

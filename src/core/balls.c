@@ -507,7 +507,6 @@ sx_status sx_ball_fetch(sx_model *m, int64_t id)
     sx_dd *d = m->dd;
     if (!sx_model_scattered(m) || d->motion_whole) return SX_OK;
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball %lld: the model is stepping", (long long)id);
-    if (sx_clump_count(m) > 0) return sx_model_gather(m); /* a pebble's motion is its clump's, stepped by its owner */
     /* ranks reading the same field of different balls at once (a loop
      * over pairs() of a table, whose order each process draws) are served
      * by a gather, as they were before any fetch: the same on every rank */

@@ -406,9 +406,9 @@ SX_API sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec whic
 /// holds it current to every rank, where sx_ball_get_vec then reads it as
 /// after a gather (its other fields every rank holds whole). A collective
 /// call; ranks that pass different ids get the whole state gathered
-/// (sx_model_gather), as does a model with clumps (a pebble's motion is
-/// its clump's). The 17th call since the last cycle shares every ball's
-/// motion instead, which then holds until the next cycle (no exchange).
+/// (sx_model_gather). The 17th call since the last cycle shares every
+/// ball's motion instead, which then holds until the next cycle (no
+/// exchange).
 /// SX_OK at once when not scattered or no such ball; SX_ELOCKED while m
 /// is stepping; SX_EINVAL when the ranks could not exchange.
 SX_API sx_status sx_ball_fetch(sx_model *m, int64_t id);
