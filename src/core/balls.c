@@ -502,6 +502,8 @@ bool sx_ball_exists(const sx_model *m, int64_t id) { return sx__ball_index(m, id
  * cycle. */
 enum { FETCH_MAX = 16 };
 
+bool sx_model_motion_current(const sx_model *m) { return !sx_model_scattered(m) || m->dd->motion_whole; }
+
 sx_status sx_ball_fetch(sx_model *m, int64_t id)
 {
     sx_dd *d = m->dd;

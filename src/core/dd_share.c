@@ -41,9 +41,9 @@ bool sx__dd_move_rows(sx_dd *d, const sx_rows *f, const int32_t *list, int64_t b
     size_t w = 0;
     for (int k = 0; k < f->nf; k++) w += f->row[k];
     if (!n || !w) return true;
-    /* kept from call to call inside a cycle (a step's exchanges move rows
-     * of about the same sizes every step): grown, not allocated anew each
-     * time; freed at the cycle's end (sx__dd_end) */
+    /* kept from call to call (a step's exchanges move rows of about the
+     * same sizes every step): grown, not allocated anew each time; freed
+     * at a cycle's end when a large move grew it (sx__dd_end) */
     if ((size_t)n * w > d->cap_rowbuf) {
         char *q = realloc(d->rowbuf, (size_t)n * w);
         if (!q) return false;

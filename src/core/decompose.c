@@ -544,7 +544,7 @@ bool sx__dd_plan(sx_model *m)
      * they clear, to its own and its near ghosts */
     const sx_span pr = d->pairs[me], lo = d->need[SX_DD_NEED * me], hi = d->need[SX_DD_NEED * me + 1];
     d->xchunk.tape_at = -1;
-    d->tape.n = 0;
+    d->tape.n = 0, d->tape.lost = false;
     for (int64_t c = 0; c < m->nchunk; c++) {
         sx_chunk *o = &m->chunks[c];
         plan_energy(o, d->bb_own[me]);
@@ -591,10 +591,15 @@ sx_status sx__dd_agree_replicated(sx_model *m)
     return agree(m, sx__replicated_digest(m), "the walls or settings differ", "a branch on seixo.rank()");
 }
 
-/* The moves' buffer serves a cycle's steps, not the model's life: a
- * build's migration or a gather may have grown it to the whole state. */
+/* The moves' buffer serves a cycle's steps, kept from cycle to cycle (a
+ * script of one-step cycles moves the same rows at each), but not at the
+ * size of the whole state a build's migration or a gather may have grown
+ * it to. */
+enum { ROWBUF_KEEP = 1 << 20 };
+
 static void drop_rowbuf(sx_dd *d)
 {
+    if (d->cap_rowbuf <= ROWBUF_KEEP) return;
     free(d->rowbuf);
     d->rowbuf = NULL, d->cap_rowbuf = 0;
 }

@@ -63,6 +63,7 @@ SX_API int64_t sx_model_step_count(const sx_model *m); ///< steps taken
 /// cycle left scattered, a collective call (the ranks' least rating).
 SX_API double sx_model_timestep(sx_model *m);
 /// The critical timestep estimate sqrt(m/k) over balls, without safety factor (s).
+/// On a model a lazy cycle left scattered, a collective call (the ranks' least).
 SX_API double sx_model_critical_timestep(sx_model *m);
 /// Sets a fixed timestep (s > 0), or 0 to return to the automatic one.
 SX_API sx_status sx_model_set_timestep(sx_model *m, double dt);
@@ -175,8 +176,11 @@ SX_API int sx_model_ranks(const sx_model *m);
 /// (scattered); the walls, their loads and resultants, the tracked
 /// energies' sums and the time are whole either way. A scattered model's next cycle goes on
 /// from where the last one stopped, without the exchange of the whole
-/// state; anything else that reads or changes the balls, pairs, bonds or
-/// clumps must first call sx_model_gather. Nothing when not decomposed.
+/// state; the queries that say so answer a scattered model with exchanges
+/// of their own (collective calls: the state hash, the ratio, the counts,
+/// the energies, the timesteps, sx_ball_fetch before a ball's motion is
+/// read), and anything else that reads or changes the balls, pairs, bonds
+/// or clumps must first call sx_model_gather. Nothing when not decomposed.
 SX_API void sx_model_gather_lazily(sx_model *m, bool lazily);
 /// Whether the last cycle left m's state scattered (see above).
 SX_API bool sx_model_scattered(const sx_model *m);
@@ -412,6 +416,9 @@ SX_API sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec whic
 /// SX_OK at once when not scattered or no such ball; SX_ELOCKED while m
 /// is stepping; SX_EINVAL when the ranks could not exchange.
 SX_API sx_status sx_ball_fetch(sx_model *m, int64_t id);
+/// Whether every ball's motion is current on this rank: not scattered, or
+/// shared since the last cycle (sx_ball_fetch then exchanges nothing).
+SX_API bool sx_model_motion_current(const sx_model *m);
 /// Sets pos, vel, spin or an applied force/moment (force and moment of the
 /// last step are results, not settable).
 SX_API sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double v[3]);

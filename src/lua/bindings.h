@@ -208,8 +208,9 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx);
 /// exchange stops every rank.
 void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
 /// A scattered model's ball `id`: its motion from the rank that holds it
-/// to every rank (sx_ball_fetch; the whole state after a few balls), a
-/// collective call behind the same check as sx_lua_gather.
+/// to every rank (sx_ball_fetch; every ball's after a few reads, then no
+/// exchange until the next cycle), a collective call behind the same check
+/// as sx_lua_gather.
 void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id);
 /// Like sx_lua_checkmodel for a query the core answers of a scattered
 /// model with a small collective exchange of its own (the ranks' sums over

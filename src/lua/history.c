@@ -68,7 +68,7 @@ static double energy_term(sx_model *m, int k)
     return terms[k];
 }
 
-/* A builtin but the ratio (sx_lua_ratio: it may gather). */
+/* A builtin but the ratio (sx_lua_ratio raises when the ranks cannot sum it). */
 static double sample_builtin(sx_model *m, int b)
 {
     switch (b) {

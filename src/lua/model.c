@@ -68,7 +68,8 @@ void sx_lua_gather(lua_State *L, sx_model *m, const char *self)
 
 void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id)
 {
-    if (sx_model_scattered(m)) collective(L, m, self, "fetch", sx_ball_fetch, id);
+    /* once every ball's motion is shared, a read exchanges nothing: no check either (every rank alike) */
+    if (!sx_model_motion_current(m)) collective(L, m, self, "fetch", sx_ball_fetch, id);
 }
 
 sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what)

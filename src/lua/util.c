@@ -647,7 +647,7 @@ void sx_lua_pushiterator(lua_State *L, int model, int64_t (*count)(const sx_mode
                          int64_t (*id_at)(const sx_model *, int64_t), lua_CFunction next)
 {
     model = lua_absindex(L, model);
-    const sx_model *m = sx_lua_checkmodel_scattered(L, model); /* the ids every rank holds: a handle gathers */
+    const sx_model *m = sx_lua_checkmodel_scattered(L, model); /* the ids every rank holds (a handle's reads exchange) */
     const int64_t n = count(m);
     lua_createtable(L, n < INT_MAX ? (int)n : INT_MAX, 0);
     for (int64_t i = 0; i < n; i++) {
