@@ -506,8 +506,8 @@ bool sx_model_motion_current(const sx_model *m) { return !sx_model_scattered(m) 
 
 sx_status sx_ball_fetch(sx_model *m, int64_t id)
 {
+    if (sx_model_motion_current(m)) return SX_OK;
     sx_dd *d = m->dd;
-    if (!sx_model_scattered(m) || d->motion_whole) return SX_OK;
     if (m->locked) return sx__fail(m, SX_ELOCKED, "ball %lld: the model is stepping", (long long)id);
     /* ranks reading the same field of different balls at once (a loop
      * over pairs() of a table, whose order each process draws) are served
