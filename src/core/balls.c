@@ -514,10 +514,18 @@ sx_status sx_ball_fetch(sx_model *m, int64_t id)
      * by a gather, as they were before any fetch: the same on every rank */
     if (!d->x.agree(d->x.ud, (uint64_t)id)) return sx_model_gather(m);
     if (!sx_ball_exists(m, id)) return SX_OK;
-    const bool every = ++d->fetched > FETCH_MAX;
-    if (!sx__dd_fetch_ball(m, every ? -1 : sx__ball_index(m, id)))
+    if (++d->fetched > FETCH_MAX) return sx_model_share_motion(m);
+    if (!sx__dd_fetch_ball(m, sx__ball_index(m, id)))
         return sx__fail(m, SX_EINVAL, "ball %lld: the ranks could not exchange its state", (long long)id);
-    d->motion_whole = every;
+    return SX_OK;
+}
+
+sx_status sx_model_share_motion(sx_model *m)
+{
+    if (sx_model_motion_current(m)) return SX_OK;
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "the balls' motion: the model is stepping");
+    if (!sx__dd_fetch_ball(m, -1)) return sx__fail(m, SX_EINVAL, "the ranks could not exchange the balls' motion");
+    m->dd->motion_whole = true;
     return SX_OK;
 }
 

@@ -419,6 +419,13 @@ SX_API sx_status sx_ball_fetch(sx_model *m, int64_t id);
 /// Whether every ball's motion is current on this rank: not scattered, or
 /// shared since the last cycle (sx_ball_fetch then exchanges nothing).
 SX_API bool sx_model_motion_current(const sx_model *m);
+/// A model a lazy cycle left scattered: every ball's motion (as
+/// sx_ball_fetch's) from the ranks that hold it current to every rank, one
+/// exchange that holds until the next cycle (for a query that reads many
+/// balls: a selection by region, a sum over the balls). A collective call;
+/// SX_OK at once when sx_model_motion_current; SX_ELOCKED while m is
+/// stepping; SX_EINVAL when the ranks could not exchange.
+SX_API sx_status sx_model_share_motion(sx_model *m);
 /// Sets pos, vel, spin or an applied force/moment (force and moment of the
 /// last step are results, not settable).
 SX_API sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const double v[3]);

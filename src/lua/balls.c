@@ -44,8 +44,7 @@ static int vec_len(const sx_model *m, sx_ball_vec which)
 static int get_vec(lua_State *L, sx_ball_vec which)
 {
     int64_t id;
-    const bool motion = which != SX_BALL_APPLIED_FORCE && which != SX_BALL_APPLIED_MOMENT;
-    const sx_model *m = motion ? check_ball_motion(L, &id) : check_ball_whole(L, &id);
+    const sx_model *m = sx_lua_is_motion(which) ? check_ball_motion(L, &id) : check_ball_whole(L, &id);
     double v[3];
     sx_lua_checkfield(L, m, sx_ball_get_vec(m, id, which, v), "ball");
     sx_lua_pushvec(L, v, vec_len(m, which));
@@ -434,12 +433,12 @@ static int model_balls(lua_State *L)
         sx_lua_pushiterator(L, 1, sx_ball_count, sx_ball_id_at, next_ball);
         return 1;
     }
-    const sx_model *m = sx_lua_checkmodel(L, 1); /* a filter may read the balls' places */
+    sx_lua_checkmodel_scattered(L, 1); /* a region shares the balls' motion, not their pairs: no gather */
     sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     sx_lua_filter f;
     sx_lua_filter_read(L, 1, 2, &f);
     int64_t n;
-    const int64_t *ids = sx_lua_filter_ids(L, m, &f, &n);
+    const int64_t *ids = sx_lua_filter_ids(L, &f, &n);
     lua_createtable(L, n < 1 << 30 ? (int)n : 1 << 30, 0);
     for (int64_t i = 0; i < n; i++) {
         lua_pushinteger(L, (lua_Integer)ids[i]);

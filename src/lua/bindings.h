@@ -212,6 +212,17 @@ void sx_lua_gather(lua_State *L, sx_model *m, const char *self);
 /// exchange until the next cycle), a collective call behind the same check
 /// as sx_lua_gather.
 void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id);
+/// Like sx_lua_checkmodel for a query that reads many balls' motion and
+/// properties, but no pairs (a selection by region, a sum over the balls):
+/// a scattered model's every ball's motion is shared first
+/// (sx_model_share_motion), behind the same check as sx_lua_gather.
+sx_model *sx_lua_checkmodel_motion(lua_State *L, int idx);
+/// Whether a ball vector is part of its motion (a step's result, current
+/// on its own rank alone in a scattered model), not an applied load.
+static inline bool sx_lua_is_motion(sx_ball_vec which)
+{
+    return which != SX_BALL_APPLIED_FORCE && which != SX_BALL_APPLIED_MOMENT;
+}
 /// Like sx_lua_checkmodel for a query the core answers of a scattered
 /// model with a small collective exchange of its own (the ranks' sums over
 /// the rows they hold: sx_model_state_hash, sx_model_bond_counts,
@@ -330,8 +341,10 @@ extern const char *const sx_lua_filter_keys[];
 /// when arg is nil or absent). May push values: keep them until done.
 void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f);
 /// Collects the ids of the balls that pass into a Lua-owned array pushed on
-/// the stack; returns it, its length in *n.
-int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n);
+/// the stack; returns it, its length in *n. A scattered model is not
+/// gathered: a region shares the balls' motion (sx_lua_checkmodel_motion),
+/// and a predicate's reads fetch what they read.
+int64_t *sx_lua_filter_ids(lua_State *L, const sx_lua_filter *f, int64_t *n);
 
 /* -------------------------------------------------------- events.c */
 

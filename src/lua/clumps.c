@@ -260,7 +260,7 @@ static void push_template(lua_State *L, const sx_model *m, int t)
 /* m:clump_template(name, pebbles | path[, {lines = N}]) -> info;  m:clump_template(name) -> info | nil */
 static int model_clump_template(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* a lookup reads the templates every rank holds */
     const char *name = sx_lua_checkname(L, 2);
     const int dim = sx_model_dim(m);
     if (lua_isnoneornil(L, 3)) {
@@ -269,6 +269,7 @@ static int model_clump_template(lua_State *L)
         push_template(L, m, t);
         return 1;
     }
+    m = sx_lua_checkmodel(L, 1);
     int64_t lines = 0;
     if (!lua_isnoneornil(L, 4)) {
         static const char *const keys[] = {"lines", NULL};
@@ -290,7 +291,7 @@ static int model_clump_template(lua_State *L)
 /* m:clump_templates() -> {name = info, ...} */
 static int model_clump_templates(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* what every rank holds alike: no gather */
     const int n = sx_clump_template_count(m);
     lua_createtable(L, 0, n);
     for (int t = 0; t < n; t++) {
@@ -544,8 +545,8 @@ void sx_lua_clump_set_group(lua_State *L, sx_model *m, int64_t id, int32_t group
 /* m:clump{...} adds a clump; m:clump(id) returns the clump with that id, or nil. */
 static int model_clump(lua_State *L)
 {
-    sx_model *m = sx_lua_checkmodel(L, 1);
-    if (lua_type(L, 2) == LUA_TTABLE) return add_clump(L, m);
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* a lookup reads the ids every rank holds */
+    if (lua_type(L, 2) == LUA_TTABLE) return add_clump(L, sx_lua_checkmodel(L, 1));
     if (lua_type(L, 2) != LUA_TNUMBER) return luaL_typeerror(L, 2, "table or integer");
     const int64_t id = (int64_t)luaL_checkinteger(L, 2);
     if (!sx_clump_exists(m, id)) return 0;
@@ -557,14 +558,14 @@ static int next_clump(lua_State *L) { return sx_lua_nexthandle(L, &clump_kind); 
 
 static int model_clumps(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1); /* the ids every rank holds (a read of a clump's state gathers) */
     sx_lua_pushiterator(L, 1, sx_clump_count, sx_clump_id_at, next_clump);
     return 1;
 }
 
 static int model_clump_count(lua_State *L)
 {
-    lua_pushinteger(L, (lua_Integer)sx_clump_count(sx_lua_checkmodel(L, 1)));
+    lua_pushinteger(L, (lua_Integer)sx_clump_count(sx_lua_checkmodel_scattered(L, 1)));
     return 1;
 }
 

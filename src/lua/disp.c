@@ -19,12 +19,13 @@ static void record(lua_State *L, const sx_model *m, int refs, int64_t id)
 /* m:reset_disp([filter]) -> n */
 static int model_reset_disp(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1); /* the positions are shared, not gathered */
     sx_lua_filter f;
     if (!lua_isnoneornil(L, 2)) sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     sx_lua_filter_read(L, 1, 2, &f);
     int64_t n;
-    const int64_t *ids = sx_lua_filter_ids(L, m, &f, &n);
+    const int64_t *ids = sx_lua_filter_ids(L, &f, &n);
+    const sx_model *m = sx_lua_checkmodel_motion(L, 1);
     sx_lua_state(L, 1, "disp_ref");
     const int refs = lua_gettop(L);
     for (int64_t i = 0; i < n; i++) record(L, m, refs, ids[i]);
@@ -42,7 +43,7 @@ void sx_lua_disp_fill(lua_State *L, int model)
         for (int64_t i = 0; i < sx_ball_count(m); i++) {
             const int64_t id = sx_ball_id_at(m, i);
             if (lua_rawgeti(L, refs, (lua_Integer)id) == LUA_TNIL) {
-                sx_lua_gather(L, m, "m"); /* a new ball's position: every rank finds it alike */
+                m = sx_lua_checkmodel_motion(L, model); /* a new ball's position: every rank finds it alike */
                 record(L, m, refs, id);
             }
             lua_pop(L, 1);

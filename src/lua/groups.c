@@ -193,7 +193,7 @@ void sx_lua_filter_read(lua_State *L, int model, int arg, sx_lua_filter *f)
     f->model = lua_absindex(L, model);
     if (lua_isnoneornil(L, arg)) return;
     arg = lua_absindex(L, arg);
-    const int dim = sx_model_dim(sx_lua_checkmodel(L, model));
+    const int dim = sx_model_dim(sx_lua_checkmodel_scattered(L, model));
     if (lua_getfield(L, arg, "group") != LUA_TNIL) f->group = existing_group(L, f->model, arg, lua_gettop(L));
     lua_pop(L, 1);
     lua_getfield(L, arg, "slot");
@@ -240,15 +240,23 @@ static bool filter_match(lua_State *L, const sx_model *m, const sx_lua_filter *f
     return true;
 }
 
-int64_t *sx_lua_filter_ids(lua_State *L, const sx_model *m, const sx_lua_filter *f, int64_t *n)
+/* The model to select from: a region reads every ball's position (shared
+ * from its rank, not gathered); groups every rank holds. */
+static const sx_model *selection_model(lua_State *L, const sx_lua_filter *f)
 {
+    return f->has_region ? sx_lua_checkmodel_motion(L, f->model) : sx_lua_checkmodel_scattered(L, f->model);
+}
+
+int64_t *sx_lua_filter_ids(lua_State *L, const sx_lua_filter *f, int64_t *n)
+{
+    const sx_model *m = selection_model(L, f);
     const int64_t count = sx_ball_count(m);
     int64_t *ids = lua_newuserdatauv(L, (size_t)(count > 0 ? count : 1) * sizeof *ids, 0);
     for (int64_t i = 0; i < count; i++) ids[i] = sx_ball_id_at(m, i);
     int64_t k = 0;
     for (int64_t i = 0; i < count; i++) {
         /* a predicate may remove balls or close the model */
-        if (f->where) m = sx_lua_checkmodel(L, f->model);
+        if (f->where) m = selection_model(L, f);
         if (!sx_ball_exists(m, ids[i])) continue;
         if (filter_match(L, m, f, ids[i])) ids[k++] = ids[i];
     }
@@ -262,7 +270,7 @@ static int64_t *select_balls(lua_State *L, int arg, int64_t *n)
 {
     sx_lua_filter f;
     sx_lua_filter_read(L, 1, arg, &f);
-    return sx_lua_filter_ids(L, sx_lua_checkmodel(L, 1), &f, n);
+    return sx_lua_filter_ids(L, &f, n);
 }
 
 /* ---------------------------------------------------- group, groups, count */
@@ -300,7 +308,7 @@ static int model_group(lua_State *L)
 
 static int model_groups(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* the groups every rank holds */
     sx_lua_state(L, 1, "group_names");
     const int names = lua_gettop(L);
     const lua_Integer ng = (lua_Integer)lua_rawlen(L, names);
@@ -329,7 +337,7 @@ static int model_groups(lua_State *L)
 
 static int model_count(lua_State *L)
 {
-    sx_lua_checkmodel(L, 1);
+    sx_lua_checkmodel_scattered(L, 1); /* a region shares the balls' motion: no gather */
     if (!lua_isnoneornil(L, 2)) sx_lua_checkkeys(L, 2, sx_lua_filter_keys);
     lua_settop(L, 2);
     int64_t n;
@@ -508,9 +516,16 @@ static void quantity_value(lua_State *L, const sx_model *m, const struct quantit
 enum { OP_SUM, OP_MEAN, OP_MIN, OP_MAX };
 static const char *const op_names[] = {"m:sum", "m:mean", "m:min", "m:max"};
 
+/* Whether a quantity reads the balls' motion, which a scattered model's
+ * ranks share for it (the rest every rank holds). */
+static bool reads_motion(const struct quantity *q)
+{
+    return q->kind == Q_SPEED || q->kind == Q_KINETIC || (q->kind == Q_VEC && sx_lua_is_motion((sx_ball_vec)q->which));
+}
+
 static int reduce(lua_State *L, int op)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1);
     const char *name = sx_lua_checkname(L, 2);
     const int qi = sx_lua_find(name, quantity_names);
     if (qi < 0) {
@@ -524,7 +539,7 @@ static int reduce(lua_State *L, int op)
     const int nc = q->kind == Q_VEC ? (q->rotational ? sx_lua_rdim(dim) : dim) : 1;
     int64_t n;
     const int64_t *ids = select_balls(L, 3, &n);
-    m = sx_lua_checkmodel(L, 1);
+    m = reads_motion(q) ? sx_lua_checkmodel_motion(L, 1) : sx_lua_checkmodel_scattered(L, 1);
     double acc[3] = {0, 0, 0};
     int64_t used = 0;
     for (int64_t i = 0; i < n; i++) {

@@ -58,7 +58,7 @@ static int model_joint(lua_State *L)
 
 static int model_joints(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* what every rank holds alike: no gather */
     const int dim = sx_model_dim(m);
     const int64_t n = sx_joint_count(m);
     lua_createtable(L, (int)n, 0);

@@ -34,6 +34,8 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx)
  * and marked with the step (gather, fetch), so that a rank in one step of
  * a call never meets another rank's other step of the same call; a failed
  * exchange stops every rank. */
+static sx_status gather(sx_model *m, int64_t unused);
+#include <stdlib.h>
 static void collective(lua_State *L, sx_model *m, const char *self, const char *step,
                        sx_status (*fn)(sx_model *m, int64_t id), int64_t id)
 {
@@ -47,6 +49,7 @@ static void collective(lua_State *L, sx_model *m, const char *self, const char *
     else
         snprintf(what, sizeof what, "a query of %s (%s)", self, step);
     sx_lua_check_model_call(L, m, what);
+    if (getenv("SX_TRACE_GATHER") && fn == gather) { luaL_traceback(L, L, what, 0); fprintf(stderr, "GATHER %s\n", lua_tostring(L, -1)); lua_pop(L, 1); }
     if (fn(m, id) != SX_OK) {
         char msg[1024];
         luaL_where(L, 1);
@@ -70,6 +73,19 @@ void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id)
 {
     /* once every ball's motion is shared, a read exchanges nothing: no check either (every rank alike) */
     if (!sx_model_motion_current(m)) collective(L, m, self, "fetch", sx_ball_fetch, id);
+}
+
+static sx_status share_motion(sx_model *m, int64_t unused)
+{
+    (void)unused;
+    return sx_model_share_motion(m);
+}
+
+sx_model *sx_lua_checkmodel_motion(lua_State *L, int idx)
+{
+    sx_model *m = sx_lua_checkmodel_scattered(L, idx);
+    if (!sx_model_motion_current(m)) collective(L, m, "m", "motion", share_motion, 0);
+    return m;
 }
 
 sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what)
@@ -659,7 +675,7 @@ static int model_contact_model(lua_State *L)
 /* m:contact_models(): the table's rows in order, each as m:contact_model takes it. */
 static int model_contact_models(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* what every rank holds alike: no gather */
     const int n = sx_cmodel_count(m);
     lua_createtable(L, n, 0);
     for (int r = 1; r <= n; r++) {
@@ -698,7 +714,7 @@ static int model_contact_models(lua_State *L)
 /* m:materials(): name -> its properties, as m:material takes them. */
 static int model_materials(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* what every rank holds alike: no gather */
     const int n = sx_material_count(m);
     lua_createtable(L, 0, n);
     for (int i = 0; i < n; i++) {
@@ -769,7 +785,7 @@ static int model_set_timestep(lua_State *L)
 
 static int model_gravity(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* what every rank holds alike: no gather */
     double g[3];
     sx_model_gravity(m, g);
     sx_lua_pushvec(L, g, sx_model_dim(m));

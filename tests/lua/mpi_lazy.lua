@@ -121,3 +121,25 @@ end
 local why, ratio, steps = m:solve{ratio = 1e-2, steps = 2000}
 print(string.format("solve: %s ratio %.17g after %d steps; hash %s", why, ratio, steps, m:hash()))
 io.stderr:write(string.format("ranks %d\n", m:ranks()))
+-- after a cycle, the sums and selections over the balls share every ball's
+-- motion (one exchange, no gather), and what every rank holds (groups,
+-- materials, gravity, contact models) is read with no exchange at all
+if scene == "servo" then
+  m:cycle(500)
+  local before = m:profile{print = false}.gathers
+  -- the sums first: the predicate below reads every ball, which shares the motion too
+  local kinetic, highest, speed, xsum = m:sum("kinetic"), m:max("pos")[2], m:mean("speed"), m:sum("pos")[1]
+  local region = {box = {{0.15, 0}, {0.35, 0.2}}} -- across the ranks' cut
+  local inside, xs = m:count{region = region}, 0
+  for b in m:balls{region = region} do xs = xs + b.pos[1] end
+  local rising = m:count{where = function(b) return b.vel[2] > 0 end}
+  local mats, groups = 0, 0
+  for _ in pairs(m:materials()) do mats = mats + 1 end
+  for _ in pairs(m:groups()) do groups = groups + 1 end
+  local gathers = m:profile{print = false}.gathers - before
+  if m:ranks() > 1 and gathers ~= 0 then error(string.format("the sums and selections gathered %d times", gathers)) end
+  print(string.format("kinetic %.17g, highest %.17g, mean speed %.17g, x sum %.17g", kinetic, highest, speed, xsum))
+  print(string.format("selected %d (x sum %.17g), %d rising", inside, xs, rising))
+  print(string.format("%d materials, %d groups, %d contact models, gravity %.17g, %d clumps", mats, groups,
+                      #m:contact_models(), m:gravity()[2], m:clump_count()))
+end
