@@ -634,6 +634,17 @@ void sx_model_gather_lazily(sx_model *m, bool lazily)
 
 bool sx_model_scattered(const sx_model *m) { return m->dd && m->dd->scattered; }
 
+/* The ranks' cracks merged as a build merges them (from crack0 on, its own
+ * balls' on each rank): what the scattered hash and counts read stays the
+ * same sums (rank 0 then holds the merged log, the others nothing past it). */
+sx_status sx_model_share_cracks(sx_model *m)
+{
+    if (!sx_model_scattered(m)) return SX_OK;
+    if (m->locked) return sx__fail(m, SX_ELOCKED, "the crack log: the model is stepping");
+    if (!sx__dd_gather_cracks(m)) return sx__fail(m, SX_EINVAL, "the ranks could not exchange their cracks (out of memory?)");
+    return SX_OK;
+}
+
 /* (model_internal.h) The last plan's (a scattered model keeps it, as a
  * resumed cycle does): a rank holds its balls current, their pairs, the
  * bonds of its pairs and the clumps it owns; a bond in no pair of the plan

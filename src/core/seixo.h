@@ -713,6 +713,14 @@ typedef struct sx_crack {
 } sx_crack;
 
 SX_API int64_t sx_crack_count(const sx_model *m);
+/// A model a lazy cycle left scattered (sx_model_scattered), where each
+/// rank holds the cracks of its own balls since the last exchange: the
+/// ranks' cracks made one log in the serial order on every rank, as a
+/// gather makes it (sx_crack_count and sx_crack_get then read the whole
+/// log), without the rest of the state. A collective call; SX_OK at once
+/// when not scattered; SX_ELOCKED while m is stepping; SX_EINVAL when the
+/// ranks could not exchange.
+SX_API sx_status sx_model_share_cracks(sx_model *m);
 /// The intact bonds, the tension cracks and the shear cracks, into
 /// counts[0..2]. Of a decomposed model left scattered
 /// (sx_model_scattered), where the crack log and the intact count are each

@@ -217,6 +217,10 @@ void sx_lua_fetch_ball(lua_State *L, sx_model *m, const char *self, int64_t id);
 /// a scattered model's every ball's motion is shared first
 /// (sx_model_share_motion), behind the same check as sx_lua_gather.
 sx_model *sx_lua_checkmodel_motion(lua_State *L, int idx);
+/// Like sx_lua_checkmodel for a query of the crack log alone (m:cracks(),
+/// the bond_break events): a scattered model's ranks merge their cracks
+/// (sx_model_share_cracks) behind the same check as sx_lua_gather.
+sx_model *sx_lua_checkmodel_cracks(lua_State *L, int idx);
 /// Whether a ball vector is part of its motion (a step's result, current
 /// on its own rank alone in a scattered model), not an applied load.
 static inline bool sx_lua_is_motion(sx_ball_vec which)

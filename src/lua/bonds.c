@@ -189,7 +189,7 @@ static int model_bond_count(lua_State *L)
 
 static int model_cracks(lua_State *L)
 {
-    const sx_model *m = sx_lua_checkmodel(L, 1);
+    const sx_model *m = sx_lua_checkmodel_cracks(L, 1); /* the log alone: no gather */
     const int64_t n = sx_crack_count(m);
     lua_createtable(L, n > 0 && n < INT32_MAX ? (int)n : 0, 0);
     for (int64_t i = 0; i < n; i++) {

@@ -347,7 +347,12 @@ void sx_lua_events_deliver(lua_State *L, int model)
         lua_pop(L, 1);
         return;
     }
-    sx_lua_gather(L, m, "m"); /* the crack log, the contacts, the balls' places */
+    /* what the events are made of: the contacts (a gather), or the crack
+     * log and the balls' places alone (no gather: a scattered model's next
+     * cycle goes on from where this one stopped) */
+    if (has(L, handlers, EV_CREATE) || has(L, handlers, EV_DELETE)) sx_lua_gather(L, m, "m");
+    if (has(L, handlers, EV_BOND)) sx_lua_checkmodel_cracks(L, model);
+    if (has(L, handlers, EV_LEAVE)) sx_lua_checkmodel_motion(L, model);
     /* the handlers may change the list: deliver from a copy */
     lua_newtable(L);
     for (lua_Integer i = 1; lua_rawgeti(L, handlers, i) != LUA_TNIL; i++) lua_rawseti(L, -2, i);

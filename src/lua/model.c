@@ -88,6 +88,19 @@ sx_model *sx_lua_checkmodel_motion(lua_State *L, int idx)
     return m;
 }
 
+static sx_status share_cracks(sx_model *m, int64_t unused)
+{
+    (void)unused;
+    return sx_model_share_cracks(m);
+}
+
+sx_model *sx_lua_checkmodel_cracks(lua_State *L, int idx)
+{
+    sx_model *m = sx_lua_checkmodel_scattered(L, idx);
+    if (sx_model_scattered(m)) collective(L, m, "m", "cracks", share_cracks, 0);
+    return m;
+}
+
 sx_model *sx_lua_checkmodel_summed(lua_State *L, int idx, const char *what)
 {
     sx_model *m = sx_lua_checkmodel_scattered(L, idx);

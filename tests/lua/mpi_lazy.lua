@@ -7,9 +7,11 @@
 --                   velocity; stopped at every 1000th step, when the bed is
 --                   unforced, and made stiffer once): it must not gather,
 --                   so nearly every step's cycle goes on from the last
---   events          the same with a bond_break handler, a history of a
---                   ball's height every 25 steps and a ball stopped every
---                   500 (each gathers), and a solve to a ratio at the end
+--   events          the same with a bond_break handler (its events come
+--                   from the ranks' merged crack logs: no gather), a
+--                   history of a ball's height every 25 steps (a fetch)
+--                   and a ball stopped every 500 (a gather), and a solve
+--                   to a ratio at the end
 --   SCRIPT ARGS...  another test scene (mpi_bonds.lua crush 3, ...) with
 --                   every m:cycle(n) cut into runs of 1 to 7 steps
 local scene = arg and arg[1] or "servo"
@@ -102,6 +104,9 @@ print(string.format("step %d hash %s", m:step(), hash))
 local resumed, cycles = p.resumed - p0.resumed, p.cycles - p0.cycles
 if scene == "servo" and m:ranks() > 1 and resumed < 0.9 * cycles then
   error(string.format("%d of %d cycles went on from the last one's scattered state", resumed, cycles))
+end
+if scene == "events" and m:ranks() > 1 and p.gathers - p0.gathers > 5000 // 500 then -- the stopped ball's alone
+  error(string.format("the events' cycle gathered the state %d times", p.gathers - p0.gathers))
 end
 if scene == "servo" and m:ranks() > 1 and p.gathers ~= p0.gathers then -- the servo and the histories read no ball
   error(string.format("the servo's cycle gathered the state %d times", p.gathers - p0.gathers))
