@@ -12,9 +12,33 @@
 --                   history of a ball's height every 25 steps (a fetch)
 --                   and a ball stopped every 500 (a gather), and a solve
 --                   to a ratio at the end
+--   leave           balls poured out of a region, a ball_leave_region
+--                   handler printing each event (the balls' motion shared
+--                   at each step's delivery: no gather)
 --   SCRIPT ARGS...  another test scene (mpi_bonds.lua crush 3, ...) with
 --                   every m:cycle(n) cut into runs of 1 to 7 steps
 local scene = arg and arg[1] or "servo"
+if scene == "leave" then
+  local m = seixo.model{dim = 2, gravity = {0, -9.81}}
+  m:material("g", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.3})
+  m:wall{kind = "box", min = {0, 0}, max = {0.2, 0.2}}
+  local upper = {box = {{0, 0.1}, {0.2, 0.2}}}
+  m:generate{count = 400, radius = {2e-3, 3e-3}, region = upper, seed = 3}
+  m:cycle(1) -- the placement's check (a gather)
+  local left, steps, heights = 0, 0, 0
+  m:on("ball_leave_region", function(_, e)
+    left, steps, heights = left + 1, steps + e.step, heights + e.pos[2] + 1e-3 * e.ball.vel[2]
+  end, {region = upper})
+  local p0 = m:profile{print = false}
+  m:cycle(1500)
+  local p = m:profile{print = false}
+  if m:ranks() > 1 and p.gathers ~= p0.gathers then
+    error(string.format("the leave handler's cycles gathered the state %d times", p.gathers - p0.gathers))
+  end
+  print(string.format("%d left the region, step sum %d, height sum %.17g; hash %s", left, steps, heights, m:hash()))
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+  return
+end
 if scene ~= "servo" and scene ~= "events" then
   local here = debug.getinfo(1, "S").source:match("^@(.*/)") or "./"
   local methods = getmetatable(seixo.model{dim = 2}).__methods
