@@ -34,8 +34,6 @@ sx_model *sx_lua_checkmodel_scattered(lua_State *L, int idx)
  * and marked with the step (gather, fetch), so that a rank in one step of
  * a call never meets another rank's other step of the same call; a failed
  * exchange stops every rank. */
-static sx_status gather(sx_model *m, int64_t unused);
-#include <stdlib.h>
 static void collective(lua_State *L, sx_model *m, const char *self, const char *step,
                        sx_status (*fn)(sx_model *m, int64_t id), int64_t id)
 {
@@ -49,7 +47,6 @@ static void collective(lua_State *L, sx_model *m, const char *self, const char *
     else
         snprintf(what, sizeof what, "a query of %s (%s)", self, step);
     sx_lua_check_model_call(L, m, what);
-    if (getenv("SX_TRACE_GATHER") && fn == gather) { luaL_traceback(L, L, what, 0); fprintf(stderr, "GATHER %s\n", lua_tostring(L, -1)); lua_pop(L, 1); }
     if (fn(m, id) != SX_OK) {
         char msg[1024];
         luaL_where(L, 1);
