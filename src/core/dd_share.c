@@ -104,21 +104,26 @@ bool sx__dd_share_by_rank(sx_dd *d, void *data, size_t size)
     return sx__dd_share(d, data, size, d->scratch, sx__dd_everything(d, d->x.ranks), 1);
 }
 
+/* (model_internal.h) */
+const uint64_t *sx__dd_words(const sx_model *m, const uint64_t *v, int n)
+{
+    sx_dd *d = m->dd;
+    assert(n <= SX_DD_SUM_MAX);
+    uint64_t *all = d->sums; /* kept from the decomposition: nothing to allocate, nothing to fail alone */
+    memcpy(all + (size_t)d->x.rank * (size_t)n, v, (size_t)n * sizeof *v);
+    return sx__dd_share_by_rank(d, all, (size_t)n * sizeof *all) ? all : NULL;
+}
+
 /* (model_internal.h) An all-gather of the ranks' values, each rank adding
  * them alike (integers: in any order). */
 bool sx__dd_sum(const sx_model *m, uint64_t *v, int n)
 {
-    sx_dd *d = m->dd;
-    const int R = d->x.ranks;
-    assert(n <= SX_DD_SUM_MAX);
-    uint64_t *all = d->sums; /* kept from the decomposition: nothing to allocate, nothing to fail alone */
-    memcpy(all + (size_t)d->x.rank * (size_t)n, v, (size_t)n * sizeof *v);
-    const bool ok = sx__dd_share_by_rank(d, all, (size_t)n * sizeof *all);
-    for (int k = 0; ok && k < n; k++) {
+    const uint64_t *all = sx__dd_words(m, v, n);
+    for (int k = 0; all && k < n; k++) {
         v[k] = 0;
-        for (int r = 0; r < R; r++) v[k] += all[(size_t)r * (size_t)n + (size_t)k];
+        for (int r = 0; r < m->dd->x.ranks; r++) v[k] += all[(size_t)r * (size_t)n + (size_t)k];
     }
-    return ok;
+    return all != NULL;
 }
 
 bool sx__dd_halo(sx_model *m)
@@ -272,20 +277,16 @@ static bool gather_fjoints(sx_model *m)
 bool sx__dd_parts(sx_model *m, int64_t count, sx_span *mine, int64_t *total)
 {
     sx_dd *d = m->dd;
-    const int R = d->x.ranks;
-    int64_t *counts = calloc((size_t)R, sizeof *counts);
-    if (!counts) return false;
-    counts[d->x.rank] = count;
-    const bool ok = sx__dd_share_by_rank(d, counts, sizeof *counts);
+    const uint64_t word = (uint64_t)count;
+    const uint64_t *counts = sx__dd_words(m, &word, 1);
     int64_t sum = 0;
-    for (int r = 0; ok && r < R; r++) {
-        d->scratch[r] = (sx_span){sum, sum + counts[r]};
-        sum += counts[r];
+    for (int r = 0; counts && r < d->x.ranks; r++) {
+        d->scratch[r] = (sx_span){sum, sum + (int64_t)counts[r]};
+        sum += (int64_t)counts[r];
     }
-    free(counts);
     *mine = d->scratch[d->x.rank];
     *total = sum;
-    return ok;
+    return counts != NULL;
 }
 
 bool sx__dd_join(sx_model *m, void *data, size_t size, int64_t total)

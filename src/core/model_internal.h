@@ -947,6 +947,10 @@ bool sx__holds_crack(const sx_model *m, const sx_rows_held *part, int64_t i); /*
 /* each v[k], k < n <= SX_DD_SUM_MAX, summed over the ranks (mod 2^64) */
 #define SX_DD_SUM_MAX 24
 bool sx__dd_sum(const sx_model *m, uint64_t *v, int n);
+/* every rank's n <= SX_DD_SUM_MAX words v, rank r's at [r * n], in a kept
+ * buffer (nothing to allocate, nothing to fail alone) valid until the next
+ * exchange; NULL when the ranks could not exchange */
+const uint64_t *sx__dd_words(const sx_model *m, const uint64_t *v, int n);
 void sx__clumps_bag(const sx_model *m, const sx_rows_held *part, sx_hash_bag *out); /* each clump's digest */
 /* FNV-1a over n bytes, continuing h (the state hash), from SX_FNV_BASIS. */
 #define SX_FNV_BASIS 0xcbf29ce484222325ULL

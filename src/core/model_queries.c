@@ -58,6 +58,68 @@ bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void
     return k->each_contact(m, false, 0, m->bb.n, fn, ud) && k->each_contact(m, true, 0, m->bw.n, fn, ud);
 }
 
+typedef struct deepest {
+    const sx_model *m;
+    int64_t skip_lo, skip_hi;
+    sx_overlap o;
+} deepest;
+
+static bool deeper(const sx_contact_info *c, void *ud)
+{
+    deepest *w = ud;
+    if (!c->is_wall && c->a >= w->skip_lo && c->a <= w->skip_hi && c->b >= w->skip_lo && c->b <= w->skip_hi) return true;
+    const double *rad = w->m->balls.rad, ra = rad[sx__ball_index(w->m, c->a)];
+    const double r = c->is_wall ? ra : fmin(ra, rad[sx__ball_index(w->m, c->b)]);
+    if (r > 0 && c->overlap / r > w->o.ratio) w->o = (sx_overlap){c->overlap / r, c->overlap, r, c->a, c->b, c->is_wall};
+    return true;
+}
+
+enum { OVERLAP_WORDS = 6 }; /* an sx_overlap in a rank's exchanged words */
+
+static void overlap_to_words(const sx_overlap *o, uint64_t *w)
+{
+    memcpy(w, &o->ratio, sizeof *w), memcpy(w + 1, &o->overlap, sizeof *w), memcpy(w + 2, &o->radius, sizeof *w);
+    w[3] = (uint64_t)o->a, w[4] = (uint64_t)o->b, w[5] = o->is_wall;
+}
+
+static sx_overlap overlap_of_words(const uint64_t *w)
+{
+    sx_overlap o = {.a = (int64_t)w[3], .b = (int64_t)w[4], .is_wall = w[5] != 0};
+    memcpy(&o.ratio, w, sizeof *w), memcpy(&o.overlap, w + 1, sizeof *w), memcpy(&o.radius, w + 2, sizeof *w);
+    return o;
+}
+
+bool sx_contact_deepest(const sx_model *m, int64_t skip_lo, int64_t skip_hi, sx_overlap *out)
+{
+    const sx_kernels *k = sx__kernels(m);
+    deepest w[2] = {{.m = m, .skip_lo = skip_lo, .skip_hi = skip_hi}, {.m = m, .skip_lo = skip_lo, .skip_hi = skip_hi}}; /* ball-ball, ball-wall */
+    const bool scattered = sx_model_scattered(m);
+    const int me = scattered ? m->dd->x.rank : 0;
+    /* scattered, the pairs of this rank's own balls: the rows it holds current */
+    const sx_span bb = scattered ? m->dd->bb_own[me] : (sx_span){0, m->bb.n};
+    const sx_span bw = scattered ? m->dd->bw_own[me] : (sx_span){0, m->bw.n};
+    k->each_contact(m, false, bb.lo, bb.hi, deeper, &w[0]);
+    k->each_contact(m, true, bw.lo, bw.hi, deeper, &w[1]);
+    if (!scattered) {
+        *out = w[1].o.ratio > w[0].o.ratio ? w[1].o : w[0].o;
+        return true;
+    }
+    uint64_t mine[2 * OVERLAP_WORDS];
+    overlap_to_words(&w[0].o, mine), overlap_to_words(&w[1].o, mine + OVERLAP_WORDS);
+    const uint64_t *all = sx__dd_words(m, mine, 2 * OVERLAP_WORDS);
+    if (!all) return false;
+    /* the ball-ball contacts before the ball-wall ones, each kind in rank
+     * order (the ranks' own balls in the dense order): the serial order */
+    sx_overlap best = {.ratio = 0};
+    for (int kind = 0; kind < 2; kind++)
+        for (int r = 0; r < m->dd->x.ranks; r++) {
+            const sx_overlap o = overlap_of_words(all + ((size_t)r * 2 + (size_t)kind) * OVERLAP_WORDS);
+            if (o.ratio > best.ratio) best = o;
+        }
+    *out = best;
+    return true;
+}
+
 /* A contact's force: its law's and its bond's (a parallel bond's or a flat
  * joint's face), as PFC counts a bonded contact's force. Without the
  * bond's, a structure that bonds alone carry (a bonded beam, balls bonded

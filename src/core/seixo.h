@@ -625,6 +625,24 @@ typedef struct sx_contact_info {
 /// Stops and returns false when fn returns false.
 SX_API bool sx_contact_each(const sx_model *m, bool (*fn)(const sx_contact_info *, void *), void *ud);
 
+/// A contact's overlap relative to the smaller radius of its balls (a
+/// ball-wall contact's: its ball's radius).
+typedef struct sx_overlap {
+    double ratio;    ///< overlap / radius; 0 when nothing overlaps
+    double overlap;  ///< m
+    double radius;   ///< m
+    int64_t a, b;    ///< ball ids (b is a wall id when is_wall)
+    bool is_wall;
+} sx_overlap;
+/// The contact with the deepest overlap relative to its smaller radius, the
+/// first in sx_contact_each's order on a tie, passing over the ball-ball
+/// contacts whose two ids both lie in [skip_lo, skip_hi] (balls placed
+/// together, whose overlaps are theirs to remove). Of a model left
+/// scattered (sx_model_scattered), a collective call: each rank scans the
+/// contacts of its own balls and every rank compares the ranks' deepest in
+/// the serial order, the serial answer. False: the ranks could not exchange.
+SX_API bool sx_contact_deepest(const sx_model *m, int64_t skip_lo, int64_t skip_hi, sx_overlap *out);
+
 /* ---------------------------------------------------------------- bonds */
 
 typedef enum sx_bond_kind {

@@ -373,11 +373,12 @@ void sx_lua_check_ball_walls(lua_State *L, int model, const sx_model *m, const d
 /// beyond the limit is an error (of the Lua call `what`) naming the two
 /// entities. Clears ud->unchecked.
 void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
-/// geometry.c: the check of sx_lua_check_placement on the state as this
-/// process holds it, without a gather (a decomposed cycle that failed on
-/// this rank alone: its copy of the other ranks' balls is as placed): true
-/// with the message (without the script's place) pushed, or false. Clears
-/// ud->unchecked.
+/// geometry.c: the check of sx_lua_check_placement without a gather: of
+/// the last step's contacts (sx_contact_deepest: a collective call on a
+/// scattered model), or, when that step `failed`, of the balls as this
+/// process holds them (a decomposed cycle that failed on this rank alone:
+/// its copy of the other ranks' balls is as placed): true with the message
+/// (without the script's place) pushed, or false. Clears ud->unchecked.
 bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed);
 /// Pushes "file:line: " of the script's line a warning names: the
 /// innermost outside seixo's Lua library (seixo.caller's where(), when the

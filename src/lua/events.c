@@ -90,7 +90,10 @@ static void push_pairs(lua_State *L, const sx_model *m)
 int sx_lua_events_add(lua_State *L, lua_Integer id)
 {
     static const char *const keys[] = {"region", NULL};
-    sx_model *m = sx_lua_checkmodel(L, 1);
+    /* what each kind starts from, of a scattered model: the balls' places
+     * (their motion shared), the contacts (a gather), the crack log (the
+     * ranks' merged) */
+    sx_model *m = sx_lua_checkmodel_scattered(L, 1);
     const int kind = sx_lua_find(lua_tostring(L, 2), event_names);
     luaL_checktype(L, 3, LUA_TFUNCTION);
     if (!lua_isnoneornil(L, 4)) sx_lua_checkkeys(L, 4, keys);
@@ -109,6 +112,7 @@ int sx_lua_events_add(lua_State *L, lua_Integer id)
         const int top = lua_gettop(L);
         sx_lua_region g;
         sx_lua_region_read(L, top, sx_model_dim(m), 4, "region", &g);
+        m = sx_lua_checkmodel_motion(L, 1);
         /* the balls inside now: those that may leave */
         lua_newtable(L);
         for (int64_t i = 0; i < sx_ball_count(m); i++) {
@@ -125,6 +129,7 @@ int sx_lua_events_add(lua_State *L, lua_Integer id)
     }
     if ((kind == EV_CREATE || kind == EV_DELETE)) {
         /* the contacts of now are not created by the next step */
+        m = sx_lua_checkmodel(L, 1);
         sx_lua_state(L, 1, "event_state");
         if (lua_getfield(L, -1, "pairs") == LUA_TNIL) {
             push_pairs(L, m);
@@ -133,6 +138,7 @@ int sx_lua_events_add(lua_State *L, lua_Integer id)
         lua_pop(L, 2);
     }
     if (kind == EV_BOND) {
+        m = sx_lua_checkmodel_cracks(L, 1);
         sx_lua_state(L, 1, "event_state");
         if (lua_getfield(L, -1, "cracks_seen") == LUA_TNIL) {
             lua_pushinteger(L, (lua_Integer)sx_crack_count(m));

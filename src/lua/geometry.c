@@ -74,16 +74,6 @@ static void consider(worst *w, double overlap, double r, int64_t a, int64_t b, b
         w->ratio = overlap / r, w->overlap = overlap, w->radius = r, w->a = a, w->b = b, w->wall = wall;
 }
 
-static bool scan_contact(const sx_contact_info *c, void *ud)
-{
-    worst *w = ud;
-    double ra = 0, rb = INFINITY;
-    sx_ball_get(w->m, c->a, SX_BALL_RADIUS, &ra);
-    if (!c->is_wall) sx_ball_get(w->m, c->b, SX_BALL_RADIUS, &rb);
-    consider(w, c->overlap, ra < rb ? ra : rb, c->a, c->b, c->is_wall);
-    return true;
-}
-
 typedef struct placed {
     double lo;  // x - r: the key of the sweep
     int64_t i;  // the ball's index
@@ -141,10 +131,13 @@ static void sweep(lua_State *L, worst *w)
 bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
 {
     worst w = {ud->m, ud->fresh_lo, ud->fresh_hi, 0, 0, 0, 0, 0, false};
+    sx_overlap o;
     if (failed)
         sweep(L, &w);
+    else if (!sx_contact_deepest(ud->m, ud->fresh_lo, ud->fresh_hi, &o)) /* scattered: the ranks' own contacts */
+        luaL_error(L, "%s: the ranks could not compare the placed balls' overlaps", what);
     else
-        sx_contact_each(ud->m, scan_contact, &w);
+        w.ratio = o.ratio, w.overlap = o.overlap, w.radius = o.radius, w.a = o.a, w.b = o.b, w.wall = o.is_wall;
     ud->unchecked = false;
     ud->fresh_lo = ud->fresh_hi = 0;
     if (w.ratio <= ud->overlap_limit * (1 + 1e-9)) return false;  // "more than": a placement at the limit, rounded, passes
@@ -165,7 +158,15 @@ bool sx_lua_placement_overlap(lua_State *L, sx_lua_model *ud, const char *what, 
 
 void sx_lua_check_placement(lua_State *L, sx_lua_model *ud, const char *what, bool failed)
 {
-    sx_lua_gather(L, ud->m, "m"); /* the first step's contacts, every rank's */
+    /* the first step's contacts: each rank's own (a collective call), or,
+     * after a failed step, every ball as placed */
+    if (failed) {
+        sx_lua_gather(L, ud->m, "m");
+    } else if (sx_model_scattered(ud->m)) {
+        char call[96];
+        snprintf(call, sizeof call, "%s (placement check)", what);
+        sx_lua_check_model_call(L, ud->m, call);
+    }
     if (!sx_lua_placement_overlap(L, ud, what, failed)) return;
     luaL_where(L, 1);
     lua_insert(L, -2);

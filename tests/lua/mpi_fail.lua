@@ -17,6 +17,10 @@
 --   placed     a ball placed over another: the first step fails on the
 --              rank that owns them, which names the placement, as
 --              serially, not the timestep
+--   overlap    two balls placed overlapping by 70 % of a radius, in the
+--              bed's upper part (the last rank's): the first step passes,
+--              and its check of the contacts (each rank its own, without
+--              a gather) names the two balls on every rank
 local scene = arg and arg[1] or "script"
 local m = dofile((debug.getinfo(1, "S").source:match("^@(.*/)") or "./") .. "mpi_bed.lua")(100)
 -- a file written: the ranks above 0 hold a shadow of it when they fail
@@ -49,7 +53,11 @@ elseif scene == "busy" then
 elseif scene == "placed" then
   m:ball{pos = m:ball(5).pos, radius = 1e-3}
   m:cycle(10)
+elseif scene == "overlap" then
+  m:ball{pos = {0.010, 0.045}, radius = 1e-3}
+  m:ball{pos = {0.0113, 0.045}, radius = 1e-3}
+  m:cycle(10)
 else
-  error("mpi_fail.lua: scene script, callback, last, first, busy or placed expected, got " .. tostring(scene))
+  error("mpi_fail.lua: scene script, callback, last, first, busy, placed or overlap expected, got " .. tostring(scene))
 end
 print("not stopped")
