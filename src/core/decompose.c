@@ -622,7 +622,7 @@ sx_status sx__dd_end(sx_model *m, bool (*replan)(sx_model *))
         return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     d->active = false;
     d->scattered = true;
-    d->fetched = 0, d->motion_whole = false;
+    d->fetched = 0, d->motion_whole = d->cracks_merged = false;
     drop_rowbuf(d);
     return d->lazy ? SX_OK : sx__dd_whole(m, replan);
 }
@@ -635,13 +635,16 @@ void sx_model_gather_lazily(sx_model *m, bool lazily)
 bool sx_model_scattered(const sx_model *m) { return m->dd && m->dd->scattered; }
 
 /* The ranks' cracks merged as a build merges them (from crack0 on, its own
- * balls' on each rank): what the scattered hash and counts read stays the
- * same sums (rank 0 then holds the merged log, the others nothing past it). */
+ * balls' on each rank): every rank then holds the whole log and crack0 is
+ * its end, so the scattered hash and counts, which take the merged entries
+ * from rank 0 alone, add the same rows. No step logs a crack until the next
+ * cycle: merged once, the log stays whole until then. */
 sx_status sx_model_share_cracks(sx_model *m)
 {
-    if (!sx_model_scattered(m)) return SX_OK;
+    if (!sx_model_scattered(m) || m->dd->cracks_merged) return SX_OK;
     if (m->locked) return sx__fail(m, SX_ELOCKED, "the crack log: the model is stepping");
     if (!sx__dd_gather_cracks(m)) return sx__fail(m, SX_EINVAL, "the ranks could not exchange their cracks (out of memory?)");
+    m->dd->cracks_merged = true;
     return SX_OK;
 }
 

@@ -405,6 +405,7 @@ typedef struct sx_dd {
     bool scattered;         /* each rank's own balls, pairs and bonds current, the rest as a gather left it */
     int fetched;            /* scattered: the balls' rows fetched since the cycle's end (sx_ball_fetch), */
     bool motion_whole;      /* and whether every ball's motion has been shared since */
+    bool cracks_merged;     /* scattered: the ranks' crack logs merged since the cycle's end (sx_model_share_cracks) */
     bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
     int64_t fail_order;     /* its error's place in the serial order where that is not the ranks' (a clump's index) */
     bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */

@@ -178,9 +178,11 @@ SX_API int sx_model_ranks(const sx_model *m);
 /// from where the last one stopped, without the exchange of the whole
 /// state; the queries that say so answer a scattered model with exchanges
 /// of their own (collective calls: the state hash, the ratio, the counts,
-/// the energies, the timesteps, sx_ball_fetch before a ball's motion is
-/// read), and anything else that reads or changes the balls, pairs, bonds
-/// or clumps must first call sx_model_gather. Nothing when not decomposed.
+/// the energies, the timesteps, the deepest contact, sx_ball_fetch before a
+/// ball's motion is read, sx_model_share_motion before many balls' are,
+/// sx_model_share_cracks before the crack log is), and anything else that
+/// reads or changes the balls, pairs, bonds or clumps must first call
+/// sx_model_gather. Nothing when not decomposed.
 SX_API void sx_model_gather_lazily(sx_model *m, bool lazily);
 /// Whether the last cycle left m's state scattered (see above).
 SX_API bool sx_model_scattered(const sx_model *m);
