@@ -32,6 +32,14 @@ static bool unforced(const sx_model *m)
     }
     if (m->balls.fapp) return false;
     if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
+    /* gravity along a periodic cell vector has no bounded potential (a
+     * chute: the balls gain kinetic energy without end), and the potential
+     * of the wrapped positions jumps by m g.h at every crossing */
+    for (int k = 0; m->cell && k < m->dim; k++) {
+        double gh = 0;
+        for (int q = 0; q < m->dim; q++) gh += m->gravity[q] * m->cell->h[k][q];
+        if (m->cell->axis[k] && gh != 0) return false;
+    }
     /* a fixed component moving at its imposed velocity does work; one held
      * at rest does none (a ball fixed as an obstacle or a rough floor), so
      * the guard stays on for it (a physics check: a bonded pair with one
@@ -115,10 +123,15 @@ sx_status sx__guard_check(sx_model *m)
     int64_t fastest;
     double crit;
     if (!most_energetic_ball(m, &fastest) || !sx__critical(m, &crit)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    /* within the estimate, the timestep may still be the cause (the
+     * estimate is the balls' translational one) or a force may feed energy */
+    const bool large = m->dt > crit;
     return sx__fail(m, SX_EUNSTABLE,
                     "unstable at step %lld: the mechanical energy of an unforced system grew by %g J "
-                    "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is too large "
-                    "(critical estimate %g s)",
+                    "(%.3g times its initial scale %g J; fastest ball %lld); the timestep %g s is %s "
+                    "(critical estimate %g s)%s",
                     (long long)m->step, gain, gain / m->guard_scale, m->guard_scale, (long long)fastest, m->dt,
-                    crit);
+                    large ? "too large" : "within the estimate", crit,
+                    large ? "" : ": lower it (m:set_timestep) to see whether it is the cause, or look for a force "
+                                 "that feeds energy");
 }
