@@ -28,6 +28,7 @@ local entries = {
     "Minimises f(x) (x an array, f a number) within bounds by an NLopt derivative-free local algorithm: 'bobyqa', 'neldermead', 'sbplx' or 'cobyla'. xtol, ftol relative; an error in f stops the search and is raised."},
   ["seixo.cores"] = {"seixo.cores() -> n", "The processors online (lab.calibrate's default number of worker processes)."},
   ["seixo.executable"] = {"seixo.executable() -> path", "The path of the running seixo program, to start worker processes."},
+  ["seixo.script"] = {"seixo.script([path]) -> path | nil", "The script the files written name as their provenance; a worker running a -e chunk for a script sets it (seixo.pool's workers take their parent's)."},
   ["seixo.rank"] = {"seixo.rank() -> r", "This process's MPI rank: 0 unless started by mpirun (and seixo built with MPI)."},
   ["seixo.ranks"] = {"seixo.ranks() -> n", "The number of MPI ranks: 1 unless started by mpirun -np N."},
   ["seixo.barrier"] = {"seixo.barrier()", "Every MPI rank waits until all are there (nothing serially): after " ..

@@ -167,7 +167,9 @@ function pool.run(o)
   local function stem(i) return string.format("%s.job%d", o.prefix, i) end
   local function start(i)
     local s = stem(i)
-    pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out"}))
+    -- the script the workers' files name as their provenance (seixo.script)
+    local sx = rawget(_G, "seixo") -- (nil in a stock Lua)
+    pool.write_file(s .. ".lua", pool.serialize({job = o.jobs[i], answer = s .. ".out", script = sx and sx.script()}))
     local h, why = io.popen(string.format("{ %s > %s 2>&1 & echo $! > %s; wait $!; echo %d $? > %s; }",
                                           o.command(s .. ".lua"), q(s .. ".txt"), q(s .. ".pid"), i, q(fifo)))
     if not h then error("seixo.pool: cannot start a process: " .. tostring(why), 0) end
@@ -306,6 +308,7 @@ function pool.answer(e, value) pool.write_file(e.answer, pool.serialize(value)) 
 function pool.serve()
   local e = pool.take(os.getenv("SEIXO_POOL_JOB"))
   if not e then error("seixo.pool: no job in $SEIXO_POOL_JOB", 0) end
+  if e.script then seixo.script(e.script) end
   local j = e.job
   local ok, value = pcall(function() return require(j.module)[j.call](table.unpack(j.args)) end)
   pool.answer(e, ok and {ok = true, value = value} or {ok = false, error = tostring(value)})

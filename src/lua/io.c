@@ -284,7 +284,12 @@ static void push_tree(lua_State *L, const sx_io_tree *t)
 
 /* ----------------------------------------------------------- save, load */
 
-/* The path of the script being run (its main chunk "@path"), or NULL. */
+/* The script a worker runs for (seixo.script(path): a seixo.pool job's
+ * parent script), in the registry. */
+static const char script_key[] = "seixo.script";
+
+/* The path of the script being run (its main chunk "@path"), or the one a
+ * worker was given, or NULL. */
 static const char *script_path(lua_State *L)
 {
     lua_Debug ar;
@@ -293,7 +298,26 @@ static const char *script_path(lua_State *L)
         if (!lua_getinfo(L, "S", &ar)) continue;
         if (strcmp(ar.what, "main") == 0 && ar.source[0] == '@') found = ar.source + 1;
     }
+    if (found) return found;
+    lua_getfield(L, LUA_REGISTRYINDEX, script_key);
+    found = lua_tostring(L, -1); /* kept alive by the registry */
+    lua_pop(L, 1);
     return found;
+}
+
+/* seixo.script([path]) -> the script the files name as their provenance:
+ * the one being run, or, in a worker that runs a -e chunk for a script
+ * (seixo.pool's), the path given, relative to the worker's directory. */
+static int seixo_script(lua_State *L)
+{
+    if (!lua_isnoneornil(L, 1)) {
+        lua_pushstring(L, luaL_checkstring(L, 1));
+        lua_setfield(L, LUA_REGISTRYINDEX, script_key);
+    }
+    const char *path = script_path(L);
+    if (path) lua_pushstring(L, path);
+    else lua_pushnil(L);
+    return 1;
 }
 
 void sx_lua_record_seed(lua_State *L, int model, int64_t seed)
@@ -820,6 +844,7 @@ void sx_lua_io_register(lua_State *L)
         {"load", seixo_load},
         {"xdmf", seixo_xdmf},
         {"replaceable", seixo_replaceable},
+        {"script", seixo_script},
         {NULL, NULL},
     };
     /* the module table is on the top of the stack */

@@ -139,6 +139,13 @@ test("seixo.pool: jobs in processes, the next started as soon as any ends; answe
   T.vec_eq(got[1].value, {1.5, 6})
   eq(got[2].ok, false)
   check(got[2].error:find("util.add", 1, true), got[2].error)
+  -- a worker's files name this script as their provenance (seixo.script):
+  -- a lab.series' test files named none when run in processes
+  local script = seixo.script()
+  check(script and script:find("lualib.lua", 1, true), tostring(script))
+  pool.run{jobs = {{module = "seixo", call = "script", args = {}}}, workers = 1, prefix = prefix,
+           command = pool.serve_command, done = function(i, answer) got[i] = answer end}
+  eq(got[1].value, script)
   -- a done callback's error comes through, the jobs still running
   -- interrupted (seixo workers, which stop at a SIGINT) and waited for; no file is left
   local busy = pool.quote(seixo.executable()) .. " -e " .. pool.quote("local t = os.time() while os.time() - t < 60 do end")
