@@ -100,8 +100,7 @@ bool sx__dd_route(sx_dd *d, const sx_hop *hop, int64_t n, sx_route *rt)
  * rank. */
 bool sx__dd_share_by_rank(sx_dd *d, void *data, size_t size)
 {
-    for (int r = 0; r < d->x.ranks; r++) d->scratch[r] = (sx_span){r, r + 1};
-    return sx__dd_share(d, data, size, d->scratch, sx__dd_everything(d, d->x.ranks), 1);
+    return sx__dd_share(d, data, size, d->by_rank, sx__dd_everything(d, d->x.ranks), 1);
 }
 
 /* (model_internal.h) */
@@ -112,6 +111,13 @@ const uint64_t *sx__dd_words(const sx_model *m, const uint64_t *v, int n)
     uint64_t *all = d->sums; /* kept from the decomposition: nothing to allocate, nothing to fail alone */
     memcpy(all + (size_t)d->x.rank * (size_t)n, v, (size_t)n * sizeof *v);
     return sx__dd_share_by_rank(d, all, (size_t)n * sizeof *all) ? all : NULL;
+}
+
+/* (model_internal.h) */
+bool sx__dd_all_ok(const sx_model *m, bool ok)
+{
+    uint64_t failed = !ok;
+    return sx__dd_sum(m, &failed, 1) && !failed;
 }
 
 /* (model_internal.h) An all-gather of the ranks' values, each rank adding
@@ -316,7 +322,7 @@ bool sx__dd_gather_cracks(sx_model *m)
     int64_t total = 0;
     bool ok = sx__dd_parts(m, kept - d->crack0, &mine, &total);
     sx_crack *all = ok && total ? malloc((size_t)total * sizeof *all) : NULL;
-    ok = ok && (!total || all);
+    ok = ok && sx__dd_all_ok(m, !total || all); /* (a rank without the buffer would miss the join) */
     if (ok && total) {
         if (mine.hi > mine.lo) memcpy(all + mine.lo, k->ev + d->crack0, (size_t)(mine.hi - mine.lo) * sizeof *all);
         ok = sx__dd_join(m, all, sizeof *all, total);

@@ -105,8 +105,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     sx_dd *d = calloc(1, sizeof *d);
     const size_t r = (size_t)x->ranks;
     /* own, need (SX_DD_NEED per rank), pairs, wblk, wrun, bb_own, bw_own, all, bs_own, scratch, cl_own,
-     * gho_own, fwd.own, back.own, bb_was, bw_was; and the routes' needs and the clumps' energy's (r per rank) */
-    enum { SPANS = 15 + SX_DD_NEED };
+     * gho_own, fwd.own, back.own, bb_was, bw_was, by_rank; and the routes' needs and the clumps' energy's (r per rank) */
+    enum { SPANS = 16 + SX_DD_NEED };
     sx_span *s = d ? calloc(SPANS * r, sizeof *s) : NULL, *routes = s ? calloc(3 * r * r, sizeof *routes) : NULL;
     double *pace = routes ? calloc(5 * r, sizeof *pace) : NULL; /* pace (r), sample (2 r), stopping (2 r) */
     uint64_t *sums = pace ? calloc(SX_DD_SUM_MAX * r, sizeof *sums) : NULL;
@@ -123,7 +123,8 @@ sx_status sx_model_decompose(sx_model *m, const sx_exchange *x)
     d->pairs = s, d->wblk = s + r, d->wrun = s + 2 * r, d->bb_own = s + 3 * r, d->bw_own = s + 4 * r;
     d->all = s + 5 * r, d->bs_own = s + 6 * r, d->scratch = s + 7 * r, d->cl_own = s + 8 * r;
     d->gho_own = s + 9 * r, d->fwd.own = s + 10 * r, d->back.own = s + 11 * r;
-    d->bb_was = s + 12 * r, d->bw_was = s + 13 * r;
+    d->bb_was = s + 12 * r, d->bw_was = s + 13 * r, d->by_rank = s + 14 * r;
+    for (int k = 0; k < x->ranks; k++) d->by_rank[k] = (sx_span){k, k + 1};
     d->fwd.need = routes, d->back.need = routes + r * r, d->cterm_need = routes + 2 * r * r;
     d->pace = pace, d->sample = pace + r, d->stopping = pace + 3 * r;
     d->sums = sums;

@@ -430,6 +430,7 @@ typedef struct sx_dd {
     int32_t *bslot;
     int64_t nbslot, cap_bslot;
     sx_span *bs_own, *scratch;
+    sx_span *by_rank;       /* rank r's entry r, {r, r + 1}: the spans of sx__dd_share_by_rank, which so leaves scratch alone */
     int64_t crack0;         /* the crack log's entries every rank holds alike */
     /* clumps: each clump's owner (cown: the rank owning its pebble
      * nearest its centroid), the clumps by owner, each rank's in clump
@@ -952,6 +953,10 @@ bool sx__dd_sum(const sx_model *m, uint64_t *v, int n);
  * buffer (nothing to allocate, nothing to fail alone) valid until the next
  * exchange; NULL when the ranks could not exchange */
 const uint64_t *sx__dd_words(const sx_model *m, const uint64_t *v, int n);
+/* whether ok on every rank (false too when the ranks could not exchange):
+ * before an exchange that a rank could not take part in (a buffer it
+ * could not allocate), so that every rank stops, not that one alone */
+bool sx__dd_all_ok(const sx_model *m, bool ok);
 void sx__clumps_bag(const sx_model *m, const sx_rows_held *part, sx_hash_bag *out); /* each clump's digest */
 /* FNV-1a over n bytes, continuing h (the state hash), from SX_FNV_BASIS. */
 #define SX_FNV_BASIS 0xcbf29ce484222325ULL
