@@ -489,6 +489,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         installed++;
     }
     m->dt_stale = true;
+    m->guard_dirty = true; /* a bond across a gap starts in tension: the strain jumps (a new baseline) */
     if (count) *count = installed;
     return SX_OK;
 }
@@ -568,5 +569,6 @@ sx_status sx_flatjoint_unbond(sx_model *m, int64_t a, int64_t b, int e)
         return sx__fail(m, SX_EINVAL, "flatjoint_unbond: element %d out of range 0 to %d (from 0)", e, nel - 1);
     uint8_t *st = &m->fjel.state[m->bonds.fj_first[s] + e];
     if (*st == SX_FJ_BONDED) *st = SX_FJ_UNBONDED;
+    m->guard_dirty = true; /* the element's strain may go: a new baseline */
     return SX_OK;
 }

@@ -101,6 +101,7 @@ sx_status sx_cmodel_add(sx_model *m, const char *name, const sx_cmodel_def *def,
     sx__cmodel_derive(r);
     m->ncmodel++;
     m->dt_stale = true;
+    m->guard_dirty = true; /* the contacts' laws may change: a new baseline */
     if (row) *row = m->ncmodel;
     return SX_OK;
 }

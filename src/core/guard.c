@@ -63,15 +63,15 @@ static double mechanical(const sx_energy *e) { return e->kinetic + e->gravitatio
 
 static const char *const NO_EXCHANGE = "cycle: the ranks could not exchange the state";
 
-sx_status sx__guard_start(sx_model *m)
+sx_status sx__guard_start(sx_model *m, bool stepped)
 {
     m->guard_on = unforced(m);
     if (!m->guard_on) return SX_OK;
     sx_energy e;
-    /* decomposed and gone on from a scattered state: the ghosts where the
-     * last step left their owners, as guard_check reads them */
-    const bool resumed = m->dd && m->dd->active && m->dd->scattered;
-    if ((resumed && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
+    /* decomposed, after a step or gone on from a scattered state: the
+     * ghosts where the last step left their owners, as guard_check reads them */
+    const bool refresh = m->dd && m->dd->active && (stepped || m->dd->scattered);
+    if ((refresh && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)) return sx__fail(m, SX_EINVAL, "%s", NO_EXCHANGE);
     m->guard_e0 = mechanical(&e);
     /* the scale: the energy in play, with a floor of each ball's weight over its radius */
     double floor_e = 0, g = 0;

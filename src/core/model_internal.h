@@ -903,8 +903,9 @@ sx_status sx__check_skin(sx_model *m);
 sx_status sx__build_failed(sx_model *m, sx_status st);
 bool sx__critical(sx_model *m, double *crit);
 sx_status sx__update_timestep(sx_model *m);
-/* guard.c: the stability guard's baseline, and its check. */
-sx_status sx__guard_start(sx_model *m);
+/* guard.c: the stability guard's baseline (stepped: after a step of the
+ * cycle, its ghosts refreshed as for a check), and its check. */
+sx_status sx__guard_start(sx_model *m, bool stepped);
 sx_status sx__guard_check(sx_model *m);
 /* The largest gravity component, as for a ball's fields: a step's velocity
  * g dt must square without overflowing, or the state cannot be saved and

@@ -29,6 +29,19 @@ static double pair_force(const sx_model *m, int64_t c, double un, double *kn, do
     return active ? fn : 0;
 }
 
+/* The shear stiffness of a touching ball-ball pair at the overlap its last
+ * force pass saw (rel: the relative position the pass kept), where its
+ * shear force was made; a linear law's, which does not depend on it, is ks. */
+static double pass_ks(const sx_model *m, const sx_pair_law *law, int64_t i, int64_t j, const double *rel, double ks)
+{
+    if (!sx__law_stiffens(law->law)) return ks;
+    const sx_balls *B = &m->balls;
+    const double rsum = B->rad[i] + B->rad[j], un = rsum - sqrt(dot(rel, rel));
+    double kn, ks_pass;
+    stiffness(law, B->rad[i], B->rad[j], 2 * B->rad[i] * B->rad[j] / rsum, un, &kn, &ks_pass);
+    return ks_pass;
+}
+
 /* The rolling spring's energy of a touching pair whose law rolls. */
 static double rolling_strain(const sx_pair_law *l, const sx_pairs *p, int64_t c, double ks, double rbar)
 {
@@ -73,8 +86,12 @@ static void energy_pairs(const sx_model *m, int64_t c0, int64_t c1, double *e)
             else e[0] += s;
             continue;
         }
-        e[0] += contact_strain(law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks);
-        e[0] += rolling_strain(law, &m->bb, c, ks, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
+        /* the shear and rolling springs' energy at the stiffness of the pass
+         * that made their forces (a Hertz ks from the overlap now: near
+         * separation it goes to 0 and 1/2 |Fs|^2 / ks without bound) */
+        const double ks_pass = m->bb.touching[c] ? pass_ks(m, law, i, j, m->bb.geo + c * D, ks) : ks;
+        e[0] += contact_strain(law, fn, un, m->bb.touching[c] ? m->bb.fs + c * D : zero, ks_pass);
+        e[0] += rolling_strain(law, &m->bb, c, ks_pass, B->rad[i] * B->rad[j] / (B->rad[i] + B->rad[j]));
         const int32_t slot = m->bb.bond ? m->bb.bond[c] - 1 : -1;
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_PARALLEL)) e[1] += sx_bond_parallel_strain(D, &m->bonds, slot);
         if (slot >= 0 && (m->bonds.kind[slot] & SX_BOND_FLATJOINT)) /* at its last evaluation's distance */
@@ -102,8 +119,10 @@ static void energy_walls(const sx_model *m, int64_t c0, int64_t c1, double *e)
         if (un <= 0) continue;
         const sx_pair_law law = wall_laws ? wall_laws[B->mat[i] * nw + m->bw.b[c]] : sx__bw_law(m, c);
         const double fn = stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
-        *e += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks);
-        *e += rolling_strain(&law, &m->bw, c, ks, B->rad[i]);
+        double kn_pass, ks_pass = ks; /* the shear spring's at its pass's overlap, as for a ball pair */
+        if (m->bw.touching[c] && sx__law_stiffens(law.law)) stiffness(&law, B->rad[i], 0, B->rad[i], m->bw.un[c], &kn_pass, &ks_pass);
+        *e += contact_strain(&law, fn, un, m->bw.touching[c] ? m->bw.fs + c * D : zero, ks_pass);
+        *e += rolling_strain(&law, &m->bw, c, ks_pass, B->rad[i]);
     }
     free(wall_laws);
 }
