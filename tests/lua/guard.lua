@@ -70,3 +70,22 @@ T.test("a Hertz bounce separating at a check keeps its strain energy bounded", f
   local e = m:energy()
   T.check(e.strain < 0.01 * e0, string.format("strain %.6g J of a bounce carrying %.6g J", e.strain, e0))
 end)
+
+-- The guard's other side: a load applied and then removed leaves the
+-- system unforced, and the guard on. It stayed off for the model's life
+-- (the loads' array, once made, stays): a bonded pair at 5 times the
+-- critical timestep ran on to 1.9e6 m/s with no error.
+T.test("a load set back to zero leaves the guard on: an unstable bonded pair is stopped", function()
+  local m = seixo.model{dim = 2}
+  m:material("rock", {kn = 1e7, ks = 1e7, friction = 0.5, damping = 0, density = 2500,
+                      bond = {radius_multiplier = 1, modulus = 1e8, stiffness_ratio = 1, tensile_strength = 1e12,
+                              cohesion = 1e12}})
+  m:ball{pos = {0, 0}, radius = 0.01, material = "rock"}
+  local b = m:ball{pos = {0.0199, 0}, radius = 0.01, material = "rock"}
+  T.eq(m:bond{kind = "parallel", gap = 1e-3}, 1)
+  b.applied_force = {1, 0}
+  m:cycle(10)
+  b.applied_force = {0, 0}
+  m:set_timestep(5 * m:critical_timestep())
+  T.raises(function() m:cycle(2000) end, "the mechanical energy of an unforced system grew")
+end)
