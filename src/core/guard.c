@@ -40,8 +40,8 @@ static bool unforced(const sx_model *m)
         if (B->tapp[i] != 0) return false;
     if (m->cell && m->cell->controlled) return false; /* the deforming cell does work on the balls */
     /* gravity along a periodic cell vector has no bounded potential (a
-     * chute: the balls gain kinetic energy without end), and the potential
-     * of the wrapped positions jumps by m g.h at every crossing */
+     * chute: the balls gain kinetic energy without end, against a growing
+     * scale the guard's hundredfold would not catch) */
     for (int k = 0; m->cell && k < m->dim; k++) {
         double gh = 0;
         for (int q = 0; q < m->dim; q++) gh += m->gravity[q] * m->cell->h[k][q];

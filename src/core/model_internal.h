@@ -122,6 +122,11 @@ typedef struct sx_balls {
     int32_t *clump;        /* clump id of each ball (0: a free ball); NULL while the model has no clumps */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
+    /* periodic space: the cell vectors each ball was brought back by, summed
+     * over the builds since it was placed (3 a ball; LAMMPS's image flags),
+     * so that x + sum image_k h_k is its unwrapped position; NULL until a
+     * periodic build wraps a ball */
+    int32_t *image;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
     int32_t *index_of;
     int64_t index_cap, next_id;
@@ -138,7 +143,7 @@ typedef struct sx_ball_field {
     sx_field_type type;
     bool ghost;            /* a periodic ghost slot carries it (applied loads: only real balls) */
 } sx_ball_field;
-#define SX_BALL_FIELDS_MAX 18
+#define SX_BALL_FIELDS_MAX 18 /* every optional array included */
 
 /* A triangle mesh (mesh.c): its shape in its own frame, fixed at creation,
  * and its pose (the wall's point and an orientation); the world vertices
@@ -725,6 +730,12 @@ void sx__ball_update_mass(sx_model *m, int64_t i);
  * what the materials or the default would (a loaded state, say). */
 sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
+sx_status sx__balls_expand_images(sx_model *m);
+void sx__balls_free_images(sx_model *m);
+/* Ball i's image shift, the cell vectors its images add up to (zero
+ * outside periodic space), and its unwrapped position x + that shift. */
+void sx__ball_image_shift(const sx_model *m, int64_t i, double *s);
+void sx__ball_unwrapped(const sx_model *m, int64_t i, double *x);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
 /* Gives both pair stores the history array at byte offset `field` of

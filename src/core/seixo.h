@@ -407,6 +407,12 @@ typedef enum sx_ball_vec {
 } sx_ball_vec;
 
 SX_API sx_status sx_ball_get_vec(const sx_model *m, int64_t id, sx_ball_vec which, double out[3]);
+/// Ball id's unwrapped position, m: in periodic space its position in the
+/// cell plus the cell vectors (the cell's now) it was brought back by since
+/// it was placed, so that it moves on without jumps across the faces (the
+/// position a displacement and the gravitational energy take); elsewhere
+/// its position.
+SX_API sx_status sx_ball_get_unwrapped(const sx_model *m, int64_t id, double out[3]);
 /// A model a lazy cycle left scattered (sx_model_gather_lazily): ball id's
 /// motion (position, velocity, spin, force, moment) from the rank that
 /// holds it current to every rank, where sx_ball_get_vec then reads it as

@@ -1,6 +1,7 @@
 /* Ball displacements, PFC's ball displacement: m:reset_disp([filter])
  * records where the (selected) balls are; b.disp is then a ball's position
- * minus that reference. A ball added after the reset is measured from
+ * minus that reference, both unwrapped in periodic space (a ball that
+ * crossed a face has moved on, not back by the cell). A ball added after the reset is measured from
  * where it was when the next cycle started. The references are a Lua table
  * of the model's state, id -> vector (ball ids are never reused), filled
  * at the start of each run once a reset has made it: nothing is kept, and
@@ -11,7 +12,7 @@
 static void record(lua_State *L, const sx_model *m, int refs, int64_t id)
 {
     double x[3];
-    sx_ball_get_vec(m, id, SX_BALL_POS, x);
+    sx_ball_get_unwrapped(m, id, x);
     sx_lua_pushvec(L, x, sx_model_dim(m));
     lua_rawseti(L, refs, (lua_Integer)id);
 }
@@ -60,7 +61,7 @@ int sx_lua_ball_disp(lua_State *L, const sx_model *m, int64_t id)
         return luaL_error(L, "ball field 'disp': no reference position yet; m:reset_disp() starts measuring displacements");
     const int dim = sx_model_dim(m);
     double x[3], r[3];
-    sx_ball_get_vec(m, id, SX_BALL_POS, x);
+    sx_ball_get_unwrapped(m, id, x);
     if (lua_rawgeti(L, -1, (lua_Integer)id) == LUA_TNIL) {  // added since: measured from the next cycle on
         sx_lua_pushvec(L, (const double[3]){0, 0, 0}, dim);
         return 1;

@@ -48,7 +48,7 @@ typedef struct cursor {
 } cursor;
 
 /* periodic space (kernels/ghosts.c) */
-static void wrap_balls(sx_model *m, int32_t *wrap);
+static bool wrap_balls(sx_model *m, int32_t *wrap);
 static bool make_ghosts(sx_model *m);
 static void build_ghost_pairs(sx_model *m, transfer *tr, cursor *to);
 static bool bonded_ends(sx_model *m, int32_t a, int32_t b, int32_t *ra, int32_t *rb);
@@ -731,7 +731,7 @@ static sx_status KERNEL(build)(sx_model *m)
     transfer tr;
     bool ok = transfer_begin(m, &tr);
     tr.poll = !m->cell && !(m->dd && m->dd->active); /* the ranks' parts must all be listed */
-    if (ok && m->cell) wrap_balls(m, tr.wrap); /* periodic space: balls into the cell, then their ghosts */
+    ok = ok && (!m->cell || wrap_balls(m, tr.wrap)); /* periodic space: balls into the cell, then their ghosts */
     ok = ok && grid_setup(m) && sort_balls(m, &tr) && (!m->cell || make_ghosts(m)) && build_store(m, &tr, false) &&
          build_store(m, &tr, true);
     bool undone = false;

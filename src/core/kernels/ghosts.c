@@ -19,15 +19,20 @@ static inline void image_shift(const double (*h)[3], const int8_t *s, double *ou
 
 /* Brings every free ball into the cell (sx__cell_wrap); wrap (3 per
  * ball) records how many cell vectors each moved by, for the history of
- * the pairs. Pebbles move with their clump (clump_motion.c places them
- * from its centroid), so a clump is wrapped as a body. */
-static void wrap_balls(sx_model *m, int32_t *wrap)
+ * the pairs, and the balls' images add them up (their unwrapped
+ * positions: displacements, the gravitational energy). Pebbles move with
+ * their clump (clump_motion.c places them from its centroid), so a clump
+ * is wrapped as a body. False when out of memory for the images. */
+static bool wrap_balls(sx_model *m, int32_t *wrap)
 {
     sx_balls *B = &m->balls;
+    if (sx__balls_expand_images(m)) return false;
     memset(wrap, 0, (size_t)(B->n * 3) * sizeof *wrap);
     for (int64_t i = 0; i < B->n; i++)
         if (!B->clump || !B->clump[i]) sx__cell_wrap(m->cell, D, B->x + i * D, wrap + i * 3);
     if (B->clump) sx__cell_wrap_clumps(m, wrap);
+    for (int64_t k = 0; k < B->n * 3; k++) B->image[k] += wrap[k];
+    return true;
 }
 
 /* The images a ball may have: every combination of -1, 0, 1 over the

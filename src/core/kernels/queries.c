@@ -58,7 +58,9 @@ static void energy_balls(const sx_model *m, int64_t i0, int64_t i1, double *e)
         double ww = 0;
         for (int k = 0; k < RD; k++) ww += w[k] * w[k];
         e[0] += 0.5 * dot(v, v) / B->inv_mass[i] + 0.5 * ww / B->inv_inertia[i];
-        e[1] -= dot(m->gravity, B->x + i * D) / B->inv_mass[i];
+        double x[D]; /* unwrapped: a crossing of a periodic face along gravity is no jump */
+        sx__ball_unwrapped(m, i, x);
+        e[1] -= dot(m->gravity, x) / B->inv_mass[i];
     }
 }
 
