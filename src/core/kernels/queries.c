@@ -8,7 +8,12 @@
 static double pair_geometry(const sx_model *m, int64_t i, int64_t j, double *n)
 {
     const sx_balls *B = &m->balls;
-    for (int k = 0; k < D; k++) n[k] = B->x[j * D + k] - B->x[i * D + k];
+    /* a periodic ghost where its ball is now: its slot is as the last
+     * contact pass copied it, a step behind (ghost_copy's sum) */
+    double shift[D];
+    int64_t o = sx__cell_owner(m, j, shift);
+    if (o < 0) o = j; /* its ball was removed (no pair is left to it) */
+    for (int k = 0; k < D; k++) n[k] = (B->x[o * D + k] + shift[k]) - B->x[i * D + k];
     const double d = sqrt(dot(n, n));
     for (int k = 0; k < D; k++) n[k] = d > 0 ? n[k] / d : 0;
     return B->rad[i] + B->rad[j] - d;
