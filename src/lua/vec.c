@@ -206,6 +206,9 @@ static int vec_copy(lua_State *L)
 /* v.x, v.y, v.z and the methods */
 static int vec_index(lua_State *L)
 {
+    /* a number past the components: nil, as a plain array's (ipairs stops
+     * there), not the field named by its digits */
+    if (lua_type(L, 2) == LUA_TNUMBER) return lua_pushnil(L), 1;
     const char *k = lua_tostring(L, 2);
     if (k && k[0] >= 'x' && k[0] <= 'z' && k[1] == 0) {
         lua_rawgeti(L, 1, k[0] - 'x' + 1);

@@ -413,6 +413,12 @@ test("vectors: arithmetic, accepted wherever {x, y, z} is, returned by the API",
   raises(function() return v * w end, "a vector times a number expected")
   raises(function() return seixo.vec(0, 0):unit() end, "the zero vector has no direction")
   raises(function() return v.w end, "vector has no field 'w'")
+  -- a plain array past its components: nil, so ipairs stops (it raised "no field '4'")
+  eq(v[4], nil)
+  local seen = 0
+  for i, x in ipairs(v) do seen = seen + 1; eq(x, v[i]) end
+  eq(seen, 3)
+  eq(seixo.model{dim = 2}:gravity()[3], nil)
   local m = seixo.model{dim = 3, gravity = {0, 0, -10}}
   m:material("a")
   local b = m:ball{pos = seixo.vec(0, 0, 1), radius = 0.1, vel = v}
