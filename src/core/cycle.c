@@ -147,11 +147,13 @@ static void keep(sx_model *m, sx_step_error *e, sx_status st, sx_fail_part part)
 }
 
 /* After a part of the step that may fail on one rank: true to go on (no
- * error, or decomposed: an instability, kept). */
+ * error, or decomposed: an instability, or another error of the rank's
+ * own part met after its exchanges, kept). */
 static bool go_on(sx_model *m, sx_step_error *e, sx_status *st, sx_fail_part part)
 {
     if (!*st) return true;
-    if (!m->dd || *st != SX_EUNSTABLE) return false;
+    if (!m->dd || (*st != SX_EUNSTABLE && !m->dd->own_error)) return false;
+    m->dd->own_error = false;
     if (!e->st) keep(m, e, *st, part);
     m->dd->failed = true;
     *st = SX_OK;
@@ -188,7 +190,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
         if (!(fabs(m->gravity[k]) < SX_GRAVITY_MAX)) /* a file's from before the limit */
             return sx__fail(m, SX_EINVAL, "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
                             m->gravity[k]);
-    if (m->dd) m->dd->failed = false, m->dd->fail_order = 0;
+    if (m->dd) m->dd->failed = false, m->dd->fail_order = 0, m->dd->own_error = false;
     double t = sx__now();
     const int64_t builds = m->builds;
     sx_status st = SX_OK;

@@ -413,6 +413,8 @@ typedef struct sx_dd {
     bool cracks_merged;     /* scattered: the ranks' crack logs merged since the cycle's end (sx_model_share_cracks) */
     bool failed;            /* this rank met an error in its own part of this step: it moves nothing more */
     int64_t fail_order;     /* its error's place in the serial order where that is not the ranks' (a clump's index) */
+    bool own_error;         /* its error is of its own part of the step, met after the part's exchanges (a
+                             * mesh too fine for a ball), to be agreed on as an instability (cycle.c go_on) */
     bool agreed;            /* the cycle ended on an error every rank agreed on (sx__dd_agree_failure) */
     sx_span *own, *need, *pairs, *wblk, *wrun, *bb_own, *bw_own, *all; /* per rank (need: SX_DD_NEED per rank) */
     /* periodic space: this rank's pairs outside pairs[rank] whose b is a

@@ -23,6 +23,11 @@
 --   clumps      a pour of clumps at a hundred times the critical timestep
 --               (mpi_clumps.lua ... unstable): the clumps' exchanges with a
 --               rank that failed
+--   mesh        a row of balls rolling onto a mesh too fine for them (a
+--               ball near more facets than a step lists), on the first
+--               rank's side: the error is that rank's alone (its wall
+--               blocks), and stopped the whole job instead of being caught
+--               (a review's finding); the run goes on once the ball is gone
 local scene = arg and arg[1] or "overlap"
 local dim = tonumber(arg and arg[2]) or 2
 local dir = (debug.getinfo(1, "S").source:match("^@(.*/)") or "./")
@@ -43,6 +48,26 @@ elseif scene == "guard" then
   print("caught", not ok, tostring(err):match("unstable at step .*") or tostring(err))
   local m = seixo.models()[1]
   print("left", m:step(), m:hash())
+  return
+end
+
+if scene == "mesh" then
+  local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
+  m:material("g", {density = 2500, kn = 1e5, ks = 1e5, friction = 0.5})
+  for i = 0, 39 do m:ball{pos = {0.004 * i, 0.004 * (i % 3), 0.0012}, radius = 1e-3} end
+  local tris, h = {}, 1e-4 -- 0.1 mm facets around the first ball
+  for i = -15, 14 do for j = -15, 14 do
+    local x0, y0 = i * h, j * h
+    tris[#tris + 1] = {{x0, y0, 0}, {x0 + h, y0, 0}, {x0 + h, y0 + h, 0}}
+    tris[#tris + 1] = {{x0, y0, 0}, {x0 + h, y0 + h, 0}, {x0, y0 + h, 0}}
+  end end
+  m:wall{kind = "mesh", triangles = tris}
+  m:wall{kind = "plane", point = {0, 0, 0}, normal = {0, 0, 1}}
+  local ok, err = pcall(m.cycle, m, 2000)
+  print("caught", not ok, tostring(err):match("ball %d+ is near %d+ facets of mesh wall %d+"), m:step())
+  m:ball(1):remove()
+  m:cycle(200)
+  print("again", m:step(), m:hash())
   return
 end
 

@@ -578,6 +578,7 @@ static sx_status KERNEL(walls)(sx_model *m)
     else if (dd && !sx__dd_walls(m, true)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange wall forces");
     for (int64_t b = 0; b < nb; b++) {
         const sx_block *o = &m->blocks[b];
+        if (o->st && m->dd) m->dd->own_error = true; /* past the exchange above: kept and agreed on */
         if (o->st == SX_EINVAL)
             return sx__fail(m, SX_EINVAL,
                             "ball %lld is near %.0f facets of mesh wall %lld, more than %d: the mesh is too fine for "
