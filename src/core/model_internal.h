@@ -734,6 +734,15 @@ sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
 sx_status sx__balls_expand_images(sx_model *m);
 void sx__balls_free_images(sx_model *m);
+/* How far the velocities' time is behind the positions' (central
+ * differences): half the last step's timestep, or, before the first step,
+ * of the user's timestep, which the first kick takes the given velocities
+ * to be half a step old by (an automatic one is not rated yet: none). */
+static inline double sx__half_step(const sx_model *m)
+{
+    return 0.5 * (m->dt_prev > 0 ? m->dt_prev : m->dt_user > 0 ? m->dt_user : m->dt);
+}
+
 /* Ball i's image shift, the cell vectors its images add up to (zero
  * outside periodic space), and its unwrapped position x + that shift. */
 void sx__ball_image_shift(const sx_model *m, int64_t i, double *s);
