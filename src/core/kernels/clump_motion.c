@@ -144,6 +144,8 @@ static inline __attribute__((always_inline)) bool step_clump(sx_model *m, const 
                 energy_term(&work[0], terms, k, (fd - force) * 0.5 * (vold + v[k]) * dt);
                 energy_term(&work[1], terms, nd + k, Fa[k] * 0.5 * (vold + v[k]) * dt);
             }
+        } else if (track) { /* held at its velocity: the holder's work, as a ball's (motion.c) */
+            energy_term(&work[1], terms, nd + k, -(F[k] - Fa[k] + g[k] * mass) * v[k] * dt);
         }
         x[k] += v[k] * dt;
     }
@@ -152,6 +154,9 @@ static inline __attribute__((always_inline)) bool step_clump(sx_model *m, const 
         double *q = C->q + c * 4, *L = C->L + c * 3, R[9];
         qmatrix(q, R);
         if ((fix & SX_FIX_SPIN) == SX_FIX_SPIN) {
+            if (track) /* held at its spin: the holder's work, -(contact moment) . w */
+                energy_term(&work[1], terms, nd + d,
+                            -((T[0] - Ta[0]) * w[0] + (T[1] - Ta[1]) * w[1] + (T[2] - Ta[2]) * w[2]) * dt);
             imposed_rotation(q, w, dt);
             qmatrix(q, R);
             momentum_of(R, I, w, L);
@@ -188,6 +193,8 @@ static inline __attribute__((always_inline)) bool step_clump(sx_model *m, const 
                 energy_term(&work[0], terms, d, (md - T[0]) * 0.5 * (wold + w[0]) * dt);
                 energy_term(&work[1], terms, nd + d, Ta[0] * 0.5 * (wold + w[0]) * dt);
             }
+        } else if (track) {
+            energy_term(&work[1], terms, nd + d, -(T[0] - Ta[0]) * w[0] * dt);
         }
         C->q[c] += w[0] * dt;
         double R[9];

@@ -35,7 +35,8 @@ static inline void motion_energy(sx_model *m, const sx_block *o, int k, double *
  * velocities, and so does the dashpots': the contact passes booked it at
  * the old velocity, this adds -dt/2 Fd . (v_new - v_old) per ball (the
  * dashpots' forces and moments on it, m->visc_f and visc_t; a pebble's
- * stays at the old velocity). A free, undamped component takes v += (F/m + g) dt, the
+ * stays at the old velocity); a component held at its velocity books the
+ * holder's work, -(F_contact + m g) v dt, with the loads'. A free, undamped component takes v += (F/m + g) dt, the
  * same lines in both instances: `plain` (a constant at each call site)
  * compiles a block without fixities, damping or tracking alone. */
 static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_block *o, const bool plain)
@@ -82,6 +83,9 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 if (track && B->fapp)
                     motion_energy(m, o, 1, &load_work, B->fapp[i * D + k] * 0.5 * (vold + v[k]) * dt);
                 if (track) visc += vf[i * D + k] * (v[k] - vold);
+            } else if (track) { /* held at its velocity: the holder's work on the rest, -(contact force + weight) . v */
+                const double fc = f[k] - (B->fapp ? B->fapp[i * D + k] : 0); /* a load on a held component does nothing */
+                motion_energy(m, o, 1, &load_work, -(fc + g[k] / im) * v[k] * dt);
             }
             x[k] += v[k] * dt; /* 4-48 */
             const double u = x[k] - xb[i * D + k];
@@ -103,6 +107,9 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
                 if (track && B->tapp)
                     motion_energy(m, o, 1, &load_work, B->tapp[i * RD + k] * 0.5 * (wold + w[k]) * dt);
                 if (track) visc += vt[i * RD + k] * (w[k] - wold);
+            } else if (track) { /* held at its spin: -(contact moment) . w */
+                const double tc = t[k] - (B->tapp ? B->tapp[i * RD + k] : 0);
+                motion_energy(m, o, 1, &load_work, -tc * w[k] * dt);
             }
             check += 0 * w[k];
         }
