@@ -363,6 +363,12 @@ typedef struct sx_cell {
     int64_t n, cap, base;   /* ghosts in ball slots [base, base + n) */
     int32_t *owner;         /* the real ball (dense index) each ghost images; -1 after its removal */
     int8_t *image;          /* the cell vectors it is shifted by, 3 per ghost (-1, 0, 1) */
+    /* with energy tracking in a deforming cell: per real ball, the sum over
+     * its ghosts of s (x) f (dim x dim: the cell vectors shifting a ghost,
+     * the force it felt this step), from which the law of motion books the
+     * cell's work on the ball, -(hdot : that) dt (kernels/ghosts.c) */
+    double *shifted;
+    int64_t cap_shifted;
 } sx_cell;
 
 /* Domain decomposition (decompose.c; docs/developer.md). Between cycles

@@ -439,8 +439,10 @@ sx_status sx__cell_restore(sx_model *m, const sx_cell *saved)
     const int64_t cap = c->cap;
     int32_t *owner = c->owner;
     int8_t *image = c->image;
+    double *shifted = c->shifted;
+    const int64_t cap_shifted = c->cap_shifted;
     *c = *saved;
-    c->cap = cap, c->owner = owner, c->image = image;
+    c->cap = cap, c->owner = owner, c->image = image, c->shifted = shifted, c->cap_shifted = cap_shifted;
     c->base = m->balls.n;
     if (c->n < 0 || c->n > INT32_MAX - m->balls.n)
         return sx__fail(m, SX_EINVAL, "state: %lld ghosts", (long long)c->n);
@@ -514,7 +516,7 @@ uint64_t sx__cell_hash(const sx_model *m, uint64_t h)
 size_t sx__cell_bytes(const sx_model *m)
 {
     const sx_cell *c = m->cell;
-    return c ? sizeof *c + (size_t)c->cap * (sizeof *c->owner + 3) : 0;
+    return c ? sizeof *c + (size_t)c->cap * (sizeof *c->owner + 3) + (size_t)c->cap_shifted * sizeof(double) : 0;
 }
 
 void sx__cell_free(sx_model *m)
@@ -523,6 +525,7 @@ void sx__cell_free(sx_model *m)
     if (!c) return;
     sx_alloc_free(&m->alloc, c->owner, (size_t)c->cap, sizeof *c->owner);
     sx_alloc_free(&m->alloc, c->image, (size_t)c->cap * 3, sizeof *c->image);
+    sx_alloc_free(&m->alloc, c->shifted, (size_t)c->cap_shifted, sizeof *c->shifted);
     sx_alloc_free(&m->alloc, c, 1, sizeof *c);
     m->cell = NULL;
 }

@@ -211,15 +211,41 @@ static bool bonded_ends(sx_model *m, int32_t a, int32_t b, int32_t *ra, int32_t 
 
 /* ------------------------------------------------------------ the pass */
 
+/* With energy tracking in a deforming cell: the balls' shifted ghost
+ * forces (sx_cell), cleared; NULL otherwise, or out of memory (*ok). */
+static double *shifted_clear(sx_model *m, bool *ok)
+{
+    sx_cell *c = m->cell;
+    const int64_t n = m->balls.n * D * D;
+    *ok = true;
+    if (!m->track_energy || !c->controlled || n == 0) return NULL;
+    if (n > c->cap_shifted) {
+        double *p = sx_alloc_resize(&m->alloc, c->shifted, (size_t)c->cap_shifted, (size_t)n, sizeof *p);
+        if (!p) return *ok = false, NULL;
+        c->shifted = p, c->cap_shifted = n;
+    }
+    memset(c->shifted, 0, (size_t)n * sizeof *c->shifted);
+    return c->shifted;
+}
+
 /* After the ball-ball pass: each ghost's force and moment added to its
- * owner's, in ghost order. */
-static void fold_ghosts(sx_model *m)
+ * owner's, in ghost order. A deforming cell moves a ghost against its
+ * owner by s dH, and so does work on the pair the ghost's force does not
+ * pay for from the owner's motion: -f . (s dH) (the wall work's image:
+ * wall_contacts.c); the owner keeps s (x) f for the law of motion, which
+ * books it with the step's rate (sx__cell_rate, after this pass). False:
+ * out of memory for that. */
+static bool fold_ghosts(sx_model *m)
 {
     const sx_cell *c = m->cell;
     sx_balls *B = &m->balls;
+    bool ok;
+    double *G = shifted_clear(m, &ok);
     for (int64_t g = 0; g < c->n; g++) {
         const int64_t q = c->base + g, o = c->owner[g];
         if (o < 0) continue;
+        for (int k = 0; k < D && G; k++)
+            for (int i = 0; i < D && c->image[g * 3 + k]; i++) G[(o * D + k) * D + i] += c->image[g * 3 + k] * B->f[q * D + i];
         for (int k = 0; k < D; k++) B->f[o * D + k] += B->f[q * D + k];
         for (int k = 0; k < RD; k++) B->t[o * RD + k] += B->t[q * RD + k];
         if (m->track_energy) { /* the dashpots' share too (motion.c) */
@@ -227,6 +253,7 @@ static void fold_ghosts(sx_model *m)
             for (int k = 0; k < RD; k++) m->visc_t[o * RD + k] += m->visc_t[q * RD + k];
         }
     }
+    return ok;
 }
 
 /* -------------------------------------------------------------- stress */

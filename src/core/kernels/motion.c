@@ -62,7 +62,15 @@ static inline __attribute__((always_inline)) void motion_pass(sx_model *m, sx_bl
      * so) and 0 x every spin: not finite once some value is not (or once
      * the squares overflow; the search below tells) */
     double check = 0;
+    /* a deforming cell's work on the balls through their ghosts (ghosts.c, fold_ghosts) */
+    const double *restrict shifted = track && m->cell && m->cell->controlled ? m->cell->shifted : NULL;
     for (int64_t i = o->b0; i < o->b1; i++) {
+        if (shifted) {
+            double w = 0;
+            for (int k = 0; k < D; k++)
+                for (int j = 0; j < D; j++) w += m->cell->hdot[k][j] * shifted[(i * D + k) * D + j];
+            if (w != 0) motion_energy(m, o, 1, &load_work, -w * dt);
+        }
         if (cl && cl[i]) continue; /* clumps: a pebble moves with its clump (clump_motion.c) */
         const unsigned fix = plain ? 0 : fixa[i];
         const double a = plain ? 0 : sx__ball_damping(m, i), im = ima[i], ii = iia[i];

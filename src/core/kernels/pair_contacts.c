@@ -933,7 +933,7 @@ static void far_pairs(sx_model *m, int64_t e0, int64_t e1)
 /* Runs the even chunks, then the odd ones (each phase in parallel), then
  * merges energies, cracks and errors in chunk order. */
 static void KERNEL(ghosts_refresh)(sx_model *m, bool all);
-static void fold_ghosts(sx_model *m);
+static bool fold_ghosts(sx_model *m);
 
 static sx_status KERNEL(contacts)(sx_model *m)
 {
@@ -956,7 +956,7 @@ static sx_status KERNEL(contacts)(sx_model *m)
         }
     }
     if (dd) far_pairs(m, dd->nxlow, dd->nxpair);
-    if (m->cell) fold_ghosts(m);
+    if (m->cell && !fold_ghosts(m)) return sx__fail(m, SX_ENOMEM, "cycle: out of memory");
     /* decomposed: the energy sums are the ranks' to chain (dd_energy.c, sx__dd_energy) */
     const bool sums = !m->dd || !m->dd->active;
     for (int64_t c = 0; c < nchunk; c++) {
