@@ -481,8 +481,9 @@ static void *run_unstable(void *arg)
     return NULL;
 }
 
-/* The error's step and cause: up to the critical estimate, the failing
- * rank's own (kernels/timestep.c, estimate_dt). */
+/* The error's step and cause: up to the critical estimate (the ranks'
+ * least, made after the other ranks' balls went on through the step:
+ * dd_agree.c; lua_mpi_caught cause compares a whole message). */
 static size_t cause_length(const char *err) { return strcspn(err, ";,("); }
 
 START_TEST(a_rank_instability_stops_every_rank)

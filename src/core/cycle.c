@@ -144,6 +144,7 @@ static void keep(sx_model *m, sx_step_error *e, sx_status st, sx_fail_part part)
 {
     e->st = st, e->part = part, e->order = m->dd->fail_order;
     memcpy(e->err, m->err, sizeof e->err);
+    e->unstable = m->unstable;
 }
 
 /* After a part of the step that may fail on one rank: true to go on (no

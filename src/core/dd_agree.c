@@ -4,6 +4,7 @@
 #include "decompose.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 /* An interrupt stops every rank at the same step. Every STOP_EVERY steps
  * the ranks share the number of their process's last unanswered interrupt
@@ -75,6 +76,15 @@ sx_status sx__dd_agree_failure(sx_model *m, const sx_step_error *mine)
     int pick = -1;
     for (int r = 0; r < R; r++)
         if (all[r].st && (pick < 0 || before(&all[r], &all[pick]))) pick = r;
+    /* an instability's critical estimate: the ranks' least, the serial
+     * one, as every rank now meets here (the failing rank's own, made where
+     * it failed, was up to twice it, and turned an overlap's cause about:
+     * "within the critical one" for "too large") */
+    double crit;
+    if (pick >= 0 && all[pick].unstable.kind != SX_UNSTABLE_NONE && sx__critical(m, &crit)) {
+        sx__unstable_fail(m, &all[pick].unstable, crit);
+        memcpy(all[pick].err, m->err, sizeof all[pick].err);
+    }
     sx_status agreed;
     if (pick < 0) /* a displacement no rank's error explains */
         agreed = sx__fail(m, SX_EUNSTABLE, "unstable at step %lld: a ball's displacement is not finite",

@@ -17,6 +17,53 @@
  * initial scale is numerically unstable. */
 #define GUARD_ENERGY_FACTOR 100.0
 
+/* ------------------------------------------------------- instabilities */
+
+/* An overlap: a timestep within the critical one is not the cause, the
+ * overlap came from before this step (a robustness tester followed "use
+ * the automatic one" and got the same error, the model still holding the
+ * blown-up state). */
+static sx_status unstable_message(sx_model *m, const sx_unstable *u, double crit)
+{
+    const long long step = (long long)u->step, a = (long long)u->a, b = (long long)u->b;
+    switch (u->kind) {
+    case SX_UNSTABLE_OVERLAP:
+        if (u->dt <= crit)
+            return sx__fail(m, SX_EUNSTABLE,
+                            "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m, "
+                            "with a timestep (%g s) within the critical one (%g s): the overlap came from before this "
+                            "step (bodies placed overlapping, a wall moved or set through them, or an earlier unstable "
+                            "run whose state the model still holds: move them apart, or load a save), or a body moved "
+                            "more than a radius in one step (slow it down)",
+                            step, u->what_a, a, u->what_b, b, u->un, u->r, u->dt, crit);
+        return sx__fail(m, SX_EUNSTABLE,
+                        "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m; "
+                        "the timestep %g s is too large for the contact stiffness (critical estimate %g s): "
+                        "lower the timestep or use the automatic one, from a save (the model keeps the state this step "
+                        "found)",
+                        step, u->what_a, a, u->what_b, b, u->un, u->r, u->dt, crit);
+    case SX_UNSTABLE_BOND:
+        return sx__fail(m, SX_EUNSTABLE,
+                        "unstable at step %lld: the bond of balls %lld and %lld broke with a force or moment that is "
+                        "not finite; the timestep %g s is too large for its stiffness (critical estimate %g s): "
+                        "lower the timestep or use the automatic one, from a save (the model keeps the state this "
+                        "step found)",
+                        step, a, b, u->dt, crit);
+    default:
+        return sx__fail(m, SX_EUNSTABLE,
+                        "unstable at step %lld: %s %lld has a non-finite position, velocity or spin; "
+                        "the timestep %g s is likely too large (critical estimate %g s)",
+                        step, u->what_a, a, u->dt, crit);
+    }
+}
+
+sx_status sx__unstable_fail(sx_model *m, const sx_unstable *u, double crit)
+{
+    const sx_status st = unstable_message(m, u, crit);
+    m->unstable = *u;
+    return st;
+}
+
 /* ---------------------------------------------------------------- guard */
 
 /* An unforced system (no moving wall, no applied load, no fixed velocity

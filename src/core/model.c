@@ -32,6 +32,7 @@ sx_status sx__fail(sx_model *m, sx_status st, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(m->err, sizeof m->err, fmt, ap);
     va_end(ap);
+    m->unstable.kind = SX_UNSTABLE_NONE; /* an instability's message sets it after (sx__unstable_fail) */
     return st;
 }
 

@@ -490,6 +490,22 @@ typedef struct sx_dd {
     sx_span *bb_was, *bw_was;
 } sx_dd;
 
+/* An instability a contact pass or the law of motion meets on its own
+ * balls: what its message says but the critical estimate, which a
+ * decomposed step knows whole only once the ranks agree on the error
+ * (sx__dd_agree_failure renders the message again from this; the
+ * estimate decides an overlap's wording: the timestep, or an overlap from
+ * before the step). */
+typedef enum { SX_UNSTABLE_NONE, SX_UNSTABLE_OVERLAP, SX_UNSTABLE_BOND, SX_UNSTABLE_NONFINITE } sx_unstable_kind;
+typedef struct sx_unstable {
+    sx_unstable_kind kind;
+    char what_a[8], what_b[8]; /* "ball", "wall", "clump" */
+    int64_t a, b, step;        /* the ids (b: none for a non-finite state) */
+    double un, r, dt;          /* an overlap's depth and the radius it passed; the timestep */
+} sx_unstable;
+/* Fails m with u's message at the critical estimate crit (s); keeps u. */
+sx_status sx__unstable_fail(sx_model *m, const sx_unstable *u, double crit);
+
 struct sx_model {
     int dim, rdim;
     double gravity[3];
@@ -508,6 +524,7 @@ struct sx_model {
 
     sx_alloc alloc;
     char err[SX_ERRLEN];
+    sx_unstable unstable;    /* the instability behind err, if one is (kind SX_UNSTABLE_NONE: none) */
 
     sx_material *mats;
     int nmat, cap_mat;
@@ -870,6 +887,7 @@ typedef struct sx_step_error {
     sx_fail_part part;
     int64_t order;
     char err[SX_ERRLEN];
+    sx_unstable unstable;  /* an instability's, to render at the ranks' estimate */
 } sx_step_error;
 sx_status sx__dd_agree_failure(sx_model *m, const sx_step_error *mine);
 bool sx__dd_walls(sx_model *m, bool in_step);

@@ -10,8 +10,8 @@
 # The energy guard (mpi_energy.lua guard): its whole message, the same
 # step, gain, scale, fastest ball and critical estimate. An instability
 # found on one rank (mpi_clumps.lua ... unstable): its step and cause, up
-# to the critical estimate, which is the failing rank's own
-# (kernels/timestep.c, estimate_dt). Errors in the script, in a callback
+# to the critical estimate (the ranks' least, made after the other ranks'
+# balls went on through the step: dd_agree.c). Errors in the script, in a callback
 # and on one rank alone (mpi_fail.lua): the message, and no rank's folder
 # of shadows left in TMPDIR. Every message comes from rank 0.
 set -u

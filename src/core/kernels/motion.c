@@ -221,10 +221,9 @@ SX_VECTOR_CLONES static void integrate_block(sx_model *m, sx_block *o)
 /* A ball's or clump's state became non-finite (what: "ball" or "clump"). */
 static sx_status KERNEL(nonfinite)(sx_model *m, const char *what, int64_t id)
 {
-    return sx__fail(m, SX_EUNSTABLE,
-                    "unstable at step %lld: %s %lld has a non-finite position, velocity or spin; "
-                    "the timestep %g s is likely too large (critical estimate %g s)",
-                    (long long)m->step, what, (long long)id, m->dt, KERNEL(estimate_dt)(m));
+    sx_unstable u = {.kind = SX_UNSTABLE_NONFINITE, .a = id, .step = m->step, .dt = m->dt};
+    strncpy(u.what_a, what, sizeof u.what_a - 1);
+    return sx__unstable_fail(m, &u, KERNEL(estimate_dt)(m));
 }
 
 /* The law of motion in fixed blocks of balls whose partial sums are added

@@ -125,41 +125,24 @@ static double KERNEL(estimate_dt)(sx_model *m);
  * x_n during the previous step, so displacement increments use its length. */
 static inline double motion_dt(const sx_model *m) { return m->dt_prev > 0 ? m->dt_prev : m->dt; }
 
-/* what_a, what_b: "ball", "ball" or "ball", "wall". A timestep within
- * the critical one is not the cause: the overlap came from before this
- * step (a robustness tester followed "use the automatic one" and got the
- * same error, the model still holding the blown-up state). */
+/* what_a, what_b: "ball", "ball" or "ball", "wall" (sx__unstable_fail). */
 static sx_status overlap_error(sx_model *m, const char *what_a, const char *what_b, int64_t ida, int64_t idb,
                                double un, double r)
 {
-    const double crit = KERNEL(estimate_dt)(m);
-    if (m->dt <= crit)
-        return sx__fail(m, SX_EUNSTABLE,
-                        "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m, with a "
-                        "timestep (%g s) within the critical one (%g s): the overlap came from before this step (bodies "
-                        "placed overlapping, a wall moved or set through them, or an earlier unstable run whose state "
-                        "the model still holds: move them apart, or load a save), or a body moved more than a radius "
-                        "in one step (slow it down)",
-                        (long long)m->step, what_a, (long long)ida, what_b, (long long)idb, un, r, m->dt, crit);
-    return sx__fail(m, SX_EUNSTABLE,
-                    "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m; "
-                    "the timestep %g s is too large for the contact stiffness (critical estimate %g s): "
-                    "lower the timestep or use the automatic one, from a save (the model keeps the state this step "
-                    "found)",
-                    (long long)m->step, what_a, (long long)ida, what_b, (long long)idb, un, r, m->dt, crit);
+    sx_unstable u = {.kind = SX_UNSTABLE_OVERLAP, .a = ida, .b = idb, .step = m->step, .un = un, .r = r, .dt = m->dt};
+    strncpy(u.what_a, what_a, sizeof u.what_a - 1);
+    strncpy(u.what_b, what_b, sizeof u.what_b - 1);
+    return sx__unstable_fail(m, &u, KERNEL(estimate_dt)(m));
 }
 
 /* A chunk's error: an overlap deeper than a radius, or a bond broken with
  * a non-finite force. */
 static sx_status chunk_error(sx_model *m, const sx_chunk *o)
 {
-    if (o->err_break)
-        return sx__fail(m, SX_EUNSTABLE,
-                        "unstable at step %lld: the bond of balls %lld and %lld broke with a force or moment that is "
-                        "not finite; the timestep %g s is too large for its stiffness (critical estimate %g s): "
-                        "lower the timestep or use the automatic one, from a save (the model keeps the state this "
-                        "step found)",
-                        (long long)m->step, (long long)o->err_a, (long long)o->err_b, m->dt, KERNEL(estimate_dt)(m));
+    if (o->err_break) {
+        const sx_unstable u = {.kind = SX_UNSTABLE_BOND, .a = o->err_a, .b = o->err_b, .step = m->step, .dt = m->dt};
+        return sx__unstable_fail(m, &u, KERNEL(estimate_dt)(m));
+    }
     return overlap_error(m, "ball", "ball", o->err_a, o->err_b, o->err_un, o->err_r);
 }
 

@@ -232,9 +232,10 @@ static double KERNEL(own_dt)(const sx_model *m)
     return best;
 }
 
-/* The critical estimate an instability message gives. Decomposed, it is
- * the failing rank's own (its balls, and its clumps from the pebble sums it
- * holds), at least the serial one: the rank rates it where it fails, with
- * no exchange the others would have to meet (they agree on the error at
- * the step's end, dd_agree.c). */
+/* The critical estimate an instability message gives where it is met.
+ * Decomposed, it is the failing rank's own (its balls, and its clumps from
+ * the pebble sums it holds), at least the serial one: the rank rates it
+ * where it fails, with no exchange the others would have to meet; where
+ * the ranks agree on the error at the step's end, the message is made
+ * again at the ranks' least (dd_agree.c). */
 static double KERNEL(estimate_dt)(sx_model *m) { return KERNEL(rate_dt)(m, false); }
