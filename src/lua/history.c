@@ -28,6 +28,7 @@
 
 #include "bindings.h"
 #include "seixo_io.h"
+#include "seixo_lua.h"
 
 enum { SRC_FUNCTION, SRC_BUILTIN, SRC_BALL, SRC_WALL };
 
@@ -641,9 +642,18 @@ static int model_history_csv(lua_State *L)
     const sx_model *m = sx_lua_tomodel(L, 1);
     const bool shared = sx_model_ranks(m) > 1;
     if (shared) sx_lua_check_model_call(L, m, "m:history_csv");
+    /* the ranks above 0 write their copy into a shadow (every rank holds
+     * the histories): a script appending to the file or reading it back
+     * then finds rank 0's bytes on every rank, whenever rank 0 gets there
+     * (the disk's file, copied late, may have rank 0's appends already, or
+     * be gone) */
+    const char *shadow = shared && !sx_lua_parallel_writes(shared) ? sx_lua_rank_shadow(L, path) : NULL;
+    char mine[1024] = "";
     if (sx_lua_parallel_writes(shared)) sx_history_csv_write(path, h, n, err, sizeof err);
+    else if (shadow) sx_history_csv_write(shadow, h, n, mine, sizeof mine);
     if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
-    sx_lua_rank_file_written(L, path);
+    if (mine[0]) return luaL_error(L, "m:history_csv: rank %d's copy of the file: %s", sx_lua_parallel_rank(), mine);
+    if (!shadow) sx_lua_rank_file_written(L, path);
     return 0;
 }
 

@@ -23,7 +23,9 @@
  * and that the script did not write, the disk answers, as it is when the
  * rank asks (rank 0 may have changed it already). C functions that read a
  * file the script may have written (an STL mesh, a clump template's
- * spheres) take its path through sx_lua_rank_file; after rank 0 has
+ * spheres) take its path through sx_lua_rank_file; a file every rank can
+ * make alike and the script may read back or append to (a history's CSV)
+ * is written by the others into a shadow (sx_lua_rank_shadow); after rank 0 has
  * written a file for every rank (m:save, m:output, os.tmpname's),
  * sx_lua_rank_file_written sends the others to the disk for it, and
  * remembers it as there: a rank that runs late removes or renames it
@@ -617,6 +619,19 @@ const char *sx_lua_rank_file(lua_State *L, const char *path)
     }
     if (s == GONE) return lua_pushliteral(L, ""); /* no such file, as on rank 0 */
     return lua_pushstring(L, s == SHADOWED ? shadow : path);
+}
+
+const char *sx_lua_rank_shadow(lua_State *L, const char *path)
+{
+    char shadow[PATH_MAX];
+    if (!shadowing() || !push_real_name(L, path)) return NULL;
+    if (!new_shadow(NULL, shadow)) {
+        lua_pop(L, 1);
+        return NULL;
+    }
+    set_shadow(L, SHADOWED, shadow, false);
+    lua_pop(L, 1);
+    return lua_pushstring(L, shadow);
 }
 
 void sx_lua_rank_file_written(lua_State *L, const char *path)

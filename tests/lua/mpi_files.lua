@@ -11,7 +11,7 @@
 -- name, a clump template's spheres read back by C, a file removed then
 -- written by m:save for every rank, a file saved then renamed, and
 -- os.tmpname's file removed (rank 0 first), files rewritten or made and
--- removed while the ranks worked alone, give every rank rank 0's answers
+-- removed while the ranks worked alone, a history's CSV appended to, give every rank rank 0's answers
 -- (and errors of Lua's io functions name the script's line):
 -- each answer goes into the model (a ball's size), so that a rank which
 -- read something else stops the next cycle ("the model differs between
@@ -159,6 +159,24 @@ f:close()
 note("dofile", dofile(base .. ".params.lua").k, loadfile(base .. ".params.lua")().name,
      dofile(base .. ".params.lua").src)
 os.remove(base .. ".params.lua")
+
+-- a history's CSV the model writes for every rank (rank 0 writes it), then
+-- appended to by the script, rank 0 first and the others late (they must
+-- start from the file rank 0 wrote, not from an empty shadow, nor from
+-- the file with rank 0's lines already appended: a review's finding, the
+-- others read 1 line of 5)
+m:history("hist_step", "step")
+m:cycle(3)
+local csv = base .. ".hist.csv"
+m:history_csv(csv, {"hist_step"})
+if seixo.rank() > 0 then os.execute("sleep 0.3") end
+local fa = assert(io.open(csv, "a"))
+fa:write("appended\n")
+fa:close()
+local lines = {}
+for line in io.lines(csv) do lines[#lines + 1] = line end
+note("a history's CSV appended to", #lines, lines[#lines])
+os.remove(csv)
 
 -- a shell command rank 0 runs alone, late, then seixo.barrier(): its file
 -- is there for every rank (an MPI user's finding: no call could wait for it)
