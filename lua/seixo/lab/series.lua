@@ -25,7 +25,7 @@ local compression_fields, test_keys, test_options, rate_control = compression.fi
 -- bit for bit. The longest first (the half-rate test, then the highest
 -- confinement down: the greater the confinement, the more steps), so that
 -- the last to start is the shortest and both cores end together. Each
--- test's log is passed on as it ends.
+-- test's log is passed on in the series' order (in_series_order).
 local function longest_first(tests)
   local order = {}
   for i = 1, #tests do order[i] = i end
@@ -38,9 +38,37 @@ local function longest_first(tests)
   return order
 end
 
+-- The tests' log lines in the series' order, whatever order the tests end
+-- in (the longest start first, and the ends race): each test's lines go to
+-- say_lines once every test before it has said its own, so a run says the
+-- same lines in the same order every time, in processes and over the
+-- ranks alike (they came in the order the tests ended). flush() says what
+-- is left, in order, past the tests that never ended (a failure).
+local function in_series_order(n, say_lines)
+  local pending, first = {}, 1
+  local o = {}
+  function o.add(i, lines)
+    pending[i] = lines
+    while pending[first] do
+      local ready = pending[first]
+      pending[first], first = nil, first + 1
+      say_lines(ready)
+    end
+  end
+  function o.flush()
+    for i = first, n do
+      if pending[i] then say_lines(pending[i]) end
+      pending[i] = nil
+    end
+    first = n + 1
+  end
+  return o
+end
+
 local function run_tests(spec, tests, jobs, opts)
   local order = longest_first(tests)
   local calls, results = {}, {}
+  local said = in_series_order(#tests, function(lines) for _, line in ipairs(lines) do say(opts, "%s", line) end end)
   for k, i in ipairs(order) do
     local o = copy(tests[i].opts)
     -- a log function stays here: the worker prints, and its lines are passed on
@@ -51,7 +79,10 @@ local function run_tests(spec, tests, jobs, opts)
   local ok, err = pcall(pool.run, {jobs = calls, workers = jobs, prefix = prefix, command = pool.serve_command,
     done = function(k, answer, output, code)
       local t = tests[order[k]]
-      for line in output:gmatch("[^\n]+") do say(opts, "%s", line) end
+      local lines = {}
+      for line in output:gmatch("[^\n]+") do lines[#lines + 1] = line end
+      said.add(order[k], lines)
+      if type(answer) ~= "table" or not answer.ok then said.flush() end
       if type(answer) ~= "table" then
         error(string.format("lab.series: the test at confining %g Pa ended without a result (exit code %s): %s",
                             t.opts.confining, tostring(code), (output:sub(-300):gsub("%s+$", ""))), 0)
@@ -72,7 +103,7 @@ end
 -- longest first; none after a failure, as the tests in turn stop at the
 -- first), runs one itself while any is left (looking for idle ranks every
 -- POLL_STEPS steps of its own test: polling; pool.hand_out), and says
--- each test's log lines as it ends. Then every rank gets the results,
+-- each test's log lines in the series' order. Then every rank gets the results,
 -- the lines rank 0 said (which the others say in turn: a log function of
 -- the script's sees the same lines on every rank; one that raises stops
 -- the lines there, on every rank) and the error to raise: that of the
@@ -104,6 +135,7 @@ local function run_ranks(spec, tests, opts)
   local done
   if seixo.rank() == 0 then
     local results, ran_on, errors = {}, {}, {}
+    local in_order = in_series_order(#tests, say_all)
     local ok, own_error = pool.hand_out{
       more = function(k) return k <= #tests and next(errors) == nil and not log_error end,
       message = function(k) return {k = k} end,
@@ -112,8 +144,9 @@ local function run_ranks(spec, tests, opts)
         local i = order[msg.k]
         ran_on[i] = msg.rank
         if msg.ok then results[i] = msg.value else errors[i] = msg.error end
-        say_all(msg.lines)
+        in_order.add(i, msg.lines)
       end}
+    in_order.flush()
     local first
     for i = 1, #tests do if errors[i] then first = first or errors[i] end end
     done = {results = results, ran_on = ran_on, said = said,
