@@ -273,10 +273,16 @@ static void stress_terms(const sx_model *m, int64_t c0, int64_t c1, double *acc,
     for (int64_t c = c0; c < c1; c++) {
         if (!p->touching[c]) continue;
         const double *l = p->geo + c * D, d = sqrt(dot(l, l));
+        /* the forces as the step applied them (as the contacts' reports
+         * give them, queries.c): a smooth joint's normal force along its
+         * joint's normal, a flat joint's face resultants as a parallel
+         * bond's (its contact law off); the centre line took both, and a
+         * flat-jointed cell read no stress */
+        const double *nc = p->joint && p->joint[c] ? p->jnormal + c * D : NULL;
         double n[D], F[D];
-        for (int k = 0; k < D; k++) n[k] = l[k] / d, F[k] = p->fn[c] * n[k] + p->fs[c * D + k];
+        for (int k = 0; k < D; k++) n[k] = l[k] / d, F[k] = p->fn[c] * (nc ? nc[k] : n[k]) + p->fs[c * D + k];
         const int32_t slot = p->bond ? p->bond[c] - 1 : -1;
-        if (slot >= 0 && (bs->kind[slot] & SX_BOND_PARALLEL))
+        if (slot >= 0 && (bs->kind[slot] & (SX_BOND_PARALLEL | SX_BOND_FLATJOINT)))
             for (int k = 0; k < D; k++) F[k] += bs->fn[slot] * n[k] + bs->fs[slot * D + k];
         for (int i = 0; i < D; i++)
             for (int j = 0; j < D; j++) acc[3 * i + j] += F[i] * l[j];
