@@ -64,7 +64,7 @@ int sx__ball_fields(const sx_model *m, sx_balls *b, sx_ball_field *f)
         f[n++] = (sx_ball_field){(void **)&b->fapp, d, SX_FIELD_F64, false};
         f[n++] = (sx_ball_field){(void **)&b->tapp, r, SX_FIELD_F64, false};
     }
-    if (b->image) f[n++] = (sx_ball_field){(void **)&b->image, 3, SX_FIELD_I32, false};
+    if (b->unwrap) f[n++] = (sx_ball_field){(void **)&b->unwrap, d, SX_FIELD_F64, false};
     return n;
 }
 
@@ -189,7 +189,7 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
         for (int k = 0; k < d; k++) b->fapp[i * d + k] = 0;
         for (int k = 0; k < r; k++) b->tapp[i * r + k] = 0;
     }
-    if (b->image) memset(b->image + i * 3, 0, 3 * sizeof *b->image); /* unwrapped where placed */
+    if (b->unwrap) memset(b->unwrap + i * d, 0, (size_t)d * sizeof *b->unwrap); /* unwrapped where placed */
     b->rad[i] = def->radius;
     b->mat[i] = (uint16_t)def->material;
     if (b->alpha) b->alpha[i] = m->mats[def->material].def.damping;
@@ -560,35 +560,31 @@ sx_status sx__balls_expand_damping(sx_model *m)
     return SX_OK;
 }
 
-sx_status sx__balls_expand_images(sx_model *m)
+sx_status sx__balls_expand_unwrap(sx_model *m)
 {
     sx_balls *b = &m->balls;
-    if (!b->image && !(b->image = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(b->cap * 3), sizeof *b->image)))
+    if (!b->unwrap && !(b->unwrap = sx_alloc_resize(&m->alloc, NULL, 0, (size_t)(b->cap * m->dim), sizeof *b->unwrap)))
         return SX_ENOMEM;
     return SX_OK;
 }
 
-void sx__balls_free_images(sx_model *m)
+void sx__balls_free_unwrap(sx_model *m)
 {
     sx_balls *b = &m->balls;
-    free_field(m, b->image, b->image ? b->cap * 3 : 0, sizeof *b->image);
-    b->image = NULL;
+    free_field(m, b->unwrap, b->unwrap ? b->cap * m->dim : 0, sizeof *b->unwrap);
+    b->unwrap = NULL;
 }
 
-void sx__ball_image_shift(const sx_model *m, int64_t i, double *s)
+void sx__ball_wraps(const sx_model *m, int64_t i, double *s)
 {
     const int d = m->dim;
-    const sx_balls *b = &m->balls;
-    for (int q = 0; q < d; q++) s[q] = 0;
-    if (!b->image || !m->cell) return;
-    for (int k = 0; k < d; k++) /* cell vector k: row k of h */
-        for (int q = 0; q < d; q++) s[q] += b->image[i * 3 + k] * m->cell->h[k][q];
+    for (int q = 0; q < d; q++) s[q] = m->balls.unwrap ? m->balls.unwrap[i * d + q] : 0;
 }
 
 void sx__ball_unwrapped(const sx_model *m, int64_t i, double *x)
 {
     double s[3];
-    sx__ball_image_shift(m, i, s);
+    sx__ball_wraps(m, i, s);
     for (int q = 0; q < m->dim; q++) x[q] = m->balls.x[i * m->dim + q] + s[q];
 }
 
@@ -681,7 +677,8 @@ sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const doub
     for (int k = 0; k < n; k++) dst[i * n + k] = val[k];
     if (which == SX_BALL_POS) {
         m->build_needed = true; /* a jump may skip the skin test */
-        if (m->balls.image) memset(m->balls.image + i * 3, 0, 3 * sizeof *m->balls.image); /* placed anew: unwrapped here */
+        if (m->balls.unwrap) /* placed anew: unwrapped here */
+            memset(m->balls.unwrap + i * m->dim, 0, (size_t)m->dim * sizeof *m->balls.unwrap);
     }
     if (which == SX_BALL_VEL && sx__speed_rated(m)) m->dt_stale = true;
     return SX_OK;

@@ -122,11 +122,12 @@ typedef struct sx_balls {
     int32_t *clump;        /* clump id of each ball (0: a free ball); NULL while the model has no clumps */
     /* cold: applied loads, allocated on first use */
     double *fapp, *tapp;
-    /* periodic space: the cell vectors each ball was brought back by, summed
-     * over the builds since it was placed (3 a ball; LAMMPS's image flags),
-     * so that x + sum image_k h_k is its unwrapped position; NULL until a
-     * periodic build wraps a ball */
-    int32_t *image;
+    /* periodic space: how far each ball was moved back into the cell since
+     * it was placed, the cell vectors of each wrap as they were then (dim a
+     * ball; LAMMPS's image flags, kept as lengths so that a deforming cell
+     * moves no ball's unwrapped position x + unwrap, which is where its
+     * velocity took it); NULL until a periodic build wraps a ball */
+    double *unwrap;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
     int32_t *index_of;
     int64_t index_cap, next_id;
@@ -755,20 +756,22 @@ void sx__ball_update_mass(sx_model *m, int64_t i);
  * what the materials or the default would (a loaded state, say). */
 sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
-sx_status sx__balls_expand_images(sx_model *m);
-void sx__balls_free_images(sx_model *m);
+sx_status sx__balls_expand_unwrap(sx_model *m);
+void sx__balls_free_unwrap(sx_model *m);
 /* How far the velocities' time is behind the positions' (central
  * differences): half the last step's timestep, or, before the first step,
- * of the user's timestep, which the first kick takes the given velocities
- * to be half a step old by (an automatic one is not rated yet: none). */
+ * of the one it will take, which the first kick takes the given
+ * velocities to be half a step old by (the user's, or the automatic one
+ * in use: sx_model_energy rates it first). */
 static inline double sx__half_step(const sx_model *m)
 {
     return 0.5 * (m->dt_prev > 0 ? m->dt_prev : m->dt_user > 0 ? m->dt_user : m->dt);
 }
 
-/* Ball i's image shift, the cell vectors its images add up to (zero
- * outside periodic space), and its unwrapped position x + that shift. */
-void sx__ball_image_shift(const sx_model *m, int64_t i, double *s);
+/* Ball i's wraps, how far it was moved back into the periodic cell since
+ * it was placed (zero outside periodic space), and its unwrapped position
+ * x + that. */
+void sx__ball_wraps(const sx_model *m, int64_t i, double *s);
 void sx__ball_unwrapped(const sx_model *m, int64_t i, double *x);
 void sx__balls_compact(sx_model *m);
 sx_status sx__pairs_reserve(sx_model *m, sx_pairs *p, int64_t cap);
@@ -948,6 +951,8 @@ sx_status sx__check_models(sx_model *m);
 sx_status sx__check_skin(sx_model *m);
 sx_status sx__build_failed(sx_model *m, sx_status st);
 bool sx__critical(sx_model *m, double *crit);
+/* The timestep the next step takes (the user's, or rated), not stored. */
+sx_status sx__next_timestep(sx_model *m, double *dt);
 sx_status sx__update_timestep(sx_model *m);
 /* guard.c: the stability guard's baseline (stepped: after a step of the
  * cycle, its ghosts refreshed as for a check), and its check. */

@@ -23,8 +23,17 @@ sx_energy sx_model_energy(sx_model *m)
      * over the ranks, as the energy guard inside a cycle, the ghosts and
      * clumps first where their owners left them; else the serial sums,
      * which cannot fail */
+    /* before the first step the gravitational energy is at the velocities'
+     * time by the first step's timestep (sx__half_step): rated here when
+     * automatic, and put back, as m:timestep() leaves the state */
+    const double dt_kept = m->dt;
+    if (!st && !(m->dt_prev > 0) && !(m->dt_user > 0) && m->balls.n > 0) {
+        double dt;
+        if (sx__next_timestep(m, &dt) == SX_OK) m->dt = dt;
+    }
     if (!st && ((split && !sx__dd_refresh(m)) || !sx__kernels(m)->energy(m, &e)))
         st = sx__fail(m, SX_EINVAL, "energy: the ranks could not exchange");
+    m->dt = dt_kept;
     if (split) m->dd->active = false;
     if (st) { /* no energy rather than a silent zero */
         double *t = (double *)&e;

@@ -91,7 +91,7 @@ bool sx__critical(sx_model *m, double *crit)
 
 /* The timestep the next step takes: the user's, the automatic one in use,
  * or, when that is stale or due for a refresh, safety x critical. */
-static sx_status next_timestep(sx_model *m, double *dt)
+sx_status sx__next_timestep(sx_model *m, double *dt)
 {
     *dt = m->dt;
     if (m->dt_user > 0) {
@@ -120,7 +120,7 @@ static sx_status next_timestep(sx_model *m, double *dt)
 
 sx_status sx__update_timestep(sx_model *m)
 {
-    const sx_status st = next_timestep(m, &m->dt);
+    const sx_status st = sx__next_timestep(m, &m->dt);
     if (!st) m->dt_stale = false;
     return st;
 }
@@ -153,7 +153,7 @@ double sx_model_timestep(sx_model *m)
     double dt = NAN;
     bool split; /* scattered (a lazy cycle's): rated rank by rank, as at a resumed cycle's start */
     sx_status st = sx__prepare_query(m, &split);
-    if (!st) st = next_timestep(m, &dt);
+    if (!st) st = sx__next_timestep(m, &dt);
     if (split) m->dd->active = false;
     return st ? NAN : dt;
 }

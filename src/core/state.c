@@ -53,7 +53,7 @@ sx_status sx__state_alloc(sx_model *m, const sx_state_sizes *s)
             !alloc_array(m, (void **)&b->tapp, b->cap * r, sizeof(double)))
             goto nomem;
     }
-    if (s->images && b->cap > 0 && sx__balls_expand_images(m)) goto nomem;
+    if (s->unwrap && b->cap > 0 && sx__balls_expand_unwrap(m)) goto nomem;
     if (!alloc_array(m, (void **)&b->index_of, s->next_ball_id, sizeof(int32_t))) goto nomem;
     b->index_cap = s->next_ball_id;
     b->n = s->balls;
@@ -630,9 +630,10 @@ static void bag_balls(sx_hash_bag *out, const sx_model *m, const sx_rows_held *p
         put_int(s, b->mat[i]);
         put_int(s, b->fix[i]);
         put_int(s, b->group ? b->group[i] : 0);
-        const int32_t *im = b->image ? b->image + i * 3 : NULL; /* none: as zeros */
-        if (im && (im[0] || im[1] || im[2]))
-            for (int k = 0; k < 3; k++) put_int(s, im[k]);
+        const double *uw = b->unwrap ? b->unwrap + i * d : NULL; /* none: as zeros */
+        bool wrapped = false;
+        for (int k = 0; uw && k < d; k++) wrapped |= uw[k] != 0;
+        if (wrapped) put_doubles(s, uw, d, 1);
         sx__hash_bag_add(out, s1.h);
     }
 }

@@ -36,7 +36,7 @@ typedef struct sx_state_sizes {
     int64_t balls;        ///< balls (dense)
     int64_t next_ball_id; ///< ids in use are 1 .. next_ball_id - 1
     bool applied;         ///< the applied force / moment arrays exist
-    bool images;          ///< the periodic images' counts exist
+    bool unwrap;          ///< the balls' periodic wraps exist
     int64_t bb, bw;       ///< ball-ball and ball-wall candidate pairs
     bool bw_facets;       ///< the ball-wall store carries mesh facets
     bool bb_bonds;        ///< the ball-ball store carries bond slots

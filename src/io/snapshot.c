@@ -95,7 +95,7 @@ static int ball_fields(const sx_model *m, const ball_cols *c, field *f)
         f[n++] = F("applied_force", T_F64, b->fapp, d, "N");
         f[n++] = F("applied_moment", T_F64, b->tapp, r, "N m");
     }
-    if (b->image) f[n++] = F("image", T_I32, b->image, 3, NULL); /* periodic space: unwrapped positions */
+    if (b->unwrap) f[n++] = F("unwrap", T_F64, b->unwrap, d, "m"); /* periodic space: unwrapped positions */
     return n;
 }
 
@@ -393,7 +393,7 @@ static bool read_sizes(sx_h5 *h, hid_t f, int d, sx_state_sizes *s)
     s->balls = sx_h5_rows(h, g, "/balls", "id", 1, true);
     sx_h5_get_i64(h, g, "/balls", "next_id", &s->next_ball_id, 1, true);
     s->applied = H5Lexists(g, "applied_force", H5P_DEFAULT) > 0;
-    s->images = H5Lexists(g, "image", H5P_DEFAULT) > 0;
+    s->unwrap = H5Lexists(g, "unwrap", H5P_DEFAULT) > 0;
     sx_h5_close(g);
     g = sx_h5_open_group(h, f, "/contacts/ball_ball", true);
     s->bb = sx_h5_rows(h, g, "/contacts/ball_ball", "a", 1, true);

@@ -19,19 +19,23 @@ static inline void image_shift(const double (*h)[3], const int8_t *s, double *ou
 
 /* Brings every free ball into the cell (sx__cell_wrap); wrap (3 per
  * ball) records how many cell vectors each moved by, for the history of
- * the pairs, and the balls' images add them up (their unwrapped
- * positions: displacements, the gravitational energy). Pebbles move with
- * their clump (clump_motion.c places them from its centroid), so a clump
- * is wrapped as a body. False when out of memory for the images. */
+ * the pairs, and the balls' unwrap adds the lengths they were moved by
+ * (their unwrapped positions: displacements, the gravitational energy).
+ * Pebbles move with their clump (clump_motion.c places them from its
+ * centroid), so a clump is wrapped as a body. False when out of memory
+ * for the unwrap. */
 static bool wrap_balls(sx_model *m, int32_t *wrap)
 {
     sx_balls *B = &m->balls;
-    if (sx__balls_expand_images(m)) return false;
+    if (sx__balls_expand_unwrap(m)) return false;
     memset(wrap, 0, (size_t)(B->n * 3) * sizeof *wrap);
     for (int64_t i = 0; i < B->n; i++)
         if (!B->clump || !B->clump[i]) sx__cell_wrap(m->cell, D, B->x + i * D, wrap + i * 3);
     if (B->clump) sx__cell_wrap_clumps(m, wrap);
-    for (int64_t k = 0; k < B->n * 3; k++) B->image[k] += wrap[k];
+    for (int64_t i = 0; i < B->n; i++)
+        for (int k = 0; k < D; k++)
+            if (wrap[i * 3 + k])
+                for (int q = 0; q < D; q++) B->unwrap[i * D + q] += wrap[i * 3 + k] * m->cell->h[k][q];
     return true;
 }
 
