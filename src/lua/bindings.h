@@ -150,11 +150,13 @@ bool sx_lua_parallel_alone(void);
 /// renames it as rank 0 did even if rank 0 got there first.
 void sx_lua_rank_file_written(lua_State *L, const char *path);
 /// rank_files.c: on a rank above 0 while the ranks share files, a new,
-/// empty shadow that stands for path from now on, its name pushed and
-/// returned, for the rank to write what rank 0 writes to path (a file every
-/// rank can make alike, which the script may then read or append to as
-/// rank 0 does, whenever rank 0 gets there); NULL (nothing pushed) otherwise.
-const char *sx_lua_rank_shadow(lua_State *L, const char *path);
+/// empty shadow, its name pushed and returned, for the rank to write what
+/// rank 0 writes to a path (a file every rank can make alike, which the
+/// script may then read or append to as rank 0 does, whenever rank 0 gets
+/// there); NULL (nothing pushed, errno set) otherwise. Once written,
+/// sx_lua_rank_shadow_take makes it stand for path (or the caller removes it).
+const char *sx_lua_rank_shadow_new(lua_State *L);
+void sx_lua_rank_shadow_take(lua_State *L, const char *path, const char *shadow);
 extern const luaL_Reg sx_lua_periodic_methods[];  ///< periodic.c: periodic, cell_control, cell_stress
 /// lab.c: pushes a dim x dim tensor as an array of rows.
 void sx_lua_push_tensor(lua_State *L, const double t[3][3], int dim);

@@ -22,13 +22,14 @@
  * saved: a history of a function comes back "detached", with its samples
  * but recording nothing until m:history(name, fn) gives it a function
  * again. */
+#include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bindings.h"
 #include "seixo_io.h"
-#include "seixo_lua.h"
 
 enum { SRC_FUNCTION, SRC_BUILTIN, SRC_BALL, SRC_WALL };
 
@@ -646,14 +647,23 @@ static int model_history_csv(lua_State *L)
      * the histories): a script appending to the file or reading it back
      * then finds rank 0's bytes on every rank, whenever rank 0 gets there
      * (the disk's file, copied late, may have rank 0's appends already, or
-     * be gone) */
-    const char *shadow = shared && !sx_lua_parallel_writes(shared) ? sx_lua_rank_shadow(L, path) : NULL;
+     * be gone). It stands for the file once rank 0's and every rank's copy
+     * are written: a failure is every rank's, the shadows as they were */
+    const bool writes = sx_lua_parallel_writes(shared);
+    const char *shadow = shared && !writes ? sx_lua_rank_shadow_new(L) : NULL;
     char mine[1024] = "";
-    if (sx_lua_parallel_writes(shared)) sx_history_csv_write(path, h, n, err, sizeof err);
+    if (writes) sx_history_csv_write(path, h, n, err, sizeof err);
     else if (shadow) sx_history_csv_write(shadow, h, n, mine, sizeof mine);
-    if (sx_lua_parallel_outcome(shared, err, sizeof err, NULL)) return luaL_error(L, "%s", err);
-    if (mine[0]) return luaL_error(L, "m:history_csv: rank %d's copy of the file: %s", sx_lua_parallel_rank(), mine);
-    if (!shadow) sx_lua_rank_file_written(L, path);
+    else if (shared) snprintf(mine, sizeof mine, "m:history_csv: no copy of '%s' for this rank: %s", path, strerror(errno));
+    bool failed = sx_lua_parallel_outcome(shared, err, sizeof err, NULL);
+    if (!failed && shared && !sx_lua_parallel_all_read(mine[0] == '\0', mine, sizeof mine))
+        failed = true, snprintf(err, sizeof err, "%s", mine);
+    if (failed) {
+        if (shadow) remove(shadow);
+        return luaL_error(L, "%s", err);
+    }
+    if (shadow) sx_lua_rank_shadow_take(L, path, shadow);
+    else sx_lua_rank_file_written(L, path);
     return 0;
 }
 

@@ -25,7 +25,8 @@
  * file the script may have written (an STL mesh, a clump template's
  * spheres) take its path through sx_lua_rank_file; a file every rank can
  * make alike and the script may read back or append to (a history's CSV)
- * is written by the others into a shadow (sx_lua_rank_shadow); after rank 0 has
+ * is written by the others into a shadow (sx_lua_rank_shadow_new, and
+ * sx_lua_rank_shadow_take once every rank wrote its own); after rank 0 has
  * written a file for every rank (m:save, m:output, os.tmpname's),
  * sx_lua_rank_file_written sends the others to the disk for it, and
  * remembers it as there: a rank that runs late removes or renames it
@@ -621,17 +622,21 @@ const char *sx_lua_rank_file(lua_State *L, const char *path)
     return lua_pushstring(L, s == SHADOWED ? shadow : path);
 }
 
-const char *sx_lua_rank_shadow(lua_State *L, const char *path)
+const char *sx_lua_rank_shadow_new(lua_State *L)
 {
     char shadow[PATH_MAX];
-    if (!shadowing() || !push_real_name(L, path)) return NULL;
-    if (!new_shadow(NULL, shadow)) {
-        lua_pop(L, 1);
-        return NULL;
+    if (!shadowing() || !new_shadow(NULL, shadow)) return NULL;
+    return lua_pushstring(L, shadow);
+}
+
+void sx_lua_rank_shadow_take(lua_State *L, const char *path, const char *shadow)
+{
+    if (!push_real_name(L, path)) {
+        remove(shadow);
+        return;
     }
     set_shadow(L, SHADOWED, shadow, false);
     lua_pop(L, 1);
-    return lua_pushstring(L, shadow);
 }
 
 void sx_lua_rank_file_written(lua_State *L, const char *path)
