@@ -758,7 +758,7 @@ function search(lab, o)
     cache, log_rows = {}, {}
     if not replay then write_settings(o) end
   end
-  local history, best = {}, nil
+  local history, best, worst_measured = {}, nil, 0
   local t_start = seixo.clock()
 
   -- Evaluates the candidates (arrays of quantized values): their runs not
@@ -802,9 +802,17 @@ function search(lab, o)
       local recs = {}
       for _, seed in ipairs(o.seeds) do recs[#recs + 1] = cache[key_of(x, seed)] end
       local c = summarize(o, x, recs)
+      -- a candidate none of whose runs succeeded costs more than any measured
+      -- one so far: at the fixed penalty alone, a failed candidate near a
+      -- start far from the targets scored best, became the start of the
+      -- guesses and of the search, and was returned as the result
+      if not c.ok then c.objective = math.max(o.penalty, 2 * worst_measured) end
+      if c.ok then worst_measured = math.max(worst_measured, c.objective) end
       history[#history + 1] = c
       c.index = #history
-      if not best or (c.within and not best.within) or (c.within == best.within and c.objective < best.objective) then
+      if not best or (c.ok and not best.ok)
+         or (c.ok == best.ok and ((c.within and not best.within)
+                                  or (c.within == best.within and c.objective < best.objective))) then
         best = c
       end
       progress(o, c, #jobs == 0, seixo.clock() - t0)
@@ -876,7 +884,7 @@ function search(lab, o)
         if math.abs(e) > 0.05 then exponents[i] = e end
       end
     end
-    if c.objective >= start.objective then break end
+    if not c.ok or c.objective >= start.objective then break end
     start = c
   end
 

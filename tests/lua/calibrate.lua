@@ -141,6 +141,28 @@ test("a failing run is recorded and skipped; a candidate with no run left costs 
   eq(p.evaluations, 4)
 end)
 
+-- Runs that fail below 40 GPa, the target 10 GPa far below: every measured
+-- candidate's objective is above the fixed penalty, so the first failed
+-- candidate scored best, became the start of the guesses and of BOBYQA, and
+-- was the result (objective 10, E "failed": a review's finding). A failed
+-- candidate now costs more than any measured one, and the best is measured.
+test("a failed candidate is never the best while a measured one exists", function()
+  local r = lab.calibrate{targets = {E = 10e9}, parameters = {modulus = {5e9, 200e9}},
+                          evaluate = function(material)
+                            if material.modulus < 40e9 then error("unstable run") end
+                            return {E = material.modulus}
+                          end,
+                          seeds = 1, workers = 1, maxeval = 8, log = fresh("calibrate_far.csv"), out = "calibrate_far",
+                          plot = false, print = false}
+  check(r.achieved.E and r.achieved.E.mean >= 40e9, "the result was measured: " .. tostring(r.parameters.modulus))
+  local first = r.history[1]
+  check(first.achieved.E, "the pilot was measured")
+  check(r.objective < first.objective, string.format("better than the pilot: %g against %g", r.objective, first.objective))
+  for _, h in ipairs(r.history) do
+    if not h.achieved.E then check(h.objective > first.objective, "a failed candidate costs more than the pilot") end
+  end
+end)
+
 test("an interrupted run (Ctrl-C, a scheduler's SIGTERM) ends the calibration, not logged as a failed run", function()
   -- it had been logged as failed (never run again on a restart) and the search went on
   local log = fresh("calibrate_interrupt.csv")
