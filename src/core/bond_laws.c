@@ -74,13 +74,15 @@ const char *sx__bond_params_invalid(const void *d, bool call, char *why, size_t 
 {
     const sx_bond_param *p[MAX_KEYS];
     const int n = keys(p);
-    for (int i = 0; i < n; i++) { /* every one >= 0 first, then the upper bounds */
+    for (int i = 0; i < n; i++) { /* every one >= 0 first, then the upper bounds; a call's NaN: not given */
         const double x = *(const double *)((const char *)d + (call ? p[i]->call : p[i]->material));
+        if (call && isnan(x)) continue;
         if (!(x >= p[i]->lo) || !isfinite(x))
             return snprintf(why, len, "%s must be >= %g (got %g)", p[i]->name, p[i]->lo, x), why;
     }
     for (int i = 0; i < n; i++) {
         const double x = *(const double *)((const char *)d + (call ? p[i]->call : p[i]->material));
+        if (call && isnan(x)) continue;
         if (p[i]->hi_closed ? !(x <= p[i]->hi) : !(x < p[i]->hi))
         {
             const char *unit = strcmp(p[i]->unit, "1") ? p[i]->unit : "";

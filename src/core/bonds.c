@@ -17,6 +17,9 @@ sx_bond_def sx_bond_default_def(void)
     d.kind = SX_BOND_PARALLEL;
     d.seed = 1;
     d.material_a = d.material_b = -1;
+    /* every micro-parameter not given (NaN): the materials' mean; a 0
+     * given is a 0 (a strength's sd, an unbonded fraction, a friction) */
+    for (int k = 0; k < sx_bond_key_count(); k++) *sx_bond_key_call(&d, k) = NAN;
     return d;
 }
 
@@ -256,8 +259,8 @@ static double draw_strength(uint64_t *s, double mean, double sd)
     return mean;
 }
 
-/* The value given in the def, or the mean of the two materials' values. */
-static double param(double given, double a, double b) { return given > 0 ? given : 0.5 * (a + b); }
+/* The value given in the def (not NaN), or the mean of the two materials' values. */
+static double param(double given, double a, double b) { return isnan(given) ? 0.5 * (a + b) : given; }
 
 /* Whether the def's material filter admits a pair of materials (a, b). */
 static bool pair_selected(const sx_bond_def *def, int a, int b)
@@ -318,6 +321,16 @@ static double pair_gap(const sx_model *m, int64_t c, double *n)
     dist = sqrt(dist);
     for (int k = 0; k < d; k++) n[k] /= dist;
     return dist - B->rad[i] - B->rad[j];
+}
+
+/* Whether pair c is to be bonded: its surfaces closer than gap, or with
+ * gap 0 touching to a part in a billion of its radii's sum (the
+ * neighbours of a generated lattice, which rounding puts a few ulps apart
+ * either way: a third of them were bonded). */
+static bool within_gap(const sx_model *m, int64_t c, double *n, double gap)
+{
+    const double rsum = m->balls.rad[m->bb.a[c]] + m->balls.rad[m->bb.b[c]];
+    return pair_gap(m, c, n) < (gap > 0 ? gap : 1e-9 * rsum);
 }
 
 /* A value of the def, or the mean of the materials', or the default. */
@@ -421,7 +434,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
             return sx__fail(m, SX_EINTERRUPT, "bond: interrupted (no bond installed)");
         const int ma = B->mat[p->a[c]], mb = B->mat[p->b[c]];
         double n[3];
-        if (!pair_selected(def, ma, mb) || pair_gap(m, c, n) >= def->gap) continue;
+        if (!pair_selected(def, ma, mb) || !within_gap(m, c, n, def->gap)) continue;
         if ((st = check_pair(m, def, ma, mb))) return st;
         /* a flat joint is its pair's contact: it takes no other bond */
         const unsigned has = p->bond[c] > 0 ? m->bonds.kind[p->bond[c] - 1] : 0;
@@ -438,7 +451,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         const int ma = B->mat[i], mb = B->mat[j];
         if (!pair_selected(def, ma, mb)) continue;
         double n[3] = {0, 0, 0};
-        if (pair_gap(m, c, n) >= def->gap) continue;
+        if (!within_gap(m, c, n, def->gap)) continue;
         int32_t slot = p->bond[c] - 1;
         if (slot < 0) {
             if (bonds_reserve(m, m->bonds.n + 1)) return sx__fail(m, SX_ENOMEM, "bond: out of memory");

@@ -689,7 +689,9 @@ typedef struct sx_bond_def {
                                 ///< unbonded, its gap the pair's (Potyondy 2012's gapped grains)
 } sx_bond_def;
 
-/// Zero everywhere (take the materials' values), kind parallel, gap 0, seed 1, any materials.
+/// Every micro-parameter NaN (not given: the mean of the pair's materials'
+/// values; a value given, 0 included, is taken), kind parallel, gap 0,
+/// seed 1, any materials.
 SX_API sx_bond_def sx_bond_default_def(void);
 /// Installs bonds; writes the number installed to *count (may be NULL).
 /// Refused for Hertz pairs (the seed: Hertz is not to be used with bonds).
