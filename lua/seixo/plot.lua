@@ -92,6 +92,13 @@ function plot.live(m, names, opts)
     if not have[name] then fail("plot.live: no history named '%s' (add it with m:history)", tostring(name)) end
   end
   if opts.x ~= nil and opts.x ~= "step" and opts.x ~= "time" then fail("plot.live: x must be 'step' or 'time'") end
+  -- a file terminal without a file writes its image to the standard output
+  local file_terminals = {png = true, pngcairo = true, pdfcairo = true, svg = true, postscript = true, eps = true,
+                          epscairo = true, jpeg = true, gif = true, cairolatex = true, pdf = true}
+  local term = opts.terminal and opts.terminal:match("^%s*(%S+)")
+  if term and file_terminals[term] and not opts.output then
+    fail("plot.live: terminal '%s' writes a file: give output = 'name' (else the image goes to the standard output)", term)
+  end
   local every = opts.every or 1000
   if type(every) ~= "number" or every ~= math.floor(every) or every < 1 or every == math.huge then
     fail("plot.live: every must be a whole number of steps >= 1")

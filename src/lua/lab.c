@@ -68,6 +68,8 @@ static int wall_radius(lua_State *L)
     sx_model *m = sx_lua_checkhandle(L, 1, &sx_lua_wall_kind, &id);
     sx_wall_def d;
     sx_lua_check(L, m, sx_wall_get(m, id, &d), "w:radius");
+    if (d.kind != SX_WALL_CYLINDER) /* as w:set_radius says: a 0 read as a radius is no answer */
+        return luaL_error(L, "w:radius: wall %d is not a cylinder; only a cylinder has a radius", (int)id);
     lua_pushnumber(L, d.radius);
     lua_pushnumber(L, d.radial_vel);
     return 2;

@@ -37,12 +37,12 @@ static const struct shape {
     const char *other;
     const char *const *keys;
 } shapes[] = {
-    [SX_WALL_PLANE] = {3, "line", plane_keys},
-    [SX_WALL_LINE] = {2, "plane", plane_keys},
-    [SX_WALL_RECT] = {3, "segment", rect_keys},
-    [SX_WALL_SEGMENT] = {2, "rect", segment_keys},
-    [SX_WALL_CYLINDER] = {3, "pair of lines", cylinder_keys},
-    [SX_WALL_MESH] = {3, "set of segments", mesh_keys},
+    [SX_WALL_PLANE] = {3, "'line'", plane_keys},
+    [SX_WALL_LINE] = {2, "'plane'", plane_keys},
+    [SX_WALL_RECT] = {3, "'segment'", rect_keys},
+    [SX_WALL_SEGMENT] = {2, "'rect'", segment_keys},
+    [SX_WALL_CYLINDER] = {3, "two 'line' walls (a kind 'cylinder' has none)", cylinder_keys},
+    [SX_WALL_MESH] = {3, "'segment' walls (a kind 'mesh' has none)", mesh_keys},
 };
 
 static const char *const wall_shown[] = {"kind", "point", "normal", "vel", "force", NULL};
@@ -461,7 +461,7 @@ static int add_wall(lua_State *L, sx_model *m, sx_wall_kind kind)
     const int dim = sx_model_dim(m);
     const struct shape *s = &shapes[kind];
     if (s->dim != dim)
-        return luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': a %s is a %dD wall; use '%s' in a %dD model",
+        return luaL_argerror(L, 2, lua_pushfstring(L, "field 'kind': a %s is a %dD wall; use %s in a %dD model",
                                                    kind_names[kind], s->dim, s->other, dim));
     sx_lua_checkkeys(L, 2, s->keys);
     sx_wall_def d = sx_wall_default_def(dim);

@@ -189,6 +189,10 @@ test("a live plot of histories is redrawn while the model cycles, and changes no
   -- issue 18's fuzzer: a file handle (userdata indexing to nil) is no model
   raises(function() plot.live(io.stdout, "kinetic energy") end, "plot.live: a model expected, got file")
   raises(function() plot.live(42, "kinetic energy") end, "plot.live: a model expected, got number")
+  -- a file terminal without a file: refused (it wrote a PNG to the standard output)
+  local mp = seixo.model{dim = 2}
+  mp:history("ke", "kinetic")
+  raises(function() plot.live(mp, "ke", {terminal = "pngcairo"}) end, "terminal 'pngcairo' writes a file: give output")
 end)
 
 test("a ball placed behind a wall or overlapping one is an error naming the wall", function()
