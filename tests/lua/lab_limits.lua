@@ -212,6 +212,9 @@ test("lab.series checks its options and its tests' before the first test, in its
          "lab.series: max_rate must be a strain rate >= strain_rate = 1 1/s (got 0.5)")
   raises(function() lab.series(rect, with{confining = {0, 5e6}, out = "no/such/folder/series"}) end,
          "lab.series: cannot write no/such/folder/series_ucs.csv (out)")
+  -- (it ran every test, then the fit found one confining stress)
+  raises(function() lab.series(rect, with{confining = {5e6, 5e6}}) end,
+         "lab.series: confining[2] repeats confining[1] (5e+06 Pa): give each once")
   check(seixo.clock() - t < 1, "refused before the tests")
 end)
 

@@ -205,6 +205,9 @@ function series.run(spec, opts)
       fail("lab.series: confining[%d] is 0: a granular specimen needs confining > 0 (nothing holds it together)", i)
     end
     local o = copy(opts)
+    for j = 1, i - 1 do -- (the fit needs two; a repeat writes the same out: refused before any test)
+      if list[j] == s3 then fail("lab.series: confining[%d] repeats confining[%d] (%g Pa): give each once", i, j, s3) end
+    end
     o.confining = s3
     o.out = out and series_out(out, s3)
     o.plot = false
