@@ -568,13 +568,6 @@ sx_status sx__balls_expand_unwrap(sx_model *m)
     return SX_OK;
 }
 
-void sx__balls_free_unwrap(sx_model *m)
-{
-    sx_balls *b = &m->balls;
-    free_field(m, b->unwrap, b->unwrap ? b->cap * m->dim : 0, sizeof *b->unwrap);
-    b->unwrap = NULL;
-}
-
 void sx__ball_wraps(const sx_model *m, int64_t i, double *s)
 {
     const int d = m->dim;

@@ -126,7 +126,9 @@ typedef struct sx_balls {
      * it was placed, the cell vectors of each wrap as they were then (dim a
      * ball; LAMMPS's image flags, kept as lengths so that a deforming cell
      * moves no ball's unwrapped position x + unwrap, which is where its
-     * velocity took it); NULL until a periodic build wraps a ball */
+     * velocity took it; kept when the space becomes open or the cell is
+     * made anew, where the balls stay: their unwrapped positions go on);
+     * NULL until a periodic build wraps a ball */
     double *unwrap;
     /* id -> dense index (-1 when deleted); ids are 1..next_id-1 */
     int32_t *index_of;
@@ -757,7 +759,6 @@ void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
 sx_status sx__balls_expand_unwrap(sx_model *m);
-void sx__balls_free_unwrap(sx_model *m);
 /* How far the velocities' time is behind the positions' (central
  * differences): half the last step's timestep, or, before the first step,
  * of the one it will take, which the first kick takes the given

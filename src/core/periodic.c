@@ -54,7 +54,6 @@ sx_status sx_model_set_periodic(sx_model *m, const sx_periodic_def *def)
         if (m->cell) {
             drop_ghost_pairs(m);
             sx__cell_free(m);
-            sx__balls_free_unwrap(m); /* the positions in the cell are the balls' now */
             m->build_needed = true;
         }
         return SX_OK;
@@ -83,7 +82,6 @@ sx_status sx_model_set_periodic(sx_model *m, const sx_periodic_def *def)
         m->cell->base = m->balls.n;
     }
     sx_cell *c = m->cell;
-    sx__balls_free_unwrap(m); /* a new cell: the balls unwrap from where they are */
     memset(c->h, 0, sizeof c->h);
     for (int k = 0; k < 3; k++) {
         c->axis[k] = k < d && def->axis[k];

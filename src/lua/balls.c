@@ -161,7 +161,7 @@ static int fix_word(lua_State *L, int dim, int idx, const char *what)
         return luaL_error(L, "%s: unknown fixity '%s' (valid: %s)", what, word, lua_tostring(L, -1));
     }
     const unsigned mask = fix_masks[i][dim == 3 ? 0 : 1];
-    if (!mask) return luaL_error(L, "%s: a 2D ball has no '%s' (only vx, vy, wz)", what, word);
+    if (!mask) return luaL_error(L, "%s: a 2D model has no '%s' (only vx, vy, wz)", what, word);
     return (int)mask;
 }
 

@@ -76,7 +76,14 @@ static int get_normal(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_de
 static int get_edge1(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge1)); }
 static int get_edge2(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge2)); }
 static int get_vel(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, vel)); }
-static int get_spin(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, spin)); }
+/* a 2D wall never turns: its spin, a 2D rotation, a plain 0 */
+static int get_spin(lua_State *L)
+{
+    sx_wall_def d;
+    const sx_model *m = wall_def(L, &d);
+    if (sx_model_dim(m) == 2) return lua_pushnumber(L, 0), 1;
+    return push_def_vec(L, offsetof(sx_wall_def, spin));
+}
 /* A stiffness or the friction as the contacts use it: the wall's own, its
  * material's, or a rigid wall's infinite stiffness (and its own friction). */
 static int push_spring(lua_State *L, size_t wall_offset, size_t material_offset)
@@ -165,6 +172,7 @@ static int set_spin(lua_State *L)
 {
     int64_t id;
     sx_model *m = check_wall(L, &id);
+    if (sx_model_dim(m) == 2) return luaL_error(L, "wall field 'spin': a 2D wall does not turn (only a 3D mesh wall spins)");
     double v[3] = {0, 0, 0};
     sx_lua_checkvalue(L, 3, 3, v, "wall", "spin");
     sx_lua_checkfield(L, m, sx_wall_set_spin(m, id, v), "wall");

@@ -219,8 +219,8 @@ test("2D ball fields", function()
   vec_eq(b.fix, {"vx", "vy", "wz"})
   b.fix = "vel"
   vec_eq(b.fix, {"vx", "vy"})
-  raises(function() b.fix = "vz" end, HERE, "2D ball has no 'vz'")
-  raises(function() b.fix = {"wx"} end, HERE, "2D ball has no 'wx'")
+  raises(function() b.fix = "vz" end, HERE, "2D model has no 'vz'")
+  raises(function() b.fix = {"wx"} end, HERE, "2D model has no 'wx'")
   raises(function() b.pos = {1, 2, 3} end, HERE, "field 'pos'", "2 components", "got 3")
   raises(function() b.spin = {0, 0, 1} end, HERE, "field 'spin'", "number expected")
   raises(function() m:ball{pos = {0, 0, 0}, radius = 0.1} end, HERE, "field 'pos'", "2 components", "got 3")
@@ -351,6 +351,16 @@ test("wall kinds and fields", function()
 end)
 
 test("wall errors", function()
+  -- a 2D wall never turns: its spin a plain 0, and setting one says so
+  -- (it read {0, 0} and said "array of 3 numbers expected"); kinds of the
+  -- other dimension name kinds that exist
+  local m2 = seixo.model{dim = 2}
+  local line = m2:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
+  eq(line.spin, 0)
+  raises(function() line.spin = 1 end, HERE, "a 2D wall does not turn")
+  raises(function() m2:wall{kind = "cylinder", point = {0, 0}, axis = {0, 1}, radius = 1, height = 1} end, HERE,
+         "use two 'line' walls")
+  raises(function() line:radius() end, HERE, "wall 1 is not a cylinder")
   local m = model3()
   raises(function() m:wall{point = {0, 0, 0}} end, HERE, "field 'kind' is required")
   raises(function() m:wall{kind = "disk"} end, HERE, "unknown kind 'disk'", "plane, line, rect, segment, cylinder, mesh, box")

@@ -602,6 +602,32 @@ T.test("a ball falling through a shrinking periodic cell keeps its energy and di
   T.check(b.disp[2] < -0.2, "it fell laps of the 0.1 m cell: " .. b.disp[2])
 end)
 
+-- The space made open again, or the cell made anew, where the balls stay:
+-- their unwrapped positions go on, so a displacement and the
+-- gravitational energy carry on without a jump (the wraps were dropped:
+-- b.disp fell back to the position in the cell, -0.00787 m after a 51.6 mm
+-- run: a new user's finding).
+T.test("a ball's displacement and energy go on when the space becomes open or the cell is made anew", function()
+  local m = seixo.model{dim = 2, gravity = {2, 0}, timestep = 1e-4}
+  m:material("g", {density = 2500, kn = 1e6, ks = 5e5, friction = 0, damping = 0})
+  m:periodic{min = {0, -1}, max = {0.05, 1}, axes = "x"}
+  local b = m:ball{pos = {0.025, 0}, radius = 0.004, vel = {1, 0}}
+  m:reset_disp()
+  local function mech() local e = m:energy(); return e.kinetic + e.gravitational end
+  local E0 = mech()
+  local function expected() local t = m:time(); return t + t * (t + 1e-4) end -- leapfrog from v0 = 1, g = 2
+  m:cycle(1000)
+  T.check(b.pos[1] < 0.05 and b.disp[1] > 0.1, "laps made: " .. b.disp[1])
+  m:periodic{min = {0, -1}, max = {0.08, 1}, axes = "x"} -- a new cell
+  T.check(math.abs(b.disp[1] - expected()) < 1e-9, string.format("new cell: %.12g against %.12g", b.disp[1], expected()))
+  m:cycle(1000)
+  m:periodic(false) -- open space
+  T.check(math.abs(b.disp[1] - expected()) < 1e-9, string.format("open: %.12g against %.12g", b.disp[1], expected()))
+  m:cycle(500)
+  T.check(math.abs(b.disp[1] - expected()) < 1e-9, string.format("after: %.12g against %.12g", b.disp[1], expected()))
+  T.check(math.abs(mech() - E0) < 1e-9 * E0, string.format("energy %.12g J against %.12g J", mech(), E0))
+end)
+
 -- A clump falling along a periodic axis: its gravitational energy is of
 -- its unwrapped centroid (its pebbles' images), as in open space (it was
 -- 0.0768 J against the open run's -0.449 J).
