@@ -273,7 +273,7 @@ static bool pair_selected(const sx_bond_def *def, int a, int b)
 
 /* Whether bonds of def's kind can join materials ma and mb: their law takes
  * bonds (not Hertz: the seed, 4.3.3), and every parameter the bond needs is positive once the
- * materials' values fill what the call leaves at 0. Checked for every
+ * materials' values fill what the call does not give (NaN). Checked for every
  * candidate pair before any bond is installed, so a refused call changes nothing. */
 static sx_status check_pair(sx_model *m, const sx_bond_def *def, int ma, int mb)
 {
@@ -323,14 +323,18 @@ static double pair_gap(const sx_model *m, int64_t c, double *n)
     return dist - B->rad[i] - B->rad[j];
 }
 
-/* Whether pair c is to be bonded: its surfaces closer than gap, or with
- * gap 0 touching to a part in a billion of its radii's sum (the
- * neighbours of a generated lattice, which rounding puts a few ulps apart
- * either way: a third of them were bonded). */
+/* The surface gap below which two balls of radii ri, rj count as
+ * touching: a part in a billion of their sum (the neighbours of a
+ * generated lattice, which rounding puts a few ulps apart either way: with
+ * gap 0 a third of them were bonded). */
+static double touching(double ri, double rj) { return 1e-9 * (ri + rj); }
+
+/* Whether pair c is to be bonded: its surfaces closer than gap, or than
+ * touching. */
 static bool within_gap(const sx_model *m, int64_t c, double *n, double gap)
 {
-    const double rsum = m->balls.rad[m->bb.a[c]] + m->balls.rad[m->bb.b[c]];
-    return pair_gap(m, c, n) < (gap > 0 ? gap : 1e-9 * rsum);
+    const double t = touching(m->balls.rad[m->bb.a[c]], m->balls.rad[m->bb.b[c]]);
+    return pair_gap(m, c, n) < (gap > t ? gap : t);
 }
 
 /* A value of the def, or the mean of the materials', or the default. */
@@ -352,8 +356,10 @@ static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t
     sx_pairs *p = &m->bb;
     const int64_t i = p->a[c], j = p->b[c];
     const sx_bpm_def *pa = &m->mats[B->mat[i]].bpm, *pb = &m->mats[B->mat[j]].bpm;
-    const int nr = (int)param_or(def->elements, pa->elements, pb->elements, d == 2 ? 4 : 2);
-    const int na = d == 2 ? 1 : (int)param_or(def->sectors, pa->sectors, pb->sectors, 4);
+    /* a count given as 0 is the material's, as a material's 0 is the default */
+    const double ge = def->elements > 0 ? def->elements : NAN, gs = def->sectors > 0 ? def->sectors : NAN;
+    const int nr = (int)param_or(ge, pa->elements, pb->elements, d == 2 ? 4 : 2);
+    const int na = d == 2 ? 1 : (int)param_or(gs, pa->sectors, pb->sectors, 4);
     sx_fjels *E = &m->fjel;
     if (E->n + nr * na > INT32_MAX - 1 || fjels_reserve(m, E->n + nr * na))
         return sx__fail(m, SX_ENOMEM, "bond: out of memory");
@@ -383,7 +389,7 @@ static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t
     const double fraction = param(def->unbonded_fraction, pa->unbonded_fraction, pb->unbonded_fraction);
     /* a gapped face: its balls apart, every element open by their surface gap */
     const double surface = b->fj_d0[s] - ri - rj;
-    const bool gapped = def->gapped && surface > 0;
+    const bool gapped = def->gapped && surface > touching(ri, rj); /* touching balls: a closed face */
     const double gap0 = gapped ? surface : param(def->initial_gap, pa->initial_gap, pb->initial_gap);
     for (int e = 0; e < nr * na; e++) {
         const int64_t x = E->n++;
@@ -414,9 +420,11 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         return sx__fail(m, SX_ENOTFOUND, "bond: no material with index %d",
                         def->material_a >= m->nmat ? def->material_a : def->material_b);
 
-    /* candidates within the gap: rebuild the broad phase with a skin at least that wide */
+    /* candidates within the gap: rebuild the broad phase with a skin at
+     * least that wide (a gap below the skin in use leaves it: a gap of
+     * 1e-18 m made the skin that, and pairs 2e-15 m apart went unlisted) */
     const double skin_user = m->skin_user;
-    if (m->skin_user < def->gap && def->gap > 0) m->skin_user = def->gap;
+    if (def->gap > (m->skin_user > 0 ? m->skin_user : sx__skin_auto(m))) m->skin_user = def->gap;
     m->build_needed = true;
     st = sx__prepare(m);
     m->skin_user = skin_user;

@@ -661,8 +661,10 @@ typedef enum sx_bond_kind {
 } sx_bond_kind;
 
 /// Bond installation, like PFC's: every ball-ball pair closer than `gap`
-/// (of the given materials) gets a bond. A parameter left at 0 takes the
-/// mean of the two materials' bond micro-parameters.
+/// (of the given materials; with gap 0, touching to 1e-9 of the radii's
+/// sum) gets a bond. A parameter left NaN (sx_bond_default_def) takes the
+/// mean of the two materials' bond micro-parameters; a value given, 0
+/// included, is taken (elements and sectors: 0 is the materials').
 typedef struct sx_bond_def {
     sx_bond_kind kind;
     double gap;                 ///< m, install where d - RA - RB < gap (>= 0)
@@ -700,7 +702,7 @@ SX_API sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *c
 SX_API int64_t sx_bond_count(const sx_model *m);
 
 /// The bonded-particle micro-parameters of a material (4.4), used by
-/// sx_bond_install where its def leaves a value at 0.
+/// sx_bond_install where its def leaves a value NaN.
 typedef struct sx_bpm_def {
     double radius_multiplier, modulus, stiffness_ratio;
     double tensile_strength, tensile_strength_sd, cohesion, cohesion_sd;

@@ -9,6 +9,7 @@
  * modulus/stiffness_ratio and the `bond` sub-table read by m:material. */
 #include "bindings.h"
 
+#include <math.h>
 #include <string.h>
 
 /* The bond kinds' micro-parameter keys from the registry (sx_bond_key),
@@ -158,7 +159,9 @@ static int model_bond(lua_State *L)
         }
     }
     lua_pop(L, 1);
-    for (int k = 0; k < sx_bond_key_count(); k++) sx_lua_optnumfield(L, 2, sx_bond_key(k, NULL), sx_bond_key_call(&d, k));
+    for (int k = 0; k < sx_bond_key_count(); k++) /* NaN is the core's "not given": a NaN given is refused */
+        if (sx_lua_optnumfield(L, 2, sx_bond_key(k, NULL), sx_bond_key_call(&d, k)) && isnan(*sx_bond_key_call(&d, k)))
+            luaL_argerror(L, 2, lua_pushfstring(L, "field '%s': a number expected, got nan", sx_bond_key(k, NULL)));
     if (lua_getfield(L, 2, "gapped") != LUA_TNIL) {
         luaL_argcheck(L, lua_isboolean(L, -1), 2, "field 'gapped': true or false expected");
         d.gapped = lua_toboolean(L, -1);

@@ -169,6 +169,25 @@ do
   end
   local n = m:bond{kind = "parallel"}
   check("a lattice's touching pairs all bonded", n == touching and n > 250, n .. " of " .. touching)
+  -- a gapped flat joint between touching balls is a closed face, every element bonded
+  local g = seixo.model{dim = 2}
+  g:material("r", {density = 2600, kn = 1e9, ks = 1e9,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 1e6}})
+  local a = g:ball{pos = {0, 0}, radius = 1e-3}
+  local b = g:ball{pos = {0.002 * (1 + 1e-12), 0}, radius = 1e-3}
+  local open = 0
+  check("a touching pair takes a gapped flat joint", g:bond{kind = "flatjoint", gapped = true} == 1, "")
+  for _, e in ipairs(g:flatjoint(a.id, b.id)) do if e.state ~= "bonded" then open = open + 1 end end
+  check("a touching pair's gapped face is closed", open == 0, open)
+  -- a gap below the touching tolerance bonds what gap 0 bonds (it shrank the broad phase's skin to itself)
+  local t = seixo.model{dim = 2}
+  t:material("r", {density = 2600, kn = 1e9, ks = 1e9,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5, tensile_strength = 1e6,
+                           cohesion = 1e6}})
+  t:ball{pos = {0, 0}, radius = 1e-3}
+  t:ball{pos = {0.002 * (1 + 1e-12), 0}, radius = 1e-3}
+  check("a gap of 1e-18 m bonds touching balls", t:bond{gap = 1e-18} == 1, "")
 end
 
 print(string.format("%d passed, %d failed", passed, failed))

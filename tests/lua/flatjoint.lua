@@ -275,6 +275,13 @@ for _, dim in ipairs{2, 3} do
   local slit = 0
   for _, e in ipairs(m2:flatjoint(a2.id, b2.id)) do if e.state ~= "bonded" then slit = slit + 1 end end
   check(dim .. "D the material's fraction when the call gives none", slit > 0, slit)
+  -- a count given as 0 is the material's (elements 6, sectors 3), as a material's 0 is the default
+  local m3, a3, b3 = pair(dim, {kind = "flatjoint", gap = 1e-6, elements = 0, sectors = 0}, {elements = 6})
+  check(dim .. "D elements = 0 given: the material's", #m3:flatjoint(a3.id, b3.id) == (dim == 3 and 18 or 6),
+        #m3:flatjoint(a3.id, b3.id))
+  -- a NaN given is refused (NaN is the core's "not given")
+  local ok, err = pcall(pair, dim, {kind = "flatjoint", gap = 1e-6, tensile_strength_sd = 0 / 0})
+  check(dim .. "D a NaN given is refused", not ok and tostring(err):find("tensile_strength_sd': a number expected, got nan", 1, true), err)
 end
 
 print(string.format("flatjoint: %d passed, %d failed", passed, failed))

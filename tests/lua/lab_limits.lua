@@ -214,7 +214,7 @@ test("lab.series checks its options and its tests' before the first test, in its
          "lab.series: cannot write no/such/folder/series_ucs.csv (out)")
   -- (it ran every test, then the fit found one confining stress)
   raises(function() lab.series(rect, with{confining = {5e6, 5e6}}) end,
-         "lab.series: confining[2] repeats confining[1] (5e+06 Pa): give each once")
+         "lab.series: confining has one stress (5000000.0 Pa): the fit needs two different ones")
   check(seixo.clock() - t < 1, "refused before the tests")
 end)
 

@@ -182,6 +182,9 @@ function series.run(spec, opts)
   check_keys(opts, "series", series_keys)
   local list = opts.confining
   if type(list) ~= "table" or #list < 2 then error("lab.series: confining = {sigma3, ...} with two values or more", 2) end
+  local distinct = false -- (the fit needs two: it ran every test, then found one; refused before any test)
+  for i = 2, #list do distinct = distinct or list[i] ~= list[1] end
+  if not distinct then fail("lab.series: confining has one stress (%s Pa): the fit needs two different ones", tostring(list[1])) end
   local jobs = number(opts.jobs or seixo.cores(), "jobs", "series", "a whole number of processes >= 1",
                       function(v) return v >= 1 and v < math.huge and v == math.floor(v) end)
   -- under mpirun, with the ranks sharing the models, the tests go to the
@@ -205,9 +208,6 @@ function series.run(spec, opts)
       fail("lab.series: confining[%d] is 0: a granular specimen needs confining > 0 (nothing holds it together)", i)
     end
     local o = copy(opts)
-    for j = 1, i - 1 do -- (the fit needs two; a repeat writes the same out: refused before any test)
-      if list[j] == s3 then fail("lab.series: confining[%d] repeats confining[%d] (%g Pa): give each once", i, j, s3) end
-    end
     o.confining = s3
     o.out = out and series_out(out, s3)
     o.plot = false
