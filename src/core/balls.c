@@ -560,13 +560,6 @@ sx_status sx__balls_expand_damping(sx_model *m)
     return SX_OK;
 }
 
-double sx__skin_auto(const sx_model *m)
-{
-    double sum = 0; /* a fifth of the mean radius */
-    for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
-    return m->balls.n > 0 ? 0.2 * sum / (double)m->balls.n : 0;
-}
-
 sx_status sx__balls_expand_unwrap(sx_model *m)
 {
     sx_balls *b = &m->balls;

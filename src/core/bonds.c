@@ -421,10 +421,13 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
                         def->material_a >= m->nmat ? def->material_a : def->material_b);
 
     /* candidates within the gap: rebuild the broad phase with a skin at
-     * least that wide (a gap below the skin in use leaves it: a gap of
+     * least that wide, and at least the touching tolerance's (a gap of
      * 1e-18 m made the skin that, and pairs 2e-15 m apart went unlisted) */
     const double skin_user = m->skin_user;
-    if (def->gap > (m->skin_user > 0 ? m->skin_user : sx__skin_auto(m))) m->skin_user = def->gap;
+    double rmax = 0;
+    for (int64_t i = 0; i < m->balls.n; i++) rmax = fmax(rmax, m->balls.rad[i]);
+    const double skin_gap = fmax(def->gap, 2 * touching(rmax, rmax));
+    if (def->gap > 0 && m->skin_user < skin_gap) m->skin_user = skin_gap;
     m->build_needed = true;
     st = sx__prepare(m);
     m->skin_user = skin_user;

@@ -759,8 +759,6 @@ void sx__ball_update_mass(sx_model *m, int64_t i);
 sx_status sx__balls_expand_damping(sx_model *m);
 sx_status sx__balls_expand_groups(sx_model *m);
 sx_status sx__balls_expand_unwrap(sx_model *m);
-/* The automatic skin of the broad phase: a fifth of the balls' mean radius. */
-double sx__skin_auto(const sx_model *m);
 /* How far the velocities' time is behind the positions' (central
  * differences): half the last step's timestep, or, before the first step,
  * of the one it will take, which the first kick takes the given

@@ -718,7 +718,14 @@ static sx_status KERNEL(build)(sx_model *m)
         return SX_OK;
     }
     const double skin = m->skin; /* the last build's, kept by a build that stops */
-    m->skin = m->skin_user > 0 ? m->skin_user : sx__skin_auto(m);
+    /* the automatic skin: a fifth of the mean radius */
+    if (m->skin_user > 0) {
+        m->skin = m->skin_user;
+    } else {
+        double sum = 0;
+        for (int64_t i = 0; i < m->balls.n; i++) sum += m->balls.rad[i];
+        m->skin = 0.2 * sum / (double)m->balls.n;
+    }
     /* each pair store made from its counted pairs, so it holds no more than
      * them and never grows while it is filled */
     transfer tr;
