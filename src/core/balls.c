@@ -189,7 +189,7 @@ sx_status sx_ball_add(sx_model *m, const sx_ball_def *def, int64_t *out_id)
         for (int k = 0; k < d; k++) b->fapp[i * d + k] = 0;
         for (int k = 0; k < r; k++) b->tapp[i * r + k] = 0;
     }
-    if (b->unwrap) memset(b->unwrap + i * d, 0, (size_t)d * sizeof *b->unwrap); /* unwrapped where placed */
+    sx__ball_placed(m, i);
     b->rad[i] = def->radius;
     b->mat[i] = (uint16_t)def->material;
     if (b->alpha) b->alpha[i] = m->mats[def->material].def.damping;
@@ -568,6 +568,11 @@ sx_status sx__balls_expand_unwrap(sx_model *m)
     return SX_OK;
 }
 
+void sx__ball_placed(sx_model *m, int64_t i)
+{
+    if (m->balls.unwrap) memset(m->balls.unwrap + i * m->dim, 0, (size_t)m->dim * sizeof *m->balls.unwrap);
+}
+
 void sx__ball_wraps(const sx_model *m, int64_t i, double *s)
 {
     const int d = m->dim;
@@ -670,8 +675,7 @@ sx_status sx_ball_set_vec(sx_model *m, int64_t id, sx_ball_vec which, const doub
     for (int k = 0; k < n; k++) dst[i * n + k] = val[k];
     if (which == SX_BALL_POS) {
         m->build_needed = true; /* a jump may skip the skin test */
-        if (m->balls.unwrap) /* placed anew: unwrapped here */
-            memset(m->balls.unwrap + i * m->dim, 0, (size_t)m->dim * sizeof *m->balls.unwrap);
+        sx__ball_placed(m, i);
     }
     if (which == SX_BALL_VEL && sx__speed_rated(m)) m->dt_stale = true;
     return SX_OK;

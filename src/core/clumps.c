@@ -267,8 +267,7 @@ sx_status sx_clump_set_vec(sx_model *m, int64_t id, sx_clump_vec which, const do
     if (which == SX_CLUMP_POS) {
         memcpy(C->x + c * d, v, (size_t)d * sizeof(double));
         m->build_needed = true; /* a jump may skip the skin test */
-        for (int64_t k = 0; m->balls.unwrap && k < C->tpl[C->tpl_of[c]].n; k++) /* placed anew: unwrapped here */
-            memset(m->balls.unwrap + m->balls.index_of[C->pebble[C->first[c] + k]] * d, 0, (size_t)d * sizeof(double));
+        for (int64_t k = 0; k < C->tpl[C->tpl_of[c]].n; k++) sx__ball_placed(m, m->balls.index_of[C->pebble[C->first[c] + k]]);
     } else if (which == SX_CLUMP_VEL) {
         memcpy(C->v + c * d, v, (size_t)d * sizeof(double));
     } else {

@@ -769,6 +769,9 @@ static inline double sx__half_step(const sx_model *m)
     return 0.5 * (m->dt_prev > 0 ? m->dt_prev : m->dt_user > 0 ? m->dt_user : m->dt);
 }
 
+/* Ball i placed anew (added, or its position or its clump's set): its
+ * wraps start again, so that it is unwrapped where it was placed. */
+void sx__ball_placed(sx_model *m, int64_t i);
 /* Ball i's wraps, how far it was moved back into the periodic cell since
  * it was placed (zero outside periodic space), and its unwrapped position
  * x + that. */
