@@ -10,12 +10,13 @@ void sx__clumps_energy(const sx_model *m, sx_energy *e)
 {
     const sx_clumps *C = m->clumps;
     const int d = m->dim, r = m->rdim;
+    const double half = sx__half_step(m);
     for (int64_t c = 0; c < C->n; c++) {
         const double *v = C->v + c * d, *x = C->x + c * d, *I = C->inertia + c * r, mass = C->mass[c];
         double v2 = 0, gx = 0, rot = 0, s[3]; /* s: unwrapped, as its pebbles (wrapped with it) */
         sx__ball_wraps(m, m->balls.index_of[C->pebble[C->first[c]]], s);
         for (int k = 0; k < d; k++) /* at the velocities' time, as a ball's (kernels/queries.c) */
-            v2 += v[k] * v[k], gx += m->gravity[k] * (x[k] + s[k] - sx__half_step(m) * v[k]);
+            v2 += v[k] * v[k], gx += m->gravity[k] * (x[k] + s[k] - half * v[k]);
         if (d == 3) { /* 1/2 w^T I w = sum L_b,i^2 / (2 I_i) in the principal frame */
             double R[9], Lb[3];
             body_rotation(m, c, R);

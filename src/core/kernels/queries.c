@@ -57,6 +57,7 @@ static double rolling_strain(const sx_pair_law *l, const sx_pairs *p, int64_t c,
 static void energy_balls(const sx_model *m, int64_t i0, int64_t i1, double *e)
 {
     const sx_balls *B = &m->balls;
+    const double half = sx__half_step(m);
     for (int64_t i = i0; i < i1; i++) {
         if (B->clump && B->clump[i]) continue; /* clumps: a body's energy is counted once (clump_queries.c) */
         const double *v = B->v + i * D, *w = B->w + i * RD;
@@ -69,7 +70,7 @@ static void energy_balls(const sx_model *m, int64_t i0, int64_t i1, double *e)
          * exactly (at x, a fall gained g^2 dt^2 / 2 a step: first order) */
         double x[D];
         sx__ball_unwrapped(m, i, x);
-        for (int k = 0; k < D; k++) x[k] -= sx__half_step(m) * v[k];
+        for (int k = 0; k < D; k++) x[k] -= half * v[k];
         e[1] -= dot(m->gravity, x) / B->inv_mass[i];
     }
 }
