@@ -71,10 +71,27 @@ static int push_def_vec(lua_State *L, size_t offset)
     return 1;
 }
 
+/* A vector of the definition that only some kinds have (a bit of 1 << kind
+ * in `kinds`): nil for the others, whose slot holds no such thing (a
+ * cylinder keeps its axis where a plane keeps its normal). */
+static int push_kind_vec(lua_State *L, size_t offset, unsigned kinds)
+{
+    sx_wall_def d;
+    const sx_model *m = wall_def(L, &d);
+    if (!(kinds & 1u << d.kind)) return lua_pushnil(L), 1;
+    sx_lua_pushvec(L, (const double *)((const char *)&d + offset), sx_model_dim(m));
+    return 1;
+}
+
+#define FLAT_KINDS (1u << SX_WALL_PLANE | 1u << SX_WALL_LINE | 1u << SX_WALL_RECT | 1u << SX_WALL_SEGMENT)
 static int get_point(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, point)); }
-static int get_normal(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, normal)); }
-static int get_edge1(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge1)); }
-static int get_edge2(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, edge2)); }
+static int get_normal(lua_State *L) { return push_kind_vec(L, offsetof(sx_wall_def, normal), FLAT_KINDS); }
+static int get_axis(lua_State *L) { return push_kind_vec(L, offsetof(sx_wall_def, normal), 1u << SX_WALL_CYLINDER); }
+static int get_edge1(lua_State *L)
+{
+    return push_kind_vec(L, offsetof(sx_wall_def, edge1), 1u << SX_WALL_RECT | 1u << SX_WALL_SEGMENT);
+}
+static int get_edge2(lua_State *L) { return push_kind_vec(L, offsetof(sx_wall_def, edge2), 1u << SX_WALL_RECT); }
 static int get_vel(lua_State *L) { return push_def_vec(L, offsetof(sx_wall_def, vel)); }
 /* a 2D wall never turns: its spin, a 2D rotation, a plain 0 */
 static int get_spin(lua_State *L)
@@ -603,6 +620,7 @@ void sx_lua_walls_register(lua_State *L)
         {"vel", get_vel},
         {"point", get_point},
         {"normal", get_normal},
+        {"axis", get_axis},
         {"edge1", get_edge1},
         {"edge2", get_edge2},
         {"spin", get_spin},

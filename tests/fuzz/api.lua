@@ -243,7 +243,7 @@ local fields = {
        "material", "fix", "damping", "group", "extra", "clump"},
   cl = {"id", "pos", "vel", "spin", "orientation", "force", "moment", "angular_momentum", "mass", "volume", "inertia",
         "principal", "scale", "template", "material", "damping", "fix", "pebbles"},
-  w = {"id", "kind", "force", "moment", "vel", "point", "normal", "edge1", "edge2", "friction", "extra", "material",
+  w = {"id", "kind", "force", "moment", "vel", "point", "normal", "axis", "edge1", "edge2", "friction", "extra", "material",
        "rigid"},
   c = {"a", "b", "kind", "normal", "point", "overlap", "fn", "fs", "force", "bond", "pb_fn", "pb_fs", "pb_moment",
        "pb_radius", "contact_model"},

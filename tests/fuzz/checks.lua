@@ -29,7 +29,7 @@ end
 
 local fields = {
   ball = {"pos", "vel", "spin", "force", "radius", "mass", "inertia", "applied_force", "damping"},
-  wall = {"point", "vel", "normal", "force", "friction"},
+  wall = {"point", "vel", "normal", "axis", "force", "friction"},
   clump = {"pos", "vel", "orientation", "mass"},
   contact = {"normal", "force", "overlap", "pb_fn", "pb_fs", "pb_moment"},
 }

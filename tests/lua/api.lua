@@ -342,6 +342,19 @@ test("wall kinds and fields", function()
   eq(s.kind, "segment")
   vec_eq(s.point, {1, 1})
   vec_eq(s.edge1, {2, 1})
+  vec_eq(s.normal, {-1 / math.sqrt(5), 2 / math.sqrt(5)})
+  vec_eq(r.normal, {0, 0, 1})
+  eq(p.edge1, nil)
+  eq(s.edge2, nil)
+  -- a cylinder's axis is its own field; a mesh has no one normal
+  local c = m:wall{kind = "cylinder", point = {0, 0, 0}, axis = {0, 0, 3}, radius = 1}
+  vec_eq(c.axis, {0, 0, 1})
+  eq(c.normal, nil)
+  eq(p.axis, nil)
+  local mesh = m:wall{kind = "mesh", triangles = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}}
+  eq(mesh.normal, nil)
+  eq(mesh.edge1, nil)
+  check(not tostring(mesh):find("normal", 1, true))
   local l = m2:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
   eq(l.kind, "line")
   check(tostring(l):find("seixo.wall", 1, true))
