@@ -394,7 +394,7 @@ static int set_orientation(lua_State *L)
     sx_model *m = check_clump(L, &id);
     double q[4];
     const char *bad = to_orientation(L, 3, sx_model_dim(m), q);
-    if (bad) return luaL_error(L, "field 'orientation': %s", bad);
+    if (bad) return luaL_error(L, "clump field 'orientation': %s", bad);
     sx_lua_checkfield(L, m, sx_clump_set_orientation(m, id, q), "clump");
     return 0;
 }

@@ -152,6 +152,8 @@ test("clump objects: fields, orientation, pebbles", function()
   raises(function() m:clump{template = "ell"} end, HERE, "pos")
   raises(function() m:clump{template = "ell", pos = {0, 0, 0}, orientation = {0, 0, 0, 0}} end, HERE, "zero")
   raises(function() m:clump{template = "ell", pos = {0, 0, 0}, scale = -1} end, HERE, "scale")
+  local d = m:clump{template = "ell", pos = {0, 0, 0}}
+  raises(function() d.orientation = {1, 2} end, HERE, "clump field 'orientation': quaternion", "got 2")
 end)
 
 test("generation: count, sizes, inside the region, no overlaps, reproducible", function()
