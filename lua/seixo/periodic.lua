@@ -211,7 +211,7 @@ function periodic.triaxial(spec, opts)
     end
     local volume = 1 -- the cell's volume over its first (the tilts are held at zero)
     for k = 1, dim do volume = volume * L[k] / L0[k] end
-    local row = {step = m:step(), ea = ea, el = el, ev = 1 - volume, sa = s[ax][ax], sl = sl,
+    local row = {step = m:step() - start, ea = ea, el = el, ev = 1 - volume, sa = s[ax][ax], sl = sl,
                  q = s[ax][ax] - sigma3, ratio = m:ratio(), cracks = m:crack_count()}
     rows[#rows + 1] = row
     if row.q > peak then peak, peak_row = row.q, #rows end
@@ -259,7 +259,7 @@ function periodic.shear(spec, opts)
   repeat
     m:cycle(record_steps(every, (max_steps or 1000000) - (m:step() - start), max_strain - gamma, rate * m:timestep()))
     local cell, s = m:periodic(), m:cell_stress()
-    local row = {step = m:step(), gamma = cell.tilt.xy / cell.size[2], tau = -s[1][2], sn = s[2][2],
+    local row = {step = m:step() - start, gamma = cell.tilt.xy / cell.size[2], tau = -s[1][2], sn = s[2][2],
                  ev = (L0[2] - cell.size[2]) / L0[2], ratio = m:ratio()}
     rows[#rows + 1] = row
     gamma = row.gamma

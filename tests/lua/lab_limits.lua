@@ -45,6 +45,8 @@ test("lab.ucs and lab.triaxial stop at max_steps when every is larger", function
   eq(s.steps, 100)
   eq(#s.rows, 4)
   eq(s.rows[4][1] - s.rows[3][1], 10)
+  -- a row's step, like its time, counts from the loading's start
+  eq(s.rows[4][1], s.steps)
 end)
 
 test("lab.ucs stops near max_strain when every is larger", function()

@@ -123,7 +123,7 @@ function brazilian.run(spec, opts)
     disp = d - (top.point[ax] - bottom.point[ax])
     local f = 0.5 * (top:load() + bottom:load())
     local st = 2 * f / (pi * d * t)
-    rows[#rows + 1] = {m:step(), m:time() - t_start, disp, f, st, m:crack_count("tension") - tension0,
+    rows[#rows + 1] = {m:step() - start, m:time() - t_start, disp, f, st, m:crack_count("tension") - tension0,
                        m:crack_count("shear") - shear0, m:ratio(), halves_apart(m, left, right) - apart0}
     if f > peak then peak, peak_row = f, #rows end
     local cracked = m:crack_count() > cracks0

@@ -286,7 +286,7 @@ local function run(spec, opts, fn)
         ratio_sum, ratio_n = ratio_sum + ratio, ratio_n + 1
         if inertial < math.huge then inertial_max = math.max(inertial_max, inertial) end
       end
-      local row = {m:step(), m:time() - t_start, ea, el, 1 - (1 - ea) * (1 - el) ^ (dim - 1), sa, sl, q,
+      local row = {m:step() - start, m:time() - t_start, ea, el, 1 - (1 - ea) * (1 - el) ^ (dim - 1), sa, sl, q,
                    m:crack_count("tension") - cracks0[1], m:crack_count("shear") - cracks0[2], ratio, inertial,
                    rate * factor}
       rows[#rows + 1] = row
