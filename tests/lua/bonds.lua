@@ -106,7 +106,7 @@ do
   m:bond{kind = "parallel", gap = 1e-6}
   a.fix = "all"; b.fix = "all"; b.vel = {1e-3, 0}
   m:cycle(100)
-  local u = b.pos[1] - 2e-3
+  local u = b.pos[1] - 2e-3 - 1e-3 * 1e-6 -- at the last force pass: a step before the positions
   local T = 1e8 / 2e-3 * 2e-3 * u        -- kn_bar = Ec/(RA+RB), A = 2 R_bar (unit thickness)
   local lo, hi = {-2e-3, -2e-3}, {4e-3, 2e-3}
   local r = m:measure{box = {min = lo, max = hi}}
@@ -188,6 +188,35 @@ do
   t:ball{pos = {0, 0}, radius = 1e-3}
   t:ball{pos = {0.002 * (1 + 1e-12), 0}, radius = 1e-3}
   check("a gap of 1e-18 m bonds touching balls", t:bond{gap = 1e-18} == 1, "")
+end
+
+-- a parallel-bonded pair spinning rigidly, its balls apart (no contact
+-- spring): the bond's normal force follows the distance between the centres,
+-- -kn_bar A (d - d0), turn after turn. The stretch taken as the half-step
+-- velocity along the step's normal gathered pi w d dt a turn (1.2e-4 m here).
+for dim = 2, 3 do
+  local function v(x, y) return dim == 3 and {x, y, 0} or {x, y} end
+  local R, gap, w = 0.01, 1e-4, 100
+  local m = seixo.model{dim = dim}
+  m:material("r", {density = 2650, kn = 1e7, ks = 1e7,
+                   bond = {radius_multiplier = 1, modulus = 1e9, stiffness_ratio = 2.5,
+                           tensile_strength = 1e12, cohesion = 1e12}})
+  local d0 = 2 * R + gap
+  local a = m:ball{pos = v(-d0 / 2, 0), radius = R, vel = v(0, -w * d0 / 2), spin = dim == 3 and {0, 0, w} or w}
+  local b = m:ball{pos = v(d0 / 2, 0), radius = R, vel = v(0, w * d0 / 2), spin = dim == 3 and {0, 0, w} or w}
+  m:bond{gap = 2 * gap}
+  local knA = 1e9 / (2 * R) * (dim == 3 and math.pi * R ^ 2 or 2 * R)
+  local turn = math.floor(2 * math.pi / (w * m:timestep()))
+  local worst = 0
+  for _ = 1, 3 do
+    m:cycle(turn)
+    local c, dt = m:contacts()(), m:timestep()
+    -- the last force pass saw the positions a step back: x - v dt
+    local dx = (b.pos[1] - b.vel[1] * dt) - (a.pos[1] - a.vel[1] * dt)
+    local dy = (b.pos[2] - b.vel[2] * dt) - (a.pos[2] - a.vel[2] * dt)
+    worst = math.max(worst, math.abs(-c.pb_fn / knA - (math.sqrt(dx * dx + dy * dy) - d0)))
+  end
+  check(dim .. "D spinning bonded pair: no false stretch", worst < 1e-12, worst)
 end
 
 print(string.format("%d passed, %d failed", passed, failed))
