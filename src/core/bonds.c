@@ -323,17 +323,11 @@ static double pair_gap(const sx_model *m, int64_t c, double *n)
     return dist - B->rad[i] - B->rad[j];
 }
 
-/* The surface gap below which two balls of radii ri, rj count as
- * touching: a part in a billion of their sum (the neighbours of a
- * generated lattice, which rounding puts a few ulps apart either way: with
- * gap 0 a third of them were bonded). */
-static double touching(double ri, double rj) { return 1e-9 * (ri + rj); }
-
 /* Whether pair c is to be bonded: its surfaces closer than gap, or than
  * touching. */
 static bool within_gap(const sx_model *m, int64_t c, double *n, double gap)
 {
-    const double t = touching(m->balls.rad[m->bb.a[c]], m->balls.rad[m->bb.b[c]]);
+    const double t = sx__touching(m->balls.rad[m->bb.a[c]], m->balls.rad[m->bb.b[c]]);
     return pair_gap(m, c, n) < (gap > t ? gap : t);
 }
 
@@ -389,7 +383,7 @@ static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t
     const double fraction = param(def->unbonded_fraction, pa->unbonded_fraction, pb->unbonded_fraction);
     /* a gapped face: its balls apart, every element open by their surface gap */
     const double surface = b->fj_d0[s] - ri - rj;
-    const bool gapped = def->gapped && surface > touching(ri, rj); /* touching balls: a closed face */
+    const bool gapped = def->gapped && surface > sx__touching(ri, rj); /* touching balls: a closed face */
     const double gap0 = gapped ? surface : param(def->initial_gap, pa->initial_gap, pb->initial_gap);
     for (int e = 0; e < nr * na; e++) {
         const int64_t x = E->n++;
@@ -426,7 +420,7 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
     const double skin_user = m->skin_user;
     double rmax = 0;
     for (int64_t i = 0; i < m->balls.n; i++) rmax = fmax(rmax, m->balls.rad[i]);
-    const double skin_gap = fmax(def->gap, 2 * touching(rmax, rmax));
+    const double skin_gap = fmax(def->gap, 2 * sx__touching(rmax, rmax));
     if (def->gap > 0 && m->skin_user < skin_gap) m->skin_user = skin_gap;
     m->build_needed = true;
     st = sx__prepare(m);

@@ -593,6 +593,13 @@ struct sx_model {
 
 /* The volume of a ball of radius r: a sphere's, or a disk's of unit
  * thickness in 2D. */
+/* The surface gap below which two balls of radii ri, rj count as
+ * touching: a part in a billion of their sum (the neighbours of a
+ * generated lattice, which rounding puts a few ulps apart either way: with
+ * gap 0 a third of them were bonded). Bonds install on it (bonds.c), and a
+ * flat joint's closed face stays while its balls are within it. */
+static inline double sx__touching(double ri, double rj) { return 1e-9 * (ri + rj); }
+
 static inline double sx__ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r; }
 
 /* Ball i's local damping: its own, or its material's. */

@@ -284,5 +284,25 @@ for _, dim in ipairs{2, 3} do
   check(dim .. "D a NaN given is refused", not ok and tostring(err):find("tensile_strength_sd': a number expected, got nan", 1, true), err)
 end
 
+-- a face of unbonded elements only (a frictional joint) on balls that just
+-- touch stays a face: pressed by u it carries kn_bar A u, not the material's
+-- linear law (it was dropped at its first step, at zero overlap)
+for _, dim in ipairs{2, 3} do
+  local m, a, b = pair(dim, {kind = "flatjoint", seed = 5}, {unbonded_fraction = 1})
+  a.fix, b.fix = "all", "all"
+  m:cycle(1)
+  check(dim .. "D unbonded face kept", m:bond_count() == 1 and m:flatjoint(a.id, b.id) ~= nil, m:bond_count())
+  local u, dt = 1e-7, m:timestep()
+  b.vel = dim == 3 and {-u / (100 * dt), 0, 0} or {-u / (100 * dt), 0}
+  m:cycle(100)
+  b.vel = dim == 3 and {0, 0, 0} or {0, 0}
+  m:cycle(1)
+  local c = m:contacts()()
+  local area = dim == 3 and math.pi or 2 -- radius_multiplier 1, unit radii
+  local expect = 1e9 / 2 * area * u
+  check(dim .. "D unbonded face carries its stiffness", c.bond == "flatjoint" and math.abs(c.pb_fn - expect) < 1e-6 * expect,
+        tostring(c.pb_fn) .. " vs " .. expect)
+end
+
 print(string.format("flatjoint: %d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

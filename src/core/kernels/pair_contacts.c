@@ -323,8 +323,13 @@ static bool flat_joint(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, co
     /* a face installed on overlapping balls opens (delta > 0) before they
      * part: it stays, carrying nothing, until they part, so the contact
      * law takes over at zero overlap rather than with a force kn u0 out
-     * of nowhere (an energy jump) */
-    if (!alive && !gapped) alive = d < m->balls.rad[i] + m->balls.rad[j];
+     * of nowhere (an energy jump); "part" as m:bond saw them touching, so
+     * a face installed on balls just touching, every element unbonded,
+     * is not dropped at its first step */
+    if (!alive && !gapped) {
+        const double ri = m->balls.rad[i], rj = m->balls.rad[j];
+        alive = d - (ri + rj) < sx__touching(ri, rj);
+    }
     /* resultants, turned to the pair's orientation (sg) */
     double *bfs = b->fs + s * D, *bms = b->ms + s * RD;
     b->fn[s] = fn_sum;
