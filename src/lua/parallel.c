@@ -693,8 +693,9 @@ bool sx_lua_parallel_same_call(const char *what, char *err, size_t size)
     if (other < world_size) {
         snprintf(err, size,
                  "%s: the ranks made different calls: rank 0 is in %.*s, rank %d in %.*s (every rank runs the "
-                 "script and must make the same calls: one under `if seixo.rank() == 0`, or after a decision "
-                 "on the clock, which differs between the ranks?)",
+                 "script and must make the same calls: one under `if seixo.rank() == 0`, after a decision "
+                 "on the clock, or in a loop over pairs() of a table with string keys, whose order "
+                 "differs between the ranks?)",
                  what, CALL_NAME, all, other, CALL_NAME, all + (size_t)other * CALL_NAME);
         name_caught(err, size, other);
     }
