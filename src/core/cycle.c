@@ -104,9 +104,9 @@ static sx_status step_build(sx_model *m, const sx_kernels *k)
 {
     sx_dd *dd = m->dd;
     sx_status st;
-    if (m->cell && (st = sx__cell_check(m))) return st; /* the cell may have shrunk */
+    if (m->cell && (st = sx__cell_check(m))) return sx__dd_agree_alike(m, st); /* the cell may have shrunk */
     if (dd && !sx__dd_build(m)) return sx__fail(m, SX_EINVAL, "cycle: the ranks could not exchange the state");
-    if ((st = sx__check_skin(m))) return st; /* as at a cycle's start, however the run is cut */
+    if ((st = sx__check_skin(m))) return sx__dd_agree_alike(m, st); /* as at a cycle's start, however the run is cut */
     st = k->build(m);
     if (!st && dd && !sx__dd_plan(m)) st = SX_ENOMEM; /* the new slabs */
     if (st) return sx__build_failed(m, st);
@@ -120,8 +120,8 @@ sx_status sx__prepare_scattered(sx_model *m)
     sx_status st = sx__dd_agree_replicated(m);
     if (!st && whole_needed(m)) st = sx_model_gather(m);
     if (st) return st;
-    if (!m->dd->scattered) return sx__prepare(m);
-    if ((st = sx__prepare_laws(m))) return st;
+    if (!m->dd->scattered) return sx__dd_agree_alike(m, sx__prepare(m));
+    if ((st = sx__prepare_laws(m))) return sx__dd_agree_alike(m, st);
     m->dd->active = true;
     if (m->build_needed && (st = step_build(m, sx__kernels(m)))) m->dd->active = false; /* as at a step */
     return st;
@@ -189,8 +189,10 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
 {
     for (int k = 0; k < m->dim; k++)
         if (!(fabs(m->gravity[k]) < SX_GRAVITY_MAX)) /* a file's from before the limit */
-            return sx__fail(m, SX_EINVAL, "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
-                            m->gravity[k]);
+            return sx__dd_agree_alike(
+                m, sx__fail(m, SX_EINVAL,
+                            "cycle: gravity component %g is beyond 1e100 m/s^2; set a smaller one (m:set_gravity)",
+                            m->gravity[k]));
     if (m->dd) m->dd->failed = false, m->dd->fail_order = 0, m->dd->own_error = false;
     double t = sx__now();
     const int64_t builds = m->builds;
@@ -200,7 +202,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
      * otherwise leave it gathering while the others resume) */
     const sx_kernels *k = sx__kernels(m);
     if (m->dd && m->dd->scattered) st = sx__prepare_scattered(m);
-    else st = sx__prepare(m);
+    else st = sx__dd_agree_alike(m, sx__prepare(m)); /* the whole model, on every rank alike */
     /* the last cycle's plan goes on (nothing but the walls and settings
      * changed since: a caller that changes more gathers first), the
      * timestep rated rank by rank */

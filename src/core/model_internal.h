@@ -904,6 +904,15 @@ typedef struct sx_step_error {
     sx_unstable unstable;  /* an instability's, to render at the ranks' estimate */
 } sx_step_error;
 sx_status sx__dd_agree_failure(sx_model *m, const sx_step_error *mine);
+/* Decomposed: st, an error of a check that every rank makes alike from
+ * what all hold alike (before a cycle's steps: the laws, the timestep's
+ * estimate once the ranks have shared it; at a build: the cell, the
+ * skin), so that each meets it at the same place: the ranks compare it
+ * (status and message), and when all met it, it is agreed
+ * (sx_model_error_agreed: they stop in step, and a script catches it on
+ * every rank as serially; any other error stops every rank). Running out
+ * of memory is a rank's own, never compared. Not decomposed, or SX_OK: st. */
+sx_status sx__dd_agree_alike(sx_model *m, sx_status st);
 bool sx__dd_walls(sx_model *m, bool in_step);
 /* Clumps, decomposed: each stepped by its owner. The pebbles' forces and
  * moments (before the step), or the timestep's sums (kt, kr, ct, cr, n

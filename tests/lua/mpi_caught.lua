@@ -35,6 +35,15 @@
 --               rank's side: the error is that rank's alone (its wall
 --               blocks), and stopped the whole job instead of being caught
 --               (a review's finding); the run goes on once the ball is gone
+--   checks      errors of checks every rank makes alike, from what all
+--               hold alike, before the steps (no ball to rate the
+--               timestep from; two laws in one model: after a cycle that
+--               left the state scattered too) or at a build inside a
+--               cycle (a cell shrunk below twice the contact reach; a
+--               skin that lists too many pairs): caught on every rank, as
+--               serially (they stopped the job from rank 0, as if that
+--               rank had met them alone: a user's finding), and the run
+--               goes on to the serial hash
 local scene = arg and arg[1] or "overlap"
 local dim = tonumber(arg and arg[2]) or 2
 local dir = (debug.getinfo(1, "S").source:match("^@(.*/)") or "./")
@@ -71,6 +80,43 @@ if scene == "cause" then
   local ok, err = pcall(m.cycle, m, 300)
   print("caught", not ok, string.format("critical %.6g s", m:critical_timestep()))
   print((tostring(err):gsub(" %(under mpirun the state is .*$", ""))) -- the rank's note aside
+  return
+end
+
+if scene == "checks" then
+  local function try(what, f, ...)
+    local ok, err = pcall(f, ...)
+    print(what, ok, (tostring(err):gsub("^.-: m:", "m:")))
+  end
+  local m = seixo.model{dim = 2, gravity = {0, -9.81}}
+  m:material("a", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.5})
+  try("empty", m.cycle, m, 10)
+  m:wall{kind = "box", min = {0, 0}, max = {0.1, 0.1}}
+  m:generate{count = 60, radius = {1.5e-3, 2.5e-3}, region = {box = {{0, 0}, {0.1, 0.1}}}, seed = 1, material = "a"}
+  m:material("b", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.5})
+  m:generate{count = 60, radius = {1.5e-3, 2.5e-3}, region = {box = {{0, 0}, {0.1, 0.1}}}, seed = 2, material = "b"}
+  m:cycle(300) -- under mpirun, the state is left scattered
+  io.stderr:write(string.format("ranks %d\n", m:ranks()))
+  m:material("b", {density = 2650, model = "hertz", shear_modulus = 1e8, poisson = 0.2, friction = 0.5})
+  try("laws", m.cycle, m, 10)
+  m:material("b", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.5})
+  m:cycle(100)
+  print("on", m:step(), m:hash())
+  local wide = seixo.model{dim = 2, skin = 0.5}
+  wide:material("a", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.5})
+  wide:generate{count = 3000, radius = {1e-3, 1e-3}, region = {box = {{0, 0}, {1, 1}}}, seed = 3}
+  try("skin", wide.cycle, wide, 10)
+  local c = seixo.model{dim = 2}
+  c:material("s", {density = 2650, kn = 1e5, ks = 1e5, friction = 0.5, damping = 0.5})
+  c:periodic{min = {0, 0}, max = {0.012, 0.05}}
+  c:generate{count = 30, radius = {1e-3, 1e-3}, region = {box = {{0, 0}, {0.012, 0.05}}}, seed = 1}
+  c:cell_control{xx = {rate = -1}}
+  try("cell", c.cycle, c, 400000)
+  print("cell left", c:step(), c:hash())
+  c:cell_control{xx = {rate = 0}}
+  c:periodic{min = {0, 0}, max = {0.02, 0.05}}
+  c:cycle(100)
+  print("cell again", c:step(), c:hash())
   return
 end
 
