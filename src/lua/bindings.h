@@ -410,6 +410,9 @@ typedef struct sx_lua_run sx_lua_run;
 /// or by lua_settop below it). Refused while the model cycles (`what` names
 /// the caller in the message).
 sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
+/// Makes coroutine.resume close a coroutine that failed (its to-be-closed
+/// values, run records among them, as coroutine.wrap does), once.
+void sx_lua_run_register(lua_State *L);
 /// Cycles the core n steps in the run, without user callbacks, stopping
 /// early at the first step that reaches model time t_end (INFINITY: none;
 /// the rounding allowed counts the run's steps, sx_model_time_reached);

@@ -259,9 +259,13 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     r->since = sx_model_step_count(m);
     atomic_init(&r->interrupted, 0);
     atomic_init(&r->in_lua, 0);
-    lua_createtable(L, 0, 1);
+    lua_createtable(L, 0, 2);
     lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__close");
+    /* and when collected open (a thread closed by no one): a Ctrl-C must
+     * not find it listed once its memory is gone */
+    lua_pushcfunction(L, run_close);
+    lua_setfield(L, -2, "__gc");
     lua_setmetatable(L, -2);
     /* to be closed before the model is taken, so that nothing can come between */
     lua_toclose(L, -1);
@@ -276,6 +280,86 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     atomic_store(&runs[slot], r);
     atomic_store(&nruns, slot + 1);
     return r;
+}
+
+/* coroutine.resume, closing a coroutine that failed. Lua closes a failed
+ * coroutine's to-be-closed values only at coroutine.close (coroutine.wrap
+ * closes them itself): a cycle that failed inside coroutine.resume left
+ * its run record open, its model cycling for good and its interrupt slot
+ * taken (16 such and no model could cycle), and a Ctrl-C once the
+ * coroutine was collected wrote to the freed record (a robustness hunt's
+ * finding). The coroutine's stack is then closed; coroutine.wrap's
+ * functions resume through it (Lua 5.4.4's leave theirs open too). */
+static void close_failed(lua_State *L, lua_State *co)
+{
+    const int st = lua_status(co);
+    if (st == LUA_OK || st == LUA_YIELD) return;
+#if LUA_VERSION_RELEASE_NUM >= 50406
+    lua_closethread(co, L);
+#else
+    (void)L;
+    lua_resetthread(co);
+#endif
+    lua_settop(co, 0); /* the error it leaves there: dead, as coroutine.status says of a failed one */
+}
+
+static int resume_closing(lua_State *L)
+{
+    lua_State *co = lua_tothread(L, 1);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+    if (co) close_failed(L, co);
+    return lua_gettop(L);
+}
+
+/* A coroutine.wrap function: resumes its coroutine (upvalue 1) through the
+ * closing resume (upvalue 2), an error raised as coroutine.wrap raises it
+ * (a string with the caller's position). */
+static int wrapped(lua_State *L)
+{
+    const int n = lua_gettop(L);
+    lua_pushvalue(L, lua_upvalueindex(2));
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_rotate(L, 1, 2);
+    lua_call(L, n + 1, LUA_MULTRET);
+    if (lua_toboolean(L, 1)) return lua_gettop(L) - 1;
+    lua_settop(L, 2);
+    if (lua_type(L, 2) == LUA_TSTRING) {
+        luaL_where(L, 1);
+        lua_insert(L, 2);
+        lua_concat(L, 2);
+    }
+    return lua_error(L);
+}
+
+static int wrap_closing(lua_State *L)
+{
+    luaL_checktype(L, 1, LUA_TFUNCTION);
+    lua_State *co = lua_newthread(L);
+    lua_pushvalue(L, 1);
+    lua_xmove(L, co, 1);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_pushcclosure(L, wrapped, 2);
+    return 1;
+}
+
+void sx_lua_run_register(lua_State *L)
+{
+    luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "coroutine") == LUA_TTABLE) {
+        lua_getfield(L, -1, "resume");
+        if (lua_iscfunction(L, -1) && lua_tocfunction(L, -1) != resume_closing) {
+            lua_pushcclosure(L, resume_closing, 1);
+            lua_pushvalue(L, -1);
+            lua_setfield(L, -3, "resume");
+            lua_pushcclosure(L, wrap_closing, 1);
+            lua_setfield(L, -2, "wrap");
+        } else {
+            lua_pop(L, 1);
+        }
+    }
+    lua_pop(L, 2);
 }
 
 /* The Ctrl-C is answered: by the error raised now (a decomposed cycle's,

@@ -233,4 +233,33 @@ test("history_csv: the union of steps, empty cells, a unique temporary name then
   raises(function() falling():history_csv(path) end, HERE, "records no history")
 end)
 
+test("a cycle that fails inside coroutine.resume gives its model back", function()
+  -- Lua closes a failed coroutine's to-be-closed values only at
+  -- coroutine.close: the run stayed open, its model cycling for good, and
+  -- after 16 of them no model could cycle
+  for _ = 1, 17 do
+    local m = falling()
+    local co = coroutine.create(function()
+      m:on("after", function() error("boom") end)
+      m:cycle(3)
+    end)
+    local ok, err = coroutine.resume(co)
+    check(not ok and tostring(err):find("boom", 1, true), err)
+    eq(coroutine.status(co), "dead")
+    m:off(1)
+    m:cycle(2)
+    eq(m:step(), 3)
+    m:close()
+  end
+  local fresh = falling()
+  fresh:cycle(1)
+  eq(fresh:step(), 1)
+  -- a coroutine.wrap's failure, as before
+  local g = falling()
+  local ok = pcall(coroutine.wrap(function() g:on("after", function() error("x") end); g:cycle(1) end))
+  check(not ok)
+  g:off(1)
+  g:cycle(1)
+end)
+
 T.done()
