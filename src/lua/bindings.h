@@ -410,6 +410,15 @@ typedef struct sx_lua_run sx_lua_run;
 /// or by lua_settop below it). Refused while the model cycles (`what` names
 /// the caller in the message).
 sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what);
+/// Marks callback `id` of the model at `model` as owner's (an output's,
+/// named in messages): m:off refuses it, and m:save does not list it.
+void sx_lua_callback_own(lua_State *L, int model, lua_Integer id, const char *owner);
+/// Appends to the table at `list` a line for each callback and event
+/// handler of the script's (m:on) of the model at `model`: a snapshot
+/// cannot keep a function.
+void sx_lua_callbacks_unsaved(lua_State *L, int model, int list);
+/// Removes callback `id` of the model at `model`, an owned one too.
+void sx_lua_callback_remove(lua_State *L, int model, lua_Integer id);
 /// Makes coroutine.resume close a coroutine that failed (its to-be-closed
 /// values, run records among them, as coroutine.wrap does), once.
 void sx_lua_run_register(lua_State *L);

@@ -182,8 +182,14 @@ static lua_Integer keys_in_order(lua_State *L, int idx)
     return n;
 }
 
-/* Writes the entries of the table at idx as children of node `parent`. */
-static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char *path)
+/* Tables deeper than this are skipped (named in the save's skipped list):
+ * the walk recurses, and a table nested 50,000 deep ran the C stack out
+ * (a segmentation fault) before Lua's stack checks could say so. */
+enum { SAVE_DEPTH_MAX = 1000 };
+
+/* Writes the entries of the table at idx as children of node `parent`,
+ * itself `depth` tables deep. */
+static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char *path, int depth)
 {
     idx = lua_absindex(L, idx);
     luaL_checkstack(L, 8, "tables nested too deeply to save");
@@ -228,10 +234,16 @@ static void ser_table(lua_State *L, ser *s, int idx, int64_t parent, const char 
                     break;
                 }
                 lua_pop(L, 1);
+                if (depth >= SAVE_DEPTH_MAX) {
+                    char why[64];
+                    snprintf(why, sizeof why, "tables nested deeper than %d", SAVE_DEPTH_MAX);
+                    skip(L, s, p, why);
+                    break;
+                }
                 n.kind = SX_IO_TABLE;
                 const int64_t me = add(s, &n);
                 /* a field vector (b.pos) is saved as its components */
-                if (me >= 0) ser_table(L, s, sx_lua_vec_array(L, val), me, p);
+                if (me >= 0) ser_table(L, s, sx_lua_vec_array(L, val), me, p, depth + 1);
                 break;
             default: skip(L, s, p, luaL_typename(L, val)); break;
             }
@@ -406,7 +418,7 @@ static int model_save(lua_State *L)
     snprintf(j->trees[0].name, sizeof j->trees[0].name, "vars");
     s.tree = &j->trees[0].tree;
     sx_lua_state(L, 1, "vars");
-    ser_table(L, &s, -1, -1, "vars");
+    ser_table(L, &s, -1, -1, "vars", 1);
     lua_pop(L, 1);
 
     snprintf(j->trees[1].name, sizeof j->trees[1].name, "state");
@@ -416,7 +428,7 @@ static int model_save(lua_State *L)
         sx_io_node n = {.parent = -1, .key_kind = SX_IO_STRING, .key_string = (char *)saved_state[k],
                         .key_length = strlen(saved_state[k]), .kind = SX_IO_TABLE};
         const int64_t me = add(&s, &n);
-        if (me >= 0) ser_table(L, &s, -1, me, saved_state[k]);
+        if (me >= 0) ser_table(L, &s, -1, me, saved_state[k], 1);
         lua_pop(L, 1);
     }
     lua_getiuservalue(L, 1, 1);
@@ -426,7 +438,7 @@ static int model_save(lua_State *L)
             sx_io_node n = {.parent = -1, .key_kind = SX_IO_STRING, .key_string = (char *)name,
                             .key_length = strlen(name), .kind = SX_IO_TABLE};
             const int64_t me = add(&s, &n);
-            if (me >= 0) ser_table(L, &s, -1, me, name);
+            if (me >= 0) ser_table(L, &s, -1, me, name, 1);
         }
         lua_pop(L, 1);
     }
@@ -445,6 +457,7 @@ static int model_save(lua_State *L)
                             o.histories[k].name);
             lua_rawseti(L, 5, (lua_Integer)lua_rawlen(L, 5) + 1);
         }
+    sx_lua_callbacks_unsaved(L, 1, 5);
     o.provenance.script = script_path(L);
     o.provenance.seeds = seeds_of(L, 1, &o.provenance.nseeds);
     char err[1024] = "";
@@ -637,12 +650,10 @@ static int output_close(lua_State *L)
     lua_settop(L, 1);
     char err[1024] = "";
     close_series(L, 1, true, err, sizeof err);
-    /* stop the callback: m:off(id), if the model is still open */
+    /* stop the callback, if the model is still open */
     if (lua_getiuservalue(L, 1, 1) == LUA_TUSERDATA && sx_lua_tomodel(L, -1)) {
-        lua_getfield(L, -1, "off");
-        lua_pushvalue(L, -2);
         lua_getiuservalue(L, 1, 2);
-        lua_call(L, 2, 0);
+        sx_lua_callback_remove(L, -2, lua_tointeger(L, -1));
     }
     if (err[0]) return luaL_error(L, "%s", err);
     return 0;
@@ -793,6 +804,7 @@ static int model_output(lua_State *L)
     lua_pushinteger(L, (lua_Integer)every);
     lua_setfield(L, -2, "every");
     lua_call(L, 4, 1);
+    sx_lua_callback_own(L, 1, lua_tointeger(L, -1), "an output's");
     lua_setiuservalue(L, 3, 2);
     return 1;
 }

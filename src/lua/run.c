@@ -600,8 +600,10 @@ static int model_on(lua_State *L)
     return 1;
 }
 
-/* Removes entry `id` from the model's list `list`; whether there was one. */
-static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
+/* Removes entry `id` from the list `list` of the model at index 1; whether
+ * there was one. An entry of an owner's (an output's) is removed only when
+ * `owned`; m:off's raises. */
+static bool remove_entry(lua_State *L, const char *list, lua_Integer id, bool owned)
 {
     sx_lua_state(L, 1, list);
     const int t = lua_gettop(L);
@@ -615,6 +617,10 @@ static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
             lua_pop(L, 1);
             continue;
         }
+        if (!owned && lua_getfield(L, -1, "owner") == LUA_TSTRING)
+            luaL_error(L, "m:off: callback %I is %s, not the script's (its o:close() stops it)", id,
+                       lua_tostring(L, -1));
+        if (!owned) lua_pop(L, 1);
         lua_pushboolean(L, 1);
         lua_setfield(L, -2, "removed");  // a snapshot being fired skips it
         lua_pop(L, 1);
@@ -631,12 +637,60 @@ static bool remove_entry(lua_State *L, const char *list, lua_Integer id)
     return false;
 }
 
+void sx_lua_callback_own(lua_State *L, int model, lua_Integer id, const char *owner)
+{
+    model = lua_absindex(L, model);
+    sx_lua_state(L, model, "callbacks");
+    const int t = lua_gettop(L);
+    for (lua_Integer i = 1; lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
+        lua_getfield(L, -1, "id");
+        const bool hit = lua_tointeger(L, -1) == id;
+        lua_pop(L, 1);
+        if (hit) {
+            lua_pushstring(L, owner);
+            lua_setfield(L, -2, "owner");
+        }
+        lua_pop(L, 1);
+    }
+    lua_settop(L, t - 1);
+}
+
+void sx_lua_callbacks_unsaved(lua_State *L, int model, int list)
+{
+    model = lua_absindex(L, model), list = lua_absindex(L, list);
+    static const char *const lists[] = {"callbacks", "events"};
+    for (int k = 0; k < 2; k++) {
+        sx_lua_state(L, model, lists[k]);
+        const int t = lua_gettop(L);
+        for (lua_Integer i = 1; lua_rawgeti(L, t, i) == LUA_TTABLE; i++) {
+            lua_getfield(L, -1, "id");
+            const lua_Integer id = lua_tointeger(L, -1);
+            if (lua_getfield(L, -2, "owner") == LUA_TNIL) {
+                lua_pushfstring(L, "%s %I (m:on's function: give it again after a load)",
+                                k ? "event handler" : "callback", id);
+                lua_rawseti(L, list, (lua_Integer)lua_rawlen(L, list) + 1);
+            }
+            lua_pop(L, 3);
+        }
+        lua_settop(L, t - 1);
+    }
+}
+
+void sx_lua_callback_remove(lua_State *L, int model, lua_Integer id)
+{
+    model = lua_absindex(L, model);
+    lua_pushvalue(L, model);
+    lua_insert(L, 1); /* remove_entry's model at index 1 */
+    remove_entry(L, "callbacks", id, true);
+    lua_remove(L, 1);
+}
+
 /* m:off(id): removes a callback or an event handler; true if there was one. */
 static int model_off(lua_State *L)
 {
     sx_lua_checkmodel_scattered(L, 1); /* also from a plot's __gc: no collective call */
     const lua_Integer id = luaL_checkinteger(L, 2);
-    lua_pushboolean(L, remove_entry(L, "callbacks", id) || remove_entry(L, "events", id));
+    lua_pushboolean(L, remove_entry(L, "callbacks", id, false) || remove_entry(L, "events", id, false));
     return 1;
 }
 

@@ -262,4 +262,33 @@ test("a cycle that fails inside coroutine.resume gives its model back", function
   g:cycle(1)
 end)
 
+test("m:save names the callbacks it cannot keep; m:off leaves an output's alone; deep tables are skipped", function()
+  local m = falling()
+  local cb = m:on("after", function() end)
+  local ev = m:on("contact_create", function() end)
+  local dir = os.tmpname()
+  os.remove(dir)
+  assert(os.execute("mkdir " .. T.quote(dir)))
+  local o = m:output{path = dir .. "/series.h5", every = 2}
+  raises(function() m:off(ev + 1) end, HERE, "m:off: callback " .. (ev + 1) .. " is an output's, not the script's")
+  local deep = {}
+  local cur = deep
+  for _ = 1, 1500 do cur[1] = {}; cur = cur[1] end
+  m:vars().deep = deep
+  local skipped = m:save(dir .. "/m.h5")
+  local said = table.concat(skipped, "\n")
+  check(said:find("callback " .. cb .. " (m:on's function", 1, true), said)
+  check(said:find("event handler " .. ev .. " (m:on's function", 1, true), said)
+  check(said:find("(tables nested deeper than 1000)", 1, true), said)
+  eq(#skipped, 3)
+  m:cycle(10)
+  eq(o:count(), 6) -- the output wrote on
+  o:close()
+  local l = seixo.load(dir .. "/m.h5")
+  local depth, t = 0, l:vars().deep
+  while t do depth, t = depth + 1, t[1] end
+  check(depth > 900 and depth < 1000, depth)
+  os.execute("rm -rf " .. T.quote(dir))
+end)
+
 T.done()
