@@ -310,7 +310,7 @@ bool sx_io_histories_read(sx_h5 *h, hid_t file, sx_io_history **out, int *nout)
     if (!x || !ord) sx_h5_fail(h, "out of memory");
     for (int k = 0; k < n && !h->failed; k++) {
         const ssize_t len = H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, (hsize_t)k, NULL, 0, H5P_DEFAULT);
-        if (len <= 0 || len > 65536 || !(x[k].name = malloc((size_t)len + 1)) ||
+        if (len <= 0 || len > SX_IO_HISTORY_NAME_MAX || !(x[k].name = malloc((size_t)len + 1)) ||
             H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, (hsize_t)k, x[k].name, (size_t)len + 1,
                                H5P_DEFAULT) != len) {
             sx_h5_fail(h, "damaged: a name in /histories is unreadable");

@@ -88,6 +88,9 @@ typedef enum sx_io_source {
     SX_IO_SOURCE_WALL = 4,     ///< a field of the wall `id`
 } sx_io_source;
 
+/// The longest history name a file keeps, in bytes (its group's name).
+enum { SX_IO_HISTORY_NAME_MAX = 65536 };
+
 /// A history: its definition and n samples, steps strictly increasing.
 /// Given to a writer its strings and arrays are borrowed; returned by a
 /// load they are owned (freed by sx_snapshot_info_free).

@@ -318,6 +318,9 @@ static int model_history(lua_State *L)
     /* a name is the name of its group in a file (and a CSV column, quoted as needed) */
     luaL_argcheck(L, len > 0 && strlen(name) == len && !strchr(name, '/') && strcmp(name, ".") != 0, 2,
                   "a name without '/' or NUL bytes, not \".\" expected (it names a group in files)");
+    if (len > SX_IO_HISTORY_NAME_MAX)
+        return luaL_argerror(L, 2, lua_pushfstring(L, "a name of at most %d bytes expected (got %I): files keep no longer one",
+                                                   SX_IO_HISTORY_NAME_MAX, (lua_Integer)len));
     int64_t every = 1;
     const bool has_every = !lua_isnoneornil(L, 4);
     if (has_every) {

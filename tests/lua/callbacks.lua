@@ -191,6 +191,8 @@ test("history errors", function()
   raises(function() m:history("x", {ball = 1, field = "pos", component = 1, every = 2}) end, HERE, "unknown key 'every'")
   raises(function() m:history("x", 5) end, HERE, "function, builtin name")
   raises(function() m:history("a/b", "time") end, HERE, "without '/'")
+  -- a file keeps names of up to 65,536 bytes: a longer one saved, and the file would not load
+  raises(function() m:history(string.rep("x", 65537), "time") end, HERE, "at most 65536 bytes")
   raises(function() m:history("x", "time", {every = -1}) end, HERE, "field 'every'")
   raises(function() m:history("nothing") end, HERE, "no history named 'nothing'")
   raises(function() m:history_remove("nothing") end, HERE, "no history named 'nothing'")
