@@ -334,6 +334,14 @@ void sx_lua_remove_wall(lua_State *L, int model, int64_t id, const char *what)
     remove_wall_now(L, model, sx_lua_checkmodel(L, model), id, what);
 }
 
+lua_Integer sx_lua_removals_queued(lua_State *L, int model)
+{
+    lua_getiuservalue(L, model, 1);
+    const lua_Integer n = lua_getfield(L, -1, "queue") == LUA_TTABLE ? (lua_Integer)lua_rawlen(L, -1) : 0;
+    lua_pop(L, 2);
+    return n;
+}
+
 void sx_lua_apply_removals(lua_State *L, int model)
 {
     model = lua_absindex(L, model);

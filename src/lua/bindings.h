@@ -184,6 +184,7 @@ typedef struct sx_lua_model {
     bool timestep_unchecked; ///< the fixed timestep was set since the last check of it (run.c, sx_lua_check_timestep)
     int64_t fresh_lo, fresh_hi; ///< the ids of the balls m:generate made since that check, their overlaps among themselves its relaxation's, not checked (0, 0: none; ids are from 1)
     bool decomposed;       ///< its cycles run decomposed over the MPI ranks (parallel.c)
+    bool after_unrecorded; ///< the "after" callbacks of a step run, its histories not recorded yet (m:save records them)
 } sx_lua_model;
 
 /// seixo.models() -> {model, ...}: the open models, in order of creation.
@@ -274,6 +275,8 @@ extern const struct sx_lua_kind sx_lua_ball_kind, sx_lua_wall_kind;
 /// one pass over the contacts, or queues them while a callback runs.
 void sx_lua_remove_balls(lua_State *L, int model, const int64_t *ids, int64_t n, const char *what);
 void sx_lua_remove_wall(lua_State *L, int model, int64_t id, const char *what);
+/// How many removals a callback queued that are not applied yet.
+lua_Integer sx_lua_removals_queued(lua_State *L, int model);
 /// Applies the queued removals (when no callback runs).
 void sx_lua_apply_removals(lua_State *L, int model);
 /// A fixity value (nil, a word or an array of words) as a core mask;

@@ -397,10 +397,28 @@ static int model_save(lua_State *L)
     static const char *const keys[] = {"compression", NULL};
     const sx_model *m = sx_lua_checkmodel(L, 1);
     const char *path = sx_lua_checkname(L, 2);
+    /* the file would hold what the model holds now, and a restart would
+     * keep what the run removes: they part */
+    const lua_Integer queued = sx_lua_removals_queued(L, 1);
+    if (queued > 0)
+        return luaL_error(L,
+                          "m:save: %I removal(s) queued in this callback (b:remove, w:remove, m:remove_balls ...) "
+                          "take effect when it returns: save after it (in the next callback, or after the cycle)",
+                          queued);
     int64_t level = 0;
     if (!lua_isnoneornil(L, 3)) {
         sx_lua_checkkeys(L, 3, keys);
         sx_lua_optintfield(L, 3, "compression", 0, 9, &level);
+    }
+    /* in an "after" callback: the step's samples, which its histories take
+     * once the callbacks have run, are taken now (a history's step is taken
+     * once), or the file, and a restart from it, would lack them */
+    sx_lua_model *ud = sx_lua_modelud(L, 1);
+    if (ud->after_unrecorded) {
+        ud->after_unrecorded = false; /* a history's function that saves records nothing again */
+        sx_lua_history_record(L, 1);
+        ud->after_unrecorded = true;
+        m = sx_lua_checkmodel(L, 1); /* a history's function may have changed it */
     }
     lua_settop(L, 3);
     /* the trees' memory belongs to a to-be-closed job, freed on any error */

@@ -239,6 +239,7 @@ static int run_close(lua_State *L)
     }
     r->ud->running--;
     r->ud->callback = r->saved_callback;
+    r->ud->after_unrecorded = false; /* a callback that failed */
     return 0;
 }
 
@@ -727,7 +728,9 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     for (bool first = true;; first = false) {
         const int64_t s = sx_model_step_count(m);
         if (!first) {
+            r->ud->after_unrecorded = true;
             fire(L, 1, POINT_AFTER, s);
+            r->ud->after_unrecorded = false;
             sx_lua_history_record(L, 1);
         }
         sx_lua_apply_removals(L, 1);

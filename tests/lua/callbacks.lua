@@ -293,4 +293,34 @@ test("m:save names the callbacks it cannot keep; m:off leaves an output's alone;
   os.execute("rm -rf " .. T.quote(dir))
 end)
 
+test("m:save in a callback: the step's history samples kept, queued removals refused", function()
+  local dir = os.tmpname()
+  os.remove(dir)
+  assert(os.execute("mkdir " .. T.quote(dir)))
+  -- saved in an "after" callback, the file holds that step's samples: a
+  -- restart's history has no hole (it lacked step 5)
+  local m = falling()
+  m:history("t", "time")
+  m:history("z", function(mm) return mm:ball(1).pos[3] end)
+  m:on("after", function(mm) if mm:step() == 5 then mm:save(dir .. "/r.h5") end end)
+  m:cycle(8)
+  local r = seixo.load(dir .. "/r.h5")
+  r:history("z", function(mm) return mm:ball(1).pos[3] end)
+  r:cycle(3)
+  eq(table.concat(r:history("t").steps, " "), table.concat(m:history("t").steps, " "))
+  eq(table.concat(r:history("z").values, " "), table.concat(m:history("z").values, " "))
+  -- a removal queued in the callback takes effect when it returns: the
+  -- file would have held the ball the run removes
+  local q = falling()
+  q:ball{pos = {1, 0, 100}, radius = 0.1}
+  q:on("after", function(mm)
+    if mm:step() == 2 then
+      mm:ball(2):remove()
+      mm:save(dir .. "/q.h5")
+    end
+  end)
+  raises(function() q:cycle(3) end, HERE, "m:save: 1 removal(s) queued in this callback", "save after it")
+  os.execute("rm -rf " .. T.quote(dir))
+end)
+
 T.done()
