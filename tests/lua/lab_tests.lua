@@ -188,6 +188,15 @@ test("bad options name the problem", function()
   raises(function() lab.rock{modulos = 30e9} end, "lab.rock: unknown key 'modulos'")
   raises(function() lab.rock{bond = {tensile = 5e7}} end, "lab.rock: unknown key 'tensile'")
   raises(function() lab.rock{modulus = -1} end, "lab.rock: modulus must be >= 0 Pa")
+  -- a sand's stiffnesses given as kn and ks are its stiffnesses: the rock's
+  -- modulus (which sets kn and ks when > 0) is not kept beside them
+  local sand = lab.rock{kn = 1e8, ks = 5e7, friction = 0.5}
+  eq(sand.modulus, nil)
+  eq(sand.kn, 1e8)
+  local m = seixo.model{dim = 2}
+  m:material("sand", sand)
+  eq(m:materials().sand.kn, 1e8)
+  eq(lab.rock{kn = 1e8, modulus = 5e9}.modulus, 5e9)
   raises(function() lab.ucs(spec, {out = dir .. "/no/such/ucs"}) end,
          "lab.ucs: cannot write " .. dir .. "/no/such/ucs.csv (out): No such file or directory")
   raises(function() lab.specimen{dim = 2, width = 0.01, height = 0.02, path = dir .. "/no/such/spec.h5"} end,

@@ -35,6 +35,12 @@ function material.rock(over)
   if dim ~= nil and dim ~= 2 and dim ~= 3 then error("lab.rock: dim must be 2 or 3 (got " .. tostring(dim) .. ")", 2) end
   if dim then over = copy(over); over.dim = nil end
   local mat = merge(dim == 3 and granite3d or granite2d, over)
+  -- stiffnesses given as kn or ks: the rock's modulus, which would take
+  -- their place (a modulus > 0 sets kn and ks), is not taken with them (a
+  -- sand's kn = 1e8 became 6.2e10 from the granite: a user's finding)
+  if over and (over.kn ~= nil or over.ks ~= nil) and over.modulus == nil then
+    mat.modulus, mat.stiffness_ratio = nil, nil
+  end
   -- its keys and values checked now, as m:material checks them (a
   -- misspelt key was otherwise named only by the lab.specimen it reached)
   local why = check.material_error(mat)
