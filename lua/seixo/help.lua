@@ -141,7 +141,7 @@ local entries = {
   ["model:measure"] = {"m:measure(region) -> {stress =, fabric =, porosity =, coordination =, balls =, contacts =, volume =, solid =}",
     "Measures in a box, sphere (3D) or disk (2D) region: the average stress tensor [Pa] (compression positive), the fabric tensor, porosity, coordination number."},
   ["wall:servo"] = {"w:servo{target =, area =, alpha = 0.5, max_speed = 1}; w:servo(nil)",
-    "Puts the wall under servo control: its velocity follows G (stress - target), target [Pa] (2D: N/m) on area [m^2] (2D: m), speed bounded by max_speed [m/s]; nil releases it."},
+    "Puts the wall under servo control: its normal velocity follows G (stress - target), its velocity along the wall kept, target [Pa] on area [m^2] (2D: m, unit thickness), speed bounded by max_speed [m/s]; call again to update area; nil releases it."},
   ["wall:load"] = {"w:load() -> force, contacts, kn", "The servo's inputs after the last step: total normal contact force [N], contact count, mean contact kn [N/m]."},
   ["wall:radius"] = {"w:radius() -> radius, radial_vel", "A cylinder's radius [m] and its rate of change [m/s]."},
   ["wall:set_radial_vel"] = {"w:set_radial_vel(v)", "Sets a cylinder's radial velocity [m/s] (> 0 expands)."},

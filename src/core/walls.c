@@ -395,7 +395,10 @@ void sx__wall_speed_changed(sx_model *m, const sx_wall *w)
 }
 
 /* PFC's servo (DESIGN 1): the normal velocity G (sigma - target), positive
- * away from the balls, from the loads of the step just computed. */
+ * away from the balls, from the loads of the step just computed. It sets
+ * the velocity's normal part only: a velocity along the wall (a shear
+ * box's top plate riding with its upper half) goes on (it was wiped out
+ * at the next step: a first-day user's finding). */
 void sx__walls_servo(sx_model *m)
 {
     for (int64_t i = 0; i < m->nwall; i++) {
@@ -415,7 +418,11 @@ void sx__walls_servo(sx_model *m)
         if (w->def.kind == SX_WALL_CYLINDER) {
             w->def.radial_vel = speed;
         } else {
-            for (int k = 0; k < m->dim; k++) w->def.vel[k] = -speed * w->def.normal[k];
+            const double *n = w->def.normal;
+            double vn = 0;
+            for (int k = 0; k < m->dim; k++) vn += w->def.vel[k] * n[k];
+            /* in two steps: along an axis the normal part is then -speed exactly */
+            for (int k = 0; k < m->dim; k++) w->def.vel[k] = (w->def.vel[k] - vn * n[k]) - speed * n[k];
         }
         sx__wall_speed_changed(m, w); /* a servo striking fast is rated too */
     }

@@ -48,6 +48,31 @@ do
 end
 
 do
+  -- a servo sets its wall's normal velocity only: a velocity along the wall
+  -- (a shear box's top plate riding with its upper half) goes on, 2D and 3D,
+  -- and a tilted wall's too
+  for _, dim in ipairs{2, 3} do
+    local m = seixo.model{dim = dim, timestep = 1e-5}
+    m:material("s", {kn = 1e6, ks = 1e6, density = 2500, damping = 0.7})
+    local zero = dim == 3 and {0, 0, 0} or {0, 0}
+    local b = m:ball{pos = zero, radius = 0.005}
+    b.fix = "all"
+    local n = dim == 3 and {0, 0.6, -0.8} or {0.6, -0.8}
+    local w = m:wall{kind = dim == 3 and "plane" or "line", point = dim == 3 and {0, -0.0036, 0.0048} or {-0.0036, 0.0048},
+                     normal = n, kn = 1e6, ks = 0}
+    w:servo{target = 1e4, area = 1e-3, max_speed = 0.05}
+    local t = dim == 3 and {1, 0, 0} or {0.8, 0.6} -- along the wall
+    w.vel = {0.01 * t[1], 0.01 * t[2], dim == 3 and 0.01 * t[3] or nil}
+    m:cycle(20000)
+    local v, along = w.vel, 0
+    for k = 1, dim do along = along + v[k] * t[k] end
+    check(dim .. "D servo keeps the velocity along the wall", math.abs(along - 0.01) < 1e-12, along)
+    local load, contacts = w:load()
+    check(dim .. "D servo holds its target meanwhile", contacts == 1 and math.abs(load / 1e-3 - 1e4) < 1e-2 * 1e4, load)
+  end
+end
+
+do
   -- issue 18: errors raised inside seixo.lab point at the caller's line,
   -- and a test that would cycle nothing forever (every = 0) is refused
   local lab = require("seixo.lab")
