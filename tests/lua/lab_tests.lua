@@ -148,6 +148,13 @@ test("a granular specimen (bonds = false) through a biaxial test: a sand's frict
   check(r.peak_strain < 0.019, "a peak before the end: at " .. r.peak_strain)
   eq(r.cracks_total.tension + r.cracks_total.shear, 0)
   for _, w in ipairs(r.warnings) do check(not w:find("before the stress fell past the peak", 1, true), w) end
+  -- the confinement the walls held at the peak is reported, and a lag of
+  -- more than 5 % is a warning (0.112 MPa here, at this stiff material's
+  -- 0.5/s: phi 25.9 deg against it)
+  local lagging = false
+  for _, w in ipairs(r.warnings) do lagging = lagging or w:find("the lateral walls held", 1, true) ~= nil end
+  eq(lagging, math.abs(r.lateral_at_peak / 1e5 - 1) > 0.05)
+  check(r.lateral_at_peak > 0.9e5 and r.lateral_at_peak < 1.3e5, r.lateral_at_peak)
   -- a dense packing dilates: its volume grows by the end (ev, compression positive, below 0)
   check(r.rows[#r.rows][5] < 0, "dilation: ev " .. r.rows[#r.rows][5])
   raises(function() lab.ucs(sand, {log = false}) end, "a granular specimen needs confining > 0")
