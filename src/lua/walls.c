@@ -564,8 +564,15 @@ static int add_box(lua_State *L, sx_model *m)
 
 static int model_wall(lua_State *L)
 {
+    if (lua_type(L, 2) == LUA_TNUMBER) { /* m:wall(id): a lookup, as m:ball(id) */
+        const sx_model *m = sx_lua_checkmodel_scattered(L, 1); /* the walls every rank holds */
+        const int64_t id = (int64_t)luaL_checkinteger(L, 2);
+        if (!sx_wall_exists(m, id)) return 0;
+        sx_lua_pushhandle(L, 1, &wall_kind, id);
+        return 1;
+    }
     sx_model *m = sx_lua_checkmodel(L, 1);
-    luaL_checktype(L, 2, LUA_TTABLE);
+    if (lua_type(L, 2) != LUA_TTABLE) return luaL_typeerror(L, 2, "table or integer");
     sx_lua_modelud(L, 1)->unchecked = true;  // a wall placed over balls is named after the next step
     const char *name = sx_lua_optstrfield(L, 2, "kind");
     if (!name) return luaL_argerror(L, 2, "field 'kind' is required");

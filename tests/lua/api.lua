@@ -355,6 +355,9 @@ test("wall kinds and fields", function()
   eq(mesh.normal, nil)
   eq(mesh.edge1, nil)
   check(not tostring(mesh):find("normal", 1, true))
+  -- a wall found by its id, as a ball is
+  eq(m:wall(c.id), c)
+  eq(m:wall(999), nil)
   local l = m2:wall{kind = "line", point = {0, 0}, normal = {0, 1}}
   eq(l.kind, "line")
   check(tostring(l):find("seixo.wall", 1, true))
