@@ -97,6 +97,24 @@ sx_status sx_material_set(sx_model *m, const char *name, const sx_material_def *
     }
     const bool density_changed = m->mats[i].def.density != d->density;
     const bool damping_changed = m->mats[i].def.damping != d->damping;
+    /* a clump's pebbles keep one density, its material's: a pebble of
+     * another material of that density (its friction, its stiffness) may
+     * not have it redefined apart from the clump's (sx_ball_set_material
+     * refuses the like; this took it silently) */
+    if (density_changed && m->balls.clump)
+        for (int64_t b = 0; b < m->balls.n; b++) {
+            int cm;
+            if (!m->balls.clump[b] || sx_clump_material(m, m->balls.clump[b], &cm) != SX_OK) continue;
+            const int pm = m->balls.mat[b];
+            if ((pm == i) == (cm == i)) continue;
+            const double other = m->mats[pm == i ? cm : pm].def.density;
+            if (other != d->density)
+                return sx__fail(m, SX_EINVAL,
+                                "material '%s': a density of %g kg/m^3 would part pebble %lld of clump %lld from its "
+                                "clump's density (%g kg/m^3, material '%s'): a clump's pebbles keep one density",
+                                name, d->density, (long long)m->balls.id[b], (long long)m->balls.clump[b], other,
+                                m->mats[pm == i ? cm : pm].name);
+        }
     m->mats[i].def = *d;
     sx__material_derive(&m->mats[i]);
     for (int64_t b = 0; b < m->balls.n; b++) {

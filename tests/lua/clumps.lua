@@ -156,6 +156,23 @@ test("clump objects: fields, orientation, pebbles", function()
   raises(function() d.orientation = {1, 2} end, HERE, "clump field 'orientation': quaternion", "got 2")
 end)
 
+test("a clump's pebbles keep one density: a material redefined apart from its clump's is refused", function()
+  local m = model(3)
+  local rho = m:materials().rock.density
+  m:material("same", {density = rho, kn = 1e6, ks = 1e6, friction = 0.2})
+  m:clump_template("pair", {{0, 0, 0, 0.01}, {0.012, 0, 0, 0.01}})
+  local c = m:clump{template = "pair", pos = {0, 0, 0}, material = "rock"}
+  local mass = c.mass
+  local peb = c.pebbles
+  peb[2].material = "same" -- another material of the clump's density: its friction
+  raises(function() m:material("same", {density = 8000, kn = 1e6, ks = 1e6}) end, HERE,
+         "material 'same': a density of 8000 kg/m^3 would part pebble " .. peb[2].id .. " of clump " .. c.id)
+  eq(m:materials().same.density, rho)
+  eq(c.mass, mass)
+  m:material("same", {density = rho, kn = 2e6, ks = 2e6}) -- the same density: taken
+  eq(m:materials().same.kn, 2e6)
+end)
+
 test("generation: count, sizes, inside the region, no overlaps, reproducible", function()
   local function make(seed)
     local m = model(3)
