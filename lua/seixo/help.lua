@@ -282,7 +282,7 @@ local entries = {
     "Finds micro-parameters whose lab tests reproduce target macro-properties (E, nu, UCS, BTS, c, phi or a stress-strain curve): the BPM's scalings, then NLopt's BOBYQA; seeds' mean and scatter; worker processes or MPI ranks; resumes from its log (out)."},
   ["lab.periodic"] = {"lab.periodic (require \"seixo.periodic\")",
     "Laboratory tests on a periodic cell, without walls: periodic.specimen{...}, periodic.triaxial(spec, {...}), periodic.shear(spec, {...}) (see docs/lua-api.md, lab.periodic)."},
-  ["lab.write_csv"] = {"lab.write_csv(path, header, rows)", "Writes rows (arrays of numbers) under a header to a CSV file, atomically."},
+  ["lab.write_csv"] = {"lab.write_csv(path, header, rows)", "Writes rows (arrays of numbers; nil: empty) under a header to a CSV file, atomically; names quoted as needed; a ragged row or a cell that is no number is an error."},
   ["plot.live"] = {"plot.live(m, names[, {every = 1000, terminal =, output =, title =, x = 'step' | 'time', log =}]) -> plot",
     "A gnuplot plot of histories of m, redrawn every `every` steps while m cycles (p:draw() now, p:close() stops it); the run's bits do not change."},
   ["lab.have_gnuplot"] = {"lab.have_gnuplot() -> bool", "Whether gnuplot can be run (the plots are skipped, with a note, if not)."},

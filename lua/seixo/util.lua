@@ -269,6 +269,17 @@ end
 
 --- Reads a CSV file written by m:history_csv: returns {header = {...}, columns = {name = {values}}, rows = n};
 --- empty cells are nil, numbers are numbers; quoted names (with commas, quotes, line breaks) are read back.
+-- A cell as a number when it is one: Lua's tonumber, and the spellings of
+-- NaN and the infinities that seixo's writers and C's printf give.
+local special = {nan = 0 / 0, ["-nan"] = 0 / 0, inf = math.huge, ["-inf"] = -math.huge}
+local function value(cell)
+  local x = tonumber(cell)
+  if x then return x end
+  x = special[cell:lower()]
+  if x then return x end
+  return cell
+end
+
 function util.read_csv(path)
   if type(path) ~= "string" then
     error("bad argument 'path' to 'util.read_csv' (string expected, got " .. type(path) .. ")", 2)
@@ -284,7 +295,7 @@ function util.read_csv(path)
     local cells = records[row]
     for i, name in ipairs(header) do
       local cell = cells[i]
-      if cell and cell ~= "" then columns[name][row - 1] = tonumber(cell) or cell end
+      if cell and cell ~= "" then columns[name][row - 1] = value(cell) end
     end
   end
   return {header = header, columns = columns, rows = math.max(#records - 1, 0)}

@@ -48,6 +48,26 @@ do
 end
 
 do
+  -- lab.write_csv: names quoted as needed, NaN and infinities spelt alike,
+  -- ragged rows and cells that are no numbers refused with their place
+  local lab = require("seixo.lab")
+  local util = require("seixo.util")
+  local path = os.tmpname()
+  lab.write_csv(path, {"a,b", "c"}, {{1, 0 / 0}, {math.huge}, {nil, -math.huge}})
+  local t = util.read_csv(path)
+  check("csv: a name with a comma is one column", #t.header == 2 and t.header[1] == "a,b", table.concat(t.header, "|"))
+  local c1 = t.columns.c[1]
+  check("csv: nan, inf, -inf read back as numbers", c1 ~= c1 and t.columns["a,b"][2] == math.huge and
+        t.columns.c[3] == -math.huge, tostring(c1))
+  check("csv: spelt nan, inf, -inf", io.open(path):read("a"):find("1,nan\ninf,\n,-inf\n", 1, true), "text")
+  local ok, err = pcall(lab.write_csv, path, {"a"}, {{1}, {1, 2}})
+  check("csv: a row longer than the header", not ok and err:find("row 2 has 2 cells, the header 1 names", 1, true), err)
+  ok, err = pcall(lab.write_csv, path, {"a", "b"}, {{1, "x"}})
+  check("csv: a cell that is no number", not ok and err:find("row 1, column 'b': a number expected, got string", 1, true), err)
+  os.remove(path)
+end
+
+do
   -- a servo sets its wall's normal velocity only: a velocity along the wall
   -- (a shear box's top plate riding with its upper half) goes on, 2D and 3D,
   -- and a tilted wall's too
