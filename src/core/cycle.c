@@ -210,9 +210,9 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
     if (resume) m->prof.resumed++;
     if (m->builds != builds) t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
     if (st) return st;
-    if ((st = sx__update_timestep(m))) {
+    if ((st = sx__update_timestep(m))) { /* every rank here alike, its estimate the ranks' least */
         if (resume) m->dd->active = false;
-        return st;
+        return sx__dd_agree_alike(m, st);
     }
     if (m->dd && !resume && (st = sx__dd_begin(m))) return st; /* decomposed: each rank its slab (decompose.c) */
     sx_dd *dd = m->dd;
@@ -249,7 +249,7 @@ static sx_status cycle_steps(sx_model *m, int64_t n, double t_end, int64_t since
             t = stage_end(m, SX_STAGE_BROAD_PHASE, t);
             if (st) break;
         }
-        st = sx__update_timestep(m);
+        st = sx__dd_agree_alike(m, sx__update_timestep(m)); /* at the same step on every rank */
         double t1 = sx__now();
         other += t1 - t;
         if (st) break;

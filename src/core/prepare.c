@@ -103,20 +103,17 @@ sx_status sx__next_timestep(sx_model *m, double *dt)
         double crit;
         if (!sx__critical(m, &crit))
             return sx__fail(m, SX_EINVAL, "timestep: the ranks could not exchange their estimates");
-        /* the ranks' estimate (sx__critical): every rank's alike */
         if (!isfinite(crit))
-            return sx__dd_agree_alike(
-                m, sx__fail(m, SX_EINVAL,
-                            "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep"));
+            return sx__fail(m, SX_EINVAL,
+                            "timestep: no ball to estimate the automatic timestep from; add balls or set a timestep");
         *dt = m->dt_safety * crit;
         /* the user's timestep has the same floor: below it the steps no
          * longer advance the time (a stiffness of 1e300 N/m gave 0 s, and
          * cycles that counted steps at a standstill) */
         if (!(*dt >= 1e-15))
-            return sx__dd_agree_alike(
-                m, sx__fail(m, SX_EINVAL,
+            return sx__fail(m, SX_EINVAL,
                             "timestep: the automatic timestep is %g s, below 1e-15 s: a stiffness far too large for "
-                            "the masses (see m:materials() and the walls' kn)", *dt));
+                            "the masses (see m:materials() and the walls' kn)", *dt);
     }
     return SX_OK;
 }
