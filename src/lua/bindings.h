@@ -184,7 +184,6 @@ typedef struct sx_lua_model {
     bool timestep_unchecked; ///< the fixed timestep was set since the last check of it (run.c, sx_lua_check_timestep)
     int64_t fresh_lo, fresh_hi; ///< the ids of the balls m:generate made since that check, their overlaps among themselves its relaxation's, not checked (0, 0: none; ids are from 1)
     bool decomposed;       ///< its cycles run decomposed over the MPI ranks (parallel.c)
-    bool after_unrecorded; ///< the "after" callbacks of a step run, its histories not recorded yet (m:save records them)
 } sx_lua_model;
 
 /// seixo.models() -> {model, ...}: the open models, in order of creation.
@@ -422,9 +421,8 @@ void sx_lua_callback_own(lua_State *L, int model, lua_Integer id, const char *ow
 void sx_lua_callbacks_unsaved(lua_State *L, int model, int list);
 /// Removes callback `id` of the model at `model`, an owned one too.
 void sx_lua_callback_remove(lua_State *L, int model, lua_Integer id);
-/// Makes coroutine.resume close a coroutine that failed (its to-be-closed
-/// values, run records among them, as coroutine.wrap does), once.
-void sx_lua_run_register(lua_State *L);
+/// Closes the runs whose thread (a coroutine) failed with them open.
+void sx_lua_runs_reap(lua_State *L);
 /// Cycles the core n steps in the run, without user callbacks, stopping
 /// early at the first step that reaches model time t_end (INFINITY: none;
 /// the rounding allowed counts the run's steps, sx_model_time_reached);

@@ -410,16 +410,6 @@ static int model_save(lua_State *L)
         sx_lua_checkkeys(L, 3, keys);
         sx_lua_optintfield(L, 3, "compression", 0, 9, &level);
     }
-    /* in an "after" callback: the step's samples, which its histories take
-     * once the callbacks have run, are taken now (a history's step is taken
-     * once), or the file, and a restart from it, would lack them */
-    sx_lua_model *ud = sx_lua_modelud(L, 1);
-    if (ud->after_unrecorded) {
-        ud->after_unrecorded = false; /* a history's function that saves records nothing again */
-        sx_lua_history_record(L, 1);
-        ud->after_unrecorded = true;
-        m = sx_lua_checkmodel(L, 1); /* a history's function may have changed it */
-    }
     lua_settop(L, 3);
     /* the trees' memory belongs to a to-be-closed job, freed on any error */
     save_job *j = lua_newuserdatauv(L, sizeof *j, 0);

@@ -351,6 +351,7 @@ static void profile_at_end(lua_State *L, const sx_model *m)
 static int model_close(lua_State *L)
 {
     sx_lua_model *u = sx_lua_modelud(L, 1);
+    sx_lua_runs_reap(L); /* a cycle a failed coroutine left open */
     if (u->running) return luaL_error(L, "the model is cycling; close it after the cycle returns");
     profile_at_end(L, u->m);
     unshare(L, u->m);

@@ -170,6 +170,8 @@ struct sx_lua_run {
     const char *what;        // the Lua call, in messages ("m:solve")
     int64_t since;           // the model's step count when the run began
     bool open;               // not closed yet
+    lua_State *thread;       // the thread it runs on, referenced while open (thread_ref)
+    int thread_ref;
     progress progress;       // the progress line, cleared when the run ends
 };
 typedef sx_lua_run run;
@@ -201,23 +203,32 @@ void sx_lua_interrupt_answered(void)
     sx_interrupt_clear();
 }
 
+/* Whether run r's thread died with it open (sx_lua_runs_reap closes it). */
+static bool run_dead(const run *r)
+{
+    const int st = lua_status(r->thread);
+    return st != LUA_OK && st != LUA_YIELD;
+}
+
 int sx_lua_interrupt_all(void)
 {
     atomic_fetch_add(&interrupts, 1);
     sx_interrupt_request();
     const int n = atomic_load(&nruns);
+    int live = 0;
+    run *inner = NULL;
     for (int i = 0; i < n; i++) {
         run *r = atomic_load(&runs[i]);
-        if (!r) continue;
+        if (!r || run_dead(r)) continue; /* a failed coroutine's: no cycle to stop */
         atomic_store(&r->interrupted, 1);
         /* a decomposed model's cycle stops on the ranks' requests: this
          * one is counted already, and must count once */
         if (!r->ud->decomposed) sx_model_interrupt(r->m);
+        live++, inner = r;
     }
     /* a callback running Lua code is stopped by the caller's hook */
-    run *inner = n > 0 ? atomic_load(&runs[n - 1]) : NULL;
     if (inner && atomic_load(&inner->in_lua)) return 0;
-    return n;
+    return live;
 }
 
 static run *innermost(void)
@@ -226,21 +237,47 @@ static run *innermost(void)
     return n > 0 ? atomic_load(&runs[n - 1]) : NULL;
 }
 
-/* __close of a run record: unlist it, give the model back. */
-static int run_close(lua_State *L)
+/* Closes run r: unlists it, gives the model back, lets its thread go. */
+static void run_release(lua_State *L, run *r)
 {
-    run *r = lua_touserdata(L, 1);
-    if (!r || !r->open) return 0;
+    if (!r->open) return;
     r->open = false;
     progress_end(&r->progress);
     if (r->slot >= 0) {
-        atomic_store(&nruns, r->slot);
         atomic_store(&runs[r->slot], NULL);
+        /* the list ends at the innermost run still open (a dead one below it is reaped in place) */
+        int n = atomic_load(&nruns);
+        while (n > 0 && !atomic_load(&runs[n - 1])) n--;
+        atomic_store(&nruns, n);
     }
     r->ud->running--;
     r->ud->callback = r->saved_callback;
-    r->ud->after_unrecorded = false; /* a callback that failed */
+    luaL_unref(L, LUA_REGISTRYINDEX, r->thread_ref);
+}
+
+/* __close of a run record (and __gc: at the Lua state's end one still open
+ * unlists itself, so that a Ctrl-C cannot find it once freed). */
+static int run_close(lua_State *L)
+{
+    run *r = lua_touserdata(L, 1);
+    if (r) run_release(L, r);
     return 0;
+}
+
+/* Closes the runs whose thread died with them open: a coroutine that failed
+ * inside a cycle keeps its to-be-closed values until coroutine.close,
+ * which scripts seldom call (the model stayed cycling for good, 16 such
+ * failures refused every model, and a Ctrl-C once the coroutine was
+ * collected wrote to the freed record: a robustness hunt's findings). The
+ * open run holds its thread (thread_ref), so its record is not collected
+ * before this finds it. */
+void sx_lua_runs_reap(lua_State *L)
+{
+    const int n = atomic_load(&nruns);
+    for (int i = 0; i < n; i++) {
+        run *r = atomic_load(&runs[i]);
+        if (r && run_dead(r)) run_release(L, r);
+    }
 }
 
 sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
@@ -248,6 +285,7 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     model = lua_absindex(L, model);
     sx_lua_model *ud = sx_lua_modelud(L, model);
     sx_model *m = sx_lua_checkmodel_scattered(L, model); /* a lazy cycle goes on from its ranks' own balls */
+    sx_lua_runs_reap(L);
     if (ud->running)
         luaL_error(L, "%s: the model is already cycling (a callback cannot cycle its own model)", what);
     run *r = lua_newuserdatauv(L, sizeof *r, 0);
@@ -260,16 +298,18 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     r->since = sx_model_step_count(m);
     atomic_init(&r->interrupted, 0);
     atomic_init(&r->in_lua, 0);
+    r->thread_ref = LUA_NOREF;
     lua_createtable(L, 0, 2);
     lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__close");
-    /* and when collected open (a thread closed by no one): a Ctrl-C must
-     * not find it listed once its memory is gone */
     lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__gc");
     lua_setmetatable(L, -2);
     /* to be closed before the model is taken, so that nothing can come between */
     lua_toclose(L, -1);
+    r->thread = L;
+    lua_pushthread(L);
+    r->thread_ref = luaL_ref(L, LUA_REGISTRYINDEX);
     ud->running++;
     r->saved_callback = ud->callback;
     r->open = true;
@@ -281,86 +321,6 @@ sx_lua_run *sx_lua_run_open(lua_State *L, int model, const char *what)
     atomic_store(&runs[slot], r);
     atomic_store(&nruns, slot + 1);
     return r;
-}
-
-/* coroutine.resume, closing a coroutine that failed. Lua closes a failed
- * coroutine's to-be-closed values only at coroutine.close (coroutine.wrap
- * closes them itself): a cycle that failed inside coroutine.resume left
- * its run record open, its model cycling for good and its interrupt slot
- * taken (16 such and no model could cycle), and a Ctrl-C once the
- * coroutine was collected wrote to the freed record (a robustness hunt's
- * finding). The coroutine's stack is then closed; coroutine.wrap's
- * functions resume through it (Lua 5.4.4's leave theirs open too). */
-static void close_failed(lua_State *L, lua_State *co)
-{
-    const int st = lua_status(co);
-    if (st == LUA_OK || st == LUA_YIELD) return;
-#if LUA_VERSION_RELEASE_NUM >= 50406
-    lua_closethread(co, L);
-#else
-    (void)L;
-    lua_resetthread(co);
-#endif
-    lua_settop(co, 0); /* the error it leaves there: dead, as coroutine.status says of a failed one */
-}
-
-static int resume_closing(lua_State *L)
-{
-    lua_State *co = lua_tothread(L, 1);
-    lua_pushvalue(L, lua_upvalueindex(1));
-    lua_insert(L, 1);
-    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
-    if (co) close_failed(L, co);
-    return lua_gettop(L);
-}
-
-/* A coroutine.wrap function: resumes its coroutine (upvalue 1) through the
- * closing resume (upvalue 2), an error raised as coroutine.wrap raises it
- * (a string with the caller's position). */
-static int wrapped(lua_State *L)
-{
-    const int n = lua_gettop(L);
-    lua_pushvalue(L, lua_upvalueindex(2));
-    lua_pushvalue(L, lua_upvalueindex(1));
-    lua_rotate(L, 1, 2);
-    lua_call(L, n + 1, LUA_MULTRET);
-    if (lua_toboolean(L, 1)) return lua_gettop(L) - 1;
-    lua_settop(L, 2);
-    if (lua_type(L, 2) == LUA_TSTRING) {
-        luaL_where(L, 1);
-        lua_insert(L, 2);
-        lua_concat(L, 2);
-    }
-    return lua_error(L);
-}
-
-static int wrap_closing(lua_State *L)
-{
-    luaL_checktype(L, 1, LUA_TFUNCTION);
-    lua_State *co = lua_newthread(L);
-    lua_pushvalue(L, 1);
-    lua_xmove(L, co, 1);
-    lua_pushvalue(L, lua_upvalueindex(1));
-    lua_pushcclosure(L, wrapped, 2);
-    return 1;
-}
-
-void sx_lua_run_register(lua_State *L)
-{
-    luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
-    if (lua_getfield(L, -1, "coroutine") == LUA_TTABLE) {
-        lua_getfield(L, -1, "resume");
-        if (lua_iscfunction(L, -1) && lua_tocfunction(L, -1) != resume_closing) {
-            lua_pushcclosure(L, resume_closing, 1);
-            lua_pushvalue(L, -1);
-            lua_setfield(L, -3, "resume");
-            lua_pushcclosure(L, wrap_closing, 1);
-            lua_setfield(L, -2, "wrap");
-        } else {
-            lua_pop(L, 1);
-        }
-    }
-    lua_pop(L, 2);
 }
 
 /* The Ctrl-C is answered: by the error raised now (a decomposed cycle's,
@@ -728,9 +688,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     for (bool first = true;; first = false) {
         const int64_t s = sx_model_step_count(m);
         if (!first) {
-            r->ud->after_unrecorded = true;
             fire(L, 1, POINT_AFTER, s);
-            r->ud->after_unrecorded = false;
             sx_lua_history_record(L, 1);
         }
         sx_lua_apply_removals(L, 1);

@@ -79,7 +79,6 @@ int luaopen_seixo(lua_State *L)
     sx_lua_lab_register(L); /* lab.c: the walls' servo, load and radius */
     sx_lua_contacts_register(L);
     sx_lua_clumps_register(L);
-    sx_lua_run_register(L); /* run.c: coroutine.resume closes a failed coroutine's cycle */
     luaL_newlib(L, functions);
     luaL_setfuncs(L, sx_lua_optimize_functions, 0); /* optimize.c: seixo.optimize (NLopt) */
     luaL_setfuncs(L, sx_lua_parallel_functions, 0); /* parallel.c: cores, executable, MPI ranks and messages */
