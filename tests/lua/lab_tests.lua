@@ -200,6 +200,8 @@ test("bad options name the problem", function()
   local sand = lab.rock{kn = 1e8, ks = 5e7, friction = 0.5}
   eq(sand.modulus, nil)
   eq(sand.kn, 1e8)
+  eq(lab.rock{kn = 1e8}.ks, 1e8 / 2.5) -- the other by the ratio, not m:material's default
+  eq(lab.rock{ks = 1e7, stiffness_ratio = 2}.kn, 2e7)
   local m = seixo.model{dim = 2}
   m:material("sand", sand)
   eq(m:materials().sand.kn, 1e8)

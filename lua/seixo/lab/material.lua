@@ -39,6 +39,11 @@ function material.rock(over)
   -- their place (a modulus > 0 sets kn and ks), is not taken with them (a
   -- sand's kn = 1e8 became 6.2e10 from the granite: a user's finding)
   if over and (over.kn ~= nil or over.ks ~= nil) and over.modulus == nil then
+    -- the one not given follows from the other by the stiffness ratio (the
+    -- override's, or the rock's 2.5), not from m:material's default 1e8
+    local ratio = mat.stiffness_ratio
+    if over.ks == nil and type(mat.kn) == "number" then mat.ks = mat.kn / ratio end
+    if over.kn == nil and type(mat.ks) == "number" then mat.kn = mat.ks * ratio end
     mat.modulus, mat.stiffness_ratio = nil, nil
   end
   -- its keys and values checked now, as m:material checks them (a
