@@ -307,6 +307,26 @@ static sx_status check_pair(sx_model *m, const sx_bond_def *def, int ma, int mb)
     return SX_OK;
 }
 
+/* x_b - x_a of pair c where its balls are now: a periodic ghost b is its
+ * ball plus its shift (its slot is as the last contact pass copied it, a
+ * step behind, unless m:bond's build with its gap made it anew: the
+ * decision to bond and the bond's starting geometry must not depend on
+ * which). */
+static void pair_rel(const sx_model *m, int64_t c, double *rel)
+{
+    const int d = m->dim;
+    const sx_balls *B = &m->balls;
+    const int64_t i = m->bb.a[c];
+    int64_t j = m->bb.b[c];
+    double shift[3] = {0, 0, 0};
+    if (m->cell) {
+        const int64_t o = sx__cell_owner(m, j, shift);
+        if (o >= 0) j = o;
+        else shift[0] = shift[1] = shift[2] = 0;
+    }
+    for (int k = 0; k < d; k++) rel[k] = (B->x[j * d + k] + shift[k]) - B->x[i * d + k];
+}
+
 /* The gap d - RA - RB of pair c, and its unit normal from a to b in n. */
 static double pair_gap(const sx_model *m, int64_t c, double *n)
 {
@@ -314,10 +334,8 @@ static double pair_gap(const sx_model *m, int64_t c, double *n)
     const sx_balls *B = &m->balls;
     const int64_t i = m->bb.a[c], j = m->bb.b[c];
     double dist = 0;
-    for (int k = 0; k < d; k++) {
-        n[k] = B->x[j * d + k] - B->x[i * d + k];
-        dist += n[k] * n[k];
-    }
+    pair_rel(m, c, n);
+    for (int k = 0; k < d; k++) dist += n[k] * n[k];
     dist = sqrt(dist);
     for (int k = 0; k < d; k++) n[k] /= dist;
     return dist - B->rad[i] - B->rad[j];
@@ -367,8 +385,9 @@ static sx_status install_flat_joint(sx_model *m, const sx_bond_def *def, int32_t
     b->fj_first[s] = (int32_t)E->n;
     b->fj_nr[s] = (uint8_t)nr;
     b->fj_na[s] = (uint8_t)na;
-    double dist = 0;
-    for (int k = 0; k < d; k++) dist += (B->x[j * d + k] - B->x[i * d + k]) * (B->x[j * d + k] - B->x[i * d + k]);
+    double rel[3], dist = 0;
+    pair_rel(m, c, rel);
+    for (int k = 0; k < d; k++) dist += rel[k] * rel[k];
     b->fj_d0[s] = sqrt(dist);
     for (int k = 0; k < d - 1; k++) b->fj_rot[s * (d - 1) + k] = 0;
     if (d == 3) { /* t1: the world axis least along n, made normal to n */
@@ -497,10 +516,8 @@ sx_status sx_bond_install(sx_model *m, const sx_bond_def *def, int64_t *count)
         if (!b->kind[slot]) b->intact++;
         b->kind[slot] |= (uint8_t)def->kind;
         if (!p->touching[c]) { /* the bond starts from the current geometry: the relative position */
-            for (int k = 0; k < d; k++) {
-                p->geo[c * d + k] = B->x[j * d + k] - B->x[i * d + k];
-                p->fs[c * d + k] = 0;
-            }
+            pair_rel(m, c, p->geo + c * d);
+            for (int k = 0; k < d; k++) p->fs[c * d + k] = 0;
             p->touching[c] = 1;
             if (p->cmodel) p->cmodel[c] = sx__cmodel_pick(m, i, j); /* a contact created: its row (cmodel.c) */
         }
