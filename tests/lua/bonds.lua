@@ -106,7 +106,7 @@ do
   m:bond{kind = "parallel", gap = 1e-6}
   a.fix = "all"; b.fix = "all"; b.vel = {1e-3, 0}
   m:cycle(100)
-  local u = b.pos[1] - 2e-3 - 1e-3 * 1e-6 -- at the last force pass: a step before the positions
+  local u = b.pos[1] - 2e-3
   local T = 1e8 / 2e-3 * 2e-3 * u        -- kn_bar = Ec/(RA+RB), A = 2 R_bar (unit thickness)
   local lo, hi = {-2e-3, -2e-3}, {4e-3, 2e-3}
   local r = m:measure{box = {min = lo, max = hi}}
@@ -193,7 +193,8 @@ end
 -- a parallel-bonded pair spinning rigidly, its balls apart (no contact
 -- spring): the bond's normal force follows the distance between the centres,
 -- -kn_bar A (d - d0), turn after turn. The stretch taken as the half-step
--- velocity along the step's normal gathered pi w d dt a turn (1.2e-4 m here).
+-- velocity along the step's normal, not the mid normal, gathered pi w d dt
+-- a turn (1.2e-4 m here).
 for dim = 2, 3 do
   local function v(x, y) return dim == 3 and {x, y, 0} or {x, y} end
   local R, gap, w = 0.01, 1e-4, 100

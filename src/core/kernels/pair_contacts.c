@@ -194,7 +194,7 @@ static inline void chunk_energy(sx_model *m, sx_chunk *o, int k, double x)
  * the contact (4-13 ... 4-15), then stepped and tested by its law. Adds its
  * force to F (on j) and its moment to mb (on j). Returns false when it
  * broke (logged, its energy released). */
-static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *n, double dd,
+static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot, const double *n, double vn,
                           const double *vs, const double *dtheta, const double *xc, int64_t i, int64_t j, double *F,
                           double *mb)
 {
@@ -204,7 +204,7 @@ static bool parallel_bond(sx_model *m, sx_chunk *o, int32_t s, const carry *rot,
     carry_apply(rot, b->ms + s * RD);
 #endif
     sx_bond_break br;
-    if (sx_bond_parallel_step(D, b, s, n, dd, vs, dtheta, motion_dt(m), &br)) {
+    if (sx_bond_parallel_step(D, b, s, n, vn, vs, dtheta, motion_dt(m), &br)) {
         log_crack(m, o, xc, br.mode, SX_BOND_PARALLEL, -1, i, j, b->fn[s], br.fsn, br.mnn, br.msn);
         if (m->track_energy) chunk_energy(m, o, E_RELEASED, sx_bond_parallel_strain(D, b, s));
         return false;
@@ -612,10 +612,9 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
         }
         /* the previous normal, from the last evaluation's relative position as n
          * was computed from dx (the same bits); none for a new contact */
-        double nold[D], d_prev = d;
+        double nold[D];
         if (touching[c]) {
-            d_prev = sqrt(dot(rel, rel));
-            const double inv_r = 1.0 / d_prev;
+            const double inv_r = 1.0 / sqrt(dot(rel, rel));
             for (int k = 0; k < D; k++) nold[k] = rel[k] * inv_r;
         } else {
             for (int k = 0; k < D; k++) fs[k] = 0, nold[k] = n[k];
@@ -738,7 +737,12 @@ static void ball_chunk_pass(sx_model *m, sx_chunk *o)
             double dtheta[RD];
             for (int k = 0; k < RD; k++) dtheta[k] = (wj[k] - wi[k]) * dt;
             for (int k = 0; k < RD; k++) mb[k] = 0;
-            if (parallel_bond(m, o, slot, &rot, n, d - d_prev, vs, dtheta, xc, i, j, F, mb)) bond_moment = true;
+            /* the normal stretch at the step's mid normal, from the centres'
+             * velocities (laws/parallel_bond.h) */
+            double nm[D], vm[D];
+            for (int k = 0; k < D; k++) nm[k] = nold[k] + n[k], vm[k] = v[j * D + k] - v[i * D + k];
+            const double vn_mid = dot(vm, nm) / sqrt(dot(nm, nm));
+            if (parallel_bond(m, o, slot, &rot, n, vn_mid, vs, dtheta, xc, i, j, F, mb)) bond_moment = true;
             else bonds &= ~(unsigned)SX_BOND_PARALLEL;
         }
         if (bonds & SX_BOND_FLATJOINT) {

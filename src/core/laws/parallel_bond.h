@@ -55,14 +55,16 @@ typedef struct sx_bond_break {
 
 /* One step of bond s (its shear force and bending moment already carried
  * with the contact plane): the increments of 4-33/4-34 from the normal n,
- * the step's change dd of the distance between the centres, the shear
- * velocity vs of b relative to a and the relative rotation dtheta, then the
- * strength test (4-38). The normal increment is the change of the distance
- * itself, not vn dt: the half-step velocity dotted with the step's normal
- * is off by w^2 d dt^2 / 2 a step on a pair turning at w, a stretch that a
- * tumbling bonded pair would gather without end (pi w dt of strain a turn);
- * the distance's change is objective. True when it broke (*out says how). */
-static inline bool sx_bond_parallel_step(int dim, sx_bonds *b, int64_t s, const double *n, double dd,
+ * the normal velocity vn of b's centre relative to a's, the shear velocity
+ * vs and the relative rotation dtheta, then the strength test (4-38). vn
+ * is along the step's mid normal (the bisector of the last evaluation's
+ * normal and this one's), not this step's: the half-step velocity dotted
+ * with the step's normal is off by w^2 d dt^2 / 2 a step on a pair turning
+ * at w, a stretch a tumbling bonded pair would gather without end (pi w dt
+ * of strain a turn), where along the mid normal a rigid turn gives none.
+ * A jump of a ball (b.pos) is no velocity: a bond does not see it, as in
+ * PFC. True when it broke (*out says how). */
+static inline bool sx_bond_parallel_step(int dim, sx_bonds *b, int64_t s, const double *n, double vn,
                                          const double *vs, const double *dtheta, double dt, sx_bond_break *out)
 {
     const int rdim = dim == 3 ? 3 : 1;
@@ -70,7 +72,7 @@ static inline bool sx_bond_parallel_step(int dim, sx_bonds *b, int64_t s, const 
     double area, inertia, polar;
     sx_bond_parallel_section(dim, rbar, &area, &inertia, &polar);
     double *fs = b->fs + s * dim, *ms = b->ms + s * rdim;
-    b->fn[s] -= b->kn[s] * area * dd; /* 4-33, compression positive */
+    b->fn[s] += b->kn[s] * area * (-vn * dt); /* 4-33, compression positive */
     for (int k = 0; k < dim; k++) fs[k] -= b->ks[s] * area * vs[k] * dt; /* 4-33 with dUs (seed typo corrected) */
     if (dim == 3) {
         const double twist = sx_bond_dot(3, dtheta, n);
