@@ -420,4 +420,40 @@ T.test("a fast Hertz impact at the automatic timestep is resolved: undamped, it 
   T.eq(dts[2], dts[1])
 end)
 
+-- The automatic timestep rates a Hertz ball by the impacts its candidate
+-- pairs may bring: under the pair's law where its partner is of another
+-- material (a soft ball on a steel plane, their law of the mean shear
+-- modulus 40 times the ball's own: it bounced 5 times as high as it fell,
+-- one step in contact), and at the closing speed of a faster partner (a
+-- resting ball struck at 50 m/s was rated at rest: 4 steps, 16 % fast).
+T.test("the automatic timestep sees a stiffer partner's law and a faster partner's speed (Hertz)", function()
+  for _, dim in ipairs{2, 3} do
+    local function v(x, z) return dim == 3 and {x, 0, z} or {x, z} end
+    local m = seixo.model{dim = dim, gravity = v(0, -9.81)}
+    m:material("soft", {model = "hertz", density = 1100, shear_modulus = 1e9, poisson = 0.45, friction = 0.5})
+    m:material("steel", {model = "hertz", density = 7800, shear_modulus = 8e10, poisson = 0.3, friction = 0.5})
+    m:wall{kind = dim == 3 and "plane" or "line", point = v(0, 0), normal = v(0, 1), material = "steel"}
+    local b = m:ball{pos = v(0, 0.05), radius = 0.005, material = "soft"}
+    local touched, top = false, 0
+    for _ = 1, 200000 do
+      m:cycle(1)
+      if m:contact_count() > 0 then touched = true
+      elseif touched then top = math.max(top, b.pos[dim]); if b.vel[dim] < 0 then break end end
+    end
+    T.check(math.abs(top / 0.05 - 1) < 0.02, dim .. "D: an elastic bounce back to 0.05 m, got " .. top)
+  end
+  local m = seixo.model{dim = 3}
+  m:material("s", {model = "hertz", density = 2650, shear_modulus = 1e8, poisson = 0.25, friction = 0})
+  local rA, rB, speed = 2e-4, 0.01, 50
+  local a = m:ball{pos = {0, 0, 0}, radius = rA}
+  local b = m:ball{pos = {-(rA + rB + 2 * rA), 0, 0}, radius = rB, vel = {speed, 0, 0}}
+  local touched = false
+  for _ = 1, 100000 do
+    m:cycle(1)
+    if m:contact_count() > 0 then touched = true elseif touched then break end
+  end
+  local exact = 2 * b.mass * speed / (a.mass + b.mass)
+  T.check(math.abs(a.vel[1] / exact - 1) < 0.01, "struck at 50 m/s: leaves at " .. a.vel[1] .. ", elastic " .. exact)
+end)
+
 T.done()

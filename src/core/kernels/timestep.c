@@ -50,6 +50,41 @@ static void self_rating(const sx_pair_law *l, double r, double mass, double spee
     if (own->series) *kn *= 2, *ks *= 2; /* undo the series combination with itself */
 }
 
+/* A law whose stiffness grows with the overlap (Hertz) rates a ball by the
+ * impact it may meet: a candidate pair's part in its balls' own ratings.
+ * Each may be struck by the other at their closing speed (struck: the
+ * fastest partner; a resting ball hit by one at 50 m/s was rated at rest
+ * and left 16 % fast), and is rated under the pair's law where that is not
+ * its material's own (a soft ball against a stiff one: their Hertz law,
+ * of the mean shear modulus, was 40 times the soft ball's, and a drop
+ * onto a steel plane bounced 5 times as high; both a verification study's
+ * findings). kself holds each ball's stiffest such rating, kn then ks. A
+ * ghost's part goes to its owner. */
+static void rate_against(const sx_model *m, const sx_pair_law *law, int64_t i, double partner_speed, double *struck,
+                         double *kself)
+{
+    const sx_balls *B = &m->balls;
+    struck[i] = fmax(struck[i], partner_speed);
+    if (law == &m->law[B->mat[i] * m->law_n + B->mat[i]]) return; /* its own: the ball's rating takes it */
+    const double speed = sqrt(dot(B->v + i * D, B->v + i * D)) + partner_speed;
+    double kn, ks;
+    self_rating(law, B->rad[i], 1.0 / B->inv_mass[i], speed, &kn, &ks);
+    if (kn + ks > kself[i] + kself[B->n + i]) kself[i] = kn, kself[B->n + i] = ks;
+}
+
+static void rate_candidate(const sx_model *m, int64_t c, double *struck, double *kself)
+{
+    const sx_balls *B = &m->balls;
+    const sx_pairs *p = &m->bb;
+    const int64_t n = B->n, i = p->a[c], j = p->b[c];
+    const int64_t jo = j < n ? j : m->cell->owner[j - m->cell->base];
+    const sx_pair_law *law = sx__bb_step_law(m, c, i, jo);
+    if (!sx__law_stiffens(law->law)) return; /* a constant stiffness: counted once the pair touches */
+    const double vi = sqrt(dot(B->v + i * D, B->v + i * D)), vj = sqrt(dot(B->v + jo * D, B->v + jo * D));
+    rate_against(m, law, i, vj, struck, kself);
+    rate_against(m, law, jo, vi, struck, kself);
+}
+
 /* Adds ball-ball pair c's stiffness and dashpot to its balls' sums kt,
  * kr, ct, cr (n each, from kt); a ghost's go to its owner. im: the
  * dashpots' inverse masses (dashpot_inverse_mass). */
@@ -108,13 +143,15 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     sx_balls *B = &m->balls;
     const int64_t n = B->n;
     if (n == 0) return INFINITY;
-    double *kt = sx__scratch(m, 5 * n + m->nwall);
+    double *kt = sx__scratch(m, 7 * n + m->nwall);
     if (!kt) return INFINITY;
     double *kr = kt + n, *ct = kt + 2 * n, *cr = kt + 3 * n; /* stiffness and dashpot sums */
-    /* the fastest wall each ball has a candidate pair with, and each wall's
-     * speed (sx__wall_speed: how fast its surface may close on a ball) */
-    double *struck = kt + 4 * n, *wall_speed = kt + 5 * n;
-    memset(kt, 0, (size_t)(5 * n) * sizeof(double));
+    /* the fastest wall or ball each ball has a candidate pair with, its
+     * stiffest rating under a candidate's law (rate_candidate: kn, then ks,
+     * n each), and each wall's speed (sx__wall_speed: how fast its surface
+     * may close on a ball) */
+    double *struck = kt + 4 * n, *kself = kt + 5 * n, *wall_speed = kt + 7 * n;
+    memset(kt, 0, (size_t)(7 * n) * sizeof(double));
     double vwall = 0;
     for (int64_t w = 0; w < m->nwall; w++) vwall = fmax(vwall, wall_speed[w] = sx__wall_speed(m, &m->walls[w]));
     m->dt_wall_speed = vwall; /* a wall set faster than a quarter more rates it again (walls.c) */
@@ -128,13 +165,17 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     const double *im;
     if (!dashpot_inverse_mass(m, &im)) return INFINITY; /* out of memory, as the scratch's above */
     if (!dd) {
-        for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, im, kt);
+        for (int64_t c = 0; c < p->n; c++) rate_pair(m, c, im, kt), rate_candidate(m, c, struck, kself);
     } else {
         const sx_span mine = dd->bb_own[dd->x.rank];
         for (int64_t e = 0; e < dd->nxlow; e++) rate_pair(m, dd->xpair[e], im, kt);
         for (int64_t e = 0; e < dd->ninpair; e++) rate_pair(m, dd->inpair[e], im, kt);
         for (int64_t c = mine.lo; c < mine.hi; c++) rate_pair(m, c, im, kt);
         for (int64_t e = dd->nxlow; e < dd->nxpair; e++) rate_pair(m, dd->xpair[e], im, kt);
+        /* maxima: in any order (every candidate pair of an own ball is among these) */
+        for (int64_t e = 0; e < dd->nxpair; e++) rate_candidate(m, dd->xpair[e], struck, kself);
+        for (int64_t e = 0; e < dd->ninpair; e++) rate_candidate(m, dd->inpair[e], struck, kself);
+        for (int64_t c = mine.lo; c < mine.hi; c++) rate_candidate(m, c, struck, kself);
     }
     p = &m->bw;
     const int64_t w0 = dd ? dd->bw_own[dd->x.rank].lo : 0, w1 = dd ? dd->bw_own[dd->x.rank].hi : p->n;
@@ -146,8 +187,9 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
         const bool mesh = m->walls[p->b[c]].mesh != NULL;
         const double un = mesh ? (p->touching[c] ? p->un[c] : 0)
                                : B->rad[i] - wall_distance(&m->walls[p->b[c]], B->x + i * D, nrm);
-        if (un <= 0) continue;
         const sx_pair_law law = sx__bw_law(m, c); /* its contact-model row's, or its ball's and wall's */
+        if (sx__law_stiffens(law.law)) rate_against(m, &law, i, wall_speed[p->b[c]], struck, kself);
+        if (un <= 0) continue;
         double kn, ks;
         stiffness(&law, B->rad[i], 0, B->rad[i], un, &kn, &ks);
         if (law.beta_n > 0 || law.beta_s > 0) {
@@ -165,12 +207,12 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
     for (int64_t i = i0; i < i1; i++) {
         /* the ball's own rating: a contact with an entity of its own stiffness */
         const double r = B->rad[i], mass = 1.0 / B->inv_mass[i], own = sqrt(dot(B->v + i * D, B->v + i * D));
-        /* a ball may be struck by a wall it has a candidate pair with at its
-         * own speed plus the wall's, and is rated as if it moved at that
-         * closing speed (as a ball flying at a resting plane is); a resting
-         * Hertz ball hit by a plane at 5 m/s was rated at rest and left at
-         * 0.955 of 10 m/s. A wall coming from farther is listed at a build,
-         * which rates the timestep again. */
+        /* a ball may be struck by a wall or a ball it has a candidate pair
+         * with at its own speed plus theirs, and is rated as if it moved at
+         * that closing speed (as a ball flying at a resting plane is); a
+         * resting Hertz ball hit by a plane at 5 m/s was rated at rest and
+         * left at 0.955 of 10 m/s. A wall or a ball coming from farther is
+         * listed at a build, which rates the timestep again. */
         const double speed = own + struck[i];
         double kn, ks;
         self_rating(&m->law[B->mat[i] * m->law_n + B->mat[i]], r, mass, speed, &kn, &ks);
@@ -179,6 +221,7 @@ static double KERNEL(rate_dt)(sx_model *m, bool ranks)
             self_rating(&m->cmodel[row].law, r, mass, speed, &knr, &ksr);
             if (knr + ksr > kn + ks) kn = knr, ks = ksr;
         }
+        if (kself[i] + kself[n + i] > kn + ks) kn = kself[i], ks = kself[n + i]; /* a candidate's law */
         for (int64_t q = 0; q < m->njoint; q++) { /* a smooth joint's contact may form at any step */
             const sx_law_sj *L = &m->joints[q].law;
             const double area = sx_law_sj_area(D, L, r, r);
