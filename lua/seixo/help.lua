@@ -376,11 +376,12 @@ end
 local overview = [[
 seixo: a DEM simulator driven from Lua.
   local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}}
-  m:material("rock", {density = 2650, kn = 1e8, ks = 1e8, friction = 0.5, damping = 0.7})
-  m:wall{kind = "box", min = {0, 0, 0}, max = {0.05, 0.05, 0.1}}
-  m:generate{count = 2000, radius = {0.8e-3, 1.2e-3}, region = {box = {{0, 0, 0}, {0.05, 0.05, 0.1}}}, seed = 7}
+  m:material("glass", {density = 2500, kn = 1e6, ks = 1e6, friction = 0.5, damping = 0.7,
+                       viscous_normal = 0.3, rolling_friction = 0.1})  -- a 3D bed settles with rolling resistance
+  m:wall{kind = "box", min = {0, 0, 0}, max = {0.12, 0.12, 0.3}}
+  m:generate{count = 300, radius = {4e-3, 6e-3}, region = {box = {{0, 0, 0}, {0.12, 0.12, 0.1}}}, seed = 7}
   m:history("ke", "kinetic", {every = 100})
-  m:solve{ratio = 1e-4}
+  print(m:solve{ratio = 1e-3, steps = 300000})  -- why it stopped, the ratio, the steps: some 10 s
   print(m)
 help(m) lists the model's methods, help(b) a ball's fields, help("solve") one entry;
 help("util") the vector helpers of require "seixo.util", help("lab") the laboratory tests
