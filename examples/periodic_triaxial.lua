@@ -11,7 +11,7 @@
 --   scripts/run examples/periodic_triaxial.lua [out_dir] [confining_Pa] [strain_rate]
 -- Measured (defaults, 1303 balls each): walled 2512 bonds, porosity 0.170,
 -- peak 246.2 MPa at 0.0036, E 73.9 GPa, nu 0.290; periodic 2579 bonds,
--- porosity 0.164, peak 213.9 MPa at 0.0031, E 73.9 GPa, nu 0.317 (ratios
+-- porosity 0.164, peak 213.8 MPa at 0.0031, E 73.9 GPa, nu 0.317 (ratios
 -- 0.87 and 1.00): the same genesis (Potyondy & Cundall's, floaters grown)
 -- gives the same modulus, and the cell, with no platens to confine its
 -- ends, a lower peak.

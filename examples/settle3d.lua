@@ -7,7 +7,7 @@
 -- `ratio` (default 1e-3) or max_steps pass (default 250,000). Measured:
 -- 300 balls stop on the ratio after 125,700 steps, 1,000 after 231,300.
 -- Without rolling resistance (rolling_friction 0) a ball rolling on the
--- bed's surface feels no force to damp: 300 balls are still at ratio 0.024
+-- bed's surface feels no force to damp: 300 balls are still at ratio 0.033
 -- after 200,000 steps. Times are wall-clock (seixo.clock).
 local count = tonumber(arg and arg[1]) or 1000
 local max_steps = tonumber(arg and arg[2]) or 250000

@@ -5,9 +5,9 @@
  * Stress (compression positive): sigma = -(1/V) sum over the balls inside,
  * over their contacts, of F (x_c - x) with F the contact force on the ball
  * (Love-Weber; for a ball-ball contact inside the region the two ends add up
- * to F_on_b (x_b - x_a)). Porosity counts a ball's whole volume when its
- * centre is inside, which is exact for a region holding whole balls (e.g. the
- * specimen's box) and an approximation at a cut boundary.
+ * to F_on_b (x_b - x_a)). Porosity counts the solid inside the region: each
+ * ball's part in it (region_cut.c), a pebble its share of its clump's
+ * volume in that proportion.
  *
  * Clumps: a pebble counts its share of its clump's volume (the union, so
  * overlaps are not counted twice), and its contacts' arms run from the
@@ -114,12 +114,14 @@ sx_status sx_measure(sx_model *m, const sx_region *region, sx_measurement *out)
     }
     const sx_balls *b = &m->balls;
     for (int64_t i = 0; i < b->n; i++) {
-        if (!inside(region, b->x + i * dim, dim)) continue;
-        const double r = b->rad[i];
-        double v = sx__ball_volume(dim, r), centre[3];
-        if (b->clump && b->clump[i]) sx__pebble_body(m, i, centre, &v); /* its share of the union */
-        out->solid += v;
-        out->balls++;
+        const double r = b->rad[i], whole = sx__ball_volume(dim, r);
+        const double cut = sx__region_cut(region, dim, b->x + i * dim, r); /* region_cut.c */
+        if (cut > 0) {
+            double v = whole, centre[3];
+            if (b->clump && b->clump[i]) sx__pebble_body(m, i, centre, &v); /* its share of the union */
+            out->solid += v * (cut / whole);
+        }
+        if (inside(region, b->x + i * dim, dim)) out->balls++;
     }
     measure_ctx c = {m, region, out, 0};
     sx_contact_each(m, visit, &c);

@@ -600,6 +600,10 @@ struct sx_model {
  * flat joint's closed face stays while its balls are within it. */
 static inline double sx__touching(double ri, double rj) { return 1e-9 * (ri + rj); }
 
+/* The volume (2D: area) of the ball of radius r at x inside the region
+ * (region_cut.c). */
+double sx__region_cut(const sx_region *region, int dim, const double *x, double r);
+
 static inline double sx__ball_volume(int dim, double r) { return dim == 3 ? 4.0 / 3.0 * SX_PI * r * r * r : SX_PI * r * r; }
 
 /* Ball i's local damping: its own, or its material's. */

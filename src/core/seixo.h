@@ -905,7 +905,7 @@ typedef struct sx_measurement {
     double stress[3][3];   ///< Pa (2D: N/m), compression positive: -(1/V) sum over balls in the
                            ///< region of their contacts' F (x_c - x); 2D fills [0..1][0..1]
     double volume;         ///< m^3 (2D: m^2) of the region
-    double solid;          ///< m^3 of the balls whose centre is inside
+    double solid;          ///< m^3 (2D: m^2) of the balls inside: each ball's part in the region
     double porosity;       ///< 1 - solid / volume
     double coordination;   ///< ball-ball contacts per ball inside
     double fabric[3][3];   ///< (1/Nc) sum n n over ball-ball contacts of balls inside

@@ -10,11 +10,15 @@ do
   m:material("s", {kn = 1e7, ks = 1e7, density = 2500})
   local r, s, n = 1e-3, 2e-3 - 1e-6, 6
   for k = 0, n - 1 do for j = 0, n - 1 do for i = 0, n - 1 do
-    m:ball{pos = {i * s, j * s, k * s}, radius = r}
+    m:ball{pos = {i * s, j * s, k * s}, radius = r}.fix = "all" -- held where they are: the lattice's geometry
   end end end
   m:cycle(1)
   local whole = m:measure{box = {min = {-s / 2, -s / 2, -s / 2}, max = {(n - 0.5) * s, (n - 0.5) * s, (n - 0.5) * s}}}
-  local expected = 1 - (4 / 3 * math.pi * r ^ 3) / s ^ 3
+  -- the balls overlap their cells by h: the box's faces cut a cap off each
+  -- of the n^2 balls along each of its 6 faces (within, the caps stay in)
+  local h = r - s / 2
+  local cap = math.pi * h * h * (3 * r - h) / 3
+  local expected = 1 - (n ^ 3 * 4 / 3 * math.pi * r ^ 3 - 6 * n ^ 2 * cap) / (n * s) ^ 3
   check("porosity of whole cells", math.abs(whole.porosity - expected) < 1e-12, whole.porosity)
   local inner = m:measure{sphere = {center = {2.5 * s, 2.5 * s, 2.5 * s}, radius = 1.5 * s}}
   check("coordination inside", math.abs(inner.coordination - 6) < 1e-12, inner.coordination)
@@ -25,6 +29,43 @@ do
   check("empty box refused", not ok, err)
   ok, err = pcall(m.measure, m, {sphere = {center = {0, 0, 0}, radius = 1}, box = {min = {0, 0, 0}, max = {1, 1, 1}}})
   check("one region only", not ok, err)
+end
+
+do
+  -- a region's solid is the balls' part inside it, cut where its boundary
+  -- crosses them (it counted every ball whose centre was inside, whole: a
+  -- region half a ball's radius across read a porosity of -7)
+  for _, dim in ipairs{2, 3} do
+    local m = seixo.model{dim = dim}
+    m:material("s", {kn = 1e6, ks = 1e6, density = 1000})
+    local function v(x, y, z) return dim == 3 and {x, y, z} or {x, y} end
+    m:ball{pos = v(0, 0, 0), radius = 1}
+    local V = dim == 3 and 4 / 3 * math.pi or math.pi
+    local function solid(region) return m:measure(region).solid end
+    local function near(name, got, want, tol)
+      check(dim .. "D " .. name, math.abs(got - want) <= tol * math.abs(want), got .. " vs " .. want)
+    end
+    near("a box about the whole ball", solid{box = {min = v(-2, -2, -2), max = v(2, 2, 2)}}, V, 1e-12)
+    near("a half", solid{box = {min = v(0, -2, -2), max = v(2, 2, 2)}}, V / 2, 1e-12)
+    near("a slab", solid{box = {min = v(-0.5, -2, -2), max = v(0.5, 2, 2)}},
+         dim == 3 and math.pi * (1 - 0.25 / 3) or 2 * (0.5 * math.sqrt(0.75) + math.asin(0.5)), 1e-9)
+    near("a box inside the ball", solid{box = {min = v(-0.2, -0.3, -0.1), max = v(0.3, 0.1, 0.4)}},
+         dim == 3 and 0.1 or 0.2, 1e-12)
+    local round = dim == 3 and "sphere" or "disk"
+    local inner = m:measure{[round] = {center = v(0, 0, 0), radius = 0.5}}
+    near("a region inside the ball: porosity 0", 1 - inner.porosity, 1, 1e-12)
+    near("a lens", solid{[round] = {center = v(1, 0, 0), radius = 1}},
+         dim == 3 and 5 * math.pi / 12 or 2 * math.pi / 3 - math.sqrt(3) / 2, 1e-12)
+    -- a box whose corner lies inside the ball, against counting a grid's points
+    local lo, hi = v(0.3, 0.2, -0.4), v(2, 2, 2)
+    local nx, count, h = dim == 3 and 100 or 1000, 0, nil
+    h = 2 / nx
+    for i = 0, nx - 1 do for j = 0, nx - 1 do for k = 0, (dim == 3 and nx - 1 or 0) do
+      local x, y, z = -1 + (i + 0.5) * h, -1 + (j + 0.5) * h, dim == 3 and -1 + (k + 0.5) * h or 0
+      if x * x + y * y + z * z <= 1 and x >= lo[1] and y >= lo[2] and (dim == 2 or z >= lo[3]) then count = count + 1 end
+    end end end
+    near("a box's corner in the ball", solid{box = {min = lo, max = hi}}, count * h ^ dim, 1e-2)
+  end
 end
 
 do
