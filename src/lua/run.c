@@ -667,6 +667,9 @@ typedef struct limits {
 enum reason { BY_STEPS, BY_TIME, BY_RATIO };
 static const char *const reason_names[] = {"steps", "time", "ratio"};
 
+/* A ratio infinite this long (steps) in m:solve is said once a model. */
+enum { INFINITE_RATIO_STEPS = 100000 };
+
 /* Steps between deliveries of bond_break events when no event needs every
  * step: a handler then acts at a multiple of it, whatever the machine. */
 #define BOND_EVENT_STEPS 100
@@ -684,6 +687,7 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
     progress_start(L, p, m, what, r->ud->decomposed);
     sx_lua_disp_fill(L, 1);  // balls added since m:reset_disp are measured from here
     *ratio = NAN;
+    int64_t since_finite = 0; /* the last ratio check that read a finite ratio */
     enum reason why = BY_STEPS;
     for (bool first = true;; first = false) {
         const int64_t s = sx_model_step_count(m);
@@ -707,6 +711,15 @@ static enum reason run_model(lua_State *L, const limits *lim, double *ratio, con
                 why = BY_RATIO;
                 break;
             }
+            /* no contact carries the forces (a free fall): the ratio cannot
+             * fall, and a solve with no other limit would run for ever */
+            if (isfinite(*ratio)) since_finite = taken;
+            else if (taken - since_finite >= INFINITE_RATIO_STEPS)
+                sx_lua_warn_once(L, 1, "infinite ratio",
+                                 "%s: the unbalanced-force ratio has been infinite for %lld steps (no contact "
+                                 "carries the balls' forces: a free fall?), so it cannot fall to %g; give steps = "
+                                 "or time = to end the run",
+                                 what, (long long)(taken - since_finite), lim->ratio);
         }
         sx_lua_run_poll(L, r);
         fire(L, 1, POINT_BEFORE, s);

@@ -318,4 +318,15 @@ test("m:save in a callback: queued removals refused", function()
   os.execute("rm -rf " .. T.quote(dir))
 end)
 
+test("m:solve says when the ratio stays infinite, which no ratio limit can end", function()
+  -- a free fall: no contact, the ratio infinite; m:solve{ratio =} alone ran for ever, silently
+  local script = "seixo.progress(false) local m = seixo.model{dim = 3, gravity = {0, 0, -9.81}} " ..
+                 "m:material('s', {kn = 1e6, ks = 1e6}) m:ball{pos = {0, 0, 0}, radius = 0.01} " ..
+                 "print(m:solve{ratio = 1e-5, steps = 120000})"
+  local status, out = T.run("-e " .. T.quote(script))
+  eq(status, 0, out)
+  check(out:find("the unbalanced-force ratio has been infinite for 100000 steps", 1, true), out)
+  check(out:find("steps\tinf\t120000", 1, true), out)
+end)
+
 T.done()
