@@ -22,7 +22,9 @@
 /* An overlap: a timestep within the critical one is not the cause, the
  * overlap came from before this step (a robustness tester followed "use
  * the automatic one" and got the same error, the model still holding the
- * blown-up state). */
+ * blown-up state), or grew over many steps under contacts too soft for
+ * their load (a newcomer's 2D bed with kn = 1e3 was told only of the first
+ * two causes). */
 static sx_status unstable_message(sx_model *m, const sx_unstable *u, double crit)
 {
     const long long step = (long long)u->step, a = (long long)u->a, b = (long long)u->b;
@@ -33,8 +35,10 @@ static sx_status unstable_message(sx_model *m, const sx_unstable *u, double crit
                             "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m, "
                             "with a timestep (%g s) within the critical one (%g s): the overlap came from before this "
                             "step (bodies placed overlapping, a wall moved or set through them, or an earlier unstable "
-                            "run whose state the model still holds: move them apart, or load a save), or a body moved "
-                            "more than a radius in one step (slow it down)",
+                            "run whose state the model still holds: move them apart, or load a save), a body moved "
+                            "more than a radius in one step (slow it down), or contacts too soft for the load they "
+                            "carry let the overlap grow step by step (raise kn, or the modulus, for the weight or the "
+                            "walls' push)",
                             step, u->what_a, a, u->what_b, b, u->un, u->r, u->dt, crit);
         return sx__fail(m, SX_EUNSTABLE,
                         "unstable at step %lld: %s %lld and %s %lld overlap by %g m, more than the radius %g m; "
