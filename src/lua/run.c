@@ -538,7 +538,12 @@ static int model_on(lua_State *L)
     static const char *const keys[] = {"every", NULL};
     sx_lua_checkmodel_scattered(L, 1);
     if (lua_type(L, 2) == LUA_TSTRING && sx_lua_is_event(lua_tostring(L, 2))) return sx_lua_events_add(L, next_id(L));
-    const int point = luaL_checkoption(L, 2, NULL, point_names);
+    const char *name = luaL_checkstring(L, 2);
+    const int point = sx_lua_find(name, point_names);
+    if (point < 0) /* the points and the events, as every other list of choices says them */
+        return luaL_argerror(L, 2, lua_pushfstring(L, "unknown point '%s' (valid: after, before, cycle; events: "
+                                                      "bond_break, contact_create, contact_delete, ball_leave_region)",
+                                                   name));
     luaL_checktype(L, 3, LUA_TFUNCTION);
     int64_t every = 1;
     if (!lua_isnoneornil(L, 4)) {

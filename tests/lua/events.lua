@@ -98,7 +98,7 @@ test("ball_leave_region: once, at the step its centre leaves", function()
   eq(events[1].step, 501)  -- x = 0.501 after step 501
   check(events[1].pos.x > 0.5005 and events[1].pos.x < 0.5015, tostring(events[1].pos))
   raises(function() m:on("ball_leave_region", function() end) end, "ball_leave_region needs {region = {...}}")
-  raises(function() m:on("bond_brake", function() end) end, "invalid option 'bond_brake'")
+  raises(function() m:on("bond_brake", function() end) end, "unknown point 'bond_brake'", "contact_create")
 end)
 
 test("events change no bit of a run, and m:off removes a handler", function()
