@@ -18,7 +18,18 @@
 #include <stdio.h>
 #include <string.h>
 
-sx_lua_model *sx_lua_modelud(lua_State *L, int idx) { return luaL_checkudata(L, idx, SX_LUA_MODEL); }
+/* The model userdata at idx. A method called with '.' for ':' (m.ball{...})
+ * passes its arguments one place early: the message says so. */
+sx_lua_model *sx_lua_modelud(lua_State *L, int idx)
+{
+    sx_lua_model *u = luaL_testudata(L, idx, SX_LUA_MODEL);
+    if (u) return u;
+    const char *got = lua_isnone(L, idx) ? "no value" : luaL_typename(L, idx);
+    return (void)luaL_argerror(L, idx, lua_pushfstring(L, "%s expected, got %s%s", SX_LUA_MODEL, got,
+                                                       idx == 1 ? " (a method is called with ':', as m:cycle(100))"
+                                                                : "")),
+           NULL;
+}
 
 sx_model *sx_lua_tomodel(lua_State *L, int idx) { return sx_lua_modelud(L, idx)->m; }
 

@@ -355,6 +355,9 @@ test("wall kinds and fields", function()
   eq(mesh.normal, nil)
   eq(mesh.edge1, nil)
   check(not tostring(mesh):find("normal", 1, true))
+  -- a method called with '.' says how to call it
+  raises(function() m.ball{pos = {0, 0, 0}, radius = 1} end, HERE, "seixo.model expected, got table",
+         "a method is called with ':'")
   -- a wall found by its id, as a ball is
   eq(m:wall(c.id), c)
   eq(m:wall(999), nil)
